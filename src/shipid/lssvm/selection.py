@@ -33,7 +33,8 @@ class DualLOOPath:
         s = np.sqrt(w)
         K *= s[:, None]
         K *= s[None, :]
-        self.lam, V = linalg.eigh(K, overwrite_a=True, check_finite=False)
+        # Divide and conquer ('evd') is the fastest LAPACK driver for all eigenvectors.
+        self.lam, V = linalg.eigh(K, overwrite_a=True, check_finite=False, driver="evd")
         self.V = V
         self.V2 = V * V
         self.s, self.w = s, w
@@ -57,19 +58,30 @@ class PrimalLOOPath:
         self.sw = w.sum()
         Fc = F - (w @ F) / self.sw
         self.y_mean = (w @ Y) / self.sw
-        Yc = Y - self.y_mean
         G = Fc.T @ (Fc * w[:, None])
         self.lam, Q = np.linalg.eigh(G)
-        self.P = Fc @ Q
-        self.P2 = self.P * self.P
-        self.PtWY = self.P.T @ (w[:, None] * Yc)
-        self.Y, self.w = Y, w
+        P = Fc @ Q
+        k = P.shape[1]
+        # [P | P²]: one GEMM per γ gives the fitted deviations and the leverages together.
+        self.PP = np.empty((P.shape[0], 2 * k))
+        self.PP[:, :k] = P
+        np.multiply(P, P, out=self.PP[:, k:])
+        self.PtWY = P.T @ (w[:, None] * (Y - self.y_mean))
+        self.Yc = Y - self.y_mean
+        self.w = w
 
     def residuals(self, gamma: float) -> np.ndarray:
         d = 1.0 / (self.lam + 1.0 / gamma)
-        fitted = self.y_mean + self.P @ (d[:, None] * self.PtWY)
-        leverage = self.w / self.sw + self.w * (self.P2 @ d)
-        return (self.Y - fitted) / (1.0 - leverage)[:, None]
+        k, q = d.shape[0], self.PtWY.shape[1]
+        C = np.zeros((2 * k, q + 1))
+        C[:k, :q] = d[:, None] * self.PtWY
+        C[k:, q] = d
+        M = self.PP @ C
+        one_minus_h = 1.0 - self.w * (1.0 / self.sw + M[:, q])
+        M = M[:, :q]
+        np.subtract(self.Yc, M, out=M)
+        M /= one_minus_h[:, None]
+        return M
 
 
 def loo_path(

@@ -1,0 +1,79 @@
+"""Regressor terms of the manoeuvring models: products of states and inputs (paper eq. 12).
+
+Every model of this package is linear in its parameters: each acceleration is Σ θⱼ·φⱼ(u, v, r, δ, T)
+over the terms below. The order of ``TERMS`` is the column order of the coefficient matrices used by
+the compiled simulator, so it must only ever be appended to.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+TERMS: tuple[str, ...] = (
+    "1", "u", "v", "r", "|u|u", "vr", "r^2", "ur", "uv", "|v|v", "|v|r", "|r|r", "|r|v",
+    "delta", "delta^2", "T",
+)  # fmt: skip
+TERM_INDEX = {name: i for i, name in enumerate(TERMS)}
+
+# How each term is printed in equations, in the paper's style.
+TERM_DISPLAY = {
+    "1": "", "u": "u", "v": "v", "r": "r", "|u|u": "|u|u", "vr": "v r", "r^2": "r²",
+    "ur": "u r", "uv": "u v", "|v|v": "|v|v", "|v|r": "|v| r", "|r|r": "|r| r", "|r|v": "|r| v",
+    "delta": "δ", "delta^2": "δ²", "T": "T",
+}  # fmt: skip
+
+
+def term_values(
+    name: str, u: np.ndarray, v: np.ndarray, r: np.ndarray, delta: np.ndarray, thrust: np.ndarray
+) -> np.ndarray:
+    """Value of one regressor term for arrays of states and inputs."""
+    match name:
+        case "1":
+            return np.ones_like(u)
+        case "u":
+            return u
+        case "v":
+            return v
+        case "r":
+            return r
+        case "|u|u":
+            return np.abs(u) * u
+        case "vr":
+            return v * r
+        case "r^2":
+            return r * r
+        case "ur":
+            return u * r
+        case "uv":
+            return u * v
+        case "|v|v":
+            return np.abs(v) * v
+        case "|v|r":
+            return np.abs(v) * r
+        case "|r|r":
+            return np.abs(r) * r
+        case "|r|v":
+            return np.abs(r) * v
+        case "delta":
+            return delta
+        case "delta^2":
+            return delta * delta
+        case "T":
+            return thrust
+    raise ValueError(f"unknown model term {name!r}; known terms: {', '.join(TERMS)}")
+
+
+def term_matrix(
+    names: tuple[str, ...] | list[str],
+    u: np.ndarray,
+    v: np.ndarray,
+    r: np.ndarray,
+    delta: np.ndarray,
+    thrust: np.ndarray | None = None,
+) -> np.ndarray:
+    """(n, len(names)) matrix of regressor values."""
+    u = np.asarray(u, dtype=float)
+    thrust = np.zeros_like(u) if thrust is None else np.asarray(thrust, dtype=float)
+    cols = [term_values(n, u, np.asarray(v, float), np.asarray(r, float),
+                        np.asarray(delta, float), thrust) for n in names]  # fmt: skip
+    return np.column_stack(cols) if cols else np.empty((u.shape[0], 0))
