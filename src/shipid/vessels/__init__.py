@@ -5,7 +5,7 @@ from __future__ import annotations
 from .kvlcc2 import kvlcc2
 from .mariner import mariner
 from .scale_ship import scale_ship, scale_ship_model
-from .sensors import NOISE_FREE, PAPER_IMU, SensorModel
+from .sensors import NOISE_FREE, PAPER_IMU, PAPER_IMU_SPEC, SensorModel
 from .vessel import Vessel
 
 VESSELS = {"scale-ship": scale_ship, "mariner": mariner, "kvlcc2": kvlcc2}
@@ -18,5 +18,5 @@ def get_vessel(name: str) -> Vessel:
     return VESSELS[name]()
 
 
-__all__ = ["NOISE_FREE", "PAPER_IMU", "VESSELS", "SensorModel", "Vessel", "get_vessel", "kvlcc2",
-           "mariner", "scale_ship", "scale_ship_model"]
+__all__ = ["NOISE_FREE", "PAPER_IMU", "PAPER_IMU_SPEC", "VESSELS", "SensorModel", "Vessel",
+           "get_vessel", "kvlcc2", "mariner", "scale_ship", "scale_ship_model"]

@@ -1,0 +1,268 @@
+"""The ``shipid`` command line. Exit 0 on success, 1 on a user error (one-line message, no
+traceback), 2 on a usage error. Every output file is written atomically."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+from .errors import ShipidError
+
+VESSEL_NAMES = ("scale-ship", "mariner", "kvlcc2")
+
+
+def _add_log_options(p: argparse.ArgumentParser) -> None:
+    g = p.add_argument_group("log files")
+    g.add_argument("--columns", metavar="MAP", help="map file columns to canonical names, "
+                   "e.g. t=time,delta=rudder_angle")
+    g.add_argument("--degrees", metavar="COLS", default="",
+                   help="angle columns given in degrees, e.g. delta,psi,r")
+    g.add_argument("--dt", type=float, help="resample to this uniform sampling time [s]")
+    g.add_argument("--start", type=float, help="trim: first time [s]")
+    g.add_argument("--end", type=float, help="trim: last time [s]")
+    g.add_argument("--rudder-positive", choices=("port", "starboard"),
+                   help="where a positive rudder angle turns the ship (default port, as the paper)")
+
+
+def _read_logs(args) -> list:
+    from .io import parse_column_map, read_log
+
+    degrees = [c.strip() for c in args.degrees.split(",") if c.strip()]
+    cols = parse_column_map(args.columns)
+    return [read_log(p, cols, degrees, args.dt, args.start, args.end, args.rudder_positive)
+            for p in args.logs]  # fmt: skip
+
+
+def _write_json(path: str, data) -> None:
+    from .atomic import atomic_write_text
+    from .modelfile import _clean
+
+    atomic_write_text(path, json.dumps(_clean(data), indent=2, ensure_ascii=False) + "\n")
+
+
+def _parse_drop(spec: str | None) -> dict[str, list[str]]:
+    out: dict[str, list[str]] = {}
+    for item in (spec or "").split(","):
+        if not item.strip():
+            continue
+        if ":" not in item:
+            raise ShipidError(f"--drop expects dof:term pairs like u:r^2, got {item!r}")
+        dof, term = (s.strip() for s in item.split(":", 1))
+        out.setdefault(dof, []).append(term)
+    return out
+
+
+# ---------------------------------------------------------------------------- commands
+def cmd_demo(args) -> int:
+    from .demo import run_demo, summary
+
+    t0 = time.perf_counter()
+    result = run_demo(args.out, args.seed, progress=lambda m: print(m, file=sys.stderr))
+    print(summary(result))
+    print(f"figures and report written to {Path(args.out) / 'report.md'} "
+          f"({time.perf_counter() - t0:.1f} s)")
+    return 0
+
+
+def cmd_identify(args) -> int:
+    from .identify import identify
+    from .modelfile import save_model
+    from .preprocess import lowpass
+
+    logs = _read_logs(args)
+    if args.filter is not None:
+        logs = [lowpass(log, args.filter) for log in logs]
+    ident = identify(logs, model=args.model, form=args.form, gamma=args.gamma,
+                     drop=_parse_drop(args.drop), names=[str(p) for p in args.logs])  # fmt: skip
+    prep = {"dt": args.dt, "start": args.start, "end": args.end, "filter_hz": args.filter,
+            "columns": args.columns, "degrees": args.degrees,
+            "approach_speed": float(logs[0]["u"].iloc[: max(1, len(logs[0]) // 50)].mean()),
+            "rudder_positive": logs[0].attrs.get("rudder_positive")}  # fmt: skip
+    save_model(args.output, ident, args.logs, prep)
+    print(ident.model.equations())
+    for dof, d in ident.diagnostics.items():
+        print(f"{dof}: condition number {d['condition_number']:.3g}, one-step R² "
+              f"{d['one_step_r2']:.4f}, bias b = {ident.discrete[dof]['bias']:.4g}")
+    for w in ident.warnings:
+        print(f"warning: {w}", file=sys.stderr)
+    print(f"model written to {args.output}")
+    return 0
+
+
+def cmd_validate(args) -> int:
+    from .modelfile import load_model
+    from .plots import measured_vs_simulated
+    from .report import error_table, indices_table
+    from .validate import validate
+
+    model = load_model(args.model)
+    logs = _read_logs(args)
+    vals = validate(model, logs, [str(p) for p in args.logs], method=args.method)
+    print(error_table(vals))
+    table = indices_table(vals)
+    if table.count("\n") > 1:
+        print()
+        print(table)
+    for v in vals:
+        if v.simulation.diverged:
+            print(f"{v.name}: {v.simulation.reason}", file=sys.stderr)
+    if args.json:
+        _write_json(args.json, {"logs": [v.to_dict() for v in vals]})
+    if args.plots:
+        for v, log in zip(vals, logs, strict=True):
+            measured_vs_simulated(log, v.simulation.log,
+                                  Path(args.plots) / f"{Path(v.name).stem}.png", v.name)  # fmt: skip
+    return 0
+
+
+def _ship_or_model(name: str):
+    from .modelfile import load_document, load_model
+    from .vessels import get_vessel
+
+    if name in VESSEL_NAMES:
+        return get_vessel(name), None
+    doc = load_document(name)
+    speed = doc.get("identification", {}).get("preprocessing", {}).get("approach_speed")
+    return load_model(name), speed
+
+
+def cmd_simulate(args) -> int:
+    from .io import read_log, write_log
+    from .simulate import simulate_log
+
+    target, _ = _ship_or_model(args.model)
+    dynamics = getattr(target, "dynamics", target)
+    log = read_log(args.rudder, degrees=[c for c in args.degrees.split(",") if c])
+    res = simulate_log(dynamics, log, method=args.method)
+    write_log(res.log, args.output)
+    if res.diverged:
+        print(res.reason, file=sys.stderr)
+    print(f"{len(res.log)} samples written to {args.output}")
+    return 0
+
+
+def cmd_manoeuvre(args) -> int:
+    from .manoeuvres import turning_circle, zigzag
+
+    target, speed = _ship_or_model(args.model)
+    speed = args.speed or speed
+    kw = {"dt": args.step, "speed": args.speed if hasattr(target, "dynamics") else speed}
+    if args.duration:
+        kw["duration"] = args.duration
+    if args.kind == "zigzag":
+        res = zigzag(target, args.rudder, args.heading or args.rudder, first=args.first, **kw)
+    else:
+        res = turning_circle(target, args.rudder, side=args.first, **kw)
+    if res.diverged:
+        print(res.reason, file=sys.stderr)
+    for k, v in res.indices.items():
+        print(f"{k}: {v:.4g}" if isinstance(v, float) else f"{k}: {v}")
+    if args.json:
+        _write_json(args.json, {"manoeuvre": res.log.attrs.get("manoeuvre"), "diverged": res.diverged,
+                                "diverged_at": res.diverged_at, "indices": res.indices})
+    if args.output:
+        from .io import write_log
+
+        write_log(res.log, args.output)
+    return 0
+
+
+def cmd_indices(args) -> int:
+    from .indices import manoeuvre_indices
+
+    logs = _read_logs(args)
+    out = []
+    for path, log in zip(args.logs, logs, strict=True):
+        ind = manoeuvre_indices(log, args.kind, heading_deg=args.heading, smooth_s=args.smooth)
+        out.append({"name": str(path), "indices": ind})
+        print(f"{path}: {ind.get('kind') or 'no manoeuvre detected'}")
+        for k, v in ind.items():
+            if k != "kind":
+                print(f"  {k}: {v:.4g}" if isinstance(v, float) else f"  {k}: {v}")
+    if args.json:
+        _write_json(args.json, {"logs": out})
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(prog="shipid", description="Semiphysical identification of ship "
+                                 "manoeuvring models with LS-SVM (Moreno-Salinas et al. 2013).")
+    sub = ap.add_subparsers(dest="command", required=True)
+
+    p = sub.add_parser("demo", help="the paper's experiment on the embedded scale ship")
+    p.add_argument("--out", default="shipid-demo", help="output folder (default ./shipid-demo)")
+    p.add_argument("--seed", type=int, default=0, help="noise seed (default 0)")
+    p.set_defaults(func=cmd_demo)
+
+    p = sub.add_parser("identify", help="identify a model from trial logs")
+    p.add_argument("logs", nargs="+", metavar="LOG")
+    p.add_argument("--model", default="blanke",
+                   help="blanke (default), blanke-thrust, linear-sway-yaw, nomoto1")
+    p.add_argument("--form", default="increment", help="increment (default) or paper")
+    p.add_argument("--gamma", type=float, default=1e4, help="LS-SVM regularisation γ (default 1e4)")
+    p.add_argument("--drop", help="terms to drop, e.g. u:r^2 (the paper drops r²)")
+    p.add_argument("--filter", type=float, metavar="HZ", help="zero-phase low-pass of u, v, r")
+    p.add_argument("-o", "--output", required=True, metavar="MODEL.json")
+    _add_log_options(p)
+    p.set_defaults(func=cmd_identify)
+
+    p = sub.add_parser("validate", help="free-run a model against logs: error table and indices")
+    p.add_argument("model", metavar="MODEL.json")
+    p.add_argument("logs", nargs="+", metavar="LOG")
+    p.add_argument("--json", metavar="OUT", help="write the results as JSON")
+    p.add_argument("--plots", metavar="DIR", help="write measured-vs-simulated figures")
+    p.add_argument("--method", default="euler", choices=("euler", "rk4"))
+    _add_log_options(p)
+    p.set_defaults(func=cmd_validate)
+
+    p = sub.add_parser("simulate", help="drive a model or vessel with a logged rudder")
+    p.add_argument("model", metavar="MODEL.json|VESSEL")
+    p.add_argument("--rudder", required=True, metavar="LOG", help="log with t, delta, u, v, r")
+    p.add_argument("--degrees", default="", help="angle columns of the rudder log in degrees")
+    p.add_argument("--method", default="rk4", choices=("euler", "rk4"))
+    p.add_argument("-o", "--output", required=True, metavar="OUT.csv")
+    p.set_defaults(func=cmd_simulate)
+
+    p = sub.add_parser("manoeuvre", help="run a standard manoeuvre on a model or vessel")
+    p.add_argument("model", metavar="MODEL.json|VESSEL")
+    p.add_argument("kind", choices=("zigzag", "turning"))
+    p.add_argument("--rudder", type=float, default=20.0, help="rudder angle [deg]")
+    p.add_argument("--heading", type=float, help="zig-zag switch heading [deg] (default = rudder)")
+    p.add_argument("--first", default="starboard", choices=("starboard", "port"),
+                   help="first rudder (zig-zag) or turn side")
+    p.add_argument("--duration", type=float, help="length of the run [s]")
+    p.add_argument("--step", type=float, default=0.05, help="integration step [s]")
+    p.add_argument("--speed", type=float, help="approach speed [m/s] (models: default from training)")
+    p.add_argument("--json", metavar="OUT")
+    p.add_argument("-o", "--output", metavar="LOG.csv", help="write the simulated log")
+    p.set_defaults(func=cmd_manoeuvre)
+
+    p = sub.add_parser("indices", help="IMO indices of measured logs")
+    p.add_argument("logs", nargs="+", metavar="LOG")
+    p.add_argument("--kind", choices=("zigzag", "turning"), help="default: detected")
+    p.add_argument("--heading", type=float, help="zig-zag switch heading [deg] (default: inferred)")
+    p.add_argument("--smooth", type=float, default=0.0, help="heading smoothing window [s]")
+    p.add_argument("--json", metavar="OUT")
+    _add_log_options(p)
+    p.set_defaults(func=cmd_indices)
+    return ap
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        return args.func(args)
+    except ShipidError as exc:
+        print(f"shipid: error: {exc}", file=sys.stderr)
+        return 1
+    except (ValueError, OSError) as exc:
+        msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        print(f"shipid: error: {msg}", file=sys.stderr)
+        return 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,170 @@
+"""Semiphysical identification: per degree of freedom, the paper's regression (eqs. 11–12) fitted by a
+linear-kernel LS-SVM (eqs. 14–15), mapped back to continuous-time coefficients (eq. 16 form)."""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from .errors import ShipidError
+from .lssvm import LSSVR, NumericalWarning
+from .model import ManoeuvringModel, ModelStructure, get_structure
+from .regression import FORMS, RegressionProblem, regression_problem
+from .terms import TERM_DISPLAY
+
+COLLINEAR_CORRELATION = 0.999
+CONSTANT_VARIATION = 1e-3
+
+
+@dataclass
+class Identification:
+    """An identified model with the raw LS-SVM solution and its diagnostics."""
+
+    model: ManoeuvringModel
+    form: str
+    gamma: float
+    dt: float
+    discrete: dict[str, dict] = field(default_factory=dict)  # dof → {"names", "gamma", "bias"}
+    diagnostics: dict[str, dict] = field(default_factory=dict)
+    warnings: list[str] = field(default_factory=list)
+
+
+def _display(name: str) -> str:
+    return TERM_DISPLAY.get(name) or "1"
+
+
+def _diagnose(p: RegressionProblem, est: LSSVR) -> tuple[dict, list[str]]:
+    """Conditioning, collinearity, standard errors and one-step R² of one DOF's regression."""
+    X, y = p.X, p.y
+    notes: list[str] = []
+    mean, std = X.mean(axis=0), X.std(axis=0)
+    constant = std <= CONSTANT_VARIATION * np.maximum(np.abs(mean), 1e-12)
+    for j in np.flatnonzero(constant):
+        notes.append(f"{p.dof}: term {_display(p.names[j])} is (nearly) constant in the data and "
+                     "cannot be told apart from the constant term: not identifiable; drop or fix it")
+    Xc = X - mean
+    norms = np.linalg.norm(Xc, axis=0)
+    scaled = Xc[:, ~constant] / norms[~constant]
+    sv = np.linalg.svd(scaled, compute_uv=False) if scaled.shape[1] else np.array([1.0])
+    cond = float(sv[0] / sv[-1]) if sv[-1] > 0 else math.inf
+    if constant.any():
+        cond = math.inf
+    pairs = []
+    if X.shape[1] >= 2:
+        with np.errstate(invalid="ignore", divide="ignore"):
+            C = np.corrcoef(X, rowvar=False)
+        for i in range(X.shape[1]):
+            for j in range(i + 1, X.shape[1]):
+                if np.isfinite(C[i, j]):
+                    pairs.append((p.names[i], p.names[j], float(C[i, j])))
+        pairs.sort(key=lambda t: -abs(t[2]))
+        for a, b, c in pairs:
+            if abs(c) > COLLINEAR_CORRELATION:
+                notes.append(f"{p.dof}: terms {_display(a)} and {_display(b)} are collinear in the "
+                             f"data (ρ = {c:.4f}): their coefficients are poorly determined")
+    resid = y - est.predict(X)
+    dof_resid = max(len(y) - X.shape[1] - 1, 1)
+    sigma2 = float(resid @ resid) / dof_resid
+    G = Xc.T @ Xc
+    A_inv = np.linalg.pinv(G + np.eye(G.shape[0]) / est.gamma)
+    cov = sigma2 * A_inv @ G @ A_inv
+    se = np.sqrt(np.clip(np.diag(cov), 0, None))
+    increment = y - X[:, 0] if p.form == "paper" else y
+    pred_increment = est.predict(X) - (X[:, 0] if p.form == "paper" else 0.0)
+    ss_tot = float(np.sum((increment - increment.mean()) ** 2))
+    r2 = 1.0 - float(np.sum((increment - pred_increment) ** 2)) / ss_tot if ss_tot > 0 else math.nan
+    scale = p.dt if p.form == "paper" else 1.0
+    std_errors = {n: float(s) / (scale if (p.form == "paper" and n != p.dof) else 1.0)
+                  for n, s in zip(p.names, se, strict=True)}  # fmt: skip
+    if p.form == "paper":
+        std_errors[p.dof] = std_errors[p.dof] / p.dt  # of the self term (g0 − 1)/Δk
+    return {
+        "n_samples": int(len(y)),
+        "condition_number": cond,
+        "most_collinear": [{"terms": [a, b], "correlation": c} for a, b, c in pairs[:3]],
+        "std_errors": std_errors,
+        "one_step_r2": r2,
+        "residual_std": math.sqrt(sigma2),
+    }, notes
+
+
+def identify(
+    logs: Sequence[pd.DataFrame] | pd.DataFrame,
+    model: str | ModelStructure = "blanke",
+    form: str = "increment",
+    gamma: float = 1e4,
+    drop: Mapping[str, Sequence[str]] | None = None,
+    fixed: Mapping[str, Mapping[str, float]] | None = None,
+    names: Sequence[str] | None = None,
+) -> Identification:
+    """Identify a manoeuvring model from one or several canonical logs.
+
+    Parameters
+    ----------
+    logs : canonical log(s) with the same uniform sampling time Δk.
+    model : structure name ('blanke', 'blanke-thrust', 'linear-sway-yaw', 'nomoto1') or structure.
+    form : 'increment' (default; the ξ(k) coefficient fixed to 1) or 'paper' (eqs. 11–12 as printed).
+    gamma : LS-SVM regularisation γ > 0 (the paper selects 10⁴).
+    drop : terms to leave out, e.g. {"u": ["r^2"]} as in the paper.
+    fixed : terms held at given continuous-time values, e.g. {"u": {"delta^2": 0.0}}.
+    """
+    if isinstance(logs, pd.DataFrame):
+        logs = [logs]
+    if not logs:
+        raise ShipidError("no training logs given")
+    if form not in FORMS:
+        raise ShipidError(f"unknown form {form!r}; use one of {', '.join(FORMS)}")
+    if not (isinstance(gamma, int | float) and math.isfinite(gamma) and gamma > 0):
+        raise ShipidError(f"--gamma must be > 0, got {gamma!r}")
+    try:
+        structure = get_structure(model) if isinstance(model, str) else model
+        if drop:
+            structure = structure.without(drop)
+    except ValueError as exc:
+        raise ShipidError(str(exc)) from None
+    fixed = {d: dict(v) for d, v in (fixed or {}).items()}
+    coefs: dict[str, dict[str, float]] = {}
+    terms: dict[str, tuple[str, ...]] = {}
+    result = Identification(None, form, float(gamma), math.nan)  # type: ignore[arg-type]
+    for dof in structure.dofs:
+        p = regression_problem(logs, structure, dof, form, fixed.get(dof), names)
+        result.dt = p.dt
+        if p.X.shape[1] == 0:
+            raise ShipidError(f"{dof}: no free terms to identify")
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", NumericalWarning)
+            est = LSSVR(gamma=gamma, kernel="linear", solver="primal").fit(p.X, p.y)
+        diag, notes = _diagnose(p, est)
+        result.warnings += notes + [f"{dof}: {w.message}" for w in caught
+                                    if issubclass(w.category, NumericalWarning)]  # fmt: skip
+        b = float(est.intercept_)
+        g = np.asarray(est.coef_, dtype=float)
+        c: dict[str, float] = dict(fixed.get(dof, {}))
+        if form == "paper":
+            c[dof] = (g[0] - 1.0) / p.dt
+            c.update({n: val / p.dt for n, val in zip(p.names[1:], g[1:], strict=True)})
+            bias_const = b / p.dt
+        else:
+            c.update(dict(zip(p.names, g.tolist(), strict=True)))
+            bias_const = b
+        if p.has_constant:
+            c["1"] = bias_const
+        elif abs(bias_const) > 0:
+            result.warnings.append(f"{dof}: the model has no constant term; the LS-SVM bias "
+                                   f"b = {b:.4g} is reported but not part of the model")
+        order = list(structure.terms[dof])
+        if dof in c and dof not in order:
+            order.insert(0, dof)
+        terms[dof] = tuple(order)
+        coefs[dof] = {n: c.get(n, 0.0) for n in order}
+        result.discrete[dof] = {"names": list(p.names) + ["1"],
+                                "gamma": g.tolist() + [0.0], "bias": b}  # fmt: skip
+        result.diagnostics[dof] = diag
+    final = ModelStructure(structure.name, terms)
+    result.model = ManoeuvringModel(final, coefs, name=f"identified ({structure.name}, {form} form)")
+    return result

@@ -1,0 +1,139 @@
+"""Trial logs in and out: canonical CSV/Parquet with column mapping, degree conversion, resampling
+and trimming, and checks that name the file, column and row of bad input."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .atomic import atomic_write
+from .errors import ShipidError
+from .log import COLUMNS, REQUIRED
+from .preprocess import resample, trim
+
+ANGLE_COLUMNS = ("delta", "psi", "r")
+# A rudder beyond 60° or a yaw rate beyond 3 rad/s (172 °/s) is not radians.
+RADIAN_PLAUSIBLE = {"delta": math.radians(60.0), "r": 3.0}
+
+
+def parse_column_map(spec: str | None) -> dict[str, str]:
+    """'t=time,delta=rudder' → {'time': 't', 'rudder': 'delta'} (file name → canonical name)."""
+    if not spec:
+        return {}
+    out = {}
+    for item in spec.split(","):
+        if "=" not in item:
+            raise ShipidError(f"--columns expects canonical=file pairs like t=time, got {item!r}")
+        canon, name = (s.strip() for s in item.split("=", 1))
+        if canon not in COLUMNS:
+            raise ShipidError(f"--columns: {canon!r} is not a canonical column ({', '.join(COLUMNS)})")
+        out[name] = canon
+    return out
+
+
+def _read_table(path: Path) -> pd.DataFrame:
+    if not path.exists():
+        raise ShipidError(f"{path}: no such file")
+    if path.is_dir():
+        raise ShipidError(f"{path}: is a directory, not a log file")
+    if path.stat().st_size == 0:
+        raise ShipidError(f"{path}: the file is empty")
+    if path.suffix.lower() in (".parquet", ".pq"):
+        try:
+            return pd.read_parquet(path)
+        except Exception as exc:  # pyarrow raises several types for a bad file
+            raise ShipidError(f"{path}: not a readable Parquet file ({exc})") from None
+    head = path.read_bytes()[:4096]
+    if b"\x00" in head:
+        raise ShipidError(f"{path}: binary file, not a CSV log (use .parquet for Parquet)")
+    try:
+        return pd.read_csv(path, skip_blank_lines=True, comment="#")
+    except UnicodeDecodeError:
+        raise ShipidError(f"{path}: not a text CSV file") from None
+    except pd.errors.EmptyDataError:
+        raise ShipidError(f"{path}: the file has no header and no rows") from None
+    except pd.errors.ParserError as exc:
+        raise ShipidError(f"{path}: not a valid CSV file ({str(exc).splitlines()[0]})") from None
+
+
+def check_log(df: pd.DataFrame, name: str, min_samples: int = 3) -> None:
+    """Required columns, finite numbers, strictly increasing time, enough samples."""
+    if len(df) == 0:
+        raise ShipidError(f"{name}: the header has no rows")
+    missing = [c for c in REQUIRED if c not in df.columns]
+    if missing:
+        have = ", ".join(map(str, df.columns))
+        raise ShipidError(f"{name}: missing column(s) {', '.join(missing)} (columns found: {have}); "
+                          "map other names with --columns, e.g. --columns delta=rudder")  # fmt: skip
+    for c in [c for c in COLUMNS if c in df.columns]:
+        values = pd.to_numeric(df[c], errors="coerce").to_numpy(dtype=float)
+        bad = ~np.isfinite(values)
+        if bad.any():
+            row = int(np.argmax(bad))
+            raw = df[c].iloc[row]
+            raise ShipidError(f"{name}: column {c!r} has a non-numeric or non-finite value "
+                              f"({raw!r}) at data row {row + 1}")  # fmt: skip
+        df[c] = values
+    t = df["t"].to_numpy()
+    dt = np.diff(t)
+    if np.any(dt == 0):
+        row = int(np.argmax(dt == 0)) + 1
+        raise ShipidError(f"{name}: duplicate time stamp t = {t[row]:g} "
+                          f"at data rows {row} and {row + 1}")
+    if np.any(dt < 0):
+        row = int(np.argmax(dt < 0)) + 1
+        raise ShipidError(f"{name}: time is not increasing at data row {row + 1} "
+                          f"(t = {t[row]:g} after {t[row - 1]:g})")  # fmt: skip
+    if len(df) < min_samples:
+        raise ShipidError(f"{name}: {len(df)} samples, too short (at least {min_samples} needed)")
+
+
+def read_log(
+    path: str | Path,
+    columns: Mapping[str, str] | None = None,
+    degrees: Sequence[str] = (),
+    dt: float | None = None,
+    start: float | None = None,
+    end: float | None = None,
+    rudder_positive: str | None = None,
+) -> pd.DataFrame:
+    """Read a canonical log (CSV or Parquet).
+
+    columns : file column name → canonical name. degrees : canonical angle columns given in degrees
+    (delta, psi in deg; r in deg/s). dt : resample to this Δk. start/end : trim [s].
+    """
+    path = Path(path)
+    df = _read_table(path).rename(columns=dict(columns or {}))
+    df.columns = [str(c).strip() for c in df.columns]
+    df = df.dropna(how="all").reset_index(drop=True)
+    check_log(df, str(path))
+    for c in degrees:
+        if c not in ANGLE_COLUMNS:
+            raise ShipidError(f"--degrees: {c!r} is not an angle column ({', '.join(ANGLE_COLUMNS)})")
+        if c in df.columns:
+            df[c] = np.radians(df[c].to_numpy())
+    for c, limit in RADIAN_PLAUSIBLE.items():
+        if c not in degrees and np.max(np.abs(df[c].to_numpy())) > limit:
+            peak = np.max(np.abs(df[c]))
+            raise ShipidError(f"{path}: column {c!r} reaches {peak:.3g}, which looks like degrees; "
+                              f"give --degrees {c} (angles are radians inside)")
+    log = df[[c for c in COLUMNS if c in df.columns]].copy()
+    log.attrs.update({"name": path.name, "source": str(path),
+                      "rudder_positive": rudder_positive or "port"})  # fmt: skip
+    if start is not None or end is not None:
+        log = trim(log, start, end, str(path))
+    if dt is not None:
+        log = resample(log, dt, str(path))
+    return log
+
+
+def write_log(log: pd.DataFrame, path: str | Path) -> Path:
+    """Write a canonical log atomically (CSV, or Parquet by extension)."""
+    path = Path(path)
+    if path.suffix.lower() in (".parquet", ".pq"):
+        return atomic_write(path, lambda p: log.to_parquet(p, index=False))
+    return atomic_write(path, lambda p: log.to_csv(p, index=False, float_format="%.9g"))

@@ -1,0 +1,115 @@
+"""From a model structure and trial logs to one regression problem per degree of freedom (paper
+eqs. 11–12).
+
+* ``form="paper"``: y_k = ξ(k+1) on x_k = [ξ(k), terms(k)...] (eq. 12), the ξ(k) coefficient
+  estimated.
+* ``form="increment"``: y_k = (ξ(k+1) − ξ(k))/Δk on the terms alone, i.e. the ξ(k) coefficient fixed
+  to 1. The regressors of the paper's form contain ξ(k) itself, which with noisy measurements makes
+  the estimated ξ(k) coefficient absorb the noise and the collinearity with the other terms.
+
+The constant term "1" is not a column: the LS-SVM bias b plays its part (and Σα = 0 would make
+its weight zero anyway). Samples pair k with k+1 of the same log only, never across two logs.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from .errors import ShipidError
+from .model import ModelStructure
+from .terms import term_matrix
+
+FORMS = ("increment", "paper")
+DT_RTOL = 1e-6
+
+
+@dataclass
+class RegressionProblem:
+    dof: str
+    form: str
+    dt: float
+    names: list[str]  # columns of X
+    X: np.ndarray
+    y: np.ndarray
+    has_constant: bool  # "1" is a term: the bias b is its coefficient
+    fixed: dict[str, float] = field(default_factory=dict)
+    n_logs: int = 1
+
+
+def sampling_time(log: pd.DataFrame, name: str = "log") -> float:
+    """Δk of a log, which must be uniform (resample it otherwise)."""
+    t = log["t"].to_numpy()
+    if len(t) < 3:
+        raise ShipidError(f"{name}: {len(t)} samples, too short for identification")
+    dts = np.diff(t)
+    dt = float(np.median(dts))
+    if np.max(np.abs(dts - dt)) > max(DT_RTOL * dt, 1e-9):
+        k = int(np.argmax(np.abs(dts - dt)))
+        raise ShipidError(f"{name}: sampling is not uniform (Δt = {dts[k]:.6g} s at row {k + 1}, "
+                          f"median {dt:.6g} s); resample it with --dt")  # fmt: skip
+    return dt
+
+
+def _log_terms(log: pd.DataFrame, names: Sequence[str]) -> np.ndarray:
+    thrust = log["thrust"].to_numpy() if "thrust" in log.columns else None
+    if "T" in names and thrust is None:
+        raise ShipidError("the model has a thrust term T but the log has no 'thrust' column")
+    return term_matrix(list(names), log["u"].to_numpy(), log["v"].to_numpy(),
+                       log["r"].to_numpy(), log["delta"].to_numpy(), thrust)  # fmt: skip
+
+
+def regression_problem(
+    logs: Sequence[pd.DataFrame],
+    structure: ModelStructure,
+    dof: str,
+    form: str = "increment",
+    fixed: Mapping[str, float] | None = None,
+    names: Sequence[str] | None = None,
+) -> RegressionProblem:
+    """Stack the regression of one degree of freedom over several logs.
+
+    ``fixed`` terms (name → continuous-time coefficient) are moved to the target side.
+    """
+    if form not in FORMS:
+        raise ShipidError(f"unknown form {form!r}; use one of {', '.join(FORMS)}")
+    if dof not in structure.terms:
+        raise ShipidError(f"{structure.name} has no {dof} equation")
+    fixed = dict(fixed or {})
+    unknown = set(fixed) - set(structure.terms[dof])
+    if unknown:
+        raise ShipidError(f"fixed terms {sorted(unknown)} are not in the {dof} equation "
+                          f"({list(structure.terms[dof])})")  # fmt: skip
+    free = [n for n in structure.terms[dof] if n not in fixed and n != "1"]
+    if form == "paper" and dof in free:
+        free.remove(dof)  # ξ(k) is already the first regressor
+    has_constant = "1" in structure.terms[dof] and "1" not in fixed
+    names = names or [f"log {i}" for i in range(len(logs))]
+    dts = [sampling_time(log, n) for log, n in zip(logs, names, strict=True)]
+    dt = dts[0]
+    for d, n in zip(dts[1:], names[1:], strict=True):
+        if abs(d - dt) > DT_RTOL * dt:
+            raise ShipidError(f"{n}: sampling time {d:.6g} s differs from {dt:.6g} s of {names[0]}; "
+                              "resample the logs to one Δk with --dt")  # fmt: skip
+    Xs, ys = [], []
+    for log in logs:
+        xi = log[dof].to_numpy()
+        F = _log_terms(log, free)[:-1]
+        target = (xi[1:] - xi[:-1]) / dt
+        if fixed:
+            Ffix = _log_terms(log, list(fixed))[:-1]
+            target = target - Ffix @ np.fromiter(fixed.values(), float)
+        if form == "paper":
+            # Eq. (12) as printed: raw terms, so Γ = [ξ(k) coefficient, Δk·θ...] is what the
+            # LS-SVM regularises, exactly as in the paper.
+            Xs.append(np.column_stack([xi[:-1], F]))
+            ys.append(xi[:-1] + dt * target)
+        else:
+            Xs.append(F)
+            ys.append(target)
+    cols = ([dof] if form == "paper" else []) + free
+    return RegressionProblem(dof, form, dt, cols, np.vstack(Xs), np.concatenate(ys), has_constant,
+                             fixed, len(logs))  # fmt: skip

@@ -1,0 +1,44 @@
+"""Tables and the Markdown report of an identification and its validation."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+from .validate import Validation
+
+INDEX_KEYS = ("first_overshoot_deg", "second_overshoot_deg", "initial_turning_time",
+              "advance", "transfer", "tactical_diameter", "steady_turning_diameter",
+              "steady_yaw_rate")  # fmt: skip
+
+
+def error_table(validations: Sequence[Validation], paper: dict | None = None) -> str:
+    """Markdown table of the error std per state (the paper's metric), with divergence."""
+    head = ("| log | surge u std (m/s) | sway v std (m/s) | yaw r std (rad/s) | rmse u / v / r "
+            "| diverged |")
+    if paper:
+        head += " paper u / v / r |"
+    lines = [head, "|" + "---|" * (head.count("|") - 1)]
+    for v in validations:
+        m = v.metrics
+        div = f"at {v.simulation.diverged_at:.1f} s" if v.simulation.diverged else "no"
+        row = (f"| {v.name} | {m['u']['std']:.4f} | {m['v']['std']:.4f} | {m['r']['std']:.4f} | "
+               f"{m['u']['rmse']:.4f} / {m['v']['rmse']:.4f} / {m['r']['rmse']:.4f} | {div} |")
+        if paper:
+            p = paper.get(v.name)
+            row += " " + (" / ".join(f"{x:.4f}" for x in p) if p else "–") + " |"
+        lines.append(row)
+    return "\n".join(lines)
+
+
+def _fmt(x) -> str:
+    return "–" if x is None else (f"{x:.3f}" if isinstance(x, float) else str(x))
+
+
+def indices_table(validations: Sequence[Validation]) -> str:
+    lines = ["| log | index | measured | simulated |", "|---|---|---|---|"]
+    for v in validations:
+        meas, sim = v.indices.get("measured", {}), v.indices.get("simulated", {})
+        for k in INDEX_KEYS:
+            if k in meas or k in sim:
+                lines.append(f"| {v.name} | {k} | {_fmt(meas.get(k))} | {_fmt(sim.get(k))} |")
+    return "\n".join(lines)
