@@ -157,3 +157,12 @@ def test_sensor_model_is_seeded_and_has_the_stated_noise():
     assert np.std(a["u"] - 1) == pytest.approx(0.04, rel=0.05)
     assert np.std(a["psi"]) == pytest.approx(math.radians(0.05), rel=0.05)
     assert np.all(a["delta"] == 0)
+
+
+def test_zigzag_detected_when_the_log_starts_with_the_rudder_over():
+    """Bug: the neutral rudder was the first sample, so a trimmed zig-zag starting at −30° was
+    not recognised (its rudder never crossed −30°)."""
+    res = zigzag(scale_ship(), 30, 30, duration=60, dt=0.1)
+    late = res.log[res.log["t"] >= 5.0].reset_index(drop=True)
+    late.attrs = dict(res.log.attrs)
+    assert detect_manoeuvre(late) == "zigzag"

@@ -76,7 +76,7 @@ def _coefficient_table(truth, fits: dict[str, Identification]) -> str:
             if term == "r^2":
                 continue
             cells = [f"{f.model.coefficients[dof].get(term, float('nan')):.4f}" for f in fits.values()]
-            label = TERM_DISPLAY[term] or "1"
+            label = (TERM_DISPLAY[term] or "1").replace("|", "\\|")  # Markdown cell
             lines.append(f"| {dof}̇ | {label} | {true:.4f} | " + " | ".join(cells) + " |")
     return "\n".join(lines)
 

@@ -141,8 +141,13 @@ def zigzag_indices(
     return _none_if_nan(result)
 
 
+def neutral_rudder(delta: np.ndarray) -> float:
+    """Mid-range of the rudder: the neutral of a zig-zag whatever side the log starts on."""
+    return 0.5 * (float(np.max(delta)) + float(np.min(delta)))
+
+
 def _inferred_switch_deg(delta: np.ndarray, dpsi: np.ndarray, i0: int) -> float | None:
-    neutral = delta[i0]
+    neutral = neutral_rudder(delta[i0:])
     side = np.sign(delta[i0:] - neutral)
     side[np.abs(delta[i0:] - neutral) < math.radians(1.0)] = 0
     nz = np.flatnonzero(side)
@@ -219,7 +224,7 @@ def detect_manoeuvre(log: pd.DataFrame) -> str | None:
     ≥ 180° on one side, else None."""
     delta = log["delta"].to_numpy()
     i0 = rudder_order_index(delta)
-    dev = delta[i0:] - delta[i0]
+    dev = delta[i0:] - neutral_rudder(delta[i0:])
     side = np.sign(dev[np.abs(dev) > math.radians(1.0)])
     if side.size and np.count_nonzero(side[1:] != side[:-1]) >= 2:
         return "zigzag"

@@ -4,6 +4,7 @@ and trimming, and checks that name the file, column and row of bad input."""
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
@@ -16,6 +17,7 @@ from .log import COLUMNS, REQUIRED
 from .preprocess import resample, trim
 
 ANGLE_COLUMNS = ("delta", "psi", "r")
+UNIT_SUFFIX = re.compile(r"\s*\[[^\]]*\]\s*$")
 # A rudder beyond 60° or a yaw rate beyond 3 rad/s (172 °/s) is not radians.
 RADIAN_PLAUSIBLE = {"delta": math.radians(60.0), "r": 3.0}
 
@@ -107,8 +109,10 @@ def read_log(
     (delta, psi in deg; r in deg/s). dt : resample to this Δk. start/end : trim [s].
     """
     path = Path(path)
-    df = _read_table(path).rename(columns=dict(columns or {}))
-    df.columns = [str(c).strip() for c in df.columns]
+    df = _read_table(path)
+    # "u_velo [m/s]" → "u_velo": units in brackets are documentation, not part of the name.
+    df.columns = [UNIT_SUFFIX.sub("", str(c)).strip() for c in df.columns]
+    df = df.rename(columns=dict(columns or {}))
     df = df.dropna(how="all").reset_index(drop=True)
     check_log(df, str(path))
     for c in degrees:
