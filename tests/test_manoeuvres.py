@@ -91,8 +91,9 @@ def test_pull_out_of_a_stable_ship_returns_to_a_straight_course():
 
 
 def test_manoeuvre_log_replays_exactly_with_simulate_log():
-    res = zigzag(scale_ship(rudder_rate_deg=9.6), 20, 20, duration=30, dt=0.1, method="euler")
-    again = simulate_log(res.log.attrs and get_vessel("scale-ship").dynamics, res.log, "euler")
+    ship = scale_ship(rudder_rate_deg=9.6)
+    res = zigzag(ship, 20, 20, duration=30, dt=0.1, method="euler")
+    again = simulate_log(ship.dynamics, res.log, "euler")
     np.testing.assert_allclose(again.log.to_numpy(), res.log.to_numpy(), rtol=1e-12, atol=1e-12)
 
 

@@ -111,6 +111,11 @@ def _check_rudder(vessel: Vessel, rudder_deg: float) -> float:
     return rudder
 
 
+def _rudder_to(side: str, vessel: Vessel, rudder_deg: float) -> float:
+    """Signed rudder angle [rad] that turns ``vessel`` to ``side``."""
+    return _side_sign(side) * starboard_sign(vessel.rudder_positive) * _check_rudder(vessel, rudder_deg)
+
+
 def _side_sign(side: str) -> float:
     if side not in SIDES:
         raise ValueError(f"first/side must be 'starboard' or 'port', got {side!r}")
@@ -169,8 +174,7 @@ def turning_circle(
 ) -> ManoeuvreResult:
     """Turning circle: rudder to ``side`` at t = ``approach`` (the rudder execute), held."""
     vessel = as_vessel(ship, speed, steering)
-    rudder = _check_rudder(vessel, rudder_deg)
-    value = _side_sign(side) * starboard_sign(vessel.rudder_positive) * rudder
+    value = _rudder_to(side, vessel, rudder_deg)
 
     def command(t: float, s: np.ndarray) -> float:
         return value if t >= approach - 1e-9 else 0.0
@@ -197,8 +201,7 @@ def pull_out(
     """Pull-out: rudder held for ``hold`` s, then returned to midships for ``release`` s. A
     straight-line stable ship's yaw rate decays to zero; an unstable one keeps a residual rate."""
     vessel = as_vessel(ship, speed, steering)
-    rudder = _check_rudder(vessel, rudder_deg)
-    value = _side_sign(side) * starboard_sign(vessel.rudder_positive) * rudder
+    value = _rudder_to(side, vessel, rudder_deg)
 
     def command(t: float, s: np.ndarray) -> float:
         return value if t < hold else 0.0
