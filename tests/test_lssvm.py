@@ -195,6 +195,15 @@ def test_lssvrcv_picks_the_gamma_with_smallest_brute_force_loo_error():
     assert cv.predict(X).shape == y.shape
 
 
+def test_fused_loo_mse_equals_mean_of_residuals():
+    from shipid.lssvm.selection import PrimalLOOPath
+
+    X, Y, w = problem(n=50, q=3, seed=12)
+    path = PrimalLOOPath(X, Y, w)
+    for g in (0.1, 10.0, 1e5):
+        assert path.mse(g) == pytest.approx(np.mean(path.residuals(g) ** 2), rel=1e-12)
+
+
 def test_lssvrcv_kfold_and_linear_kernel():
     X, y, _ = problem(n=60, seed=11)
     cv = LSSVRCV(gammas=[0.01, 1.0, 100.0], kernel="linear", cv=3).fit(X, y)

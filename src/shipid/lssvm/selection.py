@@ -11,6 +11,7 @@ x̃ the weighted-centred features and G = X̃ᵀ W X̃ = Q Λ Qᵀ, again one ei
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 from scipy import linalg
 from sklearn.base import BaseEstimator, RegressorMixin
@@ -41,6 +42,9 @@ class DualLOOPath:
         self.a = V.T @ s
         self.Yt = V.T @ (s[:, None] * Y)
 
+    def mse(self, gamma: float) -> float:
+        return float(np.mean(self.residuals(gamma) ** 2))
+
     def residuals(self, gamma: float) -> np.ndarray:
         d = 1.0 / (self.lam + 1.0 / gamma)
         eta = self.s * (self.V @ (d * self.a))
@@ -49,6 +53,30 @@ class DualLOOPath:
         alpha = nu - eta[:, None] * intercept
         diag = self.w * (self.V2 @ d) - eta * eta / eta.sum()
         return alpha / diag[:, None]
+
+
+@numba.njit(cache=True)
+def _primal_loo_sse(P, Yc, w, inv_sw, d, B):
+    """Σᵢ Σₖ (eᵢₖ/(1 − hᵢᵢ))² in one pass over the rows (no N×q temporaries)."""
+    n, k = P.shape
+    q = Yc.shape[1]
+    total = 0.0
+    # Serial on purpose: right after the path's BLAS calls, OpenBLAS threads still spin and a
+    # parallel loop competing with them measured twice as slow on 2 cores.
+    for i in range(n):
+        lev = 0.0
+        for j in range(k):
+            lev += P[i, j] * P[i, j] * d[j]
+        denom = 1.0 - w[i] * (inv_sw + lev)
+        row = 0.0
+        for c in range(q):
+            fit = 0.0
+            for j in range(k):
+                fit += P[i, j] * B[j, c]
+            e = (Yc[i, c] - fit) / denom
+            row += e * e
+        total += row
+    return total
 
 
 class PrimalLOOPath:
@@ -60,28 +88,26 @@ class PrimalLOOPath:
         self.y_mean = (w @ Y) / self.sw
         G = Fc.T @ (Fc * w[:, None])
         self.lam, Q = np.linalg.eigh(G)
-        P = Fc @ Q
-        k = P.shape[1]
-        # [P | P²]: one GEMM per γ gives the fitted deviations and the leverages together.
-        self.PP = np.empty((P.shape[0], 2 * k))
-        self.PP[:, :k] = P
-        np.multiply(P, P, out=self.PP[:, k:])
-        self.PtWY = P.T @ (w[:, None] * (Y - self.y_mean))
-        self.Yc = Y - self.y_mean
-        self.w = w
+        self.P = np.ascontiguousarray(Fc @ Q)
+        self.Yc = np.ascontiguousarray(Y - self.y_mean)
+        self.PtWY = self.P.T @ (w[:, None] * self.Yc)
+        self.w = np.ascontiguousarray(w)
+
+    def _d(self, gamma: float) -> np.ndarray:
+        return 1.0 / (self.lam + 1.0 / gamma)
 
     def residuals(self, gamma: float) -> np.ndarray:
-        d = 1.0 / (self.lam + 1.0 / gamma)
-        k, q = d.shape[0], self.PtWY.shape[1]
-        C = np.zeros((2 * k, q + 1))
-        C[:k, :q] = d[:, None] * self.PtWY
-        C[k:, q] = d
-        M = self.PP @ C
-        one_minus_h = 1.0 - self.w * (1.0 / self.sw + M[:, q])
-        M = M[:, :q]
-        np.subtract(self.Yc, M, out=M)
-        M /= one_minus_h[:, None]
-        return M
+        d = self._d(gamma)
+        fitted = self.P @ (d[:, None] * self.PtWY)
+        leverage = self.w * (1.0 / self.sw + (self.P * self.P) @ d)
+        return (self.Yc - fitted) / (1.0 - leverage)[:, None]
+
+    def mse(self, gamma: float) -> float:
+        """Mean squared LOO residual, fused: the grid search needs nothing else."""
+        d = self._d(gamma)
+        sse = _primal_loo_sse(self.P, self.Yc, self.w, 1.0 / self.sw, d,
+                              np.ascontiguousarray(d[:, None] * self.PtWY))  # fmt: skip
+        return sse / self.Yc.size
 
 
 def loo_path(
@@ -213,7 +239,7 @@ class LSSVRCV(RegressorMixin, BaseEstimator):
                 if self.cv == "loo":
                     path = loo_path(self._base(sigma=s), X, Y, w)
                     for k, g in enumerate(gammas):
-                        mse[rows][k] = np.mean(path.residuals(float(g)) ** 2)
+                        mse[rows][k] = path.mse(float(g))
                         bar.update()
                 else:
                     folds = list(KFold(self.cv, shuffle=True, random_state=0).split(X))
