@@ -189,7 +189,8 @@ def test_cli_constant_rudder_names_the_unidentifiable_terms(tmp_path, capsys):
     pd.DataFrame({"t": t, "delta": 0.0, "u": 1.9 + 0.01 * np.sin(t), "v": 0.01 * np.cos(t),
                   "r": 0.01 * np.sin(0.5 * t)}).to_csv(tmp_path / "still.csv", index=False)
     code, _, err = run(["identify", tmp_path / "still.csv", "-o", tmp_path / "m.json"], capsys)
-    assert code == 0 and "δ" in err and "not identifiable" in err
+    assert code == 1 and "never moves" in err and "δ, δ²" in err and err.count("\n") == 1
+    assert not (tmp_path / "m.json").exists()
 
 
 def test_cli_usage_error_exits_2(capsys):

@@ -93,6 +93,20 @@ def _diagnose(p: RegressionProblem, est: LSSVR) -> tuple[dict, list[str]]:
     }, notes
 
 
+def _check_rudder_excitation(logs, structure: ModelStructure, fixed: Mapping) -> None:
+    """Refuse training data whose rudder never moves: no rudder term can be identified."""
+    rudder_terms = sorted({n for dof, names in structure.terms.items() for n in names
+                           if n.startswith("delta") and n not in fixed.get(dof, {})})
+    if not rudder_terms:
+        return
+    span = max(float(np.ptp(log["delta"].to_numpy())) for log in logs)
+    if span < math.radians(0.1):
+        shown = ", ".join(_display(n) for n in rudder_terms)
+        raise ShipidError(f"the rudder never moves in the training logs (range "
+                          f"{math.degrees(span):.3g}°): no excitation, so {shown} cannot be identified; train on a manoeuvre "
+                          "(zig-zag, turning circle) or drop/fix the rudder terms")
+
+
 def identify(
     logs: Sequence[pd.DataFrame] | pd.DataFrame,
     model: str | ModelStructure = "blanke",
@@ -128,6 +142,7 @@ def identify(
     except ValueError as exc:
         raise ShipidError(str(exc)) from None
     fixed = {d: dict(v) for d, v in (fixed or {}).items()}
+    _check_rudder_excitation(logs, structure, fixed)
     coefs: dict[str, dict[str, float]] = {}
     terms: dict[str, tuple[str, ...]] = {}
     result = Identification(None, form, float(gamma), math.nan)  # type: ignore[arg-type]
