@@ -103,8 +103,9 @@ def _check_rudder_excitation(logs, structure: ModelStructure, fixed: Mapping) ->
     if span < math.radians(0.1):
         shown = ", ".join(_display(n) for n in rudder_terms)
         raise ShipidError(f"the rudder never moves in the training logs (range "
-                          f"{math.degrees(span):.3g}°): no excitation, so {shown} cannot be identified; train on a manoeuvre "
-                          "(zig-zag, turning circle) or drop/fix the rudder terms")
+                          f"{math.degrees(span):.3g}°): no excitation, so {shown} cannot be "
+                          "identified; train on a manoeuvre (zig-zag, turning circle) or drop/fix "
+                          "the rudder terms")
 
 
 def identify(
