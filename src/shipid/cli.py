@@ -16,6 +16,10 @@ VESSEL_NAMES = ("scale-ship", "mariner", "kvlcc2")
 
 def _add_log_options(p: argparse.ArgumentParser) -> None:
     g = p.add_argument_group("log files")
+    g.add_argument("--format", default="canonical", choices=("canonical", "simman-marin", "osaka-frt"),
+                   help="file format (default canonical CSV/Parquet)")
+    g.add_argument("--scale", type=float, metavar="LAMBDA",
+                   help="simman-marin: Froude-scale the full-scale data to model scale 1/λ")
     g.add_argument("--columns", metavar="MAP", help="map file columns to canonical names, "
                    "e.g. t=time,delta=rudder_angle")
     g.add_argument("--degrees", metavar="COLS", default="",
@@ -32,8 +36,8 @@ def _read_logs(args) -> list:
 
     degrees = [c.strip() for c in args.degrees.split(",") if c.strip()]
     cols = parse_column_map(args.columns)
-    return [read_log(p, cols, degrees, args.dt, args.start, args.end, args.rudder_positive)
-            for p in args.logs]  # fmt: skip
+    return [read_log(p, cols, degrees, args.dt, args.start, args.end, args.rudder_positive,
+                     args.format, args.scale) for p in args.logs]  # fmt: skip
 
 
 def _write_json(path: str, data) -> None:
@@ -187,6 +191,18 @@ def cmd_indices(args) -> int:
     return 0
 
 
+def cmd_import(args) -> int:
+    from .io import write_log
+
+    log = _read_logs(args)[0]
+    write_log(log, args.output)
+    meta = ", ".join(f"{k}={log.attrs[k]}" for k in ("ship", "rudder_positive", "scale")
+                     if k in log.attrs)  # fmt: skip
+    print(f"{len(log)} samples, {log['t'].iloc[-1] - log['t'].iloc[0]:.1f} s ({meta}) "
+          f"written to {args.output}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(prog="shipid", description="Semiphysical identification of ship "
                                  "manoeuvring models with LS-SVM (Moreno-Salinas et al. 2013).")
@@ -239,6 +255,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", metavar="OUT")
     p.add_argument("-o", "--output", metavar="LOG.csv", help="write the simulated log")
     p.set_defaults(func=cmd_manoeuvre)
+
+    p = sub.add_parser("import", help="convert a trial file to a canonical log")
+    p.add_argument("logs", nargs=1, metavar="FILE")
+    p.add_argument("-o", "--output", required=True, metavar="LOG.csv")
+    _add_log_options(p)
+    p.set_defaults(func=cmd_import)
 
     p = sub.add_parser("indices", help="IMO indices of measured logs")
     p.add_argument("logs", nargs="+", metavar="LOG")

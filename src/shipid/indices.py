@@ -147,17 +147,26 @@ def neutral_rudder(delta: np.ndarray) -> float:
 
 
 def _inferred_switch_deg(delta: np.ndarray, dpsi: np.ndarray, i0: int) -> float | None:
-    neutral = neutral_rudder(delta[i0:])
-    side = np.sign(delta[i0:] - neutral)
-    side[np.abs(delta[i0:] - neutral) < math.radians(1.0)] = 0
+    """Switch heading from the heading at the rudder reversals, read where each swing *starts*
+    (the order), not where the rudder crosses neutral: a slow rudder crosses it well past ψ."""
+    d = delta[i0:]
+    dev = d - neutral_rudder(d)
+    side = np.sign(dev)
+    side[np.abs(dev) < math.radians(1.0)] = 0
     nz = np.flatnonzero(side)
     if nz.size < 2:
         return None
-    s = side[nz]
-    flips = nz[1:][s[1:] != s[:-1]] + i0
-    if flips.size == 0:
+    flips = nz[1:][side[nz[1:]] != side[nz[:-1]]]
+    starts = []
+    for f in flips:
+        before = np.flatnonzero(side[:f] == -side[f])
+        seg = d[before]
+        plateau = seg[np.argmax(np.abs(dev[before]))]
+        near = before[np.abs(seg - plateau) <= math.radians(0.5)]
+        starts.append(int(near[-1]) if near.size else int(f))
+    if not starts:
         return None
-    return float(np.median(np.degrees(np.abs(dpsi[flips]))))
+    return float(np.median(np.degrees(np.abs(dpsi[i0 + np.array(starts)]))))
 
 
 def turning_indices(

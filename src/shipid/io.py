@@ -13,6 +13,7 @@ import pandas as pd
 
 from .atomic import atomic_write
 from .errors import ShipidError
+from .formats import read_format
 from .log import COLUMNS, REQUIRED
 from .preprocess import resample, trim
 
@@ -37,13 +38,17 @@ def parse_column_map(spec: str | None) -> dict[str, str]:
     return out
 
 
-def _read_table(path: Path) -> pd.DataFrame:
+def _check_file(path: Path) -> None:
     if not path.exists():
         raise ShipidError(f"{path}: no such file")
     if path.is_dir():
         raise ShipidError(f"{path}: is a directory, not a log file")
     if path.stat().st_size == 0:
         raise ShipidError(f"{path}: the file is empty")
+
+
+def _read_table(path: Path) -> pd.DataFrame:
+    _check_file(path)
     if path.suffix.lower() in (".parquet", ".pq"):
         try:
             return pd.read_parquet(path)
@@ -102,13 +107,23 @@ def read_log(
     start: float | None = None,
     end: float | None = None,
     rudder_positive: str | None = None,
+    fmt: str = "canonical",
+    scale: float | None = None,
 ) -> pd.DataFrame:
-    """Read a canonical log (CSV or Parquet).
+    """Read a trial log: canonical CSV/Parquet, or a known format (see ``shipid.formats``).
 
     columns : file column name → canonical name. degrees : canonical angle columns given in degrees
     (delta, psi in deg; r in deg/s). dt : resample to this Δk. start/end : trim [s].
+    rudder_positive : overrides the format's rudder convention. scale : Froude scale λ (MARIN).
     """
     path = Path(path)
+    if fmt != "canonical":
+        _check_file(path)
+        log = read_format(path, fmt, scale)
+        check_log(log, str(path))
+        if rudder_positive:
+            log.attrs["rudder_positive"] = rudder_positive
+        return _trim_resample(log, dt, start, end, path)
     df = _read_table(path)
     # "u_velo [m/s]" → "u_velo": units in brackets are documentation, not part of the name.
     df.columns = [UNIT_SUFFIX.sub("", str(c)).strip() for c in df.columns]
@@ -128,6 +143,10 @@ def read_log(
     log = df[[c for c in COLUMNS if c in df.columns]].copy()
     log.attrs.update({"name": path.name, "source": str(path),
                       "rudder_positive": rudder_positive or "port"})  # fmt: skip
+    return _trim_resample(log, dt, start, end, path)
+
+
+def _trim_resample(log: pd.DataFrame, dt, start, end, path: Path) -> pd.DataFrame:
     if start is not None or end is not None:
         log = trim(log, start, end, str(path))
     if dt is not None:
