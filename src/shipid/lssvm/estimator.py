@@ -8,7 +8,7 @@ import numpy as np
 from sklearn.base import BaseEstimator, RegressorMixin, clone
 from sklearn.exceptions import ConvergenceWarning
 from sklearn.utils import check_random_state
-from sklearn.utils.validation import _check_sample_weight, check_is_fitted, validate_data
+from sklearn.utils.validation import check_is_fitted, validate_data
 
 from .kernels import KERNELS, kernel_matrix, row_blocks
 from .nystrom import NystromMap, choose_landmarks
@@ -19,7 +19,7 @@ from .validation import (
     check_finite,
     check_positive,
     check_positive_int,
-    check_target_finite,
+    validated_training_data,
 )
 
 SOLVERS = ("auto", "dense", "primal", "fixed-size")
@@ -156,21 +156,7 @@ class LSSVR(RegressorMixin, BaseEstimator):
         left out.
         """
         self._check_params()
-        if y is not None:
-            check_target_finite(y)
-        X, y = validate_data(
-            self,
-            X,
-            y,
-            multi_output=True,
-            y_numeric=True,
-            ensure_min_samples=2,
-            ensure_all_finite=False,
-            dtype=np.float64,
-        )
-        check_finite(X, "X")
-        w = _check_sample_weight(sample_weight, X, dtype=np.float64)
-        check_finite(w, "sample_weight")
+        X, y, w = validated_training_data(self, X, y, sample_weight)
         if np.any(w < 0):
             raise ValueError(f"sample_weight must be ≥ 0; row {int(np.argmax(w < 0))} is negative")
         used = np.flatnonzero(w > 0)
@@ -263,9 +249,10 @@ class LSSVR(RegressorMixin, BaseEstimator):
         self._intercept = np.array([f._intercept[0] for f in fits])
         self.robust_weights_ = np.column_stack([f.robust_weights_ for f in fits])
         self.n_iter_ = max(f.n_iter_ for f in fits)
-        stack = lambda name: (  # noqa: E731
-            None if getattr(first, name) is None else np.hstack([getattr(f, name) for f in fits])
-        )
+        def stack(name: str) -> np.ndarray | None:
+            parts = [getattr(f, name) for f in fits]
+            return None if parts[0] is None else np.hstack(parts)
+
         self._alpha = stack("_alpha")
         self._landmark_coef = stack("_landmark_coef")
         self._coef = None if first._coef is None else np.vstack([f._coef for f in fits])

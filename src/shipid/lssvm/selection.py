@@ -17,14 +17,14 @@ from scipy import linalg
 from sklearn.base import BaseEstimator, RegressorMixin
 from sklearn.model_selection import KFold
 from sklearn.utils import check_random_state
-from sklearn.utils.validation import _check_sample_weight, check_is_fitted, validate_data
+from sklearn.utils.validation import check_is_fitted
 from tqdm.auto import tqdm
 
 from .estimator import LSSVR
 from .kernels import kernel_matrix
 from .nystrom import NystromMap, choose_landmarks
 from .solvers import check_dense_size
-from .validation import check_finite, check_positive, check_target_finite
+from .validation import check_positive, validated_training_data
 
 
 class DualLOOPath:
@@ -128,15 +128,7 @@ def loo_path(
 
 
 def _validated(X, y, sample_weight) -> tuple[np.ndarray, np.ndarray, np.ndarray, bool]:
-    if y is not None:
-        check_target_finite(y)
-    X, y = validate_data(
-        LSSVR(), X, y, multi_output=True, y_numeric=True, ensure_min_samples=2,
-        ensure_all_finite=False, dtype=np.float64, reset=True,
-    )
-    check_finite(X, "X")
-    w = _check_sample_weight(sample_weight, X, dtype=np.float64)
-    check_finite(w, "sample_weight")
+    X, y, w = validated_training_data(LSSVR(), X, y, sample_weight)
     if np.any(w <= 0):
         raise ValueError("sample_weight must be > 0 for leave-one-out residuals")
     return X, y.reshape(y.shape[0], -1), w, y.ndim == 1
@@ -235,11 +227,11 @@ class LSSVRCV(RegressorMixin, BaseEstimator):
         mse = np.empty(len(grid))
         with tqdm(total=len(grid), disable=not self.progress, desc="LS-SVM grid") as bar:
             for i_s, s in enumerate(sigmas):
-                rows = slice(i_s * len(gammas), (i_s + 1) * len(gammas))
+                first = i_s * len(gammas)
                 if self.cv == "loo":
                     path = loo_path(self._base(sigma=s), X, Y, w)
                     for k, g in enumerate(gammas):
-                        mse[rows][k] = path.mse(float(g))
+                        mse[first + k] = path.mse(float(g))
                         bar.update()
                 else:
                     folds = list(KFold(self.cv, shuffle=True, random_state=0).split(X))
@@ -249,7 +241,7 @@ class LSSVRCV(RegressorMixin, BaseEstimator):
                             est = self._base(sigma=s, gamma=float(g))
                             est.fit(X[train], Y[train], w[train])
                             sq += np.sum((est.predict(X[test]) - Y[test]) ** 2)
-                        mse[rows][k] = sq / Y.size
+                        mse[first + k] = sq / Y.size
                         bar.update()
         self.cv_results_ = {
             "sigma": np.array([s for s, _ in grid]),

@@ -39,6 +39,23 @@ def check_target_finite(y: object) -> None:
     check_finite(arr, "y")
 
 
+def validated_training_data(estimator, X, y, sample_weight):
+    """X (float64, finite), y, and finite sample weights, with errors that name the row.
+
+    ``estimator`` is the scikit-learn estimator whose ``n_features_in_`` is set.
+    """
+    from sklearn.utils.validation import _check_sample_weight, validate_data
+
+    if y is not None:
+        check_target_finite(y)
+    X, y = validate_data(estimator, X, y, multi_output=True, y_numeric=True,
+                         ensure_min_samples=2, ensure_all_finite=False, dtype=np.float64)
+    check_finite(X, "X")
+    w = _check_sample_weight(sample_weight, X, dtype=np.float64)
+    check_finite(w, "sample_weight")
+    return X, y, w
+
+
 def check_positive(value: object, name: str) -> float:
     if not isinstance(value, numbers.Real) or isinstance(value, bool):
         raise ValueError(f"{name} must be a positive number, got {value!r}")
