@@ -13,7 +13,7 @@ import pandas as pd
 
 from .errors import ShipidError
 from .lssvm import LSSVR, NumericalWarning
-from .model import ManoeuvringModel, ModelStructure, get_structure
+from .model import ManoeuvringModel, ModelStructure, coefficients_from_gamma, get_structure
 from .regression import FORMS, RegressionProblem, regression_problem
 from .terms import TERM_DISPLAY
 
@@ -78,11 +78,9 @@ def _diagnose(p: RegressionProblem, est: LSSVR) -> tuple[dict, list[str]]:
     pred_increment = est.predict(X) - (X[:, 0] if p.form == "paper" else 0.0)
     ss_tot = float(np.sum((increment - increment.mean()) ** 2))
     r2 = 1.0 - float(np.sum((increment - pred_increment) ** 2)) / ss_tot if ss_tot > 0 else math.nan
+    # Paper form: every continuous coefficient is Γ/Δk (the self term (Γ₀ − 1)/Δk), so is its error.
     scale = p.dt if p.form == "paper" else 1.0
-    std_errors = {n: float(s) / (scale if (p.form == "paper" and n != p.dof) else 1.0)
-                  for n, s in zip(p.names, se, strict=True)}  # fmt: skip
-    if p.form == "paper":
-        std_errors[p.dof] = std_errors[p.dof] / p.dt  # of the self term (g0 − 1)/Δk
+    std_errors = {n: float(s) / scale for n, s in zip(p.names, se, strict=True)}
     return {
         "n_samples": int(len(y)),
         "condition_number": cond,
@@ -146,24 +144,26 @@ def identify(
     _check_rudder_excitation(logs, structure, fixed)
     coefs: dict[str, dict[str, float]] = {}
     terms: dict[str, tuple[str, ...]] = {}
-    result = Identification(None, form, float(gamma), math.nan)  # type: ignore[arg-type]
+    discrete: dict[str, dict] = {}
+    diagnostics: dict[str, dict] = {}
+    notes: list[str] = []
+    dt = math.nan
     for dof in structure.dofs:
         p = regression_problem(logs, structure, dof, form, fixed.get(dof), names)
-        result.dt = p.dt
+        dt = p.dt
         if p.X.shape[1] == 0:
             raise ShipidError(f"{dof}: no free terms to identify")
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", NumericalWarning)
             est = LSSVR(gamma=gamma, kernel="linear", solver="primal").fit(p.X, p.y)
-        diag, notes = _diagnose(p, est)
-        result.warnings += notes + [f"{dof}: {w.message}" for w in caught
-                                    if issubclass(w.category, NumericalWarning)]  # fmt: skip
+        diagnostics[dof], dof_notes = _diagnose(p, est)
+        notes += dof_notes + [f"{dof}: {w.message}" for w in caught
+                              if issubclass(w.category, NumericalWarning)]  # fmt: skip
         b = float(est.intercept_)
         g = np.asarray(est.coef_, dtype=float)
         c: dict[str, float] = dict(fixed.get(dof, {}))
         if form == "paper":
-            c[dof] = (g[0] - 1.0) / p.dt
-            c.update({n: val / p.dt for n, val in zip(p.names[1:], g[1:], strict=True)})
+            c.update(coefficients_from_gamma(dof, p.names, g, p.dt))
             bias_const = b / p.dt
         else:
             c.update(dict(zip(p.names, g.tolist(), strict=True)))
@@ -171,16 +171,17 @@ def identify(
         if p.has_constant:
             c["1"] = bias_const
         elif abs(bias_const) > 0:
-            result.warnings.append(f"{dof}: the model has no constant term; the LS-SVM bias "
-                                   f"b = {b:.4g} is reported but not part of the model")
+            notes.append(f"{dof}: the model has no constant term; the LS-SVM bias "
+                         f"b = {b:.4g} is reported but not part of the model")
         order = list(structure.terms[dof])
         if dof in c and dof not in order:
             order.insert(0, dof)
         terms[dof] = tuple(order)
         coefs[dof] = {n: c.get(n, 0.0) for n in order}
-        result.discrete[dof] = {"names": list(p.names) + ["1"],
-                                "gamma": g.tolist() + [0.0], "bias": b}  # fmt: skip
-        result.diagnostics[dof] = diag
-    final = ModelStructure(structure.name, terms)
-    result.model = ManoeuvringModel(final, coefs, name=f"identified ({structure.name}, {form} form)")
-    return result
+        # Γ as fitted; the constant regressor's weight is Σα = 0, the bias b carries it (eq. 5).
+        const = ["1"] if p.has_constant else []
+        discrete[dof] = {"names": list(p.names) + const, "gamma": g.tolist() + [0.0] * len(const),
+                         "bias": b}  # fmt: skip
+    model = ManoeuvringModel(ModelStructure(structure.name, terms), coefs,
+                             name=f"identified ({structure.name}, {form} form)")  # fmt: skip
+    return Identification(model, form, float(gamma), dt, discrete, diagnostics, notes)

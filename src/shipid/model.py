@@ -208,12 +208,11 @@ class ManoeuvringModel:
             names = [dof] + [n for n in structure.terms[dof] if n != dof]
             if len(g) != len(names):
                 raise ValueError(f"Γ_{dof} has {len(g)} entries, the structure needs {len(names)}")
-            c = {n: float(val) / dt for n, val in zip(names[1:], g[1:], strict=True)}
-            self_coef = (float(g[0]) - 1.0) / dt
-            if self_coef != 0.0 or dof in structure.terms[dof]:
-                c[dof] = self_coef
-                if dof not in terms[dof]:
-                    terms[dof] = (dof, *terms[dof])
+            c = coefficients_from_gamma(dof, names, g, dt)
+            if c[dof] == 0.0 and dof not in structure.terms[dof]:
+                del c[dof]
+            elif dof not in terms[dof]:
+                terms[dof] = (dof, *terms[dof])
             coefs[dof] = c
         new_structure = (
             structure if terms == dict(structure.terms) else ModelStructure(structure.name, terms)
@@ -229,6 +228,16 @@ class ManoeuvringModel:
     def from_dict(cls, data: Mapping) -> ManoeuvringModel:
         return cls(ModelStructure.from_dict(data["structure"]), data["coefficients"],
                    name=str(data.get("name", "")))  # fmt: skip
+
+
+def coefficients_from_gamma(
+    dof: str, names: list[str], gamma, dt: float
+) -> dict[str, float]:
+    """Continuous-time coefficients of one equation from its Γ_ξ (eq. 13), ``names[0]`` being ξ(k):
+    θ_ξξ = (Γ₀ − 1)/Δk (a linear self term) and θⱼ = Γⱼ/Δk."""
+    c = {dof: (float(gamma[0]) - 1.0) / dt}
+    c.update({n: float(v) / dt for n, v in zip(names[1:], gamma[1:], strict=True)})
+    return c
 
 
 def nomoto_parameters(model: ManoeuvringModel) -> dict[str, float]:

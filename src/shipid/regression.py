@@ -37,7 +37,6 @@ class RegressionProblem:
     y: np.ndarray
     has_constant: bool  # "1" is a term: the bias b is its coefficient
     fixed: dict[str, float] = field(default_factory=dict)
-    n_logs: int = 1
 
 
 def sampling_time(log: pd.DataFrame, name: str = "log") -> float:
@@ -112,4 +111,4 @@ def regression_problem(
             ys.append(target)
     cols = ([dof] if form == "paper" else []) + free
     return RegressionProblem(dof, form, dt, cols, np.vstack(Xs), np.concatenate(ys), has_constant,
-                             fixed, len(logs))  # fmt: skip
+                             fixed)  # fmt: skip
