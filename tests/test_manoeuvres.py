@@ -122,6 +122,7 @@ def test_turning_indices_of_a_circle_of_known_radius():
     assert ind["steady_turning_diameter"] == pytest.approx(2 * R, rel=1e-9)
     assert ind["steady_yaw_rate"] == pytest.approx(w)
     assert ind["time_to_90"] == pytest.approx(math.pi / 2 / w, abs=1e-6)
+    assert all(type(v) in (float, str) for v in ind.values())  # plain JSON-ready values
     assert ind["advance_L"] == pytest.approx(R / 10, rel=1e-4)
     # Without x, y the track is dead-reckoned from u, v, ψ.
     ind2 = turning_indices(log.drop(columns=["x", "y"]), t_order=0.0)

@@ -42,9 +42,9 @@ def _read_logs(args) -> list:
 
 def _write_json(path: str, data) -> None:
     from .atomic import atomic_write_text
-    from .modelfile import _clean
+    from .modelfile import json_safe
 
-    atomic_write_text(path, json.dumps(_clean(data), indent=2, ensure_ascii=False) + "\n")
+    atomic_write_text(path, json.dumps(json_safe(data), indent=2, ensure_ascii=False) + "\n")
 
 
 def _parse_drop(spec: str | None) -> dict[str, list[str]]:
@@ -123,14 +123,15 @@ def cmd_validate(args) -> int:
 
 
 def _ship_or_model(name: str):
-    from .modelfile import load_document, load_model
+    """A reference ship (its trimmed speed applies) or a model file with its training speed."""
+    from .modelfile import load_document, model_from_document
     from .vessels import get_vessel
 
     if name in VESSEL_NAMES:
         return get_vessel(name), None
     doc = load_document(name)
     speed = doc.get("identification", {}).get("preprocessing", {}).get("approach_speed")
-    return load_model(name), speed
+    return model_from_document(doc, name), speed
 
 
 def cmd_simulate(args) -> int:
@@ -151,9 +152,8 @@ def cmd_simulate(args) -> int:
 def cmd_manoeuvre(args) -> int:
     from .manoeuvres import turning_circle, zigzag
 
-    target, speed = _ship_or_model(args.model)
-    speed = args.speed or speed
-    kw = {"dt": args.step, "speed": args.speed if hasattr(target, "dynamics") else speed}
+    target, training_speed = _ship_or_model(args.model)
+    kw = {"dt": args.step, "speed": args.speed or training_speed}
     if args.duration:
         kw["duration"] = args.duration
     if args.kind == "zigzag":

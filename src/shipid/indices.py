@@ -188,8 +188,8 @@ def turning_indices(
         "advance": float(p90 @ e_c),
         "transfer": float(abs(p90 @ e_n)),
         "tactical_diameter": float(abs(p180 @ e_n)),
-        "time_to_90": t90 - t[i0],
-        "time_to_180": t180 - t[i0],
+        "time_to_90": t90 - float(t[i0]),
+        "time_to_180": t180 - float(t[i0]),
         "turn_direction": "starboard" if side > 0 else "port",
     }
     result.update(_steady_turn(log, t, turned, x, y))

@@ -8,6 +8,7 @@ manoeuvre's log with ``simulate_log`` (same method and step) reproduces it exact
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -53,7 +54,7 @@ def as_vessel(ship: Vessel | ManoeuvringModel, speed: float | None = None,
     if steering is not None:
         changes["steering"] = steering
     if changes:
-        vessel = Vessel(**{**vessel.__dict__, **changes})
+        vessel = dataclasses.replace(vessel, **changes)
     if not vessel.approach_speed > 0:
         raise ValueError(f"approach speed must be > 0, got {vessel.approach_speed!r}")
     return vessel

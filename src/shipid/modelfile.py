@@ -27,20 +27,20 @@ def sha256(path: str | Path) -> str:
     return h.hexdigest()
 
 
-def _clean(obj):
+def json_safe(obj):
     """JSON cannot hold inf/NaN: write them as null."""
     if isinstance(obj, float) and not math.isfinite(obj):
         return None
     if isinstance(obj, dict):
-        return {k: _clean(v) for k, v in obj.items()}
+        return {k: json_safe(v) for k, v in obj.items()}
     if isinstance(obj, list | tuple):
-        return [_clean(v) for v in obj]
+        return [json_safe(v) for v in obj]
     return obj
 
 
 def model_document(ident: Identification, training_files: Sequence[str | Path] = (),
                    preprocessing: dict | None = None) -> dict:  # fmt: skip
-    return _clean({
+    return json_safe({
         "format": FORMAT, "version": VERSION, "shipid": __version__,
         "model": ident.model.to_dict(),
         "identification": {"form": ident.form, "gamma": ident.gamma, "dt": ident.dt,
@@ -75,7 +75,10 @@ def load_document(path: str | Path) -> dict:
 
 
 def load_model(path: str | Path) -> ManoeuvringModel:
-    doc = load_document(path)
+    return model_from_document(load_document(path), path)
+
+
+def model_from_document(doc: dict, path: str | Path) -> ManoeuvringModel:
     try:
         return ManoeuvringModel.from_dict(doc["model"])
     except (KeyError, TypeError, ValueError) as exc:

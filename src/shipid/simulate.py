@@ -62,6 +62,7 @@ class BatchResult:
     delta: np.ndarray
     states: np.ndarray
     n_valid: np.ndarray
+    limits: tuple[float, float] = (math.inf, math.inf)  # (speed, yaw rate) the run was held to
     meta: dict = field(default_factory=dict)
 
     @property
@@ -280,7 +281,7 @@ def simulate_batch(
     else:
         _integrate_generic(dynamics, t, delta, thrust, s0, method, speed_lim, yaw_lim, out,
                            n_valid)  # fmt: skip
-    return BatchResult(t, np.asarray(delta), out, n_valid, dict(meta))
+    return BatchResult(t, np.asarray(delta), out, n_valid, (speed_lim, yaw_lim), dict(meta))
 
 
 def divergence_report(
@@ -315,8 +316,7 @@ def simulate(
     n = int(batch.n_valid[0])
     if n == len(batch.t):
         return SimulationResult(log)
-    speed_lim, yaw_lim = (bounds or DivergenceBounds()).resolved(float(batch.states[0, 0, 0]))
-    t_div, reason = divergence_report(batch.states[0], batch.t, n, speed_lim, yaw_lim)
+    t_div, reason = divergence_report(batch.states[0], batch.t, n, *batch.limits)
     return SimulationResult(log, True, t_div, reason)
 
 

@@ -57,7 +57,8 @@ class SteeringMachine:
         """
         t = np.asarray(t, dtype=float)
         command = np.asarray(command, dtype=float)
-        dts = np.diff(t, prepend=t[0] - (t[1] - t[0]) if len(t) > 1 else t[0] - 1.0)
+        steps = np.diff(t)
+        dts = np.concatenate([steps[:1] if steps.size else [0.0], steps])
         out = np.empty_like(command)
         delta = delta0
         for k in range(len(t)):
