@@ -25,10 +25,24 @@ def _add_log_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--degrees", metavar="COLS", default="",
                    help="angle columns given in degrees, e.g. delta,psi,r")
     g.add_argument("--dt", type=float, help="resample to this uniform sampling time [s]")
-    g.add_argument("--start", type=float, help="trim: first time [s]")
+    g.add_argument("--start", type=_start_time, metavar="S|auto",
+                   help="trim: first time [s], or 'auto': --lead s before the detected rudder execute")
+    g.add_argument("--lead", type=float, default=5.0, metavar="S",
+                   help="with --start auto: seconds kept before the execute (default 5)")
     g.add_argument("--end", type=float, help="trim: last time [s]")
+    g.add_argument("--fill-gaps", action="store_true",
+                   help="interpolate missing values inside signals (default: refuse the log)")
     g.add_argument("--rudder-positive", choices=("port", "starboard"),
                    help="where a positive rudder angle turns the ship (default port, as the paper)")
+
+
+def _start_time(text: str) -> float | str:
+    if text == "auto":
+        return text
+    try:
+        return float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected seconds or 'auto', got {text!r}") from None
 
 
 def _read_logs(args) -> list:
@@ -37,7 +51,8 @@ def _read_logs(args) -> list:
     degrees = [c.strip() for c in args.degrees.split(",") if c.strip()]
     cols = parse_column_map(args.columns)
     return [read_log(p, cols, degrees, args.dt, args.start, args.end, args.rudder_positive,
-                     args.format, args.scale) for p in args.logs]  # fmt: skip
+                     args.format, args.scale, args.lead, args.fill_gaps)
+            for p in args.logs]  # fmt: skip
 
 
 def _write_json(path: str, data) -> None:

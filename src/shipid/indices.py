@@ -229,17 +229,19 @@ def _circle_fit_radius(x: np.ndarray, y: np.ndarray) -> float:
 
 
 def detect_manoeuvre(log: pd.DataFrame) -> str | None:
-    """'zigzag' when the rudder reverses at least twice, 'turning' when the heading changes by
-    ≥ 180° on one side, else None."""
+    """'turning' when the heading changes by ≥ 180° (no zig-zag does), 'zigzag' when the rudder
+    swings from side to side at least twice, else None. A swing takes the rudder at least halfway
+    from the neutral (mid-range) to its largest deflection: helm corrections do not count."""
     delta = log["delta"].to_numpy()
     i0 = rudder_order_index(delta)
-    dev = delta[i0:] - neutral_rudder(delta[i0:])
-    side = np.sign(dev[np.abs(dev) > math.radians(1.0)])
-    if side.size and np.count_nonzero(side[1:] != side[:-1]) >= 2:
-        return "zigzag"
     psi, _, _ = track(log)
     if np.max(np.abs(psi - psi[i0])) >= math.pi:
         return "turning"
+    dev = delta - neutral_rudder(delta)
+    big = np.abs(dev) >= max(0.5 * float(np.max(np.abs(dev))), math.radians(1.0))
+    side = np.sign(dev[big])
+    if side.size and np.count_nonzero(side[1:] != side[:-1]) >= 2:
+        return "zigzag"
     return None
 
 

@@ -15,7 +15,7 @@ from .atomic import atomic_write
 from .errors import ShipidError
 from .formats import read_format
 from .log import COLUMNS, REQUIRED
-from .preprocess import resample, trim
+from .preprocess import resample, trim, true_runs
 
 ANGLE_COLUMNS = ("delta", "psi", "r")
 UNIT_SUFFIX = re.compile(r"\s*\[[^\]]*\]\s*$")
@@ -67,8 +67,12 @@ def _read_table(path: Path) -> pd.DataFrame:
         raise ShipidError(f"{path}: not a valid CSV file ({str(exc).splitlines()[0]})") from None
 
 
-def check_log(df: pd.DataFrame, name: str, min_samples: int = 3) -> None:
-    """Required columns, finite numbers, strictly increasing time, enough samples."""
+def check_log(df: pd.DataFrame, name: str, min_samples: int = 3, fill_gaps: bool = False) -> None:
+    """Required columns, finite numbers, strictly increasing time, enough samples.
+
+    Missing values (empty cells, NaN) inside a signal are reported with their span and refused,
+    or, with ``fill_gaps``, interpolated linearly in time. Text and infinities are always refused.
+    """
     if len(df) == 0:
         raise ShipidError(f"{name}: the header has no rows")
     missing = [c for c in REQUIRED if c not in df.columns]
@@ -76,16 +80,38 @@ def check_log(df: pd.DataFrame, name: str, min_samples: int = 3) -> None:
         have = ", ".join(map(str, df.columns))
         raise ShipidError(f"{name}: missing column(s) {', '.join(missing)} (columns found: {have}); "
                           "map other names with --columns, e.g. --columns delta=rudder")  # fmt: skip
+    gaps: dict[str, np.ndarray] = {}
     for c in [c for c in COLUMNS if c in df.columns]:
-        values = pd.to_numeric(df[c], errors="coerce").to_numpy(dtype=float)
-        bad = ~np.isfinite(values)
+        raw = df[c]
+        values = pd.to_numeric(raw, errors="coerce").to_numpy(dtype=float)
+        gap = raw.isna().to_numpy()
+        bad = ~np.isfinite(values) & ~gap
         if bad.any():
             row = int(np.argmax(bad))
-            raw = df[c].iloc[row]
             raise ShipidError(f"{name}: column {c!r} has a non-numeric or non-finite value "
-                              f"({raw!r}) at data row {row + 1}")  # fmt: skip
+                              f"({raw.iloc[row]!r}) at data row {row + 1}")  # fmt: skip
+        if gap.any():
+            gaps[c] = gap
         df[c] = values
+    if "t" in gaps:
+        first, last = true_runs(gaps["t"])[0]
+        raise ShipidError(f"{name}: column 't' is missing at data rows {first + 1}–{last + 1}; "
+                          "a log needs a time stamp on every row")  # fmt: skip
     t = df["t"].to_numpy()
+    for c, gap in gaps.items():
+        runs = true_runs(gap)
+        first, last = runs[0]
+        if np.all(gap):
+            raise ShipidError(f"{name}: column {c!r} is empty")
+        if not fill_gaps:
+            more = f" and {len(runs) - 1} more gap(s)" if len(runs) > 1 else ""
+            span = (f"1 missing value at data row {first + 1} (t = {t[first]:g} s)" if first == last
+                    else f"{last - first + 1} missing values at data rows {first + 1}–{last + 1} "
+                    f"(t = {t[first]:g}–{t[last]:g} s)")
+            raise ShipidError(f"{name}: column {c!r} has {span}{more}; trim them off with "
+                              "--start/--end or interpolate with --fill-gaps")  # fmt: skip
+        good = ~gap
+        df[c] = np.interp(t, t[good], df[c].to_numpy()[good])
     dt = np.diff(t)
     if np.any(dt == 0):
         row = int(np.argmax(dt == 0)) + 1
@@ -109,27 +135,31 @@ def read_log(
     rudder_positive: str | None = None,
     fmt: str = "canonical",
     scale: float | None = None,
+    lead: float = 5.0,
+    fill_gaps: bool = False,
 ) -> pd.DataFrame:
     """Read a trial log: canonical CSV/Parquet, or a known format (see ``shipid.formats``).
 
     columns : file column name → canonical name. degrees : canonical angle columns given in degrees
-    (delta, psi in deg; r in deg/s). dt : resample to this Δk. start/end : trim [s].
-    rudder_positive : overrides the format's rudder convention. scale : Froude scale λ (MARIN).
+    (delta, psi in deg; r in deg/s). dt : resample to this Δk. start/end : trim [s]; start="auto"
+    trims to ``lead`` seconds before the detected rudder execute. rudder_positive : overrides the
+    format's rudder convention. scale : Froude scale λ (MARIN). fill_gaps : interpolate missing
+    values inside signals instead of refusing the log.
     """
     path = Path(path)
     if fmt != "canonical":
         _check_file(path)
         log = read_format(path, fmt, scale)
-        check_log(log, str(path))
+        check_log(log, str(path), fill_gaps=fill_gaps)
         if rudder_positive:
             log.attrs["rudder_positive"] = rudder_positive
-        return _trim_resample(log, dt, start, end, path)
+        return _trim_resample(log, dt, start, end, path, lead)
     df = _read_table(path)
     # "u_velo [m/s]" → "u_velo": units in brackets are documentation, not part of the name.
     df.columns = [UNIT_SUFFIX.sub("", str(c)).strip() for c in df.columns]
     df = df.rename(columns=dict(columns or {}))
     df = df.dropna(how="all").reset_index(drop=True)
-    check_log(df, str(path))
+    check_log(df, str(path), fill_gaps=fill_gaps)
     for c in degrees:
         if c not in ANGLE_COLUMNS:
             raise ShipidError(f"--degrees: {c!r} is not an angle column ({', '.join(ANGLE_COLUMNS)})")
@@ -143,12 +173,12 @@ def read_log(
     log = df[[c for c in COLUMNS if c in df.columns]].copy()
     log.attrs.update({"name": path.name, "source": str(path),
                       "rudder_positive": rudder_positive or "port"})  # fmt: skip
-    return _trim_resample(log, dt, start, end, path)
+    return _trim_resample(log, dt, start, end, path, lead)
 
 
-def _trim_resample(log: pd.DataFrame, dt, start, end, path: Path) -> pd.DataFrame:
+def _trim_resample(log: pd.DataFrame, dt, start, end, path: Path, lead: float) -> pd.DataFrame:
     if start is not None or end is not None:
-        log = trim(log, start, end, str(path))
+        log = trim(log, start, end, str(path), lead)
     if dt is not None:
         log = resample(log, dt, str(path))
     return log

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -19,7 +19,14 @@ import pandas as pd
 from .indices import turning_indices, zigzag_indices
 from .log import make_log, starboard_sign
 from .model import ManoeuvringModel
-from .simulate import METHODS, DivergenceBounds, divergence_report, step_state, within_bounds
+from .simulate import (
+    METHODS,
+    DivergenceBounds,
+    divergence_report,
+    initial_states,
+    step_state,
+    within_bounds,
+)
 from .steering import SteeringMachine
 from .vessels.vessel import Vessel
 
@@ -67,8 +74,10 @@ def run_closed_loop(
     dt: float,
     method: str = "rk4",
     bounds: DivergenceBounds | None = None,
+    initial: Mapping[str, float] | None = None,
 ) -> ManoeuvreResult:
-    """Integrate from a straight approach at ``vessel.approach_speed`` with the rudder command
+    """Integrate from a straight approach at ``vessel.approach_speed`` (or from ``initial``, a
+    mapping of u, v, r, psi, x, y and the rudder angle 'delta') with the rudder command
     ``command(t, state)`` passed through the vessel's steering machine."""
     if method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}, got {method!r}")
@@ -78,9 +87,10 @@ def run_closed_loop(
     t = np.arange(n) * dt
     states = np.zeros((n, 6))
     rudder = np.zeros(n)
-    s = np.array([[vessel.approach_speed, 0, 0, 0, 0, 0]], dtype=float)
-    speed_lim, yaw_lim = (bounds or DivergenceBounds()).resolved(vessel.approach_speed)
-    delta = 0.0
+    start = {"u": vessel.approach_speed, **(initial or {})}
+    s = initial_states({k: v for k, v in start.items() if k != "delta"}, 1)
+    speed_lim, yaw_lim = (bounds or DivergenceBounds()).resolved(float(s[0, 0]))
+    delta = float(start.get("delta", 0.0))
     dyn = vessel.dynamics
     diverged_after = None
     for k in range(n):
@@ -134,9 +144,15 @@ def zigzag(
     speed: float | None = None,
     steering: SteeringMachine | None = None,
     method: str = "rk4",
+    initial: Mapping[str, float] | None = None,
 ) -> ManoeuvreResult:
     """δ/ψ zig-zag: rudder ``first`` at t = ``approach``, reversed whenever the heading change
-    reaches ±ψ on the side the ship is turning to."""
+    reaches ±ψ on the side the ship is turning to.
+
+    ``initial`` (u, v, r, psi, delta) starts the run from a trial's measured state instead of a
+    straight approach; the rudder is held at its initial ``delta`` until ``approach`` and the
+    heading change is taken from the initial ψ.
+    """
     vessel = as_vessel(ship, speed, steering)
     rudder = _check_rudder(vessel, rudder_deg)
     if not heading_deg > 0:
@@ -144,18 +160,20 @@ def zigzag(
     switch = math.radians(heading_deg)
     stbd = starboard_sign(vessel.rudder_positive)
     state = {"side": _side_sign(first)}
+    psi_ref = float((initial or {}).get("psi", 0.0))
+    held = float((initial or {}).get("delta", 0.0))
 
     def command(t: float, s: np.ndarray) -> float:
         if t < approach - 1e-9:
-            return 0.0
-        dpsi = s[3]
+            return held
+        dpsi = s[3] - psi_ref
         if state["side"] > 0 and dpsi >= switch:
             state["side"] = -1.0
         elif state["side"] < 0 and dpsi <= -switch:
             state["side"] = 1.0
         return state["side"] * stbd * rudder
 
-    res = run_closed_loop(vessel, command, duration, dt, method)
+    res = run_closed_loop(vessel, command, duration, dt, method, initial=initial)
     res.log.attrs["manoeuvre"] = f"zigzag {rudder_deg:g}/{heading_deg:g}, first {first}"
     res.indices = zigzag_indices(res.log, heading_deg, t_order=approach,
                                  length=_finite_or_none(vessel.length))  # fmt: skip

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pandas as pd
+from scipy.ndimage import maximum_filter1d, minimum_filter1d
 from scipy.signal import butter, sosfiltfilt
 
 from .errors import ShipidError
@@ -11,10 +12,53 @@ from .errors import ShipidError
 SIGNALS = ("u", "v", "r")
 
 
-def trim(log: pd.DataFrame, start: float | None = None, end: float | None = None,
-         name: str = "log") -> pd.DataFrame:  # fmt: skip
-    """Rows with start ≤ t ≤ end, time kept as is."""
+EXECUTE_FRACTION = 0.5  # a swing reaching this fraction of the largest one is a manoeuvre
+EXECUTE_HOLD_S = 5.0  # ... and staying there this long (helm corrections do not)
+
+
+def true_runs(mask: np.ndarray) -> list[tuple[int, int]]:
+    """(first, last) indices of the runs of True in a boolean array."""
+    edges = np.diff(np.concatenate([[0], np.asarray(mask, dtype=np.int8), [0]]))
+    return list(zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1, strict=True))
+
+
+def rudder_execute_time(log: pd.DataFrame, name: str = "log") -> float:
+    """Time of the rudder execute: the start of the swing to the first rudder plateau (constant
+    within ±0.5° for 5 s) at least half the largest rudder angle. Helm corrections while the ship
+    gathers speed are smaller or never steady."""
+    t = log["t"].to_numpy()
+    delta = log["delta"].to_numpy()
+    dt = float(np.median(np.diff(t)))
+    dev = np.abs(delta)
+    peak = float(dev.max())
+    window = max(int(round(EXECUTE_HOLD_S / dt)), 1) + 1
+    # Spread of the rudder over the window starting at each sample.
+    hi = maximum_filter1d(delta, window, origin=-(window // 2), mode="nearest")
+    lo = minimum_filter1d(delta, window, origin=-(window // 2), mode="nearest")
+    fits = np.arange(delta.size) + window <= delta.size
+    plateau = (dev >= EXECUTE_FRACTION * peak) & (hi - lo <= np.radians(1.0)) & fits
+    if peak < np.radians(1.0) or not plateau.any():
+        raise ShipidError(f"{name}: no rudder execute found (no rudder deflection held for "
+                          f"{EXECUTE_HOLD_S:g} s); give --start in seconds")  # fmt: skip
+    k = int(np.argmax(plateau))
+    side = np.sign(delta[k])
+    # Back along the swing while the rudder still moves towards this side.
+    while k > 0 and side * (delta[k] - delta[k - 1]) > 0:
+        k -= 1
+    return float(t[k])
+
+
+def trim(log: pd.DataFrame, start: float | str | None = None, end: float | None = None,
+         name: str = "log", lead: float = 5.0) -> pd.DataFrame:  # fmt: skip
+    """Rows with start ≤ t ≤ end, time kept as is. ``start="auto"`` starts ``lead`` seconds
+    before the detected rudder execute (``rudder_execute_time``)."""
     t = log["t"]
+    if isinstance(start, str):
+        if start != "auto":
+            raise ShipidError(f"--start must be a time in seconds or 'auto', got {start!r}")
+        if not lead >= 0:
+            raise ShipidError(f"--lead must be ≥ 0 s, got {lead!r}")
+        start = max(rudder_execute_time(log, name) - lead, float(t.iloc[0]))
     keep = np.ones(len(log), dtype=bool)
     if start is not None:
         keep &= t >= start

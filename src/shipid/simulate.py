@@ -83,7 +83,7 @@ def _linear_acc(th, i, u, v, r, d, T):
     return (th[i, 0] + th[i, 1] * u + th[i, 2] * v + th[i, 3] * r + th[i, 4] * au * u
             + th[i, 5] * v * r + th[i, 6] * r * r + th[i, 7] * u * r + th[i, 8] * u * v
             + th[i, 9] * av * v + th[i, 10] * av * r + th[i, 11] * ar * r + th[i, 12] * ar * v
-            + th[i, 13] * d + th[i, 14] * d * d + th[i, 15] * T)  # fmt: skip
+            + th[i, 13] * d + th[i, 14] * d * d + th[i, 15] * T + th[i, 16] * u * u * d)  # fmt: skip
 
 
 @numba.njit(cache=True, inline="always")
@@ -272,13 +272,13 @@ def simulate_batch(
         raise ValueError("this model uses thrust: give a thrust series")
     thrust = None if thrust is None else _as_series(thrust, "thrust", n_traj, n_steps)
     speed_lim, yaw_lim = (bounds or DivergenceBounds()).resolved(float(np.max(np.abs(s0[:, 0]))))
-    out = np.zeros((n_traj, n_steps, 6))
-    n_valid = np.zeros(n_traj, dtype=np.int64)
     if isinstance(dynamics, ManoeuvringModel):
         T = np.zeros_like(delta) if thrust is None else thrust
-        _integrate_linear(dynamics.theta, t, delta, T, s0, method == "rk4", speed_lim, yaw_lim,
-                          out, n_valid)  # fmt: skip
+        out, n_valid = integrate_coefficients(dynamics.theta, t, delta, T, s0, method, speed_lim,
+                                              yaw_lim)  # fmt: skip
     else:
+        out = np.zeros((n_traj, n_steps, 6))
+        n_valid = np.zeros(n_traj, dtype=np.int64)
         _integrate_generic(dynamics, t, delta, thrust, s0, method, speed_lim, yaw_lim, out,
                            n_valid)  # fmt: skip
     return BatchResult(t, np.asarray(delta), out, n_valid, (speed_lim, yaw_lim), dict(meta))
@@ -335,3 +335,23 @@ def simulate_log(
     thrust = log["thrust"].to_numpy() if dynamics.uses_thrust else None
     return simulate(dynamics, log["t"].to_numpy(), log["delta"].to_numpy(), initial, thrust,
                     method, bounds, **log.attrs)  # fmt: skip
+
+
+def integrate_coefficients(
+    theta: np.ndarray,
+    t: np.ndarray,
+    delta: np.ndarray,
+    thrust: np.ndarray,
+    initial: np.ndarray,
+    method: str,
+    speed_lim: float,
+    yaw_lim: float,
+) -> tuple[np.ndarray, np.ndarray]:
+    """The compiled kernel for a raw (3, len(TERMS)) coefficient matrix: (B, N, 6) states and the
+    valid steps per trajectory. No input checks: for inner loops (refinement) that reuse
+    validated arrays; everything else goes through ``simulate_batch``."""
+    out = np.zeros((delta.shape[0], t.size, 6))
+    n_valid = np.zeros(delta.shape[0], dtype=np.int64)
+    _integrate_linear(np.ascontiguousarray(theta), t, delta, thrust, initial, method == "rk4",
+                      speed_lim, yaw_lim, out, n_valid)  # fmt: skip
+    return out, n_valid

@@ -11,7 +11,7 @@ import numpy as np
 
 TERMS: tuple[str, ...] = (
     "1", "u", "v", "r", "|u|u", "vr", "r^2", "ur", "uv", "|v|v", "|v|r", "|r|r", "|r|v",
-    "delta", "delta^2", "T",
+    "delta", "delta^2", "T", "u^2*delta",
 )  # fmt: skip
 TERM_INDEX = {name: i for i, name in enumerate(TERMS)}
 
@@ -19,7 +19,7 @@ TERM_INDEX = {name: i for i, name in enumerate(TERMS)}
 TERM_DISPLAY = {
     "1": "", "u": "u", "v": "v", "r": "r", "|u|u": "|u|u", "vr": "v r", "r^2": "r²",
     "ur": "u r", "uv": "u v", "|v|v": "|v|v", "|v|r": "|v| r", "|r|r": "|r| r", "|r|v": "|r| v",
-    "delta": "δ", "delta^2": "δ²", "T": "T",
+    "delta": "δ", "delta^2": "δ²", "T": "T", "u^2*delta": "u² δ",
 }  # fmt: skip
 
 
@@ -60,6 +60,8 @@ def term_values(
             return delta * delta
         case "T":
             return thrust
+        case "u^2*delta":
+            return u * u * delta
     raise ValueError(f"unknown model term {name!r}; known terms: {', '.join(TERMS)}")
 
 
