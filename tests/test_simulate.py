@@ -17,10 +17,10 @@ class Wrapped:
     """A ManoeuvringModel seen only through the Dynamics protocol: forces the generic NumPy path."""
 
     def __init__(self, model):
-        self.model, self.uses_thrust = model, model.uses_thrust
+        self.model, self.uses_thrust, self.uses_rps = model, model.uses_thrust, model.uses_rps
 
-    def derivatives(self, nu, delta, thrust=None):
-        return self.model.derivatives(nu, delta, thrust)
+    def derivatives(self, nu, delta, thrust=None, rps=None):
+        return self.model.derivatives(nu, delta, thrust, rps)
 
 
 def all_terms_model(seed=0):
@@ -53,10 +53,12 @@ def test_compiled_kernel_equals_numpy_evaluation_of_every_term():
     t = np.arange(0, 5, 0.1)
     d = 0.3 * np.sin(t)
     thrust = 1 + 0.1 * np.cos(t)
+    rps = 2 + 0.3 * np.sin(0.7 * t)
     for method in ("euler", "rk4"):
-        a = simulate(m, t, d, {"u": 1.0, "v": 0.1, "r": 0.05}, thrust=thrust, method=method)
+        a = simulate(m, t, d, {"u": 1.0, "v": 0.1, "r": 0.05}, thrust=thrust, method=method,
+                     rps=rps)  # fmt: skip
         b = simulate(Wrapped(m), t, d, {"u": 1.0, "v": 0.1, "r": 0.05}, thrust=thrust,
-                     method=method)  # fmt: skip
+                     method=method, rps=rps)  # fmt: skip
         np.testing.assert_allclose(a.log.to_numpy(), b.log.to_numpy(), rtol=1e-12, atol=1e-14)
 
 

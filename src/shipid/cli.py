@@ -25,18 +25,20 @@ def _add_log_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--degrees", metavar="COLS", default="",
                    help="angle columns given in degrees, e.g. delta,psi,r")
     g.add_argument("--dt", type=float, help="resample to this uniform sampling time [s]")
-    g.add_argument("--start", type=_start_time, metavar="S|auto",
+    g.add_argument("--start", type=_time_or_auto, metavar="S|auto",
                    help="trim: first time [s], or 'auto': --lead s before the detected rudder execute")
     g.add_argument("--lead", type=float, default=5.0, metavar="S",
                    help="with --start auto: seconds kept before the execute (default 5)")
-    g.add_argument("--end", type=float, help="trim: last time [s]")
+    g.add_argument("--end", type=_time_or_auto, metavar="S|auto",
+                   help="trim: last time [s], or 'auto': the end of the manoeuvre (last large rudder, "
+                   "propeller still running)")
     g.add_argument("--fill-gaps", action="store_true",
                    help="interpolate missing values inside signals (default: refuse the log)")
     g.add_argument("--rudder-positive", choices=("port", "starboard"),
                    help="where a positive rudder angle turns the ship (default port, as the paper)")
 
 
-def _start_time(text: str) -> float | str:
+def _time_or_auto(text: str) -> float | str:
     if text == "auto":
         return text
     try:
@@ -231,7 +233,8 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("identify", help="identify a model from trial logs")
     p.add_argument("logs", nargs="+", metavar="LOG")
     p.add_argument("--model", default="blanke",
-                   help="blanke (default), blanke-thrust, linear-sway-yaw, nomoto1")
+                   help="blanke (default), blanke-thrust, blanke-speed (u² δ rudder), "
+                   "blanke-rps (u² δ and |n|n thrust), linear-sway-yaw, nomoto1")
     p.add_argument("--form", default="increment", help="increment (default) or paper")
     p.add_argument("--gamma", type=float, default=1e4, help="LS-SVM regularisation γ (default 1e4)")
     p.add_argument("--drop", help="terms to drop, e.g. u:r^2 (the paper drops r²)")

@@ -120,7 +120,7 @@ def identify(
     Parameters
     ----------
     logs : canonical log(s) with the same uniform sampling time Δk.
-    model : structure name ('blanke', 'blanke-thrust', 'linear-sway-yaw', 'nomoto1') or structure.
+    model : structure name (see ``shipid.model.BASE_STRUCTURES``) or a structure.
     form : 'increment' (default; the ξ(k) coefficient fixed to 1) or 'paper' (eqs. 11–12 as printed).
     gamma : LS-SVM regularisation γ > 0 (the paper selects 10⁴).
     drop : terms to leave out, e.g. {"u": ["r^2"]} as in the paper.

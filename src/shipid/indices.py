@@ -13,6 +13,9 @@ import numpy as np
 import pandas as pd
 from scipy.integrate import cumulative_trapezoid
 
+from .errors import ShipidError
+from .preprocess import rudder_execute_time
+
 MANOEUVRE_KINDS = ("zigzag", "turning")
 
 
@@ -66,10 +69,20 @@ def _interp(t: np.ndarray, values: np.ndarray, at: float) -> float:
     return float(np.interp(at, t, values)) if math.isfinite(at) else math.nan
 
 
+def execute_index(log: pd.DataFrame) -> int:
+    """Index of the rudder execute: the start of the swing to the first held large rudder
+    (``rudder_execute_time``), which skips helm corrections during a hand-steered approach; for
+    logs without such a plateau, the first rudder movement (``rudder_order_index``)."""
+    try:
+        return int(np.searchsorted(log["t"].to_numpy(), rudder_execute_time(log)))
+    except ShipidError:
+        return rudder_order_index(log["delta"].to_numpy())
+
+
 def _reference(log: pd.DataFrame, t_order: float | None):
     t = log["t"].to_numpy()
     delta = log["delta"].to_numpy()
-    i0 = rudder_order_index(delta) if t_order is None else int(np.searchsorted(t, t_order))
+    i0 = execute_index(log) if t_order is None else int(np.searchsorted(t, t_order))
     i0 = min(i0, len(t) - 1)
     psi, x, y = track(log)
     psi0 = float(np.mean(psi[: i0 + 1]))

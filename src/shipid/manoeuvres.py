@@ -75,10 +75,12 @@ def run_closed_loop(
     method: str = "rk4",
     bounds: DivergenceBounds | None = None,
     initial: Mapping[str, float] | None = None,
+    rps: float | None = None,
 ) -> ManoeuvreResult:
     """Integrate from a straight approach at ``vessel.approach_speed`` (or from ``initial``, a
     mapping of u, v, r, psi, x, y and the rudder angle 'delta') with the rudder command
-    ``command(t, state)`` passed through the vessel's steering machine."""
+    ``command(t, state)`` passed through the vessel's steering machine. ``rps`` is the propeller
+    speed held during the manoeuvre, needed by models with propeller-speed terms."""
     if method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}, got {method!r}")
     if not dt > 0 or not duration > dt:
@@ -92,19 +94,27 @@ def run_closed_loop(
     speed_lim, yaw_lim = (bounds or DivergenceBounds()).resolved(float(s[0, 0]))
     delta = float(start.get("delta", 0.0))
     dyn = vessel.dynamics
+    prop = None
+    if getattr(dyn, "uses_rps", False):
+        if rps is None or not math.isfinite(rps):
+            raise ValueError("this model has propeller-speed terms: give the propeller speed "
+                             "(rps=..., --rps)")  # fmt: skip
+        prop = np.array([float(rps)])
     diverged_after = None
     for k in range(n):
         delta = vessel.steering.step(delta, command(t[k], s[0]), dt)
         states[k], rudder[k] = s[0], delta
         if k == n - 1:
             break
-        new = step_state(dyn, s, np.array([delta]), None, dt, method)
+        new = step_state(dyn, s, np.array([delta]), None, dt, method, prop)
         if not within_bounds(new, speed_lim, yaw_lim)[0]:
             diverged_after = k + 1
             break
         s = new
     m = n if diverged_after is None else diverged_after
     cols = dict(zip(("u", "v", "r", "psi", "x", "y"), states[:m].T, strict=True))
+    if prop is not None:
+        cols["n"] = np.full(m, prop[0])
     log = make_log({"t": t[:m], "delta": rudder[:m], **cols}, **vessel.log_metadata())
     if diverged_after is None:
         return ManoeuvreResult(log)
@@ -145,6 +155,7 @@ def zigzag(
     steering: SteeringMachine | None = None,
     method: str = "rk4",
     initial: Mapping[str, float] | None = None,
+    rps: float | None = None,
 ) -> ManoeuvreResult:
     """δ/ψ zig-zag: rudder ``first`` at t = ``approach``, reversed whenever the heading change
     reaches ±ψ on the side the ship is turning to.
@@ -173,7 +184,7 @@ def zigzag(
             state["side"] = 1.0
         return state["side"] * stbd * rudder
 
-    res = run_closed_loop(vessel, command, duration, dt, method, initial=initial)
+    res = run_closed_loop(vessel, command, duration, dt, method, initial=initial, rps=rps)
     res.log.attrs["manoeuvre"] = f"zigzag {rudder_deg:g}/{heading_deg:g}, first {first}"
     res.indices = zigzag_indices(res.log, heading_deg, t_order=approach,
                                  length=_finite_or_none(vessel.length))  # fmt: skip
@@ -190,6 +201,7 @@ def turning_circle(
     speed: float | None = None,
     steering: SteeringMachine | None = None,
     method: str = "rk4",
+    rps: float | None = None,
 ) -> ManoeuvreResult:
     """Turning circle: rudder to ``side`` at t = ``approach`` (the rudder execute), held."""
     vessel = as_vessel(ship, speed, steering)
@@ -198,7 +210,7 @@ def turning_circle(
     def command(t: float, s: np.ndarray) -> float:
         return value if t >= approach - 1e-9 else 0.0
 
-    res = run_closed_loop(vessel, command, duration, dt, method)
+    res = run_closed_loop(vessel, command, duration, dt, method, rps=rps)
     res.log.attrs["manoeuvre"] = f"turning circle {rudder_deg:g}° to {side}"
     if not res.diverged:
         res.indices = turning_indices(res.log, t_order=approach,
@@ -216,6 +228,7 @@ def pull_out(
     speed: float | None = None,
     steering: SteeringMachine | None = None,
     method: str = "rk4",
+    rps: float | None = None,
 ) -> ManoeuvreResult:
     """Pull-out: rudder held for ``hold`` s, then returned to midships for ``release`` s. A
     straight-line stable ship's yaw rate decays to zero; an unstable one keeps a residual rate."""
@@ -225,7 +238,7 @@ def pull_out(
     def command(t: float, s: np.ndarray) -> float:
         return value if t < hold else 0.0
 
-    res = run_closed_loop(vessel, command, hold + release, dt, method)
+    res = run_closed_loop(vessel, command, hold + release, dt, method, rps=rps)
     res.log.attrs["manoeuvre"] = f"pull-out {rudder_deg:g}° to {side}"
     if not res.diverged:
         r = res.log["r"].to_numpy()

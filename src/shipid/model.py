@@ -16,12 +16,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .terms import TERM_DISPLAY, TERM_INDEX, TERMS, term_matrix
+from .terms import TERM_DISPLAY, TERM_INDEX, TERMS, required_inputs, term_matrix
 
 DOFS = ("u", "v", "r")
+# Terms linear in the rudder angle; their coefficient signs say which way a positive rudder turns.
+RUDDER_GAIN_TERMS = ("delta", "u^2*delta", "|n|n*delta")
 DOF_DISPLAY = {"u": "u̇", "v": "v̇", "r": "ṙ"}
 
 _BLANKE_SWAY_YAW = ("ur", "uv", "|v|v", "|v|r", "delta", "1")
+_BLANKE_SPEED = ("ur", "uv", "|v|v", "|v|r", "u^2*delta", "1")
 BASE_STRUCTURES: dict[str, dict[str, tuple[str, ...]]] = {
     # Paper eqs. (7)–(8), (12): surge with the thrust term merged into the constant (constant
     # commanded speed, as in the paper's experiment); "blanke-thrust" keeps T as a regressor.
@@ -29,6 +32,14 @@ BASE_STRUCTURES: dict[str, dict[str, tuple[str, ...]]] = {
                "r": _BLANKE_SWAY_YAW},
     "blanke-thrust": {"u": ("|u|u", "vr", "r^2", "T", "delta^2", "1"), "v": _BLANKE_SWAY_YAW,
                       "r": _BLANKE_SWAY_YAW},
+    # Trials whose speed changes (real zig-zags lose 20–30 % of it): the rudder force scales with
+    # the inflow speed squared, so the sway/yaw rudder term is u²δ instead of δ.
+    "blanke-speed": {"u": ("|u|u", "vr", "r^2", "delta^2", "1"), "v": _BLANKE_SPEED,
+                     "r": _BLANKE_SPEED},
+    # Trials at different propeller speeds (e.g. Esso Osaka at 10, 12 and 16.7 rps): the thrust
+    # ∝ |n|n enters the surge equation; needs the log column n [rps].
+    "blanke-rps": {"u": ("|u|u", "vr", "r^2", "delta^2", "|n|n", "1"), "v": _BLANKE_SPEED,
+                   "r": _BLANKE_SPEED},
     # Linear sway–yaw (Davidson–Schiff) model at the held surge speed; its yaw transfer function is
     # Nomoto's second-order model, see ``nomoto_parameters``.
     "linear-sway-yaw": {"v": ("v", "r", "delta", "1"), "r": ("v", "r", "delta", "1")},
@@ -63,8 +74,17 @@ class ModelStructure:
         return tuple(d for d in DOFS if d not in self.terms)
 
     @property
+    def inputs(self) -> tuple[str, ...]:
+        """Log columns of the propulsion inputs the structure needs: 'n' [rps], 'thrust' [N]."""
+        return required_inputs([n for names in self.terms.values() for n in names])
+
+    @property
     def uses_thrust(self) -> bool:
-        return any("T" in names for names in self.terms.values())
+        return "thrust" in self.inputs
+
+    @property
+    def uses_rps(self) -> bool:
+        return "n" in self.inputs
 
     def without(self, drop: Mapping[str, tuple[str, ...] | list[str]]) -> ModelStructure:
         """The structure with some terms dropped, e.g. ``{"u": ["r^2"]}`` as in the paper."""
@@ -89,7 +109,8 @@ class ModelStructure:
 
 
 def get_structure(name: str) -> ModelStructure:
-    """A named base structure: 'blanke', 'blanke-thrust', 'linear-sway-yaw' or 'nomoto1'."""
+    """A named base structure: 'blanke', 'blanke-thrust', 'blanke-speed', 'blanke-rps',
+    'linear-sway-yaw' or 'nomoto1'."""
     if name not in BASE_STRUCTURES:
         raise ValueError(f"unknown model {name!r}; known models: {', '.join(BASE_STRUCTURES)}")
     return ModelStructure(name, BASE_STRUCTURES[name])
@@ -136,25 +157,31 @@ class ManoeuvringModel:
         return self.structure.uses_thrust
 
     @property
+    def uses_rps(self) -> bool:
+        return self.structure.uses_rps
+
+    @property
     def rudder_positive_turns(self) -> str:
-        """'port' or 'starboard': where a positive rudder angle turns this model (sign of ∂ṙ/∂δ)."""
-        gain = self.coefficients.get("r", {}).get("delta", 0.0)
+        """'port' or 'starboard': where a positive rudder angle turns this model (sign of ∂ṙ/∂δ,
+        read from the first rudder term of the yaw equation: δ, u² δ or |n|n δ)."""
+        yaw = self.coefficients.get("r", {})
+        gain = next((yaw[n] for n in RUDDER_GAIN_TERMS if yaw.get(n, 0.0) != 0.0), 0.0)
         return "starboard" if gain > 0 else "port"
 
-    def accelerations(self, u, v, r, delta, thrust=None) -> np.ndarray:
+    def accelerations(self, u, v, r, delta, thrust=None, rps=None) -> np.ndarray:
         """(n, 3) accelerations [u̇, v̇, ṙ] for arrays of states and inputs (held DOFs give 0)."""
         u = np.atleast_1d(np.asarray(u, dtype=float))
         out = np.zeros((u.shape[0], 3))
         for i, dof in enumerate(DOFS):
             coefs = self.coefficients.get(dof)
             if coefs:
-                Phi = term_matrix(list(coefs), u, v, r, delta, thrust)
+                Phi = term_matrix(list(coefs), u, v, r, delta, thrust, rps)
                 out[:, i] = Phi @ np.fromiter(coefs.values(), float)
         return out
 
-    def derivatives(self, nu: np.ndarray, delta: np.ndarray, thrust=None) -> np.ndarray:
+    def derivatives(self, nu: np.ndarray, delta: np.ndarray, thrust=None, rps=None) -> np.ndarray:
         """Dynamics protocol of ``shipid.simulate``: (B, 3) body accelerations."""
-        return self.accelerations(nu[:, 0], nu[:, 1], nu[:, 2], delta, thrust)
+        return self.accelerations(nu[:, 0], nu[:, 1], nu[:, 2], delta, thrust, rps)
 
     # ------------------------------------------------------------------ presentation
     def equations(self, precision: int = 4) -> str:

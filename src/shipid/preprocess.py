@@ -48,17 +48,44 @@ def rudder_execute_time(log: pd.DataFrame, name: str = "log") -> float:
     return float(t[k])
 
 
-def trim(log: pd.DataFrame, start: float | str | None = None, end: float | None = None,
+def manoeuvre_end_time(log: pd.DataFrame, name: str = "log") -> float:
+    """End of the manoeuvre: the last sample with the rudder at least half its largest angle, or
+    earlier, the last sample before the propeller speed (column n) falls below 80 % of its median
+    during the manoeuvre (the run is being stopped)."""
+    t = log["t"].to_numpy()
+    delta = log["delta"].to_numpy()
+    start = int(np.searchsorted(t, rudder_execute_time(log, name)))
+    big = np.flatnonzero(np.abs(delta) >= EXECUTE_FRACTION * np.abs(delta).max())
+    k = int(big[-1])
+    if "n" in log.columns:
+        n = np.abs(log["n"].to_numpy())
+        typical = float(np.median(n[start : k + 1]))
+        low = np.flatnonzero(n[start : k + 1] < 0.8 * typical)
+        if typical > 0 and low.size:
+            k = start + int(low[0]) - 1
+    return float(t[max(k, start)])
+
+
+def _auto_time(value, option: str) -> bool:
+    if isinstance(value, str):
+        if value != "auto":
+            raise ShipidError(f"{option} must be a time in seconds or 'auto', got {value!r}")
+        return True
+    return False
+
+
+def trim(log: pd.DataFrame, start: float | str | None = None, end: float | str | None = None,
          name: str = "log", lead: float = 5.0) -> pd.DataFrame:  # fmt: skip
     """Rows with start ≤ t ≤ end, time kept as is. ``start="auto"`` starts ``lead`` seconds
-    before the detected rudder execute (``rudder_execute_time``)."""
+    before the detected rudder execute (``rudder_execute_time``); ``end="auto"`` ends with the
+    manoeuvre (``manoeuvre_end_time``)."""
     t = log["t"]
-    if isinstance(start, str):
-        if start != "auto":
-            raise ShipidError(f"--start must be a time in seconds or 'auto', got {start!r}")
+    if _auto_time(start, "--start"):
         if not lead >= 0:
             raise ShipidError(f"--lead must be ≥ 0 s, got {lead!r}")
         start = max(rudder_execute_time(log, name) - lead, float(t.iloc[0]))
+    if _auto_time(end, "--end"):
+        end = manoeuvre_end_time(log, name)
     keep = np.ones(len(log), dtype=bool)
     if start is not None:
         keep &= t >= start

@@ -21,7 +21,7 @@ import pandas as pd
 
 from .errors import ShipidError
 from .model import ModelStructure
-from .terms import term_matrix
+from .terms import required_inputs, term_matrix
 
 FORMS = ("increment", "paper")
 DT_RTOL = 1e-6
@@ -53,12 +53,22 @@ def sampling_time(log: pd.DataFrame, name: str = "log") -> float:
     return dt
 
 
-def _log_terms(log: pd.DataFrame, names: Sequence[str]) -> np.ndarray:
-    thrust = log["thrust"].to_numpy() if "thrust" in log.columns else None
-    if "T" in names and thrust is None:
-        raise ShipidError("the model has a thrust term T but the log has no 'thrust' column")
+def input_series(log: pd.DataFrame, names: Sequence[str], name: str = "log") -> dict:
+    """The thrust and rps series that the terms ``names`` need, from the log's columns."""
+    out = {}
+    for column in required_inputs(names):
+        if column not in log.columns:
+            what = "a thrust term T" if column == "thrust" else "propeller-speed terms"
+            raise ShipidError(f"{name}: the model has {what} but the log has no {column!r} column")
+        out[column] = log[column].to_numpy()
+    return out
+
+
+def _log_terms(log: pd.DataFrame, names: Sequence[str], name: str = "log") -> np.ndarray:
+    inputs = input_series(log, names, name)
     return term_matrix(list(names), log["u"].to_numpy(), log["v"].to_numpy(),
-                       log["r"].to_numpy(), log["delta"].to_numpy(), thrust)  # fmt: skip
+                       log["r"].to_numpy(), log["delta"].to_numpy(), inputs.get("thrust"),
+                       inputs.get("n"))  # fmt: skip
 
 
 def regression_problem(
@@ -94,12 +104,12 @@ def regression_problem(
             raise ShipidError(f"{n}: sampling time {d:.6g} s differs from {dt:.6g} s of {names[0]}; "
                               "resample the logs to one Δk with --dt")  # fmt: skip
     Xs, ys = [], []
-    for log in logs:
+    for log, name in zip(logs, names, strict=True):
         xi = log[dof].to_numpy()
-        F = _log_terms(log, free)[:-1]
+        F = _log_terms(log, free, name)[:-1]
         target = (xi[1:] - xi[:-1]) / dt
         if fixed:
-            Ffix = _log_terms(log, list(fixed))[:-1]
+            Ffix = _log_terms(log, list(fixed), name)[:-1]
             target = target - Ffix @ np.fromiter(fixed.values(), float)
         if form == "paper":
             # Eq. (12) as printed: raw terms, so Γ = [ξ(k) coefficient, Δk·θ...] is what the

@@ -77,24 +77,25 @@ class BatchResult:
 
 # ---------------------------------------------------------------------------- compiled kernel
 @numba.njit(cache=True, inline="always")
-def _linear_acc(th, i, u, v, r, d, T):
+def _linear_acc(th, i, u, v, r, d, T, n):
     # Term order of shipid.terms.TERMS; a test checks this against the NumPy evaluation.
     au, av, ar = abs(u), abs(v), abs(r)
     return (th[i, 0] + th[i, 1] * u + th[i, 2] * v + th[i, 3] * r + th[i, 4] * au * u
             + th[i, 5] * v * r + th[i, 6] * r * r + th[i, 7] * u * r + th[i, 8] * u * v
             + th[i, 9] * av * v + th[i, 10] * av * r + th[i, 11] * ar * r + th[i, 12] * ar * v
-            + th[i, 13] * d + th[i, 14] * d * d + th[i, 15] * T + th[i, 16] * u * u * d)  # fmt: skip
+            + th[i, 13] * d + th[i, 14] * d * d + th[i, 15] * T + th[i, 16] * u * u * d
+            + th[i, 17] * abs(n) * n + th[i, 18] * u * n + th[i, 19] * abs(n) * n * d)  # fmt: skip
 
 
 @numba.njit(cache=True, inline="always")
-def _linear_rhs(th, u, v, r, psi, d, T):
+def _linear_rhs(th, u, v, r, psi, d, T, n):
     c, s = math.cos(psi), math.sin(psi)
-    return (_linear_acc(th, 0, u, v, r, d, T), _linear_acc(th, 1, u, v, r, d, T),
-            _linear_acc(th, 2, u, v, r, d, T), r, u * c - v * s, u * s + v * c)  # fmt: skip
+    return (_linear_acc(th, 0, u, v, r, d, T, n), _linear_acc(th, 1, u, v, r, d, T, n),
+            _linear_acc(th, 2, u, v, r, d, T, n), r, u * c - v * s, u * s + v * c)  # fmt: skip
 
 
 @numba.njit(cache=True, parallel=True)
-def _integrate_linear(th, t, delta, thrust, s0, rk4, speed_lim, yaw_lim, out, n_valid):
+def _integrate_linear(th, t, delta, thrust, rps, s0, rk4, speed_lim, yaw_lim, out, n_valid):
     n_traj, n_steps = delta.shape
     for b in numba.prange(n_traj):
         u, v, r, psi, x, y = s0[b, 0], s0[b, 1], s0[b, 2], s0[b, 3], s0[b, 4], s0[b, 5]
@@ -103,15 +104,15 @@ def _integrate_linear(th, t, delta, thrust, s0, rk4, speed_lim, yaw_lim, out, n_
         n_ok = 1
         for k in range(n_steps - 1):
             h = t[k + 1] - t[k]
-            d, T = delta[b, k], thrust[b, k]
-            k1 = _linear_rhs(th, u, v, r, psi, d, T)
+            d, T, n = delta[b, k], thrust[b, k], rps[b, k]
+            k1 = _linear_rhs(th, u, v, r, psi, d, T, n)
             if rk4:
                 k2 = _linear_rhs(th, u + 0.5 * h * k1[0], v + 0.5 * h * k1[1], r + 0.5 * h * k1[2],
-                                 psi + 0.5 * h * k1[3], d, T)  # fmt: skip
+                                 psi + 0.5 * h * k1[3], d, T, n)  # fmt: skip
                 k3 = _linear_rhs(th, u + 0.5 * h * k2[0], v + 0.5 * h * k2[1], r + 0.5 * h * k2[2],
-                                 psi + 0.5 * h * k2[3], d, T)  # fmt: skip
+                                 psi + 0.5 * h * k2[3], d, T, n)  # fmt: skip
                 k4 = _linear_rhs(th, u + h * k3[0], v + h * k3[1], r + h * k3[2],
-                                 psi + h * k3[3], d, T)  # fmt: skip
+                                 psi + h * k3[3], d, T, n)  # fmt: skip
                 w = h / 6.0
                 u += w * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0])
                 v += w * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1])
@@ -136,9 +137,11 @@ def _integrate_linear(th, t, delta, thrust, s0, rk4, speed_lim, yaw_lim, out, n_
 
 
 # ---------------------------------------------------------------------------- generic path
-def _rhs(dyn: Dynamics, s: np.ndarray, d: np.ndarray, T: np.ndarray | None) -> np.ndarray:
+def _rhs(dyn: Dynamics, s: np.ndarray, d: np.ndarray, T: np.ndarray | None,
+         n: np.ndarray | None = None) -> np.ndarray:  # fmt: skip
     out = np.empty_like(s)
-    out[:, :3] = dyn.derivatives(s[:, :3], d, T)
+    # Only models with propeller-speed terms take n; reference ships keep the 3-argument protocol.
+    out[:, :3] = dyn.derivatives(s[:, :3], d, T) if n is None else dyn.derivatives(s[:, :3], d, T, n)
     c, sn = np.cos(s[:, 3]), np.sin(s[:, 3])
     out[:, 3] = s[:, 2]
     out[:, 4] = s[:, 0] * c - s[:, 1] * sn
@@ -147,16 +150,22 @@ def _rhs(dyn: Dynamics, s: np.ndarray, d: np.ndarray, T: np.ndarray | None) -> n
 
 
 def step_state(
-    dyn: Dynamics, s: np.ndarray, d: np.ndarray, T: np.ndarray | None, h: float, method: str
+    dyn: Dynamics,
+    s: np.ndarray,
+    d: np.ndarray,
+    T: np.ndarray | None,
+    h: float,
+    method: str,
+    n: np.ndarray | None = None,
 ) -> np.ndarray:
     """One integration step of (B, 6) states with inputs held (used by closed-loop manoeuvres)."""
     with np.errstate(all="ignore"):  # divergence is detected and reported by the caller
-        k1 = _rhs(dyn, s, d, T)
+        k1 = _rhs(dyn, s, d, T, n)
         if method == "euler":
             return s + h * k1
-        k2 = _rhs(dyn, s + 0.5 * h * k1, d, T)
-        k3 = _rhs(dyn, s + 0.5 * h * k2, d, T)
-        k4 = _rhs(dyn, s + h * k3, d, T)
+        k2 = _rhs(dyn, s + 0.5 * h * k1, d, T, n)
+        k3 = _rhs(dyn, s + 0.5 * h * k2, d, T, n)
+        k4 = _rhs(dyn, s + h * k3, d, T, n)
         return s + (h / 6.0) * (k1 + 2 * k2 + 2 * k3 + k4)
 
 
@@ -166,7 +175,7 @@ def within_bounds(s: np.ndarray, speed_lim: float, yaw_lim: float) -> np.ndarray
                 & (np.abs(s[:, 1]) <= speed_lim) & (np.abs(s[:, 2]) <= yaw_lim))  # fmt: skip
 
 
-def _integrate_generic(dyn, t, delta, thrust, s0, method, speed_lim, yaw_lim, out, n_valid):
+def _integrate_generic(dyn, t, delta, thrust, rps, s0, method, speed_lim, yaw_lim, out, n_valid):
     n_traj, n_steps = delta.shape
     s = s0.copy()
     out[:, 0] = s
@@ -174,7 +183,8 @@ def _integrate_generic(dyn, t, delta, thrust, s0, method, speed_lim, yaw_lim, ou
     n_valid[:] = 1
     for k in range(n_steps - 1):
         T = None if thrust is None else thrust[alive, k]
-        new = step_state(dyn, s[alive], delta[alive, k], T, t[k + 1] - t[k], method)
+        n = None if rps is None else rps[alive, k]
+        new = step_state(dyn, s[alive], delta[alive, k], T, t[k + 1] - t[k], method, n)
         ok = within_bounds(new, speed_lim, yaw_lim)
         idx = np.flatnonzero(alive)
         s[idx[ok]] = new[ok]
@@ -250,11 +260,13 @@ def simulate_batch(
     method: str = "rk4",
     bounds: DivergenceBounds | None = None,
     n_trajectories: int | None = None,
+    rps=None,
     **meta: object,
 ) -> BatchResult:
     """Simulate B trajectories at once on the grid ``t`` (N,).
 
-    ``delta`` and ``thrust`` are (N,) (shared) or (B, N); ``initial`` is a mapping, (6,) or (B, 6).
+    ``delta``, ``thrust`` and ``rps`` (propeller speed, for models with n terms) are (N,) (shared)
+    or (B, N); ``initial`` is a mapping, (6,) or (B, 6).
     """
     if method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}, got {method!r}")
@@ -262,8 +274,7 @@ def simulate_batch(
     n_steps = t.size
     if n_trajectories is None:
         shapes = [np.shape(delta), np.shape(initial) if not isinstance(initial, Mapping) else ()]
-        if thrust is not None:
-            shapes.append(np.shape(thrust))
+        shapes += [np.shape(x) for x in (thrust, rps) if x is not None]
         n_trajectories = max([s[0] for s in shapes if len(s) == 2] or [1])
     n_traj = n_trajectories
     delta = _as_series(delta, "delta (rudder series)", n_traj, n_steps)
@@ -271,16 +282,21 @@ def simulate_batch(
     if dynamics.uses_thrust and thrust is None:
         raise ValueError("this model uses thrust: give a thrust series")
     thrust = None if thrust is None else _as_series(thrust, "thrust", n_traj, n_steps)
+    if getattr(dynamics, "uses_rps", False) and rps is None:
+        raise ValueError("this model has propeller-speed terms: give an rps series (log column n)")
+    rps = None if rps is None else _as_series(rps, "rps (propeller speed)", n_traj, n_steps)
     speed_lim, yaw_lim = (bounds or DivergenceBounds()).resolved(float(np.max(np.abs(s0[:, 0]))))
     if isinstance(dynamics, ManoeuvringModel):
         T = np.zeros_like(delta) if thrust is None else thrust
-        out, n_valid = integrate_coefficients(dynamics.theta, t, delta, T, s0, method, speed_lim,
+        n = np.zeros_like(delta) if rps is None else rps
+        out, n_valid = integrate_coefficients(dynamics.theta, t, delta, T, n, s0, method, speed_lim,
                                               yaw_lim)  # fmt: skip
     else:
         out = np.zeros((n_traj, n_steps, 6))
         n_valid = np.zeros(n_traj, dtype=np.int64)
-        _integrate_generic(dynamics, t, delta, thrust, s0, method, speed_lim, yaw_lim, out,
-                           n_valid)  # fmt: skip
+        uses_rps = getattr(dynamics, "uses_rps", False)
+        _integrate_generic(dynamics, t, delta, thrust, rps if uses_rps else None, s0, method,
+                           speed_lim, yaw_lim, out, n_valid)  # fmt: skip
     return BatchResult(t, np.asarray(delta), out, n_valid, (speed_lim, yaw_lim), dict(meta))
 
 
@@ -305,14 +321,16 @@ def simulate(
     thrust=None,
     method: str = "rk4",
     bounds: DivergenceBounds | None = None,
+    rps=None,
     **meta: object,
 ) -> SimulationResult:
     """Simulate one trajectory; returns the canonical log and a divergence report."""
     batch = simulate_batch(dynamics, t, delta, initial, thrust, method, bounds, n_trajectories=1,
-                           **meta)  # fmt: skip
+                           rps=rps, **meta)  # fmt: skip
     log = batch.log(0)
-    if thrust is not None:
-        log["thrust"] = np.asarray(thrust, dtype=float)[: len(log)]
+    for column, series in (("n", rps), ("thrust", thrust)):
+        if series is not None:
+            log[column] = np.broadcast_to(np.asarray(series, dtype=float), batch.t.shape)[: len(log)]
     n = int(batch.n_valid[0])
     if n == len(batch.t):
         return SimulationResult(log)
@@ -327,14 +345,21 @@ def simulate_log(
     bounds: DivergenceBounds | None = None,
 ) -> SimulationResult:
     """Free-run simulation from a log's measured initial state, driven by its measured rudder (and
-    thrust where the model uses it): the paper's validation (section 4)."""
+    thrust and propeller speed where the model uses them): the paper's validation (section 4)."""
     first = log.iloc[0]
     initial = {k: float(first[k]) for k in STATE_NAMES if k in log.columns}
     for k in ("psi", "x", "y"):
         initial.setdefault(k, 0.0)
-    thrust = log["thrust"].to_numpy() if dynamics.uses_thrust else None
-    return simulate(dynamics, log["t"].to_numpy(), log["delta"].to_numpy(), initial, thrust,
-                    method, bounds, **log.attrs)  # fmt: skip
+    series = {}
+    for column, needed in (("thrust", dynamics.uses_thrust),
+                           ("n", getattr(dynamics, "uses_rps", False))):  # fmt: skip
+        if needed:
+            if column not in log.columns:
+                raise ValueError(f"{log.attrs.get('name', 'log')}: the model needs the log column "
+                                 f"{column!r}, which this log does not have")  # fmt: skip
+            series[column] = log[column].to_numpy()
+    return simulate(dynamics, log["t"].to_numpy(), log["delta"].to_numpy(), initial,
+                    series.get("thrust"), method, bounds, rps=series.get("n"), **log.attrs)
 
 
 def integrate_coefficients(
@@ -342,6 +367,7 @@ def integrate_coefficients(
     t: np.ndarray,
     delta: np.ndarray,
     thrust: np.ndarray,
+    rps: np.ndarray,
     initial: np.ndarray,
     method: str,
     speed_lim: float,
@@ -352,6 +378,6 @@ def integrate_coefficients(
     validated arrays; everything else goes through ``simulate_batch``."""
     out = np.zeros((delta.shape[0], t.size, 6))
     n_valid = np.zeros(delta.shape[0], dtype=np.int64)
-    _integrate_linear(np.ascontiguousarray(theta), t, delta, thrust, initial, method == "rk4",
-                      speed_lim, yaw_lim, out, n_valid)  # fmt: skip
+    _integrate_linear(np.ascontiguousarray(theta), t, delta, thrust, rps, initial,
+                      method == "rk4", speed_lim, yaw_lim, out, n_valid)  # fmt: skip
     return out, n_valid

@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from .indices import detect_manoeuvre, manoeuvre_indices, rudder_order_index, zigzag_indices
+from .indices import detect_manoeuvre, execute_index, manoeuvre_indices, zigzag_indices
 from .log import rudder_positive, starboard_sign
 from .manoeuvres import ManoeuvreResult, zigzag
 from .metrics import error_metrics
@@ -78,7 +78,8 @@ def validate(
 def trial_zigzag(model, log: pd.DataFrame, method: str = "euler") -> ManoeuvreResult | None:
     """The zig-zag of a measured log run closed loop on ``model``: same initial state (u, v, r, ψ)
     and held rudder, first execute time and side, rudder angle (the median plateau), rudder rate
-    (the 90th percentile while it moves), switch heading (inferred from the log), duration and step.
+    (the 90th percentile while it moves), switch heading (inferred from the log), mean propeller
+    speed, duration and step.
     None when the log is not a zig-zag with a detectable switch heading."""
     measured = zigzag_indices(log)
     switch = measured.get("switch_heading_deg")
@@ -87,7 +88,7 @@ def trial_zigzag(model, log: pd.DataFrame, method: str = "euler") -> ManoeuvreRe
     t = log["t"].to_numpy()
     delta = log["delta"].to_numpy()
     dt = float(np.median(np.diff(t)))
-    i0 = rudder_order_index(delta)
+    i0 = execute_index(log)
     held = float(delta[0])
     swing = np.abs(delta - held)
     plateau = swing > 0.8 * swing.max()
@@ -102,6 +103,7 @@ def trial_zigzag(model, log: pd.DataFrame, method: str = "euler") -> ManoeuvreRe
     initial = {k: float(row[k]) for k in ("u", "v", "r", "psi") if k in log.columns}
     initial["delta"] = held
     steering = SteeringMachine(max_angle=max(math.radians(35.0), amplitude), max_rate=max_rate)
+    rps = float(log["n"].mean()) if "n" in log.columns else None
     return zigzag(model, math.degrees(amplitude), switch, first=first, duration=float(t[-1] - t[0]),
                   dt=dt, approach=float(t[i0] - t[0]), speed=initial["u"], steering=steering,
-                  method=method, initial=initial)  # fmt: skip
+                  method=method, initial=initial, rps=rps)  # fmt: skip
