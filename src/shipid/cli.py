@@ -88,29 +88,89 @@ def cmd_demo(args) -> int:
     return 0
 
 
+def _approach(log, column: str) -> float | None:
+    """Mean of a column over the first 2 % of a log (the approach), None if absent."""
+    if column not in log.columns:
+        return None
+    return float(log[column].iloc[: max(1, len(log) // 50)].mean())
+
+
+def _free_run_table(refinement) -> str:
+    lines = ["| training log | LS-SVM u / v / r std | refined u / v / r std |", "|---|---|---|"]
+    for row in refinement.free_run:
+        cells = []
+        for key in ("initial", "refined"):
+            e = row[key]
+            div = " (diverged)" if row[f"{key}_diverged"] else ""
+            cells.append(f"{e['u']:.4f} / {e['v']:.4f} / {e['r']:.4f}{div}")
+        lines.append(f"| {row['name']} | {cells[0]} | {cells[1]} |")
+    return "\n".join(lines)
+
+
 def cmd_identify(args) -> int:
     from .identify import identify
     from .modelfile import save_model
+    from .plausibility import check_plausibility
     from .preprocess import lowpass
+    from .refine import refine
 
     logs = _read_logs(args)
     if args.filter is not None:
         logs = [lowpass(log, args.filter) for log in logs]
+    names = [str(p) for p in args.logs]
     ident = identify(logs, model=args.model, form=args.form, gamma=args.gamma,
-                     drop=_parse_drop(args.drop), names=[str(p) for p in args.logs])  # fmt: skip
-    prep = {"dt": args.dt, "start": args.start, "end": args.end, "filter_hz": args.filter,
-            "columns": args.columns, "degrees": args.degrees,
-            "approach_speed": float(logs[0]["u"].iloc[: max(1, len(logs[0]) // 50)].mean()),
+                     drop=_parse_drop(args.drop), names=names)  # fmt: skip
+    speed, rps = _approach(logs[0], "u"), _approach(logs[0], "n")
+    prep = {"dt": args.dt, "start": args.start, "end": args.end, "lead": args.lead,
+            "filter_hz": args.filter, "columns": args.columns, "degrees": args.degrees,
+            "approach_speed": speed, "approach_rps": rps,
             "rudder_positive": logs[0].attrs.get("rudder_positive")}  # fmt: skip
-    save_model(args.output, ident, args.logs, prep)
+    refinement = None
     print(ident.model.equations())
     for dof, d in ident.diagnostics.items():
         print(f"{dof}: condition number {d['condition_number']:.3g}, one-step R² "
               f"{d['one_step_r2']:.4f}, bias b = {ident.discrete[dof]['bias']:.4g}")
+    if args.refine:
+        how = "whole logs" if args.segment is None else f"{args.segment:g} s segments"
+        print(f"refining by output error ({how})…", file=sys.stderr)
+        refinement = refine(ident.model, logs, segment_s=args.segment, gamma=args.gamma,
+                            max_nfev=args.refine_evals, names=names)  # fmt: skip
+        print()
+        print("refined by output error:")
+        print(refinement.model.equations())
+        print(f"cost {refinement.cost_initial:.4g} → {refinement.cost_final:.4g} in "
+              f"{refinement.nfev} evaluations ({refinement.message})")
+        print(_free_run_table(refinement))
+    final = ident.model
+    n = rps if ident.model.uses_rps else None
+    plausibility, notes = check_plausibility(ident.model, speed, n)
+    if refinement:
+        refined_report, refined_notes = check_plausibility(refinement.model, speed, n)
+        if len(refined_notes) > len(notes):
+            # Never hand out a model that fails checks the LS-SVM model passes.
+            ident.warnings.append(
+                "refinement: the refined model fails plausibility checks the LS-SVM model passes ("
+                + "; ".join(refined_notes[:2]) + "); the model file's model is the LS-SVM one, the "
+                "refined one is kept under identification.refinement.refined_model")
+        else:
+            final, plausibility, notes = refinement.model, refined_report, refined_notes
+    sl = plausibility["straight_line"]
+    if sl:
+        print(f"straight-line {'stable' if sl['stable'] else 'UNSTABLE'} (largest sway–yaw "
+              f"eigenvalue real part {sl['max_real_part']:.3g} 1/s); surge equilibrium "
+              f"{_fmt_speed(plausibility['surge_equilibrium'])}")  # fmt: skip
+    ident.warnings.extend(f"plausibility: {n}" for n in notes)
+    if refinement:
+        ident.warnings.extend(f"refinement: {n}" for n in refinement.warnings)
+    save_model(args.output, ident, args.logs, prep, refinement, plausibility, final)
     for w in ident.warnings:
         print(f"warning: {w}", file=sys.stderr)
     print(f"model written to {args.output}")
     return 0
+
+
+def _fmt_speed(u: float | None) -> str:
+    return "none" if u is None else f"{u:.3g} m/s"
 
 
 def cmd_validate(args) -> int:
@@ -119,7 +179,7 @@ def cmd_validate(args) -> int:
     from .report import error_table, indices_table
     from .validate import validate
 
-    model = load_model(args.model)
+    model = load_model(args.model, "lssvm" if args.lssvm else "model")
     logs = _read_logs(args)
     vals = validate(model, logs, [str(p) for p in args.logs], method=args.method)
     print(error_table(vals))
@@ -140,22 +200,23 @@ def cmd_validate(args) -> int:
 
 
 def _ship_or_model(name: str):
-    """A reference ship (its trimmed speed applies) or a model file with its training speed."""
+    """A reference ship (its trimmed speed applies) or a model file with its training speed and
+    propeller speed."""
     from .modelfile import load_document, model_from_document
     from .vessels import get_vessel
 
     if name in VESSEL_NAMES:
-        return get_vessel(name), None
+        return get_vessel(name), None, None
     doc = load_document(name)
-    speed = doc.get("identification", {}).get("preprocessing", {}).get("approach_speed")
-    return model_from_document(doc, name), speed
+    prep = doc.get("identification", {}).get("preprocessing", {})
+    return model_from_document(doc, name), prep.get("approach_speed"), prep.get("approach_rps")
 
 
 def cmd_simulate(args) -> int:
     from .io import read_log, write_log
     from .simulate import simulate_log
 
-    target, _ = _ship_or_model(args.model)
+    target, _, _ = _ship_or_model(args.model)
     dynamics = getattr(target, "dynamics", target)
     log = read_log(args.rudder, degrees=[c for c in args.degrees.split(",") if c])
     res = simulate_log(dynamics, log, method=args.method)
@@ -169,8 +230,8 @@ def cmd_simulate(args) -> int:
 def cmd_manoeuvre(args) -> int:
     from .manoeuvres import turning_circle, zigzag
 
-    target, training_speed = _ship_or_model(args.model)
-    kw = {"dt": args.step, "speed": args.speed or training_speed}
+    target, training_speed, training_rps = _ship_or_model(args.model)
+    kw = {"dt": args.step, "speed": args.speed or training_speed, "rps": args.rps or training_rps}
     if args.duration:
         kw["duration"] = args.duration
     if args.kind == "zigzag":
@@ -239,6 +300,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--gamma", type=float, default=1e4, help="LS-SVM regularisation γ (default 1e4)")
     p.add_argument("--drop", help="terms to drop, e.g. u:r^2 (the paper drops r²)")
     p.add_argument("--filter", type=float, metavar="HZ", help="zero-phase low-pass of u, v, r")
+    p.add_argument("--refine", action="store_true",
+                   help="refine the LS-SVM model by output error (free-run fit to the logs); the "
+                   "model file holds the refined model and keeps the LS-SVM one")
+    p.add_argument("--segment", type=float, metavar="S",
+                   help="with --refine: simulate segments of S seconds (default: whole logs)")
+    p.add_argument("--refine-evals", type=int, default=200, metavar="N",
+                   help="with --refine: cap on cost evaluations (default 200)")
     p.add_argument("-o", "--output", required=True, metavar="MODEL.json")
     _add_log_options(p)
     p.set_defaults(func=cmd_identify)
@@ -249,6 +317,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", metavar="OUT", help="write the results as JSON")
     p.add_argument("--plots", metavar="DIR", help="write measured-vs-simulated figures")
     p.add_argument("--method", default="euler", choices=("euler", "rk4"))
+    p.add_argument("--lssvm", action="store_true",
+                   help="validate the LS-SVM model a refined model file keeps")
     _add_log_options(p)
     p.set_defaults(func=cmd_validate)
 
@@ -270,6 +340,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--duration", type=float, help="length of the run [s]")
     p.add_argument("--step", type=float, default=0.05, help="integration step [s]")
     p.add_argument("--speed", type=float, help="approach speed [m/s] (models: default from training)")
+    p.add_argument("--rps", type=float,
+                   help="propeller speed [rps] for models with n terms (default from training)")
     p.add_argument("--json", metavar="OUT")
     p.add_argument("-o", "--output", metavar="LOG.csv", help="write the simulated log")
     p.set_defaults(func=cmd_manoeuvre)

@@ -190,7 +190,9 @@ class ManoeuvringModel:
         for dof in self.structure.dofs:
             parts = []
             for n, c in self.coefficients[dof].items():
-                mag = f"{abs(c):.{precision}f}"
+                # Coefficients of large regressors (|n|n ~ 100 rps²) are tiny: keep their digits.
+                small = 0 < abs(c) < 10 ** (1 - precision)
+                mag = f"{abs(c):.{precision - 1}e}" if small else f"{abs(c):.{precision}f}"
                 term = TERM_DISPLAY[n]
                 sign = "−" if c < 0 else "+"
                 parts.append((sign, f"{mag} {term}".rstrip()))

@@ -14,6 +14,7 @@ from .atomic import atomic_write_text
 from .errors import ShipidError
 from .identify import Identification
 from .model import ManoeuvringModel
+from .refine import Refinement
 
 FORMAT = "shipid-model"
 VERSION = 1
@@ -39,21 +40,32 @@ def json_safe(obj):
 
 
 def model_document(ident: Identification, training_files: Sequence[str | Path] = (),
-                   preprocessing: dict | None = None) -> dict:  # fmt: skip
+                   preprocessing: dict | None = None, refinement: Refinement | None = None,
+                   plausibility: dict | None = None,
+                   model: ManoeuvringModel | None = None) -> dict:  # fmt: skip
+    """The model file. ``model`` is the one users get (default: the refined model when there is a
+    refinement, else the LS-SVM one); the LS-SVM model stays in ``refinement.initial_model`` and
+    the refined one in ``refinement.refined_model``."""
+    if model is None:
+        model = refinement.model if refinement is not None else ident.model
     return json_safe({
         "format": FORMAT, "version": VERSION, "shipid": __version__,
-        "model": ident.model.to_dict(),
+        "model": model.to_dict(),
         "identification": {"form": ident.form, "gamma": ident.gamma, "dt": ident.dt,
                            "discrete": ident.discrete, "diagnostics": ident.diagnostics,
-                           "warnings": ident.warnings, "preprocessing": preprocessing or {}},
+                           "warnings": ident.warnings, "preprocessing": preprocessing or {},
+                           "refinement": refinement.to_dict() if refinement else None,
+                           "plausibility": plausibility},
         "provenance": {"training_files": [{"path": str(p), "sha256": sha256(p)}
                                           for p in training_files]},
     })  # fmt: skip
 
 
 def save_model(path: str | Path, ident: Identification, training_files: Sequence[str | Path] = (),
-               preprocessing: dict | None = None) -> Path:  # fmt: skip
-    doc = model_document(ident, training_files, preprocessing)
+               preprocessing: dict | None = None, refinement: Refinement | None = None,
+               plausibility: dict | None = None,
+               model: ManoeuvringModel | None = None) -> Path:  # fmt: skip
+    doc = model_document(ident, training_files, preprocessing, refinement, plausibility, model)
     # repr of a float is exact, so the coefficients survive the round trip bit for bit.
     return atomic_write_text(path, json.dumps(doc, indent=2, ensure_ascii=False) + "\n")
 
@@ -74,12 +86,20 @@ def load_document(path: str | Path) -> dict:
     return doc
 
 
-def load_model(path: str | Path) -> ManoeuvringModel:
-    return model_from_document(load_document(path), path)
+def load_model(path: str | Path, which: str = "model") -> ManoeuvringModel:
+    """The file's model, or with ``which="lssvm"`` the LS-SVM model a refinement started from."""
+    return model_from_document(load_document(path), path, which)
 
 
-def model_from_document(doc: dict, path: str | Path) -> ManoeuvringModel:
+def model_from_document(doc: dict, path: str | Path, which: str = "model") -> ManoeuvringModel:
+    if which not in ("model", "lssvm"):
+        raise ShipidError(f"which must be 'model' or 'lssvm', got {which!r}")
+    data = doc.get("model")
+    if which == "lssvm":
+        refinement = (doc.get("identification") or {}).get("refinement")
+        if refinement:
+            data = refinement.get("initial_model")
     try:
-        return ManoeuvringModel.from_dict(doc["model"])
+        return ManoeuvringModel.from_dict(data)
     except (KeyError, TypeError, ValueError) as exc:
         raise ShipidError(f"{path}: malformed model ({exc})") from None

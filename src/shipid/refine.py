@@ -61,7 +61,8 @@ class Refinement:
     warnings: list[str] = field(default_factory=list)
 
     def to_dict(self) -> dict:
-        return {"initial_model": self.initial.to_dict(), "segment_s": self.segment_s,
+        return {"initial_model": self.initial.to_dict(), "refined_model": self.model.to_dict(),
+                "segment_s": self.segment_s,
                 "n_segments": self.n_segments, "states": list(self.states),
                 "cost_initial": self.cost_initial, "cost_final": self.cost_final,
                 "nfev": self.nfev, "success": self.success, "message": self.message,

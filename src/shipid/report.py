@@ -35,10 +35,15 @@ def _fmt(x) -> str:
 
 
 def indices_table(validations: Sequence[Validation]) -> str:
-    lines = ["| log | index | measured | simulated |", "|---|---|---|---|"]
+    """Indices measured, from the open-loop replay ("simulated") and, for zig-zags, from the
+    manoeuvre run closed loop on the model ("closed loop", see ``validate.trial_zigzag``)."""
+    lines = ["| log | index | measured | simulated (replay) | closed loop |", "|---|---|---|---|---|"]
     for v in validations:
         meas, sim = v.indices.get("measured", {}), v.indices.get("simulated", {})
+        closed = v.indices.get("closed_loop")
         for k in INDEX_KEYS:
             if k in meas or k in sim:
-                lines.append(f"| {v.name} | {k} | {_fmt(meas.get(k))} | {_fmt(sim.get(k))} |")
+                loop = "n/a" if closed is None else _fmt(closed.get(k))
+                lines.append(f"| {v.name} | {k} | {_fmt(meas.get(k))} | {_fmt(sim.get(k))} | "
+                             f"{loop} |")  # fmt: skip
     return "\n".join(lines)

@@ -1,0 +1,115 @@
+"""Plausibility and stability checks of an identified model, for its diagnostics.
+
+A model can fit its training trial and still be unphysical away from it. Three checks at the
+approach condition (speed u0, propeller speed n):
+
+* straight-line stability: eigenvalues of the sway–yaw dynamics linearised about straight running
+  (v = r = 0). Both negative: stable. One positive: unstable, which real full-form ships (KVLCC2)
+  can be, but then small rudder offsets grow into turns; it is reported, not refused.
+* surge equilibrium: with the rudder amidships the speed settles where u̇(u) = 0; none (or a
+  negative one) means the surge equation drives the ship without bound.
+* held rudder: the largest rudder of the steering machine held to each side for ``duration``
+  seconds must stay bounded and settle to a steady turn (yaw rate and speed no longer changing).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .manoeuvres import turning_circle
+from .model import ManoeuvringModel
+
+SETTLED_FRACTION = 0.02  # of the steady value, over the last 10 % of the run
+
+
+def _accelerations(model: ManoeuvringModel, u, v, r, delta, rps):
+    n = None if rps is None else np.full(np.shape(np.atleast_1d(u)), rps)
+    return model.accelerations(u, v, r, delta, None, n)
+
+
+def straight_line_stability(model: ManoeuvringModel, speed: float, rps: float | None = None) -> dict:
+    """Eigenvalues [1/s] of ∂(v̇, ṙ)/∂(v, r) at (u0, 0, 0, δ = 0), by central differences."""
+    if not {"v", "r"} <= set(model.structure.dofs):
+        return {}
+    h = 1e-6 * max(speed, 1.0)
+    A = np.zeros((2, 2))
+    for j, (dv, dr) in enumerate(((h, 0.0), (0.0, h))):
+        plus = _accelerations(model, speed, dv, dr, 0.0, rps)[0]
+        minus = _accelerations(model, speed, -dv, -dr, 0.0, rps)[0]
+        A[:, j] = (plus[1:] - minus[1:]) / (2 * h)
+    eig = np.linalg.eigvals(A)
+    return {"eigenvalues": [complex(e).real if abs(complex(e).imag) < 1e-12 else str(complex(e))
+                            for e in eig],  # fmt: skip
+            "stable": bool(np.all(eig.real < 0)), "max_real_part": float(np.max(eig.real))}
+
+
+def surge_equilibrium(model: ManoeuvringModel, speed: float, rps: float | None = None) -> float | None:
+    """Steady straight speed with the rudder amidships: the root of u̇(u, 0, 0, 0) with u̇
+    falling through it, searched up to 3 × the approach speed; None if there is none."""
+    if "u" not in model.structure.dofs:
+        return None
+    grid = np.linspace(0.0, 3.0 * speed, 3001)
+    udot = _accelerations(model, grid, np.zeros_like(grid), np.zeros_like(grid),
+                          np.zeros_like(grid), rps)[:, 0]  # fmt: skip
+    falling = np.flatnonzero((udot[:-1] > 0) & (udot[1:] <= 0))
+    if falling.size == 0:
+        return None
+    k = int(falling[np.argmin(np.abs(grid[falling] - speed))])
+    return float(grid[k] + (grid[k + 1] - grid[k]) * udot[k] / (udot[k] - udot[k + 1]))
+
+
+def held_rudder(model: ManoeuvringModel, speed: float, rps: float | None = None,
+                rudder_deg: float = 35.0, duration: float = 300.0, dt: float = 0.1) -> dict:  # fmt: skip
+    """The largest rudder held to each side: bounded? settled? steady yaw rate and speed."""
+    out = {}
+    for side in ("starboard", "port"):
+        res = turning_circle(model, rudder_deg, side=side, duration=duration, dt=dt, speed=speed,
+                             rps=rps)  # fmt: skip
+        entry = {"diverged": res.diverged, "reason": res.reason}
+        if not res.diverged:
+            tail = res.log.iloc[int(0.9 * len(res.log)) :]
+            r, u = tail["r"].to_numpy(), tail["u"].to_numpy()
+            steady_r, steady_u = float(np.mean(r)), float(np.mean(u))
+            entry.update({
+                "steady_yaw_rate": steady_r, "steady_speed": steady_u,
+                "settled": bool(np.ptp(r) <= SETTLED_FRACTION * max(abs(steady_r), 1e-6)
+                                and np.ptp(u) <= SETTLED_FRACTION * max(abs(steady_u), 1e-6)),
+            })  # fmt: skip
+        out[side] = entry
+    return out
+
+
+def check_plausibility(
+    model: ManoeuvringModel,
+    speed: float,
+    rps: float | None = None,
+    rudder_deg: float = 35.0,
+    duration: float = 300.0,
+) -> tuple[dict, list[str]]:
+    """All checks, and one warning per failed one."""
+    report = {"approach_speed": speed, "rps": rps,
+              "straight_line": straight_line_stability(model, speed, rps),
+              "surge_equilibrium": surge_equilibrium(model, speed, rps),
+              "held_rudder": held_rudder(model, speed, rps, rudder_deg, duration)}  # fmt: skip
+    notes = []
+    sl = report["straight_line"]
+    if sl and not sl["stable"]:
+        notes.append(f"straight-line unstable: a sway–yaw eigenvalue has real part "
+                     f"{sl['max_real_part']:.3g} 1/s > 0 (possible for full-form ships, but a "
+                     "rudder offset grows into a turn)")  # fmt: skip
+    eq = report["surge_equilibrium"]
+    if "u" in model.structure.dofs and (eq is None or eq <= 0):
+        notes.append("no steady straight speed with the rudder amidships: the surge equation "
+                     f"does not balance between 0 and {3 * speed:.3g} m/s")  # fmt: skip
+    for side, entry in report["held_rudder"].items():
+        if entry["diverged"]:
+            notes.append(f"{rudder_deg:g}° rudder held to {side}: {entry['reason']}")
+        elif not entry["settled"]:
+            notes.append(f"{rudder_deg:g}° rudder held to {side}: no steady turn after "
+                         f"{duration:g} s (yaw rate or speed still changing)")  # fmt: skip
+        elif math.copysign(1.0, entry["steady_yaw_rate"]) != (1.0 if side == "starboard" else -1.0):
+            notes.append(f"{rudder_deg:g}° rudder held to {side}: the model turns the other way "
+                         f"(steady yaw rate {entry['steady_yaw_rate']:.3g} rad/s)")  # fmt: skip
+    return report, notes
