@@ -13,8 +13,7 @@ import numpy as np
 import pandas as pd
 from scipy.integrate import cumulative_trapezoid
 
-from .errors import ShipidError
-from .preprocess import rudder_execute_time
+from .preprocess import first_swing_index
 
 MANOEUVRE_KINDS = ("zigzag", "turning")
 
@@ -70,13 +69,10 @@ def _interp(t: np.ndarray, values: np.ndarray, at: float) -> float:
 
 
 def execute_index(log: pd.DataFrame) -> int:
-    """Index of the rudder execute: the start of the swing to the first held large rudder
-    (``rudder_execute_time``), which skips helm corrections during a hand-steered approach; for
-    logs without such a plateau, the first rudder movement (``rudder_order_index``)."""
-    try:
-        return int(np.searchsorted(log["t"].to_numpy(), rudder_execute_time(log)))
-    except ShipidError:
-        return rudder_order_index(log["delta"].to_numpy())
+    """Index of the rudder execute: the start of the first swing that takes the rudder at least
+    halfway to its largest deflection (``preprocess.first_swing_index``), so that small helm
+    corrections of a hand-steered approach are not taken for the execute."""
+    return first_swing_index(log["delta"].to_numpy())
 
 
 def _reference(log: pd.DataFrame, t_order: float | None):
@@ -179,7 +175,10 @@ def _inferred_switch_deg(delta: np.ndarray, dpsi: np.ndarray, i0: int) -> float 
         starts.append(int(near[-1]) if near.size else int(f))
     if not starts:
         return None
-    return float(np.median(np.degrees(np.abs(dpsi[i0 + np.array(starts)]))))
+    # The order fell between the last plateau sample and the next one: take their midpoint.
+    k = i0 + np.array(starts)
+    at_order = 0.5 * (np.abs(dpsi[k]) + np.abs(dpsi[np.minimum(k + 1, len(dpsi) - 1)]))
+    return float(np.median(np.degrees(at_order)))
 
 
 def turning_indices(

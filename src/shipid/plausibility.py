@@ -33,7 +33,7 @@ def straight_line_stability(model: ManoeuvringModel, speed: float, rps: float | 
     """Eigenvalues [1/s] of ∂(v̇, ṙ)/∂(v, r) at (u0, 0, 0, δ = 0), by central differences."""
     if not {"v", "r"} <= set(model.structure.dofs):
         return {}
-    h = 1e-6 * max(speed, 1.0)
+    h = 1e-7 * max(speed, 1.0)
     A = np.zeros((2, 2))
     for j, (dv, dr) in enumerate(((h, 0.0), (0.0, h))):
         plus = _accelerations(model, speed, dv, dr, 0.0, rps)[0]

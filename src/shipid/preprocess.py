@@ -41,11 +41,24 @@ def rudder_execute_time(log: pd.DataFrame, name: str = "log") -> float:
         raise ShipidError(f"{name}: no rudder execute found (no rudder deflection held for "
                           f"{EXECUTE_HOLD_S:g} s); give --start in seconds")  # fmt: skip
     k = int(np.argmax(plateau))
-    side = np.sign(delta[k])
-    # Back along the swing while the rudder still moves towards this side.
+    return float(t[swing_start(delta, k, np.sign(delta[k]))])
+
+
+def swing_start(delta: np.ndarray, k: int, side: float) -> int:
+    """Back from sample k along the rudder swing towards ``side`` (±1), to where it started."""
     while k > 0 and side * (delta[k] - delta[k - 1]) > 0:
         k -= 1
-    return float(t[k])
+    return k
+
+
+def first_swing_index(delta: np.ndarray) -> int:
+    """Start of the first swing that takes the rudder at least halfway from its initial angle to
+    its largest deflection from it (0 if the rudder never moves)."""
+    dev = np.abs(delta - delta[0])
+    if dev.max() <= 0:
+        return 0
+    k = int(np.argmax(dev >= EXECUTE_FRACTION * dev.max()))
+    return swing_start(delta, k, np.sign(delta[k] - delta[0]))
 
 
 def manoeuvre_end_time(log: pd.DataFrame, name: str = "log") -> float:

@@ -88,6 +88,7 @@ def trial_zigzag(model, log: pd.DataFrame, method: str = "euler") -> ManoeuvreRe
     t = log["t"].to_numpy()
     delta = log["delta"].to_numpy()
     dt = float(np.median(np.diff(t)))
+    # The sample after the last unmoved one is where the rudder order took effect.
     i0 = execute_index(log)
     held = float(delta[0])
     swing = np.abs(delta - held)
@@ -105,5 +106,6 @@ def trial_zigzag(model, log: pd.DataFrame, method: str = "euler") -> ManoeuvreRe
     steering = SteeringMachine(max_angle=max(math.radians(35.0), amplitude), max_rate=max_rate)
     rps = float(log["n"].mean()) if "n" in log.columns else None
     return zigzag(model, math.degrees(amplitude), switch, first=first, duration=float(t[-1] - t[0]),
-                  dt=dt, approach=float(t[i0] - t[0]), speed=initial["u"], steering=steering,
+                  dt=dt, approach=float(t[min(i0 + 1, len(t) - 1)] - t[0]), speed=initial["u"],
+                  steering=steering,
                   method=method, initial=initial, rps=rps)  # fmt: skip
