@@ -6,6 +6,8 @@ import warnings
 import numpy as np
 import pytest
 
+from shipid.errors import ShipidError
+from shipid.log import make_log
 from shipid.model import ManoeuvringModel, get_structure, nomoto_parameters
 from shipid.simulate import simulate, simulate_batch, simulate_log
 from shipid.steering import SteeringMachine
@@ -190,3 +192,39 @@ def test_steering_machine_rate_limit_and_lag():
     np.testing.assert_allclose(lag, 0.5 * (1 - np.exp(-(t + 0.1) / 2.0)), rtol=1e-12)
     with pytest.raises(ValueError, match="max_rate"):
         SteeringMachine(max_rate=0.0)
+
+
+def test_rudder_execute_found_after_helm_corrections_and_trim_auto():
+    from shipid.preprocess import manoeuvre_end_time, rudder_execute_time, trim
+
+    t = np.arange(0, 80, 0.1)
+    helm = np.radians(6) * np.sin(2 * np.pi * t / 9)  # hand steering, never steady
+    delta = np.where(t < 30.0, helm, 0.0)
+    ramp = np.clip((t - 30.0) * np.radians(10), 0, np.radians(20))
+    delta = np.where(t >= 30.0, np.where(t < 50.0, ramp, -np.radians(20)), delta)
+    delta[t >= 70.0] = 0.0  # manoeuvre over, rudder amidships
+    n = np.where(t < 75.0, 12.0, 0.0)
+    log = make_log({"t": t, "delta": delta, "u": np.ones_like(t), "v": 0 * t, "r": 0 * t, "n": n})
+    assert rudder_execute_time(log) == pytest.approx(30.0, abs=0.11)
+    assert manoeuvre_end_time(log) == pytest.approx(69.9, abs=0.11)
+    cut = trim(log, "auto", "auto", lead=4.0)
+    assert cut["t"].iloc[0] == pytest.approx(26.0, abs=0.11)
+    assert cut["t"].iloc[-1] == pytest.approx(69.9, abs=0.11)
+    with pytest.raises(ShipidError, match="--start must be a time in seconds or 'auto'"):
+        trim(log, "soon")
+
+
+def test_gaps_are_reported_with_their_span_or_interpolated(tmp_path):
+    from shipid.io import read_log
+
+    t = np.arange(0, 10, 0.5)
+    u = 1.0 + 0.1 * t
+    rows = ["t,delta,u,v,r"] + [f"{a},0.01,{'' if 4 <= i <= 6 else b},0,0"
+                                for i, (a, b) in enumerate(zip(t, u, strict=True))]
+    path = tmp_path / "gap.csv"
+    path.write_text("\n".join(rows) + "\n")
+    with pytest.raises(ShipidError, match=r"column 'u' has 3 missing values at data rows 5–7 "
+                                          r"\(t = 2–3 s\).*--fill-gaps"):
+        read_log(path)
+    filled = read_log(path, fill_gaps=True)
+    np.testing.assert_allclose(filled["u"], u, rtol=1e-12)  # linear in t: exact
