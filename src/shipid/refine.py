@@ -165,7 +165,7 @@ def _equation_error_spread(model: ManoeuvringModel, logs: Sequence[pd.DataFrame]
 def refine(
     model: ManoeuvringModel,
     logs: Sequence[pd.DataFrame] | pd.DataFrame,
-    segment_s: float | None = 30.0,
+    segment_s: float | None = None,
     gamma: float = 1e4,
     states: Sequence[str] | None = None,
     method: str = "euler",
