@@ -68,8 +68,10 @@ def test_refinement_bad_input(trial):
     with pytest.raises(ShipidError, match="cannot fit state 'x'"):
         refine(model, trial, states=("x",))
     rps_model = ManoeuvringModel("blanke-rps", {"u": {"|n|n": 1e-4}})
-    with pytest.raises(ShipidError, match="no 'n' column"):
+    with pytest.raises(ShipidError, match="needs the log column 'n'"):
         refine(rps_model, trial)
+    with pytest.raises(ShipidError, match="needs the log column 'n'"):
+        simulate_log(rps_model, trial)
 
 
 def test_plausibility_of_the_paper_model_against_closed_forms():

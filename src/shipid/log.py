@@ -13,6 +13,8 @@ from collections.abc import Mapping
 import numpy as np
 import pandas as pd
 
+from .errors import ShipidError
+
 REQUIRED = ("t", "delta", "u", "v", "r")
 OPTIONAL = ("psi", "x", "y", "n", "thrust")
 COLUMNS = REQUIRED + OPTIONAL
@@ -39,3 +41,14 @@ def rudder_positive(log: pd.DataFrame, default: str = "port") -> str:
 def starboard_sign(rudder_positive_turns: str) -> float:
     """Sign of the rudder angle that turns the ship to starboard (r > 0)."""
     return 1.0 if rudder_positive_turns == "starboard" else -1.0
+
+
+def input_columns(log: pd.DataFrame, columns, name: str | None = None) -> dict[str, np.ndarray]:
+    """The propulsion input series ('thrust', 'n') a model needs, or an error naming the column."""
+    missing = [c for c in columns if c not in log.columns]
+    if missing:
+        label = name or log.attrs.get("name", "log")
+        raise ShipidError(f"{label}: the model needs the log column {missing[0]!r} "
+                          f"({'thrust [N]' if missing[0] == 'thrust' else 'propeller speed [rps]'}),"
+                          " which this log does not have")  # fmt: skip
+    return {c: log[c].to_numpy() for c in columns}

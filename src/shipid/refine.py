@@ -32,11 +32,12 @@ import pandas as pd
 from scipy.optimize import least_squares
 
 from .errors import ShipidError
+from .log import input_columns
 from .model import DOFS, ManoeuvringModel
-from .regression import input_series, sampling_time
+from .regression import common_sampling_time
 from .simulate import METHODS, DivergenceBounds, integrate_coefficients
 from .terms import TERM_INDEX, TERMS
-from .validate import validate
+from .validate import free_run
 
 SHOT_STATES = ("u", "v", "r")
 # Residual given to every state of every sample after a segment diverged: far beyond any fit.
@@ -91,12 +92,7 @@ def _cut(
     states: tuple[str, ...],
     model: ManoeuvringModel,
 ) -> tuple[_Segments, float, float]:
-    dts = [sampling_time(log, n) for log, n in zip(logs, names, strict=True)]
-    dt = dts[0]
-    for d, n in zip(dts[1:], names[1:], strict=True):
-        if abs(d - dt) > 1e-6 * dt:
-            raise ShipidError(f"{n}: sampling time {d:.6g} s differs from {dt:.6g} s; resample the "
-                              "logs to one Δk with --dt")  # fmt: skip
+    dt = common_sampling_time(logs, names)
     longest = max(len(log) for log in logs) - 1
     if segment_s is None:
         steps = longest
@@ -104,8 +100,8 @@ def _cut(
         if not (math.isfinite(segment_s) and segment_s > 0):
             raise ShipidError(f"--segment must be > 0 s, got {segment_s!r}")
         steps = max(int(round(segment_s / dt)), 2)
-    terms = [n for names_ in model.structure.terms.values() for n in names_]
-    inputs = [input_series(log, terms, name) for log, name in zip(logs, names, strict=True)]
+    inputs = [input_columns(log, model.structure.inputs, name)
+              for log, name in zip(logs, names, strict=True)]  # fmt: skip
     bounds = []  # (log index, first sample, last sample)
     for i, log in enumerate(logs):
         n = len(log) - 1
@@ -152,7 +148,7 @@ def _equation_error_spread(model: ManoeuvringModel, logs: Sequence[pd.DataFrame]
     """One-step equation-error std per DOF of ``model`` on the logs (the increment-form residual)."""
     errors: dict[str, list] = {d: [] for d in model.structure.dofs}
     for log in logs:
-        inputs = input_series(log, [n for t in model.structure.terms.values() for n in t])
+        inputs = input_columns(log, model.structure.inputs)
         acc = model.accelerations(log["u"], log["v"], log["r"], log["delta"],
                                   inputs.get("thrust"), inputs.get("n"))[:-1]  # fmt: skip
         for i, dof in enumerate(DOFS):
@@ -247,17 +243,15 @@ def refine(
     if fit.status == 0:
         notes.append(f"refinement stopped at the evaluation cap ({max_nfev}) before converging; "
                      "raise max_nfev or shorten the segments")  # fmt: skip
-    free_run = []
-    before = validate(model, logs, names, method=method)
-    after = validate(refined, logs, names, method=method)
-    for name, b0, b1 in zip(names, before, after, strict=True):
-        free_run.append({"name": name,
-                         "initial": {s: b0.metrics[s]["std"] for s in SHOT_STATES},
-                         "refined": {s: b1.metrics[s]["std"] for s in SHOT_STATES},
-                         "initial_diverged": b0.simulation.diverged,
-                         "refined_diverged": b1.simulation.diverged})  # fmt: skip
-        if b1.simulation.diverged:
+    runs = []
+    for name, log in zip(names, logs, strict=True):
+        (sim0, m0), (sim1, m1) = free_run(model, log, method), free_run(refined, log, method)
+        runs.append({"name": name,
+                     "initial": {s: m0[s]["std"] for s in SHOT_STATES},
+                     "refined": {s: m1[s]["std"] for s in SHOT_STATES},
+                     "initial_diverged": sim0.diverged, "refined_diverged": sim1.diverged})  # fmt: skip
+        if sim1.diverged:
             notes.append(f"{name}: the refined model diverges in a free run over the whole log "
-                         f"({b1.simulation.reason})")  # fmt: skip
+                         f"({sim1.reason})")  # fmt: skip
     return Refinement(refined, model, seg_len, B, states, cost_initial, float(fit.cost),
-                      int(fit.nfev), bool(fit.success), str(fit.message), free_run, notes)  # fmt: skip
+                      int(fit.nfev), bool(fit.success), str(fit.message), runs, notes)  # fmt: skip

@@ -20,6 +20,7 @@ import numpy as np
 import pandas as pd
 
 from .errors import ShipidError
+from .log import input_columns
 from .model import ModelStructure
 from .terms import required_inputs, term_matrix
 
@@ -53,19 +54,18 @@ def sampling_time(log: pd.DataFrame, name: str = "log") -> float:
     return dt
 
 
-def input_series(log: pd.DataFrame, names: Sequence[str], name: str = "log") -> dict:
-    """The thrust and rps series that the terms ``names`` need, from the log's columns."""
-    out = {}
-    for column in required_inputs(names):
-        if column not in log.columns:
-            what = "a thrust term T" if column == "thrust" else "propeller-speed terms"
-            raise ShipidError(f"{name}: the model has {what} but the log has no {column!r} column")
-        out[column] = log[column].to_numpy()
-    return out
+def common_sampling_time(logs: Sequence[pd.DataFrame], names: Sequence[str]) -> float:
+    """The one uniform Δk of several logs (each uniform, all equal)."""
+    dts = [sampling_time(log, n) for log, n in zip(logs, names, strict=True)]
+    for d, n in zip(dts[1:], names[1:], strict=True):
+        if abs(d - dts[0]) > DT_RTOL * dts[0]:
+            raise ShipidError(f"{n}: sampling time {d:.6g} s differs from {dts[0]:.6g} s of "
+                              f"{names[0]}; resample the logs to one Δk with --dt")  # fmt: skip
+    return dts[0]
 
 
 def _log_terms(log: pd.DataFrame, names: Sequence[str], name: str = "log") -> np.ndarray:
-    inputs = input_series(log, names, name)
+    inputs = input_columns(log, required_inputs(names), name)
     return term_matrix(list(names), log["u"].to_numpy(), log["v"].to_numpy(),
                        log["r"].to_numpy(), log["delta"].to_numpy(), inputs.get("thrust"),
                        inputs.get("n"))  # fmt: skip
@@ -97,12 +97,7 @@ def regression_problem(
         free.remove(dof)  # ξ(k) is already the first regressor
     has_constant = "1" in structure.terms[dof] and "1" not in fixed
     names = names or [f"log {i}" for i in range(len(logs))]
-    dts = [sampling_time(log, n) for log, n in zip(logs, names, strict=True)]
-    dt = dts[0]
-    for d, n in zip(dts[1:], names[1:], strict=True):
-        if abs(d - dt) > DT_RTOL * dt:
-            raise ShipidError(f"{n}: sampling time {d:.6g} s differs from {dt:.6g} s of {names[0]}; "
-                              "resample the logs to one Δk with --dt")  # fmt: skip
+    dt = common_sampling_time(logs, names)
     Xs, ys = [], []
     for log, name in zip(logs, names, strict=True):
         xi = log[dof].to_numpy()

@@ -19,7 +19,7 @@ import numba
 import numpy as np
 import pandas as pd
 
-from .log import make_log
+from .log import input_columns, make_log
 from .model import ManoeuvringModel
 
 METHODS = ("euler", "rk4")
@@ -350,14 +350,9 @@ def simulate_log(
     initial = {k: float(first[k]) for k in STATE_NAMES if k in log.columns}
     for k in ("psi", "x", "y"):
         initial.setdefault(k, 0.0)
-    series = {}
-    for column, needed in (("thrust", dynamics.uses_thrust),
-                           ("n", getattr(dynamics, "uses_rps", False))):  # fmt: skip
-        if needed:
-            if column not in log.columns:
-                raise ValueError(f"{log.attrs.get('name', 'log')}: the model needs the log column "
-                                 f"{column!r}, which this log does not have")  # fmt: skip
-            series[column] = log[column].to_numpy()
+    needed = [c for c, used in (("thrust", dynamics.uses_thrust),
+                                ("n", getattr(dynamics, "uses_rps", False))) if used]  # fmt: skip
+    series = input_columns(log, needed)
     return simulate(dynamics, log["t"].to_numpy(), log["delta"].to_numpy(), initial,
                     series.get("thrust"), method, bounds, rps=series.get("n"), **log.attrs)
 

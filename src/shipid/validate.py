@@ -44,6 +44,14 @@ class Validation:
                 "indices": self.indices}  # fmt: skip
 
 
+def free_run(model, log: pd.DataFrame, method: str = "euler") -> tuple[SimulationResult, dict]:
+    """The free run of ``model`` on ``log`` and its error metrics per state (over the part
+    simulated before any divergence)."""
+    sim = simulate_log(model, log, method=method)
+    n = len(sim.log)
+    return sim, {s: error_metrics(log[s].to_numpy()[:n], sim.log[s].to_numpy()) for s in STATES}
+
+
 def validate(
     model,
     logs: Sequence[pd.DataFrame] | pd.DataFrame,
@@ -58,9 +66,7 @@ def validate(
     names = names or [log.attrs.get("name", f"log {i}") for i, log in enumerate(logs)]
     out = []
     for log, name in zip(logs, names, strict=True):
-        sim = simulate_log(model, log, method=method)
-        n = len(sim.log)
-        metrics = {s: error_metrics(log[s].to_numpy()[:n], sim.log[s].to_numpy()) for s in STATES}
+        sim, metrics = free_run(model, log, method)
         k = kind or detect_manoeuvre(log)
         indices = {}
         if k is not None:
