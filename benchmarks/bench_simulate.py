@@ -10,7 +10,7 @@ import time
 
 import numpy as np
 
-from shipid.simulate import simulate, simulate_batch
+from shipid.dynamics.simulate import simulate, simulate_batch
 from shipid.vessels import scale_ship_model
 
 

@@ -7,14 +7,14 @@ import pandas as pd
 import pytest
 
 from shipid.cli import main
+from shipid.data.preprocess import lowpass
 from shipid.demo import NOISE, PAPER_TABLE, TRAINING, synthesise_trials, within_paper_or_noise
+from shipid.dynamics.model import ManoeuvringModel
 from shipid.errors import ShipidError
-from shipid.identify import identify
-from shipid.manoeuvres import zigzag
-from shipid.model import ManoeuvringModel
-from shipid.modelfile import load_model, save_model
-from shipid.preprocess import lowpass
-from shipid.validate import validate
+from shipid.evaluation.validate import validate
+from shipid.identification.identify import identify
+from shipid.reporting.modelfile import load_model, save_model
+from shipid.trials.manoeuvres import zigzag
 from shipid.vessels import scale_ship
 
 

@@ -7,12 +7,12 @@ import math
 import numpy as np
 import pytest
 
-from shipid.indices import detect_manoeuvre, turning_indices, zigzag_indices
-from shipid.log import make_log
-from shipid.manoeuvres import pull_out, turning_circle, zigzag
-from shipid.model import ManoeuvringModel
-from shipid.simulate import simulate, simulate_log
-from shipid.steering import SteeringMachine
+from shipid.data.log import make_log
+from shipid.dynamics.model import ManoeuvringModel
+from shipid.dynamics.simulate import simulate, simulate_log
+from shipid.dynamics.steering import SteeringMachine
+from shipid.trials.indices import detect_manoeuvre, turning_indices, zigzag_indices
+from shipid.trials.manoeuvres import pull_out, turning_circle, zigzag
 from shipid.vessels import PAPER_IMU, get_vessel, kvlcc2, mariner, scale_ship
 
 TOL = 0.05  # "agreement to about ±5 % is the expected level"

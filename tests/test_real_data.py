@@ -7,12 +7,12 @@ import numpy as np
 import pytest
 
 from shipid.cli import main
+from shipid.data.io import read_log
 from shipid.errors import ShipidError
-from shipid.identify import identify
-from shipid.indices import zigzag_indices
-from shipid.io import read_log
-from shipid.manoeuvres import turning_circle
-from shipid.validate import validate
+from shipid.evaluation.validate import validate
+from shipid.identification.identify import identify
+from shipid.trials.indices import zigzag_indices
+from shipid.trials.manoeuvres import turning_circle
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
 MARIN = DATA / "kvlcc2-marin"
@@ -109,7 +109,7 @@ def test_esso_identified_on_two_20_20_runs_predicts_30_30_and_turns_without_dive
 
 @needs_data
 def test_auto_trim_finds_the_execute_after_a_hand_steered_approach():
-    from shipid.preprocess import manoeuvre_end_time, rudder_execute_time
+    from shipid.data.trim import manoeuvre_end_time, rudder_execute_time
 
     raw = read_log(OSAKA / "zigzag" / "zigzag_31-Jul-2020_13_04_24.csv", fmt="osaka-frt")
     # Data README: first large rudder at t ≈ 44 s; the helm reaches −8° before it.

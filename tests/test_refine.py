@@ -7,15 +7,19 @@ import numpy as np
 import pytest
 
 from shipid.cli import main
+from shipid.dynamics.model import ManoeuvringModel, ModelStructure, get_structure
+from shipid.dynamics.simulate import simulate_log
 from shipid.errors import ShipidError
-from shipid.identify import identify
-from shipid.manoeuvres import zigzag
-from shipid.model import ManoeuvringModel, ModelStructure, get_structure
-from shipid.modelfile import load_model
-from shipid.plausibility import check_plausibility, straight_line_stability, surge_equilibrium
-from shipid.refine import refine
-from shipid.simulate import simulate_log
-from shipid.validate import trial_zigzag, validate
+from shipid.evaluation.validate import trial_zigzag, validate
+from shipid.identification.identify import identify
+from shipid.identification.plausibility import (
+    check_plausibility,
+    straight_line_stability,
+    surge_equilibrium,
+)
+from shipid.identification.refine import refine
+from shipid.reporting.modelfile import load_model
+from shipid.trials.manoeuvres import zigzag
 from shipid.vessels import PAPER_IMU, scale_ship
 from shipid.vessels.scale_ship import scale_ship_model
 

@@ -6,12 +6,12 @@ import warnings
 import numpy as np
 import pytest
 
+from shipid.data.log import make_log
+from shipid.dynamics.model import ManoeuvringModel, get_structure, nomoto_parameters
+from shipid.dynamics.simulate import simulate, simulate_batch, simulate_log
+from shipid.dynamics.steering import SteeringMachine
+from shipid.dynamics.terms import TERMS
 from shipid.errors import ShipidError
-from shipid.log import make_log
-from shipid.model import ManoeuvringModel, get_structure, nomoto_parameters
-from shipid.simulate import simulate, simulate_batch, simulate_log
-from shipid.steering import SteeringMachine
-from shipid.terms import TERMS
 from shipid.vessels import scale_ship_model
 
 
@@ -195,7 +195,7 @@ def test_steering_machine_rate_limit_and_lag():
 
 
 def test_rudder_execute_found_after_helm_corrections_and_trim_auto():
-    from shipid.preprocess import manoeuvre_end_time, rudder_execute_time, trim
+    from shipid.data.trim import manoeuvre_end_time, rudder_execute_time, trim
 
     t = np.arange(0, 80, 0.1)
     helm = np.radians(6) * np.sin(2 * np.pi * t / 9)  # hand steering, never steady
@@ -215,7 +215,7 @@ def test_rudder_execute_found_after_helm_corrections_and_trim_auto():
 
 
 def test_gaps_are_reported_with_their_span_or_interpolated(tmp_path):
-    from shipid.io import read_log
+    from shipid.data.io import read_log
 
     t = np.arange(0, 10, 0.5)
     u = 1.0 + 0.1 * t

@@ -1,2 +1,59 @@
-"""shipid: semiphysical identification of ship manoeuvring models with LS-SVM."""
-__version__ = "0.1.0"
+"""shipid: semiphysical identification of ship manoeuvring models with LS-SVM.
+
+The public API is re-exported here and imported on first use, so that ``import shipid`` (and every
+CLI command) pays only for the modules it touches::
+
+    from shipid import read_log, identify, validate, load_model, zigzag, turning_circle, LSSVR
+"""
+
+from __future__ import annotations
+
+import importlib
+
+__version__ = "0.2.0"
+
+# name → module that defines it
+_EXPORTS = {
+    "ShipidError": "shipid.errors",
+    "ShipidWarning": "shipid.errors",
+    "read_log": "shipid.data.io",
+    "write_log": "shipid.data.io",
+    "make_log": "shipid.data.log",
+    "lowpass": "shipid.data.preprocess",
+    "resample": "shipid.data.preprocess",
+    "trim": "shipid.data.trim",
+    "ManoeuvringModel": "shipid.dynamics.model",
+    "ModelStructure": "shipid.dynamics.model",
+    "get_structure": "shipid.dynamics.model",
+    "simulate": "shipid.dynamics.simulate",
+    "simulate_log": "shipid.dynamics.simulate",
+    "SteeringMachine": "shipid.dynamics.steering",
+    "zigzag": "shipid.trials.manoeuvres",
+    "turning_circle": "shipid.trials.manoeuvres",
+    "pull_out": "shipid.trials.manoeuvres",
+    "manoeuvre_indices": "shipid.trials.indices",
+    "identify": "shipid.identification.identify",
+    "refine": "shipid.identification.refine",
+    "check_plausibility": "shipid.identification.plausibility",
+    "validate": "shipid.evaluation.validate",
+    "load_model": "shipid.reporting.modelfile",
+    "save_model": "shipid.reporting.modelfile",
+    "LSSVR": "shipid.lssvm",
+    "LSSVRCV": "shipid.lssvm",
+    "get_vessel": "shipid.vessels",
+}
+
+__all__ = ["__version__", *_EXPORTS]
+
+
+def __getattr__(name: str):
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module 'shipid' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(__all__)

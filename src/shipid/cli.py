@@ -9,7 +9,7 @@ import sys
 import time
 from pathlib import Path
 
-from .errors import ShipidError
+from shipid.errors import ShipidError
 
 VESSEL_NAMES = ("scale-ship", "mariner", "kvlcc2")
 
@@ -48,7 +48,7 @@ def _time_or_auto(text: str) -> float | str:
 
 
 def _read_logs(args) -> list:
-    from .io import parse_column_map, read_log
+    from shipid.data.io import parse_column_map, read_log
 
     degrees = [c.strip() for c in args.degrees.split(",") if c.strip()]
     cols = parse_column_map(args.columns)
@@ -58,8 +58,8 @@ def _read_logs(args) -> list:
 
 
 def _write_json(path: str, data) -> None:
-    from .atomic import atomic_write_text
-    from .modelfile import json_safe
+    from shipid.outputs import atomic_write_text
+    from shipid.reporting.modelfile import json_safe
 
     atomic_write_text(path, json.dumps(json_safe(data), indent=2, ensure_ascii=False) + "\n")
 
@@ -78,7 +78,7 @@ def _parse_drop(spec: str | None) -> dict[str, list[str]]:
 
 # ---------------------------------------------------------------------------- commands
 def cmd_demo(args) -> int:
-    from .demo import run_demo, summary
+    from shipid.demo import run_demo, summary
 
     t0 = time.perf_counter()
     result = run_demo(args.out, args.seed, progress=lambda m: print(m, file=sys.stderr))
@@ -108,11 +108,11 @@ def _free_run_table(refinement) -> str:
 
 
 def cmd_identify(args) -> int:
-    from .identify import identify
-    from .modelfile import save_model
-    from .plausibility import check_plausibility
-    from .preprocess import lowpass
-    from .refine import refine
+    from shipid.data.preprocess import lowpass
+    from shipid.identification.identify import identify
+    from shipid.identification.plausibility import check_plausibility
+    from shipid.identification.refine import refine
+    from shipid.reporting.modelfile import save_model
 
     logs = _read_logs(args)
     if args.filter is not None:
@@ -174,10 +174,10 @@ def _fmt_speed(u: float | None) -> str:
 
 
 def cmd_validate(args) -> int:
-    from .modelfile import load_model
-    from .plots import measured_vs_simulated
-    from .report import error_table, indices_table
-    from .validate import validate
+    from shipid.evaluation.validate import validate
+    from shipid.reporting.modelfile import load_model
+    from shipid.reporting.plots import measured_vs_simulated
+    from shipid.reporting.report import error_table, indices_table
 
     model = load_model(args.model, "lssvm" if args.lssvm else "model")
     logs = _read_logs(args)
@@ -202,8 +202,8 @@ def cmd_validate(args) -> int:
 def _ship_or_model(name: str):
     """A reference ship (its trimmed speed applies) or a model file with its training speed and
     propeller speed."""
-    from .modelfile import load_document, model_from_document
-    from .vessels import get_vessel
+    from shipid.reporting.modelfile import load_document, model_from_document
+    from shipid.vessels import get_vessel
 
     if name in VESSEL_NAMES:
         return get_vessel(name), None, None
@@ -213,8 +213,8 @@ def _ship_or_model(name: str):
 
 
 def cmd_simulate(args) -> int:
-    from .io import read_log, write_log
-    from .simulate import simulate_log
+    from shipid.data.io import read_log, write_log
+    from shipid.dynamics.simulate import simulate_log
 
     target, _, _ = _ship_or_model(args.model)
     dynamics = getattr(target, "dynamics", target)
@@ -228,7 +228,7 @@ def cmd_simulate(args) -> int:
 
 
 def cmd_manoeuvre(args) -> int:
-    from .manoeuvres import turning_circle, zigzag
+    from shipid.trials.manoeuvres import turning_circle, zigzag
 
     target, training_speed, training_rps = _ship_or_model(args.model)
     kw = {"dt": args.step, "speed": args.speed or training_speed, "rps": args.rps or training_rps}
@@ -246,14 +246,14 @@ def cmd_manoeuvre(args) -> int:
         _write_json(args.json, {"manoeuvre": res.log.attrs.get("manoeuvre"), "diverged": res.diverged,
                                 "diverged_at": res.diverged_at, "indices": res.indices})
     if args.output:
-        from .io import write_log
+        from shipid.data.io import write_log
 
         write_log(res.log, args.output)
     return 0
 
 
 def cmd_indices(args) -> int:
-    from .indices import manoeuvre_indices
+    from shipid.trials.indices import manoeuvre_indices
 
     logs = _read_logs(args)
     out = []
@@ -270,7 +270,7 @@ def cmd_indices(args) -> int:
 
 
 def cmd_import(args) -> int:
-    from .io import write_log
+    from shipid.data.io import write_log
 
     log = _read_logs(args)[0]
     write_log(log, args.output)

@@ -12,16 +12,16 @@ from pathlib import Path
 
 import pandas as pd
 
-from .atomic import atomic_write_text
-from .identify import Identification, identify
-from .io import write_log
-from .manoeuvres import turning_circle, zigzag
-from .plots import measured_vs_simulated, rudder_and_heading, tracks
-from .preprocess import lowpass
-from .report import error_table, indices_table
-from .terms import TERM_DISPLAY
-from .validate import Validation, validate
-from .vessels import PAPER_IMU, scale_ship
+from shipid.data.io import write_log
+from shipid.data.preprocess import lowpass
+from shipid.dynamics.terms import TERM_DISPLAY
+from shipid.evaluation.validate import Validation, validate
+from shipid.identification.identify import Identification, identify
+from shipid.outputs import atomic_write_text
+from shipid.reporting.plots import measured_vs_simulated, rudder_and_heading, tracks
+from shipid.reporting.report import error_table, indices_table
+from shipid.trials.manoeuvres import turning_circle, zigzag
+from shipid.vessels import PAPER_IMU, scale_ship
 
 DT = 0.2
 GAMMA = 1e4

@@ -13,7 +13,8 @@ from functools import lru_cache
 import numpy as np
 from scipy.optimize import brentq
 
-from ..steering import SteeringMachine
+from shipid.dynamics.steering import SteeringMachine
+
 from .vessel import Vessel
 
 RHO = 1025.0

@@ -11,7 +11,8 @@ import math
 
 import numpy as np
 
-from ..steering import SteeringMachine
+from shipid.dynamics.steering import SteeringMachine
+
 from .vessel import Vessel
 
 L = 160.93

@@ -8,8 +8,9 @@ from __future__ import annotations
 
 import math
 
-from ..model import ManoeuvringModel, get_structure
-from ..steering import SteeringMachine
+from shipid.dynamics.model import ManoeuvringModel, get_structure
+from shipid.dynamics.steering import SteeringMachine
+
 from .vessel import Vessel
 
 LENGTH = 4.389  # Lpp [m]

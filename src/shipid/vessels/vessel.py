@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..steering import SteeringMachine
+from shipid.dynamics.steering import SteeringMachine
 
 
 @dataclass(frozen=True)

@@ -17,14 +17,14 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from .indices import detect_manoeuvre, execute_index, manoeuvre_indices, zigzag_indices
-from .log import rudder_positive, starboard_sign
-from .manoeuvres import ManoeuvreResult, zigzag
-from .metrics import error_metrics
-from .model import ManoeuvringModel
-from .simulate import SimulationResult, simulate_log
-from .steering import SteeringMachine
-from .vessels.vessel import Vessel
+from shipid.data.log import rudder_positive, starboard_sign
+from shipid.dynamics.model import ManoeuvringModel
+from shipid.dynamics.simulate import SimulationResult, simulate_log
+from shipid.dynamics.steering import SteeringMachine
+from shipid.evaluation.metrics import error_metrics
+from shipid.trials.indices import detect_manoeuvre, execute_index, manoeuvre_indices, zigzag_indices
+from shipid.trials.manoeuvres import ManoeuvreResult, zigzag
+from shipid.vessels.vessel import Vessel
 
 STATES = ("u", "v", "r")
 

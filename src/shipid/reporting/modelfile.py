@@ -9,12 +9,12 @@ import math
 from collections.abc import Sequence
 from pathlib import Path
 
-from . import __version__
-from .atomic import atomic_write_text
-from .errors import ShipidError
-from .identify import Identification
-from .model import ManoeuvringModel
-from .refine import Refinement
+from shipid import __version__
+from shipid.dynamics.model import ManoeuvringModel
+from shipid.errors import ShipidError
+from shipid.identification.identify import Identification
+from shipid.identification.refine import Refinement
+from shipid.outputs import atomic_write_text
 
 FORMAT = "shipid-model"
 VERSION = 1

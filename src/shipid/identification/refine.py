@@ -31,13 +31,13 @@ import numpy as np
 import pandas as pd
 from scipy.optimize import least_squares
 
-from .errors import ShipidError
-from .log import input_columns
-from .model import DOFS, ManoeuvringModel
-from .regression import common_sampling_time
-from .simulate import METHODS, DivergenceBounds, integrate_coefficients
-from .terms import TERM_INDEX, TERMS
-from .validate import free_run
+from shipid.data.log import input_columns
+from shipid.dynamics.model import DOFS, ManoeuvringModel
+from shipid.dynamics.simulate import METHODS, DivergenceBounds, integrate_coefficients
+from shipid.dynamics.terms import TERM_INDEX, TERMS
+from shipid.errors import ShipidError
+from shipid.evaluation.validate import free_run
+from shipid.identification.regression import common_sampling_time
 
 SHOT_STATES = ("u", "v", "r")
 # Residual given to every state of every sample after a segment diverged: far beyond any fit.

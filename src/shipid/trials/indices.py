@@ -13,7 +13,7 @@ import numpy as np
 import pandas as pd
 from scipy.integrate import cumulative_trapezoid
 
-from .preprocess import first_swing_index
+from shipid.data.trim import first_swing_index
 
 MANOEUVRE_KINDS = ("zigzag", "turning")
 

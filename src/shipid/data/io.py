@@ -11,11 +11,12 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .atomic import atomic_write
-from .errors import ShipidError
-from .formats import read_format
-from .log import COLUMNS, REQUIRED
-from .preprocess import resample, trim, true_runs
+from shipid.data.formats import read_format
+from shipid.data.log import COLUMNS, REQUIRED
+from shipid.data.preprocess import resample
+from shipid.data.trim import trim, true_runs
+from shipid.errors import ShipidError
+from shipid.outputs import atomic_write
 
 ANGLE_COLUMNS = ("delta", "psi", "r")
 UNIT_SUFFIX = re.compile(r"\s*\[[^\]]*\]\s*$")

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from .validate import Validation
+from shipid.evaluation.validate import Validation
 
 INDEX_KEYS = ("first_overshoot_deg", "second_overshoot_deg", "initial_turning_time",
               "advance", "transfer", "tactical_diameter", "steady_turning_diameter",

@@ -13,7 +13,7 @@ from collections.abc import Mapping
 import numpy as np
 import pandas as pd
 
-from .errors import ShipidError
+from shipid.errors import ShipidError
 
 REQUIRED = ("t", "delta", "u", "v", "r")
 OPTIONAL = ("psi", "x", "y", "n", "thrust")

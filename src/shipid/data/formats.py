@@ -19,8 +19,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .errors import ShipidError
-from .log import make_log
+from shipid.data.log import make_log
+from shipid.errors import ShipidError
 
 FORMATS = ("canonical", "simman-marin", "osaka-frt")
 MARIN_COLUMNS = ("t", "x0", "y0", "phi", "psi", "xdot", "ydot", "p", "r", "delta", "n")

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .terms import TERM_DISPLAY, TERM_INDEX, TERMS, required_inputs, term_matrix
+from shipid.dynamics.terms import TERM_DISPLAY, TERM_INDEX, TERMS, required_inputs, term_matrix
 
 DOFS = ("u", "v", "r")
 # Terms linear in the rudder angle; their coefficient signs say which way a positive rudder turns.

@@ -12,8 +12,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
-from .atomic import atomic_write  # noqa: E402
-from .indices import track  # noqa: E402
+from shipid.outputs import atomic_write  # noqa: E402
+from shipid.trials.indices import track  # noqa: E402
 
 LABELS = {"u": "surge u [m/s]", "v": "sway v [m/s]", "r": "yaw rate r [rad/s]"}
 

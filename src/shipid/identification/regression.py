@@ -19,10 +19,10 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from .errors import ShipidError
-from .log import input_columns
-from .model import ModelStructure
-from .terms import required_inputs, term_matrix
+from shipid.data.log import input_columns
+from shipid.dynamics.model import ModelStructure
+from shipid.dynamics.terms import required_inputs, term_matrix
+from shipid.errors import ShipidError
 
 FORMS = ("increment", "paper")
 DT_RTOL = 1e-6

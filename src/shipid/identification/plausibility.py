@@ -18,8 +18,8 @@ import math
 
 import numpy as np
 
-from .manoeuvres import turning_circle
-from .model import ManoeuvringModel
+from shipid.dynamics.model import ManoeuvringModel
+from shipid.trials.manoeuvres import turning_circle
 
 SETTLED_FRACTION = 0.02  # of the steady value, over the last 10 % of the run
 

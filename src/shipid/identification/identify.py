@@ -11,11 +11,16 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from .errors import ShipidError
-from .lssvm import LSSVR, NumericalWarning
-from .model import ManoeuvringModel, ModelStructure, coefficients_from_gamma, get_structure
-from .regression import FORMS, RegressionProblem, regression_problem
-from .terms import TERM_DISPLAY
+from shipid.dynamics.model import (
+    ManoeuvringModel,
+    ModelStructure,
+    coefficients_from_gamma,
+    get_structure,
+)
+from shipid.dynamics.terms import TERM_DISPLAY
+from shipid.errors import ShipidError
+from shipid.identification.regression import FORMS, RegressionProblem, regression_problem
+from shipid.lssvm import LSSVR, NumericalWarning
 
 COLLINEAR_CORRELATION = 0.999
 CONSTANT_VARIATION = 1e-3

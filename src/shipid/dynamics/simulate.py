@@ -19,8 +19,8 @@ import numba
 import numpy as np
 import pandas as pd
 
-from .log import input_columns, make_log
-from .model import ManoeuvringModel
+from shipid.data.log import input_columns, make_log
+from shipid.dynamics.model import ManoeuvringModel
 
 METHODS = ("euler", "rk4")
 STATE_NAMES = ("u", "v", "r", "psi", "x", "y")

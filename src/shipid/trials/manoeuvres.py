@@ -16,10 +16,9 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from .indices import turning_indices, zigzag_indices
-from .log import make_log, starboard_sign
-from .model import ManoeuvringModel
-from .simulate import (
+from shipid.data.log import make_log, starboard_sign
+from shipid.dynamics.model import ManoeuvringModel
+from shipid.dynamics.simulate import (
     METHODS,
     DivergenceBounds,
     divergence_report,
@@ -27,8 +26,9 @@ from .simulate import (
     step_state,
     within_bounds,
 )
-from .steering import SteeringMachine
-from .vessels.vessel import Vessel
+from shipid.dynamics.steering import SteeringMachine
+from shipid.trials.indices import turning_indices, zigzag_indices
+from shipid.vessels.vessel import Vessel
 
 SIDES = ("starboard", "port")
 

@@ -1,0 +1,1 @@
+"""Trial logs in: known formats, the canonical log, checks, trimming and preprocessing."""

@@ -1,0 +1,1 @@
+"""Manoeuvring models and their simulation: term algebra, models, integrators, steering machine."""

@@ -1,0 +1,1 @@
+"""How well a model predicts logs: free-run validation and error metrics."""

@@ -1,0 +1,1 @@
+"""From logs to models: regression problems, LS-SVM identification, refinement, plausibility."""
