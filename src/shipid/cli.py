@@ -1,23 +1,75 @@
-"""The ``shipid`` command line. Exit 0 on success, 1 on a user error (one-line message, no
-traceback), 2 on a usage error. Every output file is written atomically."""
+"""The ``shipid`` command line.
+
+Exit 0 on success, 1 on a user error (one-line message, no traceback, no output file), 2 on a usage
+error, 130 when interrupted (Ctrl-C or SIGTERM: temporaries removed, one line). Option values are
+checked before any work, and so are output paths: an output that is also an input, an unknown
+extension or an unwritable folder is refused before anything is computed. A command's output files
+are written together at its end (``shipid.outputs.OutputSet``). Warnings print as ``warning:``
+lines on stderr and go into the JSON outputs.
+"""
 
 from __future__ import annotations
 
 import argparse
 import json
+import math
+import signal
 import sys
 import time
+import warnings
 from pathlib import Path
 
-from shipid.errors import ShipidError
+from shipid import __version__
+from shipid.errors import ShipidError, ShipidWarning
 
 VESSEL_NAMES = ("scale-ship", "mariner", "kvlcc2")
+KINDS = ("zigzag", "turning", "other")
+
+# Range checks of numeric options: dest → (rule, option as typed). Rules: '>0', '>=0', 'finite',
+# 'int>=1'. Checked before any work; a bad value is a user error (exit 1), not a usage error.
+OPTION_RULES = {
+    "gamma": (">0", "--gamma"), "dt": (">0", "--dt"), "lead": (">=0", "--lead"),
+    "filter": (">0", "--filter"), "segment": (">0", "--segment"),
+    "refine_evals": ("int>=1", "--refine-evals"), "rudder_deg": (">0", "--rudder"),
+    "heading": (">0", "--heading"), "duration": (">0", "--duration"), "step": (">0", "--step"),
+    "speed": (">0", "--speed"), "rps": ("finite", "--rps"), "smooth": (">=0", "--smooth"),
+    "scale": (">0", "--scale"), "start": ("finite", "--start"), "end": ("finite", "--end"),
+    "wind_speed": (">=0", "--wind-speed"), "wind_from": ("finite", "--wind-from"),
+}  # fmt: skip
 
 
+class Interrupted(KeyboardInterrupt):
+    """SIGTERM, handled like Ctrl-C: temporaries removed, one line, exit 130."""
+
+
+def _on_sigterm(signum, frame) -> None:
+    raise Interrupted()
+
+
+def check_options(args) -> None:
+    for dest, (rule, option) in OPTION_RULES.items():
+        value = getattr(args, dest, None)
+        if value is None or isinstance(value, str):
+            continue
+        if rule == "int>=1":
+            if not value >= 1:
+                raise ShipidError(f"{option} must be a whole number ≥ 1, got {value}")
+            continue
+        if not math.isfinite(value):
+            raise ShipidError(f"{option} must be a finite number, got {value}")
+        if rule == ">0" and not value > 0:
+            raise ShipidError(f"{option} must be > 0, got {value:g}")
+        if rule == ">=0" and not value >= 0:
+            raise ShipidError(f"{option} must be ≥ 0, got {value:g}")
+
+
+# ---------------------------------------------------------------------------- shared options
 def _add_log_options(p: argparse.ArgumentParser) -> None:
+    from shipid.data.formats import FORMATS
+
     g = p.add_argument_group("log files")
-    g.add_argument("--format", default="canonical", choices=("canonical", "simman-marin", "osaka-frt"),
-                   help="file format (default canonical CSV/Parquet)")
+    g.add_argument("--format", default="canonical", choices=FORMATS,
+                   help="file format (default: %(default)s CSV/Parquet)")
     g.add_argument("--scale", type=float, metavar="LAMBDA",
                    help="simman-marin: Froude-scale the full-scale data to model scale 1/λ")
     g.add_argument("--columns", metavar="MAP", help="map file columns to canonical names, "
@@ -28,14 +80,15 @@ def _add_log_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--start", type=_time_or_auto, metavar="S|auto",
                    help="trim: first time [s], or 'auto': --lead s before the detected rudder execute")
     g.add_argument("--lead", type=float, default=5.0, metavar="S",
-                   help="with --start auto: seconds kept before the execute (default 5)")
+                   help="with --start auto: seconds kept before the execute (default %(default)s)")
     g.add_argument("--end", type=_time_or_auto, metavar="S|auto",
                    help="trim: last time [s], or 'auto': the end of the manoeuvre (last large rudder, "
                    "propeller still running)")
     g.add_argument("--fill-gaps", action="store_true",
                    help="interpolate missing values inside signals (default: refuse the log)")
     g.add_argument("--rudder-positive", choices=("port", "starboard"),
-                   help="where a positive rudder angle turns the ship (default port, as the paper)")
+                   help="where a positive rudder angle turns the ship (default: the file's "
+                   "metadata, else port as in the paper)")
 
 
 def _time_or_auto(text: str) -> float | str:
@@ -47,21 +100,27 @@ def _time_or_auto(text: str) -> float | str:
         raise argparse.ArgumentTypeError(f"expected seconds or 'auto', got {text!r}") from None
 
 
-def _read_logs(args) -> list:
-    from shipid.data.io import parse_column_map, read_log
+def _read_options(args):
+    from shipid.data.io import ReadOptions, parse_column_map
 
-    degrees = [c.strip() for c in args.degrees.split(",") if c.strip()]
-    cols = parse_column_map(args.columns)
-    return [read_log(p, cols, degrees, args.dt, args.start, args.end, args.rudder_positive,
-                     args.format, args.scale, args.lead, args.fill_gaps)
-            for p in args.logs]  # fmt: skip
+    return ReadOptions(fmt=args.format, columns=parse_column_map(args.columns),
+                       degrees=tuple(c.strip() for c in args.degrees.split(",") if c.strip()),
+                       dt=args.dt, start=args.start, end=args.end, lead=args.lead,
+                       rudder_positive=args.rudder_positive, scale=args.scale,
+                       fill_gaps=args.fill_gaps)  # fmt: skip
 
 
-def _write_json(path: str, data) -> None:
-    from shipid.outputs import atomic_write_text
+def _read_logs(args, paths=None) -> list:
+    from shipid.data.io import read_log
+
+    options = _read_options(args)
+    return [read_log(p, options) for p in (paths or args.logs)]
+
+
+def _json_text(data) -> str:
     from shipid.reporting.modelfile import json_safe
 
-    atomic_write_text(path, json.dumps(json_safe(data), indent=2, ensure_ascii=False) + "\n")
+    return json.dumps(json_safe(data), indent=2, ensure_ascii=False) + "\n"
 
 
 def _parse_drop(spec: str | None) -> dict[str, list[str]]:
@@ -76,10 +135,16 @@ def _parse_drop(spec: str | None) -> dict[str, list[str]]:
     return out
 
 
+def _warn(message: str) -> None:
+    warnings.warn(message, ShipidWarning, stacklevel=2)
+
+
 # ---------------------------------------------------------------------------- commands
 def cmd_demo(args) -> int:
     from shipid.demo import run_demo, summary
+    from shipid.outputs import check_outputs
 
+    check_outputs({"--out": (args.out, "dir")})
     t0 = time.perf_counter()
     result = run_demo(args.out, args.seed, progress=lambda m: print(m, file=sys.stderr))
     print(summary(result))
@@ -107,22 +172,29 @@ def _free_run_table(refinement) -> str:
     return "\n".join(lines)
 
 
+def _fmt_speed(u: float | None) -> str:
+    return "none" if u is None else f"{u:.3g} m/s"
+
+
 def cmd_identify(args) -> int:
     from shipid.data.preprocess import lowpass
     from shipid.identification.identify import identify
     from shipid.identification.plausibility import check_plausibility
     from shipid.identification.refine import refine
-    from shipid.reporting.modelfile import save_model
+    from shipid.outputs import atomic_write_text, check_outputs
+    from shipid.reporting.modelfile import model_text
 
+    check_outputs({"-o": (args.output, "json")}, args.logs)
     logs = _read_logs(args)
     if args.filter is not None:
         logs = [lowpass(log, args.filter) for log in logs]
     names = [str(p) for p in args.logs]
     ident = identify(logs, model=args.model, form=args.form, gamma=args.gamma,
-                     drop=_parse_drop(args.drop), names=names)  # fmt: skip
+                     drop=_parse_drop(args.drop), names=names, force=args.force)  # fmt: skip
     speed, rps = _approach(logs[0], "u"), _approach(logs[0], "n")
     prep = {"dt": args.dt, "start": args.start, "end": args.end, "lead": args.lead,
             "filter_hz": args.filter, "columns": args.columns, "degrees": args.degrees,
+            "format": args.format, "scale": args.scale,
             "approach_speed": speed, "approach_rps": rps,
             "rudder_positive": logs[0].attrs.get("rudder_positive")}  # fmt: skip
     refinement = None
@@ -142,6 +214,9 @@ def cmd_identify(args) -> int:
               f"{refinement.nfev} evaluations ({refinement.message})")
         print(_free_run_table(refinement))
     final = ident.model
+    if speed is None or not speed > 0:
+        raise ShipidError(f"{names[0]}: the first training log starts without headway (u = "
+                          f"{speed}); trim it to the manoeuvre (--start)")  # fmt: skip
     n = rps if ident.model.uses_rps else None
     plausibility, notes = check_plausibility(ident.model, speed, n)
     if refinement:
@@ -162,63 +237,119 @@ def cmd_identify(args) -> int:
     ident.warnings.extend(f"plausibility: {n}" for n in notes)
     if refinement:
         ident.warnings.extend(f"refinement: {n}" for n in refinement.warnings)
-    save_model(args.output, ident, args.logs, prep, refinement, plausibility, final)
+    text = model_text(ident, args.logs, preprocessing=prep, refinement=refinement,
+                      plausibility=plausibility, model=final)  # fmt: skip
+    atomic_write_text(args.output, text)
     for w in ident.warnings:
-        print(f"warning: {w}", file=sys.stderr)
+        _warn(w)
     print(f"model written to {args.output}")
     return 0
 
 
-def _fmt_speed(u: float | None) -> str:
-    return "none" if u is None else f"{u:.3g} m/s"
+def _unique_figure_names(names: list[str]) -> list[str]:
+    """File stems for figures of logs that may share a file name: a, a-2, a-3, ..."""
+    out, used = [], {}
+    for n in names:
+        stem = Path(n).stem or "log"
+        used[stem] = used.get(stem, 0) + 1
+        out.append(stem if used[stem] == 1 else f"{stem}-{used[stem]}")
+    return out
 
 
 def cmd_validate(args) -> int:
+    from shipid.evaluation.envelope import outside_envelope
     from shipid.evaluation.validate import validate
-    from shipid.reporting.modelfile import load_model
+    from shipid.outputs import OutputSet, check_outputs
+    from shipid.reporting.modelfile import (
+        has_refinement,
+        load_document,
+        model_from_document,
+        training_conditions,
+    )
     from shipid.reporting.plots import measured_vs_simulated
     from shipid.reporting.report import error_table, indices_table
 
-    model = load_model(args.model, "lssvm" if args.lssvm else "model")
-    logs = _read_logs(args)
-    vals = validate(model, logs, [str(p) for p in args.logs], method=args.method)
-    print(error_table(vals))
-    table = indices_table(vals)
-    if table.count("\n") > 1:
-        print()
-        print(table)
-    for v in vals:
+    check_outputs({"--json": (args.json, "json"), "--plots": (args.plots, "dir")},
+                  [args.model, *args.logs])  # fmt: skip
+    doc = load_document(args.model)
+    if args.lssvm and not has_refinement(doc):
+        _warn(f"{args.model} has no refinement: its model is the LS-SVM one, which --lssvm "
+              "validates")  # fmt: skip
+    model = model_from_document(doc, args.model, "lssvm" if args.lssvm else "model")
+    env = training_conditions(doc)["envelope"]
+    from shipid.data.io import read_log
+
+    options = _read_options(args)
+    logs, names, failed = [], [], []
+    for p in args.logs:
+        try:
+            logs.append(read_log(p, options))
+            names.append(str(p))
+        except ShipidError as exc:
+            failed.append(str(exc))
+    vals = validate(model, logs, names, method=args.method, kind=args.kind, smooth_s=args.smooth)
+    for v, log in zip(vals, logs, strict=True):
+        if v.error is None:
+            v.warnings.extend(outside_envelope(env, log))
+    good = [v for v in vals if v.error is None]
+    if good:
+        print(error_table(good))
+        table = indices_table(good)
+        if table.count("\n") > 1:
+            print()
+            print(table)
+    for v in good:
         if v.simulation.diverged:
             print(f"{v.name}: {v.simulation.reason}", file=sys.stderr)
-    if args.json:
-        _write_json(args.json, {"logs": [v.to_dict() for v in vals]})
-    if args.plots:
-        for v, log in zip(vals, logs, strict=True):
-            measured_vs_simulated(log, v.simulation.log,
-                                  Path(args.plots) / f"{Path(v.name).stem}.png", v.name)  # fmt: skip
-    return 0
+        for w in v.warnings:
+            _warn(f"{v.name}: {w}")
+    errors = failed + [v.error for v in vals if v.error is not None]
+    for e in errors:
+        print(f"shipid: error: {e}", file=sys.stderr)
+    if not good:
+        return 1  # nothing validated: nothing to write
+    # Some logs validated: the outputs record every log, failed ones with their error.
+    with OutputSet() as out:
+        if args.json:
+            records = [v.to_dict() for v in vals] + [{"name": None, "error": e} for e in failed]
+            out.write(args.json, lambda p: p.write_text(_json_text({"logs": records}), "utf-8"))
+        if args.plots:
+            stems = _unique_figure_names([v.name for v in good])
+            pairs = [(v, log) for v, log in zip(vals, logs, strict=True) if v.error is None]
+            for (v, log), stem in zip(pairs, stems, strict=True):
+                measured_vs_simulated(log, v.simulation.log, Path(args.plots) / f"{stem}.png",
+                                      Path(v.name).name, out=out)  # fmt: skip
+    return 1 if errors else 0
 
 
 def _ship_or_model(name: str):
-    """A reference ship (its trimmed speed applies) or a model file with its training speed and
-    propeller speed."""
-    from shipid.reporting.modelfile import load_document, model_from_document
+    """A reference ship (its trimmed speed applies) or a model file with its training
+    conditions (approach speed, propeller speed, envelope)."""
+    from shipid.reporting.modelfile import load_document, model_from_document, training_conditions
     from shipid.vessels import get_vessel
 
     if name in VESSEL_NAMES:
-        return get_vessel(name), None, None
+        return get_vessel(name), {"speed": None, "rps": None, "envelope": {}}
+    if not Path(name).exists():
+        raise ShipidError(f"{name}: neither a model file nor a known vessel "
+                          f"({', '.join(VESSEL_NAMES)})")  # fmt: skip
     doc = load_document(name)
-    prep = doc.get("identification", {}).get("preprocessing", {})
-    return model_from_document(doc, name), prep.get("approach_speed"), prep.get("approach_rps")
+    return model_from_document(doc, name), training_conditions(doc)
 
 
 def cmd_simulate(args) -> int:
     from shipid.data.io import read_log, write_log
     from shipid.dynamics.simulate import simulate_log
+    from shipid.outputs import check_outputs
 
-    target, _, _ = _ship_or_model(args.model)
+    log_path = args.log or args.rudder
+    if log_path is None:
+        raise ShipidError("simulate needs the log whose rudder (and inputs) drive the model: "
+                          "shipid simulate MODEL LOG -o OUT.csv")  # fmt: skip
+    check_outputs({"-o": (args.output, "log")}, [args.model, log_path])
+    target, _ = _ship_or_model(args.model)
     dynamics = getattr(target, "dynamics", target)
-    log = read_log(args.rudder, degrees=[c for c in args.degrees.split(",") if c])
+    log = read_log(log_path, _read_options(args))
     res = simulate_log(dynamics, log, method=args.method)
     write_log(res.log, args.output)
     if res.diverged:
@@ -228,50 +359,78 @@ def cmd_simulate(args) -> int:
 
 
 def cmd_manoeuvre(args) -> int:
-    from shipid.trials.manoeuvres import turning_circle, zigzag
+    from shipid.evaluation.envelope import implausible_indices, outside_envelope
+    from shipid.outputs import OutputSet, check_outputs
+    from shipid.trials.manoeuvres import pull_out, turning_circle, zigzag
 
-    target, training_speed, training_rps = _ship_or_model(args.model)
-    kw = {"dt": args.step, "speed": args.speed or training_speed, "rps": args.rps or training_rps}
-    if args.duration:
+    check_outputs({"--json": (args.json, "json"), "-o": (args.output, "log")},
+                  [args.model] if Path(args.model).exists() else [])  # fmt: skip
+    target, cond = _ship_or_model(args.model)
+    speed = args.speed if args.speed is not None else cond["speed"]
+    rps = args.rps if args.rps is not None else cond["rps"]
+    kw = {"dt": args.step, "speed": speed, "rps": rps}
+    if args.wind_speed is not None:
+        kw["wind"] = (args.wind_speed, math.radians(args.wind_from or 0.0))
+    if args.duration is not None:
         kw["duration"] = args.duration
     if args.kind == "zigzag":
-        res = zigzag(target, args.rudder, args.heading or args.rudder, first=args.first, **kw)
+        heading = args.heading if args.heading is not None else args.rudder_deg
+        res = zigzag(target, args.rudder_deg, heading, first=args.first, **kw)
+    elif args.kind == "turning":
+        res = turning_circle(target, args.rudder_deg, side=args.first, **kw)
     else:
-        res = turning_circle(target, args.rudder, side=args.first, **kw)
+        if args.duration is not None:
+            kw.pop("duration")
+            kw["hold"] = kw["release"] = args.duration / 2
+        res = pull_out(target, args.rudder_deg, side=args.first, **kw)
     if res.diverged:
         print(res.reason, file=sys.stderr)
+    notes = outside_envelope(cond["envelope"], res.log)
+    if args.kind == "turning" and not res.diverged:
+        notes += implausible_indices(res.indices, speed or getattr(target, "approach_speed", None),
+                                     getattr(target, "length", None))  # fmt: skip
     for k, v in res.indices.items():
         print(f"{k}: {v:.4g}" if isinstance(v, float) else f"{k}: {v}")
-    if args.json:
-        _write_json(args.json, {"manoeuvre": res.log.attrs.get("manoeuvre"), "diverged": res.diverged,
-                                "diverged_at": res.diverged_at, "indices": res.indices})
-    if args.output:
-        from shipid.data.io import write_log
+    for n in notes:
+        _warn(n)
+    with OutputSet() as out:
+        if args.json:
+            doc = {"manoeuvre": res.log.attrs.get("manoeuvre"), "diverged": res.diverged,
+                   "diverged_at": res.diverged_at, "reason": res.reason,
+                   "indices": res.indices, "warnings": notes}  # fmt: skip
+            out.write(args.json, lambda p: p.write_text(_json_text(doc), "utf-8"))
+        if args.output:
+            from shipid.data.io import write_log
 
-        write_log(res.log, args.output)
+            write_log(res.log, args.output, out=out)
     return 0
 
 
 def cmd_indices(args) -> int:
+    from shipid.outputs import atomic_write_text, check_outputs
     from shipid.trials.indices import manoeuvre_indices
 
+    check_outputs({"--json": (args.json, "json")}, args.logs)
     logs = _read_logs(args)
     out = []
     for path, log in zip(args.logs, logs, strict=True):
         ind = manoeuvre_indices(log, args.kind, heading_deg=args.heading, smooth_s=args.smooth)
         out.append({"name": str(path), "indices": ind})
-        print(f"{path}: {ind.get('kind') or 'no manoeuvre detected'}")
+        kind = ind.get("kind")
+        print(f"{path}: {kind}" + (f" ({ind['reason']})" if kind == "other" else ""))
         for k, v in ind.items():
-            if k != "kind":
+            if k not in ("kind", "reason"):
                 print(f"  {k}: {v:.4g}" if isinstance(v, float) else f"  {k}: {v}")
     if args.json:
-        _write_json(args.json, {"logs": out})
+        atomic_write_text(args.json, _json_text({"logs": out}))
     return 0
 
 
 def cmd_import(args) -> int:
     from shipid.data.io import write_log
+    from shipid.outputs import check_outputs
 
+    check_outputs({"-o": (args.output, "log")}, args.logs)
     log = _read_logs(args)[0]
     write_log(log, args.output)
     meta = ", ".join(f"{k}={log.attrs[k]}" for k in ("ship", "rudder_positive", "scale")
@@ -281,32 +440,39 @@ def cmd_import(args) -> int:
     return 0
 
 
+# ---------------------------------------------------------------------------- parser
 def build_parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(prog="shipid", description="Semiphysical identification of ship "
                                  "manoeuvring models with LS-SVM (Moreno-Salinas et al. 2013).")
+    ap.add_argument("--version", action="version", version=f"shipid {__version__}")
     sub = ap.add_subparsers(dest="command", required=True)
 
     p = sub.add_parser("demo", help="the paper's experiment on the embedded scale ship")
-    p.add_argument("--out", default="shipid-demo", help="output folder (default ./shipid-demo)")
-    p.add_argument("--seed", type=int, default=0, help="noise seed (default 0)")
+    p.add_argument("--out", default="shipid-demo", help="output folder (default ./%(default)s)")
+    p.add_argument("--seed", type=int, default=0, help="noise seed (default %(default)s)")
     p.set_defaults(func=cmd_demo)
 
     p = sub.add_parser("identify", help="identify a model from trial logs")
     p.add_argument("logs", nargs="+", metavar="LOG")
     p.add_argument("--model", default="blanke",
-                   help="blanke (default), blanke-thrust, blanke-speed (u² δ rudder), "
-                   "blanke-rps (u² δ and |n|n thrust), linear-sway-yaw, nomoto1")
-    p.add_argument("--form", default="increment", help="increment (default) or paper")
-    p.add_argument("--gamma", type=float, default=1e4, help="LS-SVM regularisation γ (default 1e4)")
+                   help="structure: blanke (default), blanke-thrust, blanke-speed, blanke-rps, "
+                   "abkowitz3, low-speed, wind, linear-sway-yaw, nomoto1; combine with + "
+                   "(blanke-rps+wind) or write terms: 'u: |u|u, v*r, 1; v: ...; r: ...'")
+    p.add_argument("--form", default="increment", choices=("increment", "paper"),
+                   help="regression form (default %(default)s)")
+    p.add_argument("--gamma", type=float, default=1e4,
+                   help="LS-SVM regularisation γ (default %(default)g)")
     p.add_argument("--drop", help="terms to drop, e.g. u:r^2 (the paper drops r²)")
     p.add_argument("--filter", type=float, metavar="HZ", help="zero-phase low-pass of u, v, r")
+    p.add_argument("--force", action="store_true",
+                   help="keep a fit whose regressors are nearly dependent (still reported)")
     p.add_argument("--refine", action="store_true",
                    help="refine the LS-SVM model by output error (free-run fit to the logs); the "
                    "model file holds the refined model and keeps the LS-SVM one")
     p.add_argument("--segment", type=float, metavar="S",
                    help="with --refine: simulate segments of S seconds (default: whole logs)")
     p.add_argument("--refine-evals", type=int, default=200, metavar="N",
-                   help="with --refine: cap on cost evaluations (default 200)")
+                   help="with --refine: cap on cost evaluations (default %(default)s)")
     p.add_argument("-o", "--output", required=True, metavar="MODEL.json")
     _add_log_options(p)
     p.set_defaults(func=cmd_identify)
@@ -314,9 +480,13 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("validate", help="free-run a model against logs: error table and indices")
     p.add_argument("model", metavar="MODEL.json")
     p.add_argument("logs", nargs="+", metavar="LOG")
-    p.add_argument("--json", metavar="OUT", help="write the results as JSON")
+    p.add_argument("--json", metavar="OUT.json", help="write the results as JSON")
     p.add_argument("--plots", metavar="DIR", help="write measured-vs-simulated figures")
-    p.add_argument("--method", default="euler", choices=("euler", "rk4"))
+    p.add_argument("--method", default="euler", choices=("euler", "rk4"),
+                   help="integration scheme (default %(default)s, the paper's)")
+    p.add_argument("--kind", choices=KINDS, help="manoeuvre of the logs (default: detected)")
+    p.add_argument("--smooth", type=float, default=0.0,
+                   help="heading smoothing window for measured indices [s] (default 0)")
     p.add_argument("--lssvm", action="store_true",
                    help="validate the LS-SVM model a refined model file keeps")
     _add_log_options(p)
@@ -324,40 +494,50 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("simulate", help="drive a model or vessel with a logged rudder")
     p.add_argument("model", metavar="MODEL.json|VESSEL")
-    p.add_argument("--rudder", required=True, metavar="LOG", help="log with t, delta, u, v, r")
-    p.add_argument("--degrees", default="", help="angle columns of the rudder log in degrees")
-    p.add_argument("--method", default="rk4", choices=("euler", "rk4"))
+    p.add_argument("log", nargs="?", metavar="LOG", help="log whose rudder and inputs drive it")
+    p.add_argument("--rudder", metavar="LOG", help=argparse.SUPPRESS)  # the name before 0.2
+    p.add_argument("--method", default="rk4", choices=("euler", "rk4"),
+                   help="integration scheme (default %(default)s)")
     p.add_argument("-o", "--output", required=True, metavar="OUT.csv")
+    _add_log_options(p)
     p.set_defaults(func=cmd_simulate)
 
     p = sub.add_parser("manoeuvre", help="run a standard manoeuvre on a model or vessel")
     p.add_argument("model", metavar="MODEL.json|VESSEL")
-    p.add_argument("kind", choices=("zigzag", "turning"))
-    p.add_argument("--rudder", type=float, default=20.0, help="rudder angle [deg]")
-    p.add_argument("--heading", type=float, help="zig-zag switch heading [deg] (default = rudder)")
+    p.add_argument("kind", choices=("zigzag", "turning", "pull-out"))
+    p.add_argument("--rudder", dest="rudder_deg", type=float, default=20.0, metavar="DEG",
+                   help="rudder angle [deg] (default %(default)s)")
+    p.add_argument("--heading", type=float, metavar="DEG",
+                   help="zig-zag switch heading [deg] (default = rudder)")
     p.add_argument("--first", default="starboard", choices=("starboard", "port"),
-                   help="first rudder (zig-zag) or turn side")
+                   help="first rudder (zig-zag) or turn side (default %(default)s)")
     p.add_argument("--duration", type=float, help="length of the run [s]")
-    p.add_argument("--step", type=float, default=0.05, help="integration step [s]")
+    p.add_argument("--step", type=float, default=0.05,
+                   help="integration step [s] (default %(default)s)")
     p.add_argument("--speed", type=float, help="approach speed [m/s] (models: default from training)")
     p.add_argument("--rps", type=float,
                    help="propeller speed [rps] for models with n terms (default from training)")
-    p.add_argument("--json", metavar="OUT")
+    p.add_argument("--wind-speed", type=float, metavar="M/S",
+                   help="constant true wind for models with wind terms (default: still air)")
+    p.add_argument("--wind-from", type=float, metavar="DEG",
+                   help="direction the wind blows from, clockwise from north [deg] (default 0)")
+    p.add_argument("--json", metavar="OUT.json")
     p.add_argument("-o", "--output", metavar="LOG.csv", help="write the simulated log")
     p.set_defaults(func=cmd_manoeuvre)
 
     p = sub.add_parser("import", help="convert a trial file to a canonical log")
     p.add_argument("logs", nargs=1, metavar="FILE")
-    p.add_argument("-o", "--output", required=True, metavar="LOG.csv")
+    p.add_argument("-o", "--output", required=True, metavar="LOG.csv|LOG.parquet")
     _add_log_options(p)
     p.set_defaults(func=cmd_import)
 
     p = sub.add_parser("indices", help="IMO indices of measured logs")
     p.add_argument("logs", nargs="+", metavar="LOG")
-    p.add_argument("--kind", choices=("zigzag", "turning"), help="default: detected")
+    p.add_argument("--kind", choices=KINDS, help="default: detected")
     p.add_argument("--heading", type=float, help="zig-zag switch heading [deg] (default: inferred)")
-    p.add_argument("--smooth", type=float, default=0.0, help="heading smoothing window [s]")
-    p.add_argument("--json", metavar="OUT")
+    p.add_argument("--smooth", type=float, default=0.0,
+                   help="heading smoothing window [s] (default 0)")
+    p.add_argument("--json", metavar="OUT.json")
     _add_log_options(p)
     p.set_defaults(func=cmd_indices)
     return ap
@@ -365,15 +545,41 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
+    previous = signal.signal(signal.SIGTERM, _on_sigterm)
+    caught: list[warnings.WarningMessage] = []
     try:
-        return args.func(args)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", ShipidWarning)
+            check_options(args)
+            code = args.func(args)
     except ShipidError as exc:
-        print(f"shipid: error: {exc}", file=sys.stderr)
-        return 1
+        print(f"shipid: error: {_one_line(exc)}", file=sys.stderr)
+        code = 1
+    except KeyboardInterrupt:
+        print("shipid: interrupted", file=sys.stderr)
+        code = 130
+    except MemoryError:
+        print("shipid: error: out of memory (ask for fewer samples: a shorter run, a larger "
+              "step or --dt)", file=sys.stderr)  # fmt: skip
+        code = 1
     except (ValueError, OSError) as exc:
-        msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-        print(f"shipid: error: {msg}", file=sys.stderr)
-        return 1
+        print(f"shipid: error: {_one_line(exc)}", file=sys.stderr)
+        code = 1
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+    seen = set()
+    for w in caught:
+        if issubclass(w.category, ShipidWarning) and str(w.message) not in seen:
+            seen.add(str(w.message))
+            print(f"warning: {_one_line(w.message)}", file=sys.stderr)
+    return code
+
+
+def _one_line(exc) -> str:
+    text = str(exc)
+    if isinstance(exc, OSError) and exc.strerror:
+        text = f"{exc.filename}: {exc.strerror}" if exc.filename else exc.strerror
+    return text.splitlines()[0] if text else type(exc).__name__
 
 
 if __name__ == "__main__":

@@ -14,10 +14,10 @@ import pandas as pd
 
 from shipid.data.io import write_log
 from shipid.data.preprocess import lowpass
-from shipid.dynamics.terms import TERM_DISPLAY
+from shipid.dynamics.terms import parse_term
 from shipid.evaluation.validate import Validation, validate
 from shipid.identification.identify import Identification, identify
-from shipid.outputs import atomic_write_text
+from shipid.outputs import OutputSet
 from shipid.reporting.plots import measured_vs_simulated, rudder_and_heading, tracks
 from shipid.reporting.report import error_table, indices_table
 from shipid.trials.manoeuvres import turning_circle, zigzag
@@ -76,7 +76,7 @@ def _coefficient_table(truth, fits: dict[str, Identification]) -> str:
             if term == "r^2":
                 continue
             cells = [f"{f.model.coefficients[dof].get(term, float('nan')):.4f}" for f in fits.values()]
-            label = (TERM_DISPLAY[term] or "1").replace("|", "\\|")  # Markdown cell
+            label = (parse_term(term).display() or "1").replace("|", "\\|")  # Markdown cell
             lines.append(f"| {dof}̇ | {label} | {true:.4f} | " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
@@ -114,12 +114,14 @@ def run_demo(out_dir: str | Path = "shipid-demo", seed: int = 0, progress=print)
     parts += ["## IMO indices, measured vs simulated (increment + filter)", "",
               indices_table(validations[f"increment + {FILTER_HZ} Hz filter"]), ""]
     progress("writing figures and report ...")
-    figs = _figures(out, logs, validations)
-    parts += ["## Figures", ""] + [f"![{p.stem}]({p.name})" for p in figs] + [""]
-    text = "\n".join(parts)
-    for name, log in logs.items():
-        write_log(log, out / f"{_slug(name)}.csv")
-    atomic_write_text(out / "report.md", text)
+    # One set: the folder gets every file of this run or, on any failure, none of them.
+    with OutputSet() as files:
+        figs = _figures(out, logs, validations, files)
+        parts += ["## Figures", ""] + [f"![{p.stem}]({p.name})" for p in figs] + [""]
+        text = "\n".join(parts)
+        for name, log in logs.items():
+            write_log(log, out / f"{_slug(name)}.csv", out=files)
+        files.write(out / "report.md", lambda p: p.write_text(text, encoding="utf-8"))
     return DemoResult(logs, fits, validations, truth, text)
 
 
@@ -128,15 +130,15 @@ def _slug(name: str) -> str:
     return "".join(c if c.isalnum() else "-" for c in keep).strip("-").replace("--", "-")
 
 
-def _figures(out: Path, logs, validations) -> list[Path]:
+def _figures(out: Path, logs, validations, files: OutputSet) -> list[Path]:
     best = validations[f"increment + {FILTER_HZ} Hz filter"]
-    paths = [rudder_and_heading(logs[TRAINING], out / "training-rudder-heading.png")]
+    paths = [rudder_and_heading(logs[TRAINING], out / "training-rudder-heading.png", out=files)]
     for v in best:
         paths.append(measured_vs_simulated(logs[v.name], v.simulation.log,
                                            out / f"{_slug(v.name)}.png",
-                                           f"{v.name}: measured vs simulated"))  # fmt: skip
+                                           f"{v.name}: measured vs simulated", out=files))  # fmt: skip
     paths.append(tracks({v.name: v.simulation.log for v in best}, out / "tracks.png",
-                        "x–y tracks (simulated)"))  # fmt: skip
+                        "x–y tracks (simulated)", out=files))  # fmt: skip
     return paths
 
 

@@ -1,5 +1,15 @@
-"""The one exception type of user errors: the CLI prints its message on one line and exits 1."""
+"""The exception and warning types of user-facing problems.
+
+``ShipidError``: bad input or an impossible request; the CLI prints its message on one line and
+exits 1. ``ShipidWarning``: a result that stands but deserves a look (an implausible index, a
+manoeuvre outside the training envelope, a trim that kept little); the CLI prints each as one
+``warning:`` line and records them in its JSON outputs.
+"""
 
 
 class ShipidError(ValueError):
     """Bad input or an impossible request, with a message that names the file, column or option."""
+
+
+class ShipidWarning(UserWarning):
+    """A result that stands but should be looked at; the message names what and why."""

@@ -6,14 +6,25 @@
   are rotated to body axes; degrees become radians; positive rudder turns the ship to port. With
   ``scale`` (λ) the log is Froude-scaled to model scale: lengths ÷ λ, times and speeds ÷ √λ,
   rates and revolutions × √λ.
+* ``simman-hsva``: KVLCC2 free-running tests by HSVA (SIMMAN 2008), model scale, four Latin-1 header
+  lines then 12 whitespace-separated columns t, x0, y0, ψ [deg], ẋ0, ẏ0 (earth-fixed, rotated to body
+  axes here), r [deg/s], roll [deg], δ [deg], n [rps], thrust [N], torque [N·m]; positive rudder
+  turns the ship to port. ``scale`` is the model's λ (45.7 for the SIMMAN KVLCC2) and is only
+  recorded: the data are already at model scale.
 * ``osaka-frt``: Esso Osaka free-running tests (Osaka University), CSV with units in the header,
   body-fixed velocities at midship, ψ wrapped (unwrapped here), empty trailing rows (dropped);
-  positive rudder turns the ship to starboard.
+  positive rudder turns the ship to starboard. The relative wind at midship becomes the canonical
+  ``wind_speed`` and ``wind_angle`` (the direction the apparent wind comes from, clockwise from the
+  bow: the same convention as the file's, checked against its true wind and the ship's velocity).
+
+``detect_format`` recognises each layout from the first lines of a file, so that reading one
+without ``--format`` can say which ``--format`` it needs.
 """
 
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -22,50 +33,69 @@ import pandas as pd
 from shipid.data.log import make_log
 from shipid.errors import ShipidError
 
-FORMATS = ("canonical", "simman-marin", "osaka-frt")
+FORMATS = ("canonical", "simman-marin", "simman-hsva", "osaka-frt")
 MARIN_COLUMNS = ("t", "x0", "y0", "phi", "psi", "xdot", "ydot", "p", "r", "delta", "n")
+HSVA_COLUMNS = ("t", "x0", "y0", "psi", "xdot", "ydot", "r", "roll", "delta", "n", "thrust",
+                "torque")  # fmt: skip
+HSVA_HEADER_LINES = 4
 OSAKA_COLUMNS = {"t [s]": "t", "x_position_mid [m]": "x", "u_velo [m/s]": "u",
                  "y_position_mid [m]": "y", "vm_velo [m/s]": "v", "psi_hat [rad]": "psi",
                  "r_angvelo [rad/s]": "r", "n_prop [rps]": "n",
                  "delta_rudder [rad]": "delta"}  # fmt: skip
+OSAKA_WIND = {"wind_velo_relative_mid [m/s]": "wind_speed",
+              "wind_dir_relative_mid [rad]": "wind_angle"}  # fmt: skip
+_NUMBER = re.compile(r"^[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")
+
+
+def _numeric_rows(path: Path, lines: list[str], first: int, columns: tuple, fmt: str) -> np.ndarray:
+    rows = []
+    for i, line in enumerate(lines[first:], start=first + 1):
+        fields = line.split()
+        if not fields:
+            continue
+        if len(fields) != len(columns):
+            raise ShipidError(f"{path}: line {i} has {len(fields)} values, --format {fmt} "
+                              f"expects {len(columns)} (truncated or not a {fmt} file?)")
+        try:
+            rows.append([float(f) for f in fields])
+        except ValueError:
+            raise ShipidError(f"{path}: line {i} is not numeric (--format {fmt})") from None
+    if len(rows) < 3:
+        raise ShipidError(f"{path}: {len(rows)} data rows, too short (--format {fmt})")
+    return np.array(rows)
+
+
+def _body_velocities(xdot: np.ndarray, ydot: np.ndarray, psi: np.ndarray):
+    c, s = np.cos(psi), np.sin(psi)
+    return xdot * c + ydot * s, -xdot * s + ydot * c
+
+
+def _check_scale(scale: float | None) -> float:
+    if scale is None:
+        return 1.0
+    if not (isinstance(scale, int | float) and math.isfinite(scale) and scale > 0):
+        raise ShipidError(f"--scale must be a number > 0, got {scale!r}")
+    return float(scale)
 
 
 def read_simman_marin(path: str | Path, scale: float | None = None) -> pd.DataFrame:
     """A MARIN SIMMAN .dat file as a canonical log (full scale, or model scale with ``scale``)."""
     path = Path(path)
+    lam = _check_scale(scale)
     try:
         lines = path.read_text(encoding="ascii").splitlines()
     except UnicodeDecodeError:
         raise ShipidError(f"{path}: not a text file (--format simman-marin expects a MARIN .dat)"
                           ) from None
-    rows = []
-    for i, line in enumerate(lines[2:], start=3):
-        fields = line.split()
-        if not fields:
-            continue
-        if len(fields) != len(MARIN_COLUMNS):
-            raise ShipidError(f"{path}: line {i} has {len(fields)} values, --format simman-marin "
-                              f"expects {len(MARIN_COLUMNS)} (truncated or not a MARIN file?)")
-        try:
-            rows.append([float(f) for f in fields])
-        except ValueError:
-            raise ShipidError(f"{path}: line {i} is not numeric (--format simman-marin)") from None
-    if len(rows) < 3:
-        raise ShipidError(f"{path}: {len(rows)} data rows, too short (--format simman-marin)")
-    d = dict(zip(MARIN_COLUMNS, np.array(rows).T, strict=True))
-    n = len(rows)
+    d = dict(zip(MARIN_COLUMNS, _numeric_rows(path, lines, 2, MARIN_COLUMNS, "simman-marin").T,
+                 strict=True))  # fmt: skip
+    n = len(d["t"])
     t = np.arange(n) * (d["t"][-1] / (n - 1))
     psi = np.radians(d["psi"])
-    c, s = np.cos(psi), np.sin(psi)
-    u = d["xdot"] * c + d["ydot"] * s
-    v = -d["xdot"] * s + d["ydot"] * c
+    u, v = _body_velocities(d["xdot"], d["ydot"], psi)
     cols = {"t": t, "delta": np.radians(d["delta"]), "u": u, "v": v, "r": np.radians(d["r"]),
             "psi": psi, "x": d["x0"], "y": d["y0"], "n": d["n"] / 60.0}  # fmt: skip
-    lam = 1.0
     if scale is not None:
-        if not scale > 0:
-            raise ShipidError(f"--scale must be > 0, got {scale!r}")
-        lam = float(scale)
         root = math.sqrt(lam)
         for k in ("t", "u", "v"):
             cols[k] = cols[k] / root
@@ -74,7 +104,28 @@ def read_simman_marin(path: str | Path, scale: float | None = None) -> pd.DataFr
         for k in ("r", "n"):
             cols[k] = cols[k] * root
     return make_log(cols, name=path.name, ship="KVLCC2", source=f"MARIN SIMMAN 2008: {path}",
-                    rudder_positive="port", scale=1.0 if scale is None else lam)  # fmt: skip
+                    rudder_positive="port", scale=lam)  # fmt: skip
+
+
+def read_simman_hsva(path: str | Path, scale: float | None = None) -> pd.DataFrame:
+    """An HSVA SIMMAN .dat file (model scale) as a canonical log."""
+    path = Path(path)
+    lam = _check_scale(scale if scale is not None else 45.7)
+    raw = path.read_bytes()
+    if b"\x00" in raw[:4096]:
+        raise ShipidError(f"{path}: binary file, not an HSVA .dat (--format simman-hsva)")
+    lines = raw.decode("latin-1").splitlines()
+    d = dict(zip(HSVA_COLUMNS, _numeric_rows(path, lines, HSVA_HEADER_LINES, HSVA_COLUMNS,
+                                             "simman-hsva").T, strict=True))  # fmt: skip
+    psi = np.radians(d["psi"])
+    u, v = _body_velocities(d["xdot"], d["ydot"], psi)
+    cols = {"t": d["t"], "delta": np.radians(d["delta"]), "u": u, "v": v,
+            "r": np.radians(d["r"]), "psi": psi, "x": d["x0"], "y": d["y0"], "n": d["n"],
+            "thrust": d["thrust"]}  # fmt: skip
+    title = lines[2].strip() if len(lines) > 2 else ""
+    return make_log(cols, name=path.name, ship="KVLCC2",
+                    source=f"HSVA SIMMAN 2008 ({title}): {path}", rudder_positive="port",
+                    scale=lam)  # fmt: skip
 
 
 def read_osaka_frt(path: str | Path) -> pd.DataFrame:
@@ -87,7 +138,9 @@ def read_osaka_frt(path: str | Path) -> pd.DataFrame:
     missing = [c for c in OSAKA_COLUMNS if c not in df.columns]
     if missing:
         raise ShipidError(f"{path}: missing column(s) {', '.join(missing)} for --format osaka-frt")
-    df = df[list(OSAKA_COLUMNS)].rename(columns=OSAKA_COLUMNS).dropna(how="all")
+    mapping = dict(OSAKA_COLUMNS)
+    mapping.update({k: v for k, v in OSAKA_WIND.items() if k in df.columns})
+    df = df[list(mapping)].rename(columns=mapping).dropna(how="all")
     if len(df) < 3:
         raise ShipidError(f"{path}: {len(df)} data rows, too short (--format osaka-frt)")
     bad = df.isna().any(axis=1).to_numpy()
@@ -95,8 +148,13 @@ def read_osaka_frt(path: str | Path) -> pd.DataFrame:
         row = int(np.argmax(bad))
         col = df.columns[df.iloc[row].isna().to_numpy()][0]
         raise ShipidError(f"{path}: column {col!r} is empty at data row {row + 1}")
-    cols = {c: df[c].to_numpy(dtype=float) for c in df.columns}
+    try:
+        cols = {c: df[c].to_numpy(dtype=float) for c in df.columns}
+    except (TypeError, ValueError):
+        raise ShipidError(f"{path}: a column is not numeric (--format osaka-frt)") from None
     cols["psi"] = np.unwrap(cols["psi"])
+    if "wind_angle" in cols:
+        cols["wind_angle"] = np.angle(np.exp(1j * cols["wind_angle"]))  # (−π, π]
     return make_log(cols, name=path.name, ship="Esso Osaka 3 m model",
                     source=f"Osaka University FRT: {path}", rudder_positive="starboard", scale=1.0)
 
@@ -104,6 +162,31 @@ def read_osaka_frt(path: str | Path) -> pd.DataFrame:
 def read_format(path: str | Path, fmt: str, scale: float | None = None) -> pd.DataFrame:
     if fmt == "simman-marin":
         return read_simman_marin(path, scale)
+    if fmt == "simman-hsva":
+        return read_simman_hsva(path, scale)
     if fmt == "osaka-frt":
         return read_osaka_frt(path)
     raise ShipidError(f"unknown --format {fmt!r}; use one of {', '.join(FORMATS)}")
+
+
+def _all_numbers(line: str, count: int) -> bool:
+    fields = line.split()
+    return len(fields) == count and all(_NUMBER.match(f) for f in fields)
+
+
+def detect_format(path: str | Path) -> str | None:
+    """The known format whose layout the file's first lines match, or None."""
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(8192)
+    except OSError:
+        return None
+    lines = head.decode("latin-1").splitlines()
+    if lines and all(c in lines[0] for c in ("u_velo [m/s]", "delta_rudder [rad]")):
+        return "osaka-frt"
+    data = [ln for ln in lines[:12] if ln.strip()]
+    if len(data) >= 4 and not _all_numbers(data[0], 11) and _all_numbers(data[2], 11):
+        return "simman-marin"
+    if len(data) >= 6 and _all_numbers(data[HSVA_HEADER_LINES], 12) and not _all_numbers(data[0], 12):
+        return "simman-hsva"
+    return None

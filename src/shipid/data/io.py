@@ -1,27 +1,76 @@
 """Trial logs in and out: canonical CSV/Parquet with column mapping, degree conversion, resampling
-and trimming, and checks that name the file, column and row of bad input."""
+and trimming, and checks that name the file, column and row of bad input.
+
+Logs are written with every float at full precision (so times and Δk survive exactly) and with
+their metadata (ship, source, rudder convention, scale): Parquet in its schema metadata, CSV in a
+first comment line ``# shipid-log: {...}``. A log written by shipid reads back as it was.
+"""
 
 from __future__ import annotations
 
-import math
+import dataclasses
+import mmap
 import re
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from shipid.data.formats import read_format
-from shipid.data.log import COLUMNS, REQUIRED
+from shipid.data.checks import ANGLE_COLUMNS, check_log, check_units
+from shipid.data.formats import FORMATS, detect_format, read_format
+from shipid.data.log import COLUMNS, REQUIRED, csv_metadata_line, metadata, parse_csv_metadata
 from shipid.data.preprocess import resample
-from shipid.data.trim import trim, true_runs
+from shipid.data.trim import trim
 from shipid.errors import ShipidError
 from shipid.outputs import atomic_write
 
-ANGLE_COLUMNS = ("delta", "psi", "r")
 UNIT_SUFFIX = re.compile(r"\s*\[[^\]]*\]\s*$")
-# A rudder beyond 60° or a yaw rate beyond 3 rad/s (172 °/s) is not radians.
-RADIAN_PLAUSIBLE = {"delta": math.radians(60.0), "r": 3.0}
+# No log line comes near this: a canonical row is ~200 characters. Longer lines are not logs, and
+# parsing a line of millions of fields takes minutes.
+MAX_LINE_BYTES = 65_536
+
+
+@dataclass(frozen=True)
+class ReadOptions:
+    """How to read a trial log.
+
+    Attributes
+    ----------
+    fmt : 'canonical' (CSV/Parquet) or a known format (``shipid.data.formats.FORMATS``).
+    columns : file column name → canonical name (canonical format).
+    degrees : canonical angle columns given in degrees (delta, psi, wind_angle in deg; r in deg/s).
+    dt : resample to this Δk [s].
+    start, end : trim [s], or 'auto' (``shipid.data.trim.trim``).
+    lead : with ``start='auto'``, seconds kept before the rudder execute.
+    rudder_positive : overrides the file's rudder convention ('port' or 'starboard').
+    scale : Froude scale λ (simman formats).
+    fill_gaps : interpolate missing values inside signals instead of refusing the log.
+    """
+
+    fmt: str = "canonical"
+    columns: Mapping[str, str] = field(default_factory=dict)
+    degrees: tuple[str, ...] = ()
+    dt: float | None = None
+    start: float | str | None = None
+    end: float | str | None = None
+    lead: float = 5.0
+    rudder_positive: str | None = None
+    scale: float | None = None
+    fill_gaps: bool = False
+
+    def __post_init__(self) -> None:
+        if self.fmt not in FORMATS:
+            raise ShipidError(f"unknown --format {self.fmt!r}; use one of {', '.join(FORMATS)}")
+        object.__setattr__(self, "degrees", tuple(self.degrees))
+        for c in self.degrees:
+            if c not in ANGLE_COLUMNS:
+                raise ShipidError(f"--degrees: {c!r} is not an angle column "
+                                  f"({', '.join(ANGLE_COLUMNS)})")  # fmt: skip
+        if self.rudder_positive not in (None, "port", "starboard"):
+            raise ShipidError(f"--rudder-positive must be port or starboard, got "
+                              f"{self.rudder_positive!r}")  # fmt: skip
 
 
 def parse_column_map(spec: str | None) -> dict[str, str]:
@@ -48,146 +97,134 @@ def _check_file(path: Path) -> None:
         raise ShipidError(f"{path}: the file is empty")
 
 
-def _read_table(path: Path) -> pd.DataFrame:
+def longest_line(path: Path) -> tuple[int, int]:
+    """(length in bytes, 1-based line number) of the longest line, in one pass over the file."""
+    with open(path, "rb") as fh, mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ) as mm:
+        ends = np.flatnonzero(np.frombuffer(mm, dtype=np.uint8) == 10)
+        size = len(mm)
+    bounds = np.concatenate([[-1], ends, [size] if (ends.size == 0 or ends[-1] != size - 1) else []])
+    lengths = np.diff(bounds) - 1
+    k = int(np.argmax(lengths))
+    return int(lengths[k]), k + 1
+
+
+def _read_table(path: Path) -> tuple[pd.DataFrame, dict]:
+    """The raw table of a canonical CSV/Parquet log and the metadata the file carries."""
     _check_file(path)
     if path.suffix.lower() in (".parquet", ".pq"):
         try:
-            return pd.read_parquet(path)
+            df = pd.read_parquet(path)
         except Exception as exc:  # pyarrow raises several types for a bad file
-            raise ShipidError(f"{path}: not a readable Parquet file ({exc})") from None
-    head = path.read_bytes()[:4096]
+            raise ShipidError(f"{path}: not a readable Parquet file "
+                              f"({str(exc).splitlines()[0][:200]})") from None  # fmt: skip
+        from shipid.data.log import check_metadata
+
+        return df, check_metadata(dict(df.attrs), str(path))
+    with open(path, "rb") as fh:
+        head = fh.read(4096)
     if b"\x00" in head:
         raise ShipidError(f"{path}: binary file, not a CSV log (use .parquet for Parquet)")
+    length, line = longest_line(path)
+    if length > MAX_LINE_BYTES:
+        raise ShipidError(f"{path}: line {line} is {length} characters long; a log line is a few "
+                          "hundred: not a CSV log (or a broken one)")  # fmt: skip
+    first_lines = head.decode("utf-8", errors="replace").splitlines()[:5]
+    meta = parse_csv_metadata(first_lines, str(path))
     try:
-        return pd.read_csv(path, skip_blank_lines=True, comment="#")
+        df = pd.read_csv(path, skip_blank_lines=True, comment="#")
     except UnicodeDecodeError:
         raise ShipidError(f"{path}: not a text CSV file") from None
     except pd.errors.EmptyDataError:
         raise ShipidError(f"{path}: the file has no header and no rows") from None
     except pd.errors.ParserError as exc:
         raise ShipidError(f"{path}: not a valid CSV file ({str(exc).splitlines()[0]})") from None
+    return df, meta
 
 
-def check_log(df: pd.DataFrame, name: str, min_samples: int = 3, fill_gaps: bool = False) -> None:
-    """Required columns, finite numbers, strictly increasing time, enough samples.
+def _hint_format(path: Path, exc: ShipidError) -> ShipidError:
+    fmt = detect_format(path)
+    if fmt is None:
+        return exc
+    return ShipidError(f"{path}: not a canonical log, but its layout is that of {fmt}: read it "
+                       f"with --format {fmt}")
 
-    Missing values (empty cells, NaN) inside a signal are reported with their span and refused,
-    or, with ``fill_gaps``, interpolated linearly in time. Text and infinities are always refused.
+
+def read_log(path: str | Path, options: ReadOptions | None = None, **overrides) -> pd.DataFrame:
+    """Read a trial log: canonical CSV/Parquet, or a known format (see ``shipid.data.formats``).
+
+    ``options`` (a ``ReadOptions``) or its fields as keywords, e.g.
+    ``read_log(p, fmt="osaka-frt", start="auto", end="auto")``.
     """
-    if len(df) == 0:
-        raise ShipidError(f"{name}: the header has no rows")
-    missing = [c for c in REQUIRED if c not in df.columns]
-    if missing:
-        have = ", ".join(map(str, df.columns))
-        raise ShipidError(f"{name}: missing column(s) {', '.join(missing)} (columns found: {have}); "
-                          "map other names with --columns, e.g. --columns delta=rudder")  # fmt: skip
-    gaps: dict[str, np.ndarray] = {}
-    for c in [c for c in COLUMNS if c in df.columns]:
-        raw = df[c]
-        values = pd.to_numeric(raw, errors="coerce").to_numpy(dtype=float)
-        gap = raw.isna().to_numpy()
-        bad = ~np.isfinite(values) & ~gap
-        if bad.any():
-            row = int(np.argmax(bad))
-            raise ShipidError(f"{name}: column {c!r} has a non-numeric or non-finite value "
-                              f"({raw.iloc[row]!r}) at data row {row + 1}")  # fmt: skip
-        if gap.any():
-            gaps[c] = gap
-        df[c] = values
-    if "t" in gaps:
-        first, last = true_runs(gaps["t"])[0]
-        raise ShipidError(f"{name}: column 't' is missing at data rows {first + 1}–{last + 1}; "
-                          "a log needs a time stamp on every row")  # fmt: skip
-    t = df["t"].to_numpy()
-    for c, gap in gaps.items():
-        runs = true_runs(gap)
-        first, last = runs[0]
-        if np.all(gap):
-            raise ShipidError(f"{name}: column {c!r} is empty")
-        if not fill_gaps:
-            more = f" and {len(runs) - 1} more gap(s)" if len(runs) > 1 else ""
-            span = (f"1 missing value at data row {first + 1} (t = {t[first]:g} s)" if first == last
-                    else f"{last - first + 1} missing values at data rows {first + 1}–{last + 1} "
-                    f"(t = {t[first]:g}–{t[last]:g} s)")
-            raise ShipidError(f"{name}: column {c!r} has {span}{more}; trim them off with "
-                              "--start/--end or interpolate with --fill-gaps")  # fmt: skip
-        good = ~gap
-        df[c] = np.interp(t, t[good], df[c].to_numpy()[good])
-    dt = np.diff(t)
-    if np.any(dt == 0):
-        row = int(np.argmax(dt == 0)) + 1
-        raise ShipidError(f"{name}: duplicate time stamp t = {t[row]:g} "
-                          f"at data rows {row} and {row + 1}")
-    if np.any(dt < 0):
-        row = int(np.argmax(dt < 0)) + 1
-        raise ShipidError(f"{name}: time is not increasing at data row {row + 1} "
-                          f"(t = {t[row]:g} after {t[row - 1]:g})")  # fmt: skip
-    if len(df) < min_samples:
-        raise ShipidError(f"{name}: {len(df)} samples, too short (at least {min_samples} needed)")
-
-
-def read_log(
-    path: str | Path,
-    columns: Mapping[str, str] | None = None,
-    degrees: Sequence[str] = (),
-    dt: float | None = None,
-    start: float | None = None,
-    end: float | None = None,
-    rudder_positive: str | None = None,
-    fmt: str = "canonical",
-    scale: float | None = None,
-    lead: float = 5.0,
-    fill_gaps: bool = False,
-) -> pd.DataFrame:
-    """Read a trial log: canonical CSV/Parquet, or a known format (see ``shipid.formats``).
-
-    columns : file column name → canonical name. degrees : canonical angle columns given in degrees
-    (delta, psi in deg; r in deg/s). dt : resample to this Δk. start/end : trim [s]; start="auto"
-    trims to ``lead`` seconds before the detected rudder execute. rudder_positive : overrides the
-    format's rudder convention. scale : Froude scale λ (MARIN). fill_gaps : interpolate missing
-    values inside signals instead of refusing the log.
-    """
+    options = options or ReadOptions()
+    if overrides:
+        unknown = set(overrides) - {f.name for f in dataclasses.fields(ReadOptions)}
+        if unknown:
+            raise TypeError(f"read_log: unknown option(s) {sorted(unknown)}")
+        options = dataclasses.replace(options, **overrides)
     path = Path(path)
-    if fmt != "canonical":
+    name = str(path)
+    if options.fmt != "canonical":
         _check_file(path)
-        log = read_format(path, fmt, scale)
-        check_log(log, str(path), fill_gaps=fill_gaps)
-        if rudder_positive:
-            log.attrs["rudder_positive"] = rudder_positive
-        return _trim_resample(log, dt, start, end, path, lead)
-    df = _read_table(path)
-    # "u_velo [m/s]" → "u_velo": units in brackets are documentation, not part of the name.
-    df.columns = [UNIT_SUFFIX.sub("", str(c)).strip() for c in df.columns]
-    df = df.rename(columns=dict(columns or {}))
-    df = df.dropna(how="all").reset_index(drop=True)
-    check_log(df, str(path), fill_gaps=fill_gaps)
-    for c in degrees:
-        if c not in ANGLE_COLUMNS:
-            raise ShipidError(f"--degrees: {c!r} is not an angle column ({', '.join(ANGLE_COLUMNS)})")
-        if c in df.columns:
-            df[c] = np.radians(df[c].to_numpy())
-    for c, limit in RADIAN_PLAUSIBLE.items():
-        if c not in degrees and np.max(np.abs(df[c].to_numpy())) > limit:
-            peak = np.max(np.abs(df[c]))
-            raise ShipidError(f"{path}: column {c!r} reaches {peak:.3g}, which looks like degrees; "
-                              f"give --degrees {c} (angles are radians inside)")
-    log = df[[c for c in COLUMNS if c in df.columns]].copy()
-    log.attrs.update({"name": path.name, "source": str(path),
-                      "rudder_positive": rudder_positive or "port"})  # fmt: skip
-    return _trim_resample(log, dt, start, end, path, lead)
-
-
-def _trim_resample(log: pd.DataFrame, dt, start, end, path: Path, lead: float) -> pd.DataFrame:
-    if start is not None or end is not None:
-        log = trim(log, start, end, str(path), lead)
-    if dt is not None:
-        log = resample(log, dt, str(path))
+        log = read_format(path, options.fmt, options.scale)
+        check_log(log, name, fill_gaps=options.fill_gaps)
+        meta = {}
+    else:
+        try:
+            df, meta = _read_table(path)
+        except ShipidError as exc:
+            raise _hint_format(path, exc) from None
+        # "u_velo [m/s]" → "u_velo": units in brackets are documentation, not part of the name.
+        df.columns = [UNIT_SUFFIX.sub("", str(c)).strip() for c in df.columns]
+        df = df.rename(columns=dict(options.columns))
+        dup = df.columns[df.columns.duplicated()].tolist()
+        if dup:
+            raise ShipidError(f"{path}: column {dup[0]!r} appears twice (after --columns)")
+        df = df.dropna(how="all").reset_index(drop=True)
+        try:
+            check_log(df, name, fill_gaps=options.fill_gaps)
+        except ShipidError as exc:
+            if any(c not in df.columns for c in REQUIRED):
+                raise _hint_format(path, exc) from None
+            raise
+        for c in options.degrees:
+            if c in df.columns:
+                df[c] = np.radians(df[c].to_numpy())
+        log = df[[c for c in COLUMNS if c in df.columns]].copy()
+        log.attrs.update({"source": str(path), "rudder_positive": "port"})
+        log.attrs.update(meta)
+        log.attrs.update({k: df.attrs[k] for k in ("time_origin",) if k in df.attrs})
+    check_units(log, name, options.degrees)
+    log.attrs["name"] = path.name
+    if options.rudder_positive:
+        log.attrs["rudder_positive"] = options.rudder_positive
+    if options.start is not None or options.end is not None:
+        log = trim(log, options.start, options.end, name, options.lead)
+    if options.dt is not None:
+        log = resample(log, options.dt, name)
     return log
 
 
-def write_log(log: pd.DataFrame, path: str | Path) -> Path:
-    """Write a canonical log atomically (CSV, or Parquet by extension)."""
+def read_logs(paths: Sequence[str | Path], options: ReadOptions | None = None) -> list[pd.DataFrame]:
+    return [read_log(p, options) for p in paths]
+
+
+def write_log(log: pd.DataFrame, path: str | Path, out=None) -> Path:
+    """Write a canonical log atomically (CSV, or Parquet by extension) with its metadata.
+
+    ``out``: an ``OutputSet`` to stage the file in (written with the set), else written at once.
+    """
     path = Path(path)
+    frame = log.copy()
+    frame.attrs = metadata(log)
     if path.suffix.lower() in (".parquet", ".pq"):
-        return atomic_write(path, lambda p: log.to_parquet(p, index=False))
-    return atomic_write(path, lambda p: log.to_csv(p, index=False, float_format="%.9g"))
+        def writer(p: Path) -> None:
+            frame.to_parquet(p, index=False)
+    else:
+        def writer(p: Path) -> None:
+            with open(p, "w", encoding="utf-8", newline="") as fh:
+                fh.write(csv_metadata_line(frame))
+                # Default float format: repr, the shortest string that reads back bit for bit.
+                frame.to_csv(fh, index=False)
+    if out is not None:
+        return out.write(path, writer)
+    return atomic_write(path, writer)

@@ -1,13 +1,20 @@
 """The canonical trial log: a DataFrame in SI units and radians with its metadata in ``attrs``.
 
 Columns: ``t`` [s], ``delta`` [rad], ``u``, ``v`` [m/s], ``r`` [rad/s]; optional ``psi`` [rad],
-``x``, ``y`` [m], ``n`` [rps], ``thrust`` [N]. Metadata keys: ``ship``, ``source``,
-``rudder_positive`` ('port' or 'starboard': where a positive rudder angle turns the ship) and
-``scale`` (λ = ship length / model length, 1 at full scale).
+``x``, ``y`` [m], ``n`` [rps], ``thrust`` [N], and the relative wind ``wind_speed`` [m/s] and
+``wind_angle`` [rad] (see ``shipid.dynamics.wind`` for the convention).
+
+Metadata keys (``METADATA_KEYS``): ``ship``, ``source``, ``rudder_positive`` ('port' or
+'starboard': where a positive rudder angle turns the ship), ``scale`` (λ = ship length / model
+length, 1 at full scale), ``manoeuvre`` and ``time_origin``. They survive a round trip through
+files: Parquet keeps them in its schema metadata, CSV in a first comment line
+``# shipid-log: {...JSON...}`` (pandas reads such a file with ``comment="#"``).
 """
 
 from __future__ import annotations
 
+import json
+import math
 from collections.abc import Mapping
 
 import numpy as np
@@ -16,9 +23,11 @@ import pandas as pd
 from shipid.errors import ShipidError
 
 REQUIRED = ("t", "delta", "u", "v", "r")
-OPTIONAL = ("psi", "x", "y", "n", "thrust")
+OPTIONAL = ("psi", "x", "y", "n", "thrust", "wind_speed", "wind_angle")
 COLUMNS = REQUIRED + OPTIONAL
 RUDDER_SIDES = ("port", "starboard")
+METADATA_KEYS = ("ship", "source", "rudder_positive", "scale", "manoeuvre", "time_origin")
+CSV_METADATA_PREFIX = "# shipid-log: "
 
 
 def make_log(columns: Mapping[str, np.ndarray], **meta: object) -> pd.DataFrame:
@@ -31,10 +40,15 @@ def make_log(columns: Mapping[str, np.ndarray], **meta: object) -> pd.DataFrame:
     return df
 
 
+def log_name(log: pd.DataFrame, default: str = "log") -> str:
+    return str(log.attrs.get("name", default))
+
+
 def rudder_positive(log: pd.DataFrame, default: str = "port") -> str:
     side = log.attrs.get("rudder_positive", default)
     if side not in RUDDER_SIDES:
-        raise ValueError(f"log metadata rudder_positive must be 'port' or 'starboard', got {side!r}")
+        raise ShipidError(f"{log_name(log)}: metadata rudder_positive must be 'port' or "
+                          f"'starboard', got {side!r}")  # fmt: skip
     return side
 
 
@@ -44,11 +58,67 @@ def starboard_sign(rudder_positive_turns: str) -> float:
 
 
 def input_columns(log: pd.DataFrame, columns, name: str | None = None) -> dict[str, np.ndarray]:
-    """The propulsion input series ('thrust', 'n') a model needs, or an error naming the column."""
+    """The input series (e.g. 'thrust', 'n', 'wind_speed') a model needs, or an error naming the
+    column."""
     missing = [c for c in columns if c not in log.columns]
     if missing:
-        label = name or log.attrs.get("name", "log")
+        label = name or log_name(log)
         raise ShipidError(f"{label}: the model needs the log column {missing[0]!r} "
-                          f"({'thrust [N]' if missing[0] == 'thrust' else 'propeller speed [rps]'}),"
-                          " which this log does not have")  # fmt: skip
+                          f"({COLUMN_DESCRIPTIONS.get(missing[0], missing[0])}), which this log "
+                          "does not have")  # fmt: skip
     return {c: log[c].to_numpy() for c in columns}
+
+
+COLUMN_DESCRIPTIONS = {
+    "t": "time [s]", "delta": "rudder angle [rad]", "u": "surge speed [m/s]",
+    "v": "sway speed [m/s]", "r": "yaw rate [rad/s]", "psi": "heading [rad]", "x": "north [m]",
+    "y": "east [m]", "n": "propeller speed [rps]", "thrust": "thrust [N]",
+    "wind_speed": "relative wind speed [m/s]", "wind_angle": "relative wind angle [rad]",
+}  # fmt: skip
+
+
+def metadata(log: pd.DataFrame) -> dict:
+    """The metadata of ``log`` that files keep (``METADATA_KEYS``), JSON-safe."""
+    out = {}
+    for k in METADATA_KEYS:
+        v = log.attrs.get(k)
+        if v is None:
+            continue
+        if isinstance(v, np.generic):
+            v = v.item()
+        out[k] = v
+    return out
+
+
+def check_metadata(meta: Mapping, name: str) -> dict:
+    """Metadata read from a file: known keys with sensible values, or an error naming the key."""
+    if not isinstance(meta, Mapping):
+        raise ShipidError(f"{name}: log metadata must be a JSON object, got {type(meta).__name__}")
+    out = {}
+    for k, v in meta.items():
+        if k not in METADATA_KEYS:
+            continue  # written by a newer shipid: ignored, not an error
+        if k == "rudder_positive" and v not in RUDDER_SIDES:
+            raise ShipidError(f"{name}: metadata rudder_positive must be 'port' or 'starboard', "
+                              f"got {v!r}")  # fmt: skip
+        if k == "scale" and not (isinstance(v, int | float) and not isinstance(v, bool)
+                                 and math.isfinite(v) and v > 0):
+            raise ShipidError(f"{name}: metadata scale must be a number > 0, got {v!r}")
+        out[k] = v
+    return out
+
+
+def csv_metadata_line(log: pd.DataFrame) -> str:
+    return CSV_METADATA_PREFIX + json.dumps(metadata(log), ensure_ascii=False) + "\n"
+
+
+def parse_csv_metadata(first_lines: list[str], name: str) -> dict:
+    """The metadata of a CSV log's ``# shipid-log:`` comment line, {} when there is none."""
+    for line in first_lines:
+        if line.startswith(CSV_METADATA_PREFIX):
+            try:
+                meta = json.loads(line[len(CSV_METADATA_PREFIX) :])
+            except json.JSONDecodeError as exc:
+                raise ShipidError(f"{name}: malformed shipid-log metadata line ({exc})") from None
+            return check_metadata(meta, name)
+    return {}

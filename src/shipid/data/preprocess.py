@@ -2,21 +2,31 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pandas as pd
-from scipy.signal import butter, sosfiltfilt
 
 from shipid.errors import ShipidError
+from shipid.limits import check_samples
 
 SIGNALS = ("u", "v", "r")
+MAX_UPSAMPLING = 100.0
 
 
 def resample(log: pd.DataFrame, dt: float, name: str = "log") -> pd.DataFrame:
     """Linear interpolation of every column onto t0, t0 + dt, ... (heading unwrapped first)."""
-    if not dt > 0:
-        raise ShipidError(f"--dt must be > 0, got {dt!r}")
+    if not (isinstance(dt, int | float) and math.isfinite(dt) and dt > 0):
+        raise ShipidError(f"--dt must be a finite number > 0, got {dt!r}")
     t = log["t"].to_numpy()
-    grid = np.arange(t[0], t[-1] + 1e-9 * dt, dt)
+    own = float(np.median(np.diff(t)))
+    if dt < own / MAX_UPSAMPLING:
+        raise ShipidError(f"{name}: --dt {dt:g} s is {own / dt:.3g} times finer than the log's "
+                          f"own sampling ({own:g} s): resampling would invent data; use at most "
+                          f"{MAX_UPSAMPLING:g} times finer")  # fmt: skip
+    n = check_samples(math.floor((t[-1] - t[0]) / dt + 1e-9) + 1, 8 * (len(log.columns) + 1),
+                      f"{name}: resampling {t[-1] - t[0]:g} s at --dt {dt:g}")
+    grid = t[0] + dt * np.arange(n)
     if len(grid) < 3:
         raise ShipidError(f"{name}: resampling at --dt {dt} leaves {len(grid)} samples")
     cols = {"t": grid}
@@ -24,9 +34,11 @@ def resample(log: pd.DataFrame, dt: float, name: str = "log") -> pd.DataFrame:
         if c == "t":
             continue
         values = log[c].to_numpy()
-        if c == "psi":
+        if c in ("psi", "wind_angle"):
             values = np.unwrap(values)
         cols[c] = np.interp(grid, t, values)
+        if c == "wind_angle":
+            cols[c] = np.angle(np.exp(1j * cols[c]))
     out = pd.DataFrame(cols)
     out.attrs = dict(log.attrs)
     return out
@@ -38,6 +50,8 @@ def lowpass(log: pd.DataFrame, cutoff_hz: float, columns=SIGNALS, order: int = 2
     Filtering the regressors removes most of the errors-in-variables bias of the one-step
     regression (noise on ξ(k) sits both in the regressors and in the difference ξ(k+1) − ξ(k)).
     """
+    from scipy.signal import butter, sosfiltfilt  # 0.8 s to import: only when filtering
+
     t = log["t"].to_numpy()
     fs = 1.0 / float(np.median(np.diff(t)))
     if not 0 < cutoff_hz < fs / 2:

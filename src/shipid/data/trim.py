@@ -1,21 +1,23 @@
-"""Trimming a log to its manoeuvre: the rudder execute, the end of the manoeuvre, and gaps."""
+"""Trimming a log to its manoeuvre: the rudder execute and the end of the manoeuvre."""
 
 from __future__ import annotations
+
+import math
+import warnings
 
 import numpy as np
 import pandas as pd
 from scipy.ndimage import maximum_filter1d, minimum_filter1d
 
-from shipid.errors import ShipidError
+from shipid.errors import ShipidError, ShipidWarning
 
 EXECUTE_FRACTION = 0.5  # a swing reaching this fraction of the largest one is a manoeuvre
 EXECUTE_HOLD_S = 5.0  # ... and staying there this long (helm corrections do not)
-
-
-def true_runs(mask: np.ndarray) -> list[tuple[int, int]]:
-    """(first, last) indices of the runs of True in a boolean array."""
-    edges = np.diff(np.concatenate([[0], np.asarray(mask, dtype=np.int8), [0]]))
-    return list(zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1, strict=True))
+# A step of the rudder smaller than this fraction of the swing's steepest step is not part of the
+# swing: a resampled rudder creeps by 1e-4° per sample before the order, a real swing moves degrees.
+SWING_STEP_FRACTION = 0.05
+# An automatic trim that keeps less than this fraction of the log is reported.
+TRIM_KEEP_WARN = 0.25
 
 
 def rudder_execute_time(log: pd.DataFrame, name: str = "log") -> float:
@@ -41,8 +43,15 @@ def rudder_execute_time(log: pd.DataFrame, name: str = "log") -> float:
 
 
 def swing_start(delta: np.ndarray, k: int, side: float) -> int:
-    """Back from sample k along the rudder swing towards ``side`` (±1), to where it started."""
-    while k > 0 and side * (delta[k] - delta[k - 1]) > 0:
+    """Back from sample k along the rudder swing towards ``side`` (±1), to where it started: the
+    last sample before the rudder moved by more than ``SWING_STEP_FRACTION`` of the swing's
+    steepest step (the order), so that a slow creep before the order does not count."""
+    steepest = 0.0
+    while k > 0:
+        step = side * (delta[k] - delta[k - 1])
+        if step <= 0 or step < SWING_STEP_FRACTION * steepest:
+            break
+        steepest = max(steepest, step)
         k -= 1
     return k
 
@@ -57,13 +66,15 @@ def first_swing_index(delta: np.ndarray) -> int:
     return swing_start(delta, k, np.sign(delta[k] - delta[0]))
 
 
-def manoeuvre_end_time(log: pd.DataFrame, name: str = "log") -> float:
+def manoeuvre_end_time(log: pd.DataFrame, name: str = "log", execute: float | None = None) -> float:
     """End of the manoeuvre: the last sample with the rudder at least half its largest angle, or
     earlier, the last sample before the propeller speed (column n) falls below 80 % of its median
     during the manoeuvre (the run is being stopped)."""
     t = log["t"].to_numpy()
     delta = log["delta"].to_numpy()
-    start = int(np.searchsorted(t, rudder_execute_time(log, name)))
+    if execute is None:
+        execute = rudder_execute_time(log, name)
+    start = int(np.searchsorted(t, execute))
     big = np.flatnonzero(np.abs(delta) >= EXECUTE_FRACTION * np.abs(delta).max())
     k = int(big[-1])
     if "n" in log.columns:
@@ -89,12 +100,17 @@ def trim(log: pd.DataFrame, start: float | str | None = None, end: float | str |
     before the detected rudder execute (``rudder_execute_time``); ``end="auto"`` ends with the
     manoeuvre (``manoeuvre_end_time``)."""
     t = log["t"]
-    if _auto_time(start, "--start"):
-        if not lead >= 0:
-            raise ShipidError(f"--lead must be ≥ 0 s, got {lead!r}")
-        start = max(rudder_execute_time(log, name) - lead, float(t.iloc[0]))
-    if _auto_time(end, "--end"):
-        end = manoeuvre_end_time(log, name)
+    for option, value in (("--start", start), ("--end", end)):
+        if isinstance(value, int | float) and not math.isfinite(value):
+            raise ShipidError(f"{option} must be a finite time in seconds or 'auto', got {value!r}")
+    auto_start, auto_end = _auto_time(start, "--start"), _auto_time(end, "--end")
+    execute = rudder_execute_time(log, name) if auto_start or auto_end else None
+    if auto_start:
+        if not (isinstance(lead, int | float) and math.isfinite(lead) and lead >= 0):
+            raise ShipidError(f"--lead must be a finite number of seconds ≥ 0, got {lead!r}")
+        start = max(execute - lead, float(t.iloc[0]))
+    if auto_end:
+        end = manoeuvre_end_time(log, name, execute)
     keep = np.ones(len(log), dtype=bool)
     if start is not None:
         keep &= t >= start
@@ -107,4 +123,23 @@ def trim(log: pd.DataFrame, start: float | str | None = None, end: float | str |
     if len(out) < 3:
         raise ShipidError(f"{name}: only {len(out)} samples between --start and --end "
                           f"(the log spans {t.iloc[0]:g}–{t.iloc[-1]:g} s)")  # fmt: skip
+    if execute is not None:
+        _check_auto_span(out, log, name, execute)
     return out
+
+
+def _check_auto_span(out: pd.DataFrame, log: pd.DataFrame, name: str, execute: float) -> None:
+    """An automatic trim must keep at least the rudder plateau that defined the execute; keeping
+    little of a long log says the log is not one zig-zag or turning circle (e.g. random rudder)."""
+    kept = float(out["t"].iloc[-1] - out["t"].iloc[0])
+    after = float(out["t"].iloc[-1]) - execute
+    total = float(log["t"].iloc[-1] - log["t"].iloc[0])
+    span = f"t = {out['t'].iloc[0]:g}–{out['t'].iloc[-1]:g} s"
+    if after < EXECUTE_HOLD_S:
+        raise ShipidError(f"{name}: --start/--end auto kept {kept:.3g} s ({span}) of a "
+                          f"{total:.4g} s log, only {max(after, 0):.3g} s after the rudder execute "
+                          f"at t = {execute:g} s: no single zig-zag or turning circle found "
+                          "(random rudder?); give --start and --end in seconds")  # fmt: skip
+    if kept < TRIM_KEEP_WARN * total:
+        warnings.warn(f"{name}: --start/--end auto kept {kept:.4g} s ({span}) of a {total:.4g} s "
+                      "log; check that this is the manoeuvre", ShipidWarning, stacklevel=3)

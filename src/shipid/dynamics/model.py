@@ -2,30 +2,59 @@
 
 A model is a structure (which terms drive which degree of freedom) plus named coefficients::
 
-    u̇ = Σ θᵤⱼ φⱼ(u, v, r, δ, T),   v̇ = Σ θᵥⱼ φⱼ(...),   ṙ = Σ θᵣⱼ φⱼ(...)
+    u̇ = Σ θᵤⱼ φⱼ(u, v, r, δ, ...),   v̇ = Σ θᵥⱼ φⱼ(...),   ṙ = Σ θᵣⱼ φⱼ(...)
 
-Degrees of freedom without an equation are held at their initial value (Nomoto models hold surge and
-sway). The discrete form of eq. (9)–(13) for a sampling time Δk is ξ(k+1) = Γ_ξᵀ x_ξ(k) with
-x_ξ = [ξ(k), terms...] and Γ_ξ = [1 + Δk·θ_ξξ, Δk·θ_ξⱼ...].
+Terms are texts of the term algebra (``shipid.dynamics.terms``), stored canonically, so a user's
+own terms round-trip through model files. Degrees of freedom without an equation are held at their
+initial value (Nomoto models hold surge and sway). The discrete form of eq. (9)–(13) for a sampling
+time Δk is ξ(k+1) = Γ_ξᵀ x_ξ(k) with x_ξ = [ξ(k), terms...] and Γ_ξ = [1 + Δk·θ_ξξ, Δk·θ_ξⱼ...].
+
+Structures are named (``STRUCTURES``), combined with ``+`` (``"blanke-rps+wind"``: the union of
+terms per DOF), or written out: ``"u: |u|u, v*r, 1; v: u*r, u*v, delta, 1; r: u*r, u*v, delta, 1"``.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from shipid.dynamics.terms import TERM_DISPLAY, TERM_INDEX, TERMS, required_inputs, term_matrix
+from shipid.dynamics import kernel
+from shipid.dynamics.terms import (
+    INPUT_SIGNALS,
+    TermCode,
+    parse_term,
+    parse_terms,
+    required_inputs,
+    term_code,
+    term_matrix,
+)
+from shipid.errors import ShipidError
 
 DOFS = ("u", "v", "r")
-# Terms linear in the rudder angle; their coefficient signs say which way a positive rudder turns.
-RUDDER_GAIN_TERMS = ("delta", "u^2*delta", "|n|n*delta")
 DOF_DISPLAY = {"u": "u̇", "v": "v̇", "r": "ṙ"}
 
 _BLANKE_SWAY_YAW = ("ur", "uv", "|v|v", "|v|r", "delta", "1")
 _BLANKE_SPEED = ("ur", "uv", "|v|v", "|v|r", "u^2*delta", "1")
-BASE_STRUCTURES: dict[str, dict[str, tuple[str, ...]]] = {
+# Third-order Taylor expansion about straight running (Abkowitz 1964; the Mariner model's set):
+# surge even in v, r, δ; sway and yaw odd, with the speed-dependent couplings.
+_ABK_SURGE = ("u", "u^2", "u^3", "v^2", "r^2", "v*r", "delta^2", "u*delta^2", "v*delta",
+              "u*v*delta", "1")  # fmt: skip
+_ABK_LATERAL = ("v", "r", "v^3", "v^2*r", "v*r^2", "r^3", "u*v", "u*r", "delta", "delta^3",
+                "u*delta", "u^2*delta", "v*delta^2", "v^2*delta", "r*delta^2", "1")  # fmt: skip
+# Low and negative speed, propeller reversal (Esso random runs): hull forces in |u|, |v|, |r|
+# forms that keep their sign when the ship goes astern, thrust with n⁺ and n⁻ separately
+# (ahead and astern open-water curves), and a rudder in the propeller race only when n > 0.
+_LOW_SPEED_SURGE = ("|u|u", "v*r", "r^2", "pos(n)^2", "neg(n)^2", "u*|n|", "delta^2", "1")
+_LOW_SPEED_LATERAL = ("u*v", "|u|*r", "|v|v", "|v|r", "|r|r", "u*|u|*delta", "pos(n)^2*delta",
+                      "v*|n|", "1")  # fmt: skip
+# Wind load terms on the relative wind (Isherwood-type, to second order in the angle).
+_WIND_SURGE = ("U_A^2*cos(gamma_A)",)
+_WIND_LATERAL = ("U_A^2*sin(gamma_A)", "U_A^2*sin(2*gamma_A)")
+
+STRUCTURES: dict[str, dict[str, tuple[str, ...]]] = {
     # Paper eqs. (7)–(8), (12): surge with the thrust term merged into the constant (constant
     # commanded speed, as in the paper's experiment); "blanke-thrust" keeps T as a regressor.
     "blanke": {"u": ("|u|u", "vr", "r^2", "delta^2", "1"), "v": _BLANKE_SWAY_YAW,
@@ -40,30 +69,41 @@ BASE_STRUCTURES: dict[str, dict[str, tuple[str, ...]]] = {
     # ∝ |n|n enters the surge equation; needs the log column n [rps].
     "blanke-rps": {"u": ("|u|u", "vr", "r^2", "delta^2", "|n|n", "1"), "v": _BLANKE_SPEED,
                    "r": _BLANKE_SPEED},
+    "abkowitz3": {"u": _ABK_SURGE, "v": _ABK_LATERAL, "r": _ABK_LATERAL},
+    "low-speed": {"u": _LOW_SPEED_SURGE, "v": _LOW_SPEED_LATERAL, "r": _LOW_SPEED_LATERAL},
+    "wind": {"u": _WIND_SURGE, "v": _WIND_LATERAL, "r": _WIND_LATERAL},
     # Linear sway–yaw (Davidson–Schiff) model at the held surge speed; its yaw transfer function is
     # Nomoto's second-order model, see ``nomoto_parameters``.
     "linear-sway-yaw": {"v": ("v", "r", "delta", "1"), "r": ("v", "r", "delta", "1")},
     # Nomoto first order, T ṙ + r = K δ (+ a constant for rudder offset): ṙ = −r/T + (K/T) δ.
     "nomoto1": {"r": ("r", "delta", "1")},
 }  # fmt: skip
+BASE_STRUCTURES = STRUCTURES  # the name of earlier versions
 
 
 @dataclass(frozen=True)
 class ModelStructure:
-    """Which regressor terms drive which degree of freedom."""
+    """Which regressor terms drive which degree of freedom (canonical term texts)."""
 
     name: str
     terms: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        for dof, names in self.terms.items():
+        if not isinstance(self.terms, Mapping):
+            raise ShipidError(f"structure {self.name!r}: terms must map u/v/r to term lists")
+        canon = {}
+        for dof in DOFS:
+            if dof not in self.terms:
+                continue
+            names = self.terms[dof]
+            if isinstance(names, str) or not all(isinstance(n, str) for n in names):
+                raise ShipidError(f"structure {self.name!r}: the {dof} terms must be a list of "
+                                  f"texts, got {names!r}")  # fmt: skip
+            canon[dof] = tuple(t.text for t in parse_terms(names, f"the {dof} equation"))
+        for dof in self.terms:
             if dof not in DOFS:
-                raise ValueError(f"unknown degree of freedom {dof!r}; use one of {DOFS}")
-            for n in names:
-                if n not in TERM_INDEX:
-                    raise ValueError(f"unknown model term {n!r}; known terms: {', '.join(TERMS)}")
-            if len(set(names)) != len(names):
-                raise ValueError(f"duplicate terms in the {dof} equation: {names}")
+                raise ShipidError(f"unknown degree of freedom {dof!r}; use one of {DOFS}")
+        object.__setattr__(self, "terms", canon)
 
     @property
     def dofs(self) -> tuple[str, ...]:
@@ -74,9 +114,17 @@ class ModelStructure:
         return tuple(d for d in DOFS if d not in self.terms)
 
     @property
+    def all_terms(self) -> tuple[str, ...]:
+        """Every term of the structure once, in order of first appearance (u, v, r)."""
+        seen: dict[str, None] = {}
+        for dof in self.dofs:
+            seen.update(dict.fromkeys(self.terms[dof]))
+        return tuple(seen)
+
+    @property
     def inputs(self) -> tuple[str, ...]:
-        """Log columns of the propulsion inputs the structure needs: 'n' [rps], 'thrust' [N]."""
-        return required_inputs([n for names in self.terms.values() for n in names])
+        """Log columns besides t, u, v, r, delta the structure needs (n, thrust, wind...)."""
+        return required_inputs(self.all_terms)
 
     @property
     def uses_thrust(self) -> bool:
@@ -86,19 +134,32 @@ class ModelStructure:
     def uses_rps(self) -> bool:
         return "n" in self.inputs
 
+    @property
+    def uses_wind(self) -> bool:
+        return any(s in self.inputs for s in ("wind_speed", "wind_angle"))
+
     def without(self, drop: Mapping[str, tuple[str, ...] | list[str]]) -> ModelStructure:
         """The structure with some terms dropped, e.g. ``{"u": ["r^2"]}`` as in the paper."""
         terms = dict(self.terms)
         for dof, names in drop.items():
             if dof not in terms:
-                raise ValueError(f"cannot drop terms of {dof!r}: {self.name} has no {dof} equation")
-            missing = set(names) - set(terms[dof])
+                raise ShipidError(f"cannot drop terms of {dof!r}: {self.name} has no {dof} equation")
+            try:
+                canon = [parse_term(n).text for n in names]
+            except ShipidError as exc:
+                raise ShipidError(f"cannot drop {list(names)} from the {dof} equation: {exc}") from None
+            missing = [n for n, c in zip(names, canon, strict=True) if c not in terms[dof]]
             if missing:
-                raise ValueError(f"cannot drop {sorted(missing)} from the {dof} equation of "
-                                 f"{self.name}: it has {list(terms[dof])}")
-            terms[dof] = tuple(n for n in terms[dof] if n not in names)
+                raise ShipidError(f"cannot drop {missing} from the {dof} equation of "
+                                  f"{self.name}: it has {list(terms[dof])}")
+            terms[dof] = tuple(n for n in terms[dof] if n not in canon)
         suffix = ",".join(f"{d}-{'-'.join(n)}" for d, n in drop.items() if n)
         return ModelStructure(f"{self.name}[drop {suffix}]" if suffix else self.name, terms)
+
+    def __add__(self, other: ModelStructure) -> ModelStructure:
+        terms = {d: tuple(dict.fromkeys(self.terms.get(d, ()) + other.terms.get(d, ())))
+                 for d in DOFS if d in self.terms or d in other.terms}  # fmt: skip
+        return ModelStructure(f"{self.name}+{other.name}", terms)
 
     def to_dict(self) -> dict:
         return {"name": self.name, "terms": {d: list(t) for d, t in self.terms.items()}}
@@ -108,12 +169,71 @@ class ModelStructure:
         return cls(str(data["name"]), {d: tuple(t) for d, t in data["terms"].items()})
 
 
+def parse_structure_spec(spec: str, name: str = "custom") -> ModelStructure:
+    """'u: |u|u, v*r, 1; v: u*r, delta; r: u*r, delta' → a structure (DOFs separated by ';')."""
+    terms: dict[str, tuple[str, ...]] = {}
+    for part in spec.split(";"):
+        if not part.strip():
+            continue
+        if ":" not in part:
+            raise ShipidError(f"model terms {part.strip()!r}: expected 'dof: term, term, ...'")
+        dof, body = (s.strip() for s in part.split(":", 1))
+        if dof not in DOFS:
+            raise ShipidError(f"model terms: unknown degree of freedom {dof!r}; use u, v or r")
+        if dof in terms:
+            raise ShipidError(f"model terms: the {dof} equation is given twice")
+        terms[dof] = tuple(t.strip() for t in body.split(",") if t.strip())
+    if not terms:
+        raise ShipidError(f"model terms {spec!r}: no equations")
+    return ModelStructure(name, terms)
+
+
 def get_structure(name: str) -> ModelStructure:
-    """A named base structure: 'blanke', 'blanke-thrust', 'blanke-speed', 'blanke-rps',
-    'linear-sway-yaw' or 'nomoto1'."""
-    if name not in BASE_STRUCTURES:
-        raise ValueError(f"unknown model {name!r}; known models: {', '.join(BASE_STRUCTURES)}")
-    return ModelStructure(name, BASE_STRUCTURES[name])
+    """A structure by name ('blanke', 'abkowitz3', ...), a sum of names ('blanke-rps+wind'), or
+    a written-out spec ('u: ...; v: ...; r: ...')."""
+    if not isinstance(name, str) or not name.strip():
+        raise ShipidError(f"model must be a structure name or term spec, got {name!r}")
+    if ":" in name:
+        return parse_structure_spec(name)
+    parts = [p.strip() for p in name.split("+")]
+    unknown = [p for p in parts if p not in STRUCTURES]
+    if unknown:
+        raise ShipidError(f"unknown model {unknown[0]!r}; known models: {', '.join(STRUCTURES)} "
+                          "(combine with +, or write terms as 'u: ...; v: ...; r: ...')")
+    out = ModelStructure(parts[0], STRUCTURES[parts[0]])
+    for p in parts[1:]:
+        out = out + ModelStructure(p, STRUCTURES[p])
+    return out
+
+
+class TermTable(dict):
+    """{canonical term text: value} that also answers to any spelling of a term ('uv', 'u*v')."""
+
+    def _key(self, key):
+        if isinstance(key, str) and not dict.__contains__(self, key):
+            try:
+                return parse_term(key).text
+            except ShipidError:
+                return key
+        return key
+
+    def __getitem__(self, key):
+        return dict.__getitem__(self, self._key(key))
+
+    def __contains__(self, key) -> bool:
+        return dict.__contains__(self, self._key(key))
+
+    def get(self, key, default=None):
+        return dict.get(self, self._key(key), default)
+
+
+def _finite(value, where: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, int | float | np.floating | np.integer):
+        raise ShipidError(f"coefficient {where} must be a number, got {value!r}")
+    value = float(value)
+    if not math.isfinite(value):
+        raise ShipidError(f"coefficient {where} is {value}; coefficients must be finite")
+    return value
 
 
 class ManoeuvringModel:
@@ -121,9 +241,15 @@ class ManoeuvringModel:
 
     Parameters
     ----------
-    structure : ModelStructure or str
+    structure : ModelStructure or str (see ``get_structure``)
     coefficients : mapping dof → {term: value}; terms of the structure that are missing are 0.
+        Term texts in any spelling of the algebra ('vr' or 'v*r').
     name : str, optional
+
+    Attributes
+    ----------
+    term_texts : every term once (the columns of ``theta``); theta : (3, T) coefficient matrix of
+    the compiled simulator (a held DOF has a zero row); code : the terms' factor table.
     """
 
     def __init__(
@@ -134,24 +260,36 @@ class ManoeuvringModel:
     ) -> None:
         self.structure = get_structure(structure) if isinstance(structure, str) else structure
         self.name = name or self.structure.name
+        if not isinstance(coefficients, Mapping):
+            raise ShipidError("coefficients must map u/v/r to {term: value}")
         self.coefficients: dict[str, dict[str, float]] = {}
         for dof, names in self.structure.terms.items():
-            given = dict(coefficients.get(dof, {}))
+            given_raw = coefficients.get(dof, {})
+            if not isinstance(given_raw, Mapping):
+                raise ShipidError(f"coefficients of {dof} must map terms to numbers")
+            given = {parse_term(k).text: _finite(v, f"{dof}:{k}") for k, v in given_raw.items()}
             unknown = set(given) - set(names)
             if unknown:
-                raise ValueError(f"coefficients {sorted(unknown)} are not terms of the {dof} "
-                                 f"equation of {self.structure.name} ({list(names)})")
-            self.coefficients[dof] = {n: float(given.get(n, 0.0)) for n in names}
+                raise ShipidError(f"coefficients {sorted(unknown)} are not terms of the {dof} "
+                                  f"equation of {self.structure.name} ({list(names)})")
+            self.coefficients[dof] = TermTable({n: given.get(n, 0.0) for n in names})
         for dof in set(coefficients) - set(self.structure.terms):
-            if any(v != 0 for v in coefficients[dof].values()):
-                raise ValueError(f"{self.structure.name} has no {dof} equation")
-        # (3, len(TERMS)) coefficient matrix of the compiled simulator; held DOFs have zero rows.
-        self.theta = np.zeros((3, len(TERMS)))
+            values = coefficients[dof]
+            if not isinstance(values, Mapping) or any(v != 0 for v in values.values()):
+                raise ShipidError(f"{self.structure.name} has no {dof} equation")
+        self.term_texts = self.structure.all_terms
+        index = {t: j for j, t in enumerate(self.term_texts)}
+        self.theta = np.zeros((3, len(self.term_texts)))
         for i, dof in enumerate(DOFS):
             for n, val in self.coefficients.get(dof, {}).items():
-                self.theta[i, TERM_INDEX[n]] = val
+                self.theta[i, index[n]] = val
+        self.code: TermCode = term_code(self.term_texts)
 
-    # ------------------------------------------------------------------ evaluation
+    # ------------------------------------------------------------------ inputs
+    @property
+    def inputs(self) -> tuple[str, ...]:
+        return self.structure.inputs
+
     @property
     def uses_thrust(self) -> bool:
         return self.structure.uses_thrust
@@ -161,31 +299,59 @@ class ManoeuvringModel:
         return self.structure.uses_rps
 
     @property
-    def rudder_positive_turns(self) -> str:
-        """'port' or 'starboard': where a positive rudder angle turns this model (sign of ∂ṙ/∂δ,
-        read from the first rudder term of the yaw equation: δ, u² δ or |n|n δ)."""
-        yaw = self.coefficients.get("r", {})
-        gain = next((yaw[n] for n in RUDDER_GAIN_TERMS if yaw.get(n, 0.0) != 0.0), 0.0)
-        return "starboard" if gain > 0 else "port"
+    def uses_wind(self) -> bool:
+        return self.structure.uses_wind
 
-    def accelerations(self, u, v, r, delta, thrust=None, rps=None) -> np.ndarray:
-        """(n, 3) accelerations [u̇, v̇, ṙ] for arrays of states and inputs (held DOFs give 0)."""
+    # ------------------------------------------------------------------ evaluation
+    def accelerations(self, u, v, r, delta, thrust=None, rps=None, **inputs) -> np.ndarray:
+        """(n, 3) accelerations [u̇, v̇, ṙ] for arrays of states and inputs (held DOFs give 0).
+        ``inputs``: further input columns by name (wind_speed, wind_angle)."""
         u = np.atleast_1d(np.asarray(u, dtype=float))
-        out = np.zeros((u.shape[0], 3))
-        for i, dof in enumerate(DOFS):
-            coefs = self.coefficients.get(dof)
-            if coefs:
-                Phi = term_matrix(list(coefs), u, v, r, delta, thrust, rps)
-                out[:, i] = Phi @ np.fromiter(coefs.values(), float)
+        given = {"delta": delta, "thrust": thrust, "n": rps, **inputs}
+        Phi = term_matrix(self.term_texts, u, v, r, given)
+        return Phi @ self.theta.T
+
+    def derivatives(self, nu: np.ndarray, delta: np.ndarray, thrust=None, rps=None,
+                    **inputs) -> np.ndarray:  # fmt: skip
+        """Dynamics protocol of ``shipid.dynamics.simulate``: (B, 3) body accelerations."""
+        return self.accelerations(nu[:, 0], nu[:, 1], nu[:, 2], delta, thrust, rps, **inputs)
+
+    def compiled_accelerations(self, states: np.ndarray, inputs: np.ndarray) -> np.ndarray:
+        """The compiled kernel's accelerations at states (M, 3) and inputs (M, 5) in
+        ``INPUT_SIGNALS`` order; equal to ``accelerations`` (a test checks it)."""
+        out = np.empty((states.shape[0], 3))
+        kernel.accelerations(self.theta, *self.code.arrays(), self.code.uses_derived,
+                             np.ascontiguousarray(states, dtype=float),
+                             np.ascontiguousarray(inputs, dtype=float), out)  # fmt: skip
         return out
 
-    def derivatives(self, nu: np.ndarray, delta: np.ndarray, thrust=None, rps=None) -> np.ndarray:
-        """Dynamics protocol of ``shipid.simulate``: (B, 3) body accelerations."""
-        return self.accelerations(nu[:, 0], nu[:, 1], nu[:, 2], delta, thrust, rps)
+    def rudder_gain(self, speed: float = 1.0, rps: float | None = None) -> float:
+        """∂ṙ/∂δ at straight running at ``speed`` (propeller ``rps``, still air), by central
+        difference over ±1°."""
+        h = math.radians(1.0)
+        n = 1.0 if rps is None else float(rps)
+        u = np.array([speed, speed])
+        extra = {}
+        if self.uses_wind:
+            # Still air: the apparent wind of the ship's own motion, from ahead.
+            extra = {"wind_speed": np.abs(u), "wind_angle": np.zeros(2)}
+        acc = self.accelerations(u, np.zeros(2), np.zeros(2), np.array([h, -h]),
+                                 np.full(2, n), np.full(2, n), **extra)  # fmt: skip
+        return float(acc[0, 2] - acc[1, 2]) / (2 * h)
+
+    def rudder_positive_turns_at(self, speed: float = 1.0, rps: float | None = None) -> str:
+        """'port' or 'starboard': where a positive rudder angle turns this model at ``speed``."""
+        return "starboard" if self.rudder_gain(speed, rps) > 0 else "port"
+
+    @property
+    def rudder_positive_turns(self) -> str:
+        """Where a positive rudder angle turns this model (at 1 m/s, n = 1 rps)."""
+        return self.rudder_positive_turns_at()
 
     # ------------------------------------------------------------------ presentation
-    def equations(self, precision: int = 4) -> str:
-        """The model as equations in the paper's style (eq. 16)."""
+    def equations(self, precision: int = 4, std_errors: Mapping | None = None) -> str:
+        """The model as equations in the paper's style (eq. 16); with ``std_errors``
+        ({dof: {term: σ}}), each coefficient is followed by ± its standard error."""
         lines = []
         for dof in self.structure.dofs:
             parts = []
@@ -193,7 +359,10 @@ class ManoeuvringModel:
                 # Coefficients of large regressors (|n|n ~ 100 rps²) are tiny: keep their digits.
                 small = 0 < abs(c) < 10 ** (1 - precision)
                 mag = f"{abs(c):.{precision - 1}e}" if small else f"{abs(c):.{precision}f}"
-                term = TERM_DISPLAY[n]
+                se = (std_errors or {}).get(dof, {}).get(n)
+                if se is not None and math.isfinite(se):
+                    mag = f"({mag} ± {se:.2g})"
+                term = parse_term(n).display()
                 sign = "−" if c < 0 else "+"
                 parts.append((sign, f"{mag} {term}".rstrip()))
             body = " ".join(f"{s} {p}" for s, p in parts)
@@ -287,3 +456,6 @@ def nomoto_parameters(model: ManoeuvringModel) -> dict[str, float]:
     # Numerator of r/δ: b2 s + (a21 b1 − a11 b2) = K det (1 + T3 s)/… → T3 = b2 / (a21 b1 − a11 b2).
     T3 = b2 / (A[1, 0] * b1 - A[0, 0] * b2)
     return {"K": float(K), "T1": float(T1), "T2": float(T2), "T3": float(T3)}
+
+
+INPUT_COLUMNS = INPUT_SIGNALS

@@ -1,104 +1,388 @@
-"""Regressor terms of the manoeuvring models: products of states and inputs (paper eq. 12).
+"""Regressor terms as an open algebra: a term is a product of factors of the log's signals.
 
-Every model of this package is linear in its parameters: each acceleration is
-Σ θⱼ·φⱼ(u, v, r, δ, T, n) over the terms below (T thrust [N], n propeller speed [rps]). The order
-of ``TERMS`` is the column order of the coefficient matrices used by the compiled simulator, so it
-must only ever be appended to.
+Every model of this package is linear in its parameters: each acceleration is Σ θⱼ·φⱼ over terms
+φⱼ (paper eq. 12 for the Blanke terms). A term is written as text and parsed once::
+
+    "|u|u"   "v*r"   "u^2*delta"   "|n|*n*delta"   "delta^3"   "U^2*sin(2*wind_angle)"   "1"
+
+Signals (``SIGNALS``): the states u, v [m/s], r [rad/s]; derived U = √(u² + v²) [m/s] and the
+drift angle beta = atan2(−v, u) [rad]; the inputs delta [rad], n [rps], thrust [N] (alias T); the
+relative wind wind_speed [m/s] (alias U_A) and wind_angle [rad] (alias gamma_A).
+
+Factors: ``x`` or ``x^p`` (integer p ≥ 1), ``|x|`` or ``|x|^p``, ``pos(x)`` = max(x, 0) and
+``neg(x)`` = max(−x, 0) (four-quadrant propeller and rudder terms), and ``sin(k*a)``, ``cos(k*a)``
+of an angle signal a (beta, delta, wind_angle) with an integer k ≥ 1, each with an optional power.
+Factors are joined by ``*`` or written side by side (``vr``, ``|u|u``: the names of the original
+Blanke terms parse unchanged). Like factors merge (``u*u`` is ``u^2``), factors are put in one
+order, so each term has one canonical text (``Term.text``), which model files store.
+
+Evaluation is one vectorised NumPy path (``term_matrix``) and one compiled path (``TermCode``, the
+factor table the simulator's kernel interprets), for any set of terms.
 """
 
 from __future__ import annotations
 
+import re
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass
+from functools import lru_cache
+
 import numpy as np
 
-TERMS: tuple[str, ...] = (
-    "1", "u", "v", "r", "|u|u", "vr", "r^2", "ur", "uv", "|v|v", "|v|r", "|r|r", "|r|v",
-    "delta", "delta^2", "T", "u^2*delta", "|n|n", "un", "|n|n*delta",
-)  # fmt: skip
-TERM_INDEX = {name: i for i, name in enumerate(TERMS)}
+from shipid.errors import ShipidError
 
-# How each term is printed in equations, in the paper's style.
-TERM_DISPLAY = {
-    "1": "", "u": "u", "v": "v", "r": "r", "|u|u": "|u|u", "vr": "v r", "r^2": "r²",
-    "ur": "u r", "uv": "u v", "|v|v": "|v|v", "|v|r": "|v| r", "|r|r": "|r| r", "|r|v": "|r| v",
-    "delta": "δ", "delta^2": "δ²", "T": "T", "u^2*delta": "u² δ", "|n|n": "|n|n", "un": "u n",
-    "|n|n*delta": "|n|n δ",
-}  # fmt: skip
-# Log columns of the propulsion inputs some terms need (thrust T [N], propeller speed n [rps]).
-TERM_INPUTS = {"T": "thrust", "|n|n": "n", "un": "n", "|n|n*delta": "n"}
+# Signal order is the compiled kernel's signal vector: append only.
+SIGNALS: tuple[str, ...] = ("u", "v", "r", "U", "beta", "delta", "n", "thrust", "wind_speed",
+                            "wind_angle")  # fmt: skip
+SIGNAL_INDEX = {s: i for i, s in enumerate(SIGNALS)}
+STATE_SIGNALS = ("u", "v", "r")
+DERIVED_SIGNALS = ("U", "beta")
+# Inputs: log columns that drive a model (the rudder and the rest).
+INPUT_SIGNALS = ("delta", "n", "thrust", "wind_speed", "wind_angle")
+ANGLE_SIGNALS = ("beta", "delta", "wind_angle")
+ALIASES = {"T": "thrust", "U_A": "wind_speed", "gamma_A": "wind_angle"}
+DISPLAY = {"delta": "δ", "beta": "β", "thrust": "T", "wind_speed": "U_A", "wind_angle": "γ_A"}
+OPS = ("pow", "abs", "pos", "neg", "sin", "cos")
+OP_CODE = {op: i for i, op in enumerate(OPS)}
+FUNCTIONS = ("abs", "pos", "neg", "sin", "cos")
+# Order of factors in a term's text: states, derived, propulsion, wind, the rudder last (u² δ).
+FACTOR_ORDER = {s: i for i, s in enumerate(("u", "v", "r", "U", "beta", "n", "thrust",
+                                            "wind_speed", "wind_angle", "delta"))}  # fmt: skip
+SUPERSCRIPT = str.maketrans("0123456789", "⁰¹²³⁴⁵⁶⁷⁸⁹")
+MAX_POWER = 9
 
-
-def required_inputs(names) -> tuple[str, ...]:
-    """Log columns ('thrust', 'n') that the terms ``names`` need besides u, v, r and δ."""
-    return tuple(sorted({TERM_INPUTS[n] for n in names if n in TERM_INPUTS}))
-
-
-def term_values(
-    name: str,
-    u: np.ndarray,
-    v: np.ndarray,
-    r: np.ndarray,
-    delta: np.ndarray,
-    thrust: np.ndarray,
-    rps: np.ndarray,
-) -> np.ndarray:
-    """Value of one regressor term for arrays of states and inputs."""
-    match name:
-        case "1":
-            return np.ones_like(u)
-        case "u":
-            return u
-        case "v":
-            return v
-        case "r":
-            return r
-        case "|u|u":
-            return np.abs(u) * u
-        case "vr":
-            return v * r
-        case "r^2":
-            return r * r
-        case "ur":
-            return u * r
-        case "uv":
-            return u * v
-        case "|v|v":
-            return np.abs(v) * v
-        case "|v|r":
-            return np.abs(v) * r
-        case "|r|r":
-            return np.abs(r) * r
-        case "|r|v":
-            return np.abs(r) * v
-        case "delta":
-            return delta
-        case "delta^2":
-            return delta * delta
-        case "T":
-            return thrust
-        case "u^2*delta":
-            return u * u * delta
-        case "|n|n":
-            return np.abs(rps) * rps
-        case "un":
-            return u * rps
-        case "|n|n*delta":
-            return np.abs(rps) * rps * delta
-    raise ValueError(f"unknown model term {name!r}; known terms: {', '.join(TERMS)}")
+_NAMES = sorted([*SIGNALS, *ALIASES], key=len, reverse=True)
 
 
-def term_matrix(
-    names: tuple[str, ...] | list[str],
-    u: np.ndarray,
-    v: np.ndarray,
-    r: np.ndarray,
-    delta: np.ndarray,
-    thrust: np.ndarray | None = None,
-    rps: np.ndarray | None = None,
-) -> np.ndarray:
-    """(n, len(names)) matrix of regressor values (absent inputs count as zero)."""
+@dataclass(frozen=True, order=True)
+class Factor:
+    """op(k·signal)^power, op one of ``OPS`` (k only for sin/cos)."""
+
+    signal: int  # index into SIGNALS
+    op: int  # index into OPS
+    k: int = 1
+    power: int = 1
+
+    @property
+    def name(self) -> str:
+        return SIGNALS[self.signal]
+
+    @property
+    def text(self) -> str:
+        op, name = OPS[self.op], self.name
+        if op == "pow":
+            base = name
+        elif op == "abs":
+            base = f"|{name}|"
+        elif op in ("pos", "neg"):
+            base = f"{op}({name})"
+        else:
+            base = f"{op}({self.k}*{name})" if self.k != 1 else f"{op}({name})"
+        return base if self.power == 1 else f"{base}^{self.power}"
+
+    def display(self) -> str:
+        op, name = OPS[self.op], DISPLAY.get(self.name, self.name)
+        sup = str(self.power).translate(SUPERSCRIPT) if self.power != 1 else ""
+        if op == "pow":
+            return f"{name}{sup}"
+        if op == "abs":
+            return f"|{name}|{sup}"
+        if op in ("pos", "neg"):
+            return f"{op}({name}){sup}"
+        arg = f"{self.k}{name}" if self.k != 1 else name
+        return f"{op}{sup}({arg})" if sup else f"{op}({arg})"
+
+    def values(self, x: np.ndarray) -> np.ndarray:
+        op = OPS[self.op]
+        if op == "pow":
+            base = x
+        elif op == "abs":
+            base = np.abs(x)
+        elif op == "pos":
+            base = np.maximum(x, 0.0)
+        elif op == "neg":
+            base = np.maximum(-x, 0.0)
+        elif op == "sin":
+            base = np.sin(self.k * x)
+        else:
+            base = np.cos(self.k * x)
+        return base if self.power == 1 else base**self.power
+
+
+@dataclass(frozen=True)
+class Term:
+    """A product of factors; no factors is the constant term "1"."""
+
+    factors: tuple[Factor, ...] = ()
+
+    @property
+    def text(self) -> str:
+        return "*".join(f.text for f in self.factors) if self.factors else "1"
+
+    @property
+    def signals(self) -> tuple[str, ...]:
+        return tuple(sorted({f.name for f in self.factors}, key=SIGNAL_INDEX.get))
+
+    @property
+    def inputs(self) -> tuple[str, ...]:
+        """Log columns besides u, v, r that the term needs (e.g. 'n', 'wind_speed')."""
+        return tuple(s for s in self.signals if s in INPUT_SIGNALS and s != "delta")
+
+    def display(self) -> str:
+        """As printed in equations, in the paper's style: ``|u|u``, ``v r``, ``u² δ``."""
+        parts: list[str] = []
+        for i, f in enumerate(self.factors):
+            glue = ""
+            if i:
+                prev = self.factors[i - 1]
+                # |u|u, |v|v, |n|n: an absolute value followed by its own signal reads as one.
+                glue = "" if (OPS[prev.op] == "abs" and OPS[f.op] == "pow" and prev.power == 1
+                              and prev.signal == f.signal) else " "  # fmt: skip
+            parts.append(glue + f.display())
+        return "".join(parts)
+
+    def degree_in(self, signal: str) -> int:
+        """Total power of ``signal`` in the term (abs/pos/neg count; sin/cos do not)."""
+        i = SIGNAL_INDEX[signal]
+        return sum(f.power for f in self.factors if f.signal == i and OPS[f.op] not in ("sin", "cos"))
+
+    def __str__(self) -> str:
+        return self.text
+
+
+# ---------------------------------------------------------------------------- parsing
+_TOKEN = re.compile(r"\s*(?:(?P<num>\d+)|(?P<name>[A-Za-z_][A-Za-z_0-9]*)|(?P<sym>[|*^()]))")
+
+
+def _tokens(text: str) -> list[tuple[str, str]]:
+    out, pos = [], 0
+    text = text.strip()
+    while pos < len(text):
+        m = _TOKEN.match(text, pos)
+        if not m or m.end() == pos:
+            raise ShipidError(f"term {text!r}: unexpected {text[pos:pos + 1]!r} at position {pos + 1}")
+        pos = m.end()
+        kind = m.lastgroup
+        value = m.group(kind)
+        if kind == "name" and value not in FUNCTIONS:
+            out.extend(("name", n) for n in _split_names(value, text))
+        else:
+            out.append((kind, value))
+    return out
+
+
+def _split_names(word: str, text: str) -> list[str]:
+    """'vr' → ['v', 'r'], 'un' → ['u', 'n'], 'delta' → ['delta']: longest known names first."""
+    names, i = [], 0
+    while i < len(word):
+        for n in _NAMES:
+            if word.startswith(n, i):
+                names.append(n)
+                i += len(n)
+                break
+        else:
+            known = ", ".join(SIGNALS) + "; aliases " + ", ".join(ALIASES)
+            raise ShipidError(f"term {text!r}: unknown signal {word[i:]!r} (signals: {known})")
+    return names
+
+
+class _Parser:
+    def __init__(self, text: str) -> None:
+        self.text = text
+        self.toks = _tokens(text)
+        self.i = 0
+
+    def error(self, what: str) -> ShipidError:
+        return ShipidError(f"term {self.text!r}: {what}")
+
+    def peek(self) -> tuple[str, str] | None:
+        return self.toks[self.i] if self.i < len(self.toks) else None
+
+    def take(self, kind: str, value: str | None = None) -> str:
+        tok = self.peek()
+        if tok is None or tok[0] != kind or (value is not None and tok[1] != value):
+            got = "the end" if tok is None else repr(tok[1])
+            raise self.error(f"expected {value or kind}, got {got}")
+        self.i += 1
+        return tok[1]
+
+    def signal(self) -> int:
+        name = self.take("name")
+        return SIGNAL_INDEX[ALIASES.get(name, name)]
+
+    def power(self) -> int:
+        tok = self.peek()
+        if tok == ("sym", "^"):
+            self.i += 1
+            p = int(self.take("num"))
+            if not 1 <= p <= MAX_POWER:
+                raise self.error(f"power {p} out of range 1–{MAX_POWER}")
+            return p
+        return 1
+
+    def factor(self) -> Factor:
+        tok = self.peek()
+        if tok == ("sym", "|"):
+            self.i += 1
+            sig = self.signal()
+            self.take("sym", "|")
+            return Factor(sig, OP_CODE["abs"], 1, self.power())
+        if tok is not None and tok[0] == "name" and tok[1] in FUNCTIONS:
+            fn = self.take("name")
+            self.take("sym", "(")
+            k = 1
+            if self.peek() is not None and self.peek()[0] == "num":
+                k = int(self.take("num"))
+                self.take("sym", "*")
+                if fn not in ("sin", "cos") or not 1 <= k <= MAX_POWER:
+                    raise self.error(f"a multiple k*x is allowed in sin/cos only, k in 1–{MAX_POWER}")
+            sig = self.signal()
+            self.take("sym", ")")
+            if fn in ("sin", "cos") and SIGNALS[sig] not in ANGLE_SIGNALS:
+                raise self.error(f"{fn}() takes an angle signal ({', '.join(ANGLE_SIGNALS)}), "
+                                 f"not {SIGNALS[sig]!r}")  # fmt: skip
+            return Factor(sig, OP_CODE[fn], k, self.power())
+        if tok is not None and tok[0] == "name":
+            return Factor(self.signal(), OP_CODE["pow"], 1, self.power())
+        got = "the end" if tok is None else repr(tok[1])
+        raise self.error(f"expected a signal, |signal| or a function, got {got}")
+
+    def term(self) -> Term:
+        if self.toks == [("num", "1")]:
+            return Term(())
+        if not self.toks:
+            raise self.error("empty term")
+        factors = [self.factor()]
+        while self.peek() is not None:
+            if self.peek() == ("sym", "*"):
+                self.i += 1
+            factors.append(self.factor())
+        return _canonical(factors, self)
+
+
+def _canonical(factors: list[Factor], parser: _Parser) -> Term:
+    merged: dict[tuple[int, int, int], int] = {}
+    for f in factors:
+        key = (f.signal, f.op, f.k)
+        merged[key] = merged.get(key, 0) + f.power
+    out = []
+    for (sig, op, k), p in sorted(merged.items()):
+        if p > MAX_POWER:
+            raise parser.error(f"power {p} of {SIGNALS[sig]} out of range 1–{MAX_POWER}")
+        out.append(Factor(sig, op, k, p))
+    # |x| before x: reads as |u|u; otherwise signal order.
+    out.sort(key=lambda f: (FACTOR_ORDER[f.name],
+                            0 if OPS[f.op] == "abs" else 1 if OPS[f.op] == "pow" else 2, f.op, f.k))
+    return Term(tuple(out))
+
+
+@lru_cache(maxsize=4096)
+def parse_term(text: str) -> Term:
+    """The term of ``text`` (see the module docstring), or a one-line error naming the problem."""
+    if not isinstance(text, str):
+        raise ShipidError(f"a term must be text, got {type(text).__name__} {text!r}")
+    return _Parser(text).term()
+
+
+def canonical(text: str) -> str:
+    """The canonical text of a term: ``canonical("vr") == "v*r"``."""
+    return parse_term(text).text
+
+
+def parse_terms(texts: Iterable[str], where: str = "") -> tuple[Term, ...]:
+    """Parse several terms; duplicates (after canonicalisation) are an error."""
+    texts = list(texts)
+    terms = tuple(parse_term(t) for t in texts)
+    seen: dict[str, str] = {}
+    for raw, term in zip(texts, terms, strict=True):
+        if term.text in seen:
+            at = f" in {where}" if where else ""
+            raise ShipidError(f"terms {seen[term.text]!r} and {raw!r} are the same term{at}")
+        seen[term.text] = raw
+    return terms
+
+
+def required_inputs(terms: Iterable[str | Term]) -> tuple[str, ...]:
+    """Log columns besides t, u, v, r, delta that the terms need, in signal order."""
+    need = set()
+    for t in terms:
+        need.update((parse_term(t) if isinstance(t, str) else t).inputs)
+    return tuple(s for s in INPUT_SIGNALS if s in need)
+
+
+# ---------------------------------------------------------------------------- evaluation
+def signal_values(u, v, r, inputs: Mapping[str, np.ndarray] | None = None,
+                  needed: Iterable[str] = SIGNALS) -> dict[str, np.ndarray]:  # fmt: skip
+    """Arrays of the signals a term set needs, from states and input columns (absent: error)."""
     u = np.asarray(u, dtype=float)
-    thrust = np.zeros_like(u) if thrust is None else np.asarray(thrust, dtype=float)
-    rps = np.zeros_like(u) if rps is None else np.asarray(rps, dtype=float)
-    cols = [term_values(n, u, np.asarray(v, float), np.asarray(r, float),
-                        np.asarray(delta, float), thrust, rps) for n in names]  # fmt: skip
-    return np.column_stack(cols) if cols else np.empty((u.shape[0], 0))
+    v = np.asarray(v, dtype=float)
+    r = np.asarray(r, dtype=float)
+    inputs = inputs or {}
+    out: dict[str, np.ndarray] = {"u": u, "v": v, "r": r}
+    needed = set(needed)
+    if "U" in needed:
+        out["U"] = np.hypot(u, v)
+    if "beta" in needed:
+        out["beta"] = np.arctan2(-v, u)
+    for s in INPUT_SIGNALS:
+        if s in needed:
+            if s not in inputs or inputs[s] is None:
+                raise ShipidError(f"the model needs the input {s!r}, which was not given")
+            out[s] = np.broadcast_to(np.asarray(inputs[s], dtype=float), u.shape)
+    return out
+
+
+def term_matrix(terms: Sequence[str | Term], u, v, r, inputs: Mapping[str, np.ndarray] | None = None
+                ) -> np.ndarray:  # fmt: skip
+    """(n, len(terms)) matrix of regressor values."""
+    parsed = [parse_term(t) if isinstance(t, str) else t for t in terms]
+    needed = {s for t in parsed for s in t.signals}
+    sig = signal_values(u, v, r, inputs, needed)
+    n = np.atleast_1d(np.asarray(u)).shape[0]
+    out = np.empty((n, len(parsed)))
+    for j, term in enumerate(parsed):
+        col = np.ones(n)
+        for f in term.factors:
+            col = col * f.values(np.atleast_1d(sig[f.name]))
+        out[:, j] = col
+    return out
+
+
+@dataclass(frozen=True)
+class TermCode:
+    """A term set as the factor table the compiled kernel interprets.
+
+    Term j is the product of factors ``start[j]:start[j+1]``; factor i is
+    op[i](k[i]·s[signal[i]])^power[i] with s the signal vector in ``SIGNALS`` order.
+    """
+
+    texts: tuple[str, ...]
+    start: np.ndarray  # (n_terms + 1,) int64
+    signal: np.ndarray  # (n_factors,) int64
+    op: np.ndarray  # (n_factors,) int64
+    k: np.ndarray  # (n_factors,) float64
+    power: np.ndarray  # (n_factors,) int64
+    uses_derived: bool  # U or beta appear (computed only when needed)
+
+    @property
+    def n_terms(self) -> int:
+        return len(self.texts)
+
+    def arrays(self) -> tuple:
+        return self.start, self.signal, self.op, self.k, self.power
+
+
+def term_code(terms: Sequence[str | Term]) -> TermCode:
+    parsed = [parse_term(t) if isinstance(t, str) else t for t in terms]
+    start, sig, op, k, power = [0], [], [], [], []
+    for t in parsed:
+        for f in t.factors:
+            sig.append(f.signal)
+            op.append(f.op)
+            k.append(float(f.k))
+            power.append(f.power)
+        start.append(len(sig))
+    derived = any(SIGNALS[s] in DERIVED_SIGNALS for s in sig)
+    return TermCode(tuple(t.text for t in parsed), np.array(start, dtype=np.int64),
+                    np.array(sig, dtype=np.int64), np.array(op, dtype=np.int64),
+                    np.array(k, dtype=np.float64), np.array(power, dtype=np.int64), derived)

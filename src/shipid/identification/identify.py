@@ -17,13 +17,21 @@ from shipid.dynamics.model import (
     coefficients_from_gamma,
     get_structure,
 )
-from shipid.dynamics.terms import TERM_DISPLAY
+from shipid.dynamics.terms import parse_term
 from shipid.errors import ShipidError
+from shipid.evaluation.envelope import envelope
 from shipid.identification.regression import FORMS, RegressionProblem, regression_problem
 from shipid.lssvm import LSSVR, NumericalWarning
 
 COLLINEAR_CORRELATION = 0.999
 CONSTANT_VARIATION = 1e-3
+# Equations per unknown (terms + the bias b) below which a fit is refused, and below which it is
+# reported as thin: with fewer, the residual has too few degrees of freedom to mean anything.
+MIN_EQUATIONS_PER_UNKNOWN = 3
+FEW_EQUATIONS_PER_UNKNOWN = 10
+# Condition number of the centred, equilibrated regressors above which the coefficients are not
+# determined by the data (well-posed trials give 1.5–110: demo, KVLCC2, Esso).
+MAX_CONDITION = 1e6
 
 
 @dataclass
@@ -37,10 +45,11 @@ class Identification:
     discrete: dict[str, dict] = field(default_factory=dict)  # dof → {"names", "gamma", "bias"}
     diagnostics: dict[str, dict] = field(default_factory=dict)
     warnings: list[str] = field(default_factory=list)
+    envelope: dict[str, list[float]] = field(default_factory=dict)  # training ranges
 
 
 def _display(name: str) -> str:
-    return TERM_DISPLAY.get(name) or "1"
+    return parse_term(name).display() or "1"
 
 
 def _diagnose(p: RegressionProblem, est: LSSVR) -> tuple[dict, list[str]]:
@@ -55,10 +64,10 @@ def _diagnose(p: RegressionProblem, est: LSSVR) -> tuple[dict, list[str]]:
     Xc = X - mean
     norms = np.linalg.norm(Xc, axis=0)
     scaled = Xc[:, ~constant] / norms[~constant]
+    # Constant terms are reported above; the condition number is that of the varying ones.
     sv = np.linalg.svd(scaled, compute_uv=False) if scaled.shape[1] else np.array([1.0])
-    cond = float(sv[0] / sv[-1]) if sv[-1] > 0 else math.inf
-    if constant.any():
-        cond = math.inf
+    rank_deficient = scaled.shape[1] > 0 and scaled.shape[0] - 1 < scaled.shape[1]
+    cond = math.inf if rank_deficient or not sv[-1] > 0 else float(sv[0] / sv[-1])
     pairs = []
     if X.shape[1] >= 2:
         with np.errstate(invalid="ignore", divide="ignore"):
@@ -88,6 +97,7 @@ def _diagnose(p: RegressionProblem, est: LSSVR) -> tuple[dict, list[str]]:
     std_errors = {n: float(s) / scale for n, s in zip(p.names, se, strict=True)}
     return {
         "n_samples": int(len(y)),
+        "constant_terms": [p.names[j] for j in np.flatnonzero(constant)],
         "condition_number": cond,
         "most_collinear": [{"terms": [a, b], "correlation": c} for a, b, c in pairs[:3]],
         "std_errors": std_errors,
@@ -96,10 +106,27 @@ def _diagnose(p: RegressionProblem, est: LSSVR) -> tuple[dict, list[str]]:
     }, notes
 
 
+def _check_sample_count(p: RegressionProblem, logs) -> list[str]:
+    """Refuse a regression with too few equations for its unknowns (terms and the bias)."""
+    unknowns = p.X.shape[1] + 1
+    equations = len(p.y)
+    need = MIN_EQUATIONS_PER_UNKNOWN * unknowns
+    if equations < need:
+        samples = need + len(logs)
+        raise ShipidError(f"{p.dof}: {equations} equations ({equations + len(logs)} samples) for "
+                          f"{unknowns} unknowns ({', '.join(_display(n) for n in p.names)} and the "
+                          f"bias); identification needs at least {need} equations: {samples} "
+                          f"samples, {samples * p.dt:.3g} s of log at Δk = {p.dt:g} s")
+    if equations < FEW_EQUATIONS_PER_UNKNOWN * unknowns:
+        return [f"{p.dof}: only {equations} equations for {unknowns} unknowns: the coefficients "
+                "rest on little data"]
+    return []
+
+
 def _check_rudder_excitation(logs, structure: ModelStructure, fixed: Mapping) -> None:
     """Refuse training data whose rudder never moves: no rudder term can be identified."""
     rudder_terms = sorted({n for dof, names in structure.terms.items() for n in names
-                           if n.startswith("delta") and n not in fixed.get(dof, {})})
+                           if "delta" in parse_term(n).signals and n not in fixed.get(dof, {})})
     if not rudder_terms:
         return
     span = max(float(np.ptp(log["delta"].to_numpy())) for log in logs)
@@ -119,6 +146,7 @@ def identify(
     drop: Mapping[str, Sequence[str]] | None = None,
     fixed: Mapping[str, Mapping[str, float]] | None = None,
     names: Sequence[str] | None = None,
+    force: bool = False,
 ) -> Identification:
     """Identify a manoeuvring model from one or several canonical logs.
 
@@ -130,6 +158,10 @@ def identify(
     gamma : LS-SVM regularisation γ > 0 (the paper selects 10⁴).
     drop : terms to leave out, e.g. {"u": ["r^2"]} as in the paper.
     fixed : terms held at given continuous-time values, e.g. {"u": {"delta^2": 0.0}}.
+    force : keep a fit whose regressors are nearly dependent (condition number > ``MAX_CONDITION``)
+        instead of refusing it; it is still reported.
+
+    Fewer than ``MIN_EQUATIONS_PER_UNKNOWN`` equations per unknown are always refused.
     """
     if isinstance(logs, pd.DataFrame):
         logs = [logs]
@@ -145,23 +177,37 @@ def identify(
             structure = structure.without(drop)
     except ValueError as exc:
         raise ShipidError(str(exc)) from None
-    fixed = {d: dict(v) for d, v in (fixed or {}).items()}
+    fixed = {d: {parse_term(k).text: float(c) for k, c in v.items()}
+             for d, v in (fixed or {}).items()}  # fmt: skip
+    notes: list[str] = []
+    problems = {}
+    for dof in structure.dofs:
+        p = regression_problem(logs, structure, dof, form, fixed.get(dof), names)
+        if p.X.shape[1] == 0:
+            raise ShipidError(f"{dof}: no free terms to identify")
+        notes += _check_sample_count(p, logs)
+        problems[dof] = p
     _check_rudder_excitation(logs, structure, fixed)
     coefs: dict[str, dict[str, float]] = {}
     terms: dict[str, tuple[str, ...]] = {}
     discrete: dict[str, dict] = {}
     diagnostics: dict[str, dict] = {}
-    notes: list[str] = []
     dt = math.nan
-    for dof in structure.dofs:
-        p = regression_problem(logs, structure, dof, form, fixed.get(dof), names)
+    for dof, p in problems.items():
         dt = p.dt
-        if p.X.shape[1] == 0:
-            raise ShipidError(f"{dof}: no free terms to identify")
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", NumericalWarning)
             est = LSSVR(gamma=gamma, kernel="linear", solver="primal").fit(p.X, p.y)
         diagnostics[dof], dof_notes = _diagnose(p, est)
+        cond = diagnostics[dof]["condition_number"]
+        if not cond <= MAX_CONDITION:
+            message = (f"{dof}: the regressors {', '.join(_display(n) for n in p.names)} are "
+                       f"nearly linearly dependent in these logs (condition number {cond:.3g} > "
+                       f"{MAX_CONDITION:g}): their coefficients are not determined by the data; "
+                       "train on more varied trials or drop terms")  # fmt: skip
+            if not force:
+                raise ShipidError(message + " (or insist with --force)")
+            notes.append(message + " (kept: --force)")
         notes += dof_notes + [f"{dof}: {w.message}" for w in caught
                               if issubclass(w.category, NumericalWarning)]  # fmt: skip
         b = float(est.intercept_)
@@ -189,4 +235,5 @@ def identify(
                          "bias": b}  # fmt: skip
     model = ManoeuvringModel(ModelStructure(structure.name, terms), coefs,
                              name=f"identified ({structure.name}, {form} form)")  # fmt: skip
-    return Identification(model, form, float(gamma), dt, discrete, diagnostics, notes)
+    return Identification(model, form, float(gamma), dt, discrete, diagnostics, notes,
+                          envelope(logs))

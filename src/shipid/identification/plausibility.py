@@ -25,8 +25,13 @@ SETTLED_FRACTION = 0.02  # of the steady value, over the last 10 % of the run
 
 
 def _accelerations(model: ManoeuvringModel, u, v, r, delta, rps):
-    n = None if rps is None else np.full(np.shape(np.atleast_1d(u)), rps)
-    return model.accelerations(u, v, r, delta, None, n)
+    u = np.atleast_1d(np.asarray(u, dtype=float))
+    n = None if rps is None else np.full(u.shape, rps)
+    wind = {}
+    if model.uses_wind:  # still air: the apparent wind of the ship's own motion
+        v_ = np.broadcast_to(np.asarray(v, dtype=float), u.shape)
+        wind = {"wind_speed": np.hypot(u, v_), "wind_angle": np.arctan2(v_, u)}
+    return model.accelerations(u, v, r, delta, None, n, **wind)
 
 
 def straight_line_stability(model: ManoeuvringModel, speed: float, rps: float | None = None) -> dict:

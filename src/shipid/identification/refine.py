@@ -33,8 +33,8 @@ from scipy.optimize import least_squares
 
 from shipid.data.log import input_columns
 from shipid.dynamics.model import DOFS, ManoeuvringModel
-from shipid.dynamics.simulate import METHODS, DivergenceBounds, integrate_coefficients
-from shipid.dynamics.terms import TERM_INDEX, TERMS
+from shipid.dynamics.simulate import METHODS, DivergenceBounds, run_kernel
+from shipid.dynamics.terms import INPUT_SIGNALS
 from shipid.errors import ShipidError
 from shipid.evaluation.validate import free_run
 from shipid.identification.regression import common_sampling_time
@@ -75,9 +75,7 @@ class _Segments:
     """Training logs cut into B segments, padded to one length for the batch simulator."""
 
     t: np.ndarray  # (L,) common grid from 0
-    delta: np.ndarray  # (B, L)
-    thrust: np.ndarray  # (B, L)
-    rps: np.ndarray  # (B, L)
+    inputs: np.ndarray  # (B, L, 5) in INPUT_SIGNALS order
     measured: np.ndarray  # (B, L, n_states)
     mask: np.ndarray  # (B, L) True on real samples
     psi0: np.ndarray  # (B,)
@@ -100,7 +98,7 @@ def _cut(
         if not (math.isfinite(segment_s) and segment_s > 0):
             raise ShipidError(f"--segment must be > 0 s, got {segment_s!r}")
         steps = max(int(round(segment_s / dt)), 2)
-    inputs = [input_columns(log, model.structure.inputs, name)
+    inputs = [{"delta": log["delta"].to_numpy(), **input_columns(log, model.inputs, name)}
               for log, name in zip(logs, names, strict=True)]  # fmt: skip
     bounds = []  # (log index, first sample, last sample)
     for i, log in enumerate(logs):
@@ -111,19 +109,17 @@ def _cut(
     L = max(b - a for _, a, b in bounds) + 1
     B = len(bounds)
     seg = _Segments(
-        t=np.arange(L) * dt, delta=np.zeros((B, L)), thrust=np.zeros((B, L)), rps=np.zeros((B, L)),
+        t=np.arange(L) * dt, inputs=np.zeros((B, L, len(INPUT_SIGNALS))),
         measured=np.zeros((B, L, len(states))), mask=np.zeros((B, L), dtype=bool),
         psi0=np.zeros(B), shot0=np.zeros((B, 3)), sigma=np.ones(len(states)),
     )  # fmt: skip
     for b, (i, a, e) in enumerate(bounds):
         log = logs[i]
         m = e - a + 1
-        d = log["delta"].to_numpy()[a : e + 1]
-        seg.delta[b, :m], seg.delta[b, m:] = d, d[-1]
-        for column, target in (("thrust", seg.thrust), ("n", seg.rps)):
+        for j, column in enumerate(INPUT_SIGNALS):
             if column in inputs[i]:
                 x = inputs[i][column][a : e + 1]
-                target[b, :m], target[b, m:] = x, x[-1]
+                seg.inputs[b, :m, j], seg.inputs[b, m:, j] = x, x[-1]
         for j, s in enumerate(states):
             seg.measured[b, :m, j] = _signal(log, s)[a : e + 1]
         seg.mask[b, :m] = True
@@ -148,9 +144,10 @@ def _equation_error_spread(model: ManoeuvringModel, logs: Sequence[pd.DataFrame]
     """One-step equation-error std per DOF of ``model`` on the logs (the increment-form residual)."""
     errors: dict[str, list] = {d: [] for d in model.structure.dofs}
     for log in logs:
-        inputs = input_columns(log, model.structure.inputs)
+        inputs = input_columns(log, model.inputs)
         acc = model.accelerations(log["u"], log["v"], log["r"], log["delta"],
-                                  inputs.get("thrust"), inputs.get("n"))[:-1]  # fmt: skip
+                                  inputs.pop("thrust", None), inputs.pop("n", None),
+                                  **inputs)[:-1]  # fmt: skip
         for i, dof in enumerate(DOFS):
             if dof in errors:
                 x = log[dof].to_numpy()
@@ -203,10 +200,11 @@ def refine(
         if missing:
             raise ShipidError(f"{missing[0]}: no {s!r} column to fit")
     seg, dt, seg_len = _cut(logs, names, segment_s, states, model)
-    B, L = seg.delta.shape
+    B, L = seg.inputs.shape[:2]
 
     # Parameters: the model's coefficients, in the compiled simulator's coefficient matrix.
-    slots = [(i, TERM_INDEX[n]) for i, dof in enumerate(DOFS)
+    index = {t: j for j, t in enumerate(model.term_texts)}
+    slots = [(i, index[n]) for i, dof in enumerate(DOFS)
              for n in model.coefficients.get(dof, {})]  # fmt: skip
     rows = np.array([i for i, _ in slots], dtype=int)
     cols = np.array([j for _, j in slots], dtype=int)
@@ -223,8 +221,8 @@ def refine(
     def residuals(x: np.ndarray) -> np.ndarray:
         theta = np.zeros_like(model.theta)
         theta[rows, cols] = x
-        out, n_valid = integrate_coefficients(theta, seg.t, seg.delta, seg.thrust, seg.rps, s0,
-                                              method, speed_lim, yaw_lim)  # fmt: skip
+        out, n_valid = run_kernel(model.code, theta, seg.t, seg.inputs, s0, method, speed_lim,
+                                  yaw_lim)  # fmt: skip
         res = (out[:, :, state_col] - seg.measured) / seg.sigma
         res[alive_grid >= n_valid[:, None]] = DIVERGED_RESIDUAL
         res[~seg.mask] = 0.0
@@ -236,7 +234,7 @@ def refine(
     fit = least_squares(residuals, x0, method="trf", x_scale=scale, max_nfev=max_nfev)
     coefs = {dof: {} for dof in dofs}
     for (i, j), value in zip(slots, fit.x, strict=True):
-        coefs[DOFS[i]][TERMS[j]] = float(value)
+        coefs[DOFS[i]][model.term_texts[j]] = float(value)
     refined = ManoeuvringModel(model.structure, coefs, name=f"refined ({model.structure.name})")
 
     notes = []

@@ -23,6 +23,8 @@ import numpy as np
 from scipy import linalg
 from threadpoolctl import threadpool_limits
 
+from shipid.limits import available_memory_bytes
+
 # SciPy's bundled OpenBLAS has crashed in a threaded Cholesky on 16 000 × 16 000 matrices on the
 # 2-core machines this project targets; above this size the factorisation runs single-threaded.
 SINGLE_THREAD_CHOLESKY_ABOVE = 12_000
@@ -30,18 +32,6 @@ SINGLE_THREAD_CHOLESKY_ABOVE = 12_000
 
 class NumericalWarning(UserWarning):
     """An ill-conditioned or otherwise suspicious linear solve."""
-
-
-def available_memory_bytes() -> int | None:
-    """MemAvailable from /proc/meminfo, or None where it cannot be read."""
-    try:
-        with open("/proc/meminfo") as fh:
-            for line in fh:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024
-    except OSError:
-        return None
-    return None
 
 
 def check_dense_size(n_samples: int, max_dense_samples: int, n_copies: float = 1.5) -> None:

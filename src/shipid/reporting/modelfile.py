@@ -1,12 +1,18 @@
-"""Versioned JSON model files: structure, named coefficients, Δk, γ, form, the raw LS-SVM solution,
-diagnostics and provenance (training files with their sha256). The round trip is exact."""
+"""Versioned JSON model files: structure (term texts), named coefficients, Δk, γ, form, the raw
+LS-SVM solution, diagnostics, the training envelope and provenance (training files with their
+sha256). The round trip is exact.
+
+Loading checks the file against its schema: a wrong type, a missing key or a non-finite coefficient
+gives one message naming the key (``model.coefficients.r.delta``) and what was expected.
+Version 1 files (before the term algebra) load unchanged: their term names parse.
+"""
 
 from __future__ import annotations
 
 import hashlib
 import json
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 from shipid import __version__
@@ -17,7 +23,8 @@ from shipid.identification.refine import Refinement
 from shipid.outputs import atomic_write_text
 
 FORMAT = "shipid-model"
-VERSION = 1
+VERSION = 2
+READABLE_VERSIONS = (1, 2)
 
 
 def sha256(path: str | Path) -> str:
@@ -54,6 +61,7 @@ def model_document(ident: Identification, training_files: Sequence[str | Path] =
         "identification": {"form": ident.form, "gamma": ident.gamma, "dt": ident.dt,
                            "discrete": ident.discrete, "diagnostics": ident.diagnostics,
                            "warnings": ident.warnings, "preprocessing": preprocessing or {},
+                           "envelope": ident.envelope,
                            "refinement": refinement.to_dict() if refinement else None,
                            "plausibility": plausibility},
         "provenance": {"training_files": [{"path": str(p), "sha256": sha256(p)}
@@ -61,28 +69,117 @@ def model_document(ident: Identification, training_files: Sequence[str | Path] =
     })  # fmt: skip
 
 
+def model_text(ident: Identification, training_files: Sequence[str | Path] = (), **kw) -> str:
+    # repr of a float is exact, so the coefficients survive the round trip bit for bit.
+    return json.dumps(model_document(ident, training_files, **kw), indent=2,
+                      ensure_ascii=False) + "\n"  # fmt: skip
+
+
 def save_model(path: str | Path, ident: Identification, training_files: Sequence[str | Path] = (),
                preprocessing: dict | None = None, refinement: Refinement | None = None,
                plausibility: dict | None = None,
                model: ManoeuvringModel | None = None) -> Path:  # fmt: skip
-    doc = model_document(ident, training_files, preprocessing, refinement, plausibility, model)
-    # repr of a float is exact, so the coefficients survive the round trip bit for bit.
-    return atomic_write_text(path, json.dumps(doc, indent=2, ensure_ascii=False) + "\n")
+    text = model_text(ident, training_files, preprocessing=preprocessing, refinement=refinement,
+                      plausibility=plausibility, model=model)  # fmt: skip
+    return atomic_write_text(path, text)
+
+
+# ---------------------------------------------------------------------------- schema
+def _type_name(value) -> str:
+    return "null" if value is None else type(value).__name__
+
+
+def _expect(value, kind, key: str, path) -> None:
+    ok = {
+        "mapping": isinstance(value, Mapping),
+        "list": isinstance(value, list),
+        "text": isinstance(value, str),
+        "number": isinstance(value, int | float) and not isinstance(value, bool),
+        "number|null": value is None or (isinstance(value, int | float)
+                                         and not isinstance(value, bool)),
+        "mapping|null": value is None or isinstance(value, Mapping),
+    }[kind]
+    if not ok:
+        raise ShipidError(f"{path}: {key} must be a {kind.replace('mapping', 'JSON object')}, "
+                          f"got {_type_name(value)} {str(value)[:40]!r}")
+
+
+def _check_model_data(data, key: str, path) -> None:
+    _expect(data, "mapping", key, path)
+    for k in ("structure", "coefficients"):
+        if k not in data:
+            raise ShipidError(f"{path}: {key} has no {k!r}")
+    structure = data["structure"]
+    _expect(structure, "mapping", f"{key}.structure", path)
+    _expect(structure.get("name", ""), "text", f"{key}.structure.name", path)
+    if "terms" not in structure:
+        raise ShipidError(f"{path}: {key}.structure has no 'terms'")
+    _expect(structure["terms"], "mapping", f"{key}.structure.terms", path)
+    for dof, terms in structure["terms"].items():
+        _expect(terms, "list", f"{key}.structure.terms.{dof}", path)
+        for i, t in enumerate(terms):
+            _expect(t, "text", f"{key}.structure.terms.{dof}[{i}]", path)
+    coefs = data["coefficients"]
+    _expect(coefs, "mapping", f"{key}.coefficients", path)
+    for dof, values in coefs.items():
+        _expect(values, "mapping", f"{key}.coefficients.{dof}", path)
+        for term, c in values.items():
+            where = f"{key}.coefficients.{dof}.{term}"
+            _expect(c, "number", where, path)
+            if not math.isfinite(c):
+                raise ShipidError(f"{path}: {where} is {c}; coefficients must be finite")
+    if "name" in data:
+        _expect(data["name"], "text", f"{key}.name", path)
+
+
+def check_document(doc, path) -> None:
+    """Refuse a model file that does not follow the schema, naming the first bad key."""
+    _expect(doc, "mapping", "the file", path)
+    _check_model_data(doc.get("model"), "model", path)
+    ident = doc.get("identification")
+    _expect(ident, "mapping|null", "identification", path)
+    if ident:
+        prep = ident.get("preprocessing")
+        _expect(prep, "mapping|null", "identification.preprocessing", path)
+        for k in ("approach_speed", "approach_rps"):
+            if prep and k in prep:
+                _expect(prep[k], "number|null", f"identification.preprocessing.{k}", path)
+        env = ident.get("envelope")
+        _expect(env, "mapping|null", "identification.envelope", path)
+        for s, bounds in (env or {}).items():
+            _expect(bounds, "list", f"identification.envelope.{s}", path)
+            for b in bounds:
+                _expect(b, "number", f"identification.envelope.{s}", path)
+        refinement = ident.get("refinement")
+        _expect(refinement, "mapping|null", "identification.refinement", path)
+        if refinement:
+            _check_model_data(refinement.get("initial_model"),
+                              "identification.refinement.initial_model", path)  # fmt: skip
+
+
+def _no_constants(token: str):
+    raise ValueError(f"{token} is not a number JSON allows")
 
 
 def load_document(path: str | Path) -> dict:
     path = Path(path)
     if not path.exists():
         raise ShipidError(f"{path}: no such model file")
+    if path.is_dir():
+        raise ShipidError(f"{path}: is a directory, not a model file")
     try:
-        doc = json.loads(path.read_text(encoding="utf-8"))
-    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise ShipidError(f"{path}: not a JSON model file ({exc})") from None
+        text = path.read_text(encoding="utf-8")
+        doc = json.loads(text, parse_constant=_no_constants)
+    except UnicodeDecodeError:
+        raise ShipidError(f"{path}: not a JSON model file (not UTF-8 text)") from None
+    except (json.JSONDecodeError, ValueError, RecursionError) as exc:
+        raise ShipidError(f"{path}: not a JSON model file ({str(exc)[:120]})") from None
     if not isinstance(doc, dict) or doc.get("format") != FORMAT:
         raise ShipidError(f"{path}: not a shipid model file (no \"format\": \"{FORMAT}\")")
-    if doc.get("version") != VERSION:
+    if doc.get("version") not in READABLE_VERSIONS:
         raise ShipidError(f"{path}: model file version {doc.get('version')!r} is not supported "
-                          f"(this shipid reads version {VERSION})")  # fmt: skip
+                          f"(this shipid reads versions {', '.join(map(str, READABLE_VERSIONS))})")
+    check_document(doc, path)
     return doc
 
 
@@ -91,15 +188,27 @@ def load_model(path: str | Path, which: str = "model") -> ManoeuvringModel:
     return model_from_document(load_document(path), path, which)
 
 
+def has_refinement(doc: Mapping) -> bool:
+    return bool((doc.get("identification") or {}).get("refinement"))
+
+
 def model_from_document(doc: dict, path: str | Path, which: str = "model") -> ManoeuvringModel:
     if which not in ("model", "lssvm"):
         raise ShipidError(f"which must be 'model' or 'lssvm', got {which!r}")
     data = doc.get("model")
-    if which == "lssvm":
-        refinement = (doc.get("identification") or {}).get("refinement")
-        if refinement:
-            data = refinement.get("initial_model")
+    if which == "lssvm" and has_refinement(doc):
+        data = doc["identification"]["refinement"]["initial_model"]
     try:
         return ManoeuvringModel.from_dict(data)
+    except ShipidError as exc:
+        raise ShipidError(f"{path}: {exc}") from None
     except (KeyError, TypeError, ValueError) as exc:
         raise ShipidError(f"{path}: malformed model ({exc})") from None
+
+
+def training_conditions(doc: Mapping) -> dict:
+    """Approach speed, propeller speed and envelope of a model file's training logs."""
+    ident = doc.get("identification") or {}
+    prep = ident.get("preprocessing") or {}
+    return {"speed": prep.get("approach_speed"), "rps": prep.get("approach_rps"),
+            "envelope": ident.get("envelope") or {}}  # fmt: skip

@@ -12,19 +12,30 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
-from shipid.outputs import atomic_write  # noqa: E402
+from shipid.outputs import OutputSet, atomic_write  # noqa: E402
 from shipid.trials.indices import track  # noqa: E402
 
 LABELS = {"u": "surge u [m/s]", "v": "sway v [m/s]", "r": "yaw rate r [rad/s]"}
 
 
-def _save(fig, path: str | Path) -> Path:
-    out = atomic_write(path, lambda p: fig.savefig(p, format="png", dpi=110, bbox_inches="tight"))
-    plt.close(fig)
-    return out
+FORMATS = {".png": "png", ".svg": "svg", ".pdf": "pdf"}
 
 
-def rudder_and_heading(log: pd.DataFrame, path: str | Path, title: str = "") -> Path:
+def _save(fig, path: str | Path, out: OutputSet | None = None) -> Path:
+    """Save ``fig`` by the extension of ``path`` (PNG, SVG, PDF), staged in ``out`` if given."""
+    fmt = FORMATS.get(Path(path).suffix.lower(), "png")
+
+    def writer(p: Path) -> None:
+        fig.savefig(p, format=fmt, dpi=110, bbox_inches="tight")
+
+    try:
+        return out.write(path, writer) if out is not None else atomic_write(path, writer)
+    finally:
+        plt.close(fig)
+
+
+def rudder_and_heading(log: pd.DataFrame, path: str | Path, title: str = "",
+                       out: OutputSet | None = None) -> Path:  # fmt: skip
     psi, _, _ = track(log)
     fig, ax = plt.subplots(figsize=(8, 3.5))
     ax.plot(log["t"], np.degrees(log["delta"]), label="rudder δ [deg]")
@@ -33,11 +44,11 @@ def rudder_and_heading(log: pd.DataFrame, path: str | Path, title: str = "") -> 
     ax.grid(alpha=0.3)
     ax.legend()
     ax.set_title(title or "training zig-zag: rudder and heading")
-    return _save(fig, path)
+    return _save(fig, path, out)
 
 
 def measured_vs_simulated(measured: pd.DataFrame, simulated: pd.DataFrame, path: str | Path,
-                          title: str = "") -> Path:  # fmt: skip
+                          title: str = "", out: OutputSet | None = None) -> Path:  # fmt: skip
     fig, axes = plt.subplots(3, 2, figsize=(11, 7), sharex=True)
     n = len(simulated)
     for i, s in enumerate(("u", "v", "r")):
@@ -55,10 +66,11 @@ def measured_vs_simulated(measured: pd.DataFrame, simulated: pd.DataFrame, path:
     axes[2, 1].set_xlabel("t [s]")
     fig.suptitle(title)
     fig.tight_layout()
-    return _save(fig, path)
+    return _save(fig, path, out)
 
 
-def tracks(logs: dict[str, pd.DataFrame], path: str | Path, title: str = "x–y track") -> Path:
+def tracks(logs: dict[str, pd.DataFrame], path: str | Path, title: str = "x–y track",
+           out: OutputSet | None = None) -> Path:  # fmt: skip
     fig, ax = plt.subplots(figsize=(6, 6))
     for label, log in logs.items():
         _, x, y = track(log)
@@ -69,4 +81,4 @@ def tracks(logs: dict[str, pd.DataFrame], path: str | Path, title: str = "x–y 
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     ax.set_title(title)
-    return _save(fig, path)
+    return _save(fig, path, out)

@@ -3,136 +3,222 @@
 Event times (heading crossings) are interpolated between the bracketing samples. Headings are
 unwrapped and taken relative to ψ0, the mean heading over the approach (up to the rudder order).
 Angles in the returned dictionaries are in degrees where the key says ``_deg``; everything else SI.
+Every function is linear in the length of the log.
+
+Positions: measured positions carry metres of noise, velocities centimetres per second. The track
+(``track``) is the measured positions smoothed with the velocities (a Rauch–Tung–Striebel smoother
+whose noise levels are estimated from the log itself), dead reckoning from u, v, ψ where the log
+has no positions. Track lengths are integrals of the speed √(u² + v²), which noise barely biases.
 """
 
 from __future__ import annotations
 
 import math
 
+import numba
 import numpy as np
 import pandas as pd
 from scipy.integrate import cumulative_trapezoid
 
-from shipid.data.trim import first_swing_index
+from shipid.errors import ShipidError
+from shipid.trials.trial import KINDS, Trial, describe_trial, unwrapped_heading
 
-MANOEUVRE_KINDS = ("zigzag", "turning")
+MANOEUVRE_KINDS = KINDS
+# Fraction of the steady yaw rate within which r counts as settled in a held turn.
+SETTLED_RATE = 0.05
+
+
+# ---------------------------------------------------------------------------- the track
+@numba.njit(cache=True)
+def _rts_smooth(z: np.ndarray, w: np.ndarray, R: float, q: float) -> np.ndarray:
+    """Smoothed positions of p_{k+1} = p_k + w_k + η (var q), z_k = p_k + ε (var R); z (N, 2)."""
+    n = z.shape[0]
+    pf = np.empty_like(z)
+    pp = np.empty_like(z)
+    Pf = np.empty(n)
+    Pp = np.empty(n)
+    pp[0] = z[0]
+    Pp[0] = 1e6 * R + 1e-12
+    for k in range(n):
+        K = Pp[k] / (Pp[k] + R)
+        pf[k] = pp[k] + K * (z[k] - pp[k])
+        Pf[k] = (1.0 - K) * Pp[k]
+        if k + 1 < n:
+            pp[k + 1] = pf[k] + w[k]
+            Pp[k + 1] = Pf[k] + q
+    out = np.empty_like(z)
+    out[n - 1] = pf[n - 1]
+    for k in range(n - 2, -1, -1):
+        G = Pf[k] / Pp[k + 1] if Pp[k + 1] > 0 else 0.0
+        out[k] = pf[k] + G * (out[k + 1] - pp[k + 1])
+    return out
+
+
+def _white_noise_var(x: np.ndarray) -> float:
+    """Variance of the white noise on a smooth signal, from its second differences
+    (Var Δ²e = 6σ²), robustly (1.4826·MAD)."""
+    d2 = np.diff(x, 2)
+    if d2.size < 3:
+        return 0.0
+    mad = float(np.median(np.abs(d2 - np.median(d2))))
+    return (1.4826 * mad) ** 2 / 6.0
+
+
+def smoothed_positions(t, x, y, u, v, psi) -> tuple[np.ndarray, np.ndarray]:
+    """Positions smoothed with the velocity-integrated increments (see module docstring).
+
+    Position noise R from the one-step innovations d_k = Δz_k − w_k (Cov(d_k, d_k+1) = −R);
+    increment noise q from the velocities' own white noise (their second differences), which the
+    innovations cannot resolve under metres of position noise. A constant drift of d (a current)
+    is kept in the increments."""
+    xd = u * np.cos(psi) - v * np.sin(psi)
+    yd = u * np.sin(psi) + v * np.cos(psi)
+    h = np.diff(t)
+    if len(t) < 4:
+        return x, y
+    w = np.column_stack([0.5 * (xd[1:] + xd[:-1]) * h, 0.5 * (yd[1:] + yd[:-1]) * h])
+    z = np.column_stack([x, y]).astype(float)
+    d = np.diff(z, axis=0) - w
+    drift = d.mean(axis=0)
+    w = w + drift
+    d = d - drift
+    var = float(np.mean(d * d))
+    R = max(-float(np.mean(d[1:] * d[:-1])), 0.0)
+    if R <= 1e-9 * max(var, 1e-30):
+        return x, y  # positions as precise as the increments: keep them
+    h2 = float(np.median(h)) ** 2
+    q_velocity = 0.5 * h2 * 0.5 * (_white_noise_var(xd) + _white_noise_var(yd))
+    # Var d − 2R is q only where it stands out of its own sampling error (≈ var·√(2/N)).
+    q_moment = var - 2.0 * R
+    if q_moment < 3.0 * var * math.sqrt(2.0 / d.size):
+        q_moment = 0.0
+    q = max(q_moment, q_velocity, 1e-9 * R)
+    out = _rts_smooth(np.ascontiguousarray(z), np.ascontiguousarray(w), R, q)
+    return out[:, 0], out[:, 1]
 
 
 def track(log: pd.DataFrame) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Unwrapped heading and earth-fixed position; dead-reckoned from u, v, r where absent."""
+    """Unwrapped heading and earth-fixed position (smoothed; dead-reckoned where absent)."""
     t = log["t"].to_numpy()
-    if "psi" in log.columns:
-        psi = np.unwrap(log["psi"].to_numpy())
-    else:
-        psi = cumulative_trapezoid(log["r"].to_numpy(), t, initial=0.0)
-    if "x" in log.columns and "y" in log.columns:
-        return psi, log["x"].to_numpy(), log["y"].to_numpy()
+    psi = unwrapped_heading(log)
     u, v = log["u"].to_numpy(), log["v"].to_numpy()
+    if "x" in log.columns and "y" in log.columns:
+        x, y = smoothed_positions(t, log["x"].to_numpy(), log["y"].to_numpy(), u, v, psi)
+        return psi, x, y
     xd = u * np.cos(psi) - v * np.sin(psi)
     yd = u * np.sin(psi) + v * np.cos(psi)
     return psi, cumulative_trapezoid(xd, t, initial=0.0), cumulative_trapezoid(yd, t, initial=0.0)
 
 
-def rudder_order_index(delta: np.ndarray, threshold: float = math.radians(0.5)) -> int:
-    """Index of the rudder order: the last sample before the rudder leaves its initial angle."""
-    moved = np.flatnonzero(np.abs(delta - delta[0]) > threshold)
-    if moved.size == 0:
-        return 0
-    return max(int(moved[0]) - 1, 0)
+def travelled(log: pd.DataFrame) -> np.ndarray:
+    """Distance along the track from the first sample: ∫ √(u² + v²) dt."""
+    speed = np.hypot(log["u"].to_numpy(), log["v"].to_numpy())
+    return cumulative_trapezoid(speed, log["t"].to_numpy(), initial=0.0)
 
 
-def _smooth(x: np.ndarray, t: np.ndarray, window_s: float) -> np.ndarray:
-    if window_s <= 0:
+# ---------------------------------------------------------------------------- events
+def smooth_heading(x: np.ndarray, t: np.ndarray, window_s: float) -> np.ndarray:
+    """Centred moving average over ``window_s`` seconds (cumulative sums: linear time)."""
+    if not (math.isfinite(window_s) and window_s >= 0):
+        raise ShipidError(f"--smooth must be a finite number of seconds ≥ 0, got {window_s!r}")
+    if window_s == 0:
         return x
+    span = float(t[-1] - t[0])
+    if window_s >= span:
+        raise ShipidError(f"--smooth {window_s:g} s is not shorter than the log ({span:.4g} s)")
     n = max(1, int(round(window_s / np.median(np.diff(t)))))
     if n < 2:
         return x
-    kernel = np.ones(n) / n
-    pad = np.pad(x, (n // 2, n - 1 - n // 2), mode="edge")
-    return np.convolve(pad, kernel, mode="valid")
+    pad = np.concatenate([np.full(n // 2, x[0]), x, np.full(n - 1 - n // 2, x[-1])])
+    c = np.concatenate([[0.0], np.cumsum(pad)])
+    return (c[n:] - c[:-n]) / n
 
 
-def _crossing_time(t: np.ndarray, y: np.ndarray, level: float, start: int) -> tuple[float, int]:
-    """First time ≥ t[start] at which y rises through ``level`` (linear interpolation)."""
-    above = np.flatnonzero(y[start:] >= level)
-    if above.size == 0:
+def _crossings(y: np.ndarray, level: float) -> np.ndarray:
+    """Indices k ≥ 1 where y rises through ``level`` between k − 1 and k (k = 0 if it starts at it)."""
+    up = np.flatnonzero((y[:-1] < level) & (y[1:] >= level)) + 1
+    return np.concatenate([[0], up]) if y[0] >= level else up
+
+
+def _event_time(t: np.ndarray, y: np.ndarray, level: float, k: int, sign: float = 1.0) -> float:
+    """Time at which sign·y reaches ``level`` between samples k − 1 and k (interpolated)."""
+    if k == 0 or sign * y[k - 1] >= level:
+        return float(t[k])
+    a, b = sign * y[k - 1], sign * y[k]
+    frac = (level - a) / (b - a)
+    return float(t[k - 1] + frac * (t[k] - t[k - 1]))
+
+
+def _first_crossing(t, y, level, start) -> tuple[float, int]:
+    """First time ≥ t[start] at which y reaches ``level`` (interpolated), and its sample."""
+    if y[start] >= level:
+        return float(t[start]), start
+    ks = _crossings(y, level)
+    ks = ks[ks > start]
+    if ks.size == 0:
         return math.nan, -1
-    k = start + int(above[0])
-    if k == 0 or y[k - 1] >= level:
-        return float(t[k]), k
-    frac = (level - y[k - 1]) / (y[k] - y[k - 1])
-    return float(t[k - 1] + frac * (t[k] - t[k - 1])), k
+    k = int(ks[0])
+    return _event_time(t, y, level, k), k
 
 
 def _interp(t: np.ndarray, values: np.ndarray, at: float) -> float:
     return float(np.interp(at, t, values)) if math.isfinite(at) else math.nan
 
 
-def execute_index(log: pd.DataFrame) -> int:
-    """Index of the rudder execute: the start of the first swing that takes the rudder at least
-    halfway to its largest deflection (``preprocess.first_swing_index``), so that small helm
-    corrections of a hand-steered approach are not taken for the execute."""
-    return first_swing_index(log["delta"].to_numpy())
-
-
-def _reference(log: pd.DataFrame, t_order: float | None):
-    t = log["t"].to_numpy()
-    delta = log["delta"].to_numpy()
-    i0 = execute_index(log) if t_order is None else int(np.searchsorted(t, t_order))
-    i0 = min(i0, len(t) - 1)
-    psi, x, y = track(log)
-    psi0 = float(np.mean(psi[: i0 + 1]))
-    return t, delta, i0, psi, x, y, psi0
-
-
 def _none_if_nan(d: dict) -> dict:
     return {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in d.items()}
 
 
+# ---------------------------------------------------------------------------- zig-zag
 def zigzag_indices(
     log: pd.DataFrame,
     heading_deg: float | None = None,
     t_order: float | None = None,
     smooth_s: float = 0.0,
     length: float | None = None,
+    trial: Trial | None = None,
 ) -> dict:
-    """Overshoot angles, initial turning time and time to check yaw of a δ/ψ zig-zag.
+    """Overshoot angles, initial turning time, time to check yaw and the track length to the
+    second execute of a δ/ψ zig-zag.
 
     ``heading_deg`` is the switch heading ψ; when None it is inferred from the heading at the
-    rudder reversals. ``smooth_s`` is a moving-average window on the heading (noisy logs).
+    rudder orders. ``smooth_s`` is a moving-average window on the heading (noisy logs).
     """
-    t, delta, i0, psi, x, y, psi0 = _reference(log, t_order)
-    dpsi = _smooth(psi - psi0, t, smooth_s)
-    if heading_deg is None:
-        heading_deg = _inferred_switch_deg(delta, dpsi, i0)
+    if trial is None:
+        trial = describe_trial(log, "zigzag", heading_deg, t_order)
+    t = log["t"].to_numpy()
+    i0 = trial.execute_index
+    dpsi = smooth_heading(unwrapped_heading(log) - trial.psi0, t, smooth_s)
+    heading = heading_deg if heading_deg is not None else trial.switch_heading_deg
     nan = math.nan
-    result = {"switch_heading_deg": heading_deg if heading_deg is not None else nan,
+    result = {"switch_heading_deg": heading if heading is not None else nan,
               "first_overshoot_deg": nan, "second_overshoot_deg": nan,
               "initial_turning_time": nan, "time_to_check_yaw": nan,
               "distance_to_second_execute": nan, "first_execute_time": float(t[i0])}  # fmt: skip
-    if heading_deg is None or heading_deg <= 0:
+    if heading is None or not heading > 0:
         return _none_if_nan(result)
-    switch = math.radians(heading_deg)
+    switch = math.radians(heading)
+    up = _crossings(dpsi, switch)
+    down = _crossings(-dpsi, switch)
+    up, down = up[up >= i0], down[down >= i0]
+    if up.size == 0 and down.size == 0:
+        return _none_if_nan(result)
     # First turning direction: the side on which the heading first reaches the switch angle.
-    t_pos, _ = _crossing_time(t, dpsi, switch, i0)
-    t_neg, _ = _crossing_time(t, -dpsi, switch, i0)
-    if math.isnan(t_pos) and math.isnan(t_neg):
-        return _none_if_nan(result)
-    side = 1.0 if (math.isnan(t_neg) or (not math.isnan(t_pos) and t_pos <= t_neg)) else -1.0
+    side = 1.0 if down.size == 0 or (up.size and up[0] <= down[0]) else -1.0
     executes = [(float(t[i0]), i0, side)]
     while True:
         _, k_prev, s = executes[-1]
-        te, k = _crossing_time(t, s * dpsi, switch, k_prev)
-        if k < 0:
+        ks = up if s > 0 else down
+        j = int(np.searchsorted(ks, k_prev))
+        if j >= ks.size:
             break
-        executes.append((te, k, -s))
+        k = int(ks[j])
+        executes.append((_event_time(t, dpsi, switch, k, s), k, -s))
     if len(executes) >= 2:
         result["initial_turning_time"] = executes[1][0] - executes[0][0]
-        seg = slice(i0, executes[1][1] + 1)
-        result["distance_to_second_execute"] = float(np.sum(np.hypot(np.diff(x[seg]),
-                                                                      np.diff(y[seg]))))
-    keys = ("first_overshoot_deg", "second_overshoot_deg")
-    for j, key in enumerate(keys, start=1):
+        dist = travelled(log)
+        result["distance_to_second_execute"] = _interp(t, dist, executes[1][0]) - float(dist[i0])
+    for j, key in enumerate(("first_overshoot_deg", "second_overshoot_deg"), start=1):
         if j >= len(executes):
             break
         _, k_start, _ = executes[j]
@@ -142,7 +228,7 @@ def zigzag_indices(
         k_max = int(np.argmax(window))
         if k_start + k_max >= len(t) - 1:
             break  # the heading had not turned back before the log ended
-        result[key] = math.degrees(window[k_max]) - heading_deg
+        result[key] = math.degrees(window[k_max]) - heading
         if j == 1:
             result["time_to_check_yaw"] = float(t[k_start + k_max]) - executes[1][0]
     if length:
@@ -150,50 +236,30 @@ def zigzag_indices(
     return _none_if_nan(result)
 
 
-def neutral_rudder(delta: np.ndarray) -> float:
-    """Mid-range of the rudder: the neutral of a zig-zag whatever side the log starts on."""
-    return 0.5 * (float(np.max(delta)) + float(np.min(delta)))
-
-
-def _inferred_switch_deg(delta: np.ndarray, dpsi: np.ndarray, i0: int) -> float | None:
-    """Switch heading from the heading at the rudder reversals, read where each swing *starts*
-    (the order), not where the rudder crosses neutral: a slow rudder crosses it well past ψ."""
-    d = delta[i0:]
-    dev = d - neutral_rudder(d)
-    side = np.sign(dev)
-    side[np.abs(dev) < math.radians(1.0)] = 0
-    nz = np.flatnonzero(side)
-    if nz.size < 2:
-        return None
-    flips = nz[1:][side[nz[1:]] != side[nz[:-1]]]
-    starts = []
-    for f in flips:
-        before = np.flatnonzero(side[:f] == -side[f])
-        seg = d[before]
-        plateau = seg[np.argmax(np.abs(dev[before]))]
-        near = before[np.abs(seg - plateau) <= math.radians(0.5)]
-        starts.append(int(near[-1]) if near.size else int(f))
-    if not starts:
-        return None
-    # The order fell between the last plateau sample and the next one: take their midpoint.
-    k = i0 + np.array(starts)
-    at_order = 0.5 * (np.abs(dpsi[k]) + np.abs(dpsi[np.minimum(k + 1, len(dpsi) - 1)]))
-    return float(np.median(np.degrees(at_order)))
-
-
+# ---------------------------------------------------------------------------- turning circle
 def turning_indices(
-    log: pd.DataFrame, t_order: float | None = None, length: float | None = None
+    log: pd.DataFrame,
+    t_order: float | None = None,
+    length: float | None = None,
+    trial: Trial | None = None,
 ) -> dict:
-    """Advance, transfer, tactical diameter, steady turning diameter, speed and yaw rate."""
-    t, delta, i0, psi, x, y, psi0 = _reference(log, t_order)
-    dpsi = psi - psi0
-    side = 1.0 if dpsi[-1] >= 0 else -1.0
+    """Advance, transfer, tactical diameter, times to 90° and 180°, and the steady turn
+    (diameter, speed and yaw rate over the span with the rudder held and r settled)."""
+    if trial is None:
+        trial = describe_trial(log, "turning", t_order=t_order)
+    t = log["t"].to_numpy()
+    i0 = trial.execute_index
+    psi, x, y = track(log)
+    dpsi = psi - trial.psi0
+    held = slice(i0, trial.held_end_index + 1)
+    side = 1.0 if dpsi[held][-1] >= 0 else -1.0
     turned = side * dpsi
+    psi0 = trial.psi0
     e_c = np.array([math.cos(psi0), math.sin(psi0)])
     e_n = np.array([-math.sin(psi0), math.cos(psi0)])
     p0 = np.array([x[i0], y[i0]])
-    t90, _ = _crossing_time(t, turned, math.pi / 2, i0)
-    t180, _ = _crossing_time(t, turned, math.pi, i0)
+    t90, _ = _first_crossing(t, turned, math.pi / 2, i0)
+    t180, _ = _first_crossing(t, turned, math.pi, i0)
     p90 = np.array([_interp(t, x, t90), _interp(t, y, t90)]) - p0
     p180 = np.array([_interp(t, x, t180), _interp(t, y, t180)]) - p0
     result = {
@@ -204,57 +270,68 @@ def turning_indices(
         "time_to_180": t180 - float(t[i0]),
         "turn_direction": "starboard" if side > 0 else "port",
     }
-    result.update(_steady_turn(log, t, turned, x, y))
+    result.update(_steady_turn(log, t, turned, x, y, i0, trial.held_end_index))
     if length:
         for k in ("advance", "transfer", "tactical_diameter", "steady_turning_diameter"):
             result[f"{k}_L"] = result[k] / length
     return _none_if_nan(result)
 
 
-def _steady_turn(log, t, turned, x, y) -> dict:
-    """Steady turn: the last 360° of heading change after the first 360° (or after 180° when the
-    log is shorter): circle fit to the track when the window spans ≥ 270°, else 2U/|r|."""
-    final = turned[-1]
-    start = max(360.0, math.degrees(final) - 360.0) if math.degrees(final) >= 540.0 else 180.0
-    win = turned >= math.radians(start)
+def _steady_turn(log, t, turned, x, y, i0: int, held_end: int) -> dict:
+    """Steady turn over the held rudder only (a measured turn often ends with a pull-out): past
+    180° of heading change, from where the yaw rate has settled (its trailing mean within 5 % of
+    the final value) to the end of the held phase, the last 360° when more is available. Circle
+    fit to the track when the span covers ≥ 270°, else 2U/|r|. ``steady_from``/``steady_to`` say
+    which span was used."""
     nan = math.nan
-    if win.sum() < 3:
-        return {"steady_turning_diameter": nan, "steady_speed": nan, "steady_yaw_rate": nan}
-    u, v, r = (log[c].to_numpy()[win] for c in ("u", "v", "r"))
+    empty = {"steady_turning_diameter": nan, "steady_speed": nan, "steady_yaw_rate": nan,
+             "steady_from": nan, "steady_to": nan}  # fmt: skip
+    r = log["r"].to_numpy()
+    k1 = held_end
+    past180 = np.flatnonzero(turned[i0 : k1 + 1] >= math.pi)
+    if past180.size == 0 or k1 - (i0 + int(past180[0])) < 3:
+        return empty
+    k0 = i0 + int(past180[0])
+    n = k1 - k0 + 1
+    w = max(3, n // 10)
+    c = np.concatenate([[0.0], np.cumsum(r[k0 : k1 + 1])])
+    trailing = (c[w:] - c[:-w]) / w  # mean of r over the w samples ending at k0 + w − 1 + i
+    final = float(trailing[-1])
+    off = np.flatnonzero(np.abs(trailing - final) > SETTLED_RATE * abs(final))
+    if off.size and off[-1] + w < n - w:
+        k0 += int(off[-1]) + 1
+    lo = turned[k1] - 2 * math.pi
+    if turned[k0] < lo:
+        k0 += int(np.searchsorted(turned[k0 : k1 + 1], lo))  # the last 360°
+    win = slice(k0, k1 + 1)
+    u, v, rr = log["u"].to_numpy()[win], log["v"].to_numpy()[win], r[win]
     speed = float(np.mean(np.hypot(u, v)))
-    yaw_rate = float(np.mean(r))
-    span = math.degrees(turned[win][-1] - turned[win][0])
+    yaw_rate = float(np.mean(rr))
+    span = math.degrees(turned[k1] - turned[k0])
     if span >= 270.0:
         diameter = 2.0 * _circle_fit_radius(x[win], y[win])
     else:
-        diameter = float(np.mean(2.0 * np.hypot(u, v) / np.abs(r)))
-    return {"steady_turning_diameter": diameter, "steady_speed": speed, "steady_yaw_rate": yaw_rate}
+        diameter = float(2.0 * speed / abs(yaw_rate)) if yaw_rate != 0 else nan
+    return {"steady_turning_diameter": diameter, "steady_speed": speed,
+            "steady_yaw_rate": yaw_rate, "steady_from": float(t[k0]),
+            "steady_to": float(t[k1])}  # fmt: skip
 
 
 def _circle_fit_radius(x: np.ndarray, y: np.ndarray) -> float:
     """Algebraic (Kåsa) least-squares circle fit."""
-    A = np.column_stack([x, y, np.ones_like(x)])
-    b = x * x + y * y
+    xm, ym = float(np.mean(x)), float(np.mean(y))
+    xc, yc = x - xm, y - ym  # centred: keeps the fit accurate far from the origin
+    A = np.column_stack([xc, yc, np.ones_like(xc)])
+    b = xc * xc + yc * yc
     cx2, cy2, c = np.linalg.lstsq(A, b, rcond=None)[0]
     cx, cy = cx2 / 2, cy2 / 2
-    return float(math.sqrt(c + cx * cx + cy * cy))
+    return float(math.sqrt(max(c + cx * cx + cy * cy, 0.0)))
 
 
-def detect_manoeuvre(log: pd.DataFrame) -> str | None:
-    """'turning' when the heading changes by ≥ 180° (no zig-zag does), 'zigzag' when the rudder
-    swings from side to side at least twice, else None. A swing takes the rudder at least halfway
-    from the neutral (mid-range) to its largest deflection: helm corrections do not count."""
-    delta = log["delta"].to_numpy()
-    i0 = rudder_order_index(delta)
-    psi, _, _ = track(log)
-    if np.max(np.abs(psi - psi[i0])) >= math.pi:
-        return "turning"
-    dev = delta - neutral_rudder(delta)
-    big = np.abs(dev) >= max(0.5 * float(np.max(np.abs(dev))), math.radians(1.0))
-    side = np.sign(dev[big])
-    if side.size and np.count_nonzero(side[1:] != side[:-1]) >= 2:
-        return "zigzag"
-    return None
+# ---------------------------------------------------------------------------- any log
+def detect_manoeuvre(log: pd.DataFrame) -> str:
+    """'zigzag', 'turning' or 'other' (see ``shipid.trials.trial``)."""
+    return describe_trial(log).kind
 
 
 def manoeuvre_indices(
@@ -263,15 +340,17 @@ def manoeuvre_indices(
     heading_deg: float | None = None,
     length: float | None = None,
     smooth_s: float = 0.0,
+    trial: Trial | None = None,
 ) -> dict:
-    """Indices of a log, the manoeuvre detected when ``kind`` is None ({} if none is detected)."""
-    kind = kind or detect_manoeuvre(log)
-    if kind is None:
-        return {}
-    if kind == "zigzag":
-        out = zigzag_indices(log, heading_deg=heading_deg, smooth_s=smooth_s, length=length)
-    elif kind == "turning":
-        out = turning_indices(log, length=length)
+    """Indices of a log, the manoeuvre detected when ``kind`` is None ({"kind": "other"} when the
+    log is neither a zig-zag nor a turning circle)."""
+    if trial is None:
+        trial = describe_trial(log, kind, heading_deg)
+    if trial.kind == "zigzag":
+        out = zigzag_indices(log, heading_deg=heading_deg, smooth_s=smooth_s, length=length,
+                             trial=trial)  # fmt: skip
+    elif trial.kind == "turning":
+        out = turning_indices(log, length=length, trial=trial)
     else:
-        raise ValueError(f"manoeuvre kind must be one of {MANOEUVRE_KINDS}, got {kind!r}")
-    return {"kind": kind, **out}
+        return {"kind": "other", "reason": trial.reason}
+    return {"kind": trial.kind, **out}

@@ -4,19 +4,25 @@ pull-out (IMO MSC.137(76), ITTC 7.5-04-02-01).
 "Starboard" and "port" mean the same for every ship: the rudder sign is taken from the ship's (or
 model's) convention. The rudder sample logged at t_k is the one held over [t_k, t_k+1), so replaying a
 manoeuvre's log with ``simulate_log`` (same method and step) reproduces it exactly.
+
+Identified models run on the compiled closed loop (``shipid.dynamics.kernel.integrate_closed``);
+reference ships step their NumPy dynamics with the same compiled rudder command and steering
+machine. A model with wind terms meets a constant true wind (``wind=(speed, from_direction)``,
+still air by default: the apparent wind of its own motion).
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
 
 from shipid.data.log import make_log, starboard_sign
+from shipid.dynamics import kernel
 from shipid.dynamics.model import ManoeuvringModel
 from shipid.dynamics.simulate import (
     METHODS,
@@ -27,6 +33,8 @@ from shipid.dynamics.simulate import (
     within_bounds,
 )
 from shipid.dynamics.steering import SteeringMachine
+from shipid.errors import ShipidError
+from shipid.limits import check_samples
 from shipid.trials.indices import turning_indices, zigzag_indices
 from shipid.vessels.vessel import Vessel
 
@@ -42,34 +50,61 @@ class ManoeuvreResult:
     reason: str = ""
 
 
+def _positive(value, what: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value) \
+            or not value > 0:
+        raise ShipidError(f"{what} must be a finite number > 0, got {value!r}")
+    return float(value)
+
+
 def as_vessel(ship: Vessel | ManoeuvringModel, speed: float | None = None,
-              steering: SteeringMachine | None = None) -> Vessel:  # fmt: skip
+              steering: SteeringMachine | None = None, rps: float | None = None) -> Vessel:  # fmt: skip
     """A Vessel for a reference ship or an identified model (which needs an approach speed)."""
     if isinstance(ship, Vessel):
         vessel = ship
     elif isinstance(ship, ManoeuvringModel):
         if speed is None:
-            raise ValueError("a manoeuvre on a model needs the approach speed (speed=...)")
+            raise ShipidError("a manoeuvre on a model needs the approach speed (speed=..., --speed)")
+        speed = _positive(speed, "approach speed")
         vessel = Vessel(ship.name, ship, length=float("nan"), approach_speed=speed,
                         steering=steering or SteeringMachine(),
-                        rudder_positive=ship.rudder_positive_turns, source=ship.name)  # fmt: skip
+                        rudder_positive=ship.rudder_positive_turns_at(speed, rps),
+                        source=ship.name)  # fmt: skip
     else:
         raise TypeError(f"expected a Vessel or ManoeuvringModel, got {type(ship).__name__}")
     changes = {}
     if speed is not None:
-        changes["approach_speed"] = speed
+        changes["approach_speed"] = _positive(speed, "approach speed")
     if steering is not None:
         changes["steering"] = steering
     if changes:
         vessel = dataclasses.replace(vessel, **changes)
-    if not vessel.approach_speed > 0:
-        raise ValueError(f"approach speed must be > 0, got {vessel.approach_speed!r}")
+    _positive(vessel.approach_speed, "approach speed")
     return vessel
+
+
+def _params(vessel: Vessel, mode: int, value: float, held: float, approach: float,
+            release: float = math.inf, switch: float = 0.0, side: float = 1.0, psi_ref: float = 0.0,
+            rps: float | None = None, wind: tuple[float, float] | None = None,
+            ) -> np.ndarray:  # fmt: skip
+    p = np.zeros(kernel.N_PARAMS)
+    st = vessel.steering
+    p[kernel.P_MODE], p[kernel.P_VALUE], p[kernel.P_HELD] = mode, value, held
+    p[kernel.P_APPROACH], p[kernel.P_RELEASE] = approach, release
+    p[kernel.P_SWITCH], p[kernel.P_SIDE], p[kernel.P_PSI_REF] = switch, side, psi_ref
+    p[kernel.P_STBD] = starboard_sign(vessel.rudder_positive)
+    p[kernel.P_MAX_ANGLE] = st.max_angle
+    p[kernel.P_MAX_RATE] = st.max_rate or 0.0
+    p[kernel.P_TIME_CONST] = st.time_constant
+    p[kernel.P_RPS] = 0.0 if rps is None else rps
+    if wind is not None:
+        p[kernel.P_WIND_SPEED], p[kernel.P_WIND_DIR] = wind
+    return p
 
 
 def run_closed_loop(
     vessel: Vessel,
-    command: Callable[[float, np.ndarray], float],
+    params: np.ndarray,
     duration: float,
     dt: float,
     method: str = "rk4",
@@ -78,57 +113,78 @@ def run_closed_loop(
     rps: float | None = None,
 ) -> ManoeuvreResult:
     """Integrate from a straight approach at ``vessel.approach_speed`` (or from ``initial``, a
-    mapping of u, v, r, psi, x, y and the rudder angle 'delta') with the rudder command
-    ``command(t, state)`` passed through the vessel's steering machine. ``rps`` is the propeller
-    speed held during the manoeuvre, needed by models with propeller-speed terms."""
+    mapping of u, v, r, psi, x, y) with the rudder command of ``params`` (``kernel.command``)
+    through the vessel's steering machine. ``rps`` is the propeller speed held during the
+    manoeuvre, needed by models with propeller-speed terms."""
     if method not in METHODS:
-        raise ValueError(f"method must be one of {METHODS}, got {method!r}")
-    if not dt > 0 or not duration > dt:
-        raise ValueError(f"need 0 < dt < duration, got dt={dt!r}, duration={duration!r}")
+        raise ShipidError(f"method must be one of {METHODS}, got {method!r}")
+    dt = _positive(dt, "step dt")
+    duration = _positive(duration, "duration")
+    if not duration > dt:
+        raise ShipidError(f"duration ({duration:g} s) must be longer than the step ({dt:g} s)")
+    n = check_samples(duration / dt + 1, 8 * 14, f"a {duration:g} s manoeuvre at a {dt:g} s step")
     n = int(round(duration / dt)) + 1
-    t = np.arange(n) * dt
-    states = np.zeros((n, 6))
-    rudder = np.zeros(n)
     start = {"u": vessel.approach_speed, **(initial or {})}
-    s = initial_states({k: v for k, v in start.items() if k != "delta"}, 1)
-    speed_lim, yaw_lim = (bounds or DivergenceBounds()).resolved(float(s[0, 0]))
-    delta = float(start.get("delta", 0.0))
+    s0 = initial_states({k: v for k, v in start.items() if k != "delta"}, 1)
+    speed_lim, yaw_lim = (bounds or DivergenceBounds()).resolved(float(s0[0, 0]))
     dyn = vessel.dynamics
-    prop = None
-    if getattr(dyn, "uses_rps", False):
-        if rps is None or not math.isfinite(rps):
-            raise ValueError("this model has propeller-speed terms: give the propeller speed "
-                             "(rps=..., --rps)")  # fmt: skip
-        prop = np.array([float(rps)])
-    diverged_after = None
-    for k in range(n):
-        delta = vessel.steering.step(delta, command(t[k], s[0]), dt)
-        states[k], rudder[k] = s[0], delta
-        if k == n - 1:
-            break
-        new = step_state(dyn, s, np.array([delta]), None, dt, method, prop)
-        if not within_bounds(new, speed_lim, yaw_lim)[0]:
-            diverged_after = k + 1
-            break
-        s = new
-    m = n if diverged_after is None else diverged_after
+    uses_rps = getattr(dyn, "uses_rps", False)
+    if uses_rps and (rps is None or not math.isfinite(rps)):
+        raise ShipidError("this model has propeller-speed terms: give the propeller speed "
+                          "(rps=..., --rps)")  # fmt: skip
+    if isinstance(dyn, ManoeuvringModel):
+        if dyn.uses_thrust:
+            raise ShipidError("manoeuvres on a model with a thrust term need a thrust model; "
+                              "identify with propeller speed (n) terms instead")  # fmt: skip
+        states = np.zeros((1, n, 6))
+        rudder = np.zeros((1, n))
+        n_valid = np.zeros(1, dtype=np.int64)
+        kernel.integrate_closed(dyn.theta[None].copy(), *dyn.code.arrays(), dyn.code.uses_derived,
+                                dt, n, s0, params[None].copy(), method == "rk4",
+                                np.array([speed_lim]), np.array([yaw_lim]), states, rudder,
+                                n_valid)  # fmt: skip
+        m = int(n_valid[0])
+        states, rudder = states[0], rudder[0]
+    else:
+        states, rudder, m = _generic_closed_loop(dyn, params, n, dt, s0, method, speed_lim,
+                                                 yaw_lim, rps if uses_rps else None)  # fmt: skip
+    t = np.arange(n) * dt
     cols = dict(zip(("u", "v", "r", "psi", "x", "y"), states[:m].T, strict=True))
-    if prop is not None:
-        cols["n"] = np.full(m, prop[0])
+    if rps is not None and uses_rps:
+        cols["n"] = np.full(m, float(rps))
     log = make_log({"t": t[:m], "delta": rudder[:m], **cols}, **vessel.log_metadata())
-    if diverged_after is None:
+    if m == n:
         return ManoeuvreResult(log)
     t_div, reason = divergence_report(states, t, m, speed_lim, yaw_lim)
     return ManoeuvreResult(log, diverged=True, diverged_at=t_div, reason=reason)
 
 
+def _generic_closed_loop(dyn, params, n, dt, s0, method, speed_lim, yaw_lim, rps):
+    states = np.zeros((n, 6))
+    rudder = np.zeros(n)
+    s = s0
+    delta = float(params[kernel.P_HELD])
+    side = float(params[kernel.P_SIDE])
+    prop = None if rps is None else np.array([float(rps)])
+    st = (params[kernel.P_MAX_ANGLE], params[kernel.P_MAX_RATE], params[kernel.P_TIME_CONST])
+    for k in range(n):
+        cmd, side = kernel.command(params, k * dt, s[0, 3], side)
+        delta = kernel.steer(delta, cmd, dt, *st)
+        states[k], rudder[k] = s[0], delta
+        if k == n - 1:
+            break
+        new = step_state(dyn, s, np.array([delta]), None, dt, method, prop)
+        if not within_bounds(new, speed_lim, yaw_lim)[0]:
+            return states, rudder, k + 1
+        s = new
+    return states, rudder, n
+
+
 def _check_rudder(vessel: Vessel, rudder_deg: float) -> float:
-    rudder = math.radians(rudder_deg)
-    if not rudder > 0:
-        raise ValueError(f"rudder angle must be > 0 degrees, got {rudder_deg!r}")
+    rudder = math.radians(_positive(rudder_deg, "rudder angle [deg]"))
     if rudder > vessel.steering.max_angle + 1e-12:
-        raise ValueError(f"rudder {rudder_deg}° is beyond the steering machine's limit of "
-                         f"{math.degrees(vessel.steering.max_angle):g}°")  # fmt: skip
+        raise ShipidError(f"rudder {rudder_deg}° is beyond the steering machine's limit of "
+                          f"{math.degrees(vessel.steering.max_angle):g}°")  # fmt: skip
     return rudder
 
 
@@ -139,8 +195,20 @@ def _rudder_to(side: str, vessel: Vessel, rudder_deg: float) -> float:
 
 def _side_sign(side: str) -> float:
     if side not in SIDES:
-        raise ValueError(f"first/side must be 'starboard' or 'port', got {side!r}")
+        raise ShipidError(f"first/side must be 'starboard' or 'port', got {side!r}")
     return 1.0 if side == "starboard" else -1.0
+
+
+def _check_wind(wind) -> tuple[float, float] | None:
+    if wind is None:
+        return None
+    try:
+        speed, direction = (float(x) for x in wind)
+    except (TypeError, ValueError):
+        raise ShipidError(f"wind must be (speed m/s, direction rad), got {wind!r}") from None
+    if not (math.isfinite(speed) and speed >= 0 and math.isfinite(direction)):
+        raise ShipidError(f"wind speed must be ≥ 0 and its direction finite, got {wind!r}")
+    return speed, direction
 
 
 def zigzag(
@@ -156,35 +224,24 @@ def zigzag(
     method: str = "rk4",
     initial: Mapping[str, float] | None = None,
     rps: float | None = None,
+    wind: tuple[float, float] | None = None,
 ) -> ManoeuvreResult:
     """δ/ψ zig-zag: rudder ``first`` at t = ``approach``, reversed whenever the heading change
     reaches ±ψ on the side the ship is turning to.
 
     ``initial`` (u, v, r, psi, delta) starts the run from a trial's measured state instead of a
     straight approach; the rudder is held at its initial ``delta`` until ``approach`` and the
-    heading change is taken from the initial ψ.
+    heading change is taken from the initial ψ. ``wind``: constant true wind (speed [m/s],
+    direction it blows from [rad], clockwise from north) for models with wind terms.
     """
-    vessel = as_vessel(ship, speed, steering)
+    vessel = as_vessel(ship, speed, steering, rps)
     rudder = _check_rudder(vessel, rudder_deg)
-    if not heading_deg > 0:
-        raise ValueError(f"heading switch angle must be > 0 degrees, got {heading_deg!r}")
-    switch = math.radians(heading_deg)
-    stbd = starboard_sign(vessel.rudder_positive)
-    state = {"side": _side_sign(first)}
+    switch = math.radians(_positive(heading_deg, "heading switch angle [deg]"))
     psi_ref = float((initial or {}).get("psi", 0.0))
     held = float((initial or {}).get("delta", 0.0))
-
-    def command(t: float, s: np.ndarray) -> float:
-        if t < approach - 1e-9:
-            return held
-        dpsi = s[3] - psi_ref
-        if state["side"] > 0 and dpsi >= switch:
-            state["side"] = -1.0
-        elif state["side"] < 0 and dpsi <= -switch:
-            state["side"] = 1.0
-        return state["side"] * stbd * rudder
-
-    res = run_closed_loop(vessel, command, duration, dt, method, initial=initial, rps=rps)
+    params = _params(vessel, kernel.MODE_ZIGZAG, rudder, held, approach, switch=switch,
+                     side=_side_sign(first), psi_ref=psi_ref, rps=rps, wind=_check_wind(wind))
+    res = run_closed_loop(vessel, params, duration, dt, method, initial=initial, rps=rps)
     res.log.attrs["manoeuvre"] = f"zigzag {rudder_deg:g}/{heading_deg:g}, first {first}"
     res.indices = zigzag_indices(res.log, heading_deg, t_order=approach,
                                  length=_finite_or_none(vessel.length))  # fmt: skip
@@ -202,15 +259,14 @@ def turning_circle(
     steering: SteeringMachine | None = None,
     method: str = "rk4",
     rps: float | None = None,
+    wind: tuple[float, float] | None = None,
 ) -> ManoeuvreResult:
     """Turning circle: rudder to ``side`` at t = ``approach`` (the rudder execute), held."""
-    vessel = as_vessel(ship, speed, steering)
+    vessel = as_vessel(ship, speed, steering, rps)
     value = _rudder_to(side, vessel, rudder_deg)
-
-    def command(t: float, s: np.ndarray) -> float:
-        return value if t >= approach - 1e-9 else 0.0
-
-    res = run_closed_loop(vessel, command, duration, dt, method, rps=rps)
+    params = _params(vessel, kernel.MODE_HOLD, value, 0.0, approach, rps=rps,
+                     wind=_check_wind(wind))  # fmt: skip
+    res = run_closed_loop(vessel, params, duration, dt, method, rps=rps)
     res.log.attrs["manoeuvre"] = f"turning circle {rudder_deg:g}° to {side}"
     if not res.diverged:
         res.indices = turning_indices(res.log, t_order=approach,
@@ -229,16 +285,17 @@ def pull_out(
     steering: SteeringMachine | None = None,
     method: str = "rk4",
     rps: float | None = None,
+    wind: tuple[float, float] | None = None,
 ) -> ManoeuvreResult:
     """Pull-out: rudder held for ``hold`` s, then returned to midships for ``release`` s. A
     straight-line stable ship's yaw rate decays to zero; an unstable one keeps a residual rate."""
-    vessel = as_vessel(ship, speed, steering)
+    vessel = as_vessel(ship, speed, steering, rps)
     value = _rudder_to(side, vessel, rudder_deg)
-
-    def command(t: float, s: np.ndarray) -> float:
-        return value if t < hold else 0.0
-
-    res = run_closed_loop(vessel, command, hold + release, dt, method, rps=rps)
+    hold = _positive(hold, "hold time")
+    release = _positive(release, "release time")
+    params = _params(vessel, kernel.MODE_HOLD, value, 0.0, 0.0, release=hold, rps=rps,
+                     wind=_check_wind(wind))  # fmt: skip
+    res = run_closed_loop(vessel, params, hold + release, dt, method, rps=rps)
     res.log.attrs["manoeuvre"] = f"pull-out {rudder_deg:g}° to {side}"
     if not res.diverged:
         r = res.log["r"].to_numpy()

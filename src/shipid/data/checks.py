@@ -1,0 +1,175 @@
+"""Checks of a log at the boundary: types, missing values, time, and units that look wrong.
+
+Every check names the file, the column and where possible the row. Units cannot be read off a
+number, but they can be read off how signals relate: the heading's rate of change must equal the
+yaw rate (ψ̇ = r), which tells degrees from radians and milliseconds from seconds; a rudder beyond
+60° or a yaw rate beyond 3 rad/s is not in radians.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+import pandas as pd
+
+from shipid.data.log import COLUMNS, REQUIRED
+from shipid.errors import ShipidError, ShipidWarning
+
+ANGLE_COLUMNS = ("delta", "psi", "r", "wind_angle")
+# A rudder beyond 60° or a yaw rate beyond 3 rad/s (172 °/s) is not radians.
+RADIAN_PLAUSIBLE = {"delta": math.radians(60.0), "r": 3.0}
+SPEED_PLAUSIBLE = 40.0  # m/s on |u| and |v|: 78 kn, beyond any displacement ship
+# No manoeuvre can be identified from samples this far apart: the time is not in seconds.
+MAX_SAMPLING_S = 30.0
+DEG = 180.0 / math.pi
+
+
+def true_runs(mask: np.ndarray) -> list[tuple[int, int]]:
+    """(first, last) indices of the runs of True in a boolean array."""
+    edges = np.diff(np.concatenate([[0], np.asarray(mask, dtype=np.int8), [0]]))
+    return list(zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1, strict=True))
+
+
+def convert_types(df: pd.DataFrame, name: str) -> pd.DataFrame:
+    """Refuse boolean columns; a datetime or timedelta ``t`` becomes seconds from its first
+    sample (the datetime origin is kept in ``attrs["time_origin"]``)."""
+    for c in [c for c in COLUMNS if c in df.columns]:
+        col = df[c]
+        if pd.api.types.is_bool_dtype(col):
+            raise ShipidError(f"{name}: column {c!r} holds true/false values, not numbers")
+        if pd.api.types.is_datetime64_any_dtype(col) or pd.api.types.is_timedelta64_dtype(col):
+            if c != "t":
+                raise ShipidError(f"{name}: column {c!r} holds dates or durations, not numbers")
+            if col.isna().any():
+                row = int(np.argmax(col.isna().to_numpy()))
+                raise ShipidError(f"{name}: column 't' is missing at data row {row + 1}")
+            if pd.api.types.is_datetime64_any_dtype(col):
+                df.attrs["time_origin"] = str(col.iloc[0])
+                seconds = (col - col.iloc[0]).dt.total_seconds()
+            else:
+                seconds = col.dt.total_seconds()
+            df[c] = seconds.to_numpy(dtype=float)
+    return df
+
+
+def check_log(df: pd.DataFrame, name: str, min_samples: int = 3, fill_gaps: bool = False) -> None:
+    """Required columns, finite numbers, strictly increasing time, enough samples.
+
+    Missing values (empty cells, NaN) inside a signal are reported with their span and refused,
+    or, with ``fill_gaps``, interpolated linearly in time. Text and infinities are always refused.
+    """
+    if len(df) == 0:
+        raise ShipidError(f"{name}: the header has no rows")
+    missing = [c for c in REQUIRED if c not in df.columns]
+    if missing:
+        have = ", ".join(map(str, df.columns[:20])) + (" ..." if len(df.columns) > 20 else "")
+        raise ShipidError(f"{name}: missing column(s) {', '.join(missing)} (columns found: {have}); "
+                          "map other names with --columns, e.g. --columns delta=rudder")  # fmt: skip
+    convert_types(df, name)
+    gaps: dict[str, np.ndarray] = {}
+    for c in [c for c in COLUMNS if c in df.columns]:
+        raw = df[c]
+        values = pd.to_numeric(raw, errors="coerce").to_numpy(dtype=float)
+        gap = raw.isna().to_numpy()
+        bad = ~np.isfinite(values) & ~gap
+        if bad.any():
+            row = int(np.argmax(bad))
+            raise ShipidError(f"{name}: column {c!r} has a non-numeric or non-finite value "
+                              f"({str(raw.iloc[row])[:40]!r}) at data row {row + 1}")  # fmt: skip
+        if gap.any():
+            gaps[c] = gap
+        df[c] = values
+    if "t" in gaps:
+        first, last = true_runs(gaps["t"])[0]
+        raise ShipidError(f"{name}: column 't' is missing at data rows {first + 1}–{last + 1}; "
+                          "a log needs a time stamp on every row")  # fmt: skip
+    t = df["t"].to_numpy()
+    for c, gap in gaps.items():
+        runs = true_runs(gap)
+        first, last = runs[0]
+        if np.all(gap):
+            raise ShipidError(f"{name}: column {c!r} is empty")
+        if not fill_gaps:
+            more = f" and {len(runs) - 1} more gap(s)" if len(runs) > 1 else ""
+            span = (f"1 missing value at data row {first + 1} (t = {t[first]:g} s)" if first == last
+                    else f"{last - first + 1} missing values at data rows {first + 1}–{last + 1} "
+                    f"(t = {t[first]:g}–{t[last]:g} s)")
+            raise ShipidError(f"{name}: column {c!r} has {span}{more}; trim them off with "
+                              "--start/--end or interpolate with --fill-gaps")  # fmt: skip
+        good = ~gap
+        df[c] = np.interp(t, t[good], df[c].to_numpy()[good])
+    dt = np.diff(t)
+    if np.any(dt == 0):
+        row = int(np.argmax(dt == 0)) + 1
+        raise ShipidError(f"{name}: duplicate time stamp t = {t[row]:g} "
+                          f"at data rows {row} and {row + 1}")
+    if np.any(dt < 0):
+        row = int(np.argmax(dt < 0)) + 1
+        raise ShipidError(f"{name}: time is not increasing at data row {row + 1} "
+                          f"(t = {t[row]:g} after {t[row - 1]:g})")  # fmt: skip
+    if len(df) < min_samples:
+        raise ShipidError(f"{name}: {len(df)} samples, too short (at least {min_samples} needed)")
+
+
+def check_units(df: pd.DataFrame, name: str, degrees=()) -> None:
+    """Refuse signals whose units are evidently not the canonical ones (after ``--degrees``)."""
+    for c, limit in RADIAN_PLAUSIBLE.items():
+        if c in df.columns and c not in degrees:
+            peak = float(np.max(np.abs(df[c].to_numpy())))
+            if peak > limit:
+                raise ShipidError(f"{name}: column {c!r} reaches {peak:.3g}, which looks like "
+                                  f"degrees; give --degrees {c} (angles are radians inside)")
+    for c in ("u", "v"):
+        peak = float(np.max(np.abs(df[c].to_numpy())))
+        if peak > SPEED_PLAUSIBLE:
+            raise ShipidError(f"{name}: column {c!r} reaches {peak:.3g}, not a ship speed in m/s "
+                              "(knots or km/h? convert to m/s)")  # fmt: skip
+    t = df["t"].to_numpy()
+    dt = float(np.median(np.diff(t))) if len(t) > 1 else 0.0
+    if dt > MAX_SAMPLING_S:
+        raise ShipidError(f"{name}: samples are {dt:g} apart in 't'; that is not seconds "
+                          "(milliseconds?): give t in seconds")  # fmt: skip
+    if "psi" in df.columns:
+        _check_heading_against_yaw_rate(df, name)
+
+
+def heading_rate_ratio(t: np.ndarray, psi: np.ndarray, r: np.ndarray) -> float | None:
+    """Least-squares ratio ψ̇ / r over the samples turning fastest, or None when the log does not
+    turn enough to tell (or the ratio is not defined)."""
+    d = np.diff(psi)
+    h = np.diff(t)
+    r_mid = 0.5 * (r[1:] + r[:-1])
+    peak = float(np.max(np.abs(r_mid))) if r_mid.size else 0.0
+    # Wraps (±π in radians, ±180 in degrees) are jumps far beyond one sample's turn.
+    keep = (np.abs(d) < math.pi) & (np.abs(r_mid) >= 0.3 * peak) & (h > 0)
+    if peak <= 0 or keep.sum() < 10:
+        return None
+    rate, rr = d[keep] / h[keep], r_mid[keep]
+    # Enough turning to judge: at least 5° of heading change (in r's units) over the kept samples.
+    if np.sum(np.abs(rr) * h[keep]) < math.radians(5.0):
+        return None
+    denom = float(rr @ rr)
+    return float(rate @ rr) / denom if denom > 0 else None
+
+
+def _check_heading_against_yaw_rate(df: pd.DataFrame, name: str) -> None:
+    ratio = heading_rate_ratio(df["t"].to_numpy(), df["psi"].to_numpy(), df["r"].to_numpy())
+    if ratio is None or 0.5 <= ratio <= 2.0:
+        return
+    if DEG / 2 <= ratio <= DEG * 2:
+        raise ShipidError(f"{name}: the heading 'psi' changes {ratio:.3g} times faster than the "
+                          "yaw rate 'r' turns: psi looks like degrees; give --degrees psi")
+    if 1 / (2 * DEG) <= ratio <= 2 / DEG:
+        raise ShipidError(f"{name}: the heading 'psi' changes {1 / ratio:.3g} times slower than "
+                          "the yaw rate 'r' says: r looks like degrees per second; give --degrees r")
+    if 0.5e-3 <= ratio <= 2e-3:
+        raise ShipidError(f"{name}: the heading 'psi' changes 1000 times slower than the yaw "
+                          "rate 'r' says: 't' looks like milliseconds; give t in seconds")
+    if -2.0 <= ratio <= -0.5:
+        raise ShipidError(f"{name}: the heading 'psi' decreases while the yaw rate 'r' is "
+                          "positive: psi and r have opposite sign conventions (canonical: both "
+                          "positive turning to starboard); negate one of them")  # fmt: skip
+    warnings.warn(f"{name}: the heading 'psi' changes {ratio:.3g} times as fast as the yaw rate "
+                  "'r' says (expected 1): check their units", ShipidWarning, stacklevel=3)

@@ -1,0 +1,68 @@
+"""The training envelope of a model and the checks of a run against it.
+
+A model identified from trials is only known where the trials went: the ranges of speed, sway,
+yaw rate, rudder, propeller speed and wind of its training logs. A run (a manoeuvre, a free run) that
+leaves them is an extrapolation, and one that ends in an implausible state (a ship that stops in a
+turn, a tactical diameter under one ship length) is reported; neither is refused.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+import pandas as pd
+
+ENVELOPE_SIGNALS = ("u", "v", "r", "delta", "n", "wind_speed")
+UNITS = {"u": "m/s", "v": "m/s", "r": "rad/s", "delta": "rad", "n": "rps", "wind_speed": "m/s"}
+# A run may exceed the training range by this fraction of its span before it is reported.
+MARGIN = 0.1
+# A turn that keeps less than this fraction of its approach speed has left any plausible regime.
+MIN_SPEED_FRACTION = 0.2
+
+
+def envelope(logs: Sequence[pd.DataFrame]) -> dict[str, list[float]]:
+    """{signal: [min, max]} over the training logs, for the signals they have."""
+    out = {}
+    for s in ENVELOPE_SIGNALS:
+        values = [log[s].to_numpy() for log in logs if s in log.columns]
+        if values:
+            allv = np.concatenate(values)
+            out[s] = [float(np.min(allv)), float(np.max(allv))]
+    return out
+
+
+def outside_envelope(env: Mapping[str, Sequence[float]], log: pd.DataFrame) -> list[str]:
+    """One message per signal of ``log`` that leaves the envelope by more than ``MARGIN``."""
+    notes = []
+    for s, bounds in (env or {}).items():
+        if s not in log.columns or len(bounds) != 2:
+            continue
+        lo, hi = (float(b) for b in bounds)
+        margin = MARGIN * max(hi - lo, 1e-12)
+        x = log[s].to_numpy()
+        if x.size == 0:
+            continue
+        xmin, xmax = float(np.min(x)), float(np.max(x))
+        if xmin < lo - margin or xmax > hi + margin:
+            unit = UNITS.get(s, "")
+            notes.append(f"{s} spans {xmin:.3g}…{xmax:.3g} {unit}, outside the training range "
+                         f"{lo:.3g}…{hi:.3g} {unit}: the model is extrapolating")  # fmt: skip
+    return notes
+
+
+def implausible_indices(indices: Mapping, approach_speed: float | None,
+                        length: float | None = None) -> list[str]:  # fmt: skip
+    """Messages for turning indices no ship shows: the speed nearly lost, a circle under 1 L."""
+    notes = []
+    speed = indices.get("steady_speed")
+    if speed is not None and approach_speed and math.isfinite(speed) \
+            and speed < MIN_SPEED_FRACTION * approach_speed:
+        notes.append(f"steady turning speed {speed:.3g} m/s is under {MIN_SPEED_FRACTION:.0%} of "
+                     f"the approach speed {approach_speed:.3g} m/s: implausible")
+    td = indices.get("tactical_diameter")
+    if length and td is not None and math.isfinite(td) and td < length:
+        notes.append(f"tactical diameter {td:.3g} m is under one ship length ({length:.3g} m): "
+                     "implausible")
+    return notes

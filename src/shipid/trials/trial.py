@@ -1,0 +1,222 @@
+"""What a log is, decided once: the kind of manoeuvre and the facts its indices and replicas need.
+
+``describe_trial`` reads the rudder execute, the approach heading ψ0, the rudder neutral and
+amplitude, and classifies the log:
+
+* **turning**: the rudder goes to one side and is held until the heading has changed by 180°;
+* **zigzag**: the rudder swings from side to side at least twice, every swing to a similar angle
+  (within ±40 % of the median), each reversal ordered with the heading on the side the ship was
+  turning to at a similar heading (within 0.3–3 × the median), the heading within ±90°, and the
+  propeller not reversed;
+* **other**: anything else (random rudder and propeller orders, a stopping run, a straight run).
+  Such a log has no IMO indices; it is still validated by its free-run errors.
+
+A kind can be forced (``kind=``); then the classification only supplies the facts.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from shipid.data.trim import EXECUTE_FRACTION, first_swing_index
+from shipid.errors import ShipidError
+
+KINDS = ("zigzag", "turning", "other")
+AMPLITUDE_SPREAD = 0.4  # zig-zag swings within ±40 % of the median swing
+SWITCH_SPREAD = (0.3, 3.0)  # zig-zag switch headings within this factor of the median
+MIN_SWITCH = math.radians(3.0)  # IMO zig-zags switch at 5°–20°; a 2° "switch" is helm noise
+MAX_ZIGZAG_HEADING = math.radians(90.0)
+HELD_TOLERANCE = math.radians(3.0)  # a held rudder stays within this of its plateau (or 15 %)
+PLATEAU_TOLERANCE = math.radians(0.5)
+
+
+@dataclass(frozen=True)
+class Trial:
+    """Facts of one log (angles in radians, times in seconds).
+
+    Attributes
+    ----------
+    kind : 'zigzag', 'turning' or 'other'.
+    reason : why the log is of this kind (for 'other': which test a zig-zag or turn failed).
+    execute_index, execute_time : the rudder order (start of the first large swing).
+    psi0 : mean heading over the approach (up to the order).
+    neutral : the rudder's neutral (mid-range) angle.
+    amplitude : median rudder deflection from neutral on the plateaus.
+    plateau_angle : median |δ| where the rudder is within 80 % of its largest swing from the
+        initial angle: the commanded rudder angle of a zig-zag or turn.
+    first_rudder : signed deflection of the first plateau from neutral.
+    switch_heading_deg : zig-zag switch heading inferred at the rudder orders (None if none).
+    rudder_rate : 90th percentile of the rudder rate while it moves [rad/s] (None if it never does).
+    held_end_index : last sample of the held rudder after the execute (turning; else the end).
+    """
+
+    kind: str
+    reason: str
+    execute_index: int
+    execute_time: float
+    psi0: float
+    neutral: float
+    amplitude: float
+    plateau_angle: float
+    first_rudder: float
+    switch_heading_deg: float | None
+    rudder_rate: float | None
+    held_end_index: int
+
+
+def unwrapped_heading(log: pd.DataFrame) -> np.ndarray:
+    """ψ unwrapped, or integrated from r when the log has no heading."""
+    from scipy.integrate import cumulative_trapezoid
+
+    if "psi" in log.columns:
+        return np.unwrap(log["psi"].to_numpy())
+    return cumulative_trapezoid(log["r"].to_numpy(), log["t"].to_numpy(), initial=0.0)
+
+
+def neutral_rudder(delta: np.ndarray) -> float:
+    """Mid-range of the rudder: the neutral of a zig-zag whatever side the log starts on."""
+    return 0.5 * (float(np.max(delta)) + float(np.min(delta)))
+
+
+def runs_of(values: np.ndarray) -> list[tuple[int, int, float]]:
+    """(first, last, value) of the runs of equal values, in one pass."""
+    if values.size == 0:
+        return []
+    edges = np.flatnonzero(values[1:] != values[:-1]) + 1
+    starts = np.concatenate([[0], edges])
+    ends = np.concatenate([edges - 1, [values.size - 1]])
+    return [(int(a), int(b), float(values[a])) for a, b in zip(starts, ends, strict=True)]
+
+
+def _plateau_orders(delta: np.ndarray, side: np.ndarray, i0: int) -> list[tuple[int, int]]:
+    """(order index, new side) of each rudder reversal after ``i0``: the last sample of the
+    previous plateau (within 0.5° of its extreme angle) before the rudder swung over."""
+    runs = [r for r in runs_of(side[i0:]) if r[2] != 0]
+    orders = []
+    for (a0, b0, s0), (_, _, s1) in zip(runs[:-1], runs[1:], strict=True):
+        if s1 == s0:
+            continue
+        seg = delta[i0 + a0 : i0 + b0 + 1]
+        extreme = seg[np.argmax(s0 * seg)]
+        near = np.flatnonzero(np.abs(seg - extreme) <= PLATEAU_TOLERANCE)
+        orders.append((i0 + a0 + int(near[-1]), int(s1)))
+    return orders
+
+
+def _rudder_rate(t: np.ndarray, delta: np.ndarray) -> float | None:
+    rate = np.abs(np.diff(delta)) / np.diff(t)
+    moving = rate > math.radians(0.5)
+    return float(np.percentile(rate[moving], 90)) if moving.any() else None
+
+
+def describe_trial(
+    log: pd.DataFrame,
+    kind: str | None = None,
+    heading_deg: float | None = None,
+    t_order: float | None = None,
+) -> Trial:
+    """The trial facts of ``log``; ``kind`` forces the kind, ``heading_deg`` the zig-zag switch
+    heading, ``t_order`` the execute time (a simulated manoeuvre knows it)."""
+    if kind is not None and kind not in KINDS:
+        raise ShipidError(f"manoeuvre kind must be one of {', '.join(KINDS)}, got {kind!r}")
+    t = log["t"].to_numpy()
+    delta = log["delta"].to_numpy()
+    if t_order is None:
+        i0 = first_swing_index(delta)
+    else:
+        i0 = min(int(np.searchsorted(t, t_order - 1e-9)), len(t) - 1)
+    psi = unwrapped_heading(log)
+    psi0 = float(np.mean(psi[: i0 + 1]))
+    dpsi = psi - psi0
+    neutral = neutral_rudder(delta[i0:])
+    if np.ptp(delta[i0:]) < math.radians(1.0):
+        neutral = 0.0  # the rudder never swings: it is held where it is (a log cut after the order)
+    dev = delta - neutral
+    peak = float(np.max(np.abs(dev[i0:])))
+    side = np.sign(dev)
+    side[np.abs(dev) < max(EXECUTE_FRACTION * peak, math.radians(1.0))] = 0
+    big = np.flatnonzero(side[i0:]) + i0
+    amplitudes = []
+    for a, b, s in runs_of(side[i0:]):
+        if s != 0:
+            amplitudes.append(float(np.max(s * dev[i0 + a : i0 + b + 1])))
+    amplitude = float(np.median(amplitudes)) if amplitudes else 0.0
+    first_rudder = float(side[big[0]] * amplitudes[0]) if amplitudes else 0.0
+    orders = _plateau_orders(delta, side, i0)
+    switch = None
+    if heading_deg is not None:
+        switch = float(heading_deg)
+    elif orders:
+        k = np.array([o for o, _ in orders])
+        # The order fell between the last plateau sample and the next one: take their midpoint.
+        at_order = 0.5 * (np.abs(dpsi[k]) + np.abs(dpsi[np.minimum(k + 1, len(dpsi) - 1)]))
+        switch = float(np.degrees(np.median(at_order)))
+    held_end = _held_end(delta, i0)
+    swing = np.abs(delta - delta[0])
+    plateau_angle = float(np.median(np.abs(delta[swing > 0.8 * swing.max()]))) if swing.max() > 0 \
+        else 0.0
+    facts = dict(execute_index=i0, execute_time=float(t[i0]), psi0=psi0, neutral=neutral,
+                 amplitude=amplitude, plateau_angle=plateau_angle, first_rudder=first_rudder,
+                 switch_heading_deg=switch,
+                 rudder_rate=_rudder_rate(t, delta), held_end_index=held_end)  # fmt: skip
+    if kind is not None:
+        return Trial(kind=kind, reason="given", **facts)
+    found, reason = _classify(log, dpsi, dev, side, i0, held_end, amplitudes, orders)
+    return Trial(kind=found, reason=reason, **facts)
+
+
+def _held_end(delta: np.ndarray, i0: int) -> int:
+    """Last sample of the rudder held where the execute swing took it: the swing is followed to
+    where the rudder stops moving its way; held ends where the rudder leaves that angle by more
+    than 3° (or 15 % of the swing)."""
+    side = np.sign(delta[min(i0 + 1, len(delta) - 1)] - delta[i0]) or 1.0
+    k = i0
+    while k + 1 < len(delta) and side * (delta[k + 1] - delta[k]) > 0:
+        k += 1
+    held = float(delta[k])
+    tol = max(HELD_TOLERANCE, 0.15 * abs(held - delta[i0]))
+    away = np.flatnonzero(np.abs(delta[k:] - held) > tol)
+    return int(k + away[0] - 1) if away.size else len(delta) - 1
+
+
+def _classify(log, dpsi, dev, side, i0, held_end, amplitudes, orders) -> tuple[str, str]:
+    if not amplitudes:
+        return "other", "the rudder never swings"
+    n = log["n"].to_numpy()[i0:] if "n" in log.columns else None
+    reversed_prop = n is not None and np.min(n) < 0 < np.max(n)
+    turned = np.abs(dpsi[i0 : held_end + 1])
+    if turned.size and np.max(turned) >= math.pi and not reversed_prop:
+        return "turning", "rudder held to one side through 180° of heading"
+    if len(orders) < 2:
+        if np.max(np.abs(dpsi[i0:])) >= math.pi:
+            return "other", "the heading turns 180° but the rudder is not held"
+        return "other", "fewer than two rudder reversals"
+    if reversed_prop:
+        return "other", "the propeller is reversed"
+    amp = np.array(amplitudes)
+    med = float(np.median(amp))
+    if np.any(np.abs(amp - med) > AMPLITUDE_SPREAD * med):
+        return "other", (f"rudder swings of {np.degrees(amp.min()):.3g}°–{np.degrees(amp.max()):.3g}°"
+                         " are not one zig-zag angle")  # fmt: skip
+    if np.max(np.abs(dpsi[i0:])) > MAX_ZIGZAG_HEADING:
+        return "other", "the heading leaves ±90° (not a zig-zag)"
+    k = np.array([o for o, _ in orders])
+    new_side = np.array([s for _, s in orders], dtype=float)
+    at = dpsi[k]
+    # Each reversal sends the ship back: the heading then lies on the side opposite to the new
+    # rudder's turn; with either rudder convention sign(Δψ)·(new side) is the same at every order.
+    agree = np.sign(at) * new_side
+    consistent = max(np.mean(agree > 0), np.mean(agree < 0))
+    mag = np.abs(at)
+    med_sw = float(np.median(mag))
+    lo, hi = SWITCH_SPREAD
+    if consistent < 0.75 or med_sw <= 0 or np.any((mag < lo * med_sw) | (mag > hi * med_sw)):
+        return "other", "the rudder reversals are not ordered at one switch heading"
+    if med_sw < MIN_SWITCH:
+        return "other", (f"the rudder reversals come at {np.degrees(med_sw):.2g}° of heading: "
+                         "helm corrections, not a zig-zag")  # fmt: skip
+    return "zigzag", f"{len(orders)} rudder reversals at ≈ {np.degrees(med_sw):.3g}° heading"

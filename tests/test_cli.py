@@ -1,0 +1,191 @@
+"""The command line on bad options, thin data, extrapolation, interruption and huge requests:
+one line, exit 1 (or 130), nothing written (issue #11 items 3, 11, 12, 20, 22, 23)."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from shipid.cli import main
+from shipid.data.io import write_log
+from shipid.evaluation.envelope import implausible_indices
+from shipid.identification.identify import identify
+from shipid.trials.manoeuvres import zigzag
+from shipid.vessels import scale_ship
+
+SHIP = scale_ship(rudder_rate_deg=9.6)
+
+
+def run(argv, capsys):
+    code = main([str(a) for a in argv])
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+@pytest.fixture(scope="module")
+def trial():
+    return zigzag(SHIP, 20, 20, duration=90, dt=0.2, method="euler", approach=2.0).log
+
+
+@pytest.fixture()
+def files(tmp_path, trial, capsys):
+    log = write_log(trial, tmp_path / "zz.csv")
+    model = tmp_path / "m.json"
+    assert run(["identify", log, "-o", model], capsys)[0] == 0
+    return log, model
+
+
+def one_line_error(code, err, match=None):
+    assert code == 1, err
+    lines = [ln for ln in err.splitlines() if not ln.startswith("warning:")]
+    assert len(lines) == 1 and lines[0].startswith("shipid: error:"), err
+    assert "Traceback" not in err
+    if match:
+        assert match in lines[0], lines[0]
+
+
+# ---------------------------------------------------------------------------- 3: thin data
+@pytest.mark.parametrize(("rows", "dt"), [(4, None), (8, None), (None, 40.0)])
+def test_too_few_samples_are_refused_with_how_many_are_needed(tmp_path, trial, capsys, rows, dt):
+    log = write_log(trial if rows is None else trial.iloc[20 : 20 + rows], tmp_path / "short.csv")
+    argv = ["identify", log, "-o", tmp_path / "m.json"] + (["--dt", dt] if dt else [])
+    code, _, err = run(argv, capsys)
+    one_line_error(code, err)
+    assert "identification needs at least" in err or "leaves" in err
+    assert not (tmp_path / "m.json").exists()
+
+
+def test_ill_conditioned_fit_is_refused_unless_forced(tmp_path, trial, capsys):
+    # Sway proportional to yaw rate: u·v ∝ u·r and |v|v ∝ |v|·r, exactly.
+    flat = trial.copy()
+    flat["v"] = 0.5 * flat["r"]
+    log = write_log(flat, tmp_path / "flat.csv")
+    code, _, err = run(["identify", log, "-o", tmp_path / "m.json"], capsys)
+    one_line_error(code, err, "condition number")
+    assert "--force" in err and not (tmp_path / "m.json").exists()
+    code, _, err = run(["identify", log, "-o", tmp_path / "m.json", "--force"], capsys)
+    assert code == 0 and "kept: --force" in err
+
+
+def test_the_sample_rule_counts_equations_per_unknown(trial):
+    from shipid.errors import ShipidError
+
+    # u: 4 terms + the bias = 5 unknowns, 3 equations each.
+    with pytest.raises(ShipidError, match=r"u: 14 equations .* needs at least 15 equations"):
+        identify(trial.iloc[10:25])
+    fit = identify(trial.iloc[10:50])
+    assert any("rest on little data" in w for w in fit.warnings)
+
+
+# ---------------------------------------------------------------------------- 11, 12
+def test_a_manoeuvre_outside_the_training_envelope_is_reported(tmp_path, files, capsys):
+    _, model = files
+    out = tmp_path / "tc.json"
+    code, _, err = run(["manoeuvre", model, "turning", "--rudder", "35", "--duration", "100",
+                        "--json", out], capsys)  # fmt: skip
+    assert code == 0
+    assert "warning: delta spans" in err and "outside the training range" in err
+    assert any("delta spans" in w for w in json.loads(out.read_text())["warnings"])
+    code, _, err = run(["manoeuvre", model, "zigzag", "--rudder", "20", "--duration", "60"],
+                       capsys)  # fmt: skip
+    assert code == 0 and "warning" not in err
+
+
+def test_implausible_turning_indices_are_named():
+    notes = implausible_indices({"steady_speed": 0.047, "tactical_diameter": 1.1}, 0.35, 3.0)
+    assert len(notes) == 2 and "implausible" in notes[0] and "one ship length" in notes[1]
+
+
+def test_validate_lssvm_on_an_unrefined_model_says_so(files, capsys):
+    log, model = files
+    code, _, err = run(["validate", model, log, "--lssvm"], capsys)
+    assert code == 0 and "has no refinement" in err
+
+
+# ---------------------------------------------------------------------------- 22: option values
+@pytest.mark.parametrize(("argv", "match"), [
+    (["manoeuvre", "{model}", "zigzag", "--heading", "0"], "--heading must be > 0"),
+    (["manoeuvre", "{model}", "zigzag", "--duration", "0"], "--duration must be > 0"),
+    (["manoeuvre", "{model}", "zigzag", "--speed", "0"], "--speed must be > 0"),
+    (["manoeuvre", "{model}", "zigzag", "--duration", "inf"], "--duration must be a finite"),
+    (["manoeuvre", "{model}", "turning", "--step", "-1"], "--step must be > 0"),
+    (["indices", "{log}", "--heading", "0"], "--heading must be > 0"),
+    (["indices", "{log}", "--smooth", "-5"], "--smooth must be ≥ 0"),
+    (["indices", "{log}", "--start", "nan"], "--start must be a finite"),
+    (["identify", "{log}", "-o", "{d}/m2.json", "--dt", "inf"], "--dt must be a finite"),
+    (["identify", "{log}", "-o", "{d}/m2.json", "--refine", "--refine-evals", "0"],
+     "--refine-evals must be a whole number"),
+    (["identify", "{log}", "-o", "{d}/m2.json", "--lead", "-1", "--start", "auto"], "--lead"),
+    (["identify", "{log}", "-o", "{d}/m2.json", "--dt", "1e-6"], "would invent data"),
+    (["manoeuvre", "{model}", "zigzag", "--duration", "1e12"], "samples would need"),
+    (["manoeuvre", "{model}", "zigzag", "--duration", "1e7"], "samples would need"),
+    (["manoeuvre", "{model}", "zigzag", "--duration", "1e308"], "asks for inf samples"),  # fuzz
+    (["indices", "{log}", "--smooth", "1e9"], "not shorter than the log"),
+])  # fmt: skip
+def test_bad_option_values_are_one_line_errors(tmp_path, files, capsys, argv, match):
+    log, model = files
+    code, _, err = run([a.format(log=log, model=model, d=tmp_path) for a in argv], capsys)
+    one_line_error(code, err, match)
+    assert not (tmp_path / "m2.json").exists()
+
+
+def test_version_and_defaults_in_help(capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["--version"])
+    assert exc.value.code == 0 and capsys.readouterr().out.startswith("shipid 0.")
+    with pytest.raises(SystemExit):
+        main(["identify", "--help"])
+    assert "default 10000" in capsys.readouterr().out
+
+
+# ---------------------------------------------------------------------------- 20: interruption
+def test_interrupt_during_a_write_removes_the_temporary(tmp_path, files, capsys, monkeypatch):
+    import shipid.data.io as io
+
+    log, _ = files
+    real = io.pd.DataFrame.to_csv
+
+    def interrupted(self, fh, *args, **kwargs):
+        real(self, fh, *args, **kwargs)
+        raise KeyboardInterrupt  # what SIGINT/SIGTERM raise in the main thread
+
+    monkeypatch.setattr(io.pd.DataFrame, "to_csv", interrupted)
+    code, _, err = run(["import", log, "-o", tmp_path / "out.csv"], capsys)
+    assert code == 130 and err == "shipid: interrupted\n"
+    assert not (tmp_path / "out.csv").exists() and not list(tmp_path.glob(".out.csv*"))
+
+
+def test_sigterm_gives_one_line_exit_130_and_no_temporaries(tmp_path):
+    exe = Path(sys.executable).parent / "shipid"
+    out = tmp_path / "long.csv"
+    proc = subprocess.Popen([str(exe), "manoeuvre", "kvlcc2", "turning", "--duration", "20000",
+                             "-o", str(out)], stderr=subprocess.PIPE, text=True, cwd=tmp_path)
+    time.sleep(4.0)  # past start-up, inside the manoeuvre
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err
+    assert err.strip() == "shipid: interrupted"
+    assert os.listdir(tmp_path) == []
+
+
+def test_a_failing_demo_leaves_no_partial_folder(tmp_path, capsys, monkeypatch):
+    import shipid.demo as demo
+
+    calls = {"n": 0}
+    real = demo.write_log
+
+    def fail_on_third(log, path, out=None):
+        calls["n"] += 1
+        if calls["n"] == 3:
+            raise OSError(28, "No space left on device")
+        return real(log, path, out=out)
+
+    monkeypatch.setattr(demo, "write_log", fail_on_third)
+    code, _, err = run(["demo", "--out", tmp_path / "demo"], capsys)
+    assert code == 1 and err.splitlines()[-1] == "shipid: error: No space left on device"
+    assert "Traceback" not in err and not (tmp_path / "demo").exists()

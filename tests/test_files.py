@@ -1,0 +1,324 @@
+"""Files in and out: round trips of logs and metadata, output safety, model-file schema, readers,
+and units that look wrong. Each test reproduces a defect of issue #11 (numbered there)."""
+
+import json
+import math
+import os
+import stat
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from shipid.cli import main
+from shipid.data.io import read_log, write_log
+from shipid.errors import ShipidError
+from shipid.trials.manoeuvres import zigzag
+from shipid.vessels import scale_ship
+
+DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
+needs_data = pytest.mark.skipif(not DATA.is_dir(), reason="../shared/data is not present")
+MARIN_ZZ20 = DATA / "kvlcc2-marin" / "MARIN_FREE_KVLCC2_zz_20_m.dat"
+OSAKA_3030 = DATA / "esso-osaka" / "zigzag" / "zigzag_31-Jul-2020_13_14_21.csv"
+HSVA = DATA / "kvlcc2-hsva" / "HSVA_CPMC_KVLCC2_Z_20_10_P.dat"
+
+
+def run(argv, capsys):
+    code = main([str(a) for a in argv])
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+@pytest.fixture(scope="module")
+def trial():
+    log = zigzag(scale_ship(rudder_rate_deg=9.6), 20, 20, duration=60, dt=0.2, method="euler",
+                 approach=2.0).log  # fmt: skip
+    log.attrs.update({"ship": "scale-ship", "rudder_positive": "port"})
+    return log
+
+
+@pytest.fixture()
+def trial_csv(tmp_path, trial):
+    path = tmp_path / "zz.csv"
+    write_log(trial, path)
+    return path
+
+
+# ---------------------------------------------------------------------------- 1, 2: round trips
+@pytest.mark.parametrize("ext", [".csv", ".parquet"])
+def test_log_round_trip_keeps_times_exactly_and_metadata(tmp_path, ext):
+    t = np.arange(4481) * (606.0 / 4480) / math.sqrt(45.7)  # the MARIN rebuilt time grid
+    log = pd.DataFrame({"t": t, "delta": 0.1 * np.sin(t), "u": 1.0 + 0 * t, "v": 0 * t,
+                        "r": 0.01 * np.cos(t)})  # fmt: skip
+    log.attrs.update({"ship": "KVLCC2", "rudder_positive": "starboard", "scale": 45.7,
+                      "source": "test"})  # fmt: skip
+    path = write_log(log, tmp_path / f"log{ext}")
+    back = read_log(path)
+    np.testing.assert_array_equal(back["t"].to_numpy(), t)  # bit for bit
+    for k in ("ship", "rudder_positive", "scale"):
+        assert back.attrs[k] == log.attrs[k]
+
+
+@needs_data
+def test_imported_marin_file_identifies_as_is(tmp_path, capsys):
+    csv = tmp_path / "zz20.csv"
+    code, _, err = run(["import", "--format", "simman-marin", "--scale", "45.7", MARIN_ZZ20,
+                        "-o", csv], capsys)  # fmt: skip
+    assert code == 0, err
+    code, _, err = run(["identify", csv, "--model", "blanke-speed", "-o", tmp_path / "m.json"],
+                       capsys)  # fmt: skip
+    assert code == 0, err
+
+
+@needs_data
+def test_imported_osaka_log_keeps_its_rudder_convention(tmp_path, capsys):
+    imported = tmp_path / "zz.csv"
+    assert run(["import", "--format", "osaka-frt", "--start", "auto", "--end", "auto", OSAKA_3030,
+                "-o", imported], capsys)[0] == 0  # fmt: skip
+    direct = read_log(OSAKA_3030, fmt="osaka-frt", start="auto", end="auto")
+    back = read_log(imported)
+    assert back.attrs["rudder_positive"] == "starboard" == direct.attrs["rudder_positive"]
+    assert back.attrs["ship"] == "Esso Osaka 3 m model"
+    from shipid.evaluation.validate import validate
+    from shipid.identification.identify import identify
+
+    fit = identify(direct, model="blanke-rps")
+    a, b = validate(fit.model, direct)[0], validate(fit.model, back)[0]
+    for key in ("first_overshoot_deg", "second_overshoot_deg"):
+        assert a.indices["closed_loop"][key] == pytest.approx(b.indices["closed_loop"][key])
+
+
+def test_uniformity_judged_with_a_relative_tolerance(trial):
+    from shipid.identification.regression import sampling_time
+
+    jittered = trial.copy()
+    jittered["t"] = jittered["t"] * (1 + 1e-7 * np.sin(np.arange(len(trial))))  # printed times
+    assert sampling_time(jittered) == pytest.approx(0.2)
+    uneven = trial.copy()
+    uneven.loc[5:, "t"] += 0.05
+    with pytest.raises(ShipidError, match="not uniform.*--dt"):
+        sampling_time(uneven)
+
+
+# ---------------------------------------------------------------------------- 4, 5, 16, 21: outputs
+def test_output_honours_the_umask_and_keeps_a_replaced_files_mode(tmp_path, trial):
+    old = os.umask(0o022)
+    try:
+        path = write_log(trial, tmp_path / "a.csv")
+        assert stat.S_IMODE(path.stat().st_mode) == 0o644
+        os.chmod(path, 0o600)
+        write_log(trial, path)
+        assert stat.S_IMODE(path.stat().st_mode) == 0o600
+    finally:
+        os.umask(old)
+
+
+@pytest.mark.parametrize("cmd", [
+    ["import", "{log}", "-o", "{d}/turn.xlsx"],
+    ["identify", "{log}", "-o", "{d}/model.txt"],
+    ["validate", "{model}", "{log}", "--json", "{d}/v.csv"],
+    ["manoeuvre", "kvlcc2", "turning", "--duration", "20", "-o", "{d}/tc.xlsx"],
+])  # fmt: skip
+def test_unknown_output_extensions_are_refused_before_any_work(tmp_path, trial_csv, capsys, cmd):
+    model = tmp_path / "m.json"
+    assert run(["identify", trial_csv, "-o", model], capsys)[0] == 0
+    argv = [a.format(log=trial_csv, d=tmp_path, model=model) for a in cmd]
+    code, _, err = run(argv, capsys)
+    assert code == 1 and "unknown extension" in err and err.count("\n") == 1
+    assert not list(tmp_path.glob("turn.xlsx")) and not list(tmp_path.glob("*.tmp"))
+
+
+@pytest.mark.parametrize("cmd", [
+    ["identify", "{log}", "-o", "{log}"],
+    ["validate", "{model}", "{log}", "--json", "{model}"],
+    ["simulate", "{model}", "{log}", "-o", "{log}"],
+    ["import", "{log}", "-o", "{link}"],
+])  # fmt: skip
+def test_an_output_that_is_an_input_is_refused_and_the_input_kept(tmp_path, trial_csv, capsys,
+                                                                   cmd):  # fmt: skip
+    model = tmp_path / "m.json"
+    assert run(["identify", trial_csv, "-o", model], capsys)[0] == 0
+    link = tmp_path / "link.csv"
+    link.symlink_to(trial_csv)
+    before = {p: p.read_bytes() for p in (trial_csv, model)}
+    argv = [a.format(log=trial_csv, model=model, link=link) for a in cmd]
+    code, _, err = run(argv, capsys)
+    assert code == 1 and "is also an input" in err and err.count("\n") == 1
+    assert {p: p.read_bytes() for p in before} == before
+
+
+def test_output_through_a_symlink_writes_the_target(tmp_path, trial_csv, capsys):
+    target = tmp_path / "real.csv"
+    target.write_text("old")
+    link = tmp_path / "out.csv"
+    link.symlink_to(target)
+    assert run(["import", trial_csv, "-o", link], capsys)[0] == 0
+    assert link.is_symlink() and len(read_log(target)) == len(read_log(trial_csv))
+
+
+@pytest.mark.parametrize(("out", "match"), [("", "empty path"), ("{file}/x.csv", "which is a file")])
+def test_unwritable_output_paths_get_a_clear_message(tmp_path, trial_csv, capsys, out, match):
+    code, _, err = run(["import", trial_csv, "-o", out.format(file=trial_csv)], capsys)
+    assert code == 1 and match in err and "Errno" not in err
+
+
+def test_plots_of_logs_with_the_same_file_name_do_not_overwrite_each_other(tmp_path, trial,
+                                                                           capsys):  # fmt: skip
+    a, b = tmp_path / "a" / "zz.csv", tmp_path / "b" / "zz.csv"
+    for p in (a, b):
+        p.parent.mkdir()
+        write_log(trial, p)
+    model = tmp_path / "m.json"
+    assert run(["identify", a, "-o", model], capsys)[0] == 0
+    assert run(["validate", model, a, b, "--plots", tmp_path / "plots"], capsys)[0] == 0
+    assert sorted(p.name for p in (tmp_path / "plots").iterdir()) == ["zz-2.png", "zz.png"]
+
+
+def test_a_failed_multi_output_command_leaves_no_files(tmp_path, trial_csv, capsys, monkeypatch):
+    """validate with --json and --plots: when the figures fail, the JSON is not written either."""
+    import shipid.reporting.plots as plots
+
+    model = tmp_path / "m.json"
+    assert run(["identify", trial_csv, "-o", model], capsys)[0] == 0
+
+    def broken(*args, **kwargs):
+        raise OSError("disk full")
+
+    monkeypatch.setattr(plots, "measured_vs_simulated", broken)
+    code, _, err = run(["validate", model, trial_csv, "--json", tmp_path / "v.json", "--plots",
+                        tmp_path / "plots"], capsys)  # fmt: skip
+    assert code == 1 and "disk full" in err
+    assert not (tmp_path / "v.json").exists() and not (tmp_path / "plots").exists()
+    assert not list(tmp_path.glob(".*.tmp"))
+
+
+# ---------------------------------------------------------------------------- 18, 23: model files
+@pytest.fixture()
+def model_doc(tmp_path, trial_csv, capsys):
+    model = tmp_path / "m.json"
+    assert run(["identify", trial_csv, "-o", model], capsys)[0] == 0
+    return model, json.loads(model.read_text())
+
+
+@pytest.mark.parametrize(("edit", "match"), [
+    (lambda d: d["model"]["coefficients"]["r"].update({"delta": float("nan")}), "NaN is not"),
+    (lambda d: d["model"]["coefficients"]["r"].update({"delta": float("inf")}), "Infinity is not"),
+    (lambda d: d["model"]["coefficients"]["r"].update({"delta": "x"}), r"model\.coefficients\.r\.delta"),
+    (lambda d: d["model"]["structure"].update({"terms": "u v r"}), r"model\.structure\.terms"),
+    (lambda d: d.update({"identification": "yes"}), "identification must be"),
+    (lambda d: d.update({"identification": [1]}), "identification must be"),
+    (lambda d: d["identification"]["preprocessing"].update({"approach_speed": "fast"}),
+     "approach_speed"),
+    (lambda d: d["model"]["structure"]["terms"]["u"].append("w^2"), "unknown signal 'w'"),
+])  # fmt: skip
+@pytest.mark.parametrize("command", ["validate", "simulate", "manoeuvre"])
+def test_malformed_model_files_give_one_line(tmp_path, trial_csv, capsys, model_doc, edit, match,
+                                             command):  # fmt: skip
+    path, doc = model_doc
+    edit(doc)
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps(doc, allow_nan=True))
+    argv = {"validate": ["validate", bad, trial_csv],
+            "simulate": ["simulate", bad, trial_csv, "-o", tmp_path / "s.csv"],
+            "manoeuvre": ["manoeuvre", bad, "zigzag", "--duration", "20"]}[command]
+    code, _, err = run(argv, capsys)
+    assert code == 1 and err.startswith("shipid: error:") and err.count("\n") == 1, err
+    assert __import__("re").search(match, err), err
+
+
+def test_version_1_model_files_still_load(tmp_path, model_doc):
+    from shipid.reporting.modelfile import load_model
+
+    _, doc = model_doc
+    doc["version"] = 1
+    doc["model"]["structure"]["terms"]["u"] = ["|u|u", "vr", "r^2", "delta^2", "1"]
+    old = {"|u|u": 1.0, "vr": 2.0, "r^2": 0.0, "delta^2": 3.0, "1": 4.0}
+    doc["model"]["coefficients"]["u"] = old
+    (tmp_path / "v1.json").write_text(json.dumps(doc))
+    m = load_model(tmp_path / "v1.json")
+    assert m.coefficients["u"]["v*r"] == 2.0 and m.coefficients["u"]["vr"] == 2.0
+
+
+# ---------------------------------------------------------------------------- 13, 14: readers
+@needs_data
+def test_hsva_reader_model_scale_body_axes_port_positive():
+    log = read_log(HSVA, fmt="simman-hsva")
+    assert len(log) == 3801 and np.diff(log["t"]).max() == pytest.approx(0.05)
+    assert log.attrs["rudder_positive"] == "port" and log.attrs["scale"] == 45.7
+    assert log["u"].iloc[0] == pytest.approx(1.1775, abs=1e-3) and abs(log["v"].iloc[0]) < 1e-3
+    assert log["n"].mean() == pytest.approx(10.23, abs=0.01) and "thrust" in log.columns
+    # Starting to port with positive rudder: the heading first goes negative.
+    from shipid.trials.indices import manoeuvre_indices
+
+    ind = manoeuvre_indices(log)
+    assert ind["kind"] == "zigzag" and ind["switch_heading_deg"] == pytest.approx(10, abs=1.0)
+    k = int(np.argmax(np.abs(log["delta"].to_numpy()) > np.radians(5)))
+    assert log["delta"].iloc[k] > 0 and log["psi"].iloc[k + 100] < 0
+
+
+@needs_data
+@pytest.mark.parametrize(("path", "fmt"), [(MARIN_ZZ20, "simman-marin"), (HSVA, "simman-hsva"),
+                                           (OSAKA_3030, "osaka-frt")])  # fmt: skip
+def test_a_known_format_read_without_format_names_it(capsys, path, fmt):
+    code, _, err = run(["indices", path], capsys)
+    assert code == 1 and f"--format {fmt}" in err and err.count("\n") == 1
+
+
+def test_an_unknown_vessel_lists_the_known_ones(capsys):
+    code, _, err = run(["manoeuvre", "titanic", "turning"], capsys)
+    assert code == 1 and "scale-ship, mariner, kvlcc2" in err
+
+
+# ---------------------------------------------------------------------------- 17, 19: types, units
+def _write(tmp_path, df, name="log.parquet"):
+    path = tmp_path / name
+    if name.endswith(".parquet"):
+        df.to_parquet(path, index=False)
+    else:
+        df.to_csv(path, index=False)
+    return path
+
+
+def test_datetime_time_becomes_seconds(tmp_path, trial):
+    df = trial.copy()
+    df["t"] = pd.Timestamp("2020-07-31 13:04:24") + pd.to_timedelta(df["t"], unit="s")
+    log = read_log(_write(tmp_path, df))
+    np.testing.assert_allclose(log["t"], trial["t"] - trial["t"].iloc[0], atol=1e-6)
+    assert log.attrs["time_origin"].startswith("2020-07-31 13:04:24")
+
+
+@pytest.mark.parametrize(("change", "match"), [
+    (lambda d: d.assign(psi=np.degrees(d["psi"])), "psi looks like degrees"),
+    (lambda d: d.assign(t=d["t"] * 1000), "not seconds|milliseconds"),
+    (lambda d: d.assign(u=d["u"] > 1), "true/false"),
+    (lambda d: d.assign(u=d["u"] * 3.6 * 20), "not a ship speed"),
+    (lambda d: d.assign(r=np.degrees(d["r"])), "'r' reaches .* looks like degrees"),
+    (lambda d: d.assign(psi=-d["psi"]), "opposite sign conventions"),
+])  # fmt: skip
+def test_misread_units_and_types_are_refused(tmp_path, trial, change, match):
+    path = _write(tmp_path, change(trial.copy()))
+    with pytest.raises(ShipidError, match=match):
+        read_log(path)
+
+
+def test_yaw_rate_in_degrees_on_a_gentle_manoeuvre_is_caught_by_the_heading(tmp_path):
+    # A 5°/5° zig-zag turns at under 3 °/s, so only ψ̇ = r tells degrees from radians.
+    log = zigzag(scale_ship(rudder_rate_deg=9.6), 5, 5, duration=60, dt=0.2).log
+    assert np.degrees(log["r"]).abs().max() < 3
+    with pytest.raises(ShipidError, match="r looks like degrees per second; give --degrees r"):
+        read_log(_write(tmp_path, log.assign(r=np.degrees(log["r"]))))
+
+
+def test_over_long_lines_are_refused_quickly(tmp_path):
+    path = tmp_path / "wide.csv"
+    path.write_text(",".join(f"c{i}" for i in range(200_000)) + "\n0\n")
+    with pytest.raises(ShipidError, match="line 1 is .* characters long"):
+        read_log(path)
+
+
+def test_missing_column_from_the_api_is_a_named_error(trial):
+    from shipid.identification.identify import identify
+
+    with pytest.raises(ShipidError, match="column 'n'"):
+        identify(trial, model="blanke-rps")

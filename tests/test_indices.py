@@ -1,0 +1,234 @@
+"""IMO indices on realistic logs against noise-free truths, trial classification, and automatic
+trimming (issue #11 items 6–10 and 19)."""
+
+import math
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from shipid.cli import main
+from shipid.data.io import read_log, write_log
+from shipid.data.log import make_log
+from shipid.data.trim import trim
+from shipid.errors import ShipidError
+from shipid.trials.indices import manoeuvre_indices, turning_indices, zigzag_indices
+from shipid.trials.manoeuvres import pull_out, turning_circle, zigzag
+from shipid.trials.trial import describe_trial
+from shipid.vessels import PAPER_IMU, scale_ship
+
+DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
+needs_data = pytest.mark.skipif(not DATA.is_dir(), reason="../shared/data is not present")
+OSAKA = DATA / "esso-osaka"
+SHIP = scale_ship(rudder_rate_deg=9.6)
+
+
+def test_steady_turn_ignores_the_pull_out_that_ends_a_measured_turn():
+    """Item 6: a 35° turn followed by 100 s of rudder 0 (as a measured turning log ends)."""
+    pure = turning_circle(SHIP, 35, duration=200, dt=0.1).indices
+    log = pull_out(SHIP, 35, hold=200, release=100, dt=0.1).log
+    ind = turning_indices(log, t_order=0.0)
+    assert ind["steady_turning_diameter"] == pytest.approx(pure["steady_turning_diameter"], rel=0.01)
+    assert ind["steady_yaw_rate"] == pytest.approx(pure["steady_yaw_rate"], rel=0.01)
+    # It says which span it used: to where the rudder (9.6 °/s) leaves the held angle.
+    assert ind["steady_to"] == pytest.approx(200.0, abs=1.0)
+    assert ind["steady_from"] > 20.0
+    assert manoeuvre_indices(log)["kind"] == "turning"
+
+
+@pytest.fixture(scope="module")
+def clean_turn():
+    return turning_circle(SHIP, 20, duration=240, dt=0.2, method="rk4", approach=2.0).log
+
+
+@pytest.fixture(scope="module")
+def clean_zigzag_10():
+    return zigzag(SHIP, 10, 10, duration=90, dt=0.2, method="rk4", approach=2.0).log
+
+
+def test_noisy_positions_do_not_inflate_the_track_length(clean_zigzag_10):
+    """Item 7: 0.5 m position noise made distance_to_second_execute 2.4× too long."""
+    truth = zigzag_indices(clean_zigzag_10, t_order=2.0)["distance_to_second_execute"]
+    errors = [zigzag_indices(PAPER_IMU.apply(clean_zigzag_10, s), t_order=2.0)
+              ["distance_to_second_execute"] - truth for s in range(10)]  # fmt: skip
+    assert max(map(abs, errors)) < 0.15  # m, on 7.5 m (measured 0.12 over 20 seeds)
+
+
+def test_noisy_positions_barely_move_advance_and_tactical_diameter(clean_turn):
+    truth = turning_indices(clean_turn, t_order=2.0)
+    for seed in range(10):
+        noisy = turning_indices(PAPER_IMU.apply(clean_turn, seed), t_order=2.0)
+        # Raw positions: errors up to 1.1 m (advance) and 2.4 m (tactical diameter).
+        assert noisy["advance"] == pytest.approx(truth["advance"], abs=0.2)
+        assert noisy["tactical_diameter"] == pytest.approx(truth["tactical_diameter"], abs=0.2)
+        assert noisy["steady_turning_diameter"] == pytest.approx(
+            truth["steady_turning_diameter"], abs=0.2)
+
+
+def test_clean_positions_are_kept(clean_turn):
+    from shipid.trials.indices import track
+
+    _, x, y = track(clean_turn)
+    np.testing.assert_allclose(x, clean_turn["x"], atol=1e-3)
+
+
+def test_a_creeping_resampled_rudder_keeps_its_execute(clean_turn):
+    """Item 8: a rudder creeping 2e-4° before the order slid the execute to t = 0."""
+    crept = clean_turn.copy()
+    i0 = int(np.searchsorted(crept["t"], 2.0)) - 1
+    crept.loc[: i0, "delta"] = np.linspace(0, np.radians(2e-4), i0 + 1) * np.sign(
+        crept["delta"].iloc[-1])
+    assert describe_trial(crept).execute_index == describe_trial(clean_turn).execute_index == i0
+    a, b = turning_indices(clean_turn), turning_indices(crept)
+    assert b["advance"] == pytest.approx(a["advance"], rel=1e-6)
+
+
+def test_trial_facts_of_a_simulated_zigzag(clean_zigzag_10):
+    tr = describe_trial(clean_zigzag_10)
+    assert tr.kind == "zigzag" and tr.switch_heading_deg == pytest.approx(10, abs=0.3)
+    assert np.degrees(tr.plateau_angle) == pytest.approx(10, abs=1e-6)
+    assert np.degrees(tr.rudder_rate) == pytest.approx(9.6, rel=0.01)
+    assert tr.execute_time == pytest.approx(1.8)  # the last sample before the rudder moves
+
+
+def _random_run(seed=0, duration=400.0):
+    """Random rudder and propeller orders on the scale ship: neither a zig-zag nor a turn."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(0, duration, 0.2)
+    orders = rng.uniform(-35, 35, size=int(duration // 20) + 1)
+    delta = np.radians(orders[(t // 20).astype(int)])
+    from shipid.dynamics.simulate import simulate
+
+    log = simulate(SHIP.dynamics, t, delta, {"u": 1.9}).log
+    log["n"] = np.where((t // 50) % 2 == 0, 10.0, -6.0)
+    return log
+
+
+def test_random_rudder_runs_are_other_with_a_reason():
+    """Item 9: a random run was labelled zig-zag (first overshoot 144°) or turning."""
+    ind = manoeuvre_indices(_random_run())
+    assert ind["kind"] == "other" and ind["reason"]
+    assert set(ind) == {"kind", "reason"}
+
+
+@needs_data
+@pytest.mark.parametrize("name", ["random_03-Aug-2020_11_04_37.csv", "random_31-Jul-2020_12_29_58.csv",
+                                  "random_31-Jul-2020_12_48_39.csv", "random_31-Jul-2020_14_52_18.csv"])
+def test_esso_random_runs_are_not_zigzags_or_turns(name):
+    log = read_log(OSAKA / "random" / name, fmt="osaka-frt")
+    assert describe_trial(log).kind == "other"
+
+
+@needs_data
+def test_esso_turns_and_trimmed_zigzags_are_recognised():
+    for f in sorted((OSAKA / "turning").glob("*.csv")):
+        assert describe_trial(read_log(f, fmt="osaka-frt")).kind == "turning"
+    for f in sorted((OSAKA / "zigzag").glob("*.csv")):
+        log = read_log(f, fmt="osaka-frt", start="auto", end="auto")
+        assert describe_trial(log).kind == "zigzag", f.name
+
+
+def test_forced_kind_and_per_log_errors_in_a_validate_batch(tmp_path, capsys, clean_zigzag_10):
+    """Item 9: a run starting astern aborted the whole batch without naming the file."""
+    good = write_log(clean_zigzag_10, tmp_path / "good.csv")
+    astern = clean_zigzag_10.copy()
+    astern["u"] = -astern["u"]
+    astern["psi"] = -astern["psi"]
+    astern["r"] = -astern["r"]
+    bad = write_log(astern, tmp_path / "astern.csv")
+    lacking = write_log(clean_zigzag_10.drop(columns=["psi"]).assign(), tmp_path / "nopsi.csv")
+    model = tmp_path / "m.json"
+    assert main(["identify", str(good), "-o", str(model)]) == 0
+    capsys.readouterr()
+    code = main(["validate", str(model), str(good), str(bad), str(lacking), "--json",
+                 str(tmp_path / "v.json")])  # fmt: skip
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    assert "good.csv" in out and "nopsi.csv" in out
+    import json
+
+    logs = json.loads((tmp_path / "v.json").read_text())["logs"]
+    assert [v["error"] for v in logs] == [None, None, None]
+    code = main(["validate", str(model), str(good), "--kind", "other"])
+    out, _ = capsys.readouterr()
+    assert code == 0 and "first_overshoot" not in out
+
+
+def test_a_log_that_cannot_be_validated_is_named_and_the_others_still_run(tmp_path, capsys,
+                                                                          clean_zigzag_10):
+    good = write_log(clean_zigzag_10, tmp_path / "good.csv")
+    broken = tmp_path / "broken.csv"
+    broken.write_text("t,delta,u,v,r\n0,0,1,0\n")
+    model = tmp_path / "m.json"
+    assert main(["identify", str(good), "-o", str(model)]) == 0
+    capsys.readouterr()
+    code = main(["validate", str(model), str(broken), str(good)])
+    out, err = capsys.readouterr()
+    assert code == 1
+    assert "broken.csv" in err and err.startswith("shipid: error:")
+    assert "good.csv" in out  # the good log was validated
+
+
+def _auto_trim_never_silent(read) -> None:
+    """Either refused (no manoeuvre found) or kept with a warning that says how little was kept."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            out = read()
+        except ShipidError as exc:
+            assert "no single zig-zag or turning circle" in str(exc)
+            return
+    assert any("kept" in str(w.message) for w in caught), len(out)
+
+
+def test_auto_trim_of_a_random_run_is_refused_or_reported():
+    """Item 10: --start/--end auto on a random run silently kept 1.6 s."""
+    log = _random_run(duration=600.0)
+    _auto_trim_never_silent(lambda: trim(log, "auto", "auto", "random.csv"))
+
+
+@needs_data
+@pytest.mark.parametrize("name", ["random_03-Aug-2020_11_04_37.csv", "random_31-Jul-2020_12_29_58.csv",
+                                  "random_31-Jul-2020_12_48_39.csv", "random_31-Jul-2020_14_52_18.csv"])
+def test_auto_trim_of_esso_random_runs_never_passes_silently(name):
+    _auto_trim_never_silent(lambda: read_log(OSAKA / "random" / name, fmt="osaka-frt",
+                                             start="auto", end="auto"))
+
+
+def test_zigzag_indices_with_many_reversals_match_a_brute_force_scan():
+    """Item 19: the event search is one pass; it must give what a sample-by-sample scan gives."""
+    log = zigzag(SHIP, 10, 10, duration=400, dt=0.1).log
+    ind = zigzag_indices(log, heading_deg=10.0, t_order=0.0)
+    t, psi = log["t"].to_numpy(), log["psi"].to_numpy() - log["psi"].iloc[0]
+    k, side, switch = 0, 1.0, math.radians(10.0)
+    executes = []
+    while True:
+        nxt = next((j for j in range(k, len(t)) if side * psi[j] >= switch), None)
+        if nxt is None:
+            break
+        executes.append(nxt)
+        k, side = nxt, -side
+    first = executes[0]
+    frac = (switch - psi[first - 1]) / (psi[first] - psi[first - 1])
+    assert ind["initial_turning_time"] == pytest.approx(t[first - 1] + frac * 0.1, abs=1e-9)
+    over = math.degrees(np.max(psi[executes[0]:executes[1] + 1])) - 10.0
+    assert ind["first_overshoot_deg"] == pytest.approx(over, abs=1e-9)
+    assert len(executes) > 20
+
+
+def test_smoothing_window_is_checked():
+    log = zigzag(SHIP, 10, 10, duration=60, dt=0.2).log
+    with pytest.raises(ShipidError, match="--smooth"):
+        zigzag_indices(log, smooth_s=-5)
+    with pytest.raises(ShipidError, match="not shorter than the log"):
+        zigzag_indices(log, smooth_s=1e9)
+    assert zigzag_indices(log, smooth_s=1.0)["first_overshoot_deg"] == pytest.approx(
+        zigzag_indices(log)["first_overshoot_deg"], abs=0.2)
+
+
+def test_straight_run_is_other():
+    t = np.arange(0, 60, 0.2)
+    log = make_log({"t": t, "delta": np.zeros(t.size), "u": np.full(t.size, 2.0),
+                    "v": np.zeros(t.size), "r": np.zeros(t.size)})  # fmt: skip
+    assert manoeuvre_indices(log) == {"kind": "other", "reason": "the rudder never swings"}
