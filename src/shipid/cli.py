@@ -23,6 +23,7 @@ from shipid import __version__
 from shipid.errors import ShipidError, ShipidWarning
 
 VESSEL_NAMES = ("scale-ship", "mariner", "kvlcc2")
+LINEAR_ESTIMATORS = ("lssvm", "ols", "ridge", "lasso", "svr")
 KINDS = ("zigzag", "turning", "other")
 
 # Range checks of numeric options: dest → (rule, option as typed). Rules: '>0', '>=0', 'finite',
@@ -35,6 +36,7 @@ OPTION_RULES = {
     "speed": (">0", "--speed"), "rps": ("finite", "--rps"), "smooth": (">=0", "--smooth"),
     "scale": (">0", "--scale"), "start": ("finite", "--start"), "end": ("finite", "--end"),
     "wind_speed": (">=0", "--wind-speed"), "wind_from": ("finite", "--wind-from"),
+    "max_evaluations": ("int>=1", "--max-evaluations"), "show": ("int>=1", "--show"),
 }  # fmt: skip
 
 
@@ -89,6 +91,10 @@ def _add_log_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--rudder-positive", choices=("port", "starboard"),
                    help="where a positive rudder angle turns the ship (default: the file's "
                    "metadata, else port as in the paper)")
+
+
+def _number_or_auto(text: str) -> float | str:
+    return _time_or_auto(text)
 
 
 def _time_or_auto(text: str) -> float | str:
@@ -189,8 +195,12 @@ def cmd_identify(args) -> int:
     if args.filter is not None:
         logs = [lowpass(log, args.filter) for log in logs]
     names = [str(p) for p in args.logs]
-    ident = identify(logs, model=args.model, form=args.form, gamma=args.gamma,
-                     drop=_parse_drop(args.drop), names=names, force=args.force)  # fmt: skip
+    gamma, gamma_report = args.gamma, None
+    if gamma == "auto":
+        gamma, gamma_report = _auto_gamma(args, logs, names)
+    ident = identify(logs, model=args.model, form=args.form, gamma=gamma,
+                     drop=_parse_drop(args.drop), names=names, force=args.force,
+                     estimator=args.estimator)  # fmt: skip
     speed, rps = _approach(logs[0], "u"), _approach(logs[0], "n")
     prep = {"dt": args.dt, "start": args.start, "end": args.end, "lead": args.lead,
             "filter_hz": args.filter, "columns": args.columns, "degrees": args.degrees,
@@ -205,7 +215,7 @@ def cmd_identify(args) -> int:
     if args.refine:
         how = "whole logs" if args.segment is None else f"{args.segment:g} s segments"
         print(f"refining by output error ({how})…", file=sys.stderr)
-        refinement = refine(ident.model, logs, segment_s=args.segment, gamma=args.gamma,
+        refinement = refine(ident.model, logs, segment_s=args.segment, gamma=gamma,
                             max_nfev=args.refine_evals, names=names)  # fmt: skip
         print()
         print("refined by output error:")
@@ -238,11 +248,142 @@ def cmd_identify(args) -> int:
     if refinement:
         ident.warnings.extend(f"refinement: {n}" for n in refinement.warnings)
     text = model_text(ident, args.logs, preprocessing=prep, refinement=refinement,
-                      plausibility=plausibility, model=final)  # fmt: skip
+                      plausibility=plausibility, model=final, selection=gamma_report)  # fmt: skip
     atomic_write_text(args.output, text)
     for w in ident.warnings:
         _warn(w)
     print(f"model written to {args.output}")
+    return 0
+
+
+def _auto_gamma(args, logs, names) -> tuple[float, dict]:
+    """γ for the given structure: exact LOO of the LS-SVM pre-screens the grid, free-run
+    cross-validation over the logs decides (``shipid.identification.select``)."""
+    from shipid.dynamics.model import get_structure
+    from shipid.identification.select import select
+
+    structure = get_structure(args.model)
+    drop = _parse_drop(args.drop)
+    if drop:
+        structure = structure.without(drop)
+    cv = args.cv or ("logo" if len(logs) >= 2 else "blocks:4")
+    sel = select(logs, library=structure, search="none", names=names, cv=cv,
+                 estimator=args.estimator, plausibility=False)  # fmt: skip
+    table = sel.candidates[["gamma", "score", "score_se", "folds_diverged"]]
+    print(f"γ chosen by free-run cross-validation ({cv}): {sel.gamma:g}")
+    print(table.to_markdown(index=False, floatfmt=".4g"))
+    print()
+    return sel.gamma, {"gamma_by": "free-run CV", **sel.to_dict()}
+
+
+def _parse_gammas(text: str | None) -> tuple[float, ...] | None:
+    if not text:
+        return None
+    try:
+        return tuple(float(x) for x in text.split(",") if x.strip())
+    except ValueError:
+        raise ShipidError(f"--gammas expects numbers separated by commas, got {text!r}") from None
+
+
+def cmd_select(args) -> int:
+    from shipid.identification.plausibility import check_plausibility
+    from shipid.identification.select import SelectOptions, select
+    from shipid.outputs import OutputSet, check_outputs
+    from shipid.reporting.modelfile import model_text
+
+    check_outputs({"-o": (args.output, "json"), "--table": (args.table, "log")}, args.logs)
+    options = SelectOptions(library=args.library, search=args.search, cv=args.cv,
+                            estimator=args.estimator, method=args.method,
+                            max_evaluations=args.max_evaluations,
+                            plausibility=not args.no_plausibility, speed=args.speed,
+                            rps=args.rps, one_standard_error=not args.best,
+                            progress=not args.quiet,
+                            **({"gammas": _parse_gammas(args.gammas)} if args.gammas else {}))
+    logs = _read_logs(args)
+    names = [str(p) for p in args.logs]
+    sel = select(logs, options, names=names)
+    ident = sel.identification
+    print(sel.model.equations())
+    print(f"\nγ = {sel.gamma:g}; free-run CV score {sel.score:.4f} ({options.cv}; 1 ≈ predicting "
+          f"the mean); {len(sel.candidates)} candidates")
+    cols = ["chosen", "score", "score_se", "score_u", "score_v", "score_r", "gamma", "n_terms",
+            "folds_diverged", "plausible", "stage", "note"]
+    shown = sel.candidates.head(args.show)
+    if not shown["chosen"].any():
+        shown = _pd().concat([shown, sel.candidates[sel.candidates["chosen"]]])
+    print(shown[cols].to_markdown(index=False, floatfmt=".4g"))
+    print("\nHeld-out logs (the chosen structure fitted without each):")
+    print(_fold_table(sel.folds))
+    speed, rps = _approach(logs[0], "u"), _approach(logs[0], "n")
+    plausibility, notes = check_plausibility(sel.model, speed, rps if sel.model.uses_rps else None)
+    ident.warnings.extend(f"plausibility: {n}" for n in notes)
+    prep = {"dt": args.dt, "start": args.start, "end": args.end, "lead": args.lead,
+            "columns": args.columns, "degrees": args.degrees, "format": args.format,
+            "scale": args.scale, "approach_speed": speed, "approach_rps": rps,
+            "rudder_positive": logs[0].attrs.get("rudder_positive")}  # fmt: skip
+    text = model_text(ident, args.logs, preprocessing=prep, plausibility=plausibility,
+                      selection=sel.to_dict())  # fmt: skip
+    with OutputSet() as out:
+        out.write(args.output, lambda p: p.write_text(text, encoding="utf-8"))
+        if args.table:
+            from shipid.data.io import write_table
+
+            write_table(sel.candidates, args.table, out)
+    for w in sel.warnings:
+        _warn(w)
+    print(f"model written to {args.output}")
+    return 0
+
+
+def _pd():
+    import pandas as pd
+
+    return pd
+
+
+def _fold_table(folds) -> str:
+    pd = _pd()
+
+    rows = []
+    for f in folds:
+        if "error" in f:
+            rows.append({"held-out log": f["held_out"], "error": f["error"]})
+            continue
+        m, sp = f["metrics"], f["spread"]
+        ind = (f.get("indices") or {})
+        meas = ind.get("measured", {})
+        # Zig-zags: the closed-loop run of the trial on the model, not the open-loop replay.
+        sim = ind.get("closed_loop") or {} if f.get("kind") == "zigzag" else ind.get("simulated", {})
+        key = "tactical_diameter" if f.get("kind") == "turning" else "first_overshoot_deg"
+        rows.append({"held-out log": Path(f["held_out"]).name, "kind": f.get("kind"),
+                     "u err / spread": f"{m['u']:.4f} / {sp['u']:.4f}",
+                     "v err / spread": f"{m['v']:.4f} / {sp['v']:.4f}",
+                     "r err / spread": f"{m['r']:.4f} / {sp['r']:.4f}",
+                     "diverged": f["diverged"],
+                     key.replace("_", " ") + " meas / pred": (
+                         f"{meas.get(key):.3g} / {sim.get(key):.3g}"
+                         if meas.get(key) is not None and sim.get(key) is not None else "–")})
+    return pd.DataFrame(rows).to_markdown(index=False)
+
+
+def cmd_compare(args) -> int:
+    from shipid.evaluation.compare import compare, summary
+    from shipid.outputs import OutputSet, check_outputs
+
+    check_outputs({"--json": (args.json, "json")}, args.logs)
+    methods = [m.strip() for m in args.methods.split(",") if m.strip()]
+    logs = _read_logs(args)
+    names = [Path(p).name for p in args.logs]
+    table = compare(logs, args.model, methods, names, gamma=args.gamma, cv=args.cv,
+                    method=args.method, progress=not args.quiet)  # fmt: skip
+    print(f"Free-run score per held-out log ({args.cv}; error RMS over the log's spread, mean of "
+          "u, v, r; 1 ≈ predicting the mean), model structure " + str(args.model) + ":")
+    print(summary(table).to_markdown(floatfmt=".3f"))
+    with OutputSet() as out:
+        if args.json:
+            doc = {"structure": args.model, "cv": args.cv, "gamma": args.gamma,
+                   "rows": table.to_dict(orient="records")}  # fmt: skip
+            out.write(args.json, lambda p: p.write_text(_json_text(doc), "utf-8"))
     return 0
 
 
@@ -460,8 +601,13 @@ def build_parser() -> argparse.ArgumentParser:
                    "(blanke-rps+wind) or write terms: 'u: |u|u, v*r, 1; v: ...; r: ...'")
     p.add_argument("--form", default="increment", choices=("increment", "paper"),
                    help="regression form (default %(default)s)")
-    p.add_argument("--gamma", type=float, default=1e4,
-                   help="LS-SVM regularisation γ (default %(default)g)")
+    p.add_argument("--gamma", type=_number_or_auto, default=1e4, metavar="G|auto",
+                   help="LS-SVM regularisation γ, or 'auto': chosen by free-run cross-validation "
+                   "over the logs (default %(default)g)")
+    p.add_argument("--estimator", default="lssvm", choices=LINEAR_ESTIMATORS,
+                   help="equation-error estimator (default %(default)s, the paper's)")
+    p.add_argument("--cv", help="with --gamma auto: logo, kfold:K or blocks:K (default: logo, "
+                   "blocks:4 for one log)")
     p.add_argument("--drop", help="terms to drop, e.g. u:r^2 (the paper drops r²)")
     p.add_argument("--filter", type=float, metavar="HZ", help="zero-phase low-pass of u, v, r")
     p.add_argument("--force", action="store_true",
@@ -476,6 +622,53 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", required=True, metavar="MODEL.json")
     _add_log_options(p)
     p.set_defaults(func=cmd_identify)
+
+    p = sub.add_parser("select", help="choose the structure and γ by cross-validated free-run "
+                       "error over several logs")
+    p.add_argument("logs", nargs="+", metavar="LOG")
+    p.add_argument("--library", default="low-speed+wind",
+                   help="candidate terms: a structure name, a sum (abkowitz3+blanke) or written "
+                   "terms 'u: ...; v: ...; r: ...' (default %(default)s)")
+    p.add_argument("--search", default="stepwise", choices=("stepwise", "frols", "stlsq", "none"),
+                   help="how candidates are generated (default %(default)s)")
+    p.add_argument("--gammas", metavar="G,G,...", help="γ grid (default 1e2,1e3,1e4,1e5,1e6)")
+    p.add_argument("--cv", default="logo", help="logo (leave one log out, default), kfold:K or "
+                   "blocks:K (every log cut into K blocks)")
+    p.add_argument("--estimator", default="lssvm", choices=LINEAR_ESTIMATORS,
+                   help="equation-error estimator (default %(default)s)")
+    p.add_argument("--method", default="euler", choices=("euler", "rk4"),
+                   help="integration scheme of the free runs (default %(default)s)")
+    p.add_argument("--max-evaluations", type=int, default=400, metavar="N",
+                   help="cap on candidates evaluated (default %(default)s)")
+    p.add_argument("--best", action="store_true",
+                   help="take the best CV score instead of the sparsest within one standard error")
+    p.add_argument("--no-plausibility", action="store_true",
+                   help="do not restrict the choice to plausible models")
+    p.add_argument("--speed", type=float, help="plausibility checks at this speed [m/s] "
+                   "(default: the first log's approach)")
+    p.add_argument("--rps", type=float, help="... and this propeller speed [rps]")
+    p.add_argument("--show", type=int, default=10, metavar="N", help="candidates printed (default 10)")
+    p.add_argument("--table", metavar="OUT.csv", help="write every candidate with its scores")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("-o", "--output", required=True, metavar="MODEL.json")
+    _add_log_options(p)
+    p.set_defaults(func=cmd_select)
+
+    p = sub.add_parser("compare", help="methods × held-out logs: free-run cross-validation")
+    p.add_argument("logs", nargs="+", metavar="LOG")
+    p.add_argument("--model", default="blanke", help="structure for the semiphysical methods "
+                   "(default %(default)s)")
+    p.add_argument("--methods", default="lssvm,ols,ridge,lasso,svr,elm",
+                   help="comma-separated: lssvm, ols, ridge, lasso, svr, elm, lssvm-rbf, "
+                   "select:LIBRARY (default %(default)s)")
+    p.add_argument("--gamma", type=float, default=1e4, help="γ (α = 1/γ) (default %(default)g)")
+    p.add_argument("--cv", default="logo", help="logo (default) or kfold:K")
+    p.add_argument("--method", default="euler", choices=("euler", "rk4"),
+                   help="integration scheme (default %(default)s)")
+    p.add_argument("--json", metavar="OUT.json", help="write every (method, log) row")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    _add_log_options(p)
+    p.set_defaults(func=cmd_compare)
 
     p = sub.add_parser("validate", help="free-run a model against logs: error table and indices")
     p.add_argument("model", metavar="MODEL.json")

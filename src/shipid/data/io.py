@@ -228,3 +228,15 @@ def write_log(log: pd.DataFrame, path: str | Path, out=None) -> Path:
     if out is not None:
         return out.write(path, writer)
     return atomic_write(path, writer)
+
+
+def write_table(table: pd.DataFrame, path: str | Path, out=None) -> Path:
+    """Write a results table (CSV, or Parquet by extension), atomically or staged in ``out``."""
+    path = Path(path)
+    if path.suffix.lower() in (".parquet", ".pq"):
+        def writer(p: Path) -> None:
+            table.to_parquet(p, index=False)
+    else:
+        def writer(p: Path) -> None:
+            table.to_csv(p, index=False)
+    return out.write(path, writer) if out is not None else atomic_write(path, writer)

@@ -70,7 +70,7 @@ def _acc(th, start, sig, op, kk, pw, s):
     return a0, a1, a2
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True)
 def _rhs(th, start, sig, op, kk, pw, derived, s, u, v, r, psi, inp, wind_true, vw, dw):
     c, sn = math.cos(psi), math.sin(psi)
     xd = u * c - v * sn
@@ -94,7 +94,7 @@ def _rhs(th, start, sig, op, kk, pw, derived, s, u, v, r, psi, inp, wind_true, v
     return a0, a1, a2, r, xd, yd
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True)
 def _step(th, start, sig, op, kk, pw, derived, s, st, inp, h, rk4, wind_true, vw, dw):
     """One Euler or RK4 step of the state tuple st = (u, v, r, ψ, x, y), inputs held."""
     u, v, r, psi, x, y = st

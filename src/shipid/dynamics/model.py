@@ -45,11 +45,15 @@ _ABK_SURGE = ("u", "u^2", "u^3", "v^2", "r^2", "v*r", "delta^2", "u*delta^2", "v
 _ABK_LATERAL = ("v", "r", "v^3", "v^2*r", "v*r^2", "r^3", "u*v", "u*r", "delta", "delta^3",
                 "u*delta", "u^2*delta", "v*delta^2", "v^2*delta", "r*delta^2", "1")  # fmt: skip
 # Low and negative speed, propeller reversal (Esso random runs): hull forces in |u|, |v|, |r|
-# forms that keep their sign when the ship goes astern, thrust with n⁺ and n⁻ separately
-# (ahead and astern open-water curves), and a rudder in the propeller race only when n > 0.
-_LOW_SPEED_SURGE = ("|u|u", "v*r", "r^2", "pos(n)^2", "neg(n)^2", "u*|n|", "delta^2", "1")
-_LOW_SPEED_LATERAL = ("u*v", "|u|*r", "|v|v", "|v|r", "|r|r", "u*|u|*delta", "pos(n)^2*delta",
-                      "v*|n|", "1")  # fmt: skip
+# forms that keep their sign when the ship goes astern; thrust with n⁺ and n⁻ separately (ahead
+# and astern open-water curves) and its fall with advance (u|n|); the rudder's lift and drag in
+# the free stream (u|u|δ, u²δ²) and in the propeller race, which only an ahead propeller throws
+# on it (n⁺²δ, n⁺²δ²); the astern propeller's side force and its race on the rudder (n⁻², n⁻²δ);
+# propeller-race damping of sway and yaw (v|n|, r|n|).
+_LOW_SPEED_SURGE = ("|u|u", "v*r", "r^2", "v^2", "pos(n)^2", "neg(n)^2", "u*|n|", "delta^2",
+                    "u^2*delta^2", "pos(n)^2*delta^2", "1")  # fmt: skip
+_LOW_SPEED_LATERAL = ("u*v", "|u|*r", "|v|v", "|v|r", "|r|r", "v*|r|", "u*|u|*delta",
+                      "pos(n)^2*delta", "neg(n)^2*delta", "neg(n)^2", "v*|n|", "r*|n|", "1")  # fmt: skip
 # Wind load terms on the relative wind (Isherwood-type, to second order in the angle).
 _WIND_SURGE = ("U_A^2*cos(gamma_A)",)
 _WIND_LATERAL = ("U_A^2*sin(gamma_A)", "U_A^2*sin(2*gamma_A)")

@@ -81,10 +81,16 @@ class BatchResult:
 
 # ---------------------------------------------------------------------------- generic path
 def _rhs(dyn: Dynamics, s: np.ndarray, d: np.ndarray, T: np.ndarray | None,
-         n: np.ndarray | None = None) -> np.ndarray:  # fmt: skip
+         n: np.ndarray | None = None, other: dict | None = None) -> np.ndarray:  # fmt: skip
     out = np.empty_like(s)
-    # Only models with propeller-speed terms take n; reference ships keep the 3-argument protocol.
-    out[:, :3] = dyn.derivatives(s[:, :3], d, T) if n is None else dyn.derivatives(s[:, :3], d, T, n)
+    # Only models with propeller-speed (or wind) inputs take them; reference ships keep the
+    # 3-argument protocol.
+    if other:
+        out[:, :3] = dyn.derivatives(s[:, :3], d, T, n, **other)
+    elif n is None:
+        out[:, :3] = dyn.derivatives(s[:, :3], d, T)
+    else:
+        out[:, :3] = dyn.derivatives(s[:, :3], d, T, n)
     c, sn = np.cos(s[:, 3]), np.sin(s[:, 3])
     out[:, 3] = s[:, 2]
     out[:, 4] = s[:, 0] * c - s[:, 1] * sn
@@ -100,15 +106,16 @@ def step_state(
     h: float,
     method: str,
     n: np.ndarray | None = None,
+    other: dict | None = None,
 ) -> np.ndarray:
     """One integration step of (B, 6) states with inputs held (generic dynamics)."""
     with np.errstate(all="ignore"):  # divergence is detected and reported by the caller
-        k1 = _rhs(dyn, s, d, T, n)
+        k1 = _rhs(dyn, s, d, T, n, other)
         if method == "euler":
             return s + h * k1
-        k2 = _rhs(dyn, s + 0.5 * h * k1, d, T, n)
-        k3 = _rhs(dyn, s + 0.5 * h * k2, d, T, n)
-        k4 = _rhs(dyn, s + h * k3, d, T, n)
+        k2 = _rhs(dyn, s + 0.5 * h * k1, d, T, n, other)
+        k3 = _rhs(dyn, s + 0.5 * h * k2, d, T, n, other)
+        k4 = _rhs(dyn, s + h * k3, d, T, n, other)
         return s + (h / 6.0) * (k1 + 2 * k2 + 2 * k3 + k4)
 
 
@@ -118,7 +125,8 @@ def within_bounds(s: np.ndarray, speed_lim: float, yaw_lim: float) -> np.ndarray
                 & (np.abs(s[:, 1]) <= speed_lim) & (np.abs(s[:, 2]) <= yaw_lim))  # fmt: skip
 
 
-def _integrate_generic(dyn, t, delta, thrust, rps, s0, method, speed_lim, yaw_lim, out, n_valid):
+def _integrate_generic(dyn, t, delta, thrust, rps, s0, method, speed_lim, yaw_lim, out, n_valid,
+                       other=None):  # fmt: skip
     n_traj, n_steps = delta.shape
     s = s0.copy()
     out[:, 0] = s
@@ -127,7 +135,8 @@ def _integrate_generic(dyn, t, delta, thrust, rps, s0, method, speed_lim, yaw_li
     for k in range(n_steps - 1):
         T = None if thrust is None else thrust[alive, k]
         n = None if rps is None else rps[alive, k]
-        new = step_state(dyn, s[alive], delta[alive, k], T, t[k + 1] - t[k], method, n)
+        o = {c: x[alive, k] for c, x in (other or {}).items()}
+        new = step_state(dyn, s[alive], delta[alive, k], T, t[k + 1] - t[k], method, n, o)
         ok = within_bounds(new, speed_lim, yaw_lim)
         idx = np.flatnonzero(alive)
         s[idx[ok]] = new[ok]
@@ -273,8 +282,10 @@ def simulate_batch(
         out = np.zeros((n_traj, n_steps, 6))
         n_valid = np.zeros(n_traj, dtype=np.int64)
         uses_rps = getattr(dynamics, "uses_rps", False)
+        other = {c: _as_series(x, c, n_traj, n_steps) for c, x in extra.items() if x is not None
+                 and c in getattr(dynamics, "inputs", ())}  # fmt: skip
         _integrate_generic(dynamics, t, delta, thrust, rps if uses_rps else None, s0, method,
-                           speed_lim, yaw_lim, out, n_valid)  # fmt: skip
+                           speed_lim, yaw_lim, out, n_valid, other)  # fmt: skip
     return BatchResult(t, np.asarray(delta), out, n_valid, (speed_lim, yaw_lim), dict(meta))
 
 
@@ -321,8 +332,8 @@ def simulate(
 def model_inputs(dynamics, log: pd.DataFrame, name: str | None = None) -> dict[str, np.ndarray]:
     """The log's input series that ``dynamics`` needs besides the rudder (or an error naming the
     missing column)."""
-    if isinstance(dynamics, ManoeuvringModel):
-        needed = list(dynamics.inputs)
+    if isinstance(dynamics, ManoeuvringModel) or hasattr(dynamics, "inputs"):
+        needed = [c for c in dynamics.inputs if c != "delta"]
     else:
         needed = [c for c, used in (("thrust", dynamics.uses_thrust),
                                     ("n", getattr(dynamics, "uses_rps", False))) if used]  # fmt: skip

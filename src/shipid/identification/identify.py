@@ -20,8 +20,9 @@ from shipid.dynamics.model import (
 from shipid.dynamics.terms import parse_term
 from shipid.errors import ShipidError
 from shipid.evaluation.envelope import envelope
+from shipid.identification.estimators import check_estimator_name, fit_linear
 from shipid.identification.regression import FORMS, RegressionProblem, regression_problem
-from shipid.lssvm import LSSVR, NumericalWarning
+from shipid.lssvm import NumericalWarning
 
 COLLINEAR_CORRELATION = 0.999
 CONSTANT_VARIATION = 1e-3
@@ -46,13 +47,15 @@ class Identification:
     diagnostics: dict[str, dict] = field(default_factory=dict)
     warnings: list[str] = field(default_factory=list)
     envelope: dict[str, list[float]] = field(default_factory=dict)  # training ranges
+    estimator: str = "lssvm"
 
 
 def _display(name: str) -> str:
     return parse_term(name).display() or "1"
 
 
-def _diagnose(p: RegressionProblem, est: LSSVR) -> tuple[dict, list[str]]:
+def _diagnose(p: RegressionProblem, coef: np.ndarray, bias: float, gamma: float
+              ) -> tuple[dict, list[str]]:  # fmt: skip
     """Conditioning, collinearity, standard errors and one-step R² of one DOF's regression."""
     X, y = p.X, p.y
     notes: list[str] = []
@@ -81,15 +84,16 @@ def _diagnose(p: RegressionProblem, est: LSSVR) -> tuple[dict, list[str]]:
             if abs(c) > COLLINEAR_CORRELATION:
                 notes.append(f"{p.dof}: terms {_display(a)} and {_display(b)} are collinear in the "
                              f"data (ρ = {c:.4f}): their coefficients are poorly determined")
-    resid = y - est.predict(X)
+    fitted = X @ coef + bias
+    resid = y - fitted
     dof_resid = max(len(y) - X.shape[1] - 1, 1)
     sigma2 = float(resid @ resid) / dof_resid
     G = Xc.T @ Xc
-    A_inv = np.linalg.pinv(G + np.eye(G.shape[0]) / est.gamma)
+    A_inv = np.linalg.pinv(G + np.eye(G.shape[0]) / gamma)
     cov = sigma2 * A_inv @ G @ A_inv
     se = np.sqrt(np.clip(np.diag(cov), 0, None))
     increment = y - X[:, 0] if p.form == "paper" else y
-    pred_increment = est.predict(X) - (X[:, 0] if p.form == "paper" else 0.0)
+    pred_increment = fitted - (X[:, 0] if p.form == "paper" else 0.0)
     ss_tot = float(np.sum((increment - increment.mean()) ** 2))
     r2 = 1.0 - float(np.sum((increment - pred_increment) ** 2)) / ss_tot if ss_tot > 0 else math.nan
     # Paper form: every continuous coefficient is Γ/Δk (the self term (Γ₀ − 1)/Δk), so is its error.
@@ -147,6 +151,7 @@ def identify(
     fixed: Mapping[str, Mapping[str, float]] | None = None,
     names: Sequence[str] | None = None,
     force: bool = False,
+    estimator="lssvm",
 ) -> Identification:
     """Identify a manoeuvring model from one or several canonical logs.
 
@@ -160,6 +165,8 @@ def identify(
     fixed : terms held at given continuous-time values, e.g. {"u": {"delta^2": 0.0}}.
     force : keep a fit whose regressors are nearly dependent (condition number > ``MAX_CONDITION``)
         instead of refusing it; it is still reported.
+    estimator : 'lssvm' (the paper's, default), 'ols', 'ridge', 'lasso', 'svr' or a
+        scikit-learn linear regressor (see ``shipid.identification.estimators``).
 
     Fewer than ``MIN_EQUATIONS_PER_UNKNOWN`` equations per unknown are always refused.
     """
@@ -171,6 +178,7 @@ def identify(
         raise ShipidError(f"unknown form {form!r}; use one of {', '.join(FORMS)}")
     if not (isinstance(gamma, int | float) and math.isfinite(gamma) and gamma > 0):
         raise ShipidError(f"--gamma must be > 0, got {gamma!r}")
+    check_estimator_name(estimator)
     try:
         structure = get_structure(model) if isinstance(model, str) else model
         if drop:
@@ -197,8 +205,8 @@ def identify(
         dt = p.dt
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", NumericalWarning)
-            est = LSSVR(gamma=gamma, kernel="linear", solver="primal").fit(p.X, p.y)
-        diagnostics[dof], dof_notes = _diagnose(p, est)
+            g, b = fit_linear(p.X, p.y, estimator, gamma)
+        diagnostics[dof], dof_notes = _diagnose(p, g, b, gamma)
         cond = diagnostics[dof]["condition_number"]
         if not cond <= MAX_CONDITION:
             message = (f"{dof}: the regressors {', '.join(_display(n) for n in p.names)} are "
@@ -210,8 +218,6 @@ def identify(
             notes.append(message + " (kept: --force)")
         notes += dof_notes + [f"{dof}: {w.message}" for w in caught
                               if issubclass(w.category, NumericalWarning)]  # fmt: skip
-        b = float(est.intercept_)
-        g = np.asarray(est.coef_, dtype=float)
         c: dict[str, float] = dict(fixed.get(dof, {}))
         if form == "paper":
             c.update(coefficients_from_gamma(dof, p.names, g, p.dt))
@@ -236,4 +242,5 @@ def identify(
     model = ManoeuvringModel(ModelStructure(structure.name, terms), coefs,
                              name=f"identified ({structure.name}, {form} form)")  # fmt: skip
     return Identification(model, form, float(gamma), dt, discrete, diagnostics, notes,
-                          envelope(logs))
+                          envelope(logs), estimator if isinstance(estimator, str)
+                          else type(estimator).__name__)  # fmt: skip

@@ -118,3 +118,20 @@ def check_plausibility(
             notes.append(f"{rudder_deg:g}° rudder held to {side}: the model turns the other way "
                          f"(steady yaw rate {entry['steady_yaw_rate']:.3g} rad/s)")  # fmt: skip
     return report, notes
+
+
+def disqualifying(report: dict, model: ManoeuvringModel) -> list[str]:
+    """The failed checks that rule a model out of a selection: the rudder held to a side
+    diverges or turns the ship the other way, or surge has no steady speed. Straight-line
+    instability (real full-form ships have it) and slow settling stay warnings."""
+    reasons = []
+    eq = report.get("surge_equilibrium")
+    if "u" in model.structure.dofs and (eq is None or eq <= 0):
+        reasons.append("no steady straight speed")
+    for side, entry in (report.get("held_rudder") or {}).items():
+        if entry.get("diverged"):
+            reasons.append(f"diverges with the rudder held to {side}")
+        elif entry.get("steady_yaw_rate") is not None and math.copysign(
+                1.0, entry["steady_yaw_rate"]) != (1.0 if side == "starboard" else -1.0):
+            reasons.append(f"turns the wrong way with the rudder to {side}")
+    return reasons

@@ -48,8 +48,8 @@ def json_safe(obj):
 
 def model_document(ident: Identification, training_files: Sequence[str | Path] = (),
                    preprocessing: dict | None = None, refinement: Refinement | None = None,
-                   plausibility: dict | None = None,
-                   model: ManoeuvringModel | None = None) -> dict:  # fmt: skip
+                   plausibility: dict | None = None, model: ManoeuvringModel | None = None,
+                   selection: dict | None = None) -> dict:  # fmt: skip
     """The model file. ``model`` is the one users get (default: the refined model when there is a
     refinement, else the LS-SVM one); the LS-SVM model stays in ``refinement.initial_model`` and
     the refined one in ``refinement.refined_model``."""
@@ -59,6 +59,7 @@ def model_document(ident: Identification, training_files: Sequence[str | Path] =
         "format": FORMAT, "version": VERSION, "shipid": __version__,
         "model": model.to_dict(),
         "identification": {"form": ident.form, "gamma": ident.gamma, "dt": ident.dt,
+                           "estimator": ident.estimator, "selection": selection,
                            "discrete": ident.discrete, "diagnostics": ident.diagnostics,
                            "warnings": ident.warnings, "preprocessing": preprocessing or {},
                            "envelope": ident.envelope,

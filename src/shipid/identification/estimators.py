@@ -1,0 +1,132 @@
+"""Equation-error estimators: which regressor fits the per-DOF regression (paper eqs. 11–12).
+
+Semiphysical (the model keeps its named terms; any estimator with ``coef_`` and ``intercept_``):
+
+* ``lssvm`` (default): the paper's linear-kernel LS-SVM, ½‖w‖² + γ/2 Σe² with an unpenalised
+  bias (eqs. 2–6, 14–15). On the raw regressors it equals ridge regression with α = 1/γ.
+* ``ols``: ordinary least squares (γ → ∞).
+* ``ridge``: ridge on standardised regressors, α = 1/γ (every term shrunk alike, whatever its
+  scale: |n|n ~ 100 and δ ~ 0.3 are penalised the same).
+* ``lasso``: ℓ1 on standardised regressors, α = 1/γ (sparse: zero coefficients drop terms).
+* ``svr``: ε-insensitive support vector regression, linear kernel, C = γ, ε half the spread of
+  the least-squares residual (the noise level: errors inside it are not fitted).
+* any scikit-learn regressor object with ``coef_`` after ``fit`` (API only).
+
+Black-box (no physical structure; a dynamics model of the accelerations on u, v, r and the
+inputs, simulated by the generic path): ``elm`` (extreme learning machine, scikit-elm) and
+``lssvm-rbf`` (RBF LS-SVM, fixed-size for large N). They are for comparisons (``shipid compare``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from sklearn.base import clone
+
+from shipid.errors import ShipidError
+
+LINEAR_ESTIMATORS = ("lssvm", "ols", "ridge", "lasso", "svr")
+BLACK_BOX_ESTIMATORS = ("elm", "lssvm-rbf")
+ESTIMATORS = LINEAR_ESTIMATORS + BLACK_BOX_ESTIMATORS
+
+
+def check_estimator_name(name) -> str:
+    if isinstance(name, str) and name not in ESTIMATORS:
+        raise ShipidError(f"unknown estimator {name!r}; use one of {', '.join(ESTIMATORS)}")
+    return name
+
+
+def fit_linear(X: np.ndarray, y: np.ndarray, estimator="lssvm", gamma: float = 1e4,
+               sample_weight: np.ndarray | None = None) -> tuple[np.ndarray, float]:  # fmt: skip
+    """Coefficients and bias of one DOF's regression y ≈ X w + b with ``estimator``."""
+    from shipid.lssvm import LSSVR
+
+    if not isinstance(estimator, str):
+        est = clone(estimator).fit(X, y)
+        return _coef_and_bias(est, X.shape[1])
+    check_estimator_name(estimator)
+    if estimator in BLACK_BOX_ESTIMATORS:
+        raise ShipidError(f"estimator {estimator!r} is a black-box model without named terms; "
+                          "use it with shipid compare")  # fmt: skip
+    if estimator == "lssvm":
+        est = LSSVR(gamma=gamma, kernel="linear", solver="primal").fit(X, y, sample_weight)
+        return np.asarray(est.coef_, float), float(est.intercept_)
+    if estimator == "ols":
+        A = np.column_stack([X, np.ones(len(X))])
+        sol = np.linalg.lstsq(A, y, rcond=None)[0]
+        return sol[:-1], float(sol[-1])
+    # Standardised regressors: the penalty treats every term alike whatever its units.
+    mean, scale = X.mean(axis=0), X.std(axis=0)
+    scale[scale == 0] = 1.0
+    Z = (X - mean) / scale
+    if estimator == "ridge":
+        from sklearn.linear_model import Ridge
+
+        est = Ridge(alpha=len(y) / gamma).fit(Z, y)
+    elif estimator == "lasso":
+        from sklearn.linear_model import Lasso
+
+        est = Lasso(alpha=float(np.std(y)) / np.sqrt(gamma), max_iter=20_000).fit(Z, y)
+    else:
+        from sklearn.svm import LinearSVR
+
+        A = np.column_stack([Z, np.ones(len(y))])
+        noise = float(np.std(y - A @ np.linalg.lstsq(A, y, rcond=None)[0]))
+        est = LinearSVR(C=gamma, epsilon=0.5 * noise, max_iter=50_000, dual="auto",
+                        loss="squared_epsilon_insensitive").fit(Z, y)  # fmt: skip
+    coef, bias = _coef_and_bias(est, X.shape[1])
+    w = coef / scale
+    return w, float(bias - w @ mean)
+
+
+def _coef_and_bias(est, p: int) -> tuple[np.ndarray, float]:
+    coef = np.ravel(getattr(est, "coef_", None) if hasattr(est, "coef_") else [])
+    if coef.size != p:
+        raise ShipidError(f"estimator {type(est).__name__} has no coef_ of the {p} terms after "
+                          "fit: only linear estimators can fit named terms")  # fmt: skip
+    return coef.astype(float), float(np.ravel(getattr(est, "intercept_", 0.0))[0])
+
+
+class RegressorDynamics:
+    """A black-box dynamics model: one regressor per DOF maps (u, v, r, inputs) to the
+    acceleration. Follows the simulator's Dynamics protocol (generic path)."""
+
+    uses_thrust = False
+
+    def __init__(self, estimators: Sequence, inputs: Sequence[str], name: str = "black box"):
+        self.estimators = list(estimators)
+        self.inputs = tuple(inputs)
+        self.uses_rps = "n" in self.inputs
+        self.name = name
+
+    def features(self, u, v, r, given: dict) -> np.ndarray:
+        cols = [u, v, r] + [np.broadcast_to(np.asarray(given[c], float), np.shape(u))
+                            for c in self.inputs]  # fmt: skip
+        return np.column_stack(cols)
+
+    def derivatives(self, nu, delta, thrust=None, rps=None, **inputs) -> np.ndarray:
+        given = {"delta": delta, "n": rps, "thrust": thrust, **inputs}
+        X = self.features(nu[:, 0], nu[:, 1], nu[:, 2], given)
+        return np.column_stack([est.predict(X) for est in self.estimators])
+
+
+def make_black_box(name: str, gamma: float = 1e4, n_neurons: int = 200, seed: int = 0):
+    """An unfitted regressor of a black-box estimator name."""
+    if name == "elm":
+        try:
+            from skelm import ELMRegressor
+        except ImportError as exc:  # pragma: no cover - a dependency of shipid
+            raise ShipidError(f"the ELM estimator needs scikit-elm ({exc})") from None
+        return ELMRegressor(n_neurons=n_neurons, ufunc="tanh", alpha=1.0 / gamma,
+                            include_original_features=True, random_state=seed)  # fmt: skip
+    if name == "lssvm-rbf":
+        from sklearn.pipeline import make_pipeline
+        from sklearn.preprocessing import StandardScaler
+
+        from shipid.lssvm import LSSVR
+
+        return make_pipeline(StandardScaler(), LSSVR(gamma=gamma, kernel="rbf", sigma=3.0,
+                                                     solver="fixed-size", n_landmarks=400,
+                                                     random_state=seed))  # fmt: skip
+    raise ShipidError(f"{name!r} is not a black-box estimator ({', '.join(BLACK_BOX_ESTIMATORS)})")

@@ -1,0 +1,714 @@
+"""Structure and γ chosen by cross-validated free-run error on logs the model was not fitted to.
+
+The one-step regression of the paper (eqs. 11–12) is fitted per degree of freedom; what users run a
+model for is the free run. So every candidate (a subset of a term library, a γ) is scored by
+**leave-one-log-out** (or k-fold by log, or contiguous blocks of long logs): fitted on the other
+logs, simulated over the held-out one from its measured initial state with its measured inputs,
+and its error per state divided by that state's spread in the held-out log (1 ≈ predicting the
+mean). A fold that diverges scores ``divergence_penalty`` on every sample after the divergence.
+The CV score is the mean over folds and states.
+
+Search (``search``):
+
+* ``stepwise`` (default): terms of each DOF ranked by forward orthogonal least squares (FROLS, the
+  error-reduction ratio of Billings); the number of leading terms of each DOF is scanned one DOF at
+  a time, keeping the best free-run CV score, until a round improves nothing.
+* ``frols``: the nested models that keep, in every DOF, the terms needed to reach a share
+  1 − ρ of the library's error reduction, over a grid of ρ.
+* ``stlsq``: sequentially thresholded least squares (SINDy) on standardised regressors, over a grid
+  of thresholds.
+* ``none``: the library as it is (γ only; what ``identify --gamma auto`` runs).
+
+γ: the exact leave-one-out of the linear LS-SVM (closed form, ``shipid.lssvm.selection``) over the
+grid pre-screens; the free-run CV decides among the values within 1.5× of the best LOO error, for
+the full library and again for the chosen structure.
+
+Candidates must be plausible (``plausibility.disqualifying``): the chosen one, fitted on all logs,
+has a steady speed and turns the right way, bounded, with the rudder held; implausible candidates
+stay in the table, marked, and are not chosen.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from shipid.data.log import input_columns
+from shipid.dynamics.model import DOFS, ManoeuvringModel, ModelStructure, get_structure
+from shipid.dynamics.simulate import DivergenceBounds, input_array, run_kernel
+from shipid.dynamics.terms import INPUT_SIGNALS, parse_term, term_code
+from shipid.errors import ShipidError
+from shipid.identification.estimators import LINEAR_ESTIMATORS, check_estimator_name, fit_linear
+from shipid.identification.regression import common_sampling_time, log_terms
+
+SEARCHES = ("stepwise", "frols", "stlsq", "none")
+STATES = ("u", "v", "r")
+RHO_GRID = (0.3, 0.1, 0.03, 0.01, 3e-3, 1e-3, 3e-4, 1e-4, 1e-5, 0.0)
+STLSQ_GRID = (0.0, 0.01, 0.02, 0.05, 0.1, 0.2, 0.3)
+
+
+@dataclass(frozen=True)
+class SelectOptions:
+    """How ``select`` searches.
+
+    library : term library (a structure name, sum or spec; see ``shipid.dynamics.model``).
+    search : 'stepwise', 'frols', 'stlsq' or 'none'.
+    gammas : the γ grid.
+    cv : 'logo' (leave one log out), 'kfold:K' (K folds of whole logs) or 'blocks:K' (every log
+        cut into K contiguous blocks, then leave one block out: for one or two long logs).
+    estimator : equation-error estimator ('lssvm', 'ols', 'ridge', 'lasso', 'svr').
+    method : integration scheme of the free runs ('euler', the paper's, or 'rk4').
+    divergence_penalty : normalised error given to each sample after a fold diverged.
+    max_evaluations : cap on candidate evaluations (each one: a fit and a free run per fold).
+    plausibility : restrict the choice to plausible models.
+    one_standard_error : choose the sparsest candidate within one standard error of the best
+        CV score (else the best).
+    speed, rps : condition of the plausibility checks (default: the first log's approach).
+    progress : show a progress bar.
+    """
+
+    library: str | ModelStructure = "low-speed+wind"
+    search: str = "stepwise"
+    gammas: tuple[float, ...] = (1e2, 1e3, 1e4, 1e5, 1e6)
+    cv: str = "logo"
+    estimator: str = "lssvm"
+    method: str = "euler"
+    divergence_penalty: float = 2.0
+    max_evaluations: int = 400
+    plausibility: bool = True
+    speed: float | None = None
+    rps: float | None = None
+    one_standard_error: bool = True
+    progress: bool = False
+
+    def __post_init__(self) -> None:
+        if self.search not in SEARCHES:
+            raise ShipidError(f"--search must be one of {', '.join(SEARCHES)}, got {self.search!r}")
+        gammas = tuple(float(g) for g in self.gammas)
+        if not gammas or not all(math.isfinite(g) and g > 0 for g in gammas):
+            raise ShipidError(f"--gammas must be numbers > 0, got {self.gammas!r}")
+        object.__setattr__(self, "gammas", tuple(sorted(set(gammas))))
+        check_estimator_name(self.estimator)
+        if self.estimator not in LINEAR_ESTIMATORS:
+            raise ShipidError(f"select fits named terms: estimator must be one of "
+                              f"{', '.join(LINEAR_ESTIMATORS)}, got {self.estimator!r}")
+        _parse_cv(self.cv)
+        if not (isinstance(self.max_evaluations, int) and self.max_evaluations >= 1):
+            raise ShipidError(f"--max-evaluations must be ≥ 1, got {self.max_evaluations!r}")
+        if not (math.isfinite(self.divergence_penalty) and self.divergence_penalty > 0):
+            raise ShipidError("divergence_penalty must be > 0")
+
+
+def _parse_cv(cv: str) -> tuple[str, int]:
+    if cv == "logo":
+        return "logo", 0
+    for kind in ("kfold", "blocks"):
+        if isinstance(cv, str) and cv.startswith(kind + ":"):
+            try:
+                k = int(cv.split(":", 1)[1])
+            except ValueError:
+                k = 0
+            if k >= 2:
+                return kind, k
+    raise ShipidError(f"--cv must be 'logo', 'kfold:K' or 'blocks:K' with K ≥ 2, got {cv!r}")
+
+
+@dataclass
+class Candidate:
+    terms: dict[str, tuple[str, ...]]
+    gamma: float
+    score: float = math.inf
+    state_scores: dict[str, float] = field(default_factory=dict)
+    fold_scores: list[float] = field(default_factory=list)
+    folds_diverged: int = 0
+    plausible: bool | None = None
+    note: str = ""
+    stage: str = ""
+
+    @property
+    def standard_error(self) -> float:
+        f = np.asarray(self.fold_scores)
+        return float(f.std(ddof=1) / math.sqrt(f.size)) if f.size > 1 else 0.0
+
+    @property
+    def key(self) -> tuple:
+        return (tuple((d, tuple(sorted(t))) for d, t in sorted(self.terms.items())), self.gamma)
+
+    def n_terms(self) -> int:
+        return sum(len(t) for t in self.terms.values())
+
+
+@dataclass
+class Selection:
+    """The chosen model (fitted on all logs), its identification, and the record of the search."""
+
+    model: ManoeuvringModel
+    identification: object  # Identification of the chosen structure on all logs
+    gamma: float
+    score: float
+    candidates: pd.DataFrame
+    folds: list[dict]
+    options: SelectOptions
+    library: ModelStructure
+    ranking: dict[str, list[tuple[str, float]]]
+    warnings: list[str] = field(default_factory=list)
+
+    def to_dict(self) -> dict:
+        opts = {k: getattr(self.options, k) for k in ("search", "gammas", "cv", "estimator",
+                                                       "method", "divergence_penalty")}
+        return {"options": {**opts, "library": self.library.to_dict()}, "gamma": self.gamma,
+                "score": self.score, "ranking": {d: [[t, e] for t, e in r]
+                                                 for d, r in self.ranking.items()},
+                "candidates": self.candidates.to_dict(orient="records"), "folds": self.folds,
+                "warnings": self.warnings}  # fmt: skip
+
+
+# ---------------------------------------------------------------------------- the data, once
+@dataclass
+class _Data:
+    names: list[str]
+    dt: float
+    library: ModelStructure
+    texts: tuple[str, ...]  # library terms, the kernel's columns ("1" excluded)
+    phi: list[np.ndarray]  # per log (N_i − 1, T)
+    targets: list[dict[str, np.ndarray]]  # per log, per DOF: increments (N_i − 1,)
+    gram: list[np.ndarray]  # per log (T + 1, T + 1): [Φ 1]ᵀ[Φ 1]
+    cross: list[dict[str, np.ndarray]]  # per log, per DOF: [Φ 1]ᵀ y
+    inputs: list[np.ndarray]  # per log (N_i, 5)
+    measured: list[np.ndarray]  # per log (N_i, 3) u, v, r
+    s0: np.ndarray  # (L, 6)
+
+
+def _prepare(logs: Sequence[pd.DataFrame], names: Sequence[str], library: ModelStructure) -> _Data:
+    texts = tuple(t for t in library.all_terms if t != "1")
+    for log, name in zip(logs, names, strict=True):
+        missing = [c for c in library.inputs if c not in log.columns]
+        if missing:
+            term = next(t for t in texts if missing[0] in parse_term(t).inputs)
+            hint = " (the wind library needs the relative wind: read the Osaka files with " \
+                   "--format osaka-frt)" if missing[0].startswith("wind") else ""
+            raise ShipidError(f"{name}: the library term {term!r} needs the log column "
+                              f"{missing[0]!r}, which this log does not have{hint}")
+    dt = common_sampling_time(logs, names)
+    data = _Data(list(names), dt, library, texts, [], [], [], [], [], [], np.zeros((len(logs), 6)))
+    for i, (log, name) in enumerate(zip(logs, names, strict=True)):
+        phi = log_terms(log, texts, name)
+        ext = np.column_stack([phi[:-1], np.ones(len(log) - 1)])
+        data.phi.append(phi[:-1])
+        y = {d: np.diff(log[d].to_numpy()) / dt for d in DOFS}
+        data.targets.append(y)
+        data.gram.append(ext.T @ ext)
+        data.cross.append({d: ext.T @ y[d] for d in DOFS})
+        series = {"delta": log["delta"].to_numpy(), **input_columns(log, library.inputs, name)}
+        data.inputs.append(input_array(series, 1, len(log))[0])
+        data.measured.append(log[list(STATES)].to_numpy(dtype=float))
+        first = log.iloc[0]
+        data.s0[i] = [float(first.get(k, 0.0)) if k in log.columns else 0.0
+                      for k in ("u", "v", "r", "psi", "x", "y")]  # fmt: skip
+    return data
+
+
+# ---------------------------------------------------------------------------- folds
+def _split_blocks(logs, names, k: int) -> tuple[list[pd.DataFrame], list[str]]:
+    out, out_names = [], []
+    for log, name in zip(logs, names, strict=True):
+        edges = np.linspace(0, len(log), k + 1).round().astype(int)
+        for j, (a, b) in enumerate(zip(edges[:-1], edges[1:], strict=True)):
+            if b - a < 10:
+                raise ShipidError(f"{name}: too short for --cv blocks:{k} ({len(log)} samples)")
+            block = log.iloc[a:b].reset_index(drop=True)
+            block.attrs = dict(log.attrs)
+            out.append(block)
+            out_names.append(f"{name} [block {j + 1}/{k}]")
+    return out, out_names
+
+
+def _folds(n_logs: int, cv: str) -> list[list[int]]:
+    """Held-out log indices of each fold."""
+    kind, k = _parse_cv(cv)
+    if kind == "kfold":
+        if k > n_logs:
+            raise ShipidError(f"--cv kfold:{k} needs at least {k} logs, got {n_logs}")
+        return [list(f) for f in np.array_split(np.arange(n_logs), k)]
+    return [[i] for i in range(n_logs)]
+
+
+# ---------------------------------------------------------------------------- fits
+def _fit_theta(data: _Data, terms: Mapping[str, Sequence[str]], gamma: float, train: Sequence[int],
+               estimator: str) -> np.ndarray:  # fmt: skip
+    """θ (3, T) over the library columns, fitted on the logs ``train``."""
+    index = {t: j for j, t in enumerate(data.texts)}
+    theta = np.zeros((3, len(data.texts) + 1))  # last column: "1" (the bias)
+    T = len(data.texts)
+    for i, dof in enumerate(DOFS):
+        if dof not in terms:
+            continue
+        cols = [index[t] for t in terms[dof] if t != "1"]
+        has_const = "1" in terms[dof]
+        if estimator in ("lssvm", "ols"):
+            sel = cols + [T]
+            A = sum(data.gram[j][np.ix_(sel, sel)] for j in train)
+            b = sum(data.cross[j][dof][sel] for j in train)
+            reg = np.zeros(len(sel))
+            if estimator == "lssvm":
+                reg[:-1] = 1.0 / gamma
+            A = A + np.diag(reg)
+            d = 1.0 / np.sqrt(np.maximum(np.diag(A), 1e-300))
+            try:
+                z = np.linalg.solve(A * d[:, None] * d[None, :], b * d)
+            except np.linalg.LinAlgError:
+                z = np.linalg.lstsq(A * d[:, None] * d[None, :], b * d, rcond=None)[0]
+            sol = z * d
+            w, bias = sol[:-1], sol[-1]
+        else:
+            X = np.vstack([data.phi[j][:, cols] for j in train])
+            y = np.concatenate([data.targets[j][dof] for j in train])
+            w, bias = fit_linear(X, y, estimator, gamma)
+        theta[i, cols] = w
+        if has_const:
+            theta[i, T] = bias
+    return theta
+
+
+def _model_from_theta(data: _Data, terms, theta: np.ndarray, name: str) -> ManoeuvringModel:
+    texts = (*data.texts, "1")
+    index = {t: j for j, t in enumerate(texts)}
+    coefs = {d: {t: float(theta[DOFS.index(d), index[t]]) for t in terms[d]} for d in terms}
+    return ManoeuvringModel(ModelStructure(name, {d: tuple(terms[d]) for d in terms}), coefs,
+                            name=name)  # fmt: skip
+
+
+# ---------------------------------------------------------------------------- scoring
+def normalised_error(measured: np.ndarray, simulated: np.ndarray, penalty: float) -> np.ndarray:
+    """Per state: RMS of (simulated − measured)/σ(measured) over the whole log, the samples after
+    a divergence (simulated is shorter) counting ``penalty`` each. 1 ≈ predicting the mean."""
+    n, m = len(measured), len(simulated)
+    sigma = np.maximum(measured.std(axis=0), 1e-9)
+    err = (simulated - measured[:m]) / sigma
+    return np.sqrt((np.sum(err * err, axis=0) + (n - m) * penalty * penalty) / n)
+
+
+class _Scorer:
+    def __init__(self, data: _Data, options: SelectOptions, folds: list[list[int]]):
+        self.data, self.options, self.folds = data, options, folds
+        self.code = term_code((*data.texts, "1"))
+        held = [h for f in folds for h in f]
+        self.held = held
+        n_max = max(len(data.measured[h]) for h in held)
+        B = len(held)
+        self.t = np.arange(n_max) * data.dt
+        self.inputs = np.zeros((B, n_max, len(INPUT_SIGNALS)))
+        self.n_steps = np.zeros(B, dtype=np.int64)
+        for b, h in enumerate(held):
+            n = len(data.measured[h])
+            self.inputs[b, :n] = data.inputs[h]
+            self.inputs[b, n:] = data.inputs[h][-1]
+            self.n_steps[b] = n
+        self.s0 = data.s0[held]
+        speed_lim, yaw_lim = DivergenceBounds().resolved(float(np.max(np.abs(data.s0[:, 0]))))
+        self.bounds = (speed_lim, yaw_lim)
+        self.cache: dict[tuple, Candidate] = {}
+        self.evaluations = 0
+
+    def thetas(self, terms, gamma) -> np.ndarray:
+        n_logs = len(self.data.phi)
+        out = []
+        for fold in self.folds:
+            train = [j for j in range(n_logs) if j not in fold]
+            theta = _fit_theta(self.data, terms, gamma, train, self.options.estimator)
+            out += [theta] * len(fold)
+        return np.array(out)
+
+    def free_runs(self, terms, gamma):
+        thetas = self.thetas(terms, gamma)
+        out, n_valid = run_kernel(self.code, thetas, self.t, self.inputs, self.s0,
+                                  self.options.method, *self.bounds, n_steps=self.n_steps)
+        return out, n_valid
+
+    def score(self, cand: Candidate) -> Candidate:
+        if cand.key in self.cache:
+            return self.cache[cand.key]
+        self.evaluations += 1
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            out, n_valid = self.free_runs(cand.terms, cand.gamma)
+        P = self.options.divergence_penalty
+        per_fold = np.zeros((len(self.held), 3))
+        diverged = 0
+        for b, h in enumerate(self.held):
+            n, m = int(self.n_steps[b]), int(n_valid[b])
+            per_fold[b] = normalised_error(self.data.measured[h], out[b, :m, :3], P)
+            diverged += m < n
+        cand.state_scores = dict(zip(STATES, per_fold.mean(axis=0).round(6).tolist(), strict=True))
+        cand.fold_scores = per_fold.mean(axis=1).tolist()
+        cand.score = float(per_fold.mean())
+        cand.folds_diverged = diverged
+        if diverged == len(self.held):
+            cand.note = "diverged in every fold"
+        self.cache[cand.key] = cand
+        return cand
+
+
+# ---------------------------------------------------------------------------- rankings
+def frols_ranking(X: np.ndarray, y: np.ndarray, names: Sequence[str]) -> list[tuple[str, float]]:
+    """Terms in the order of forward orthogonal least squares, with their error-reduction ratio
+    (share of the centred target variance each term explains, orthogonally to the ones before)."""
+    Xc = X - X.mean(axis=0)
+    yc = y - y.mean()
+    yy = float(yc @ yc)
+    if yy <= 0:
+        return [(n, 0.0) for n in names]
+    remaining = list(range(X.shape[1]))
+    basis: list[np.ndarray] = []
+    out = []
+    norms0 = np.maximum(np.linalg.norm(Xc, axis=0), 1e-300)
+    while remaining:
+        best, best_err, best_w = None, -1.0, None
+        for j in remaining:
+            w = Xc[:, j].copy()
+            for q in basis:
+                w -= (q @ w) * q
+            nw = float(np.linalg.norm(w))
+            if nw < 1e-8 * norms0[j]:
+                err = 0.0
+            else:
+                g = float(w @ yc) / nw
+                err = g * g / yy
+            if err > best_err:
+                best, best_err, best_w = j, err, (w / nw if nw >= 1e-8 * norms0[j] else None)
+        out.append((names[best], float(best_err)))
+        remaining.remove(best)
+        if best_w is not None:
+            basis.append(best_w)
+    return out
+
+
+def _stlsq_terms(X: np.ndarray, y: np.ndarray, names: Sequence[str], threshold: float,
+                 gamma: float) -> tuple[str, ...]:  # fmt: skip
+    """Sequentially thresholded ridge on standardised regressors (SINDy): drop terms whose
+    standardised coefficient is below ``threshold`` × the largest, refit, until stable."""
+    mean, scale = X.mean(axis=0), X.std(axis=0)
+    scale[scale == 0] = 1.0
+    Z = (X - mean) / scale
+    yc = y - y.mean()
+    keep = np.ones(X.shape[1], dtype=bool)
+    for _ in range(10):
+        if not keep.any():
+            break
+        Zk = Z[:, keep]
+        w = np.linalg.solve(Zk.T @ Zk + np.eye(Zk.shape[1]) * len(y) / gamma, Zk.T @ yc)
+        big = np.abs(w) >= threshold * np.max(np.abs(w))
+        if big.all():
+            break
+        idx = np.flatnonzero(keep)
+        keep[idx[~big]] = False
+    return tuple(n for n, k in zip(names, keep, strict=True) if k)
+
+
+# ---------------------------------------------------------------------------- γ pre-screen
+def _loo_gamma_scores(data: _Data, terms, gammas) -> dict[float, float]:
+    """Sum over DOFs of the exact LOO MSE of the linear LS-SVM / var(target), per γ."""
+    from shipid.lssvm.selection import PrimalLOOPath
+
+    index = {t: j for j, t in enumerate(data.texts)}
+    scores = dict.fromkeys(gammas, 0.0)
+    for dof in terms:
+        cols = [index[t] for t in terms[dof] if t != "1"]
+        if not cols:
+            continue
+        X = np.vstack([p[:, cols] for p in data.phi])
+        y = np.concatenate([t[dof] for t in data.targets])
+        var = float(np.var(y)) or 1.0
+        path = PrimalLOOPath(X, y[:, None], np.ones(len(y)))
+        for g in gammas:
+            scores[g] += path.mse(float(g)) / var
+    return scores
+
+
+# ---------------------------------------------------------------------------- fixed structures
+def cross_validate(
+    logs: Sequence[pd.DataFrame],
+    structure: str | ModelStructure,
+    gammas: Sequence[float] = (1e4,),
+    names: Sequence[str] | None = None,
+    cv: str = "logo",
+    estimator: str = "lssvm",
+    method: str = "euler",
+    divergence_penalty: float = 2.0,
+) -> pd.DataFrame:
+    """Free-run CV of one structure at each γ: one row per (γ, held-out log) with the normalised
+    error per state (see ``normalised_error``) and whether the fold diverged."""
+    options = SelectOptions(library=structure, search="none", gammas=tuple(gammas), cv=cv,
+                            estimator=estimator, method=method,
+                            divergence_penalty=divergence_penalty)  # fmt: skip
+    logs, names, data, folds, scorer = _setup(logs, names, options)
+    full = {d: tuple(data.library.terms[d]) for d in data.library.dofs}
+    rows = []
+    for g in options.gammas:
+        out, n_valid = scorer.free_runs(full, g)
+        for b, h in enumerate(scorer.held):
+            m = int(n_valid[b])
+            e = normalised_error(data.measured[h], out[b, :m, :3], divergence_penalty)
+            rows.append({"gamma": g, "held_out": names[h], "diverged": m < len(data.measured[h]),
+                         **dict(zip(STATES, e.tolist(), strict=True)), "score": float(e.mean())})
+    return pd.DataFrame(rows)
+
+
+def _setup(logs, names, options: SelectOptions):
+    if isinstance(logs, pd.DataFrame):
+        logs = [logs]
+    logs = list(logs)
+    names = list(names or [log.attrs.get("name", f"log {i}") for i, log in enumerate(logs)])
+    kind, k = _parse_cv(options.cv)
+    if kind == "blocks":
+        logs, names = _split_blocks(logs, names, k)
+    if len(logs) < 2:
+        raise ShipidError("cross-validation needs at least 2 logs to hold one out; give more "
+                          "logs, or cut one into blocks with --cv blocks:K")  # fmt: skip
+    try:
+        library = (get_structure(options.library) if isinstance(options.library, str)
+                   else options.library)  # fmt: skip
+    except ValueError as exc:
+        raise ShipidError(str(exc)) from None
+    data = _prepare(logs, names, library)
+    folds = _folds(len(logs), options.cv)
+    return logs, names, data, folds, _Scorer(data, options, folds)
+
+
+# ---------------------------------------------------------------------------- the search
+def select(
+    logs: Sequence[pd.DataFrame],
+    options: SelectOptions | None = None,
+    names: Sequence[str] | None = None,
+    **overrides,
+) -> Selection:
+    """Choose the structure (from ``options.library``) and γ by cross-validated free-run error.
+
+    ``options`` (a ``SelectOptions``) or its fields as keywords. Logs share one Δk (resample with
+    ``dt=`` when reading) and are trimmed to what the model should reproduce.
+    """
+    import dataclasses
+
+    from shipid.identification.identify import identify
+    from shipid.identification.plausibility import check_plausibility, disqualifying
+
+    options = dataclasses.replace(options or SelectOptions(), **overrides)
+    logs, names, data, folds, scorer = _setup(logs, names, options)
+    library = data.library
+    notes: list[str] = []
+    speed = options.speed if options.speed is not None else _approach(logs[0], "u")
+    rps = options.rps if options.rps is not None else _approach(logs[0], "n")
+    if speed is None or not speed > 0:
+        raise ShipidError(f"{names[0]}: starts without headway; give the plausibility condition "
+                          "(speed=..., --speed)")  # fmt: skip
+    bar = _progress(options)
+
+    def evaluate(terms, gamma, stage) -> Candidate:
+        cand = Candidate({d: tuple(t) for d, t in terms.items()}, float(gamma), stage=stage)
+        if scorer.evaluations >= options.max_evaluations and cand.key not in scorer.cache:
+            cand.note = "not evaluated (--max-evaluations reached)"
+            return cand
+        out = scorer.score(cand)
+        bar.update()
+        return out
+
+    plausibility_cache: dict[tuple, tuple[bool, str]] = {}
+
+    def plausible(cand: Candidate) -> bool:
+        if not options.plausibility or cand.score == math.inf:
+            return cand.score < math.inf
+        if cand.key not in plausibility_cache:
+            theta = _fit_theta(data, cand.terms, cand.gamma, range(len(logs)), options.estimator)
+            model = _model_from_theta(data, cand.terms, theta, "candidate")
+            report, _ = check_plausibility(model, speed, rps if model.uses_rps else None)
+            reasons = disqualifying(report, model)
+            plausibility_cache[cand.key] = (not reasons, "; ".join(reasons))
+        ok, why = plausibility_cache[cand.key]
+        cand.plausible = ok
+        if not ok:
+            cand.note = f"implausible: {why}"
+        return ok
+
+    def best(cands: list[Candidate]) -> Candidate | None:
+        for c in sorted(cands, key=lambda c: c.score):
+            if c.score < math.inf and plausible(c):
+                return c
+        return None
+
+    full = {d: tuple(library.terms[d]) for d in library.dofs}
+    # γ: exact LOO pre-screen, free-run CV the arbiter.
+    loo = _loo_gamma_scores(data, full, options.gammas)
+    best_loo = min(loo.values())
+    gammas = [g for g in options.gammas if loo[g] <= 1.5 * best_loo] or [min(loo, key=loo.get)]
+    start = best([evaluate(full, g, "γ on the library") for g in gammas])
+    if start is None:
+        start = min((scorer.cache[k] for k in scorer.cache), key=lambda c: c.score)
+        notes.append("no plausible model with the whole library; the search starts from the "
+                     "best-scoring one")  # fmt: skip
+    gamma = start.gamma
+    ranking = _rankings(data, full)
+    current = start
+    if options.search == "stepwise":
+        current = _stepwise(full, ranking, gamma, evaluate, best, current)
+    elif options.search == "frols":
+        cands = [evaluate(_by_rho(full, ranking, rho), gamma, f"frols ρ = {rho:g}")
+                 for rho in RHO_GRID]  # fmt: skip
+        current = best(cands + [current]) or current
+    elif options.search == "stlsq":
+        cands = [evaluate(_stlsq(data, full, thr, gamma), gamma, f"stlsq threshold {thr:g}")
+                 for thr in STLSQ_GRID]  # fmt: skip
+        current = best(cands + [current]) or current
+    # γ again, for the chosen structure.
+    if options.search != "none":
+        current = best([current] + [evaluate(current.terms, g, "γ on the chosen structure")
+                                    for g in options.gammas]) or current  # fmt: skip
+    bar.close()
+    if options.one_standard_error:
+        current = _one_standard_error(scorer.cache.values(), current, plausible)
+    if not plausible(current):
+        notes.append(f"the chosen model is implausible ({current.note}); no candidate passed "
+                     "the checks")  # fmt: skip
+    structure = ModelStructure(f"selected from {library.name}", current.terms)
+    ident = identify(logs, model=structure, gamma=current.gamma, names=names, force=True,
+                     estimator=options.estimator)  # fmt: skip
+    folds_report = _fold_report(data, scorer, current, logs, names)
+    table = _table(scorer.cache.values(), current)
+    failed = [c for c in scorer.cache.values() if c.folds_diverged == len(scorer.held)]
+    if failed:
+        notes.append(f"{len(failed)} candidate(s) diverged in every fold (kept in the table)")
+    return Selection(ident.model, ident, current.gamma, current.score, table, folds_report,
+                     options, library, ranking, notes + ident.warnings)  # fmt: skip
+
+
+def _one_standard_error(cands, best: Candidate, plausible) -> Candidate:
+    """The sparsest plausible candidate whose CV score is within one standard error (over the
+    folds) of the best one's (Breiman et al. 1984): as good as the data can tell, and simpler."""
+    limit = best.score + best.standard_error
+    pool = sorted((c for c in cands if c.score <= limit), key=lambda c: (c.n_terms(), c.score))
+    return next((c for c in pool if plausible(c)), best)
+
+
+def _approach(log: pd.DataFrame, column: str) -> float | None:
+    if column not in log.columns:
+        return None
+    return float(log[column].iloc[: max(1, len(log) // 50)].mean())
+
+
+class _NoBar:
+    def update(self, n=1):
+        pass
+
+    def close(self):
+        pass
+
+
+def _progress(options: SelectOptions):
+    if not options.progress:
+        return _NoBar()
+    from tqdm.auto import tqdm
+
+    return tqdm(desc="candidates", unit="cand", total=None)
+
+
+def _rankings(data: _Data, full) -> dict[str, list[tuple[str, float]]]:
+    index = {t: j for j, t in enumerate(data.texts)}
+    out = {}
+    for dof, terms in full.items():
+        names = [t for t in terms if t != "1"]
+        X = np.vstack([p[:, [index[t] for t in names]] for p in data.phi])
+        y = np.concatenate([t[dof] for t in data.targets])
+        out[dof] = frols_ranking(X, y, names)
+    return out
+
+
+def _with_const(full, dof, names) -> tuple[str, ...]:
+    return tuple(names) + (("1",) if "1" in full[dof] else ())
+
+
+def _stepwise(full, ranking, gamma, evaluate, best, current: Candidate) -> Candidate:
+    sizes = {d: len(ranking[d]) for d in full}
+
+    def terms_for(s):
+        return {d: _with_const(full, d, [t for t, _ in ranking[d][: s[d]]]) for d in full}
+
+    for _ in range(3):
+        improved = False
+        for dof in full:
+            trials = []
+            for k in range(1, len(ranking[dof]) + 1):
+                s = dict(sizes, **{dof: k})
+                trials.append((k, evaluate(terms_for(s), gamma, f"stepwise {dof} ≤ {k} terms")))
+            chosen = best([c for _, c in trials] + [current])
+            if chosen is not None and chosen.score < current.score - 1e-12:
+                current = chosen
+                sizes[dof] = next(k for k, c in trials if c is chosen)
+                improved = True
+        if not improved:
+            break
+    return current
+
+
+def _by_rho(full, ranking, rho: float):
+    out = {}
+    for dof, ranked in ranking.items():
+        total = sum(e for _, e in ranked)
+        acc, keep = 0.0, []
+        for t, e in ranked:
+            if acc >= (1.0 - rho) * total and keep:
+                break
+            keep.append(t)
+            acc += e
+        out[dof] = _with_const(full, dof, keep)
+    return out
+
+
+def _stlsq(data: _Data, full, threshold: float, gamma: float):
+    index = {t: j for j, t in enumerate(data.texts)}
+    out = {}
+    for dof, terms in full.items():
+        names = [t for t in terms if t != "1"]
+        X = np.vstack([p[:, [index[t] for t in names]] for p in data.phi])
+        y = np.concatenate([t[dof] for t in data.targets])
+        out[dof] = _with_const(full, dof, _stlsq_terms(X, y, names, threshold, gamma))
+    return out
+
+
+def _table(cands, chosen: Candidate) -> pd.DataFrame:
+    rows = []
+    for c in cands:
+        rows.append({"chosen": c is chosen, "score": c.score, "score_se": c.standard_error,
+                     **{f"score_{s}": c.state_scores.get(s, math.nan) for s in STATES},
+                     "gamma": c.gamma, "n_terms": c.n_terms(),
+                     **{f"terms_{d}": ", ".join(t) for d, t in c.terms.items()},
+                     "folds_diverged": c.folds_diverged, "plausible": c.plausible,
+                     "stage": c.stage, "note": c.note})  # fmt: skip
+    df = pd.DataFrame(rows)
+    return df.sort_values("score", kind="stable").reset_index(drop=True)
+
+
+def _fold_report(data, scorer: _Scorer, chosen: Candidate, logs, names) -> list[dict]:
+    """Per held-out log: the chosen candidate fitted without it, its free-run errors (the
+    ``validate`` metrics) and indices."""
+    from shipid.evaluation.validate import validate_log
+
+    out = []
+    n_logs = len(logs)
+    for fold in scorer.folds:
+        train = [j for j in range(n_logs) if j not in fold]
+        theta = _fit_theta(data, chosen.terms, chosen.gamma, train, scorer.options.estimator)
+        model = _model_from_theta(data, chosen.terms, theta, "fold model")
+        for h in fold:
+            try:
+                v = validate_log(model, logs[h], names[h], scorer.options.method)
+                out.append({"held_out": names[h], "diverged": v.simulation.diverged,
+                            "metrics": {s: v.metrics[s]["std"] for s in STATES},
+                            "spread": {s: float(np.std(logs[h][s])) for s in STATES},
+                            "kind": v.kind, "indices": v.indices})  # fmt: skip
+            except ShipidError as exc:
+                out.append({"held_out": names[h], "error": str(exc)})
+    return out
