@@ -569,15 +569,30 @@ def cmd_indices(args) -> int:
 
 def cmd_import(args) -> int:
     from shipid.data.io import write_log
-    from shipid.outputs import check_outputs
+    from shipid.outputs import OutputSet, check_outputs
 
-    check_outputs({"-o": (args.output, "log")}, args.logs)
-    log = _read_logs(args)[0]
-    write_log(log, args.output)
-    meta = ", ".join(f"{k}={log.attrs[k]}" for k in ("ship", "rudder_positive", "scale")
-                     if k in log.attrs)  # fmt: skip
-    print(f"{len(log)} samples, {log['t'].iloc[-1] - log['t'].iloc[0]:.1f} s ({meta}) "
-          f"written to {args.output}")
+    several = len(args.logs) > 1
+    if several:
+        # Several files: -o is a folder; each file keeps its name with the extension of --ext.
+        check_outputs({"-o": (args.output, "dir")}, args.logs)
+        targets = [Path(args.output) / (Path(p).stem + args.ext) for p in args.logs]
+        check_outputs({f"-o {t.name}": (t, "log") for t in targets}, args.logs)
+        stems = [t.name for t in targets]
+        dup = next((n for n in stems if stems.count(n) > 1), None)
+        if dup:
+            raise ShipidError(f"-o {args.output}: two inputs would both be written as {dup}")
+    else:
+        check_outputs({"-o": (args.output, "log")}, args.logs)
+        targets = [Path(args.output)]
+    logs = _read_logs(args)
+    with OutputSet() as out:
+        for log, target in zip(logs, targets, strict=True):
+            write_log(log, target, out=out)
+    for log, target in zip(logs, targets, strict=True):
+        meta = ", ".join(f"{k}={log.attrs[k]}" for k in ("ship", "rudder_positive", "scale")
+                         if k in log.attrs)  # fmt: skip
+        print(f"{len(log)} samples, {log['t'].iloc[-1] - log['t'].iloc[0]:.1f} s ({meta}) "
+              f"written to {target}")
     return 0
 
 
@@ -718,9 +733,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", metavar="LOG.csv", help="write the simulated log")
     p.set_defaults(func=cmd_manoeuvre)
 
-    p = sub.add_parser("import", help="convert a trial file to a canonical log")
-    p.add_argument("logs", nargs=1, metavar="FILE")
-    p.add_argument("-o", "--output", required=True, metavar="LOG.csv|LOG.parquet")
+    p = sub.add_parser("import", help="convert trial files to canonical logs")
+    p.add_argument("logs", nargs="+", metavar="FILE")
+    p.add_argument("-o", "--output", required=True, metavar="LOG.csv|LOG.parquet|DIR",
+                   help="the canonical log; with several files, a folder")
+    p.add_argument("--ext", default=".csv", choices=(".csv", ".parquet"),
+                   help="with several files: the output format (default %(default)s)")
     _add_log_options(p)
     p.set_defaults(func=cmd_import)
 
