@@ -10,6 +10,7 @@ import time
 from pathlib import Path
 
 import pytest
+from cli_helpers import run
 
 from shipid.cli import main
 from shipid.data.io import write_log
@@ -19,12 +20,6 @@ from shipid.trials.manoeuvres import zigzag
 from shipid.vessels import scale_ship
 
 SHIP = scale_ship(rudder_rate_deg=9.6)
-
-
-def run(argv, capsys):
-    code = main([str(a) for a in argv])
-    out = capsys.readouterr()
-    return code, out.out, out.err
 
 
 @pytest.fixture(scope="module")

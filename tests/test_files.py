@@ -10,8 +10,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+from cli_helpers import run
 
-from shipid.cli import main
 from shipid.data.io import read_log, write_log
 from shipid.errors import ShipidError
 from shipid.trials.manoeuvres import zigzag
@@ -22,12 +22,6 @@ needs_data = pytest.mark.skipif(not DATA.is_dir(), reason="../shared/data is not
 MARIN_ZZ20 = DATA / "kvlcc2-marin" / "MARIN_FREE_KVLCC2_zz_20_m.dat"
 OSAKA_3030 = DATA / "esso-osaka" / "zigzag" / "zigzag_31-Jul-2020_13_14_21.csv"
 HSVA = DATA / "kvlcc2-hsva" / "HSVA_CPMC_KVLCC2_Z_20_10_P.dat"
-
-
-def run(argv, capsys):
-    code = main([str(a) for a in argv])
-    out = capsys.readouterr()
-    return code, out.out, out.err
 
 
 @pytest.fixture(scope="module")

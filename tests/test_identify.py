@@ -5,6 +5,7 @@ import json
 import numpy as np
 import pandas as pd
 import pytest
+from cli_helpers import run
 
 from shipid.cli import main
 from shipid.data.preprocess import lowpass
@@ -100,12 +101,6 @@ def trial_csv(tmp_path, clean_zigzag):
     path = tmp_path / "zz.csv"
     clean_zigzag.to_csv(path, index=False)
     return path
-
-
-def run(argv, capsys):
-    code = main([str(a) for a in argv])
-    out = capsys.readouterr()
-    return code, out.out, out.err
 
 
 def test_cli_end_to_end(tmp_path, trial_csv, capsys):

@@ -407,7 +407,6 @@ def cmd_validate(args) -> int:
         model_from_document,
         training_conditions,
     )
-    from shipid.reporting.plots import measured_vs_simulated
     from shipid.reporting.report import error_table, indices_table
 
     check_outputs({"--json": (args.json, "json"), "--plots": (args.plots, "dir")},
@@ -455,11 +454,14 @@ def cmd_validate(args) -> int:
             records = [v.to_dict() for v in vals] + [{"name": None, "error": e} for e in failed]
             out.write(args.json, lambda p: p.write_text(_json_text({"logs": records}), "utf-8"))
         if args.plots:
+            from shipid.reporting import plots
+
             stems = _unique_figure_names([v.name for v in good])
             pairs = [(v, log) for v, log in zip(vals, logs, strict=True) if v.error is None]
             for (v, log), stem in zip(pairs, stems, strict=True):
-                measured_vs_simulated(log, v.simulation.log, Path(args.plots) / f"{stem}.png",
-                                      Path(v.name).name, out=out)  # fmt: skip
+                plots.measured_vs_simulated(log, v.simulation.log,
+                                            Path(args.plots) / f"{stem}.png", Path(v.name).name,
+                                            out=out)  # fmt: skip
     return 1 if errors else 0
 
 

@@ -22,7 +22,6 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
-from sklearn.base import clone
 
 from shipid.errors import ShipidError
 
@@ -40,9 +39,9 @@ def check_estimator_name(name) -> str:
 def fit_linear(X: np.ndarray, y: np.ndarray, estimator="lssvm", gamma: float = 1e4,
                sample_weight: np.ndarray | None = None) -> tuple[np.ndarray, float]:  # fmt: skip
     """Coefficients and bias of one DOF's regression y ≈ X w + b with ``estimator``."""
-    from shipid.lssvm import LSSVR
-
     if not isinstance(estimator, str):
+        from sklearn.base import clone
+
         est = clone(estimator).fit(X, y)
         return _coef_and_bias(est, X.shape[1])
     check_estimator_name(estimator)
@@ -50,8 +49,13 @@ def fit_linear(X: np.ndarray, y: np.ndarray, estimator="lssvm", gamma: float = 1
         raise ShipidError(f"estimator {estimator!r} is a black-box model without named terms; "
                           "use it with shipid compare")  # fmt: skip
     if estimator == "lssvm":
-        est = LSSVR(gamma=gamma, kernel="linear", solver="primal").fit(X, y, sample_weight)
-        return np.asarray(est.coef_, float), float(est.intercept_)
+        # LSSVR(kernel="linear", solver="primal") without the estimator class (and scikit-learn).
+        from shipid.lssvm.solvers import accumulate_normal_equations, solve_primal
+
+        w = np.ones(len(y)) if sample_weight is None else np.asarray(sample_weight, float)
+        A, B = accumulate_normal_equations([(X, y[:, None], w)], X.shape[1], 1)
+        coef, intercept, _ = solve_primal(A, B, gamma)
+        return coef[0], float(intercept[0])
     if estimator == "ols":
         A = np.column_stack([X, np.ones(len(X))])
         sol = np.linalg.lstsq(A, y, rcond=None)[0]

@@ -22,7 +22,7 @@ from shipid.errors import ShipidError
 from shipid.evaluation.envelope import envelope
 from shipid.identification.estimators import check_estimator_name, fit_linear
 from shipid.identification.regression import FORMS, RegressionProblem, regression_problem
-from shipid.lssvm import NumericalWarning
+from shipid.lssvm.solvers import NumericalWarning
 
 COLLINEAR_CORRELATION = 0.999
 CONSTANT_VARIATION = 1e-3

@@ -415,14 +415,11 @@ def _loo_gamma_scores(data: _Data, terms, gammas) -> dict[float, float]:
     """Sum over DOFs of the exact LOO MSE of the linear LS-SVM / var(target), per γ."""
     from shipid.lssvm.selection import PrimalLOOPath
 
-    index = {t: j for j, t in enumerate(data.texts)}
     scores = dict.fromkeys(gammas, 0.0)
     for dof in terms:
-        cols = [index[t] for t in terms[dof] if t != "1"]
-        if not cols:
+        names, X, y = _stacked(data, dof, terms[dof])
+        if not names:
             continue
-        X = np.vstack([p[:, cols] for p in data.phi])
-        y = np.concatenate([t[dof] for t in data.targets])
         var = float(np.var(y)) or 1.0
         path = PrimalLOOPath(X, y[:, None], np.ones(len(y)))
         for g in gammas:
@@ -615,13 +612,19 @@ def _progress(options: SelectOptions):
     return tqdm(desc="candidates", unit="cand", total=None)
 
 
-def _rankings(data: _Data, full) -> dict[str, list[tuple[str, float]]]:
+def _stacked(data: _Data, dof: str, terms) -> tuple[list[str], np.ndarray, np.ndarray]:
+    """The regression of one DOF over all logs: term names (the constant excluded), X, y."""
     index = {t: j for j, t in enumerate(data.texts)}
+    names = [t for t in terms if t != "1"]
+    X = np.vstack([p[:, [index[t] for t in names]] for p in data.phi])
+    y = np.concatenate([t[dof] for t in data.targets])
+    return names, X, y
+
+
+def _rankings(data: _Data, full) -> dict[str, list[tuple[str, float]]]:
     out = {}
     for dof, terms in full.items():
-        names = [t for t in terms if t != "1"]
-        X = np.vstack([p[:, [index[t] for t in names]] for p in data.phi])
-        y = np.concatenate([t[dof] for t in data.targets])
+        names, X, y = _stacked(data, dof, terms)
         out[dof] = frols_ranking(X, y, names)
     return out
 
@@ -668,12 +671,9 @@ def _by_rho(full, ranking, rho: float):
 
 
 def _stlsq(data: _Data, full, threshold: float, gamma: float):
-    index = {t: j for j, t in enumerate(data.texts)}
     out = {}
     for dof, terms in full.items():
-        names = [t for t in terms if t != "1"]
-        X = np.vstack([p[:, [index[t] for t in names]] for p in data.phi])
-        y = np.concatenate([t[dof] for t in data.targets])
+        names, X, y = _stacked(data, dof, terms)
         out[dof] = _with_const(full, dof, _stlsq_terms(X, y, names, threshold, gamma))
     return out
 

@@ -14,13 +14,16 @@ import json
 import math
 from collections.abc import Mapping, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from shipid import __version__
 from shipid.dynamics.model import ManoeuvringModel
 from shipid.errors import ShipidError
-from shipid.identification.identify import Identification
-from shipid.identification.refine import Refinement
 from shipid.outputs import atomic_write_text
+
+if TYPE_CHECKING:  # loading a model file needs neither (nor scikit-learn behind them)
+    from shipid.identification.identify import Identification
+    from shipid.identification.refine import Refinement
 
 FORMAT = "shipid-model"
 VERSION = 2

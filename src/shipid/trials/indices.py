@@ -18,10 +18,15 @@ import math
 import numba
 import numpy as np
 import pandas as pd
-from scipy.integrate import cumulative_trapezoid
 
 from shipid.errors import ShipidError
-from shipid.trials.trial import KINDS, Trial, describe_trial, unwrapped_heading
+from shipid.trials.trial import (
+    KINDS,
+    Trial,
+    cumulative_integral,
+    describe_trial,
+    unwrapped_heading,
+)
 
 MANOEUVRE_KINDS = KINDS
 # Fraction of the steady yaw rate within which r counts as settled in a held turn.
@@ -107,13 +112,13 @@ def track(log: pd.DataFrame) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         return psi, x, y
     xd = u * np.cos(psi) - v * np.sin(psi)
     yd = u * np.sin(psi) + v * np.cos(psi)
-    return psi, cumulative_trapezoid(xd, t, initial=0.0), cumulative_trapezoid(yd, t, initial=0.0)
+    return psi, cumulative_integral(xd, t, initial=0.0), cumulative_integral(yd, t, initial=0.0)
 
 
 def travelled(log: pd.DataFrame) -> np.ndarray:
     """Distance along the track from the first sample: ∫ √(u² + v²) dt."""
     speed = np.hypot(log["u"].to_numpy(), log["v"].to_numpy())
-    return cumulative_trapezoid(speed, log["t"].to_numpy(), initial=0.0)
+    return cumulative_integral(speed, log["t"].to_numpy(), initial=0.0)
 
 
 # ---------------------------------------------------------------------------- events

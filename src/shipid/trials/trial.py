@@ -68,13 +68,21 @@ class Trial:
     held_end_index: int
 
 
+def cumulative_integral(y: np.ndarray, t: np.ndarray, initial: float = 0.0) -> np.ndarray:
+    """∫ y dt from t[0] by the trapezoidal rule, sample by sample."""
+    out = np.empty(len(y))
+    out[0] = initial
+    np.cumsum(0.5 * (y[1:] + y[:-1]) * np.diff(t), out=out[1:])
+    out[1:] += initial
+    return out
+
+
 def unwrapped_heading(log: pd.DataFrame) -> np.ndarray:
     """ψ unwrapped, or integrated from r when the log has no heading."""
-    from scipy.integrate import cumulative_trapezoid
 
     if "psi" in log.columns:
         return np.unwrap(log["psi"].to_numpy())
-    return cumulative_trapezoid(log["r"].to_numpy(), log["t"].to_numpy(), initial=0.0)
+    return cumulative_integral(log["r"].to_numpy(), log["t"].to_numpy(), initial=0.0)
 
 
 def neutral_rudder(delta: np.ndarray) -> float:
