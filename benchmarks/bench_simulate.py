@@ -171,5 +171,41 @@ def main() -> None:
                   f"{rate / py_rate:.0f}× | {rate / nb_rate:.2f}× | {target} |")
 
 
+class NumpyPath:
+    """A reference ship seen through its NumPy ``derivatives`` only: the simulator's generic
+    path, which is how the reference ships ran before their physics was compiled."""
+
+    uses_thrust = False
+
+    def __init__(self, dynamics):
+        self.dynamics = dynamics
+
+    def derivatives(self, nu, delta, thrust=None):
+        return self.dynamics.derivatives(nu, delta)
+
+
+def reference_ships() -> None:
+    """Closed-loop turning circles of the reference ships: compiled physics against the NumPy
+    path they ran on before (one ``derivatives`` call per RK4 stage), same steps."""
+    import dataclasses
+
+    from shipid.trials.manoeuvres import turning_circle
+    from shipid.vessels import kvlcc2, mariner
+
+    print("\nReference ships, closed-loop 35° turning circle (RK4)\n")
+    print("| ship | steps | compiled (s) | steps/s | NumPy path (s) | speed-up |")
+    print("|---|---|---|---|---|---|")
+    for ship, duration, dt in ((kvlcc2(), 200.0, 0.05), (mariner(), 1000.0, 0.25)):
+        slow_ship = dataclasses.replace(ship, dynamics=NumpyPath(ship.dynamics))
+        turning_circle(ship, 35, duration=10 * dt, dt=dt)  # compile or load the caches
+        n = int(duration / dt)
+        fast = best_of(lambda s=ship, d=duration, h=dt: turning_circle(s, 35, duration=d, dt=h))
+        slow = best_of(lambda s=slow_ship, d=duration, h=dt: turning_circle(
+            s, 35, duration=d, dt=h), 1)
+        print(f"| {ship.name} | {n} | {fast:.3f} | {n / fast:.3g} | {slow:.2f} | "
+              f"{slow / fast:.0f}× |")
+
+
 if __name__ == "__main__":
     main()
+    reference_ships()

@@ -108,7 +108,7 @@ def test_validate_lssvm_on_an_unrefined_model_says_so(files, capsys):
     (["manoeuvre", "{model}", "zigzag", "--duration", "0"], "--duration must be > 0"),
     (["manoeuvre", "{model}", "zigzag", "--speed", "0"], "--speed must be > 0"),
     (["manoeuvre", "{model}", "zigzag", "--duration", "inf"], "--duration must be a finite"),
-    (["manoeuvre", "{model}", "turning", "--step", "-1"], "--step must be > 0"),
+    (["manoeuvre", "{model}", "turning", "--dt", "-1"], "--dt must be > 0"),
     (["indices", "{log}", "--heading", "0"], "--heading must be > 0"),
     (["indices", "{log}", "--smooth", "-5"], "--smooth must be ≥ 0"),
     (["indices", "{log}", "--start", "nan"], "--start must be a finite"),
@@ -160,7 +160,7 @@ def test_sigterm_gives_one_line_exit_130_and_no_temporaries(tmp_path):
     out = tmp_path / "long.csv"
     proc = subprocess.Popen([str(exe), "manoeuvre", "kvlcc2", "turning", "--duration", "20000",
                              "-o", str(out)], stderr=subprocess.PIPE, text=True, cwd=tmp_path)
-    time.sleep(4.0)  # past start-up, inside the manoeuvre
+    time.sleep(2.5)  # past start-up, inside the manoeuvre (about 8 s of work)
     proc.send_signal(signal.SIGTERM)
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 130, err

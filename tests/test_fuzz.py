@@ -210,15 +210,25 @@ COMMANDS = {
     "indices": ["indices", "{log}", "--json", "{out}/i.json"],
     "import": ["import", "{log}", "-o", "{out}/x.csv"],
     "simulate": ["simulate", "{model}", "{log}", "-o", "{out}/s.csv"],
+    "criteria": ["criteria", "{model}", "--length", "7", "--json", "{out}/c.json"],
+    "linearise": ["linearise", "{model}"],
+    "autopilot": ["autopilot", "{model}", "-o", "{out}/a.png"],
+    "follow": ["follow", "{model}", "--json", "{out}/f.json"],
+    "plot": ["plot", "{log}", "-o", "{out}/p.png"],
 }
 OPTIONS = {
     "identify": ["--gamma", "--dt", "--filter", "--lead", "--start", "--end"],
     "validate": ["--dt", "--smooth", "--start", "--end"],
-    "manoeuvre": ["--rudder", "--heading", "--duration", "--step", "--speed", "--rps",
+    "manoeuvre": ["--rudder", "--heading", "--duration", "--dt", "--speed", "--rps",
                   "--wind-speed", "--wind-from"],
     "indices": ["--heading", "--smooth", "--dt", "--start"],
     "import": ["--dt", "--start", "--end", "--scale"],
     "simulate": ["--dt", "--start"],
+    "criteria": ["--length", "--speed", "--scale", "--rudder-rate", "--dt"],
+    "linearise": ["--speed"],
+    "autopilot": ["--omega", "--dt", "--heading", "--duration", "--speed"],
+    "follow": ["--omega", "--dt", "--lookahead", "--speed"],
+    "plot": ["--dt", "--start", "--end"],
 }
 
 

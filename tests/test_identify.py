@@ -114,10 +114,10 @@ def test_cli_end_to_end(tmp_path, trial_csv, capsys):
     assert code == 0
     v = json.loads((tmp_path / "v.json").read_text())["logs"][0]
     assert set(v["metrics"]) == {"u", "v", "r"} and v["diverged"] is False
-    assert set(v["metrics"]["u"]) == {"mean", "std", "rmse", "max_abs", "nrmse"}
+    assert set(v["metrics"]["u"]) == {"rmse", "fit_percent", "mean", "std", "max_abs", "nrmse"}
     assert v["indices"]["measured"]["first_overshoot_deg"] is not None
     assert list((tmp_path / "plots").glob("*.png"))
-    code, out, _ = run(["simulate", model, "--rudder", trial_csv, "-o", tmp_path / "sim.csv"],
+    code, out, _ = run(["simulate", model, trial_csv, "-o", tmp_path / "sim.csv"],
                        capsys)  # fmt: skip
     assert code == 0 and len(pd.read_csv(tmp_path / "sim.csv", comment="#")) == 451
     code, out, _ = run(["manoeuvre", "kvlcc2", "turning", "--rudder", "35", "--duration", "60",

@@ -14,6 +14,7 @@ from shipid.dynamics.steering import SteeringMachine
 from shipid.trials.indices import detect_manoeuvre, turning_indices, zigzag_indices
 from shipid.trials.manoeuvres import pull_out, turning_circle, zigzag
 from shipid.vessels import PAPER_IMU, get_vessel, kvlcc2, mariner, scale_ship
+from shipid.vessels.kvlcc2 import KVLCC2Dynamics
 
 TOL = 0.05  # "agreement to about ±5 % is the expected level"
 
@@ -168,3 +169,55 @@ def test_zigzag_detected_when_the_log_starts_with_the_rudder_over():
     late = res.log[res.log["t"] >= 5.0].reset_index(drop=True)
     late.attrs = dict(res.log.attrs)
     assert detect_manoeuvre(late) == "zigzag"
+
+
+# Accelerations of the NumPy implementation the compiled physics replaced (commit af37349), at
+# states off the trimmed run: the compiled scalar code must give the same numbers.
+MARINER_STATES = [[7.71873, -0.363737, -0.004922, 0.031624], [8.016246, -0.793317, -0.006205, -0.27914],
+                  [7.443362, 0.048115, 0.004898, -0.008776], [6.826908, 1.072172, 0.003569, 0.208591]]
+MARINER_ACC = [[0.000788394334601078, 0.026719857496448073, 0.000854151808363587],
+               [-0.005273783491688095, 0.02444288351031545, 0.003016670696314775],
+               [0.003007075159495063, -0.014636573101747694, -0.0004036829538022366],
+               [0.0037709256067353382, -0.02966623373182463, -0.0017005374771294297]]
+KVLCC2_STATES = [[0.910157, -0.184174, 0.007838, -0.0194], [1.087477, -0.023509, -0.009347, 0.045324],
+                 [0.798755, -0.126745, -0.125838, -0.612054], [0.921092, 0.027126, -0.026935, -0.191101]]
+KVLCC2_ACC = [[0.0031363064071741344, 0.017375056741102537, 0.008704520767722048],
+              [0.002925331828450515, 0.004515277393921785, 0.0067415615778668985],
+              [0.03870451447915523, 0.06768165027370017, 0.032378439938102306],
+              [0.005401192685838309, 0.011791988894091013, 0.0004852666520730444]]  # fmt: skip
+
+
+@pytest.mark.parametrize(("dynamics", "states", "expected"), [
+    (lambda: mariner().dynamics, MARINER_STATES, MARINER_ACC),
+    (lambda: KVLCC2Dynamics(11.85), KVLCC2_STATES, KVLCC2_ACC)])  # fmt: skip
+def test_compiled_ship_physics_equals_the_numpy_formulas(dynamics, states, expected):
+    s = np.array(states)
+    acc = dynamics().derivatives(s[:, :3], s[:, 3])
+    np.testing.assert_allclose(acc, expected, rtol=1e-12)
+
+
+class _DerivativesOnly:
+    """A reference ship seen through ``derivatives`` only: the NumPy RK4 path of the simulator."""
+
+    uses_thrust = False
+
+    def __init__(self, dynamics):
+        self.dynamics = dynamics
+
+    def derivatives(self, nu, delta, thrust=None):
+        return self.dynamics.derivatives(nu, delta)
+
+
+@pytest.mark.parametrize("name", ["mariner", "kvlcc2"])
+def test_compiled_closed_and_open_loops_equal_the_numpy_path(name):
+    ship = get_vessel(name)
+    numpy_ship = dataclasses.replace(ship, dynamics=_DerivativesOnly(ship.dynamics))
+    dt = 0.5 if name == "mariner" else 0.1
+    fast = zigzag(ship, 20, 20, duration=60, dt=dt).log
+    slow = zigzag(numpy_ship, 20, 20, duration=60, dt=dt).log
+    np.testing.assert_allclose(fast.to_numpy(), slow.to_numpy(), rtol=1e-10, atol=1e-12)
+    again = simulate_log(numpy_ship.dynamics, fast, "rk4").log
+    replay = simulate_log(ship.dynamics, fast, "rk4").log
+    np.testing.assert_allclose(replay.to_numpy(), again.to_numpy(), rtol=1e-10, atol=1e-12)
+    np.testing.assert_allclose(replay[["u", "v", "r"]], fast[["u", "v", "r"]], rtol=1e-10,
+                               atol=1e-12)  # fmt: skip

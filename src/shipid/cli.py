@@ -11,12 +11,14 @@ lines on stderr and go into the JSON outputs.
 from __future__ import annotations
 
 import argparse
+import io
 import json
 import math
 import signal
 import sys
 import time
 import warnings
+from functools import partial
 from pathlib import Path
 
 from shipid import __version__
@@ -32,11 +34,15 @@ OPTION_RULES = {
     "gamma": (">0", "--gamma"), "dt": (">0", "--dt"), "lead": (">=0", "--lead"),
     "filter": (">0", "--filter"), "segment": (">0", "--segment"),
     "refine_evals": ("int>=1", "--refine-evals"), "rudder_deg": (">0", "--rudder"),
-    "heading": (">0", "--heading"), "duration": (">0", "--duration"), "step": (">0", "--step"),
+    "heading": (">0", "--heading"), "duration": (">0", "--duration"), "step": (">0", "--dt"),
     "speed": (">0", "--speed"), "rps": ("finite", "--rps"), "smooth": (">=0", "--smooth"),
+    "length": (">0", "--length"), "rudder_rate": (">0", "--rudder-rate"),
+    "astern_rps": ("finite", "--astern-rps"),
     "scale": (">0", "--scale"), "start": ("finite", "--start"), "end": ("finite", "--end"),
     "wind_speed": (">=0", "--wind-speed"), "wind_from": ("finite", "--wind-from"),
     "max_evaluations": ("int>=1", "--max-evaluations"), "show": ("int>=1", "--show"),
+    "max_lag": ("int>=1", "--max-lag"), "omega": (">0", "--omega"),
+    "lookahead": (">0", "--lookahead"),
 }  # fmt: skip
 
 
@@ -49,6 +55,7 @@ def _on_sigterm(signum, frame) -> None:
 
 
 def check_options(args) -> None:
+    """Range checks of the numeric options (``OPTION_RULES``) before any work."""
     for dest, (rule, option) in OPTION_RULES.items():
         value = getattr(args, dest, None)
         if value is None or isinstance(value, str):
@@ -66,9 +73,12 @@ def check_options(args) -> None:
 
 
 # ---------------------------------------------------------------------------- shared options
-def _add_log_options(p: argparse.ArgumentParser) -> None:
-    from shipid.data.formats import FORMATS
+# The readers of shipid.data.formats (kept here so that --help and --version import no pandas;
+# a test checks the two agree).
+FORMATS = ("canonical", "simman-marin", "simman-hsva", "osaka-frt")
 
+
+def _add_log_options(p: argparse.ArgumentParser) -> None:
     g = p.add_argument_group("log files")
     g.add_argument("--format", default="canonical", choices=FORMATS,
                    help="file format (default: %(default)s CSV/Parquet)")
@@ -91,6 +101,9 @@ def _add_log_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--rudder-positive", choices=("port", "starboard"),
                    help="where a positive rudder angle turns the ship (default: the file's "
                    "metadata, else port as in the paper)")
+    g.add_argument("--particulars", metavar="FILE",
+                   help="ship particulars (YAML or JSON: length, beam, draught, ...; the MARIN "
+                   "ship_data.yml reads as is), kept with the logs and the model")
 
 
 def _number_or_auto(text: str) -> float | str:
@@ -120,7 +133,25 @@ def _read_logs(args, paths=None) -> list:
     from shipid.data.io import read_log
 
     options = _read_options(args)
-    return [read_log(p, options) for p in (paths or args.logs)]
+    logs = [read_log(p, options) for p in (paths or args.logs)]
+    particulars = _particulars(args)
+    if particulars is not None:
+        for log in logs:
+            log.attrs["particulars"] = particulars.to_dict()
+    return logs
+
+
+def _particulars(args):
+    """The particulars of --particulars (None when not given)."""
+    if not getattr(args, "particulars", None):
+        return None
+    from shipid.data.particulars import read_particulars
+
+    return read_particulars(args.particulars)
+
+
+def _log_particulars(logs) -> dict | None:
+    return next((log.attrs["particulars"] for log in logs if log.attrs.get("particulars")), None)
 
 
 def _json_text(data) -> str:
@@ -147,6 +178,7 @@ def _warn(message: str) -> None:
 
 # ---------------------------------------------------------------------------- commands
 def cmd_demo(args) -> int:
+    """``shipid demo``: the paper's experiment on the embedded scale ship."""
     from shipid.demo import run_demo, summary
     from shipid.outputs import check_outputs
 
@@ -178,11 +210,25 @@ def _free_run_table(refinement) -> str:
     return "\n".join(lines)
 
 
+def _std_errors(ident) -> dict:
+    return {d: ident.diagnostics[d].get("std_errors", {}) for d in ident.diagnostics}
+
+
+def _rudder_rate(logs) -> float | None:
+    """The training logs' rudder rate [rad/s] (90th percentile while the rudder moves)."""
+    from shipid.trials.trial import describe_trial
+
+    rates = [describe_trial(log).rudder_rate for log in logs]
+    rates = [r for r in rates if r]
+    return max(rates) if rates else None
+
+
 def _fmt_speed(u: float | None) -> str:
     return "none" if u is None else f"{u:.3g} m/s"
 
 
 def cmd_identify(args) -> int:
+    """``shipid identify``: a model from logs (LS-SVM, optional refinement, checks)."""
     from shipid.data.preprocess import lowpass
     from shipid.identification.identify import identify
     from shipid.identification.plausibility import check_plausibility
@@ -205,10 +251,10 @@ def cmd_identify(args) -> int:
     prep = {"dt": args.dt, "start": args.start, "end": args.end, "lead": args.lead,
             "filter_hz": args.filter, "columns": args.columns, "degrees": args.degrees,
             "format": args.format, "scale": args.scale,
-            "approach_speed": speed, "approach_rps": rps,
+            "approach_speed": speed, "approach_rps": rps, "rudder_rate": _rudder_rate(logs),
             "rudder_positive": logs[0].attrs.get("rudder_positive")}  # fmt: skip
     refinement = None
-    print(ident.model.equations())
+    print(ident.model.equations(std_errors=_std_errors(ident)))
     for dof, d in ident.diagnostics.items():
         print(f"{dof}: condition number {d['condition_number']:.3g}, one-step R² "
               f"{d['one_step_r2']:.4f}, bias b = {ident.discrete[dof]['bias']:.4g}")
@@ -248,7 +294,8 @@ def cmd_identify(args) -> int:
     if refinement:
         ident.warnings.extend(f"refinement: {n}" for n in refinement.warnings)
     text = model_text(ident, args.logs, preprocessing=prep, refinement=refinement,
-                      plausibility=plausibility, model=final, selection=gamma_report)  # fmt: skip
+                      plausibility=plausibility, model=final, selection=gamma_report,
+                      particulars=_log_particulars(logs))  # fmt: skip
     atomic_write_text(args.output, text)
     for w in ident.warnings:
         _warn(w)
@@ -286,6 +333,7 @@ def _parse_gammas(text: str | None) -> tuple[float, ...] | None:
 
 
 def cmd_select(args) -> int:
+    """``shipid select``: structure and γ by cross-validated free-run error."""
     from shipid.identification.plausibility import check_plausibility
     from shipid.identification.select import SelectOptions, select
     from shipid.outputs import OutputSet, check_outputs
@@ -322,7 +370,7 @@ def cmd_select(args) -> int:
             "scale": args.scale, "approach_speed": speed, "approach_rps": rps,
             "rudder_positive": logs[0].attrs.get("rudder_positive")}  # fmt: skip
     text = model_text(ident, args.logs, preprocessing=prep, plausibility=plausibility,
-                      selection=sel.to_dict())  # fmt: skip
+                      selection=sel.to_dict(), particulars=_log_particulars(logs))  # fmt: skip
     with OutputSet() as out:
         out.write(args.output, lambda p: p.write_text(text, encoding="utf-8"))
         if args.table:
@@ -367,6 +415,7 @@ def _fold_table(folds) -> str:
 
 
 def cmd_compare(args) -> int:
+    """``shipid compare``: methods × held-out logs in one table."""
     from shipid.evaluation.compare import compare, summary
     from shipid.outputs import OutputSet, check_outputs
 
@@ -387,6 +436,189 @@ def cmd_compare(args) -> int:
     return 0
 
 
+def cmd_criteria(args) -> int:
+    """``shipid criteria``: the IMO MSC.137(76) criteria of a model or vessel."""
+    import math
+
+    from shipid.data.particulars import read_particulars
+    from shipid.dynamics.steering import SteeringMachine
+    from shipid.outputs import OutputSet, check_outputs
+    from shipid.trials.criteria import imo_criteria
+
+    check_outputs({"--json": (args.json, "json")},
+                  [args.model] if Path(args.model).exists() else [])  # fmt: skip
+    target, cond = _ship_or_model(args.model)
+    particulars = read_particulars(args.particulars) if args.particulars else cond["particulars"]
+    speed = args.speed or cond["speed"]
+    rps = args.rps or cond["rps"]
+    steering = None
+    rate = math.radians(args.rudder_rate) if args.rudder_rate is not None else cond["rudder_rate"]
+    if rate:  # given, else the rate of the training logs' rudder
+        steering = SteeringMachine(math.radians(35.0), rate)
+    crit = imo_criteria(target, particulars, length=args.length, speed=speed, scale=args.scale,
+                        rps=rps, steering=steering, astern_rps=args.astern_rps, dt=args.dt)
+    c = crit.conditions
+    print(f"IMO MSC.137(76) criteria for {args.model}: L = {c['length']:g} m, V = {c['speed']:.4g} "
+          f"m/s, λ = {c['scale']:g} (full-scale L/V = {c['L_over_V_full_scale']:.3g} s), " + (
+              f"rudder rate {c['rudder_rate_deg_s']:.3g} °/s" if c["rudder_rate_deg_s"]
+              else "instantaneous rudder"))
+    table = crit.table.copy()
+    table["passed"] = table["passed"].map({True: "pass", False: "FAIL", None: "–"})
+    print(table.to_markdown(index=False, floatfmt=".3g"))
+    print("all criteria met" if crit.passed else "NOT all criteria met")
+    for n in crit.notes:
+        _warn(n)
+    with OutputSet() as out:
+        if args.json:
+            out.write(args.json, lambda p: p.write_text(_json_text(crit.to_dict()), "utf-8"))
+    return 0
+
+
+def _controlled(args):
+    """The model (or vessel) to control, the truth to test on, speed and rps."""
+    from shipid.vessels import get_vessel
+
+    target, cond = _ship_or_model(args.model)
+    speed = args.speed or cond["speed"] or getattr(target, "approach_speed", None)
+    rps = args.rps or cond["rps"]
+    truth = get_vessel(args.truth) if args.truth else None
+    if truth is not None and args.truth not in VESSEL_NAMES:
+        raise ShipidError(f"--truth must be a reference ship ({', '.join(VESSEL_NAMES)})")
+    return target, truth, speed, rps
+
+
+def _tuned(ship, speed, rps, omega):
+    from shipid.control.autopilot import pid_from_nomoto
+    from shipid.control.linear import nomoto
+
+    nm = nomoto(ship, speed, rps)
+    return nm, pid_from_nomoto(nm["K"], nm["T"], omega)
+
+
+def cmd_linearise(args) -> int:
+    """``shipid linearise``: state-space A, B and Nomoto K, T about the straight run."""
+    from shipid.control.linear import nomoto
+
+    target, cond = _ship_or_model(args.model)
+    speed = args.speed or cond["speed"] or getattr(target, "approach_speed", None)
+    if not speed:
+        raise ShipidError("give the speed to linearise at (--speed)")
+    nm = nomoto(target, speed, args.rps or cond["rps"])
+    pd = _pd()
+    print(f"Linearised about straight running at u = {speed:.4g} m/s (states u, v, r; input δ):")
+    print("A =")
+    print(pd.DataFrame(nm["A"], index=["u", "v", "r"], columns=["u", "v", "r"]).to_markdown(
+        floatfmt=".5g"))
+    print("B =")
+    print(pd.DataFrame({"δ": nm["B"]}, index=["u", "v", "r"]).to_markdown(floatfmt=".5g"))
+    print(f"Nomoto: K = {nm['K']:.5g} 1/s, T1 = {nm['T1']:.5g} s, T2 = {nm['T2']:.5g} s, "
+          f"T3 = {nm['T3']:.5g} s; first order T = T1 + T2 − T3 = {nm['T']:.5g} s; "
+          f"{'stable' if nm['stable'] else 'UNSTABLE'}")  # fmt: skip
+    return 0
+
+
+def cmd_export(args) -> int:
+    """``shipid export``: write the model as a standalone NumPy function file."""
+    from shipid.control.export import export_numpy
+    from shipid.outputs import check_outputs
+    from shipid.reporting.modelfile import load_model
+
+    if Path(args.output).suffix != ".py":
+        raise ShipidError(f"-o {args.output}: the exported module must be a .py file")
+    check_outputs({"-o": (args.output, "dir")}, [args.model])
+    model = load_model(args.model)
+    export_numpy(model, args.output)
+    print(f"standalone NumPy module written to {args.output} (accelerations, derivatives, "
+          "simulate)")  # fmt: skip
+    return 0
+
+
+def cmd_autopilot(args) -> int:
+    """``shipid autopilot``: heading step of a PID tuned on the model, run on model and truth."""
+    from shipid.control.autopilot import heading_step
+    from shipid.outputs import check_outputs
+
+    check_outputs({"-o": (args.output, "figure")}, [])
+    target, truth, speed, rps = _controlled(args)
+    nm, pid = _tuned(target, speed, rps, args.omega)
+    print(f"PID tuned on {args.model} (Nomoto K = {nm['K']:.4g} 1/s, T = {nm['T']:.4g} s): "
+          f"Kp = {pid.kp:.4g}, Ki = {pid.ki:.4g} 1/s, Kd = {pid.kd:.4g} s")
+    runs = {args.model: heading_step(target, pid, args.heading, args.duration, args.dt,
+                                     speed, rps)}  # fmt: skip
+    if truth is not None:
+        runs[f"{args.truth} (truth)"] = heading_step(truth, pid, args.heading, args.duration,
+                                                     args.dt)  # fmt: skip
+    for name, log in runs.items():
+        psi = _np().degrees(log["psi"].to_numpy())
+        over = float(psi.max() - args.heading) if args.heading > 0 else float(args.heading - psi.min())
+        print(f"{name}: overshoot {over:.3g}°, final heading {psi[-1]:.4g}°, max rudder "
+              f"{_np().degrees(log['delta'].abs().max()):.3g}°")
+    if args.output:
+        from shipid.reporting.plots import autopilot_figure
+
+        autopilot_figure(runs, args.output, f"heading autopilot, step to {args.heading:g}°")
+        print(f"figure written to {args.output}")
+    return 0
+
+
+def _parse_waypoints(text: str) -> list[tuple[float, float]]:
+    try:
+        pts = [tuple(float(x) for x in p.split(",")) for p in text.split(";") if p.strip()]
+    except ValueError:
+        raise ShipidError(f"--waypoints expects 'x,y;x,y;...' in metres, got {text!r}") from None
+    if len(pts) < 2 or any(len(p) != 2 for p in pts):
+        raise ShipidError(f"--waypoints expects at least two 'x,y' pairs, got {text!r}")
+    return pts
+
+
+def cmd_follow(args) -> int:
+    """``shipid follow``: line-of-sight path following of waypoints on model and truth."""
+    from shipid.control.autopilot import follow_path
+    from shipid.outputs import OutputSet, check_outputs
+
+    check_outputs({"-o": (args.output, "figure"), "--json": (args.json, "json")}, [])
+    target, truth, speed, rps = _controlled(args)
+    waypoints = _parse_waypoints(args.waypoints)
+    length = getattr(target, "length", None)
+    lookahead = args.lookahead or 2.0 * (length if length and length == length else 10.0)
+    nm, pid = _tuned(target, speed, rps, args.omega)
+    runs, rows = {}, []
+    cases = [("model", target, pid, speed, rps)]
+    if truth is not None:
+        _, pid_truth = _tuned(truth, truth.approach_speed, None, args.omega)
+        cases += [("truth, model-tuned PID", truth, pid, None, None),
+                  ("truth, truth-tuned PID", truth, pid_truth, None, None)]
+    for label, ship, gains, sp, n in cases:
+        res = follow_path(ship, gains, waypoints, lookahead, dt=args.dt, speed=sp, rps=n)
+        runs[label] = res.log
+        rows.append({"run": label, "rms cross-track [m]": res.rms_cross_track,
+                     "max cross-track [m]": res.max_cross_track, "completed": res.completed,
+                     "Kp": gains.kp, "Ki": gains.ki, "Kd": gains.kd})  # fmt: skip
+    table = _pd().DataFrame(rows)
+    print(f"Line-of-sight path following (lookahead {lookahead:.3g} m), PID tuned on "
+          f"{args.model}:")
+    print(table.to_markdown(index=False, floatfmt=".4g"))
+    if truth is not None:
+        ratio = rows[1]["rms cross-track [m]"] / rows[2]["rms cross-track [m]"]
+        print(f"on the truth, the model-tuned controller's rms cross-track error is {ratio:.3g} × "
+              "the truth-tuned one's")
+    with OutputSet() as out:
+        if args.output:
+            from shipid.reporting.plots import tracks_with_waypoints
+
+            tracks_with_waypoints(runs, waypoints, args.output, "path following", out=out)
+        if args.json:
+            doc = {"waypoints": waypoints, "lookahead": lookahead, "runs": rows}
+            out.write(args.json, lambda p: p.write_text(_json_text(doc), "utf-8"))
+    return 0
+
+
+def _np():
+    import numpy as np
+
+    return np
+
+
 def _unique_figure_names(names: list[str]) -> list[str]:
     """File stems for figures of logs that may share a file name: a, a-2, a-3, ..."""
     out, used = [], {}
@@ -398,6 +630,7 @@ def _unique_figure_names(names: list[str]) -> list[str]:
 
 
 def cmd_validate(args) -> int:
+    """``shipid validate``: free runs on logs, metrics, indices, figures, report."""
     from shipid.evaluation.envelope import outside_envelope
     from shipid.evaluation.validate import validate
     from shipid.outputs import OutputSet, check_outputs
@@ -407,10 +640,10 @@ def cmd_validate(args) -> int:
         model_from_document,
         training_conditions,
     )
-    from shipid.reporting.report import error_table, indices_table
+    from shipid.reporting.report import indices_frame, metrics_frame
 
-    check_outputs({"--json": (args.json, "json"), "--plots": (args.plots, "dir")},
-                  [args.model, *args.logs])  # fmt: skip
+    check_outputs({"--json": (args.json, "json"), "--plots": (args.plots, "dir"),
+                   "--report": (args.report, "dir")}, [args.model, *args.logs])  # fmt: skip
     doc = load_document(args.model)
     if args.lssvm and not has_refinement(doc):
         _warn(f"{args.model} has no refinement: its model is the LS-SVM one, which --lssvm "
@@ -427,17 +660,48 @@ def cmd_validate(args) -> int:
             names.append(str(p))
         except ShipidError as exc:
             failed.append(str(exc))
-    vals = validate(model, logs, names, method=args.method, kind=args.kind, smooth_s=args.smooth)
+    from tqdm.auto import tqdm
+
+    vals = [validate(model, log, [name], method=args.method, kind=args.kind,
+                     smooth_s=args.smooth)[0]
+            for log, name in tqdm(list(zip(logs, names, strict=True)), desc="logs", unit="log",
+                                  disable=args.quiet or len(logs) < 3)]  # fmt: skip
     for v, log in zip(vals, logs, strict=True):
         if v.error is None:
             v.warnings.extend(outside_envelope(env, log))
     good = [v for v in vals if v.error is None]
     if good:
-        print(error_table(good))
-        table = indices_table(good)
-        if table.count("\n") > 1:
+        print(metrics_frame(good).to_markdown(index=False, floatfmt=".4g"))
+        table = indices_frame(good)
+        if len(table):
+            table = table.astype(object).where(table.notna(), "–")
             print()
-            print(table)
+            print(table.to_markdown(index=False, floatfmt=".4g"))
+    residuals = {}
+    if args.resid or args.report:
+        from shipid.evaluation.metrics import residual_correlations
+
+        for v, log in zip(vals, logs, strict=True):
+            if v.error is None:
+                n = len(v.simulation.log)
+                residuals[v.name] = {s: residual_correlations(
+                    log[s].to_numpy()[:n], v.simulation.log[s].to_numpy(),
+                    log["delta"].to_numpy()[:n], args.max_lag) for s in ("u", "v", "r")}
+    if args.resid and residuals:
+        rows = [{"log": Path(name).name, **{f"{s} autocorr. outside band": a[s]["auto_outside"]
+                                            for s in ("u", "v", "r")},
+                 **{f"{s} corr. with δ outside band": a[s]["cross_outside"]
+                    for s in ("u", "v", "r")}} for name, a in residuals.items()]  # fmt: skip
+        print("\nResidual analysis of the free-run errors (share of lags outside the 95 % band "
+              "of white noise; ≈ 0.05 when the error is white and independent of the rudder):")
+        print(_pd().DataFrame(rows).to_markdown(index=False, floatfmt=".2f"))
+    particulars = _particulars(args) or training_conditions(doc)["particulars"]
+    crit = None
+    if particulars is not None:
+        crit = _criteria_of_logs(good, logs, vals, particulars)
+        if crit is not None:
+            print("\nIMO criteria of the logs that are standard manoeuvres (measured, predicted):")
+            print(crit.to_markdown(index=False, floatfmt=".3g"))
     for v in good:
         if v.simulation.diverged:
             print(f"{v.name}: {v.simulation.reason}", file=sys.stderr)
@@ -453,16 +717,87 @@ def cmd_validate(args) -> int:
         if args.json:
             records = [v.to_dict() for v in vals] + [{"name": None, "error": e} for e in failed]
             out.write(args.json, lambda p: p.write_text(_json_text({"logs": records}), "utf-8"))
+        figures: dict[str, dict[str, bytes]] = {}
         if args.plots:
             from shipid.reporting import plots
 
             stems = _unique_figure_names([v.name for v in good])
             pairs = [(v, log) for v, log in zip(vals, logs, strict=True) if v.error is None]
+            ext = "." + args.plot_format
+            # PNGs drawn once serve the folder and the report alike.
+            share = args.report is not None and args.plot_format == "png"
             for (v, log), stem in zip(pairs, stems, strict=True):
-                plots.measured_vs_simulated(log, v.simulation.log,
-                                            Path(args.plots) / f"{stem}.png", Path(v.name).name,
-                                            out=out)  # fmt: skip
+                title = Path(v.name).name
+                jobs = [("fit", stem + ext, partial(plots.measured_vs_simulated, log,
+                                                   v.simulation.log, title=title))]  # fmt: skip
+                if args.resid:
+                    jobs.append(("resid", stem + "-resid" + ext, partial(
+                        plots.residuals, residuals[v.name], title=f"{title}: residual analysis")))
+                for key, file_name, plot in jobs:
+                    if not share:
+                        plot(Path(args.plots) / file_name, out=out)
+                        continue
+                    buf = io.BytesIO()
+                    plot(buf)
+                    figures.setdefault(v.name, {})[key] = png = buf.getvalue()
+                    out.write(Path(args.plots) / file_name, partial(Path.write_bytes, data=png))
+        if args.report:
+            from shipid.reporting.html import validation_report
+
+            ident = doc.get("identification") or {}
+            se = {d: (ident.get("diagnostics") or {}).get(d, {}).get("std_errors")
+                  for d in model.structure.dofs} if not args.lssvm else None  # fmt: skip
+            text = validation_report(model, vals, logs, f"Validation of {Path(args.model).name}",
+                                     std_errors=se, criteria=crit,
+                                     warnings=[w for v in good for w in v.warnings],
+                                     residuals=residuals, figures=figures)  # fmt: skip
+            out.write(Path(args.report) / "report.html",
+                      lambda p: p.write_text(text, encoding="utf-8"))
     return 1 if errors else 0
+
+
+def cmd_plot(args) -> int:
+    """``shipid plot``: a figure of any logs."""
+    from shipid.outputs import check_outputs
+    from shipid.reporting.plots import logs_figure
+
+    check_outputs({"-o": (args.output, "figure")}, args.logs)
+    logs = _read_logs(args)
+    logs_figure({Path(p).name: log for p, log in zip(args.logs, logs, strict=True)}, args.output,
+                args.title or ", ".join(Path(p).name for p in args.logs))  # fmt: skip
+    print(f"figure written to {args.output}")
+    return 0
+
+
+def _criteria_of_logs(good, logs, vals, particulars):
+    """Measured and predicted criteria rows of 35° turns and 10/10, 20/20 zig-zags."""
+    import math
+
+    from shipid.trials.criteria import measured_criteria
+    from shipid.trials.trial import describe_trial
+
+    rows = []
+    by_name = {v.name: log for v, log in zip(vals, logs, strict=True)}
+    for v in good:
+        log = by_name[v.name]
+        trial = describe_trial(log, v.kind)
+        rudder = math.degrees(trial.plateau_angle)
+        speed = float(log["u"].iloc[: max(1, len(log) // 50)].mean())
+        if not speed > 0:
+            continue
+        meas = v.indices.get("measured", {})
+        pred = v.indices.get("closed_loop") if v.kind == "zigzag" else v.indices.get("simulated")
+        args = (rudder, meas.get("switch_heading_deg"), particulars.length, speed, particulars.scale)
+        m_rows = measured_criteria(meas, *args)
+        p_rows = {r["criterion"]: r for r in measured_criteria({**(pred or {}), "kind": v.kind},
+                                                               *args)}  # fmt: skip
+        for r in m_rows:
+            p = p_rows.get(r["criterion"], {})
+            rows.append({"log": Path(v.name).name, "criterion": r["criterion"], "unit": r["unit"],
+                         "limit": r["limit"], "measured": r["value"],
+                         "measured passes": r["passed"], "predicted": p.get("value"),
+                         "predicted passes": p.get("passed")})  # fmt: skip
+    return _pd().DataFrame(rows) if rows else None
 
 
 def _ship_or_model(name: str):
@@ -472,7 +807,8 @@ def _ship_or_model(name: str):
     from shipid.vessels import get_vessel
 
     if name in VESSEL_NAMES:
-        return get_vessel(name), {"speed": None, "rps": None, "envelope": {}}
+        return get_vessel(name), {"speed": None, "rps": None, "envelope": {}, "particulars": None,
+                                  "rudder_rate": None}  # fmt: skip
     if not Path(name).exists():
         raise ShipidError(f"{name}: neither a model file nor a known vessel "
                           f"({', '.join(VESSEL_NAMES)})")  # fmt: skip
@@ -481,14 +817,12 @@ def _ship_or_model(name: str):
 
 
 def cmd_simulate(args) -> int:
+    """``shipid simulate``: drive a model or vessel with a log's inputs."""
     from shipid.data.io import read_log, write_log
     from shipid.dynamics.simulate import simulate_log
     from shipid.outputs import check_outputs
 
-    log_path = args.log or args.rudder
-    if log_path is None:
-        raise ShipidError("simulate needs the log whose rudder (and inputs) drive the model: "
-                          "shipid simulate MODEL LOG -o OUT.csv")  # fmt: skip
+    log_path = args.log
     check_outputs({"-o": (args.output, "log")}, [args.model, log_path])
     target, _ = _ship_or_model(args.model)
     dynamics = getattr(target, "dynamics", target)
@@ -502,9 +836,10 @@ def cmd_simulate(args) -> int:
 
 
 def cmd_manoeuvre(args) -> int:
+    """``shipid manoeuvre``: a standard manoeuvre on a model or vessel."""
     from shipid.evaluation.envelope import implausible_indices, outside_envelope
     from shipid.outputs import OutputSet, check_outputs
-    from shipid.trials.manoeuvres import pull_out, turning_circle, zigzag
+    from shipid.trials.manoeuvres import pull_out, spiral, stopping, turning_circle, zigzag
 
     check_outputs({"--json": (args.json, "json"), "-o": (args.output, "log")},
                   [args.model] if Path(args.model).exists() else [])  # fmt: skip
@@ -521,11 +856,22 @@ def cmd_manoeuvre(args) -> int:
         res = zigzag(target, args.rudder_deg, heading, first=args.first, **kw)
     elif args.kind == "turning":
         res = turning_circle(target, args.rudder_deg, side=args.first, **kw)
-    else:
+    elif args.kind == "pull-out":
         if args.duration is not None:
             kw.pop("duration")
             kw["hold"] = kw["release"] = args.duration / 2
         res = pull_out(target, args.rudder_deg, side=args.first, **kw)
+    elif args.kind == "spiral":
+        kw.pop("wind", None)
+        if args.duration is not None:
+            kw["hold"] = kw.pop("duration")
+        res = spiral(target, **kw)
+    else:
+        if not rps:
+            raise ShipidError("stopping needs the approach propeller speed (--rps, or a model "
+                              "trained with the n column)")  # fmt: skip
+        kw.pop("rps")
+        res = stopping(target, rps, args.astern_rps, **kw)
     if res.diverged:
         print(res.reason, file=sys.stderr)
     notes = outside_envelope(cond["envelope"], res.log)
@@ -533,6 +879,9 @@ def cmd_manoeuvre(args) -> int:
         notes += implausible_indices(res.indices, speed or getattr(target, "approach_speed", None),
                                      getattr(target, "length", None))  # fmt: skip
     for k, v in res.indices.items():
+        if k == "table":
+            print(_pd().DataFrame(v).to_markdown(index=False, floatfmt=".4g"))
+            continue
         print(f"{k}: {v:.4g}" if isinstance(v, float) else f"{k}: {v}")
     for n in notes:
         _warn(n)
@@ -550,6 +899,7 @@ def cmd_manoeuvre(args) -> int:
 
 
 def cmd_indices(args) -> int:
+    """``shipid indices``: IMO indices of measured logs."""
     from shipid.outputs import atomic_write_text, check_outputs
     from shipid.trials.indices import manoeuvre_indices
 
@@ -570,6 +920,7 @@ def cmd_indices(args) -> int:
 
 
 def cmd_import(args) -> int:
+    """``shipid import``: trial files to canonical logs."""
     from shipid.data.io import write_log
     from shipid.outputs import OutputSet, check_outputs
 
@@ -600,6 +951,7 @@ def cmd_import(args) -> int:
 
 # ---------------------------------------------------------------------------- parser
 def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of every command."""
     ap = argparse.ArgumentParser(prog="shipid", description="Semiphysical identification of ship "
                                  "manoeuvring models with LS-SVM (Moreno-Salinas et al. 2013).")
     ap.add_argument("--version", action="version", version=f"shipid {__version__}")
@@ -699,13 +1051,28 @@ def build_parser() -> argparse.ArgumentParser:
                    help="heading smoothing window for measured indices [s] (default 0)")
     p.add_argument("--lssvm", action="store_true",
                    help="validate the LS-SVM model a refined model file keeps")
+    p.add_argument("--plot-format", default="png", choices=("png", "svg", "pdf"),
+                   help="format of the --plots figures (default %(default)s)")
+    p.add_argument("--resid", action="store_true",
+                   help="residual analysis: autocorrelation of the errors and correlation with "
+                   "the rudder (a table, and figures with --plots)")
+    p.add_argument("--max-lag", type=int, default=50, metavar="N",
+                   help="with --resid: largest lag [samples] (default %(default)s)")
+    p.add_argument("--report", metavar="DIR", help="write a self-contained HTML report")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
     _add_log_options(p)
     p.set_defaults(func=cmd_validate)
 
+    p = sub.add_parser("plot", help="figure of any logs: u, v, r, rudder, heading, track")
+    p.add_argument("logs", nargs="+", metavar="LOG")
+    p.add_argument("-o", "--output", required=True, metavar="FIG.png|.svg|.pdf")
+    p.add_argument("--title", help="figure title (default: the file names)")
+    _add_log_options(p)
+    p.set_defaults(func=cmd_plot)
+
     p = sub.add_parser("simulate", help="drive a model or vessel with a logged rudder")
     p.add_argument("model", metavar="MODEL.json|VESSEL")
-    p.add_argument("log", nargs="?", metavar="LOG", help="log whose rudder and inputs drive it")
-    p.add_argument("--rudder", metavar="LOG", help=argparse.SUPPRESS)  # the name before 0.2
+    p.add_argument("log", metavar="LOG", help="log whose rudder and inputs drive it")
     p.add_argument("--method", default="rk4", choices=("euler", "rk4"),
                    help="integration scheme (default %(default)s)")
     p.add_argument("-o", "--output", required=True, metavar="OUT.csv")
@@ -714,7 +1081,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("manoeuvre", help="run a standard manoeuvre on a model or vessel")
     p.add_argument("model", metavar="MODEL.json|VESSEL")
-    p.add_argument("kind", choices=("zigzag", "turning", "pull-out"))
+    p.add_argument("kind", choices=("zigzag", "turning", "pull-out", "spiral", "stopping"))
     p.add_argument("--rudder", dest="rudder_deg", type=float, default=20.0, metavar="DEG",
                    help="rudder angle [deg] (default %(default)s)")
     p.add_argument("--heading", type=float, metavar="DEG",
@@ -722,11 +1089,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--first", default="starboard", choices=("starboard", "port"),
                    help="first rudder (zig-zag) or turn side (default %(default)s)")
     p.add_argument("--duration", type=float, help="length of the run [s]")
-    p.add_argument("--step", type=float, default=0.05,
+    p.add_argument("--dt", "--step", dest="step", type=float, default=0.05,
                    help="integration step [s] (default %(default)s)")
     p.add_argument("--speed", type=float, help="approach speed [m/s] (models: default from training)")
     p.add_argument("--rps", type=float,
                    help="propeller speed [rps] for models with n terms (default from training)")
+    p.add_argument("--astern-rps", type=float, help="stopping: the full-astern order (default −rps)")
     p.add_argument("--wind-speed", type=float, metavar="M/S",
                    help="constant true wind for models with wind terms (default: still air)")
     p.add_argument("--wind-from", type=float, metavar="DEG",
@@ -734,6 +1102,65 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", metavar="OUT.json")
     p.add_argument("-o", "--output", metavar="LOG.csv", help="write the simulated log")
     p.set_defaults(func=cmd_manoeuvre)
+
+    p = sub.add_parser("criteria", help="IMO MSC.137(76) criteria: run the standard manoeuvres "
+                       "on a model or vessel and judge them")
+    p.add_argument("model", metavar="MODEL.json|VESSEL")
+    p.add_argument("--particulars", metavar="FILE", help="ship particulars (default: the model "
+                   "file's)")
+    p.add_argument("--length", type=float, help="Lpp [m] (default: the particulars')")
+    p.add_argument("--speed", type=float, help="test speed [m/s] (default: the training approach)")
+    p.add_argument("--scale", type=float, metavar="LAMBDA",
+                   help="model scale λ, for the full-scale L/V and rudder rate (default: the "
+                   "particulars', else 1)")
+    p.add_argument("--rps", type=float, help="propeller speed for models with n terms (default: "
+                   "the training approach)")
+    p.add_argument("--astern-rps", type=float, help="stopping test order (default −rps)")
+    p.add_argument("--rudder-rate", type=float, metavar="DEG/S",
+                   help="steering machine rate (default: the training logs' rudder rate, else "
+                   "SOLAS 2.32 °/s at full scale, × √λ)")
+    p.add_argument("--dt", type=float, default=0.05, help="integration step [s] (default %(default)s)")
+    p.add_argument("--json", metavar="OUT.json")
+    p.set_defaults(func=cmd_criteria)
+
+    p = sub.add_parser("linearise", help="state-space A, B and Nomoto K, T of a model or vessel")
+    p.add_argument("model", metavar="MODEL.json|VESSEL")
+    p.add_argument("--speed", type=float, help="straight-running speed [m/s] (default: training)")
+    p.add_argument("--rps", type=float, help="propeller speed for models with n terms")
+    p.set_defaults(func=cmd_linearise)
+
+    p = sub.add_parser("export", help="a model as a standalone NumPy module (no shipid needed)")
+    p.add_argument("model", metavar="MODEL.json")
+    p.add_argument("-o", "--output", required=True, metavar="MODEL.py")
+    p.set_defaults(func=cmd_export)
+
+    for name, helptext in (("autopilot", "PID heading autopilot tuned on a model: a heading step "
+                            "on the model and on a true ship"),
+                           ("follow", "line-of-sight path following along waypoints with a PID "
+                            "tuned on a model, on the model and on a true ship")):  # fmt: skip
+        p = sub.add_parser(name, help=helptext)
+        p.add_argument("model", metavar="MODEL.json|VESSEL")
+        p.add_argument("--truth", metavar="VESSEL", help="reference ship to test the controller "
+                       "on (scale-ship, mariner, kvlcc2)")
+        p.add_argument("--speed", type=float, help="approach speed [m/s] (default: training)")
+        p.add_argument("--rps", type=float, help="propeller speed for models with n terms")
+        p.add_argument("--omega", type=float, help="closed-loop natural frequency [rad/s] "
+                       "(default 1/T)")
+        p.add_argument("--dt", type=float, default=0.1, help="step [s] (default %(default)s)")
+        if name == "autopilot":
+            p.add_argument("--heading", type=float, default=20.0, metavar="DEG",
+                           help="heading step (default %(default)s; positive to starboard)")
+            p.add_argument("--duration", type=float, default=120.0, help="[s] (default %(default)s)")
+            p.add_argument("-o", "--output", metavar="FIG.png", help="figure of the responses")
+            p.set_defaults(func=cmd_autopilot)
+        else:
+            p.add_argument("--waypoints", required=True, metavar="X,Y;X,Y;...",
+                           help="waypoints [m], x north, y east")
+            p.add_argument("--lookahead", type=float, metavar="M",
+                           help="line-of-sight lookahead [m] (default 2 L, else 20 m)")
+            p.add_argument("-o", "--output", metavar="FIG.png", help="figure of the tracks")
+            p.add_argument("--json", metavar="OUT.json")
+            p.set_defaults(func=cmd_follow)
 
     p = sub.add_parser("import", help="convert trial files to canonical logs")
     p.add_argument("logs", nargs="+", metavar="FILE")
@@ -757,6 +1184,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Run the command line; returns the exit code (0, 1, 2 usage, 130 interrupted)."""
     args = build_parser().parse_args(argv)
     previous = signal.signal(signal.SIGTERM, _on_sigterm)
     caught: list[warnings.WarningMessage] = []
@@ -777,6 +1205,15 @@ def main(argv: list[str] | None = None) -> int:
         code = 1
     except (ValueError, OSError) as exc:
         print(f"shipid: error: {_one_line(exc)}", file=sys.stderr)
+        code = 1
+    except Exception as exc:  # a bug: still one line, no traceback (SHIPID_DEBUG=1 shows it)
+        import os
+
+        if os.environ.get("SHIPID_DEBUG"):
+            raise
+        print(f"shipid: error: internal error ({type(exc).__name__}: {_one_line(exc)}); please "
+              "report it with the command line (SHIPID_DEBUG=1 shows the traceback)",
+              file=sys.stderr)  # fmt: skip
         code = 1
     finally:
         signal.signal(signal.SIGTERM, previous)

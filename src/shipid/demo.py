@@ -82,6 +82,7 @@ def _coefficient_table(truth, fits: dict[str, Identification]) -> str:
 
 
 def run_demo(out_dir: str | Path = "shipid-demo", seed: int = 0, progress=print) -> DemoResult:
+    """Run the paper's experiment (module docstring) and write its report and figures to ``out_dir``."""
     out = Path(out_dir)
     progress(f"synthesising the paper's trials on the scale ship (seed {seed}) ...")
     logs = synthesise_trials(seed)

@@ -142,6 +142,7 @@ class OutputSet:
         return final
 
     def commit(self) -> list[Path]:
+        """Rename every staged file into place (mode of the umask or of the file replaced)."""
         mask = _umask()
         for tmp, final in self._staged:
             try:
@@ -157,6 +158,7 @@ class OutputSet:
         return self.written
 
     def abort(self) -> None:
+        """Remove the staged temporaries and the folders this set created."""
         for tmp, _ in self._staged:
             tmp.unlink(missing_ok=True)
         self._staged = []
@@ -186,4 +188,5 @@ def atomic_write(path: str | Path, write: Callable[[Path], None]) -> Path:
 
 
 def atomic_write_text(path: str | Path, text: str) -> Path:
+    """Write ``text`` to ``path`` atomically (UTF-8)."""
     return atomic_write(path, lambda p: p.write_text(text, encoding="utf-8"))

@@ -160,6 +160,7 @@ def read_osaka_frt(path: str | Path) -> pd.DataFrame:
 
 
 def read_format(path: str | Path, fmt: str, scale: float | None = None) -> pd.DataFrame:
+    """Read ``path`` with the reader of ``fmt`` (see the module docstring)."""
     if fmt == "simman-marin":
         return read_simman_marin(path, scale)
     if fmt == "simman-hsva":

@@ -205,6 +205,7 @@ def read_log(path: str | Path, options: ReadOptions | None = None, **overrides) 
 
 
 def read_logs(paths: Sequence[str | Path], options: ReadOptions | None = None) -> list[pd.DataFrame]:
+    """``read_log`` of several paths with one set of options."""
     return [read_log(p, options) for p in paths]
 
 

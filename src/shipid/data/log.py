@@ -26,7 +26,8 @@ REQUIRED = ("t", "delta", "u", "v", "r")
 OPTIONAL = ("psi", "x", "y", "n", "thrust", "wind_speed", "wind_angle")
 COLUMNS = REQUIRED + OPTIONAL
 RUDDER_SIDES = ("port", "starboard")
-METADATA_KEYS = ("ship", "source", "rudder_positive", "scale", "manoeuvre", "time_origin")
+METADATA_KEYS = ("ship", "source", "rudder_positive", "scale", "manoeuvre", "time_origin",
+                 "particulars")
 CSV_METADATA_PREFIX = "# shipid-log: "
 
 
@@ -41,10 +42,12 @@ def make_log(columns: Mapping[str, np.ndarray], **meta: object) -> pd.DataFrame:
 
 
 def log_name(log: pd.DataFrame, default: str = "log") -> str:
+    """The log's name (its file name when read from a file)."""
     return str(log.attrs.get("name", default))
 
 
 def rudder_positive(log: pd.DataFrame, default: str = "port") -> str:
+    """Where a positive rudder angle turns the ship: 'port' or 'starboard'."""
     side = log.attrs.get("rudder_positive", default)
     if side not in RUDDER_SIDES:
         raise ShipidError(f"{log_name(log)}: metadata rudder_positive must be 'port' or "
@@ -104,11 +107,16 @@ def check_metadata(meta: Mapping, name: str) -> dict:
         if k == "scale" and not (isinstance(v, int | float) and not isinstance(v, bool)
                                  and math.isfinite(v) and v > 0):
             raise ShipidError(f"{name}: metadata scale must be a number > 0, got {v!r}")
+        if k == "particulars":
+            from shipid.data.particulars import Particulars
+
+            v = Particulars.from_mapping(v, f"{name} metadata").to_dict()
         out[k] = v
     return out
 
 
 def csv_metadata_line(log: pd.DataFrame) -> str:
+    """The ``# shipid-log: {...}`` first line of a CSV log."""
     return CSV_METADATA_PREFIX + json.dumps(metadata(log), ensure_ascii=False) + "\n"
 
 

@@ -2,13 +2,17 @@
 by input series, and closed-loop manoeuvres (zig-zag, held rudder, pull-out) with the steering
 machine, all batched over trajectories that may each have their own coefficients.
 
+The integrators (``step``, ``open_run``, ``closed_run``) take the state derivative as a function
+``rhs(ctx, u, v, r, ψ) -> (u̇, v̇, ṙ, ψ̇, ẋ, ẏ)`` and its context tuple: ``terms_rhs`` for a term
+set, the reference ships' own compiled physics (``shipid.vessels``) otherwise.
+
 A term set is the factor table of ``shipid.dynamics.terms.TermCode``; coefficients are θ (B, 3, T)
 (rows u̇, v̇, ṙ; a held DOF has a zero row). Inputs are (B, N, 5) in ``INPUT_SIGNALS`` order
 (delta, n, thrust, wind_speed, wind_angle), held over each step (zero-order hold).
 
 State: [u, v, r, ψ, x, y] with ψ̇ = r, ẋ = u cosψ − v sinψ, ẏ = u sinψ + v cosψ.
 
-Closed loop: each step the rudder command of the manoeuvre (``_command``) goes through the steering
+Closed loop: each step the rudder command of the manoeuvre (``command``) goes through the steering
 machine (``steer``), the state is recorded, then integrated over the step; the same order as a log
 replays with ``simulate_log``. Wind in a closed loop is a constant true wind (speed, direction it
 blows from, clockwise from north), turned into the relative wind from the ship's heading and
@@ -22,13 +26,25 @@ import math
 import numba
 import numpy as np
 
+# numba caches a function that hands ``terms_rhs`` on only when it reaches it as a module
+# attribute, not as a bare global.
+import shipid.dynamics.kernel as _kernel  # noqa: E402  (this module)
+
 N_INPUTS = 5
 N_SIGNALS = 10
 # Closed-loop parameters, one row per trajectory.
 P_MODE, P_VALUE, P_SWITCH, P_SIDE, P_STBD, P_APPROACH, P_RELEASE, P_HELD, P_PSI_REF = range(9)
 P_MAX_ANGLE, P_MAX_RATE, P_TIME_CONST, P_RPS, P_THRUST, P_WIND_SPEED, P_WIND_DIR = range(9, 16)
-N_PARAMS = 16
+# Propeller order: from P_RPS to P_RPS_TO, linearly over P_RPS_RAMP seconds from P_RPS_AT.
+P_RPS_TO, P_RPS_AT, P_RPS_RAMP = range(16, 19)
+N_PARAMS = 19
 MODE_HOLD, MODE_ZIGZAG = 0, 1
+
+
+def c_array(a, dtype=np.float64) -> np.ndarray:
+    """``a`` as a writeable C-contiguous array: every entry point is compiled for that layout
+    only (a read-only or strided argument would compile, and cache, one more version)."""
+    return np.require(a, dtype, ("C", "W"))
 
 
 @numba.njit(cache=True, inline="always")
@@ -70,11 +86,19 @@ def _acc(th, start, sig, op, kk, pw, s):
     return a0, a1, a2
 
 
-@numba.njit(cache=True)
-def _rhs(th, start, sig, op, kk, pw, derived, s, u, v, r, psi, inp, wind_true, vw, dw):
+@numba.njit(cache=True, inline="always")
+def kinematics(u, v, r, psi):
+    """(ψ̇, ẋ, ẏ) of the planar kinematics."""
     c, sn = math.cos(psi), math.sin(psi)
-    xd = u * c - v * sn
-    yd = u * sn + v * c
+    return r, u * c - v * sn, u * sn + v * c
+
+
+@numba.njit(cache=True, inline="always")
+def terms_rhs(ctx, u, v, r, psi):
+    """State derivative of a term-set model; ctx = (θ, factor table (5 arrays), derived, signal
+    buffer, inputs, true wind?, wind speed, wind direction)."""
+    th, start, sig, op, kk, pw, derived, s, inp, wind_true, vw, dw = ctx
+    _, xd, yd = kinematics(u, v, r, psi)
     s[0], s[1], s[2] = u, v, r
     if derived:
         s[3] = math.sqrt(u * u + v * v)
@@ -82,6 +106,7 @@ def _rhs(th, start, sig, op, kk, pw, derived, s, u, v, r, psi, inp, wind_true, v
     s[5], s[6], s[7] = inp[0], inp[1], inp[2]
     if wind_true:
         # Air velocity relative to the ship, earth frame, then body frame; the angle it comes from.
+        c, sn = math.cos(psi), math.sin(psi)
         ax = -vw * math.cos(dw) - xd
         ay = -vw * math.sin(dw) - yd
         bx = ax * c + ay * sn
@@ -94,21 +119,20 @@ def _rhs(th, start, sig, op, kk, pw, derived, s, u, v, r, psi, inp, wind_true, v
     return a0, a1, a2, r, xd, yd
 
 
-@numba.njit(cache=True)
-def _step(th, start, sig, op, kk, pw, derived, s, st, inp, h, rk4, wind_true, vw, dw):
-    """One Euler or RK4 step of the state tuple st = (u, v, r, ψ, x, y), inputs held."""
+# Inlined: a function passed on through two calls would make numba refuse to cache the caller.
+@numba.njit(cache=True, inline="always")
+def step(rhs, ctx, st, h, rk4):
+    """One Euler or RK4 step of the state tuple st = (u, v, r, ψ, x, y) with the inputs held;
+    ``rhs(ctx, u, v, r, ψ)`` is the state derivative (``terms_rhs`` or a reference ship's)."""
     u, v, r, psi, x, y = st
-    k1 = _rhs(th, start, sig, op, kk, pw, derived, s, u, v, r, psi, inp, wind_true, vw, dw)
+    k1 = rhs(ctx, u, v, r, psi)
     if not rk4:
         return (u + h * k1[0], v + h * k1[1], r + h * k1[2], psi + h * k1[3], x + h * k1[4],
                 y + h * k1[5])  # fmt: skip
     g = 0.5 * h
-    k2 = _rhs(th, start, sig, op, kk, pw, derived, s, u + g * k1[0], v + g * k1[1], r + g * k1[2],
-              psi + g * k1[3], inp, wind_true, vw, dw)  # fmt: skip
-    k3 = _rhs(th, start, sig, op, kk, pw, derived, s, u + g * k2[0], v + g * k2[1], r + g * k2[2],
-              psi + g * k2[3], inp, wind_true, vw, dw)  # fmt: skip
-    k4 = _rhs(th, start, sig, op, kk, pw, derived, s, u + h * k3[0], v + h * k3[1], r + h * k3[2],
-              psi + h * k3[3], inp, wind_true, vw, dw)  # fmt: skip
+    k2 = rhs(ctx, u + g * k1[0], v + g * k1[1], r + g * k1[2], psi + g * k1[3])
+    k3 = rhs(ctx, u + g * k2[0], v + g * k2[1], r + g * k2[2], psi + g * k2[3])
+    k4 = rhs(ctx, u + h * k3[0], v + h * k3[1], r + h * k3[2], psi + h * k3[3])
     w = h / 6.0
     return (u + w * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0]),
             v + w * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1]),
@@ -124,28 +148,42 @@ def _ok(st, speed_lim, yaw_lim):
             and math.isfinite(st[3]) and math.isfinite(st[4]) and math.isfinite(st[5]))  # fmt: skip
 
 
+@numba.njit(cache=True)
+def open_run(rhs, ctx, inp, t, inputs, n_steps, s0, rk4, speed_lim, yaw_lim, out):
+    """One free run driven by the input series ``inputs`` (N, 5), copied step by step into
+    ``inp`` (the buffer ``rhs`` reads); out (N, 6). Returns the valid samples."""
+    st = (s0[0], s0[1], s0[2], s0[3], s0[4], s0[5])
+    for j in range(6):
+        out[0, j] = st[j]
+    n_ok = 1
+    for k in range(n_steps - 1):
+        for j in range(N_INPUTS):
+            inp[j] = inputs[k, j]
+        new = step(rhs, ctx, st, t[k + 1] - t[k], rk4)
+        if not _ok(new, speed_lim, yaw_lim):
+            break
+        st = new
+        for j in range(6):
+            out[k + 1, j] = st[j]
+        n_ok = k + 2
+    return n_ok
+
+
+@numba.njit(cache=True)
+def _terms_ctx(th, start, sig, op, kk, pw, derived, wind_true, vw, dw):
+    return (th, start, sig, op, kk, pw, derived, np.zeros(N_SIGNALS), np.zeros(N_INPUTS),
+            wind_true, vw, dw)
+
+
 @numba.njit(cache=True, parallel=True)
 def integrate_open(theta, start, sig, op, kk, pw, derived, t, inputs, n_steps, s0, rk4,
                    speed_lim, yaw_lim, out, n_valid):  # fmt: skip
     """Free runs driven by input series: out (B, N, 6), n_valid (B,) valid samples per run
     (a run stops at ``n_steps[b]`` samples or where it diverges)."""
     for b in numba.prange(theta.shape[0]):
-        s = np.zeros(N_SIGNALS)
-        th = theta[b]
-        st = (s0[b, 0], s0[b, 1], s0[b, 2], s0[b, 3], s0[b, 4], s0[b, 5])
-        for j in range(6):
-            out[b, 0, j] = st[j]
-        n_ok = 1
-        for k in range(n_steps[b] - 1):
-            new = _step(th, start, sig, op, kk, pw, derived, s, st, inputs[b, k], t[k + 1] - t[k],
-                        rk4, False, 0.0, 0.0)  # fmt: skip
-            if not _ok(new, speed_lim[b], yaw_lim[b]):
-                break
-            st = new
-            for j in range(6):
-                out[b, k + 1, j] = st[j]
-            n_ok = k + 2
-        n_valid[b] = n_ok
+        ctx = _terms_ctx(theta[b], start, sig, op, kk, pw, derived, False, 0.0, 0.0)
+        n_valid[b] = open_run(_kernel.terms_rhs, ctx, ctx[8], t, inputs[b], n_steps[b], s0[b],
+                              rk4, speed_lim[b], yaw_lim[b], out[b])  # fmt: skip
 
 
 @numba.njit(cache=True)
@@ -180,45 +218,62 @@ def command(p, t, psi, side):
     return side * p[P_STBD] * p[P_VALUE], side
 
 
+@numba.njit(cache=True)
+def propeller(p, t):
+    """Propeller speed of a manoeuvre at time t: the approach rps, then a ramp to the order."""
+    if p[P_RPS_RAMP] < 0.0 or t < p[P_RPS_AT]:
+        return p[P_RPS]
+    frac = 1.0 if p[P_RPS_RAMP] == 0.0 else min((t - p[P_RPS_AT]) / p[P_RPS_RAMP], 1.0)
+    return p[P_RPS] + frac * (p[P_RPS_TO] - p[P_RPS])
+
+
+@numba.njit(cache=True)
+def closed_run(rhs, ctx, inp, p, dt, n_steps, s0, rk4, speed_lim, yaw_lim, states, rudder):
+    """One closed-loop manoeuvre of parameters ``p``: each step the rudder command through the
+    steering machine, the state recorded, then one step with δ and the propeller speed set in
+    ``inp`` (the buffer ``rhs`` reads). states (N, 6), rudder (N,); returns the valid samples."""
+    st = (s0[0], s0[1], s0[2], s0[3], s0[4], s0[5])
+    delta = p[P_HELD]
+    side = p[P_SIDE]
+    inp[2] = p[P_THRUST]
+    for k in range(n_steps):
+        cmd, side = command(p, k * dt, st[3], side)
+        delta = steer(delta, cmd, dt, p[P_MAX_ANGLE], p[P_MAX_RATE], p[P_TIME_CONST])
+        for j in range(6):
+            states[k, j] = st[j]
+        rudder[k] = delta
+        if k == n_steps - 1:
+            break
+        inp[0] = delta
+        inp[1] = propeller(p, k * dt)
+        new = step(rhs, ctx, st, dt, rk4)
+        if not _ok(new, speed_lim, yaw_lim):
+            return k + 1
+        st = new
+    return n_steps
+
+
 @numba.njit(cache=True, parallel=True)
 def integrate_closed(theta, start, sig, op, kk, pw, derived, dt, n_steps, s0, params, rk4,
                      speed_lim, yaw_lim, states, rudder, n_valid):  # fmt: skip
     """Closed-loop manoeuvres: states (B, N, 6), rudder (B, N), n_valid (B,)."""
     for b in numba.prange(theta.shape[0]):
-        s = np.zeros(N_SIGNALS)
         p = params[b]
-        th = theta[b]
-        inp = np.zeros(N_INPUTS)
-        inp[1], inp[2] = p[P_RPS], p[P_THRUST]
-        st = (s0[b, 0], s0[b, 1], s0[b, 2], s0[b, 3], s0[b, 4], s0[b, 5])
-        delta = p[P_HELD]
-        side = p[P_SIDE]
-        m = n_steps
-        for k in range(n_steps):
-            cmd, side = command(p, k * dt, st[3], side)
-            delta = steer(delta, cmd, dt, p[P_MAX_ANGLE], p[P_MAX_RATE], p[P_TIME_CONST])
-            for j in range(6):
-                states[b, k, j] = st[j]
-            rudder[b, k] = delta
-            if k == n_steps - 1:
-                break
-            inp[0] = delta
-            # Still air is wind too: the apparent wind of the ship's own motion.
-            new = _step(th, start, sig, op, kk, pw, derived, s, st, inp, dt, rk4, True,
-                        p[P_WIND_SPEED], p[P_WIND_DIR])  # fmt: skip
-            if not _ok(new, speed_lim[b], yaw_lim[b]):
-                m = k + 1
-                break
-            st = new
-        n_valid[b] = m
+        # Still air is wind too: the apparent wind of the ship's own motion.
+        ctx = _terms_ctx(theta[b], start, sig, op, kk, pw, derived, True, p[P_WIND_SPEED],
+                         p[P_WIND_DIR])  # fmt: skip
+        n_valid[b] = closed_run(_kernel.terms_rhs, ctx, ctx[8], p, dt, n_steps, s0[b], rk4,
+                                speed_lim[b], yaw_lim[b], states[b], rudder[b])  # fmt: skip
 
 
 @numba.njit(cache=True)
 def accelerations(theta, start, sig, op, kk, pw, derived, states, inputs, out):
     """(M, 3) accelerations of one coefficient set θ (3, T) at states (M, 3) and inputs (M, 5):
     the compiled evaluation, checked against ``term_matrix`` by the tests."""
-    s = np.zeros(N_SIGNALS)
+    ctx = _terms_ctx(theta, start, sig, op, kk, pw, derived, False, 0.0, 0.0)
+    inp = ctx[8]
     for i in range(states.shape[0]):
-        a = _rhs(theta, start, sig, op, kk, pw, derived, s, states[i, 0], states[i, 1],
-                 states[i, 2], 0.0, inputs[i], False, 0.0, 0.0)  # fmt: skip
+        for j in range(N_INPUTS):
+            inp[j] = inputs[i, j]
+        a = terms_rhs(ctx, states[i, 0], states[i, 1], states[i, 2], 0.0)
         out[i, 0], out[i, 1], out[i, 2] = a[0], a[1], a[2]

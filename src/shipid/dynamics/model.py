@@ -111,10 +111,12 @@ class ModelStructure:
 
     @property
     def dofs(self) -> tuple[str, ...]:
+        """The degrees of freedom with an equation, in u, v, r order."""
         return tuple(d for d in DOFS if d in self.terms)
 
     @property
     def held(self) -> tuple[str, ...]:
+        """The degrees of freedom held at their initial value."""
         return tuple(d for d in DOFS if d not in self.terms)
 
     @property
@@ -132,14 +134,17 @@ class ModelStructure:
 
     @property
     def uses_thrust(self) -> bool:
+        """Whether a term needs the thrust column."""
         return "thrust" in self.inputs
 
     @property
     def uses_rps(self) -> bool:
+        """Whether a term needs the propeller-speed column n."""
         return "n" in self.inputs
 
     @property
     def uses_wind(self) -> bool:
+        """Whether a term needs the relative wind columns."""
         return any(s in self.inputs for s in ("wind_speed", "wind_angle"))
 
     def without(self, drop: Mapping[str, tuple[str, ...] | list[str]]) -> ModelStructure:
@@ -166,6 +171,7 @@ class ModelStructure:
         return ModelStructure(f"{self.name}+{other.name}", terms)
 
     def to_dict(self) -> dict:
+        """The structure as JSON-ready data (canonical term texts)."""
         return {"name": self.name, "terms": {d: list(t) for d, t in self.terms.items()}}
 
     @classmethod
@@ -228,6 +234,7 @@ class TermTable(dict):
         return dict.__contains__(self, self._key(key))
 
     def get(self, key, default=None):
+        """``dict.get`` that also accepts any spelling of the term."""
         return dict.get(self, self._key(key), default)
 
 
@@ -292,18 +299,22 @@ class ManoeuvringModel:
     # ------------------------------------------------------------------ inputs
     @property
     def inputs(self) -> tuple[str, ...]:
+        """Log columns besides t, u, v, r, delta the model needs."""
         return self.structure.inputs
 
     @property
     def uses_thrust(self) -> bool:
+        """Whether the model needs a thrust series."""
         return self.structure.uses_thrust
 
     @property
     def uses_rps(self) -> bool:
+        """Whether the model needs a propeller-speed series."""
         return self.structure.uses_rps
 
     @property
     def uses_wind(self) -> bool:
+        """Whether the model needs the relative wind."""
         return self.structure.uses_wind
 
     # ------------------------------------------------------------------ evaluation
@@ -423,13 +434,30 @@ class ManoeuvringModel:
 
     # ------------------------------------------------------------------ serialisation
     def to_dict(self) -> dict:
+        """The model as JSON-ready data (what model files store)."""
         return {"name": self.name, "structure": self.structure.to_dict(),
                 "coefficients": self.coefficients}  # fmt: skip
 
     @classmethod
     def from_dict(cls, data: Mapping) -> ManoeuvringModel:
+        """The model of ``to_dict`` data (term texts in any spelling)."""
         return cls(ModelStructure.from_dict(data["structure"]), data["coefficients"],
                    name=str(data.get("name", "")))  # fmt: skip
+
+    def save(self, path, particulars: Mapping | None = None):
+        """Write the model alone as a model file (no identification record), atomically;
+        ``shipid.load_model`` and every command read it."""
+        import json
+
+        from shipid import __version__
+        from shipid.outputs import atomic_write_text
+        from shipid.reporting.modelfile import FORMAT, VERSION, json_safe
+
+        doc = {"format": FORMAT, "version": VERSION, "shipid": __version__,
+               "model": self.to_dict(), "particulars": particulars, "identification": None,
+               "provenance": {"training_files": []}}  # fmt: skip
+        return atomic_write_text(path, json.dumps(json_safe(doc), indent=2, ensure_ascii=False)
+                                 + "\n")  # fmt: skip
 
 
 def coefficients_from_gamma(

@@ -4,9 +4,10 @@ or RK4, zero-order-hold inputs, planar kinematics, divergence detection, batches
 State: [u, v, r, ψ, x, y] with ψ̇ = r, ẋ = u cosψ − v sinψ, ẏ = u sinψ + v cosψ (earth x north,
 y east, ψ clockwise). Input sample k (rudder, propeller, wind) is held over [t_k, t_k+1).
 
-``ManoeuvringModel`` runs on the compiled kernel (``shipid.dynamics.kernel``) for any term set.
-Any other object with ``derivatives(nu (B, 3), delta (B,), thrust (B,) or None) -> (B, 3)`` and
-``uses_thrust`` (the reference ships) runs on a vectorised NumPy path.
+``ManoeuvringModel`` runs on the compiled kernel (``shipid.dynamics.kernel``) for any term set,
+the reference ships on their own compiled physics through the same integrators
+(``integrate_open``). Any other object with ``derivatives(nu (B, 3), delta (B,), thrust (B,) or
+None) -> (B, 3)`` and ``uses_thrust`` (e.g. a black-box estimator) runs on a vectorised NumPy path.
 """
 
 from __future__ import annotations
@@ -31,9 +32,12 @@ STATE_NAMES = ("u", "v", "r", "psi", "x", "y")
 
 
 class Dynamics(Protocol):
+    """What the generic simulator path needs of a dynamics object (the reference ships)."""
+
     uses_thrust: bool
 
-    def derivatives(self, nu: np.ndarray, delta: np.ndarray, thrust=None) -> np.ndarray: ...
+    def derivatives(self, nu: np.ndarray, delta: np.ndarray, thrust=None) -> np.ndarray:
+        """(B, 3) body accelerations at states nu (B, 3) and rudder delta (B,)."""
 
 
 @dataclass(frozen=True)
@@ -44,6 +48,7 @@ class DivergenceBounds:
     yaw_rate: float = 5.0  # rad/s
 
     def resolved(self, u0: float) -> tuple[float, float]:
+        """(speed, yaw rate) limits for a run starting at surge speed ``u0``."""
         speed = self.speed if math.isfinite(self.speed) else 10.0 * max(abs(u0), 1.0)
         return speed, self.yaw_rate
 
@@ -71,9 +76,11 @@ class BatchResult:
 
     @property
     def diverged(self) -> np.ndarray:
+        """Per trajectory: whether it stopped before the end of the grid."""
         return self.n_valid < len(self.t)
 
     def log(self, i: int) -> pd.DataFrame:
+        """Trajectory ``i`` as a canonical log (up to where it diverged)."""
         n = int(self.n_valid[i])
         cols = {name: self.states[i, :n, j] for j, name in enumerate(STATE_NAMES)}
         return make_log({"t": self.t[:n], "delta": self.delta[i, :n], **cols}, **self.meta)
@@ -120,6 +127,7 @@ def step_state(
 
 
 def within_bounds(s: np.ndarray, speed_lim: float, yaw_lim: float) -> np.ndarray:
+    """Per row of (B, 6) states: finite and within the divergence bounds."""
     with np.errstate(invalid="ignore"):
         return (np.all(np.isfinite(s), axis=1) & (np.abs(s[:, 0]) <= speed_lim)
                 & (np.abs(s[:, 1]) <= speed_lim) & (np.abs(s[:, 2]) <= yaw_lim))  # fmt: skip
@@ -212,13 +220,14 @@ def run_kernel(code: TermCode, theta: np.ndarray, t: np.ndarray, inputs: np.ndar
     valid samples per run. No input checks: for inner loops (refinement, selection) that reuse
     validated arrays; everything else goes through ``simulate_batch``."""
     B, N = inputs.shape[0], t.size
-    theta = np.ascontiguousarray(np.broadcast_to(theta, (B, *theta.shape[-2:])), dtype=np.float64)
-    steps = np.full(B, N, dtype=np.int64) if n_steps is None else np.asarray(n_steps, np.int64)
+    theta = kernel.c_array(np.broadcast_to(theta, (B, *theta.shape[-2:])))
+    steps = np.full(B, N, dtype=np.int64) if n_steps is None else kernel.c_array(n_steps, np.int64)
     out = np.zeros((B, N, 6))
     n_valid = np.zeros(B, dtype=np.int64)
-    kernel.integrate_open(theta, *code.arrays(), code.uses_derived, t, inputs, steps, s0,
-                          method == "rk4", np.broadcast_to(np.asarray(speed_lim, float), B).copy(),
-                          np.broadcast_to(np.asarray(yaw_lim, float), B).copy(), out,
+    kernel.integrate_open(theta, *code.arrays(), code.uses_derived, kernel.c_array(t),
+                          kernel.c_array(inputs), steps, kernel.c_array(s0), method == "rk4",
+                          kernel.c_array(np.broadcast_to(np.asarray(speed_lim, float), B)),
+                          kernel.c_array(np.broadcast_to(np.asarray(yaw_lim, float), B)), out,
                           n_valid)  # fmt: skip
     return out, n_valid
 
@@ -276,6 +285,13 @@ def simulate_batch(
         out, n_valid = run_kernel(dynamics.code, dynamics.theta, t,
                                   input_array(series, n_traj, n_steps), s0, method, speed_lim,
                                   yaw_lim)  # fmt: skip
+    elif hasattr(dynamics, "integrate_open"):  # a compiled reference ship: rudder input only
+        out = np.zeros((n_traj, n_steps, 6))
+        n_valid = np.zeros(n_traj, dtype=np.int64)
+        dynamics.integrate_open(kernel.c_array(t), input_array({"delta": delta}, n_traj, n_steps),
+                                np.full(n_traj, n_steps, dtype=np.int64), s0, method == "rk4",
+                                np.full(n_traj, speed_lim), np.full(n_traj, yaw_lim), out,
+                                n_valid)  # fmt: skip
     else:
         thrust = None if thrust is None else _as_series(thrust, "thrust", n_traj, n_steps)
         rps = None if rps is None else _as_series(rps, "rps (propeller speed)", n_traj, n_steps)

@@ -65,10 +65,12 @@ class Factor:
 
     @property
     def name(self) -> str:
+        """The signal's name."""
         return SIGNALS[self.signal]
 
     @property
     def text(self) -> str:
+        """The factor's canonical text (``|u|``, ``delta^2``, ``sin(2*beta)``)."""
         op, name = OPS[self.op], self.name
         if op == "pow":
             base = name
@@ -81,6 +83,7 @@ class Factor:
         return base if self.power == 1 else f"{base}^{self.power}"
 
     def display(self) -> str:
+        """The factor as printed in equations (``|u|``, ``δ²``, ``sin(2β)``)."""
         op, name = OPS[self.op], DISPLAY.get(self.name, self.name)
         sup = str(self.power).translate(SUPERSCRIPT) if self.power != 1 else ""
         if op == "pow":
@@ -93,6 +96,7 @@ class Factor:
         return f"{op}{sup}({arg})" if sup else f"{op}({arg})"
 
     def values(self, x: np.ndarray) -> np.ndarray:
+        """The factor's values for the signal's values ``x``."""
         op = OPS[self.op]
         if op == "pow":
             base = x
@@ -117,10 +121,12 @@ class Term:
 
     @property
     def text(self) -> str:
+        """The term's canonical text (what model files store)."""
         return "*".join(f.text for f in self.factors) if self.factors else "1"
 
     @property
     def signals(self) -> tuple[str, ...]:
+        """The signals the term uses, in signal order."""
         return tuple(sorted({f.name for f in self.factors}, key=SIGNAL_INDEX.get))
 
     @property
@@ -366,13 +372,16 @@ class TermCode:
 
     @property
     def n_terms(self) -> int:
+        """Number of terms in the table."""
         return len(self.texts)
 
     def arrays(self) -> tuple:
+        """(start, signal, op, k, power): the arrays the compiled kernel takes."""
         return self.start, self.signal, self.op, self.k, self.power
 
 
 def term_code(terms: Sequence[str | Term]) -> TermCode:
+    """The factor table (``TermCode``) of a term set, for the compiled kernel."""
     parsed = [parse_term(t) if isinstance(t, str) else t for t in terms]
     start, sig, op, k, power = [0], [], [], [], []
     for t in parsed:

@@ -50,7 +50,14 @@ class Validation:
     error: str | None = None
     warnings: list[str] = field(default_factory=list)
 
+    def to_frame(self):
+        """The metrics as a DataFrame: one row per state (u, v, r), one column per metric."""
+        import pandas as pd
+
+        return pd.DataFrame.from_dict(self.metrics, orient="index").rename_axis("state")
+
     def to_dict(self) -> dict:
+        """The validation as JSON-ready data (``validate --json``)."""
         sim = self.simulation
         return {"name": self.name, "error": self.error,
                 "diverged": sim.diverged if sim else None,

@@ -31,6 +31,7 @@ ESTIMATORS = LINEAR_ESTIMATORS + BLACK_BOX_ESTIMATORS
 
 
 def check_estimator_name(name) -> str:
+    """``name`` if it is a known estimator (or an estimator object), else an error."""
     if isinstance(name, str) and name not in ESTIMATORS:
         raise ShipidError(f"unknown estimator {name!r}; use one of {', '.join(ESTIMATORS)}")
     return name
@@ -105,11 +106,13 @@ class RegressorDynamics:
         self.name = name
 
     def features(self, u, v, r, given: dict) -> np.ndarray:
+        """(N, 3 + inputs) regressor inputs: u, v, r and the input signals."""
         cols = [u, v, r] + [np.broadcast_to(np.asarray(given[c], float), np.shape(u))
                             for c in self.inputs]  # fmt: skip
         return np.column_stack(cols)
 
     def derivatives(self, nu, delta, thrust=None, rps=None, **inputs) -> np.ndarray:
+        """(B, 3) accelerations predicted by the three regressors."""
         given = {"delta": delta, "n": rps, "thrust": thrust, **inputs}
         X = self.features(nu[:, 0], nu[:, 1], nu[:, 2], given)
         return np.column_stack([est.predict(X) for est in self.estimators])

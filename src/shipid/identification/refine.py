@@ -62,6 +62,7 @@ class Refinement:
     warnings: list[str] = field(default_factory=list)
 
     def to_dict(self) -> dict:
+        """The refinement as JSON-ready data (kept in the model file)."""
         return {"initial_model": self.initial.to_dict(), "refined_model": self.model.to_dict(),
                 "segment_s": self.segment_s,
                 "n_segments": self.n_segments, "states": list(self.states),

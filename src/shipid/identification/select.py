@@ -132,14 +132,17 @@ class Candidate:
 
     @property
     def standard_error(self) -> float:
+        """Standard error of the CV score over the folds."""
         f = np.asarray(self.fold_scores)
         return float(f.std(ddof=1) / math.sqrt(f.size)) if f.size > 1 else 0.0
 
     @property
     def key(self) -> tuple:
+        """Identity of the candidate: its terms per DOF and γ."""
         return (tuple((d, tuple(sorted(t))) for d, t in sorted(self.terms.items())), self.gamma)
 
     def n_terms(self) -> int:
+        """Number of terms over all equations."""
         return sum(len(t) for t in self.terms.values())
 
 
@@ -159,6 +162,7 @@ class Selection:
     warnings: list[str] = field(default_factory=list)
 
     def to_dict(self) -> dict:
+        """The search record as JSON-ready data (kept in the model file)."""
         opts = {k: getattr(self.options, k) for k in ("search", "gammas", "cv", "estimator",
                                                        "method", "divergence_penalty")}
         return {"options": {**opts, "library": self.library.to_dict()}, "gamma": self.gamma,

@@ -33,9 +33,11 @@ class NystromMap:
         self.n_components = int(keep.sum())
 
     def kernel_to_landmarks(self, X: np.ndarray) -> np.ndarray:
+        """K(X, landmarks), (N, m)."""
         return kernel_matrix(X, self.landmarks, self.kernel, **self.kernel_params)
 
     def features(self, X: np.ndarray) -> np.ndarray:
+        """Nyström features φ(X), (N, k)."""
         return self.kernel_to_landmarks(X) @ self.transform
 
     def feature_blocks(self, X: np.ndarray) -> Iterator[tuple[slice, np.ndarray]]:

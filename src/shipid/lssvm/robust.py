@@ -23,11 +23,13 @@ def robust_scale(residuals: np.ndarray) -> float:
 
 
 def huber_weights(z: np.ndarray) -> np.ndarray:
+    """Huber weights of standardised residuals z: 1 inside ±1.345, 1.345/|z| outside."""
     a = np.abs(z)
     return np.where(a <= HUBER_C, 1.0, HUBER_C / np.maximum(a, HUBER_C))
 
 
 def hampel_weights(z: np.ndarray) -> np.ndarray:
+    """Hampel weights of standardised residuals z (Suykens et al. 2002): 1, linear, floor."""
     a = np.abs(z)
     w = np.where(a <= HAMPEL_C1, 1.0, (HAMPEL_C2 - a) / (HAMPEL_C2 - HAMPEL_C1))
     return np.where(a > HAMPEL_C2, HAMPEL_FLOOR, w)

@@ -43,9 +43,11 @@ class DualLOOPath:
         self.Yt = V.T @ (s[:, None] * Y)
 
     def mse(self, gamma: float) -> float:
+        """Mean squared exact LOO residual at ``gamma``."""
         return float(np.mean(self.residuals(gamma) ** 2))
 
     def residuals(self, gamma: float) -> np.ndarray:
+        """Exact LOO residuals at ``gamma``, (N, q)."""
         d = 1.0 / (self.lam + 1.0 / gamma)
         eta = self.s * (self.V @ (d * self.a))
         nu = self.s[:, None] * (self.V @ (d[:, None] * self.Yt))
@@ -97,6 +99,7 @@ class PrimalLOOPath:
         return 1.0 / (self.lam + 1.0 / gamma)
 
     def residuals(self, gamma: float) -> np.ndarray:
+        """Exact LOO residuals at ``gamma``, (N, q)."""
         d = self._d(gamma)
         fitted = self.P @ (d[:, None] * self.PtWY)
         leverage = self.w * (1.0 / self.sw + (self.P * self.P) @ d)
@@ -211,6 +214,7 @@ class LSSVRCV(RegressorMixin, BaseEstimator):
         return LSSVR(**params)
 
     def fit(self, X, y, sample_weight=None) -> LSSVRCV:
+        """Search the grid, then refit the best parameters on all data."""
         gammas = np.logspace(-2, 6, 20) if self.gammas is None else np.asarray(self.gammas, float)
         for g in gammas.ravel():
             check_positive(g, "gammas")
@@ -258,5 +262,6 @@ class LSSVRCV(RegressorMixin, BaseEstimator):
         return self
 
     def predict(self, X) -> np.ndarray:
+        """Predictions of the refitted best estimator."""
         check_is_fitted(self, "best_estimator_")
         return self.best_estimator_.predict(X)

@@ -57,6 +57,7 @@ def validated_training_data(estimator, X, y, sample_weight):
 
 
 def check_positive(value: object, name: str) -> float:
+    """``value`` as a float if it is a finite number > 0, else a ValueError naming it."""
     if not isinstance(value, numbers.Real) or isinstance(value, bool):
         raise ValueError(f"{name} must be a positive number, got {value!r}")
     if not np.isfinite(value) or value <= 0:
@@ -65,12 +66,14 @@ def check_positive(value: object, name: str) -> float:
 
 
 def check_choice(value: object, name: str, choices: tuple[str, ...]) -> str:
+    """``value`` if it is one of ``choices``, else a ValueError naming it."""
     if value not in choices:
         raise ValueError(f"{name} must be one of {', '.join(map(repr, choices))}, got {value!r}")
     return str(value)
 
 
 def check_positive_int(value: object, name: str, minimum: int = 1) -> int:
+    """``value`` if it is an integer ≥ ``minimum``, else a ValueError naming it."""
     if not isinstance(value, numbers.Integral) or isinstance(value, bool) or value < minimum:
         raise ValueError(f"{name} must be an integer ≥ {minimum}, got {value!r}")
     return int(value)

@@ -31,6 +31,7 @@ READABLE_VERSIONS = (1, 2)
 
 
 def sha256(path: str | Path) -> str:
+    """SHA-256 of a file, read in 1 MiB chunks."""
     h = hashlib.sha256()
     with open(path, "rb") as fh:
         for chunk in iter(lambda: fh.read(1 << 20), b""):
@@ -39,7 +40,9 @@ def sha256(path: str | Path) -> str:
 
 
 def json_safe(obj):
-    """JSON cannot hold inf/NaN: write them as null."""
+    """JSON-ready data: NumPy scalars and arrays become Python ones, inf/NaN become null."""
+    if hasattr(obj, "tolist") and not isinstance(obj, str):  # NumPy scalars and arrays
+        obj = obj.tolist()
     if isinstance(obj, float) and not math.isfinite(obj):
         return None
     if isinstance(obj, dict):
@@ -52,7 +55,7 @@ def json_safe(obj):
 def model_document(ident: Identification, training_files: Sequence[str | Path] = (),
                    preprocessing: dict | None = None, refinement: Refinement | None = None,
                    plausibility: dict | None = None, model: ManoeuvringModel | None = None,
-                   selection: dict | None = None) -> dict:  # fmt: skip
+                   selection: dict | None = None, particulars: dict | None = None) -> dict:  # fmt: skip
     """The model file. ``model`` is the one users get (default: the refined model when there is a
     refinement, else the LS-SVM one); the LS-SVM model stays in ``refinement.initial_model`` and
     the refined one in ``refinement.refined_model``."""
@@ -61,6 +64,7 @@ def model_document(ident: Identification, training_files: Sequence[str | Path] =
     return json_safe({
         "format": FORMAT, "version": VERSION, "shipid": __version__,
         "model": model.to_dict(),
+        "particulars": particulars,
         "identification": {"form": ident.form, "gamma": ident.gamma, "dt": ident.dt,
                            "estimator": ident.estimator, "selection": selection,
                            "discrete": ident.discrete, "diagnostics": ident.diagnostics,
@@ -74,6 +78,7 @@ def model_document(ident: Identification, training_files: Sequence[str | Path] =
 
 
 def model_text(ident: Identification, training_files: Sequence[str | Path] = (), **kw) -> str:
+    """The model file's JSON text (``model_document`` serialised; floats exact)."""
     # repr of a float is exact, so the coefficients survive the round trip bit for bit.
     return json.dumps(model_document(ident, training_files, **kw), indent=2,
                       ensure_ascii=False) + "\n"  # fmt: skip
@@ -83,6 +88,7 @@ def save_model(path: str | Path, ident: Identification, training_files: Sequence
                preprocessing: dict | None = None, refinement: Refinement | None = None,
                plausibility: dict | None = None,
                model: ManoeuvringModel | None = None) -> Path:  # fmt: skip
+    """Write the model file of an identification atomically."""
     text = model_text(ident, training_files, preprocessing=preprocessing, refinement=refinement,
                       plausibility=plausibility, model=model)  # fmt: skip
     return atomic_write_text(path, text)
@@ -140,6 +146,11 @@ def check_document(doc, path) -> None:
     """Refuse a model file that does not follow the schema, naming the first bad key."""
     _expect(doc, "mapping", "the file", path)
     _check_model_data(doc.get("model"), "model", path)
+    if doc.get("particulars") is not None:
+        from shipid.data.particulars import Particulars
+
+        _expect(doc["particulars"], "mapping", "particulars", path)
+        Particulars.from_mapping(doc["particulars"], f"{path}: particulars")
     ident = doc.get("identification")
     _expect(ident, "mapping|null", "identification", path)
     if ident:
@@ -166,6 +177,7 @@ def _no_constants(token: str):
 
 
 def load_document(path: str | Path) -> dict:
+    """The parsed model file, checked against its schema (one-line errors)."""
     path = Path(path)
     if not path.exists():
         raise ShipidError(f"{path}: no such model file")
@@ -193,10 +205,12 @@ def load_model(path: str | Path, which: str = "model") -> ManoeuvringModel:
 
 
 def has_refinement(doc: Mapping) -> bool:
+    """Whether the model file keeps an output-error refinement."""
     return bool((doc.get("identification") or {}).get("refinement"))
 
 
 def model_from_document(doc: dict, path: str | Path, which: str = "model") -> ManoeuvringModel:
+    """The model (or, with ``which='lssvm'``, the LS-SVM one) of a parsed model file."""
     if which not in ("model", "lssvm"):
         raise ShipidError(f"which must be 'model' or 'lssvm', got {which!r}")
     data = doc.get("model")
@@ -214,5 +228,11 @@ def training_conditions(doc: Mapping) -> dict:
     """Approach speed, propeller speed and envelope of a model file's training logs."""
     ident = doc.get("identification") or {}
     prep = ident.get("preprocessing") or {}
-    return {"speed": prep.get("approach_speed"), "rps": prep.get("approach_rps"),
-            "envelope": ident.get("envelope") or {}}  # fmt: skip
+    out = {"speed": prep.get("approach_speed"), "rps": prep.get("approach_rps"),
+           "envelope": ident.get("envelope") or {}, "particulars": None,
+           "rudder_rate": prep.get("rudder_rate")}  # fmt: skip
+    if doc.get("particulars"):
+        from shipid.data.particulars import Particulars
+
+        out["particulars"] = Particulars.from_mapping(doc["particulars"])
+    return out

@@ -1,8 +1,11 @@
-"""Tables and the Markdown report of an identification and its validation."""
+"""Tables of an identification and its validation (pandas, for Markdown and HTML)."""
 
 from __future__ import annotations
 
 from collections.abc import Sequence
+from pathlib import Path
+
+import pandas as pd
 
 from shipid.evaluation.validate import Validation
 
@@ -47,3 +50,40 @@ def indices_table(validations: Sequence[Validation]) -> str:
                 lines.append(f"| {v.name} | {k} | {_fmt(meas.get(k))} | {_fmt(sim.get(k))} | "
                              f"{loop} |")  # fmt: skip
     return "\n".join(lines)
+
+
+STATES = ("u", "v", "r")
+UNITS = {"u": "m/s", "v": "m/s", "r": "rad/s"}
+
+
+def metrics_frame(validations: Sequence[Validation]) -> pd.DataFrame:
+    """One row per log: rmse and fit % of u, v, r first, then bias and std, and divergence."""
+    rows = []
+    for v in validations:
+        if v.error is not None:
+            continue
+        m = v.metrics
+        row = {"log": Path(v.name).name}
+        row.update({f"rmse {s} [{UNITS[s]}]": m[s]["rmse"] for s in STATES})
+        row.update({f"fit {s} [%]": m[s]["fit_percent"] for s in STATES})
+        row.update({f"bias {s}": m[s]["mean"] for s in STATES})
+        row.update({f"std {s}": m[s]["std"] for s in STATES})
+        row["diverged"] = (f"at {v.simulation.diverged_at:.1f} s" if v.simulation.diverged
+                           else "no")  # fmt: skip
+        rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def indices_frame(validations: Sequence[Validation]) -> pd.DataFrame:
+    """Long form: log, index, measured, simulated (replay), closed loop."""
+    rows = []
+    for v in validations:
+        meas, sim = v.indices.get("measured", {}), v.indices.get("simulated", {})
+        closed = v.indices.get("closed_loop")
+        for k in INDEX_KEYS:
+            if k in meas or k in sim:
+                rows.append({"log": Path(v.name).name, "index": k, "measured": meas.get(k),
+                             "simulated (replay)": sim.get(k),
+                             "closed loop": None if closed is None else closed.get(k)})  # fmt: skip
+    return pd.DataFrame(rows, columns=["log", "index", "measured", "simulated (replay)",
+                                       "closed loop"])  # fmt: skip

@@ -5,9 +5,10 @@ pull-out (IMO MSC.137(76), ITTC 7.5-04-02-01).
 model's) convention. The rudder sample logged at t_k is the one held over [t_k, t_k+1), so replaying a
 manoeuvre's log with ``simulate_log`` (same method and step) reproduces it exactly.
 
-Identified models run on the compiled closed loop (``shipid.dynamics.kernel.integrate_closed``);
-reference ships step their NumPy dynamics with the same compiled rudder command and steering
-machine. A model with wind terms meets a constant true wind (``wind=(speed, from_direction)``,
+Identified models and reference ships run on the compiled closed loop
+(``shipid.dynamics.kernel.closed_run``: rudder command, steering machine, integration); other
+dynamics (black-box estimators) step their NumPy derivatives with the same compiled command and
+steering machine. A model with wind terms meets a constant true wind (``wind=(speed, from_direction)``,
 still air by default: the apparent wind of its own motion).
 """
 
@@ -97,6 +98,7 @@ def _params(vessel: Vessel, mode: int, value: float, held: float, approach: floa
     p[kernel.P_MAX_RATE] = st.max_rate or 0.0
     p[kernel.P_TIME_CONST] = st.time_constant
     p[kernel.P_RPS] = 0.0 if rps is None else rps
+    p[kernel.P_RPS_TO], p[kernel.P_RPS_RAMP] = p[kernel.P_RPS], -1.0  # no propeller order
     if wind is not None:
         p[kernel.P_WIND_SPEED], p[kernel.P_WIND_DIR] = wind
     return p
@@ -145,18 +147,36 @@ def run_closed_loop(
                                 n_valid)  # fmt: skip
         m = int(n_valid[0])
         states, rudder = states[0], rudder[0]
+    elif hasattr(dyn, "integrate_closed"):  # a compiled reference ship
+        states, rudder = np.zeros((1, n, 6)), np.zeros((1, n))
+        n_valid = np.zeros(1, dtype=np.int64)
+        dyn.integrate_closed(dt, n, s0, params[None].copy(), method == "rk4",
+                             np.array([speed_lim]), np.array([yaw_lim]), states, rudder,
+                             n_valid)  # fmt: skip
+        m = int(n_valid[0])
+        states, rudder = states[0], rudder[0]
     else:
         states, rudder, m = _generic_closed_loop(dyn, params, n, dt, s0, method, speed_lim,
                                                  yaw_lim, rps if uses_rps else None)  # fmt: skip
     t = np.arange(n) * dt
     cols = dict(zip(("u", "v", "r", "psi", "x", "y"), states[:m].T, strict=True))
     if rps is not None and uses_rps:
-        cols["n"] = np.full(m, float(rps))
+        cols["n"] = propeller_series(params, t[:m])
     log = make_log({"t": t[:m], "delta": rudder[:m], **cols}, **vessel.log_metadata())
     if m == n:
         return ManoeuvreResult(log)
     t_div, reason = divergence_report(states, t, m, speed_lim, yaw_lim)
     return ManoeuvreResult(log, diverged=True, diverged_at=t_div, reason=reason)
+
+
+def propeller_series(params: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """The propeller speed of a manoeuvre along ``t`` (``kernel.propeller`` vectorised)."""
+    n0, n1 = params[kernel.P_RPS], params[kernel.P_RPS_TO]
+    at, ramp = params[kernel.P_RPS_AT], params[kernel.P_RPS_RAMP]
+    if ramp < 0:
+        return np.full(t.shape, n0)
+    frac = np.ones_like(t) if ramp == 0 else np.clip((t - at) / ramp, 0.0, 1.0)
+    return np.where(t < at, n0, n0 + frac * (n1 - n0))
 
 
 def _generic_closed_loop(dyn, params, n, dt, s0, method, speed_lim, yaw_lim, rps):
@@ -173,6 +193,8 @@ def _generic_closed_loop(dyn, params, n, dt, s0, method, speed_lim, yaw_lim, rps
         states[k], rudder[k] = s[0], delta
         if k == n - 1:
             break
+        if prop is not None:
+            prop = np.array([kernel.propeller(params, k * dt)])
         new = step_state(dyn, s, np.array([delta]), None, dt, method, prop)
         if not within_bounds(new, speed_lim, yaw_lim)[0]:
             return states, rudder, k + 1
@@ -304,6 +326,123 @@ def pull_out(
                        "residual_yaw_rate": float(r[-1]),
                        "residual_fraction": float(r[-1] / np.interp(hold, t, r))}  # fmt: skip
     return res
+
+
+def stopping(
+    ship: Vessel | ManoeuvringModel,
+    rps: float,
+    astern_rps: float | None = None,
+    reversal_time: float = 0.0,
+    duration: float = 600.0,
+    dt: float = 0.05,
+    speed: float | None = None,
+    method: str = "rk4",
+    wind: tuple[float, float] | None = None,
+) -> ManoeuvreResult:
+    """Full-astern stopping test (IMO): from a straight approach at ``rps``, the propeller is
+    ordered to ``astern_rps`` (default −``rps``) at t = 0, reaching it in ``reversal_time`` s; the
+    rudder stays amidships. Indices: track reach (path length until the ship stops in the water,
+    u = 0), head reach (along the original course), lateral deviation, time to stop."""
+    if not getattr(getattr(ship, "dynamics", ship), "uses_rps", False):
+        raise ShipidError("a stopping test needs a model with propeller-speed terms (n): the "
+                          "ship's thrust must respond to the astern order")  # fmt: skip
+    if not (isinstance(rps, int | float) and math.isfinite(rps) and rps > 0):
+        raise ShipidError(f"stopping: the approach propeller speed must be > 0 rps, got {rps!r}")
+    astern = -float(rps) if astern_rps is None else float(astern_rps)
+    if not (math.isfinite(astern) and astern < 0):
+        raise ShipidError(f"stopping: the astern order must be < 0 rps, got {astern_rps!r}")
+    if not (math.isfinite(reversal_time) and reversal_time >= 0):
+        raise ShipidError(f"stopping: reversal time must be ≥ 0 s, got {reversal_time!r}")
+    vessel = as_vessel(ship, speed, None, rps)
+    params = _params(vessel, kernel.MODE_HOLD, 0.0, 0.0, 0.0, rps=rps, wind=_check_wind(wind))
+    params[kernel.P_RPS_TO], params[kernel.P_RPS_AT] = astern, 0.0
+    params[kernel.P_RPS_RAMP] = reversal_time
+    res = run_closed_loop(vessel, params, duration, dt, method, rps=rps)
+    res.log.attrs["manoeuvre"] = f"stopping, {rps:g} → {astern:g} rps in {reversal_time:g} s"
+    log = res.log
+    u, t = log["u"].to_numpy(), log["t"].to_numpy()
+    stopped = np.flatnonzero(u <= 0.0)
+    from shipid.trials.indices import travelled
+
+    nan = math.nan
+    res.indices = {"track_reach": nan, "head_reach": nan, "lateral_deviation": nan,
+                   "time_to_stop": nan}  # fmt: skip
+    if stopped.size:
+        k = int(stopped[0])
+        frac = u[k - 1] / (u[k - 1] - u[k]) if k > 0 and u[k - 1] != u[k] else 0.0
+        t_stop = float(t[k - 1] + frac * (t[k] - t[k - 1])) if k > 0 else float(t[0])
+        dist = travelled(log)
+        psi0 = float(log["psi"].iloc[0])
+        x = np.interp(t_stop, t, log["x"]) - log["x"].iloc[0]
+        y = np.interp(t_stop, t, log["y"]) - log["y"].iloc[0]
+        res.indices = {"track_reach": float(np.interp(t_stop, t, dist)),
+                       "head_reach": float(x * math.cos(psi0) + y * math.sin(psi0)),
+                       "lateral_deviation": float(-x * math.sin(psi0) + y * math.cos(psi0)),
+                       "time_to_stop": t_stop}  # fmt: skip
+    if vessel.length and math.isfinite(vessel.length):
+        res.indices["track_reach_L"] = res.indices["track_reach"] / vessel.length
+    return res
+
+
+def spiral(
+    ship: Vessel | ManoeuvringModel,
+    rudders_deg=(25, 15, 10, 5, 2, 0, -2, -5, -10, -15, -25, -15, -10, -5, -2, 0, 2, 5, 10, 15, 25),
+    hold: float = 120.0,
+    dt: float = 0.05,
+    speed: float | None = None,
+    method: str = "rk4",
+    rps: float | None = None,
+) -> ManoeuvreResult:
+    """Dieudonné spiral: each rudder angle (positive = to starboard, in degrees) held ``hold`` s
+    from the state the previous one left; the steady yaw rate of each (mean over the last fifth)
+    traces r(δ). A straight-line unstable ship shows a loop: at the same small rudder, a
+    different steady rate coming from each side. Indices: the r(δ) table, ``loop`` (whether any
+    rudder angle gave steady turns both ways) and ``loop_rudders_deg`` (those angles)."""
+    vessel = as_vessel(ship, speed, None, rps)
+    angles = [float(a) for a in rudders_deg]
+    if not angles or any(not math.isfinite(a) or abs(math.radians(a)) > vessel.steering.max_angle
+                         for a in angles):  # fmt: skip
+        raise ShipidError("spiral: rudder angles must be finite and within the steering "
+                          "machine's limit")  # fmt: skip
+    stbd = starboard_sign(vessel.rudder_positive)
+    initial = {"u": vessel.approach_speed}
+    logs, table = [], []
+    t0 = 0.0
+    res = None
+    for a in angles:
+        value = stbd * math.radians(a)
+        params = _params(vessel, kernel.MODE_HOLD, value, initial.get("delta", 0.0), 0.0,
+                         rps=rps)  # fmt: skip
+        res = run_closed_loop(vessel, params, hold, dt, method, initial=initial, rps=rps)
+        seg = res.log
+        seg["t"] = seg["t"] + t0
+        logs.append(seg.iloc[:-1] if len(logs) < len(angles) - 1 else seg)
+        tail = seg.iloc[int(0.8 * len(seg)):]
+        table.append({"rudder_deg": a, "steady_yaw_rate": float(tail["r"].mean()),
+                      "steady_speed": float(np.hypot(tail["u"], tail["v"]).mean())})  # fmt: skip
+        if res.diverged:
+            break
+        last = seg.iloc[-1]
+        initial = {k: float(last[k]) for k in ("u", "v", "r", "psi", "x", "y")}
+        initial["delta"] = float(last["delta"])
+        t0 = float(last["t"])
+    log = pd.concat(logs, ignore_index=True)
+    log.attrs = dict(res.log.attrs)
+    log.attrs["manoeuvre"] = "spiral"
+    out = ManoeuvreResult(log, diverged=res.diverged, diverged_at=res.diverged_at, reason=res.reason)
+    loop = _loop_rudders(table)
+    out.indices = {"table": table, "loop": bool(loop), "loop_rudders_deg": loop}
+    return out
+
+
+def _loop_rudders(table: list[dict]) -> list[float]:
+    """Rudder angles at which the spiral found steady turns both ways (the instability loop)."""
+    by_rudder: dict[float, list[float]] = {}
+    for row in table:
+        by_rudder.setdefault(row["rudder_deg"], []).append(row["steady_yaw_rate"])
+    peak = max((abs(row["steady_yaw_rate"]) for row in table), default=0.0)
+    return sorted(a for a, rs in by_rudder.items()
+                  if min(rs) < -0.01 * peak and max(rs) > 0.01 * peak)  # fmt: skip
 
 
 def _finite_or_none(x: float) -> float | None:

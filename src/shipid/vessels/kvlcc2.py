@@ -10,12 +10,14 @@ from __future__ import annotations
 import math
 from functools import lru_cache
 
+import numba
 import numpy as np
-from scipy.optimize import brentq
 
+import shipid.vessels.kvlcc2 as _this  # this module: see the entries below
+from shipid.dynamics import kernel
 from shipid.dynamics.steering import SteeringMachine
 
-from .vessel import Vessel
+from .vessel import CompiledDynamics, Vessel
 
 RHO = 1025.0
 L, B, D_DRAUGHT, VOLUME, XG = 7.00, 1.27, 0.46, 3.27, 0.25
@@ -41,60 +43,105 @@ Jz = JZ * 0.5 * RHO * L**4 * D_DRAUGHT
 IzG = m * (0.25 * L) ** 2
 # Mass matrix of the sway–yaw equations: [[m + my, xG m], [xG m, IzG + xG² m + Jz]].
 _MSY = np.array([[m + my, XG * m], [XG * m, IzG + XG**2 * m + Jz]])
-_MSY_INV = np.linalg.inv(_MSY)
+(_MI00, _MI01), (_MI10, _MI11) = np.linalg.inv(_MSY).tolist()
 
 
-class KVLCC2Dynamics:
+@numba.njit(cache=True)
+def accelerations(u, vm, r, delta, n):
+    """(u̇, v̇m, ṙ) of the MMG model at midship sway vm, rudder δ and propeller speed n [rps]:
+    hull, propeller and rudder forces (reference-ships.md §2) through the mass matrix."""
+    U = math.sqrt(u * u + vm * vm)
+    beta = math.atan2(-vm, u)
+    vp, rp = vm / U, r * L / U
+    q = 0.5 * RHO * L * D_DRAUGHT * U * U
+    XH = q * (-R0 + XVV * vp**2 + XVR * vp * rp + XRR * rp**2 + XVVVV * vp**4)
+    YH = q * (YV * vp + YR * rp + YVVV * vp**3 + YVVR * vp**2 * rp + YVRR * vp * rp**2
+              + YRRR * rp**3)  # fmt: skip
+    NH = q * L * (NV * vp + NR * rp + NVVV * vp**3 + NVVR * vp**2 * rp + NVRR * vp * rp**2
+                  + NRRR * rp**3)  # fmt: skip
+    beta_p = beta - XP_PRIME * rp
+    c2 = 1.6 if beta_p > 0 else 1.1
+    one_minus_wp = (1 - WP0) * (1 + (1 - math.exp(-C1 * abs(beta_p))) * (c2 - 1))
+    Jp = u * one_minus_wp / (n * DP)
+    KT = K0 + K1 * Jp + K2 * Jp**2
+    XP = (1 - TP) * RHO * n**2 * DP**4 * KT
+    beta_r = beta - LR_PRIME * rp
+    gamma_r = 0.395 if beta_r < 0 else 0.640
+    vR = U * gamma_r * beta_r
+    uR = EPS * u * one_minus_wp * math.sqrt(
+        ETA * (1 + KAPPA * (math.sqrt(1 + 8 * KT / (math.pi * Jp**2)) - 1)) ** 2 + (1 - ETA))
+    alpha_r = delta - math.atan2(vR, uR)
+    FN = 0.5 * RHO * AR * (uR**2 + vR**2) * F_ALPHA * math.sin(alpha_r)
+    X = XH + XP - (1 - TR) * FN * math.sin(delta)
+    Y = YH - (1 + AH) * FN * math.cos(delta)
+    N = NH - (XR_PRIME * L + AH * XH_PRIME * L) * FN * math.cos(delta)
+    # Sway–yaw: [[m + my, xG m], [xG m, IzG + xG² m + Jz]] (v̇, ṙ) = (Y − (m + mx) u r, N − xG m u r)
+    ry = Y - (m + mx) * u * r
+    rn = N - XG * m * u * r
+    return ((X + (m + my) * vm * r + XG * m * r * r) / (m + mx),
+            _MI00 * ry + _MI01 * rn, _MI10 * ry + _MI11 * rn)  # fmt: skip
+
+
+@numba.njit(cache=True)
+def rhs(ctx, u, v, r, psi):
+    """State derivative for the compiled integrators; ctx = (inputs, n): δ = inputs[0]."""
+    a0, a1, a2 = accelerations(u, v, r, ctx[0][0], ctx[1])
+    psi_dot, xd, yd = kernel.kinematics(u, v, r, psi)
+    return a0, a1, a2, psi_dot, xd, yd
+
+
+class KVLCC2Dynamics(CompiledDynamics):
     """MMG accelerations at constant propeller revolutions ``n_prop`` [rps]."""
-
-    uses_thrust = False
 
     def __init__(self, n_prop: float) -> None:
         self.n_prop = n_prop
 
-    def forces(self, u, vm, r, delta):
-        U = np.sqrt(u**2 + vm**2)
-        beta = np.arctan2(-vm, u)
-        vp, rp = vm / U, r * L / U
-        q = 0.5 * RHO * L * D_DRAUGHT * U**2
-        XH = q * (-R0 + XVV * vp**2 + XVR * vp * rp + XRR * rp**2 + XVVVV * vp**4)
-        YH = q * (YV * vp + YR * rp + YVVV * vp**3 + YVVR * vp**2 * rp + YVRR * vp * rp**2
-                  + YRRR * rp**3)  # fmt: skip
-        NH = q * L * (NV * vp + NR * rp + NVVV * vp**3 + NVVR * vp**2 * rp + NVRR * vp * rp**2
-                      + NRRR * rp**3)  # fmt: skip
-        n = self.n_prop
-        beta_p = beta - XP_PRIME * rp
-        c2 = np.where(beta_p > 0, 1.6, 1.1)
-        one_minus_wp = (1 - WP0) * (1 + (1 - np.exp(-C1 * np.abs(beta_p))) * (c2 - 1))
-        Jp = u * one_minus_wp / (n * DP)
-        KT = K0 + K1 * Jp + K2 * Jp**2
-        XP = (1 - TP) * RHO * n**2 * DP**4 * KT
-        beta_r = beta - LR_PRIME * rp
-        gamma_r = np.where(beta_r < 0, 0.395, 0.640)
-        vR = U * gamma_r * beta_r
-        uR = EPS * u * one_minus_wp * np.sqrt(
-            ETA * (1 + KAPPA * (np.sqrt(1 + 8 * KT / (np.pi * Jp**2)) - 1)) ** 2 + (1 - ETA))
-        alpha_r = delta - np.arctan2(vR, uR)
-        FN = 0.5 * RHO * AR * (uR**2 + vR**2) * F_ALPHA * np.sin(alpha_r)
-        X_rudder = -(1 - TR) * FN * np.sin(delta)
-        Y_rudder = -(1 + AH) * FN * np.cos(delta)
-        N_rudder = -(XR_PRIME * L + AH * XH_PRIME * L) * FN * np.cos(delta)
-        return XH + X_rudder + XP, YH + Y_rudder, NH + N_rudder
-
     def derivatives(self, nu: np.ndarray, delta: np.ndarray, thrust=None) -> np.ndarray:
-        u, vm, r = nu[:, 0], nu[:, 1], nu[:, 2]
-        X, Y, N = self.forces(u, vm, r, delta)
-        out = np.empty_like(nu)
-        out[:, 0] = (X + (m + my) * vm * r + XG * m * r**2) / (m + mx)
-        rhs = np.vstack([Y - (m + mx) * u * r, N - XG * m * u * r])
-        acc = _MSY_INV @ rhs
-        out[:, 1], out[:, 2] = acc[0], acc[1]
-        return out
+        """(B, 3) body accelerations of the MMG model at states nu and rudder delta."""
+        return _batch(kernel.c_array(nu), kernel.c_array(delta),
+                      float(self.n_prop))  # fmt: skip
+
+    def integrate_open(self, t, inputs, n_steps, s0, rk4, speed_lim, yaw_lim, out, n_valid):
+        """Free runs driven by (B, N, 5) inputs, the propeller at ``n_prop``."""
+        _open(float(self.n_prop), t, inputs, n_steps, s0, rk4, speed_lim, yaw_lim, out, n_valid)
+
+    def integrate_closed(self, dt, n_steps, s0, params, rk4, speed_lim, yaw_lim, states, rudder,
+                         n_valid):  # fmt: skip
+        """Closed-loop manoeuvres of parameter rows ``params``, the propeller at ``n_prop``."""
+        _closed(float(self.n_prop), dt, n_steps, s0, params, rk4, speed_lim, yaw_lim, states,
+                rudder, n_valid)  # fmt: skip
+
+
+# Entries reach ``rhs`` as a module attribute: numba caches them only then.
+@numba.njit(cache=True)
+def _batch(nu, delta, n):
+    out = np.empty_like(nu)
+    for i in range(nu.shape[0]):
+        out[i, 0], out[i, 1], out[i, 2] = accelerations(nu[i, 0], nu[i, 1], nu[i, 2], delta[i], n)
+    return out
+
+
+@numba.njit(cache=True)
+def _open(n, t, inputs, n_steps, s0, rk4, speed_lim, yaw_lim, out, n_valid):
+    for b in range(inputs.shape[0]):
+        inp = np.zeros(kernel.N_INPUTS)
+        n_valid[b] = kernel.open_run(_this.rhs, (inp, n), inp, t, inputs[b], n_steps[b], s0[b],
+                                     rk4, speed_lim[b], yaw_lim[b], out[b])  # fmt: skip
+
+
+@numba.njit(cache=True)
+def _closed(n, dt, n_steps, s0, params, rk4, speed_lim, yaw_lim, states, rudder, n_valid):
+    for b in range(params.shape[0]):
+        inp = np.zeros(kernel.N_INPUTS)
+        n_valid[b] = kernel.closed_run(_this.rhs, (inp, n), inp, params[b], dt, n_steps, s0[b],
+                                       rk4, speed_lim[b], yaw_lim[b], states[b], rudder[b])
 
 
 @lru_cache(maxsize=8)
 def trimmed_revolutions(speed: float = APPROACH_SPEED) -> float:
     """Propeller rps for u̇ = 0 at ``speed`` in straight running (≈ 11.85 rps at 1.179 m/s)."""
+    from scipy.optimize import brentq  # 0.4 s to import: only when a KVLCC2 is built
+
     state = np.array([[speed, 0.0, 0.0]])
 
     def surge_acc(n: float) -> float:
@@ -104,6 +151,7 @@ def trimmed_revolutions(speed: float = APPROACH_SPEED) -> float:
 
 
 def kvlcc2(speed: float = APPROACH_SPEED) -> Vessel:
+    """The KVLCC2 L7 model as a vessel, trimmed for ``speed`` [m/s]."""
     return Vessel(
         name="kvlcc2",
         dynamics=KVLCC2Dynamics(trimmed_revolutions(speed)),

@@ -9,11 +9,14 @@ from __future__ import annotations
 
 import math
 
+import numba
 import numpy as np
 
+import shipid.vessels.mariner as _this  # this module: see the entries below
+from shipid.dynamics import kernel
 from shipid.dynamics.steering import SteeringMachine
 
-from .vessel import Vessel
+from .vessel import CompiledDynamics, Vessel
 
 L = 160.93
 U0 = 7.7175
@@ -35,34 +38,87 @@ M33 = IZ - N["rdot"]
 DET = M22 * M33 - M23 * M32
 
 
-class MarinerDynamics:
+# Coefficient tuples in the order _lateral reads them (numba freezes global tuples as constants).
+_LATERAL_KEYS = ("v", "r", "vvv", "vvr", "vu", "ru", "d", "ddd", "ud", "uud", "vdd", "vvd", "c0",
+                 "c0u", "c0uu")  # fmt: skip
+_YC = tuple(Y[k] for k in _LATERAL_KEYS)
+_NC = tuple(N[k] for k in _LATERAL_KEYS)
+_XC = tuple(X[k] for k in ("u", "uu", "uuu", "vv", "rr", "rv", "dd", "udd", "vd", "uvd"))
+
+
+@numba.njit(cache=True, inline="always")
+def _lateral(c, up, vp, rp, d):
+    return (c[0] * vp + c[1] * rp + c[2] * vp**3 + c[3] * vp**2 * rp + c[4] * vp * up
+            + c[5] * rp * up + c[6] * d + c[7] * d**3 + c[8] * up * d + c[9] * up**2 * d
+            + c[10] * vp * d**2 + c[11] * vp**2 * d + c[12] + c[13] * up + c[14] * up**2)  # fmt: skip
+
+
+@numba.njit(cache=True)
+def accelerations(u, v, r, delta):
+    """(u̇, v̇, ṙ) of the Abkowitz model at total surge speed u = U0 + Δu and rudder δ."""
+    du = u - U0
+    U = math.sqrt(u * u + v * v)
+    up, vp, rp, d = du / U, v / U, r * L / U, delta
+    x = _XC
+    Xp = (x[0] * up + x[1] * up**2 + x[2] * up**3 + x[3] * vp**2 + x[4] * rp**2 + x[5] * rp * vp
+          + x[6] * d**2 + x[7] * up * d**2 + x[8] * vp * d + x[9] * up * vp * d)  # fmt: skip
+    Yp, Np = _lateral(_YC, up, vp, rp, d), _lateral(_NC, up, vp, rp, d)
+    q = U * U / L
+    return (Xp * q / M11, (M33 * Yp - M23 * Np) * q / DET, (-M32 * Yp + M22 * Np) * q / L / DET)
+
+
+@numba.njit(cache=True)
+def rhs(ctx, u, v, r, psi):
+    """State derivative for the compiled integrators; ctx = (inputs,), δ = inputs[0]."""
+    a0, a1, a2 = accelerations(u, v, r, ctx[0][0])
+    psi_dot, xd, yd = kernel.kinematics(u, v, r, psi)
+    return a0, a1, a2, psi_dot, xd, yd
+
+
+class MarinerDynamics(CompiledDynamics):
     """Body accelerations of the Mariner; the state's u is the total surge speed U0 + Δu."""
 
-    uses_thrust = False
-
     def derivatives(self, nu: np.ndarray, delta: np.ndarray, thrust=None) -> np.ndarray:
-        du, v, r = nu[:, 0] - U0, nu[:, 1], nu[:, 2]
-        U = np.sqrt((U0 + du) ** 2 + v**2)
-        up, vp, rp, d = du / U, v / U, r * L / U, delta
-        Xp = (X["u"] * up + X["uu"] * up**2 + X["uuu"] * up**3 + X["vv"] * vp**2
-              + X["rr"] * rp**2 + X["rv"] * rp * vp + X["dd"] * d**2 + X["udd"] * up * d**2
-              + X["vd"] * vp * d + X["uvd"] * up * vp * d)  # fmt: skip
+        """(B, 3) body accelerations of the Abkowitz model at states nu and rudder delta."""
+        return _batch(kernel.c_array(nu), kernel.c_array(delta))
 
-        def lateral(C: dict) -> np.ndarray:
-            return (C["v"] * vp + C["r"] * rp + C["vvv"] * vp**3 + C["vvr"] * vp**2 * rp
-                    + C["vu"] * vp * up + C["ru"] * rp * up + C["d"] * d + C["ddd"] * d**3
-                    + C["ud"] * up * d + C["uud"] * up**2 * d + C["vdd"] * vp * d**2
-                    + C["vvd"] * vp**2 * d + C["c0"] + C["c0u"] * up + C["c0uu"] * up**2)  # fmt: skip
+    def integrate_open(self, t, inputs, n_steps, s0, rk4, speed_lim, yaw_lim, out, n_valid):
+        """Free runs driven by (B, N, 5) inputs (``shipid.dynamics.kernel.open_run``)."""
+        _open(t, inputs, n_steps, s0, rk4, speed_lim, yaw_lim, out, n_valid)
 
-        Yp, Np = lateral(Y), lateral(N)
-        out = np.empty_like(nu)
-        out[:, 0] = Xp * (U**2 / L) / M11
-        out[:, 1] = (M33 * Yp - M23 * Np) * (U**2 / L) / DET
-        out[:, 2] = (-M32 * Yp + M22 * Np) * (U**2 / L**2) / DET
-        return out
+    def integrate_closed(self, dt, n_steps, s0, params, rk4, speed_lim, yaw_lim, states, rudder,
+                         n_valid):  # fmt: skip
+        """Closed-loop manoeuvres of parameter rows ``params`` (``kernel.closed_run``)."""
+        _closed(dt, n_steps, s0, params, rk4, speed_lim, yaw_lim, states, rudder, n_valid)
+
+
+# Entries reach ``rhs`` as a module attribute: numba caches them only then.
+@numba.njit(cache=True)
+def _batch(nu, delta):
+    out = np.empty_like(nu)
+    for i in range(nu.shape[0]):
+        out[i, 0], out[i, 1], out[i, 2] = accelerations(nu[i, 0], nu[i, 1], nu[i, 2], delta[i])
+    return out
+
+
+@numba.njit(cache=True)
+def _open(t, inputs, n_steps, s0, rk4, speed_lim, yaw_lim, out, n_valid):
+    for b in range(inputs.shape[0]):
+        inp = np.zeros(kernel.N_INPUTS)
+        n_valid[b] = kernel.open_run(_this.rhs, (inp,), inp, t, inputs[b], n_steps[b], s0[b], rk4,
+                                     speed_lim[b], yaw_lim[b], out[b])  # fmt: skip
+
+
+@numba.njit(cache=True)
+def _closed(dt, n_steps, s0, params, rk4, speed_lim, yaw_lim, states, rudder, n_valid):
+    for b in range(params.shape[0]):
+        inp = np.zeros(kernel.N_INPUTS)
+        n_valid[b] = kernel.closed_run(_this.rhs, (inp,), inp, params[b], dt, n_steps, s0[b], rk4,
+                                       speed_lim[b], yaw_lim[b], states[b], rudder[b])  # fmt: skip
 
 
 def mariner() -> Vessel:
+    """The Mariner as a vessel (U0 = 7.7175 m/s, its 5 °/s servo with a 1 s lag)."""
     return Vessel(
         name="mariner",
         dynamics=MarinerDynamics(),

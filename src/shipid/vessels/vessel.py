@@ -7,13 +7,36 @@ from dataclasses import dataclass
 from shipid.dynamics.steering import SteeringMachine
 
 
+class CompiledDynamics:
+    """Base of the reference ships' dynamics: NumPy ``derivatives`` for analysis and compiled
+    ``integrate_open`` / ``integrate_closed`` (same arguments as ``shipid.dynamics.kernel``'s,
+    without the term table) for the simulator and the manoeuvres. Rudder and trimmed propeller
+    only: no thrust, propeller-speed or wind inputs."""
+
+    uses_thrust = False
+    uses_rps = False
+
+    def derivatives(self, nu, delta, thrust=None):
+        """(B, 3) body accelerations at states nu (B, 3) and rudder delta (B,)."""
+        raise NotImplementedError
+
+    def integrate_open(self, t, inputs, n_steps, s0, rk4, speed_lim, yaw_lim, out, n_valid):
+        """Free runs driven by (B, N, 5) inputs: out (B, N, 6), n_valid (B,)."""
+        raise NotImplementedError
+
+    def integrate_closed(self, dt, n_steps, s0, params, rk4, speed_lim, yaw_lim, states, rudder,
+                         n_valid):  # fmt: skip
+        """Closed-loop manoeuvres of the rows of ``params``: states (B, N, 6), rudder (B, N)."""
+        raise NotImplementedError
+
+
 @dataclass(frozen=True)
 class Vessel:
     """A truth simulator.
 
     Attributes
     ----------
-    dynamics : object with ``derivatives(nu, delta, thrust)`` and ``uses_thrust`` (see simulate)
+    dynamics : a ``CompiledDynamics`` (or a ``ManoeuvringModel``)
     length : Lpp [m], for indices in ship lengths
     approach_speed : straight-running surge speed [m/s] at which the ship is trimmed
     steering : the rudder servo of the ship
@@ -31,5 +54,6 @@ class Vessel:
     source: str = ""
 
     def log_metadata(self) -> dict:
+        """Metadata of the logs this vessel's simulations produce."""
         return {"ship": self.name, "source": f"simulated: {self.source}",
                 "rudder_positive": self.rudder_positive, "scale": self.scale}  # fmt: skip

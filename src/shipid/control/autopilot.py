@@ -1,0 +1,180 @@
+"""A heading autopilot and line-of-sight path following, run on any model or ship.
+
+Autopilot: PID on the heading error with the steering machine's angle and rate limits,
+δc = −(Kp ψ̃ + Ki ∫ψ̃ dt + Kd r), ψ̃ = ψ − ψd wrapped to (−π, π], the integral frozen while the
+rudder is saturated (anti-windup). ``pid_from_nomoto`` places the closed-loop poles of Nomoto's
+first-order model T ψ̈ + ψ̇ = K δ (Fossen 2021, §15.3): Kp = ωn² T / K, Kd = (2ζωn T − 1) / K,
+Ki = ωn³ T / (10 K), so a controller tuned on an identified model is the same rule applied to its
+K and T.
+
+Path following: waypoints p₀, p₁, ...; on the leg from pₖ to pₖ₊₁ (course αₖ) the cross-track
+error is e = −(x − xₖ) sin αₖ + (y − yₖ) cos αₖ and the line-of-sight heading
+ψd = αₖ + atan(−e / Δ), Δ the lookahead distance; the next leg starts when the along-track
+distance reaches the leg's length less the acceptance radius.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from shipid.data.log import make_log
+from shipid.dynamics.simulate import DivergenceBounds, initial_states, step_state, within_bounds
+from shipid.dynamics.steering import SteeringMachine
+from shipid.errors import ShipidError
+from shipid.limits import check_samples
+from shipid.trials.manoeuvres import as_vessel
+
+
+@dataclass(frozen=True)
+class PID:
+    """Gains of the heading autopilot (rudder in rad per rad of heading error, per rad·s, per
+    rad/s of yaw rate). The signs carry the ship's rudder convention (K < 0 for a ship that
+    turns to port with positive rudder)."""
+
+    kp: float
+    ki: float
+    kd: float
+
+    def __post_init__(self) -> None:
+        for k in ("kp", "ki", "kd"):
+            if not math.isfinite(getattr(self, k)):
+                raise ShipidError(f"PID gain {k} must be finite")
+
+
+def pid_from_nomoto(K: float, T: float, omega: float | None = None, zeta: float = 0.9) -> PID:
+    """Pole placement on Nomoto's first-order model; ``omega`` (closed-loop natural frequency,
+    rad/s) defaults to 1/T (as fast as the ship's own yaw response)."""
+    if not (math.isfinite(K) and K != 0 and math.isfinite(T) and T > 0):
+        raise ShipidError(f"PID tuning needs a finite K ≠ 0 and T > 0, got K = {K}, T = {T}")
+    w = omega if omega is not None else 1.0 / T
+    return PID(kp=w * w * T / K, ki=w**3 * T / (10.0 * K), kd=(2.0 * zeta * w * T - 1.0) / K)
+
+
+def _wrap(a: float) -> float:
+    return (a + math.pi) % (2 * math.pi) - math.pi
+
+
+@dataclass
+class FollowResult:
+    """The run (a canonical log with ``psi_d`` and ``cross_track`` columns added) and its
+    cross-track error statistics over the path (from the first leg on)."""
+
+    log: pd.DataFrame
+    rms_cross_track: float
+    max_cross_track: float
+    completed: bool
+    diverged: bool = False
+
+
+def _run(ship, pid: PID, desired, duration: float, dt: float, speed: float | None,
+         rps: float | None, steering: SteeringMachine | None, method: str,
+         psi0: float = 0.0):  # fmt: skip
+    """Closed loop of the autopilot: ``desired(t, state) -> (ψd, cross-track or nan, done)``."""
+    vessel = as_vessel(ship, speed, steering, rps)
+    dyn = vessel.dynamics
+    n = check_samples(duration / dt + 1, 8 * 12, f"a {duration:g} s run at a {dt:g} s step")
+    s = initial_states({"u": vessel.approach_speed, "psi": psi0}, 1)
+    speed_lim, yaw_lim = DivergenceBounds().resolved(vessel.approach_speed)
+    prop = np.array([float(rps)]) if getattr(dyn, "uses_rps", False) and rps is not None else None
+    st = vessel.steering
+    out = np.zeros((n, 9))
+    delta, integral = 0.0, 0.0
+    m = n
+    done = False
+    for k in range(n):
+        t = k * dt
+        psi_d, cross, done = desired(t, s[0])
+        err = _wrap(float(s[0, 3]) - psi_d)
+        command = -(pid.kp * err + pid.ki * integral + pid.kd * float(s[0, 2]))
+        limited = min(max(command, -st.max_angle), st.max_angle)
+        if limited == command:  # anti-windup: integrate only while the rudder is not saturated
+            integral += err * dt
+        delta = st.step(delta, limited, dt)
+        out[k, :6], out[k, 6], out[k, 7], out[k, 8] = s[0], delta, psi_d, cross
+        if done or k == n - 1:
+            m = k + 1
+            break
+        new = step_state(dyn, s, np.array([delta]), None, dt, method, prop)
+        if not within_bounds(new, speed_lim, yaw_lim)[0]:
+            m = k + 1
+            break
+        s = new
+    t = np.arange(m) * dt
+    cols = dict(zip(("u", "v", "r", "psi", "x", "y"), out[:m, :6].T, strict=True))
+    log = make_log({"t": t, "delta": out[:m, 6], **cols}, **vessel.log_metadata())
+    log["psi_d"] = out[:m, 7]
+    log["cross_track"] = out[:m, 8]
+    return log, done, m < n and not done
+
+
+def heading_step(ship, pid: PID, heading_deg: float, duration: float = 120.0, dt: float = 0.1,
+                 speed: float | None = None, rps: float | None = None,
+                 steering: SteeringMachine | None = None,
+                 method: str = "rk4") -> pd.DataFrame:  # fmt: skip
+    """The autopilot ordered from the initial heading to ``heading_deg`` (positive: starboard)."""
+    target = math.radians(heading_deg)
+    log, _, _ = _run(ship, pid, lambda t, s: (target, math.nan, False), duration, dt, speed, rps,
+                     steering, method)  # fmt: skip
+    return log
+
+
+def follow_path(
+    ship,
+    pid: PID,
+    waypoints: Sequence[tuple[float, float]],
+    lookahead: float,
+    acceptance: float | None = None,
+    duration: float | None = None,
+    dt: float = 0.1,
+    speed: float | None = None,
+    rps: float | None = None,
+    steering: SteeringMachine | None = None,
+    method: str = "rk4",
+) -> FollowResult:
+    """Line-of-sight path following from the first waypoint (the ship starts there, heading
+    north) along ``waypoints`` (x north, y east [m])."""
+    wp = np.asarray(waypoints, dtype=float)
+    if wp.ndim != 2 or wp.shape[1] != 2 or len(wp) < 2 or not np.all(np.isfinite(wp)):
+        raise ShipidError("waypoints must be at least two finite (x, y) pairs")
+    legs = np.diff(wp, axis=0)
+    lengths = np.hypot(legs[:, 0], legs[:, 1])
+    if np.any(lengths <= 0):
+        raise ShipidError("two consecutive waypoints are the same point")
+    if not (math.isfinite(lookahead) and lookahead > 0):
+        raise ShipidError(f"lookahead must be > 0 m, got {lookahead!r}")
+    accept = lookahead if acceptance is None else acceptance
+    vessel = as_vessel(ship, speed, steering, rps)
+    if duration is None:
+        duration = 3.0 * float(lengths.sum()) / vessel.approach_speed
+    courses = np.arctan2(legs[:, 1], legs[:, 0])
+    state = {"leg": 0}
+    offset = wp[0]
+
+    def desired(t, s):
+        x, y = s[4] + offset[0], s[5] + offset[1]
+        k = state["leg"]
+        while True:
+            a = courses[k]
+            dx, dy = x - wp[k, 0], y - wp[k, 1]
+            along = dx * math.cos(a) + dy * math.sin(a)
+            if along >= lengths[k] - accept and k + 1 < len(legs):
+                k += 1
+                state["leg"] = k
+                continue
+            break
+        cross = -dx * math.sin(a) + dy * math.cos(a)
+        done = k == len(legs) - 1 and along >= lengths[k]
+        return a + math.atan2(-cross, lookahead), cross, done
+
+    log, done, diverged = _run(vessel, pid, desired, duration, dt, None, rps, None, method,
+                               psi0=float(courses[0]))  # fmt: skip
+    log["x"] += offset[0]
+    log["y"] += offset[1]
+    e = log["cross_track"].to_numpy()
+    return FollowResult(log, float(np.sqrt(np.mean(e * e))), float(np.max(np.abs(e))), done,
+                        diverged)  # fmt: skip

@@ -1,0 +1,182 @@
+"""Exports of an identified model: a python-control nonlinear I/O system (and its linearisation),
+and a standalone NumPy module with no shipid dependency.
+
+python-control: states [u, v, r, ψ, x, y], inputs ['delta', and the model's input columns n,
+thrust, wind_speed, wind_angle], outputs the states. With ``dt=None`` a continuous-time system
+(integrate it with ``control.input_output_response``); with ``dt`` a discrete-time system whose
+update is one step of shipid's own Euler or RK4 scheme, so its response equals ``simulate``'s.
+
+NumPy module: ``accelerations``, ``derivatives`` and ``simulate`` (Euler or RK4, inputs held over
+each step as in shipid), the coefficients written out exactly (``repr`` of each float).
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from shipid.dynamics.model import DOFS, ManoeuvringModel
+from shipid.dynamics.terms import OPS, parse_term
+from shipid.errors import ShipidError
+
+STATE_NAMES = ("u", "v", "r", "psi", "x", "y")
+
+
+def _inputs(model: ManoeuvringModel) -> list[str]:
+    return ["delta", *model.inputs]
+
+
+def _check(model) -> ManoeuvringModel:
+    if not isinstance(model, ManoeuvringModel):
+        raise ShipidError(f"only identified models can be exported, got {type(model).__name__}")
+    return model
+
+
+def to_control(model: ManoeuvringModel, dt: float | None = None, method: str = "rk4",
+               name: str = "ship"):  # fmt: skip
+    """The model as a ``control.NonlinearIOSystem`` (see the module docstring)."""
+    import control
+
+    model = _check(model)
+    inputs = _inputs(model)
+
+    def rhs(x, u):
+        given = dict(zip(inputs, (np.atleast_1d(ui) for ui in u), strict=True))
+        acc = model.accelerations(np.atleast_1d(x[0]), x[1], x[2], given.pop("delta"),
+                                  given.pop("thrust", None), given.pop("n", None),
+                                  **given)[0]  # fmt: skip
+        c, s = math.cos(x[3]), math.sin(x[3])
+        return np.array([acc[0], acc[1], acc[2], x[2], x[0] * c - x[1] * s, x[0] * s + x[1] * c])
+
+    if dt is None:
+        def update(t, x, u, params):
+            return rhs(x, u)
+    else:
+        if not (math.isfinite(dt) and dt > 0) or method not in ("euler", "rk4"):
+            raise ShipidError("a discrete export needs dt > 0 and method 'euler' or 'rk4'")
+
+        def update(t, x, u, params):
+            k1 = rhs(x, u)
+            if method == "euler":
+                return x + dt * k1
+            k2 = rhs(x + 0.5 * dt * k1, u)
+            k3 = rhs(x + 0.5 * dt * k2, u)
+            k4 = rhs(x + dt * k3, u)
+            return x + (dt / 6.0) * (k1 + 2 * k2 + 2 * k3 + k4)
+
+    return control.nlsys(update, None, states=list(STATE_NAMES), inputs=inputs,
+                         outputs=list(STATE_NAMES), dt=0 if dt is None else dt,
+                         name=name)  # fmt: skip
+
+
+def linearised_control(model: ManoeuvringModel, speed: float, rps: float | None = None):
+    """``control.StateSpace`` of the surge–sway–yaw dynamics linearised about straight running
+    (states u, v, r; input δ), from ``shipid.control.linear.linearise``."""
+    import control
+
+    from shipid.control.linear import linearise
+
+    lin = linearise(model, speed, rps)
+    return control.ss(lin["A"], lin["B"][:, None], np.eye(3), np.zeros((3, 1)),
+                      states=list(lin["states"]), inputs=["delta"],
+                      outputs=list(lin["states"]))  # fmt: skip
+
+
+_SIGNAL_EXPR = {"U": "np.sqrt(u * u + v * v)", "beta": "np.arctan2(-v, u)"}
+
+
+def _factor_expr(f) -> str:
+    x = _SIGNAL_EXPR.get(f.name, f.name)
+    op = OPS[f.op]
+    if op == "pow":
+        base = x
+    elif op == "abs":
+        base = f"np.abs({x})"
+    elif op == "pos":
+        base = f"np.maximum({x}, 0.0)"
+    elif op == "neg":
+        base = f"np.maximum(-({x}), 0.0)"
+    else:
+        base = f"np.{op}({f.k} * {x})" if f.k != 1 else f"np.{op}({x})"
+    return base if f.power == 1 else f"{base} ** {f.power}"
+
+
+def numpy_source(model: ManoeuvringModel) -> str:
+    """Python source of a standalone module (NumPy only) that evaluates and simulates the model."""
+    from shipid import __version__
+
+    model = _check(model)
+    inputs = [s for s in model.inputs]
+    lines = [
+        f'"""{model.name}: a manoeuvring model exported by shipid {__version__}.',
+        "",
+        "Standalone (NumPy only). States u, v [m/s], r [rad/s], psi [rad], x, y [m]; inputs delta",
+        f"[rad]{', ' if inputs else ''}{', '.join(inputs)}. Equations:",
+        "",
+        *("    " + ln for ln in model.equations(precision=6).splitlines()),
+        '"""',
+        "",
+        "import numpy as np",
+        "",
+        f"INPUTS = {('delta', *inputs)!r}",
+        "",
+        "",
+        f"def accelerations(u, v, r, delta{''.join(f', {s}=0.0' for s in inputs)}):",
+        '    """(u̇, v̇, ṙ) at arrays of states and inputs."""',
+        "    u, v, r, delta = (np.asarray(a, dtype=float) for a in (u, v, r, delta))",
+    ]
+    for dof in DOFS:
+        coefs = model.coefficients.get(dof)
+        if not coefs:
+            lines.append(f"    {dof}dot = np.zeros_like(u)")
+            continue
+        parts = []
+        for text, c in coefs.items():
+            term = parse_term(text)
+            factors = " * ".join(_factor_expr(f) for f in term.factors)
+            parts.append(f"{c!r}" + (f" * {factors}" if factors else " * np.ones_like(u)"))
+        lines.append(f"    {dof}dot = (" + "\n             + ".join(parts) + ")")
+    lines += [
+        "    return udot, vdot, rdot",
+        "",
+        "",
+        "def derivatives(state, inputs):",
+        '    """d/dt [u, v, r, psi, x, y] for one state and the inputs (in INPUTS order)."""',
+        "    u, v, r, psi = state[0], state[1], state[2], state[3]",
+        "    a = accelerations(u, v, r, *inputs)",
+        "    c, s = np.cos(psi), np.sin(psi)",
+        "    return np.array([float(a[0]), float(a[1]), float(a[2]), r, u * c - v * s, u * s + v * c])",
+        "",
+        "",
+        'def simulate(t, inputs, state0, method="euler"):',
+        '    """States (N, 6) on the grid t (N,) from state0 (6,), inputs (N, len(INPUTS)) held over',
+        "    each step (sample k over [t_k, t_k+1)), Euler or RK4 as shipid.simulate does.\"\"\"",
+        "    t = np.asarray(t, dtype=float)",
+        "    inputs = np.asarray(inputs, dtype=float).reshape(len(t), -1)",
+        "    out = np.empty((len(t), 6))",
+        "    x = np.asarray(state0, dtype=float)",
+        "    out[0] = x",
+        "    for k in range(len(t) - 1):",
+        "        h, w = t[k + 1] - t[k], inputs[k]",
+        "        k1 = derivatives(x, w)",
+        '        if method == "euler":',
+        "            x = x + h * k1",
+        "        else:",
+        "            k2 = derivatives(x + 0.5 * h * k1, w)",
+        "            k3 = derivatives(x + 0.5 * h * k2, w)",
+        "            k4 = derivatives(x + h * k3, w)",
+        "            x = x + (h / 6.0) * (k1 + 2 * k2 + 2 * k3 + k4)",
+        "        out[k + 1] = x",
+        "    return out",
+        "",
+    ]
+    return "\n".join(lines)
+
+
+def export_numpy(model: ManoeuvringModel, path: str | Path) -> Path:
+    """Write ``numpy_source(model)`` atomically to ``path`` (a .py file)."""
+    from shipid.outputs import atomic_write_text
+
+    return atomic_write_text(path, numpy_source(model))

@@ -1,0 +1,165 @@
+"""Ship particulars: what the IMO criteria, the prime system and physical priors need.
+
+A small file (YAML or JSON) or options. Keys (SI units; aliases of common files in brackets)::
+
+    length        Lpp [m]                         (L, Lpp, lpp)
+    beam          B [m]                           (B)
+    draught       T, mean [m]                     (T, draft)
+    block_coefficient  Cb [-]                     (CB, Cb)
+    mass          m [kg]                          (m, displacement_mass)
+    rudder_area   A_R [m²]                        (A_R, AR)
+    propeller_diameter  D [m]                     (D, Dp)
+    scale         λ = ship length / model length (scale_factor)
+    design_speed  approach speed of the trials [m/s]   (U0, speed)
+    rho           water density [kg/m³]           (default 1025; the MARIN file gives 1000)
+    xg            longitudinal centre of gravity from midship [m]   (x_G)
+
+Only ``length`` is required (it turns indices into ship lengths); the rest is used where present.
+The MARIN ``ship_data.yml`` of the KVLCC2 reads as is. Particulars travel in log metadata and model
+files (``to_dict``/``from_mapping``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+
+from shipid.errors import ShipidError
+
+ALIASES = {
+    "length": ("length", "L", "Lpp", "lpp", "LPP"),
+    "beam": ("beam", "B"),
+    "draught": ("draught", "T", "draft"),
+    "block_coefficient": ("block_coefficient", "CB", "Cb", "cb"),
+    "mass": ("mass", "m", "displacement_mass"),
+    "rudder_area": ("rudder_area", "A_R", "AR"),
+    "propeller_diameter": ("propeller_diameter", "D", "Dp"),
+    "scale": ("scale", "scale_factor"),
+    "design_speed": ("design_speed", "U0", "speed"),
+    "rho": ("rho",),
+    "xg": ("xg", "x_G"),
+}
+POSITIVE = ("length", "beam", "draught", "block_coefficient", "mass", "rudder_area",
+            "propeller_diameter", "scale", "design_speed", "rho")  # fmt: skip
+
+
+@dataclass(frozen=True)
+class Particulars:
+    """Main particulars of a ship or model (SI units); see the module docstring."""
+
+    length: float
+    beam: float | None = None
+    draught: float | None = None
+    block_coefficient: float | None = None
+    mass: float | None = None
+    rudder_area: float | None = None
+    propeller_diameter: float | None = None
+    scale: float = 1.0
+    design_speed: float | None = None
+    rho: float = 1025.0
+    xg: float = 0.0
+
+    def __post_init__(self) -> None:
+        for f in dataclasses.fields(self):
+            value = getattr(self, f.name)
+            if value is None:
+                continue
+            if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+                raise ShipidError(f"particulars: {f.name} must be a finite number, got {value!r}")
+            if f.name in POSITIVE and not value > 0:
+                raise ShipidError(f"particulars: {f.name} must be > 0, got {value!r}")
+        cb = self.block_coefficient
+        if cb is not None and cb > 1.0:
+            raise ShipidError(f"particulars: block_coefficient {cb:g} > 1 is impossible")
+        if self.draught is not None and self.beam is not None and self.draught > self.beam:
+            raise ShipidError(f"particulars: draught {self.draught:g} m > beam {self.beam:g} m "
+                              "(inconsistent: beam and draught swapped?)")  # fmt: skip
+        if self.beam is not None and self.beam > self.length:
+            raise ShipidError(f"particulars: beam {self.beam:g} m > length {self.length:g} m")
+        if abs(self.xg) > 0.5 * self.length:
+            raise ShipidError(f"particulars: xg {self.xg:g} m is outside the hull "
+                              f"(|xg| ≤ L/2 = {0.5 * self.length:g} m)")  # fmt: skip
+        if None not in (self.mass, self.beam, self.draught, self.block_coefficient):
+            implied = self.rho * self.block_coefficient * self.length * self.beam * self.draught
+            if not 0.8 <= self.mass / implied <= 1.25:
+                raise ShipidError(f"particulars: mass {self.mass:g} kg is inconsistent with "
+                                  f"ρ·Cb·L·B·T = {implied:.4g} kg (more than 25 % apart)")
+
+    @property
+    def volume(self) -> float | None:
+        """Displaced volume [m³] from the mass, else from Cb·L·B·T (None if unknown)."""
+        if self.mass is not None:
+            return self.mass / self.rho
+        if None not in (self.beam, self.draught, self.block_coefficient):
+            return self.block_coefficient * self.length * self.beam * self.draught
+        return None
+
+    def to_dict(self) -> dict:
+        """The particulars that are set, as a plain mapping (for JSON and metadata)."""
+        return {k: v for k, v in dataclasses.asdict(self).items() if v is not None}
+
+    def scaled(self, speed: float | None = None) -> dict:
+        """The prime-system scales: length L and speed U (``speed`` or the design speed)."""
+        U = speed if speed is not None else self.design_speed
+        if U is None or not U > 0:
+            raise ShipidError("the prime system needs a reference speed: give design_speed in "
+                              "the particulars (or --speed)")  # fmt: skip
+        return {"L": self.length, "U": float(U)}
+
+    @classmethod
+    def from_mapping(cls, data: Mapping, where: str = "particulars") -> Particulars:
+        if not isinstance(data, Mapping):
+            raise ShipidError(f"{where}: particulars must be a mapping of names to numbers")
+        values = {}
+        for name, aliases in ALIASES.items():
+            found = [a for a in aliases if a in data]
+            if len(found) > 1 and len({str(data[a]) for a in found}) > 1:
+                raise ShipidError(f"{where}: {name} is given twice ({', '.join(found)})")
+            if found:
+                values[name] = data[found[0]]
+        if "length" not in values:
+            raise ShipidError(f"{where}: the particulars need the length Lpp (key 'length' or "
+                              "'L')")  # fmt: skip
+        for k, v in list(values.items()):
+            if isinstance(v, str):
+                try:
+                    values[k] = float(v)
+                except ValueError:
+                    raise ShipidError(f"{where}: {k} must be a number, got {v!r}") from None
+        try:
+            return cls(**values)
+        except ShipidError as exc:
+            raise ShipidError(f"{where}: {str(exc).removeprefix('particulars: ')}") from None
+
+
+def read_particulars(path: str | Path) -> Particulars:
+    """Particulars from a YAML (``key: value`` lines, comments) or JSON file."""
+    path = Path(path)
+    if not path.is_file():
+        raise ShipidError(f"{path}: no such particulars file")
+    text = path.read_text(encoding="utf-8", errors="replace")
+    if path.suffix.lower() == ".json":
+        try:
+            data = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise ShipidError(f"{path}: not a JSON particulars file ({exc})") from None
+    else:
+        data = _simple_yaml(text, path)
+    return Particulars.from_mapping(data, str(path))
+
+
+def _simple_yaml(text: str, path: Path) -> dict:
+    import yaml
+
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        raise ShipidError(f"{path}: not a YAML particulars file ({str(exc).splitlines()[0]})") \
+            from None
+    if not isinstance(data, dict):
+        raise ShipidError(f"{path}: particulars must be a YAML mapping of names to numbers")
+    return data

@@ -1,0 +1,92 @@
+"""A self-contained HTML report of a model and its validation: one file, figures embedded (PNG in
+base64), tables from pandas, the model's equations with the standard errors of its coefficients,
+the IMO criteria where the logs (or the model's manoeuvres) speak to them."""
+
+from __future__ import annotations
+
+import base64
+import html
+import io
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+import pandas as pd
+
+from shipid import __version__
+
+
+def _figure_html(draw, png: bytes | None = None) -> str:
+    """An <img> tag of ``png``, or of what ``draw(buffer)`` (a plot function writing a PNG)
+    draws when there is none."""
+    if png is None:
+        buf = io.BytesIO()
+        draw(buf)
+        png = buf.getvalue()
+    data = base64.b64encode(png).decode("ascii")
+    return f'<img src="data:image/png;base64,{data}" alt="figure" style="max-width:100%">'
+
+
+def _table(df: pd.DataFrame | None, floatfmt: str = "{:.4g}") -> str:
+    if df is None or len(df) == 0:
+        return "<p><em>none</em></p>"
+    return df.to_html(index=False, float_format=lambda x: floatfmt.format(x), na_rep="–",
+                      border=0, classes="t")  # fmt: skip
+
+
+STYLE = """body{font-family:sans-serif;max-width:1200px;margin:2em auto;color:#222}
+table.t{border-collapse:collapse;font-size:13px;margin:0.5em 0 1.5em}
+table.t td,table.t th{border-bottom:1px solid #ddd;padding:3px 8px;text-align:right}
+table.t th{background:#f3f3f3} pre{background:#f6f6f6;padding:1em;overflow-x:auto}
+h2{border-bottom:2px solid #ccc;padding-bottom:3px}.warn{color:#a40}"""
+
+
+def validation_report(
+    model,
+    validations: Sequence,
+    logs: Sequence[pd.DataFrame],
+    title: str,
+    std_errors: Mapping | None = None,
+    criteria: pd.DataFrame | None = None,
+    warnings: Sequence[str] = (),
+    residuals: Mapping[str, Mapping] | None = None,
+    figures: Mapping[str, Mapping[str, bytes]] | None = None,
+) -> str:
+    """The HTML text of the report. ``figures``: PNGs already drawn, {log name: {"fit": ...,
+    "resid": ...}} (``shipid validate --plots`` shares its own); the others are drawn here."""
+    from shipid.reporting import plots
+    from shipid.reporting.report import indices_frame, metrics_frame
+
+    good = [(v, log) for v, log in zip(validations, logs, strict=True) if v.error is None]
+    parts = [f"<!doctype html><html><head><meta charset='utf-8'><title>{html.escape(title)}"
+             f"</title><style>{STYLE}</style></head><body>",
+             f"<h1>{html.escape(title)}</h1>",
+             f"<p>shipid {__version__}. Errors are measured − simulated over the free run from "
+             "each log's measured initial state, driven by its measured inputs. Fit % as "
+             "MATLAB's compare (100 % perfect, 0 % no better than the mean).</p>",
+             "<h2>Model</h2>", f"<pre>{html.escape(model.equations(std_errors=std_errors))}</pre>"]
+    if std_errors:
+        parts.append("<p>± one standard error of each coefficient (LS-SVM linear fit).</p>")
+    if warnings:
+        parts.append("<h2>Warnings</h2><ul>" + "".join(
+            f"<li class='warn'>{html.escape(w)}</li>" for w in warnings) + "</ul>")
+    parts += ["<h2>Free-run errors</h2>", _table(metrics_frame([v for v, _ in good]))]
+    failed = [v for v in validations if v.error is not None]
+    if failed:
+        parts.append("<ul>" + "".join(f"<li class='warn'>{html.escape(v.error)}</li>"
+                                      for v in failed) + "</ul>")  # fmt: skip
+    ind = indices_frame([v for v, _ in good])
+    if len(ind):
+        parts += ["<h2>Manoeuvring indices</h2>", _table(ind)]
+    if criteria is not None and len(criteria):
+        parts += ["<h2>IMO MSC.137(76) criteria</h2>", _table(criteria)]
+    for v, log in good:
+        name = Path(v.name).name
+        drawn = (figures or {}).get(v.name, {})
+        parts += [f"<h2>{html.escape(name)}</h2>",
+                  _figure_html(lambda p, v=v, log=log, name=name: plots.measured_vs_simulated(
+                      log, v.simulation.log, p, name), drawn.get("fit"))]
+        if residuals and v.name in residuals:
+            parts.append(_figure_html(lambda p, v=v, name=name: plots.residuals(
+                residuals[v.name], p, f"{name}: residual analysis"), drawn.get("resid")))
+    parts.append("</body></html>")
+    return "\n".join(parts)

@@ -1,0 +1,184 @@
+"""IMO MSC.137(76) manoeuvrability criteria (manoeuvring-standards.md §1.3), predicted by running the
+standard manoeuvres on a model or ship, or read off measured logs.
+
+* turning: advance ≤ 4.5 L, tactical diameter ≤ 5 L (35° rudder, both sides);
+* initial turning: ≤ 2.5 L travelled when the heading has changed 10° with 10° rudder (the first
+  leg of the 10°/10° zig-zag);
+* 10°/10° overshoots: first ≤ 10° (L/V < 10 s), 5 + ½ L/V (10–30 s), 20° (≥ 30 s); second ≤ 25°,
+  17.5 + 0.75 L/V, 40°;
+* 20°/20° first overshoot ≤ 25°;
+* stopping: track reach ≤ 15 L (models with propeller terms).
+
+L/V is the full-scale value: at model scale λ, L/V = (L/V)model · √λ. A reference ship turns its
+rudder with its own steering gear; a model at the rate given (the CLI passes the training logs'
+rate), else at the SOLAS rate 2.32 °/s at full scale (2.32·√λ °/s at model scale).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import pandas as pd
+
+from shipid.data.particulars import Particulars
+from shipid.dynamics.model import ManoeuvringModel
+from shipid.dynamics.steering import SteeringMachine
+from shipid.errors import ShipidError
+from shipid.trials.manoeuvres import stopping, turning_circle, zigzag
+from shipid.vessels.vessel import Vessel
+
+SOLAS_RUDDER_RATE_DEG = 2.32
+SIDES = ("starboard", "port")
+
+
+def overshoot_limits(l_over_v: float) -> tuple[float, float]:
+    """(first, second) 10°/10° overshoot limits [deg] for the full-scale L/V [s]."""
+    if not (math.isfinite(l_over_v) and l_over_v > 0):
+        raise ShipidError(f"L/V must be a positive time in seconds, got {l_over_v!r}")
+    if l_over_v < 10.0:
+        return 10.0, 25.0
+    if l_over_v >= 30.0:
+        return 20.0, 40.0
+    return 5.0 + 0.5 * l_over_v, 17.5 + 0.75 * l_over_v
+
+
+@dataclass
+class Criteria:
+    """The criteria table (a DataFrame: criterion, manoeuvre, value, limit, unit, margin, passed),
+    the conditions they were judged at, and the manoeuvre results behind them."""
+
+    table: pd.DataFrame
+    conditions: dict
+    runs: dict = field(default_factory=dict)
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def passed(self) -> bool:
+        """Whether every criterion that could be judged is met."""
+        judged = self.table["passed"].dropna()
+        return bool(len(judged)) and bool(judged.all())
+
+    def to_dict(self) -> dict:
+        """The criteria as JSON-ready data (``criteria --json``)."""
+        return {"conditions": self.conditions, "passed": self.passed, "notes": self.notes,
+                "criteria": self.table.to_dict(orient="records")}  # fmt: skip
+
+
+def _row(name, manoeuvre, value, limit, unit) -> dict:
+    ok = None if value is None or not math.isfinite(value) else bool(value <= limit)
+    margin = None if ok is None else float(limit - value)
+    return {"criterion": name, "manoeuvre": manoeuvre,
+            "value": None if value is None or not math.isfinite(value) else float(value),
+            "limit": float(limit), "unit": unit, "margin": margin, "passed": ok}  # fmt: skip
+
+
+def imo_criteria(
+    ship: Vessel | ManoeuvringModel,
+    particulars: Particulars | None = None,
+    length: float | None = None,
+    speed: float | None = None,
+    scale: float | None = None,
+    rps: float | None = None,
+    steering: SteeringMachine | None = None,
+    astern_rps: float | None = None,
+    dt: float = 0.05,
+    method: str = "rk4",
+) -> Criteria:
+    """Run the IMO standard manoeuvres on ``ship`` and judge them against MSC.137(76).
+
+    ``length`` (Lpp [m]) and ``scale`` default to the particulars' (or the reference ship's);
+    ``speed`` to the ship's approach speed or the particulars' design speed; ``rps`` is the
+    propeller speed of models with propeller terms (also the stopping test's approach).
+    """
+    vessel_length = getattr(ship, "length", math.nan)
+    L = length or (particulars.length if particulars else None) or (
+        vessel_length if math.isfinite(vessel_length) else None)  # fmt: skip
+    if not L or not (math.isfinite(L) and L > 0):
+        raise ShipidError("the IMO criteria are in ship lengths: give the length (--length, or "
+                          "particulars with the length)")  # fmt: skip
+    lam = scale or (particulars.scale if particulars else None) or getattr(ship, "scale", 1.0)
+    V = speed or getattr(ship, "approach_speed", None) or (
+        particulars.design_speed if particulars else None)  # fmt: skip
+    if not V or not V > 0:
+        raise ShipidError("the IMO criteria need the test speed (--speed or the particulars' "
+                          "design_speed)")  # fmt: skip
+    if steering is None:
+        # A reference ship has its own steering gear; a model gets the SOLAS rate at its scale.
+        steering = getattr(ship, "steering", None) or SteeringMachine(
+            math.radians(35.0), math.radians(SOLAS_RUDDER_RATE_DEG * math.sqrt(lam)))
+    l_over_v = L / V * math.sqrt(lam)
+    first_lim, second_lim = overshoot_limits(l_over_v)
+    # Long enough for any plausible ship: a turn reaches 180° within ~15 L/V, a zig-zag's second
+    # overshoot within ~20 L/V (model-scale times).
+    duration = max(60.0, 40.0 * L / V)
+    kw = {"dt": dt, "speed": V, "steering": steering, "method": method, "rps": rps}
+    rows, runs, notes = [], {}, []
+
+    for side in SIDES:
+        res = turning_circle(ship, 35.0, side=side, duration=duration, **kw)
+        runs[f"turning 35° {side}"] = res
+        if res.diverged:
+            notes.append(f"turning circle 35° to {side}: {res.reason}")
+        ind = res.indices
+        rows.append(_row("advance", f"turning 35° {side}", _in_l(ind.get("advance"), L), 4.5, "L"))
+        rows.append(_row("tactical diameter", f"turning 35° {side}",
+                         _in_l(ind.get("tactical_diameter"), L), 5.0, "L"))  # fmt: skip
+    for side in SIDES:
+        res = zigzag(ship, 10.0, 10.0, first=side, duration=duration, **kw)
+        runs[f"zigzag 10/10 {side}"] = res
+        ind = res.indices
+        rows.append(_row("initial turning (distance at 10° heading change)", f"zigzag 10/10 {side}",
+                         _in_l(ind.get("distance_to_second_execute"), L), 2.5, "L"))  # fmt: skip
+        rows.append(_row("10/10 first overshoot", f"zigzag 10/10 {side}",
+                         ind.get("first_overshoot_deg"), first_lim, "deg"))  # fmt: skip
+        rows.append(_row("10/10 second overshoot", f"zigzag 10/10 {side}",
+                         ind.get("second_overshoot_deg"), second_lim, "deg"))  # fmt: skip
+    for side in SIDES:
+        res = zigzag(ship, 20.0, 20.0, first=side, duration=duration, **kw)
+        runs[f"zigzag 20/20 {side}"] = res
+        rows.append(_row("20/20 first overshoot", f"zigzag 20/20 {side}",
+                         res.indices.get("first_overshoot_deg"), 25.0, "deg"))  # fmt: skip
+    dyn = getattr(ship, "dynamics", ship)
+    if getattr(dyn, "uses_rps", False) and rps:
+        res = stopping(ship, rps, astern_rps, reversal_time=10.0 / math.sqrt(lam),
+                       duration=3 * duration, dt=dt, speed=V, method=method)  # fmt: skip
+        runs["stopping"] = res
+        rows.append(_row("stopping track reach", "full astern", _in_l(res.indices["track_reach"], L),
+                         15.0, "L"))  # fmt: skip
+    else:
+        notes.append("stopping ability not judged: the model has no propeller-speed terms")
+    conditions = {"length": L, "speed": V, "scale": lam, "L_over_V_full_scale": l_over_v,
+                  "rudder_rate_deg_s": (math.degrees(steering.max_rate) if steering.max_rate
+                                        else None),
+                  "rps": rps}  # fmt: skip
+    return Criteria(pd.DataFrame(rows), conditions, runs, notes)
+
+
+def _in_l(value, L: float) -> float | None:
+    return None if value is None else value / L
+
+
+def measured_criteria(indices: dict, rudder_deg: float, switch_deg: float | None, L: float,
+                      V: float, scale: float = 1.0) -> list[dict]:  # fmt: skip
+    """The criteria a measured (or simulated) standard manoeuvre speaks to: a 35° turning circle,
+    a 10°/10° or a 20°/20° zig-zag (angles within 1.5°). ``indices`` as from ``manoeuvre_indices``."""
+    kind = indices.get("kind")
+    rows = []
+    near = lambda a, b: a is not None and abs(a - b) <= 1.5  # noqa: E731
+    if kind == "turning" and near(rudder_deg, 35.0):
+        rows.append(_row("advance", "turning 35°", _in_l(indices.get("advance"), L), 4.5, "L"))
+        rows.append(_row("tactical diameter", "turning 35°",
+                         _in_l(indices.get("tactical_diameter"), L), 5.0, "L"))  # fmt: skip
+    if kind == "zigzag" and near(rudder_deg, 10.0) and near(switch_deg, 10.0):
+        first, second = overshoot_limits(L / V * math.sqrt(scale))
+        rows.append(_row("initial turning (distance at 10° heading change)", "zigzag 10/10",
+                         _in_l(indices.get("distance_to_second_execute"), L), 2.5, "L"))  # fmt: skip
+        rows.append(_row("10/10 first overshoot", "zigzag 10/10",
+                         indices.get("first_overshoot_deg"), first, "deg"))  # fmt: skip
+        rows.append(_row("10/10 second overshoot", "zigzag 10/10",
+                         indices.get("second_overshoot_deg"), second, "deg"))  # fmt: skip
+    if kind == "zigzag" and near(rudder_deg, 20.0) and near(switch_deg, 20.0):
+        rows.append(_row("20/20 first overshoot", "zigzag 20/20",
+                         indices.get("first_overshoot_deg"), 25.0, "deg"))  # fmt: skip
+    return rows

@@ -1,0 +1,147 @@
+"""The model put to work (issue #12 item 7): linearisation, Nomoto parameters, autopilot, path
+following on the true ship, and the exports against the simulator."""
+
+import importlib.util
+import math
+
+import numpy as np
+import pytest
+from cli_helpers import run
+
+from shipid import identify, lowpass, zigzag
+from shipid.control.autopilot import follow_path, heading_step, pid_from_nomoto
+from shipid.control.export import export_numpy, linearised_control, to_control
+from shipid.control.linear import linearise, nomoto
+from shipid.dynamics.model import ManoeuvringModel, nomoto_parameters
+from shipid.dynamics.simulate import simulate
+from shipid.vessels import PAPER_IMU, scale_ship, scale_ship_model
+
+TRUTH = scale_ship(rudder_rate_deg=9.6)
+
+
+def test_linearisation_of_the_paper_model_against_its_coefficients():
+    """At v = r = 0 only u·v, u·r and δ have a slope: A = u0 [[Y_uv, Y_ur], [N_uv, N_ur]]
+    (reference-ships.md §7.2 gives it at 2 m/s), B = [Y_δ, N_δ]; surge: ∂u̇/∂u = 2 X_|u|u u0."""
+    m, u0 = scale_ship_model(), 2.0
+    cv, cr = m.coefficients["v"], m.coefficients["r"]
+    lin = linearise(m, u0)
+    expected = u0 * np.array([[cv["uv"], cv["ur"]], [cr["uv"], cr["ur"]]])
+    np.testing.assert_allclose(lin["A"][1:, 1:], expected, rtol=1e-6)
+    np.testing.assert_allclose(lin["A"][1:, 1:], [[-1.0568, -0.9062], [-1.3392, -2.3398]],
+                               atol=5e-5)  # fmt: skip
+    assert lin["A"][0, 0] == pytest.approx(2 * -0.0321 * u0, rel=1e-7)
+    np.testing.assert_allclose(lin["B"][1:], [cv["delta"], cr["delta"]], rtol=1e-7)
+    # Nomoto of the linear sway-yaw model with the same A, B (closed form in model.py).
+    lsy = ManoeuvringModel("linear-sway-yaw", {
+        "v": {"v": expected[0, 0], "r": expected[0, 1], "delta": cv["delta"]},
+        "r": {"v": expected[1, 0], "r": expected[1, 1], "delta": cr["delta"]}})  # fmt: skip
+    ref, got = nomoto_parameters(lsy), nomoto(m, u0)
+    for k in ("K", "T1", "T2", "T3"):
+        assert got[k] == pytest.approx(ref[k], rel=1e-6)
+    assert got["K"] == pytest.approx(-0.517, abs=0.002)  # §7.2: steady r/δ = −0.517
+
+
+def test_pid_from_nomoto_places_the_closed_loop_poles():
+    K, T, w, z = -0.5, 2.0, 0.4, 0.9
+    pid = pid_from_nomoto(K, T, w, z)
+    # T s³ + (1 + K Kd) s² + K Kp s + K Ki: roots of the closed loop with the integral.
+    poly = [T, 1 + K * pid.kd, K * pid.kp, K * pid.ki]
+    roots = np.roots(poly)
+    # Two poles at ω(ζ ± i√(1−ζ²)), shifted by the slow integral pole (Ki = ω³T/10K).
+    assert np.all(roots.real < 0)
+    osc = roots[np.abs(roots.imag) > 0]
+    assert np.abs(osc[0]) == pytest.approx(w, rel=0.15)
+    assert pid.kp * K > 0 and pid.kd * K > 0  # the gains carry the sign of K
+
+
+def test_a_heading_step_settles_on_the_ordered_heading():
+    nm = nomoto(TRUTH, TRUTH.approach_speed)
+    log = heading_step(TRUTH, pid_from_nomoto(nm["K"], nm["T"]), 20.0, duration=60, dt=0.05)
+    assert math.degrees(log["psi"].iloc[-1]) == pytest.approx(20.0, abs=0.2)
+    assert abs(math.degrees(log["delta"].iloc[-1])) < 2.0
+
+
+def test_pid_tuned_on_an_identified_model_follows_a_path_on_the_true_ship():
+    """Acceptance (#12): identified from one noisy 20/20 zig-zag (paper noise), the PID tuned on
+    the model keeps the cross-track error of a 4-waypoint path on the true ship within 1.2× of
+    the same controller tuned on the truth."""
+    trial = PAPER_IMU.apply(zigzag(TRUTH, 20, 20, duration=90, dt=0.2, method="euler",
+                                   approach=2.0).log, seed=1)  # fmt: skip
+    model = identify(lowpass(trial, 0.5), drop={"u": ["r^2"]}).model
+    u0 = TRUTH.approach_speed
+    nm, nt = nomoto(model, u0), nomoto(TRUTH, u0)
+    waypoints = [(0, 0), (60, 0), (60, 60), (0, 60)]
+    lookahead = 2 * 4.389
+    on_truth = {}
+    for label, n in (("model", nm), ("truth", nt)):
+        res = follow_path(TRUTH, pid_from_nomoto(n["K"], n["T"]), waypoints, lookahead, dt=0.1)
+        assert res.completed and not res.diverged
+        on_truth[label] = res.rms_cross_track
+    assert on_truth["model"] <= 1.2 * on_truth["truth"]
+    assert nm["K"] == pytest.approx(nt["K"], rel=0.1)
+
+
+@pytest.mark.parametrize("method", ["euler", "rk4"])
+def test_exports_reproduce_the_simulator(tmp_path, method):
+    import control
+
+    m = ManoeuvringModel(
+        "u: |u|u, v*r, delta^2, |n|*n, 1; v: u*r, u*v, |v|v, pos(n)^2*delta, U^2*sin(2*beta); "
+        "r: u*r, u*v, |v|r, delta, wind_speed^2*sin(2*wind_angle), 1",
+        {"u": {"|u|u": -0.03, "v*r": -2.0, "delta^2": -0.2, "|n|*n": 1e-3, "1": 0.0},
+         "v": {"u*r": -0.45, "u*v": -0.52, "|v|v": -0.5, "pos(n)^2*delta": 1e-4,
+               "U^2*sin(2*beta)": 0.01},
+         "r": {"u*r": -1.17, "u*v": -0.67, "|v|r": 3.9, "delta": -0.55,
+               "wind_speed^2*sin(2*wind_angle)": 1e-3, "1": -0.005}})  # fmt: skip
+    t = np.arange(0, 60, 0.1)
+    d, n = 0.3 * np.sign(np.sin(t / 8)), 5 + np.sin(t / 5)
+    ws, wa = 2 + np.cos(t / 3), np.sin(t / 7)
+    ref = simulate(m, t, d, {"u": 1.5}, rps=n, inputs={"wind_speed": ws, "wind_angle": wa},
+                   method=method).log[["u", "v", "r", "psi", "x", "y"]].to_numpy()  # fmt: skip
+    path = export_numpy(m, tmp_path / "exported.py")
+    spec = importlib.util.spec_from_file_location("exported", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    text = path.read_text()
+    assert "import shipid" not in text and "from shipid" not in text
+    got = mod.simulate(t, np.column_stack([d, n, ws, wa]), [1.5, 0, 0, 0, 0, 0], method)
+    np.testing.assert_allclose(got, ref, atol=1e-9, rtol=0)
+    sys = to_control(m, dt=0.1, method=method)
+    resp = control.input_output_response(sys, t, np.vstack([d, n, ws, wa]), [1.5, 0, 0, 0, 0, 0])
+    np.testing.assert_allclose(resp.states.T, ref, atol=1e-9, rtol=0)
+
+
+def test_continuous_control_system_and_its_linearisation():
+    import control
+
+    m = scale_ship_model()
+    sys = to_control(m)
+    x = np.array([1.9, 0.05, -0.02, 0.3, 0.0, 0.0])
+    got = sys.updfcn(0.0, x, np.array([0.1]), {})
+    acc = m.accelerations(x[0], x[1], x[2], 0.1)[0]
+    np.testing.assert_allclose(got[:3], acc, rtol=1e-14)
+    ss = linearised_control(m, 2.0)
+    assert isinstance(ss, control.StateSpace)
+    np.testing.assert_allclose(ss.A, linearise(m, 2.0)["A"])
+
+
+def test_cli_linearise_export_autopilot_follow(tmp_path, capsys):
+    code, out, err = run(["linearise", "scale-ship"], capsys)
+    assert code == 0 and "Nomoto: K = -0.53" in out
+    path = tmp_path / "m.json"
+    scale_ship_model().save(path)
+    code, out, err = run(["export", path, "-o", tmp_path / "m.py"], capsys)
+    assert code == 0 and (tmp_path / "m.py").exists()
+    code, _, err = run(["export", path, "-o", tmp_path / "m.txt"], capsys)
+    assert code == 1 and ".py file" in err
+    code, out, err = run(["autopilot", path, "--speed", "1.93", "--truth", "scale-ship",
+                          "--heading", "30", "-o", tmp_path / "ap.png"], capsys)  # fmt: skip
+    assert code == 0, err
+    assert "overshoot" in out and (tmp_path / "ap.png").exists()
+    code, out, err = run(["follow", path, "--speed", "1.93", "--truth", "scale-ship",
+                          "--waypoints", "0,0;40,0;40,40", "-o", tmp_path / "f.png",
+                          "--json", tmp_path / "f.json"], capsys)  # fmt: skip
+    assert code == 0, err
+    assert "truth, model-tuned PID" in out and (tmp_path / "f.png").exists()
+    code, _, err = run(["follow", path, "--speed", "1.93", "--waypoints", "0,0"], capsys)
+    assert code == 1 and "two 'x,y' pairs" in err

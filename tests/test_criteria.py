@@ -1,0 +1,144 @@
+"""Ship particulars and the IMO MSC.137(76) criteria against hand-computed values (issue #12)."""
+
+import json
+import math
+from pathlib import Path
+
+import pytest
+from cli_helpers import run
+
+from shipid.data.particulars import Particulars, read_particulars
+from shipid.errors import ShipidError
+from shipid.trials.criteria import imo_criteria, measured_criteria, overshoot_limits
+from shipid.trials.manoeuvres import stopping
+from shipid.vessels import kvlcc2, mariner
+
+DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
+needs_data = pytest.mark.skipif(not DATA.is_dir(), reason="../shared/data is not present")
+
+
+@pytest.mark.parametrize(("lv", "first", "second"), [
+    (5.0, 10.0, 25.0), (10.0, 10.0, 25.0), (20.0, 15.0, 32.5), (29.99, 19.995, 39.9925),
+    (30.0, 20.0, 40.0), (60.0, 20.0, 40.0)])  # fmt: skip
+def test_overshoot_limits_by_hand(lv, first, second):
+    assert overshoot_limits(lv) == pytest.approx((first, second))
+
+
+def test_mariner_fails_the_turning_criterion_and_passes_the_rest():
+    """Mariner (reference-ships.md §1.9): tactical diameter 6.651 L to port with its own servo,
+    over the 5 L limit; L/V = 160.93 / 7.7175 = 20.85 s → 10/10 limits 15.43° and 33.14°."""
+    c = imo_criteria(mariner(), dt=0.5)
+    t = c.table.set_index(["criterion", "manoeuvre"])
+    assert t.loc[("tactical diameter", "turning 35° port"), "value"] == pytest.approx(6.651, rel=0.01)
+    assert t.loc[("tactical diameter", "turning 35° port"), "passed"] is False or not \
+        t.loc[("tactical diameter", "turning 35° port"), "passed"]
+    assert t.loc[("advance", "turning 35° port"), "value"] == pytest.approx(3.706, rel=0.01)
+    lv = 160.93 / 7.7175
+    assert c.conditions["L_over_V_full_scale"] == pytest.approx(lv)
+    assert t.loc[("10/10 first overshoot", "zigzag 10/10 port"), "limit"] == pytest.approx(
+        5 + lv / 2)
+    assert t.loc[("10/10 second overshoot", "zigzag 10/10 port"), "limit"] == pytest.approx(
+        17.5 + 0.75 * lv)
+    assert t.loc[("20/20 first overshoot", "zigzag 20/20 port"), "value"] == pytest.approx(
+        6.70, rel=0.05)
+    assert not c.passed
+    assert any("stopping" in n for n in c.notes)
+
+
+def test_kvlcc2_passes_with_its_check_values(tmp_path, capsys):
+    """KVLCC2 (§2.8): tactical diameter 3.12 L, advance 3.08 L; model scale λ = 45.7, so the
+    full-scale L/V is 7.0 / 1.179 · √45.7 = 40.1 s: overshoot limits 20° and 40°. Through the
+    CLI, with its JSON output."""
+    code, out, err = run(["criteria", "kvlcc2", "--dt", "0.1", "--json", tmp_path / "c.json"],
+                         capsys)  # fmt: skip
+    assert code == 0, err
+    assert "tactical diameter" in out and "all criteria met" in out
+    doc = json.loads((tmp_path / "c.json").read_text())
+    assert doc["passed"] is True and len(doc["criteria"]) == 12
+    import pandas as pd
+
+    c = type("C", (), {"table": pd.DataFrame(doc["criteria"]), "conditions": doc["conditions"],
+                       "passed": doc["passed"]})  # fmt: skip
+    t = c.table.set_index(["criterion", "manoeuvre"])
+    assert t.loc[("tactical diameter", "turning 35° starboard"), "value"] == pytest.approx(
+        3.11, rel=0.05)
+    assert t.loc[("advance", "turning 35° starboard"), "value"] == pytest.approx(3.085, rel=0.05)
+    assert c.conditions["L_over_V_full_scale"] == pytest.approx(7.0 / 1.179 * math.sqrt(45.7))
+    assert t.loc[("10/10 first overshoot", "zigzag 10/10 port"), "limit"] == 20.0
+    assert c.passed
+
+
+def test_stopping_of_a_model_with_propeller_terms():
+    from shipid.dynamics.model import ManoeuvringModel
+
+    # u̇ = a |n|n − b |u|u: at 10 rps the speed settles at √(a/b)·10; full astern brakes it.
+    m = ManoeuvringModel("u: |n|n, |u|u; v: u*v, delta; r: u*r, delta",
+                         {"u": {"|n|n": 0.01, "|u|u": -0.25}, "v": {"u*v": -1.0, "delta": 0.1},
+                          "r": {"u*r": -1.0, "delta": -0.2}})  # fmt: skip
+    res = stopping(m, 10.0, duration=60, dt=0.01, speed=2.0)
+    # With n reversed at once: u̇ = −0.01·100 − 0.25 u² → t_stop = atan(u0·√(b/c))/√(b c).
+    b, c = 0.25, 1.0
+    t_stop = math.atan(2.0 * math.sqrt(b / c)) / math.sqrt(b * c)
+    assert res.indices["time_to_stop"] == pytest.approx(t_stop, rel=1e-3)
+    reach = math.log(1 + b * 4.0 / c) / (2 * b)  # ∫u dt = ln(1 + b u0²/c) / 2b
+    assert res.indices["track_reach"] == pytest.approx(reach, rel=1e-3)
+    with pytest.raises(ShipidError, match="propeller-speed terms"):
+        stopping(kvlcc2(), 10.0)
+
+
+def test_measured_criteria_pick_the_standard_manoeuvres():
+    turn = {"kind": "turning", "advance": 30.0, "tactical_diameter": 40.0}
+    rows = measured_criteria(turn, 35.0, None, 10.0, 1.0)
+    assert [(r["criterion"], r["value"], r["passed"]) for r in rows] == [
+        ("advance", 3.0, True), ("tactical diameter", 4.0, True)]
+    assert measured_criteria(turn, 20.0, None, 10.0, 1.0) == []  # not a 35° turn
+    zz = {"kind": "zigzag", "first_overshoot_deg": 12.0, "second_overshoot_deg": 30.0,
+          "distance_to_second_execute": 30.0}  # fmt: skip
+    rows = measured_criteria(zz, 10.0, 10.0, 10.0, 1.0)  # L/V = 10 s: limits 10° and 25°
+    assert [r["passed"] for r in rows] == [False, False, False]
+
+
+@pytest.mark.parametrize(("data", "match"), [
+    ({"beam": 1.0}, "need the length"), ({"L": -3}, "length must be > 0"),
+    ({"L": 3, "CB": 1.2}, "block_coefficient 1.2 > 1"), ({"L": 3, "B": 0.4, "T": 0.5}, "swapped"),
+    ({"L": 3, "B": 0.5, "T": 0.2, "CB": 0.8, "m": 900}, "inconsistent"),
+    ({"L": "long"}, "length must be a number"), ({"L": 3, "Lpp": 4}, "given twice"),
+])  # fmt: skip
+def test_bad_particulars_name_the_field(data, match):
+    with pytest.raises(ShipidError, match=match):
+        Particulars.from_mapping(data)
+
+
+@needs_data
+def test_marin_ship_data_reads_as_is():
+    p = read_particulars(DATA / "kvlcc2-marin" / "ship_data.yml")
+    assert (p.length, p.beam, p.draught, p.scale, p.rho) == (7.0, 1.27, 0.46, 45.7, 1000)
+    assert p.volume == pytest.approx(3.27)
+
+
+def test_cli_criteria_of_a_reference_ship_and_of_a_model_file(tmp_path, capsys):
+    code, out, err = run(["criteria", "scale-ship"], capsys)
+    assert code == 0 and "instantaneous rudder" in out  # the paper's ship: no rate stated
+    code, out, err = run(["criteria", "scale-ship", "--rudder-rate", "20", "--json",
+                          tmp_path / "s.json"], capsys)  # fmt: skip
+    assert code == 0 and "rudder rate 20 °/s" in out
+    rows = {(r["criterion"], r["manoeuvre"]): r for r in
+            json.loads((tmp_path / "s.json").read_text())["criteria"]}  # fmt: skip
+    # reference-ships.md §7.3: 15.6° at 20 °/s from 2 m/s (here the trimmed 1.93 m/s).
+    assert rows[("20/20 first overshoot", "zigzag 20/20 port")]["value"] == pytest.approx(15.6,
+                                                                                         rel=0.05)
+    # A model file without particulars needs the length.
+    from shipid.data.io import write_log
+    from shipid.trials.manoeuvres import zigzag
+    from shipid.vessels import scale_ship
+
+    log = zigzag(scale_ship(rudder_rate_deg=9.6), 20, 20, duration=60, dt=0.2, approach=2).log
+    path = write_log(log, tmp_path / "zz.csv")
+    assert run(["identify", path, "-o", tmp_path / "m.json"], capsys)[0] == 0
+    code, _, err = run(["criteria", tmp_path / "m.json"], capsys)
+    assert code == 1 and "give the length" in err
+    (tmp_path / "p.yml").write_text("length: 4.389\nscale: 16.95\n")
+    code, out, err = run(["criteria", tmp_path / "m.json", "--particulars", tmp_path / "p.yml"],
+                         capsys)  # fmt: skip
+    assert code == 0, err
+    assert "λ = 16.95" in out and "rudder rate 9.6" in out  # the training logs' rudder rate
