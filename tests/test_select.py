@@ -125,8 +125,8 @@ def test_a_candidate_diverging_in_every_fold_is_reported_and_the_others_scored(p
     training, _ = paper_trials
     real = select_module._fit_theta
 
-    def explosive_without_delta_squared(data, terms, gamma, train, estimator):
-        theta = real(data, terms, gamma, train, estimator)
+    def explosive_without_delta_squared(data, terms, gamma, train, estimator, physics=None):
+        theta = real(data, terms, gamma, train, estimator, physics)
         if "delta^2" not in terms["u"]:
             theta[0, :] = 0.0
             theta[0, data.texts.index("|u|*u")] = 50.0  # u̇ = 50 u|u|: blows up in seconds

@@ -29,7 +29,7 @@ LINEAR_ESTIMATORS = ("lssvm", "ols", "ridge", "lasso", "svr")
 KINDS = ("zigzag", "turning", "other")
 
 # Range checks of numeric options: dest → (rule, option as typed). Rules: '>0', '>=0', 'finite',
-# 'int>=1'. Checked before any work; a bad value is a user error (exit 1), not a usage error.
+# 'int>=N'. Checked before any work; a bad value is a user error (exit 1), not a usage error.
 OPTION_RULES = {
     "gamma": (">0", "--gamma"), "dt": (">0", "--dt"), "lead": (">=0", "--lead"),
     "filter": (">0", "--filter"), "segment": (">0", "--segment"),
@@ -42,7 +42,8 @@ OPTION_RULES = {
     "wind_speed": (">=0", "--wind-speed"), "wind_from": ("finite", "--wind-from"),
     "max_evaluations": ("int>=1", "--max-evaluations"), "show": ("int>=1", "--show"),
     "max_lag": ("int>=1", "--max-lag"), "omega": (">0", "--omega"),
-    "lookahead": (">0", "--lookahead"),
+    "lookahead": (">0", "--lookahead"), "bootstrap": ("int>=10", "--bootstrap"),
+    "block": (">0", "--block"),
 }  # fmt: skip
 
 
@@ -60,9 +61,10 @@ def check_options(args) -> None:
         value = getattr(args, dest, None)
         if value is None or isinstance(value, str):
             continue
-        if rule == "int>=1":
-            if not value >= 1:
-                raise ShipidError(f"{option} must be a whole number ≥ 1, got {value}")
+        if rule.startswith("int>="):
+            least = int(rule[5:])
+            if not value >= least:
+                raise ShipidError(f"{option} must be a whole number ≥ {least}, got {value}")
             continue
         if not math.isfinite(value):
             raise ShipidError(f"{option} must be a finite number, got {value}")
@@ -154,6 +156,65 @@ def _log_particulars(logs) -> dict | None:
     return next((log.attrs["particulars"] for log in logs if log.attrs.get("particulars")), None)
 
 
+BOUND_PATTERN = r"^\s*([uvr])\s*:\s*(.+?)\s*(<=|>=)\s*(\S+)\s*$"
+
+
+def _parse_bounds(specs) -> dict[str, dict[str, tuple[float, float]]]:
+    """--bound 'r: u*r <= 0' (repeatable) as {dof: {term: (lower, upper)}}."""
+    import re
+
+    out: dict[str, dict[str, tuple[float, float]]] = {}
+    for spec in specs or []:
+        m = re.match(BOUND_PATTERN, spec)
+        if not m:
+            raise ShipidError(f"--bound expects 'DOF: TERM <= X' or 'DOF: TERM >= X' (DOF u, v "
+                              f"or r), got {spec!r}")  # fmt: skip
+        dof, term, op, value = m.groups()
+        try:
+            x = float(value)
+        except ValueError:
+            raise ShipidError(f"--bound {spec!r}: {value!r} is not a number") from None
+        if not math.isfinite(x):
+            raise ShipidError(f"--bound {spec!r}: the bound must be finite")
+        lo, hi = out.setdefault(dof, {}).get(term, (-math.inf, math.inf))
+        out[dof][term] = (lo, min(hi, x)) if op == "<=" else (max(lo, x), hi)
+    return out
+
+
+def _physics(args, logs, structure):
+    """PhysicsOptions of --prior, --constraints, --bound (None when none is given)."""
+    from shipid.identification.physics import PhysicsOptions, parse_constraints, rudder_sign
+
+    signs, steady = parse_constraints(args.constraints)
+    bounds = _parse_bounds(args.bound)
+    prior = None
+    if args.prior == "clarke":
+        from shipid.data.particulars import Particulars
+        from shipid.identification.priors import clarke_prior
+
+        found = _particulars(args) or _log_particulars(logs)
+        if found is None:
+            raise ShipidError("--prior clarke needs the ship's particulars (--particulars FILE)")
+        part = found if isinstance(found, Particulars) else Particulars.from_mapping(found)
+        sign = rudder_sign(logs)
+        side = None if sign is None else ("starboard" if sign > 0 else "port")
+        speed = _approach(logs[0], "u")
+        prior = clarke_prior(part, structure, speed or 0.0, side)
+    elif args.prior:
+        from shipid.identification.priors import prior_from_model
+        from shipid.reporting.modelfile import load_model
+
+        prior = prior_from_model(load_model(args.prior))
+    options = PhysicsOptions(prior=prior, signs=signs, bounds=bounds or None, steady_speed=steady)
+    return options if options.active else None
+
+
+def _term_display(text: str) -> str:
+    from shipid.dynamics.terms import parse_term
+
+    return parse_term(text).display() or "1"
+
+
 def _json_text(data) -> str:
     from shipid.reporting.modelfile import json_safe
 
@@ -237,16 +298,19 @@ def cmd_identify(args) -> int:
     from shipid.reporting.modelfile import model_text
 
     check_outputs({"-o": (args.output, "json")}, args.logs)
+    if args.bootstrap is not None and args.refine:
+        raise ShipidError("--bootstrap describes the LS-SVM fit; it does not go with --refine")
     logs = _read_logs(args)
     if args.filter is not None:
         logs = [lowpass(log, args.filter) for log in logs]
     names = [str(p) for p in args.logs]
+    physics = _physics(args, logs, _structure(args))
     gamma, gamma_report = args.gamma, None
     if gamma == "auto":
-        gamma, gamma_report = _auto_gamma(args, logs, names)
+        gamma, gamma_report = _auto_gamma(args, logs, names, physics)
     ident = identify(logs, model=args.model, form=args.form, gamma=gamma,
                      drop=_parse_drop(args.drop), names=names, force=args.force,
-                     estimator=args.estimator)  # fmt: skip
+                     estimator=args.estimator, physics=physics)  # fmt: skip
     speed, rps = _approach(logs[0], "u"), _approach(logs[0], "n")
     prep = {"dt": args.dt, "start": args.start, "end": args.end, "lead": args.lead,
             "filter_hz": args.filter, "columns": args.columns, "degrees": args.degrees,
@@ -258,6 +322,22 @@ def cmd_identify(args) -> int:
     for dof, d in ident.diagnostics.items():
         print(f"{dof}: condition number {d['condition_number']:.3g}, one-step R² "
               f"{d['one_step_r2']:.4f}, bias b = {ident.discrete[dof]['bias']:.4g}")
+    ensemble = None
+    if args.bootstrap is not None:
+        from shipid.identification.uncertainty import bootstrap
+
+        def refit(weights):
+            return identify(logs, model=args.model, form=args.form, gamma=gamma,
+                            drop=_parse_drop(args.drop), names=names, force=True,
+                            estimator=args.estimator, physics=physics,
+                            sample_weight=weights).model  # fmt: skip
+
+        ensemble = bootstrap(logs, refit, args.bootstrap, args.block, args.seed, progress=True)
+        table = ensemble.coefficient_table()
+        table["term"] = [_term_display(t) for t in table["term"]]
+        print(f"\n95 % intervals of the coefficients ({ensemble.method}, "
+              f"{ensemble.replicates} replicates, {ensemble.block_s:g} s blocks):")
+        print(table.to_markdown(index=False, floatfmt=".4g"))
     if args.refine:
         how = "whole logs" if args.segment is None else f"{args.segment:g} s segments"
         print(f"refining by output error ({how})…", file=sys.stderr)
@@ -295,7 +375,8 @@ def cmd_identify(args) -> int:
         ident.warnings.extend(f"refinement: {n}" for n in refinement.warnings)
     text = model_text(ident, args.logs, preprocessing=prep, refinement=refinement,
                       plausibility=plausibility, model=final, selection=gamma_report,
-                      particulars=_log_particulars(logs))  # fmt: skip
+                      particulars=_log_particulars(logs),
+                      uncertainty=ensemble.to_dict() if ensemble else None)  # fmt: skip
     atomic_write_text(args.output, text)
     for w in ident.warnings:
         _warn(w)
@@ -303,19 +384,27 @@ def cmd_identify(args) -> int:
     return 0
 
 
-def _auto_gamma(args, logs, names) -> tuple[float, dict]:
+def _structure(args):
+    """The structure of --model without the --drop terms."""
+    from shipid.dynamics.model import get_structure
+
+    try:
+        structure = get_structure(args.model)
+        drop = _parse_drop(args.drop)
+        return structure.without(drop) if drop else structure
+    except ValueError as exc:
+        raise ShipidError(str(exc)) from None
+
+
+def _auto_gamma(args, logs, names, physics=None) -> tuple[float, dict]:
     """γ for the given structure: exact LOO of the LS-SVM pre-screens the grid, free-run
     cross-validation over the logs decides (``shipid.identification.select``)."""
-    from shipid.dynamics.model import get_structure
     from shipid.identification.select import select
 
-    structure = get_structure(args.model)
-    drop = _parse_drop(args.drop)
-    if drop:
-        structure = structure.without(drop)
+    structure = _structure(args)
     cv = args.cv or ("logo" if len(logs) >= 2 else "blocks:4")
     sel = select(logs, library=structure, search="none", names=names, cv=cv,
-                 estimator=args.estimator, plausibility=False)  # fmt: skip
+                 estimator=args.estimator, plausibility=False, physics=physics)  # fmt: skip
     table = sel.candidates[["gamma", "score", "score_se", "folds_diverged"]]
     print(f"γ chosen by free-run cross-validation ({cv}): {sel.gamma:g}")
     print(table.to_markdown(index=False, floatfmt=".4g"))
@@ -340,15 +429,21 @@ def cmd_select(args) -> int:
     from shipid.reporting.modelfile import model_text
 
     check_outputs({"-o": (args.output, "json"), "--table": (args.table, "log")}, args.logs)
-    options = SelectOptions(library=args.library, search=args.search, cv=args.cv,
+    logs = _read_logs(args)
+    names = [str(p) for p in args.logs]
+    from shipid.dynamics.model import get_structure
+
+    try:
+        library = get_structure(args.library)
+    except ValueError as exc:
+        raise ShipidError(str(exc)) from None
+    options = SelectOptions(library=library, search=args.search, cv=args.cv,
                             estimator=args.estimator, method=args.method,
                             max_evaluations=args.max_evaluations,
                             plausibility=not args.no_plausibility, speed=args.speed,
                             rps=args.rps, one_standard_error=not args.best,
-                            progress=not args.quiet,
+                            progress=not args.quiet, physics=_physics(args, logs, library),
                             **({"gammas": _parse_gammas(args.gammas)} if args.gammas else {}))
-    logs = _read_logs(args)
-    names = [str(p) for p in args.logs]
     sel = select(logs, options, names=names)
     ident = sel.identification
     print(sel.model.equations())
@@ -368,6 +463,7 @@ def cmd_select(args) -> int:
     prep = {"dt": args.dt, "start": args.start, "end": args.end, "lead": args.lead,
             "columns": args.columns, "degrees": args.degrees, "format": args.format,
             "scale": args.scale, "approach_speed": speed, "approach_rps": rps,
+            "rudder_rate": _rudder_rate(logs),
             "rudder_positive": logs[0].attrs.get("rudder_positive")}  # fmt: skip
     text = model_text(ident, args.logs, preprocessing=prep, plausibility=plausibility,
                       selection=sel.to_dict(), particulars=_log_particulars(logs))  # fmt: skip
@@ -455,22 +551,33 @@ def cmd_criteria(args) -> int:
     rate = math.radians(args.rudder_rate) if args.rudder_rate is not None else cond["rudder_rate"]
     if rate:  # given, else the rate of the training logs' rudder
         steering = SteeringMachine(math.radians(35.0), rate)
-    crit = imo_criteria(target, particulars, length=args.length, speed=speed, scale=args.scale,
-                        rps=rps, steering=steering, astern_rps=args.astern_rps, dt=args.dt)
+    run = partial(imo_criteria, particulars=particulars, length=args.length, speed=speed,
+                  scale=args.scale, rps=rps, steering=steering, astern_rps=args.astern_rps,
+                  dt=args.dt)  # fmt: skip
+    crit = run(target)
+    table = crit.table.copy()
+    ensemble = cond.get("ensemble")
+    if ensemble is not None and not args.no_bands:
+        from shipid.trials.criteria import with_intervals
+
+        table = with_intervals(crit, [run(m) for m in ensemble.members()])
     c = crit.conditions
     print(f"IMO MSC.137(76) criteria for {args.model}: L = {c['length']:g} m, V = {c['speed']:.4g} "
           f"m/s, λ = {c['scale']:g} (full-scale L/V = {c['L_over_V_full_scale']:.3g} s), " + (
               f"rudder rate {c['rudder_rate_deg_s']:.3g} °/s" if c["rudder_rate_deg_s"]
               else "instantaneous rudder"))
-    table = crit.table.copy()
+    record = {**crit.to_dict(), "criteria": table.to_dict(orient="records")}
     table["passed"] = table["passed"].map({True: "pass", False: "FAIL", None: "–"})
     print(table.to_markdown(index=False, floatfmt=".3g"))
+    if "pass_share" in table:
+        print(f"lower, upper: 95 % interval of the value and pass_share: the share of passes "
+              f"over the model's {ensemble.replicates} bootstrap replicates")
     print("all criteria met" if crit.passed else "NOT all criteria met")
     for n in crit.notes:
         _warn(n)
     with OutputSet() as out:
         if args.json:
-            out.write(args.json, lambda p: p.write_text(_json_text(crit.to_dict()), "utf-8"))
+            out.write(args.json, lambda p: p.write_text(_json_text(record), "utf-8"))
     return 0
 
 
@@ -635,6 +742,7 @@ def cmd_validate(args) -> int:
     from shipid.evaluation.validate import validate
     from shipid.outputs import OutputSet, check_outputs
     from shipid.reporting.modelfile import (
+        ensemble_from_document,
         has_refinement,
         load_document,
         model_from_document,
@@ -649,6 +757,7 @@ def cmd_validate(args) -> int:
         _warn(f"{args.model} has no refinement: its model is the LS-SVM one, which --lssvm "
               "validates")  # fmt: skip
     model = model_from_document(doc, args.model, "lssvm" if args.lssvm else "model")
+    ensemble = None if args.no_bands else ensemble_from_document(doc, args.model, model)
     env = training_conditions(doc)["envelope"]
     from shipid.data.io import read_log
 
@@ -663,7 +772,7 @@ def cmd_validate(args) -> int:
     from tqdm.auto import tqdm
 
     vals = [validate(model, log, [name], method=args.method, kind=args.kind,
-                     smooth_s=args.smooth)[0]
+                     smooth_s=args.smooth, ensemble=ensemble)[0]
             for log, name in tqdm(list(zip(logs, names, strict=True)), desc="logs", unit="log",
                                   disable=args.quiet or len(logs) < 3)]  # fmt: skip
     for v, log in zip(vals, logs, strict=True):
@@ -674,6 +783,8 @@ def cmd_validate(args) -> int:
         print(metrics_frame(good).to_markdown(index=False, floatfmt=".4g"))
         table = indices_frame(good)
         if len(table):
+            # Mixed columns (numbers and blanks) are objects, which floatfmt leaves alone.
+            table = table.map(lambda x: f"{x:.4g}" if isinstance(x, float) and x == x else x)
             table = table.astype(object).where(table.notna(), "–")
             print()
             print(table.to_markdown(index=False, floatfmt=".4g"))
@@ -729,7 +840,8 @@ def cmd_validate(args) -> int:
             for (v, log), stem in zip(pairs, stems, strict=True):
                 title = Path(v.name).name
                 jobs = [("fit", stem + ext, partial(plots.measured_vs_simulated, log,
-                                                   v.simulation.log, title=title))]  # fmt: skip
+                                                   v.simulation.log, title=title,
+                                                   bands=v.bands))]  # fmt: skip
                 if args.resid:
                     jobs.append(("resid", stem + "-resid" + ext, partial(
                         plots.residuals, residuals[v.name], title=f"{title}: residual analysis")))
@@ -812,8 +924,13 @@ def _ship_or_model(name: str):
     if not Path(name).exists():
         raise ShipidError(f"{name}: neither a model file nor a known vessel "
                           f"({', '.join(VESSEL_NAMES)})")  # fmt: skip
+    from shipid.reporting.modelfile import ensemble_from_document
+
     doc = load_document(name)
-    return model_from_document(doc, name), training_conditions(doc)
+    model = model_from_document(doc, name)
+    cond = training_conditions(doc)
+    cond["ensemble"] = ensemble_from_document(doc, name, model)
+    return model, cond
 
 
 def cmd_simulate(args) -> int:
@@ -853,25 +970,37 @@ def cmd_manoeuvre(args) -> int:
         kw["duration"] = args.duration
     if args.kind == "zigzag":
         heading = args.heading if args.heading is not None else args.rudder_deg
-        res = zigzag(target, args.rudder_deg, heading, first=args.first, **kw)
+        run = partial(zigzag, rudder_deg=args.rudder_deg, heading_deg=heading, first=args.first,
+                      **kw)  # fmt: skip
     elif args.kind == "turning":
-        res = turning_circle(target, args.rudder_deg, side=args.first, **kw)
+        run = partial(turning_circle, rudder_deg=args.rudder_deg, side=args.first, **kw)
     elif args.kind == "pull-out":
         if args.duration is not None:
             kw.pop("duration")
             kw["hold"] = kw["release"] = args.duration / 2
-        res = pull_out(target, args.rudder_deg, side=args.first, **kw)
+        run = partial(pull_out, rudder_deg=args.rudder_deg, side=args.first, **kw)
     elif args.kind == "spiral":
         kw.pop("wind", None)
         if args.duration is not None:
             kw["hold"] = kw.pop("duration")
-        res = spiral(target, **kw)
+        run = partial(spiral, **kw)
     else:
         if not rps:
             raise ShipidError("stopping needs the approach propeller speed (--rps, or a model "
                               "trained with the n column)")  # fmt: skip
         kw.pop("rps")
-        res = stopping(target, rps, args.astern_rps, **kw)
+        run = partial(stopping, rps=rps, astern_rps=args.astern_rps, **kw)
+    res = run(target)
+    intervals = {}
+    ensemble = cond.get("ensemble")
+    if ensemble is not None and not args.no_bands and args.kind != "spiral":
+        from shipid.identification.uncertainty import index_intervals
+
+        runs = [run(member) for member in ensemble.members()]
+        intervals = index_intervals([r.indices for r in runs if not r.diverged])
+        diverged = sum(r.diverged for r in runs)
+        print(f"95 % intervals over the {ensemble.replicates} bootstrap replicates"
+              + (f" ({diverged} diverged, left out)" if diverged else "") + ":")
     if res.diverged:
         print(res.reason, file=sys.stderr)
     notes = outside_envelope(cond["envelope"], res.log)
@@ -882,14 +1011,17 @@ def cmd_manoeuvre(args) -> int:
         if k == "table":
             print(_pd().DataFrame(v).to_markdown(index=False, floatfmt=".4g"))
             continue
-        print(f"{k}: {v:.4g}" if isinstance(v, float) else f"{k}: {v}")
+        text = f"{k}: {v:.4g}" if isinstance(v, float) else f"{k}: {v}"
+        lo, hi = intervals.get(k, (math.nan, math.nan))
+        print(text + (f"  [{lo:.4g}, {hi:.4g}]" if math.isfinite(lo) else ""))
     for n in notes:
         _warn(n)
     with OutputSet() as out:
         if args.json:
             doc = {"manoeuvre": res.log.attrs.get("manoeuvre"), "diverged": res.diverged,
                    "diverged_at": res.diverged_at, "reason": res.reason,
-                   "indices": res.indices, "warnings": notes}  # fmt: skip
+                   "indices": res.indices, "index_intervals": intervals or None,
+                   "warnings": notes}  # fmt: skip
             out.write(args.json, lambda p: p.write_text(_json_text(doc), "utf-8"))
         if args.output:
             from shipid.data.io import write_log
@@ -950,6 +1082,18 @@ def cmd_import(args) -> int:
 
 
 # ---------------------------------------------------------------------------- parser
+def _add_physics_options(p) -> None:
+    g = p.add_argument_group("physics (increment form; lssvm or ols)")
+    g.add_argument("--prior", metavar="clarke|MODEL.json",
+                   help="draw the fit toward a prior instead of zero: 'clarke' (linear sway–yaw "
+                   "and rudder terms from the particulars, Clarke et al. 1983) or a model file")
+    g.add_argument("--constraints", metavar="LIST",
+                   help="comma list: signs (damping, resistance, thrust and rudder terms keep "
+                   "their physical sign), steady-speed (u̇ = 0 on the approach)")
+    g.add_argument("--bound", action="append", metavar="'DOF: TERM <= X'",
+                   help="a bound on one coefficient, e.g. 'r: u*r <= 0' (repeatable)")
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of every command."""
     ap = argparse.ArgumentParser(prog="shipid", description="Semiphysical identification of ship "
@@ -988,7 +1132,16 @@ def build_parser() -> argparse.ArgumentParser:
                    help="with --refine: simulate segments of S seconds (default: whole logs)")
     p.add_argument("--refine-evals", type=int, default=200, metavar="N",
                    help="with --refine: cap on cost evaluations (default %(default)s)")
+    p.add_argument("--bootstrap", type=int, metavar="N",
+                   help="uncertainty: N moving-block bootstrap refits (≥ 10; e.g. 200), stored in "
+                   "the model file: coefficient intervals here, prediction bands and index "
+                   "intervals in validate, manoeuvre and criteria")
+    p.add_argument("--block", type=float, default=10.0, metavar="S",
+                   help="with --bootstrap: block length [s] (default %(default)g)")
+    p.add_argument("--seed", type=int, default=0, help="with --bootstrap: random seed "
+                   "(default %(default)s)")
     p.add_argument("-o", "--output", required=True, metavar="MODEL.json")
+    _add_physics_options(p)
     _add_log_options(p)
     p.set_defaults(func=cmd_identify)
 
@@ -1020,6 +1173,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--table", metavar="OUT.csv", help="write every candidate with its scores")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("-o", "--output", required=True, metavar="MODEL.json")
+    _add_physics_options(p)
     _add_log_options(p)
     p.set_defaults(func=cmd_select)
 
@@ -1051,6 +1205,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="heading smoothing window for measured indices [s] (default 0)")
     p.add_argument("--lssvm", action="store_true",
                    help="validate the LS-SVM model a refined model file keeps")
+    p.add_argument("--no-bands", action="store_true",
+                   help="skip the bootstrap ensemble of the model file (its prediction bands and "
+                   "index intervals cost one free run per replicate)")
     p.add_argument("--plot-format", default="png", choices=("png", "svg", "pdf"),
                    help="format of the --plots figures (default %(default)s)")
     p.add_argument("--resid", action="store_true",
@@ -1101,6 +1258,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="direction the wind blows from, clockwise from north [deg] (default 0)")
     p.add_argument("--json", metavar="OUT.json")
     p.add_argument("-o", "--output", metavar="LOG.csv", help="write the simulated log")
+    p.add_argument("--no-bands", action="store_true",
+                   help="skip the intervals from the model file's bootstrap ensemble")
     p.set_defaults(func=cmd_manoeuvre)
 
     p = sub.add_parser("criteria", help="IMO MSC.137(76) criteria: run the standard manoeuvres "
@@ -1121,6 +1280,8 @@ def build_parser() -> argparse.ArgumentParser:
                    "SOLAS 2.32 °/s at full scale, × √λ)")
     p.add_argument("--dt", type=float, default=0.05, help="integration step [s] (default %(default)s)")
     p.add_argument("--json", metavar="OUT.json")
+    p.add_argument("--no-bands", action="store_true",
+                   help="skip the intervals from the model file's bootstrap ensemble")
     p.set_defaults(func=cmd_criteria)
 
     p = sub.add_parser("linearise", help="state-space A, B and Nomoto K, T of a model or vessel")

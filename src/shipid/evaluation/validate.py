@@ -30,6 +30,12 @@ from shipid.dynamics.simulate import SimulationResult, simulate_log
 from shipid.dynamics.steering import SteeringMachine
 from shipid.errors import ShipidError
 from shipid.evaluation.metrics import error_metrics
+from shipid.identification.uncertainty import (
+    Ensemble,
+    ensemble_runs,
+    free_run_bands,
+    index_intervals,
+)
 from shipid.trials.indices import manoeuvre_indices, zigzag_indices
 from shipid.trials.manoeuvres import ManoeuvreResult, zigzag
 from shipid.trials.trial import Trial, describe_trial
@@ -49,6 +55,11 @@ class Validation:
     kind: str | None = None
     error: str | None = None
     warnings: list[str] = field(default_factory=list)
+    # With a bootstrap ensemble: 95 % bands of the free run per state, how many replicates
+    # diverged, and {"simulated"/"closed_loop": {index: (lower, upper)}}.
+    bands: dict | None = None
+    ensemble_diverged: int = 0
+    intervals: dict[str, dict] = field(default_factory=dict)
 
     def to_frame(self):
         """The metrics as a DataFrame: one row per state (u, v, r), one column per metric."""
@@ -64,6 +75,9 @@ class Validation:
                 "diverged_at": sim.diverged_at if sim else None,
                 "reason": sim.reason if sim else "", "manoeuvre": self.kind,
                 "metrics": self.metrics, "indices": self.indices,
+                "index_intervals": {k: {i: list(b) for i, b in v.items()}
+                                    for k, v in self.intervals.items()},
+                "ensemble_diverged": self.ensemble_diverged if self.bands else None,
                 "warnings": self.warnings}  # fmt: skip
 
 
@@ -76,22 +90,41 @@ def free_run(model, log: pd.DataFrame, method: str = "euler") -> tuple[Simulatio
 
 
 def validate_log(model, log: pd.DataFrame, name: str, method: str = "euler",
-                 kind: str | None = None, smooth_s: float = 0.0) -> Validation:  # fmt: skip
-    """Validate ``model`` on one log (raises ``ShipidError`` when it cannot)."""
+                 kind: str | None = None, smooth_s: float = 0.0,
+                 ensemble: Ensemble | None = None) -> Validation:  # fmt: skip
+    """Validate ``model`` on one log (raises ``ShipidError`` when it cannot). With a bootstrap
+    ``ensemble`` of the model: prediction bands and intervals on the predicted indices."""
     sim, metrics = free_run(model, log, method)
     trial = describe_trial(log, kind)
     indices: dict[str, dict] = {}
     if trial.kind != "other":
         measured = manoeuvre_indices(log, smooth_s=smooth_s, trial=trial)
-        simulated = {}
-        if not sim.diverged:
-            simulated = manoeuvre_indices(sim.log, trial=describe_trial(
-                sim.log, trial.kind, trial.switch_heading_deg, trial.execute_time))
-        indices = {"measured": measured, "simulated": simulated}
+        indices = {"measured": measured, "simulated": _replay_indices(sim, trial)}
         if trial.kind == "zigzag" and isinstance(model, ManoeuvringModel | Vessel):
-            replica = trial_zigzag(model, log, method, trial)
-            indices["closed_loop"] = replica.indices if replica and not replica.diverged else {}
-    return Validation(name, sim, metrics, indices, trial.kind)
+            indices["closed_loop"] = _replica_indices(model, log, method, trial)
+    out = Validation(name, sim, metrics, indices, trial.kind)
+    if ensemble is not None:
+        runs = ensemble_runs(ensemble, log, method)
+        out.bands, out.ensemble_diverged = free_run_bands(runs, len(log))
+        if trial.kind != "other":
+            out.intervals["simulated"] = index_intervals([_replay_indices(r, trial)
+                                                          for r in runs])  # fmt: skip
+            if "closed_loop" in indices:
+                out.intervals["closed_loop"] = index_intervals(
+                    [_replica_indices(m, log, method, trial) for m in ensemble.members()])
+    return out
+
+
+def _replay_indices(sim: SimulationResult, trial: Trial) -> dict:
+    if sim.diverged:
+        return {}
+    return manoeuvre_indices(sim.log, trial=describe_trial(
+        sim.log, trial.kind, trial.switch_heading_deg, trial.execute_time))
+
+
+def _replica_indices(model, log: pd.DataFrame, method: str, trial: Trial) -> dict:
+    replica = trial_zigzag(model, log, method, trial)
+    return replica.indices if replica and not replica.diverged else {}
 
 
 def validate(
@@ -101,16 +134,19 @@ def validate(
     method: str = "euler",
     kind: str | None = None,
     smooth_s: float = 0.0,
+    ensemble: Ensemble | None = None,
 ) -> list[Validation]:
     """Validate ``model`` on each log; errors are over the simulated (not diverged) part. A log
-    that cannot be validated gets a ``Validation`` with ``error`` set; the others go on."""
+    that cannot be validated gets a ``Validation`` with ``error`` set; the others go on. With a
+    bootstrap ``ensemble`` of the model (``shipid.identification.uncertainty``): bands and
+    intervals."""
     if isinstance(logs, pd.DataFrame):
         logs = [logs]
     names = names or [log.attrs.get("name", f"log {i}") for i, log in enumerate(logs)]
     out = []
     for log, name in zip(logs, names, strict=True):
         try:
-            out.append(validate_log(model, log, name, method, kind, smooth_s))
+            out.append(validate_log(model, log, name, method, kind, smooth_s, ensemble))
         except ShipidError as exc:
             message = str(exc)
             out.append(Validation(name, None, {}, {}, None,

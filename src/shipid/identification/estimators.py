@@ -19,6 +19,7 @@ inputs, simulated by the generic path): ``elm`` (extreme learning machine, sciki
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 import numpy as np
@@ -38,12 +39,29 @@ def check_estimator_name(name) -> str:
 
 
 def fit_linear(X: np.ndarray, y: np.ndarray, estimator="lssvm", gamma: float = 1e4,
-               sample_weight: np.ndarray | None = None) -> tuple[np.ndarray, float]:  # fmt: skip
-    """Coefficients and bias of one DOF's regression y ≈ X w + b with ``estimator``."""
+               sample_weight: np.ndarray | None = None, physics=None,
+               ) -> tuple[np.ndarray, float]:  # fmt: skip
+    """Coefficients and bias of one DOF's regression y ≈ X w + b with ``estimator``.
+
+    ``physics``: a ``shipid.identification.physics.DofPhysics`` (prior, bounds, tied bias),
+    for the ``lssvm`` and ``ols`` estimators; the bounds held are in ``physics.active``."""
+    if physics is not None and _changes_fit(physics):
+        if estimator not in ("lssvm", "ols"):
+            raise ShipidError(f"priors and constraints need the lssvm or ols estimator, not "
+                              f"{estimator if isinstance(estimator, str) else type(estimator).__name__}")
+        from shipid.lssvm.solvers import accumulate_normal_equations, solve_primal_constrained
+
+        w = np.ones(len(y)) if sample_weight is None else np.asarray(sample_weight, float)
+        A, B = accumulate_normal_equations([(X, y[:, None], w)], X.shape[1], 1)
+        coef, bias, physics.active = solve_primal_constrained(
+            A, B[:, 0], gamma if estimator == "lssvm" else math.inf, physics.prior,
+            physics.lower, physics.upper, physics.bias_row, physics.bias_offset)
+        return coef, bias
+    fit_kw = {} if sample_weight is None else {"sample_weight": sample_weight}
     if not isinstance(estimator, str):
         from sklearn.base import clone
 
-        est = clone(estimator).fit(X, y)
+        est = clone(estimator).fit(X, y, **fit_kw)
         return _coef_and_bias(est, X.shape[1])
     check_estimator_name(estimator)
     if estimator in BLACK_BOX_ESTIMATORS:
@@ -58,8 +76,9 @@ def fit_linear(X: np.ndarray, y: np.ndarray, estimator="lssvm", gamma: float = 1
         coef, intercept, _ = solve_primal(A, B, gamma)
         return coef[0], float(intercept[0])
     if estimator == "ols":
-        A = np.column_stack([X, np.ones(len(X))])
-        sol = np.linalg.lstsq(A, y, rcond=None)[0]
+        sw = np.ones(len(y)) if sample_weight is None else np.sqrt(np.asarray(sample_weight, float))
+        A = np.column_stack([X, np.ones(len(X))]) * sw[:, None]
+        sol = np.linalg.lstsq(A, y * sw, rcond=None)[0]
         return sol[:-1], float(sol[-1])
     # Standardised regressors: the penalty treats every term alike whatever its units.
     mean, scale = X.mean(axis=0), X.std(axis=0)
@@ -68,21 +87,26 @@ def fit_linear(X: np.ndarray, y: np.ndarray, estimator="lssvm", gamma: float = 1
     if estimator == "ridge":
         from sklearn.linear_model import Ridge
 
-        est = Ridge(alpha=len(y) / gamma).fit(Z, y)
+        est = Ridge(alpha=len(y) / gamma).fit(Z, y, **fit_kw)
     elif estimator == "lasso":
         from sklearn.linear_model import Lasso
 
-        est = Lasso(alpha=float(np.std(y)) / np.sqrt(gamma), max_iter=20_000).fit(Z, y)
+        est = Lasso(alpha=float(np.std(y)) / np.sqrt(gamma), max_iter=20_000).fit(Z, y, **fit_kw)
     else:
         from sklearn.svm import LinearSVR
 
         A = np.column_stack([Z, np.ones(len(y))])
         noise = float(np.std(y - A @ np.linalg.lstsq(A, y, rcond=None)[0]))
         est = LinearSVR(C=gamma, epsilon=0.5 * noise, max_iter=50_000, dual="auto",
-                        loss="squared_epsilon_insensitive").fit(Z, y)  # fmt: skip
+                        loss="squared_epsilon_insensitive").fit(Z, y, **fit_kw)  # fmt: skip
     coef, bias = _coef_and_bias(est, X.shape[1])
     w = coef / scale
     return w, float(bias - w @ mean)
+
+
+def _changes_fit(physics) -> bool:
+    return (physics.prior is not None or physics.bias_row is not None
+            or bool(np.isfinite(physics.lower).any() or np.isfinite(physics.upper).any()))
 
 
 def _coef_and_bias(est, p: int) -> tuple[np.ndarray, float]:

@@ -21,6 +21,7 @@ from shipid.dynamics.terms import parse_term
 from shipid.errors import ShipidError
 from shipid.evaluation.envelope import envelope
 from shipid.identification.estimators import check_estimator_name, fit_linear
+from shipid.identification.physics import PhysicsOptions, dof_physics
 from shipid.identification.regression import FORMS, RegressionProblem, regression_problem
 from shipid.lssvm.solvers import NumericalWarning
 
@@ -48,6 +49,7 @@ class Identification:
     warnings: list[str] = field(default_factory=list)
     envelope: dict[str, list[float]] = field(default_factory=dict)  # training ranges
     estimator: str = "lssvm"
+    physics: dict | None = None  # PhysicsOptions.describe() when priors/constraints were used
 
 
 def _display(name: str) -> str:
@@ -152,6 +154,8 @@ def identify(
     names: Sequence[str] | None = None,
     force: bool = False,
     estimator="lssvm",
+    physics: PhysicsOptions | None = None,
+    sample_weight: np.ndarray | None = None,
 ) -> Identification:
     """Identify a manoeuvring model from one or several canonical logs.
 
@@ -167,6 +171,10 @@ def identify(
         instead of refusing it; it is still reported.
     estimator : 'lssvm' (the paper's, default), 'ols', 'ridge', 'lasso', 'svr' or a
         scikit-learn linear regressor (see ``shipid.identification.estimators``).
+    physics : a prior, sign constraints, bounds, steady speed (``PhysicsOptions``; increment
+        form, lssvm or ols). Coefficients held at a bound are reported.
+    sample_weight : a weight per equation (the logs' samples but the last of each, in order):
+        bootstrap multiplicities (``shipid.identification.uncertainty``).
 
     Fewer than ``MIN_EQUATIONS_PER_UNKNOWN`` equations per unknown are always refused.
     """
@@ -179,6 +187,9 @@ def identify(
     if not (isinstance(gamma, int | float) and math.isfinite(gamma) and gamma > 0):
         raise ShipidError(f"--gamma must be > 0, got {gamma!r}")
     check_estimator_name(estimator)
+    if physics is not None and physics.active and form != "increment":
+        raise ShipidError("priors and constraints act on the continuous-time coefficients of "
+                          "the increment form; use --form increment")  # fmt: skip
     try:
         structure = get_structure(model) if isinstance(model, str) else model
         if drop:
@@ -196,6 +207,13 @@ def identify(
         notes += _check_sample_count(p, logs)
         problems[dof] = p
     _check_rudder_excitation(logs, structure, fixed)
+    if sample_weight is not None:
+        rows = next(iter(problems.values())).X.shape[0]
+        sample_weight = np.asarray(sample_weight, dtype=float)
+        if sample_weight.shape != (rows,) or not np.all(np.isfinite(sample_weight)) \
+                or np.any(sample_weight < 0):
+            raise ShipidError(f"sample_weight must be {rows} finite weights ≥ 0 (one per "
+                              "equation), got shape " + str(sample_weight.shape))  # fmt: skip
     coefs: dict[str, dict[str, float]] = {}
     terms: dict[str, tuple[str, ...]] = {}
     discrete: dict[str, dict] = {}
@@ -203,10 +221,17 @@ def identify(
     dt = math.nan
     for dof, p in problems.items():
         dt = p.dt
+        extra = dof_physics(physics, dof, p.names, p.has_constant, p.fixed, logs)
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", NumericalWarning)
-            g, b = fit_linear(p.X, p.y, estimator, gamma)
+            g, b = fit_linear(p.X, p.y, estimator, gamma, sample_weight, physics=extra)
         diagnostics[dof], dof_notes = _diagnose(p, g, b, gamma)
+        held = [] if extra.active is None else [n for n, a in zip(p.names, extra.active,
+                                                                   strict=True) if a]  # fmt: skip
+        diagnostics[dof]["at_bound"] = held
+        notes += extra.notes + [f"{dof}: {_display(n)} held at its bound {g[p.names.index(n)]:.4g} "
+                                f"({extra.reasons.get(n, 'bound')}): the unconstrained fit goes "
+                                "past it" for n in held]  # fmt: skip
         cond = diagnostics[dof]["condition_number"]
         if not cond <= MAX_CONDITION:
             message = (f"{dof}: the regressors {', '.join(_display(n) for n in p.names)} are "
@@ -243,4 +268,6 @@ def identify(
                              name=f"identified ({structure.name}, {form} form)")  # fmt: skip
     return Identification(model, form, float(gamma), dt, discrete, diagnostics, notes,
                           envelope(logs), estimator if isinstance(estimator, str)
-                          else type(estimator).__name__)  # fmt: skip
+                          else type(estimator).__name__,
+                          physics.describe() if physics is not None and physics.active
+                          else None)  # fmt: skip

@@ -44,7 +44,9 @@ from shipid.dynamics.simulate import DivergenceBounds, input_array, run_kernel
 from shipid.dynamics.terms import INPUT_SIGNALS, parse_term, term_code
 from shipid.errors import ShipidError
 from shipid.identification.estimators import LINEAR_ESTIMATORS, check_estimator_name, fit_linear
+from shipid.identification.physics import PhysicsOptions, dof_physics
 from shipid.identification.regression import common_sampling_time, log_terms
+from shipid.lssvm.solvers import solve_primal_constrained
 
 SEARCHES = ("stepwise", "frols", "stlsq", "none")
 STATES = ("u", "v", "r")
@@ -70,6 +72,7 @@ class SelectOptions:
         CV score (else the best).
     speed, rps : condition of the plausibility checks (default: the first log's approach).
     progress : show a progress bar.
+    physics : prior, sign constraints, bounds, steady speed (``PhysicsOptions``) in every fit.
     """
 
     library: str | ModelStructure = "low-speed+wind"
@@ -85,6 +88,7 @@ class SelectOptions:
     rps: float | None = None
     one_standard_error: bool = True
     progress: bool = False
+    physics: PhysicsOptions | None = None
 
     def __post_init__(self) -> None:
         if self.search not in SEARCHES:
@@ -186,6 +190,7 @@ class _Data:
     inputs: list[np.ndarray]  # per log (N_i, 5)
     measured: list[np.ndarray]  # per log (N_i, 3) u, v, r
     s0: np.ndarray  # (L, 6)
+    logs: list[pd.DataFrame] = field(default_factory=list)  # for the physics (rudder sign, approach)
 
 
 def _prepare(logs: Sequence[pd.DataFrame], names: Sequence[str], library: ModelStructure) -> _Data:
@@ -199,7 +204,8 @@ def _prepare(logs: Sequence[pd.DataFrame], names: Sequence[str], library: ModelS
             raise ShipidError(f"{name}: the library term {term!r} needs the log column "
                               f"{missing[0]!r}, which this log does not have{hint}")
     dt = common_sampling_time(logs, names)
-    data = _Data(list(names), dt, library, texts, [], [], [], [], [], [], np.zeros((len(logs), 6)))
+    data = _Data(list(names), dt, library, texts, [], [], [], [], [], [], np.zeros((len(logs), 6)),
+                 list(logs))
     for i, (log, name) in enumerate(zip(logs, names, strict=True)):
         phi = log_terms(log, texts, name)
         ext = np.column_stack([phi[:-1], np.ones(len(log) - 1)])
@@ -244,7 +250,7 @@ def _folds(n_logs: int, cv: str) -> list[list[int]]:
 
 # ---------------------------------------------------------------------------- fits
 def _fit_theta(data: _Data, terms: Mapping[str, Sequence[str]], gamma: float, train: Sequence[int],
-               estimator: str) -> np.ndarray:  # fmt: skip
+               estimator: str, physics: PhysicsOptions | None = None) -> np.ndarray:  # fmt: skip
     """θ (3, T) over the library columns, fitted on the logs ``train``."""
     index = {t: j for j, t in enumerate(data.texts)}
     theta = np.zeros((3, len(data.texts) + 1))  # last column: "1" (the bias)
@@ -252,27 +258,21 @@ def _fit_theta(data: _Data, terms: Mapping[str, Sequence[str]], gamma: float, tr
     for i, dof in enumerate(DOFS):
         if dof not in terms:
             continue
-        cols = [index[t] for t in terms[dof] if t != "1"]
+        names = [t for t in terms[dof] if t != "1"]
+        cols = [index[t] for t in names]
         has_const = "1" in terms[dof]
+        extra = dof_physics(physics, dof, names, has_const, {}, data.logs)
         if estimator in ("lssvm", "ols"):
             sel = cols + [T]
             A = sum(data.gram[j][np.ix_(sel, sel)] for j in train)
             b = sum(data.cross[j][dof][sel] for j in train)
-            reg = np.zeros(len(sel))
-            if estimator == "lssvm":
-                reg[:-1] = 1.0 / gamma
-            A = A + np.diag(reg)
-            d = 1.0 / np.sqrt(np.maximum(np.diag(A), 1e-300))
-            try:
-                z = np.linalg.solve(A * d[:, None] * d[None, :], b * d)
-            except np.linalg.LinAlgError:
-                z = np.linalg.lstsq(A * d[:, None] * d[None, :], b * d, rcond=None)[0]
-            sol = z * d
-            w, bias = sol[:-1], sol[-1]
+            w, bias, _ = solve_primal_constrained(
+                A, b, gamma if estimator == "lssvm" else math.inf, extra.prior, extra.lower,
+                extra.upper, extra.bias_row, extra.bias_offset)
         else:
             X = np.vstack([data.phi[j][:, cols] for j in train])
             y = np.concatenate([data.targets[j][dof] for j in train])
-            w, bias = fit_linear(X, y, estimator, gamma)
+            w, bias = fit_linear(X, y, estimator, gamma, physics=extra)
         theta[i, cols] = w
         if has_const:
             theta[i, T] = bias
@@ -324,7 +324,8 @@ class _Scorer:
         out = []
         for fold in self.folds:
             train = [j for j in range(n_logs) if j not in fold]
-            theta = _fit_theta(self.data, terms, gamma, train, self.options.estimator)
+            theta = _fit_theta(self.data, terms, gamma, train, self.options.estimator,
+                               self.options.physics)
             out += [theta] * len(fold)
         return np.array(out)
 
@@ -524,7 +525,8 @@ def select(
         if not options.plausibility or cand.score == math.inf:
             return cand.score < math.inf
         if cand.key not in plausibility_cache:
-            theta = _fit_theta(data, cand.terms, cand.gamma, range(len(logs)), options.estimator)
+            theta = _fit_theta(data, cand.terms, cand.gamma, range(len(logs)), options.estimator,
+                               options.physics)
             model = _model_from_theta(data, cand.terms, theta, "candidate")
             report, _ = check_plausibility(model, speed, rps if model.uses_rps else None)
             reasons = disqualifying(report, model)
@@ -576,7 +578,7 @@ def select(
                      "the checks")  # fmt: skip
     structure = ModelStructure(f"selected from {library.name}", current.terms)
     ident = identify(logs, model=structure, gamma=current.gamma, names=names, force=True,
-                     estimator=options.estimator)  # fmt: skip
+                     estimator=options.estimator, physics=options.physics)  # fmt: skip
     folds_report = _fold_report(data, scorer, current, logs, names)
     table = _table(scorer.cache.values(), current)
     failed = [c for c in scorer.cache.values() if c.folds_diverged == len(scorer.held)]
@@ -704,7 +706,8 @@ def _fold_report(data, scorer: _Scorer, chosen: Candidate, logs, names) -> list[
     n_logs = len(logs)
     for fold in scorer.folds:
         train = [j for j in range(n_logs) if j not in fold]
-        theta = _fit_theta(data, chosen.terms, chosen.gamma, train, scorer.options.estimator)
+        theta = _fit_theta(data, chosen.terms, chosen.gamma, train, scorer.options.estimator,
+                           scorer.options.physics)
         model = _model_from_theta(data, chosen.terms, theta, "fold model")
         for h in fold:
             try:

@@ -147,3 +147,79 @@ def solve_primal(
         z = linalg.lstsq(Ms, B * d[:, None], check_finite=False)[0]
     x = z * d[:, None]
     return x[:p].T.copy(), x[p].copy(), condition
+
+
+def solve_primal_constrained(
+    A: np.ndarray,
+    b: np.ndarray,
+    gamma: float,
+    prior: np.ndarray | None = None,
+    lower: np.ndarray | None = None,
+    upper: np.ndarray | None = None,
+    bias_row: np.ndarray | None = None,
+    bias_offset: float = 0.0,
+) -> tuple[np.ndarray, float, np.ndarray]:
+    """One output of the primal LS-SVM with physics: a prior, bounds and a tied bias.
+
+    Solves ``min ½‖ω − ω₀‖² + ½ Σ γ wᵢ eᵢ²`` (the LS-SVM regularisation drawn toward the prior
+    ω₀ instead of 0) subject to ``lower ≤ ω ≤ upper`` and, with ``bias_row`` φ₀,
+    ``b = −φ₀ᵀω − bias_offset`` (the fitted equation, plus terms held fixed worth
+    ``bias_offset`` there, vanishes at the state φ₀: e.g. steady speed on the approach).
+
+    Parameters
+    ----------
+    A, b : the bordered normal equations of ``accumulate_normal_equations`` (without I/γ), A
+        (p+1, p+1) and b (p+1,); the last row is the bias.
+    gamma : γ > 0; ``math.inf`` for least squares (no regularisation, the prior unused).
+
+    Returns
+    -------
+    coef (p,), bias, and the boolean mask of the coefficients held at a bound.
+
+    The bounded problem is the quadratic program of the equilibrated normal equations, solved as
+    the least-squares problem of its Cholesky factor by SciPy's bounded-variable least squares.
+    """
+    from scipy.optimize import lsq_linear
+
+    p = A.shape[0] - 1
+    M = A.astype(float).copy()
+    c = np.asarray(b, dtype=float).reshape(-1).copy()
+    if np.isfinite(gamma):
+        M[np.arange(p), np.arange(p)] += 1.0 / gamma
+        if prior is not None:
+            c[:p] += np.asarray(prior, dtype=float) / gamma
+    lo = np.full(p, -np.inf) if lower is None else np.asarray(lower, dtype=float)
+    hi = np.full(p, np.inf) if upper is None else np.asarray(upper, dtype=float)
+    if bias_row is not None:
+        # x = T ω + e with T = [I; −φ₀ᵀ], e = (0, …, 0, −offset): the bias is eliminated exactly.
+        T = np.vstack([np.eye(p), -np.asarray(bias_row, dtype=float)[None, :]])
+        e = np.zeros(p + 1)
+        e[p] = -bias_offset
+        M, c = T.T @ M @ T, T.T @ (c - M @ e)
+    else:
+        lo, hi = np.append(lo, -np.inf), np.append(hi, np.inf)
+    n = M.shape[0]
+    d = 1.0 / np.sqrt(np.maximum(np.diag(M), 1e-300))
+    Ms, cs = M * d[:, None] * d[None, :], c * d
+    if np.all(np.isneginf(lo)) and np.all(np.isposinf(hi)):
+        try:
+            z = linalg.solve(Ms, cs, assume_a="pos", check_finite=False)
+        except linalg.LinAlgError:
+            z = linalg.lstsq(Ms, cs, check_finite=False)[0]
+        active = np.zeros(n, dtype=bool)
+    else:
+        # ½ zᵀ Ms z − csᵀ z = ½ ‖R z − R⁻ᵀ cs‖² + const with Ms = RᵀR (eigen-square-root if Ms is
+        # only semi-definite, as least squares with dependent regressors can be).
+        vals, vecs = np.linalg.eigh(Ms)
+        keep = vals > vals[-1] * 1e-14
+        R = np.sqrt(vals[keep])[:, None] * vecs[:, keep].T
+        rhs = (vecs[:, keep].T @ cs) / np.sqrt(vals[keep])
+        res = lsq_linear(R, rhs, bounds=(lo / d, hi / d), method="bvls", tol=1e-12)
+        z = res.x
+        active = res.active_mask != 0
+    x = z * d
+    if bias_row is not None:
+        coef = x
+        bias = float(-np.asarray(bias_row, dtype=float) @ coef) - bias_offset
+        return coef, bias, active
+    return x[:p], float(x[p]), active[:p]

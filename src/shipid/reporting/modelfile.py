@@ -55,7 +55,8 @@ def json_safe(obj):
 def model_document(ident: Identification, training_files: Sequence[str | Path] = (),
                    preprocessing: dict | None = None, refinement: Refinement | None = None,
                    plausibility: dict | None = None, model: ManoeuvringModel | None = None,
-                   selection: dict | None = None, particulars: dict | None = None) -> dict:  # fmt: skip
+                   selection: dict | None = None, particulars: dict | None = None,
+                   uncertainty: dict | None = None) -> dict:  # fmt: skip
     """The model file. ``model`` is the one users get (default: the refined model when there is a
     refinement, else the LS-SVM one); the LS-SVM model stays in ``refinement.initial_model`` and
     the refined one in ``refinement.refined_model``."""
@@ -65,8 +66,10 @@ def model_document(ident: Identification, training_files: Sequence[str | Path] =
         "format": FORMAT, "version": VERSION, "shipid": __version__,
         "model": model.to_dict(),
         "particulars": particulars,
+        "uncertainty": uncertainty,
         "identification": {"form": ident.form, "gamma": ident.gamma, "dt": ident.dt,
                            "estimator": ident.estimator, "selection": selection,
+                           "physics": ident.physics,
                            "discrete": ident.discrete, "diagnostics": ident.diagnostics,
                            "warnings": ident.warnings, "preprocessing": preprocessing or {},
                            "envelope": ident.envelope,
@@ -222,6 +225,18 @@ def model_from_document(doc: dict, path: str | Path, which: str = "model") -> Ma
         raise ShipidError(f"{path}: {exc}") from None
     except (KeyError, TypeError, ValueError) as exc:
         raise ShipidError(f"{path}: malformed model ({exc})") from None
+
+
+def ensemble_from_document(doc: Mapping, path: str | Path, model: ManoeuvringModel):
+    """The bootstrap ensemble of a model file (``shipid identify --bootstrap``), or None."""
+    data = doc.get("uncertainty")
+    if not data:
+        return None
+    from shipid.identification.uncertainty import Ensemble
+
+    if not isinstance(data, Mapping):
+        raise ShipidError(f"{path}: uncertainty must be a mapping")
+    return Ensemble.from_dict(data, model, f"{path}: uncertainty")
 
 
 def training_conditions(doc: Mapping) -> dict:

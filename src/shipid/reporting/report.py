@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -75,15 +76,29 @@ def metrics_frame(validations: Sequence[Validation]) -> pd.DataFrame:
 
 
 def indices_frame(validations: Sequence[Validation]) -> pd.DataFrame:
-    """Long form: log, index, measured, simulated (replay), closed loop."""
+    """Long form: log, index, measured, simulated (replay), closed loop; with a bootstrap
+    ensemble also the 95 % intervals of the two predictions ("[lower, upper]")."""
     rows = []
+    with_intervals = any(v.intervals for v in validations)
     for v in validations:
         meas, sim = v.indices.get("measured", {}), v.indices.get("simulated", {})
         closed = v.indices.get("closed_loop")
         for k in INDEX_KEYS:
             if k in meas or k in sim:
-                rows.append({"log": Path(v.name).name, "index": k, "measured": meas.get(k),
-                             "simulated (replay)": sim.get(k),
-                             "closed loop": None if closed is None else closed.get(k)})  # fmt: skip
-    return pd.DataFrame(rows, columns=["log", "index", "measured", "simulated (replay)",
-                                       "closed loop"])  # fmt: skip
+                row = {"log": Path(v.name).name, "index": k, "measured": meas.get(k),
+                       "simulated (replay)": sim.get(k),
+                       "closed loop": None if closed is None else closed.get(k)}  # fmt: skip
+                if with_intervals:
+                    row["replay 95 %"] = _bracket(v.intervals.get("simulated", {}).get(k))
+                    row["closed loop 95 %"] = _bracket(v.intervals.get("closed_loop", {}).get(k))
+                rows.append(row)
+    columns = ["log", "index", "measured", "simulated (replay)", "closed loop"]
+    if with_intervals:
+        columns += ["replay 95 %", "closed loop 95 %"]
+    return pd.DataFrame(rows, columns=columns)
+
+
+def _bracket(bounds) -> str | None:
+    if bounds is None or not all(math.isfinite(b) for b in bounds):
+        return None
+    return f"[{bounds[0]:.4g}, {bounds[1]:.4g}]"

@@ -17,8 +17,10 @@ rate), else at the SOLAS rate 2.32 °/s at full scale (2.32·√λ °/s at model
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
+import numpy as np
 import pandas as pd
 
 from shipid.data.particulars import Particulars
@@ -153,6 +155,24 @@ def imo_criteria(
                                         else None),
                   "rps": rps}  # fmt: skip
     return Criteria(pd.DataFrame(rows), conditions, runs, notes)
+
+
+def with_intervals(criteria: Criteria, replicates: Sequence[Criteria], level: float = 0.95
+                   ) -> pd.DataFrame:  # fmt: skip
+    """The criteria table with, per row, the percentile interval of the value over bootstrap
+    replicates of the model (``lower``, ``upper``) and the share of replicates that pass
+    (``pass_share``): how sure the verdict is."""
+    from shipid.identification.uncertainty import interval
+
+    table = criteria.table.copy()
+    values = np.array([[np.nan if v is None else v for v in c.table["value"]] for c in replicates],
+                      dtype=float)  # fmt: skip
+    passed = np.array([[p is True for p in c.table["passed"]] for c in replicates])
+    bounds = [interval(values[:, i], level) for i in range(len(table))]
+    table["lower"] = [b[0] for b in bounds]
+    table["upper"] = [b[1] for b in bounds]
+    table["pass_share"] = passed.mean(axis=0)
+    return table
 
 
 def _in_l(value, L: float) -> float | None:

@@ -50,7 +50,8 @@ class Trial:
         initial angle: the commanded rudder angle of a zig-zag or turn.
     first_rudder : signed deflection of the first plateau from neutral.
     switch_heading_deg : zig-zag switch heading inferred at the rudder orders (None if none).
-    rudder_rate : 90th percentile of the rudder rate while it moves [rad/s] (None if it never does).
+    rudder_rate : 90th percentile of the rudder rate while it moves [rad/s] (None if it never does,
+        or if the sampling does not resolve the movement).
     held_end_index : last sample of the held rudder after the execute (turning; else the end).
     """
 
@@ -116,9 +117,16 @@ def _plateau_orders(delta: np.ndarray, side: np.ndarray, i0: int) -> list[tuple[
 
 
 def _rudder_rate(t: np.ndarray, delta: np.ndarray) -> float | None:
-    rate = np.abs(np.diff(delta)) / np.diff(t)
+    step = np.abs(np.diff(delta))
+    rate = step / np.diff(t)
     moving = rate > math.radians(0.5)
-    return float(np.percentile(rate[moving], 90)) if moving.any() else None
+    if not moving.any():
+        return None
+    # Half the rudder's travel between two samples: the sampling does not resolve the movement,
+    # and step/Δt would only measure the sampling.
+    if step.max() >= 0.5 * np.ptp(delta):
+        return None
+    return float(np.percentile(rate[moving], 90))
 
 
 def describe_trial(

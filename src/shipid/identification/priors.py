@@ -1,0 +1,116 @@
+"""Prior models for the physics-informed fit: from the ship's particulars (Clarke et al. 1983)
+or from another model (an earlier fit of the same ship, a reference ship).
+
+Clarke, D., Gedling, P. and Hine, G. (1983), The application of manoeuvring criteria in hull design
+using linear theory, Trans. RINA 125, 45–68: regressions of the linear sway–yaw derivatives on
+T/L, B/T, B/L and Cb over merchant hulls, in the prime system with ½ρL²U (forces) and ½ρL³U
+(moments, and forces per r), S = π(T/L)²::
+
+    Y′v = −S (1 + 0.40 Cb B/T)            Y′r = −S (−1/2 + 2.2 B/L − 0.08 B/T)
+    N′v = −S (1/2 + 2.4 T/L)              N′r = −S (1/4 + 0.039 B/T − 0.56 B/L)
+    Y′v̇ = −S (1 + 0.16 Cb B/T − 5.1 (B/L)²)      Y′ṙ = −S (0.67 B/L − 0.0033 (B/T)²)
+    N′v̇ = −S (1.1 B/L − 0.041 B/T)               N′ṙ = −S (1/12 + 0.017 Cb B/T − 0.33 B/L)
+
+The rudder: normal force F = ½ρ A_R U² f_α δ with f_α = 6.13 Λ/(Λ + 2.25) (Fujii), aspect ratio
+Λ = 1.5, the rudder at x_R = −L/2 with hull interaction a_H = 0.2 at x_H = −0.45 L (MMG
+standard method, Yasukawa & Yoshimura 2015), no propeller slipstream (the data correct that):
+Yδ = −(1 + a_H) F/δ, Nδ = −(x_R + a_H x_H) F/δ for a rudder turning to starboard.
+
+The linear model M (v̇, ṙ) = F(v, r, δ) with M = [[m − Yv̇, m x_G − Yṙ], [m x_G − Nv̇, I_z − Nṙ]]
+and the rigid-body terms −m u r, −m x_G u r, solved for (v̇, ṙ), gives the acceleration-form
+coefficients of u·v, u·r and u²·δ (or v, r, δ at the approach speed) of any structure that has
+them; other terms get no prior (drawn toward 0 as without one). I_z = m (0.25 L)² + m x_G².
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from shipid.data.particulars import Particulars
+from shipid.dynamics.model import ManoeuvringModel, ModelStructure
+from shipid.dynamics.terms import parse_term
+from shipid.errors import ShipidError
+
+ASPECT_RATIO = 1.5
+A_H, X_H, X_R = 0.2, -0.45, -0.5  # hull interaction, its position and the rudder's, in L
+# Terms of the acceleration form each linear coefficient maps to, with the power of the approach
+# speed U0 the coefficient is multiplied by (v·U: power 0 on u·v, 1 on v alone, ...).
+SPEED_TERMS = {
+    "v": (("u*v", 0), ("|u|*v", 0), ("v*U", 0), ("v", 1)),
+    "r": (("u*r", 0), ("|u|*r", 0), ("r*U", 0), ("r", 1)),
+    "delta": (("u^2*delta", 0), ("|u|*u*delta", 0), ("U^2*delta", 0), ("delta", 2)),
+}
+
+
+def clarke_derivatives(p: Particulars) -> dict[str, float]:
+    """Clarke et al. (1983) prime derivatives Y′v … N′ṙ from the particulars."""
+    missing = [k for k in ("beam", "draught", "block_coefficient") if getattr(p, k) is None]
+    if missing:
+        raise ShipidError(f"the Clarke prior needs the particulars {', '.join(missing)}")
+    L, B, T, Cb = p.length, p.beam, p.draught, p.block_coefficient
+    S = math.pi * (T / L) ** 2
+    return {
+        "Yv": -S * (1 + 0.40 * Cb * B / T), "Yr": -S * (-0.5 + 2.2 * B / L - 0.08 * B / T),
+        "Nv": -S * (0.5 + 2.4 * T / L), "Nr": -S * (0.25 + 0.039 * B / T - 0.56 * B / L),
+        "Yvdot": -S * (1 + 0.16 * Cb * B / T - 5.1 * (B / L) ** 2),
+        "Yrdot": -S * (0.67 * B / L - 0.0033 * (B / T) ** 2),
+        "Nvdot": -S * (1.1 * B / L - 0.041 * B / T),
+        "Nrdot": -S * (1 / 12 + 0.017 * Cb * B / T - 0.33 * B / L),
+    }  # fmt: skip
+
+
+def clarke_linear(p: Particulars, rudder_positive: str | None) -> dict[str, dict[str, float]]:
+    """Acceleration-form linear coefficients {v, r} × {v, r, delta} per unit u (v̇ ≈ c_v u v +
+    c_r u r + c_δ u² δ), the rudder's sign by ``rudder_positive`` (None: no rudder prior)."""
+    d = clarke_derivatives(p)
+    rho, L = p.rho, p.length
+    m = p.mass if p.mass is not None else rho * p.volume
+    xg = p.xg
+    Iz = m * (0.25 * L) ** 2 + m * xg**2
+    q = 0.5 * rho
+    M = np.array([[m - q * L**3 * d["Yvdot"], m * xg - q * L**4 * d["Yrdot"]],
+                  [m * xg - q * L**4 * d["Nvdot"], Iz - q * L**5 * d["Nrdot"]]])  # fmt: skip
+    F = np.array([[q * L**2 * d["Yv"], q * L**3 * d["Yr"] - m],
+                  [q * L**3 * d["Nv"], q * L**4 * d["Nr"] - m * xg]])  # fmt: skip
+    acc = np.linalg.solve(M, F)
+    out = {"v": {"v": acc[0, 0], "r": acc[0, 1]}, "r": {"v": acc[1, 0], "r": acc[1, 1]}}
+    if rudder_positive is not None and p.rudder_area is not None:
+        f_alpha = 6.13 * ASPECT_RATIO / (ASPECT_RATIO + 2.25)
+        force = q * p.rudder_area * f_alpha  # per u² δ, for a rudder turning to starboard
+        sign = 1.0 if rudder_positive == "starboard" else -1.0
+        rud = np.linalg.solve(M, sign * force * np.array([-(1 + A_H), -(X_R + A_H * X_H) * L]))
+        out["v"]["delta"], out["r"]["delta"] = rud[0], rud[1]
+    return {k: {kk: float(vv) for kk, vv in v.items()} for k, v in out.items()}
+
+
+def clarke_prior(p: Particulars, structure: ModelStructure, speed: float,
+                 rudder_positive: str | None = None) -> dict[str, dict[str, float]]:  # fmt: skip
+    """Prior coefficients of ``structure`` from the particulars: its terms among
+    ``SPEED_TERMS`` (at approach speed ``speed`` for the speed-free ones)."""
+    if not speed > 0:
+        raise ShipidError("the Clarke prior needs the approach speed (> 0)")
+    linear = clarke_linear(p, rudder_positive)
+    prior: dict[str, dict[str, float]] = {}
+    for dof in ("v", "r"):
+        if dof not in structure.terms:
+            continue
+        texts = {parse_term(t).text for t in structure.terms[dof]}
+        for signal, options in SPEED_TERMS.items():
+            if signal not in linear[dof]:
+                continue
+            for text, power in options:
+                if parse_term(text).text in texts:
+                    prior.setdefault(dof, {})[parse_term(text).text] = \
+                        linear[dof][signal] * speed**power
+    if not prior:
+        raise ShipidError(f"the Clarke prior gives the u·v, u·r and u²·δ terms (or v, r, δ) of "
+                          f"v̇ and ṙ; the structure {structure.name} has none of them")
+    return prior
+
+
+def prior_from_model(model: ManoeuvringModel) -> dict[str, dict[str, float]]:
+    """A model's coefficients as a prior (e.g. a fit of other trials of the same ship)."""
+    return {d: {parse_term(t).text: float(c) for t, c in model.coefficients[d].items()}
+            for d in model.structure.dofs}  # fmt: skip

@@ -1,0 +1,215 @@
+"""Uncertainty of an identified model: a moving-block bootstrap of the regression equations gives
+an ensemble of coefficient sets, hence intervals on the coefficients, prediction bands on free
+runs and intervals on manoeuvring indices and criteria.
+
+Each replicate refits the same regression (structure, form, γ, estimator, priors and constraints)
+with the equations resampled in blocks of ``block_s`` seconds within each log (Künsch 1989): the
+blocks keep the equation errors' autocorrelation, which resampling single equations would
+ignore. The intervals are percentile intervals of the replicates. They cover what the equation
+error makes uncertain; a bias common to all replicates (errors in the measured states, a
+structure that lacks a term) is not in them.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from shipid.dynamics.model import DOFS, ManoeuvringModel
+from shipid.errors import ShipidError
+
+METHOD = "moving-block bootstrap of the regression equations"
+LEVEL = 0.95
+
+
+@dataclass
+class Ensemble:
+    """Bootstrap replicates of a model's coefficients.
+
+    Attributes
+    ----------
+    model : the point estimate (the fit of all equations).
+    thetas : (R, 3, T) coefficients of the replicates, columns ``model.term_texts``.
+    block_s, seed : the resampling.
+    """
+
+    model: ManoeuvringModel
+    thetas: np.ndarray
+    block_s: float
+    seed: int
+    method: str = METHOD
+
+    @property
+    def replicates(self) -> int:
+        """Number of replicates R."""
+        return int(self.thetas.shape[0])
+
+    def members(self) -> list[ManoeuvringModel]:
+        """The replicates as models (same structure as the point estimate)."""
+        index = {t: j for j, t in enumerate(self.model.term_texts)}
+        out = []
+        for theta in self.thetas:
+            coefs = {d: {t: float(theta[DOFS.index(d), index[t]]) for t in terms}
+                     for d, terms in self.model.structure.terms.items()}  # fmt: skip
+            out.append(ManoeuvringModel(self.model.structure, coefs, name=self.model.name))
+        return out
+
+    def coefficient_table(self, level: float = LEVEL) -> pd.DataFrame:
+        """One row per coefficient: estimate, bootstrap standard deviation and interval."""
+        index = {t: j for j, t in enumerate(self.model.term_texts)}
+        rows = []
+        for dof, terms in self.model.structure.terms.items():
+            i = DOFS.index(dof)
+            for t in terms:
+                values = self.thetas[:, i, index[t]]
+                lo, hi = interval(values, level)
+                rows.append({"equation": dof, "term": t,
+                             "value": float(self.model.coefficients[dof][t]),
+                             "bootstrap_std": float(np.std(values, ddof=1)), "lower": lo,
+                             "upper": hi})  # fmt: skip
+        return pd.DataFrame(rows)
+
+    def to_dict(self) -> dict:
+        """The model file's ``uncertainty`` record."""
+        return {"method": self.method, "replicates": self.replicates, "block_s": self.block_s,
+                "seed": self.seed, "terms": list(self.model.term_texts),
+                "thetas": self.thetas.tolist()}  # fmt: skip
+
+    @classmethod
+    def from_dict(cls, data: Mapping, model: ManoeuvringModel, where: str = "uncertainty"
+                  ) -> Ensemble:  # fmt: skip
+        """The ensemble of a model file (validated against its model's terms)."""
+        try:
+            terms = [str(t) for t in data["terms"]]
+            thetas = np.asarray(data["thetas"], dtype=float)
+            block_s, seed = float(data["block_s"]), int(data["seed"])
+        except (KeyError, TypeError, ValueError) as exc:
+            raise ShipidError(f"{where}: not a bootstrap ensemble ({exc})") from None
+        if terms != list(model.term_texts):
+            raise ShipidError(f"{where}: the ensemble's terms {terms} are not the model's "
+                              f"{list(model.term_texts)}")  # fmt: skip
+        if thetas.ndim != 3 or thetas.shape[1:] != (3, len(terms)) or thetas.shape[0] < 2:
+            raise ShipidError(f"{where}: thetas must be R ≥ 2 coefficient sets of shape "
+                              f"(3, {len(terms)}), got {thetas.shape}")  # fmt: skip
+        if not np.all(np.isfinite(thetas)):
+            raise ShipidError(f"{where}: the ensemble contains a non-finite coefficient")
+        return cls(model, thetas, block_s, seed, str(data.get("method", METHOD)))
+
+
+def interval(values: Sequence[float], level: float = LEVEL) -> tuple[float, float]:
+    """Central percentile interval of ``values`` (NaN ignored; NaN if none is finite)."""
+    v = np.asarray(values, dtype=float)
+    v = v[np.isfinite(v)]
+    if v.size == 0:
+        return math.nan, math.nan
+    a = 50.0 * (1.0 - level)
+    lo, hi = np.percentile(v, [a, 100.0 - a])
+    return float(lo), float(hi)
+
+
+def block_weights(lengths: Sequence[int], block: int, rng: np.random.Generator) -> np.ndarray:
+    """Multiplicity of each equation in one moving-block bootstrap replicate: blocks of ``block``
+    consecutive equations, never across two logs (of ``lengths`` equations each), drawn until
+    they hold as many equations as the data."""
+    lengths = [int(n) for n in lengths]
+    total = sum(lengths)
+    offsets = np.cumsum([0] + lengths[:-1])
+    # Block starts: every position of every log at which a whole block (or the whole log) fits.
+    starts, sizes = [], []
+    for off, n in zip(offsets, lengths, strict=True):
+        size = min(block, n)
+        k = n - size + 1
+        starts.append(off + np.arange(k))
+        sizes.append(np.full(k, size))
+    starts_a, sizes_a = np.concatenate(starts), np.concatenate(sizes)
+    # Enough draws for any mix of block sizes; keep those up to the first that reaches the total.
+    draws = rng.integers(len(starts_a), size=-(-total // int(sizes_a.min())))
+    used = int(np.searchsorted(np.cumsum(sizes_a[draws]), total)) + 1
+    s, m = starts_a[draws[:used]], sizes_a[draws[:used]]
+    edges = np.zeros(total + 1)  # +1 at each block's start, −1 after its end
+    np.add.at(edges, s, 1.0)
+    np.add.at(edges, s + m, -1.0)
+    return np.cumsum(edges[:-1])
+
+
+def bootstrap(
+    logs: Sequence[pd.DataFrame],
+    fit: Callable[[np.ndarray | None], ManoeuvringModel],
+    replicates: int = 200,
+    block_s: float = 10.0,
+    seed: int = 0,
+    progress: bool = False,
+) -> Ensemble:
+    """Bootstrap ensemble of the fit ``fit(weights) -> model`` (e.g. ``identify`` with
+    ``sample_weight``) over the equations of ``logs`` (one per sample but the last of each)."""
+    if not (isinstance(replicates, int) and replicates >= 10):
+        raise ShipidError(f"--bootstrap needs at least 10 replicates, got {replicates!r}")
+    if not (math.isfinite(block_s) and block_s > 0):
+        raise ShipidError(f"--block must be > 0 s, got {block_s!r}")
+    dt = float(np.median(np.diff(logs[0]["t"].to_numpy())))
+    block = max(1, int(round(block_s / dt)))
+    lengths = [len(log) - 1 for log in logs]
+    rng = np.random.default_rng(seed)
+    point = fit(None)
+    thetas = np.empty((replicates, *point.theta.shape))
+    bar = _bar(progress, replicates)
+    for k in range(replicates):
+        thetas[k] = fit(block_weights(lengths, block, rng)).theta
+        bar.update()
+    bar.close()
+    return Ensemble(point, thetas, float(block_s), int(seed))
+
+
+def _bar(progress: bool, total: int):
+    if progress:
+        from tqdm.auto import tqdm
+
+        return tqdm(total=total, desc="bootstrap", unit="fit", disable=None)  # None: off if no TTY
+
+    class _No:
+        def update(self, n=1):
+            pass
+
+        def close(self):
+            pass
+
+    return _No()
+
+
+Bands = dict[str, tuple[np.ndarray, np.ndarray]]
+
+
+def ensemble_runs(ensemble: Ensemble, log: pd.DataFrame, method: str = "euler") -> list:
+    """The replicates' free runs on ``log`` (``simulate_log`` of each member)."""
+    from shipid.dynamics.simulate import simulate_log
+
+    return [simulate_log(member, log, method) for member in ensemble.members()]
+
+
+def free_run_bands(runs: Sequence, n: int, level: float = LEVEL) -> tuple[Bands, int]:
+    """Prediction bands from the replicates' free runs (``ensemble_runs``) on a log of ``n``
+    samples: per state u, v, r the pointwise percentile interval, and how many replicates
+    diverged (their samples after the divergence are left out)."""
+    values = np.full((len(runs), n, 3), np.nan)
+    for k, sim in enumerate(runs):
+        m = len(sim.log)
+        values[k, :m] = sim.log[["u", "v", "r"]].to_numpy()
+    a = 50.0 * (1.0 - level)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # samples after every replicate diverged
+        lo = np.nanpercentile(values, a, axis=0)
+        hi = np.nanpercentile(values, 100.0 - a, axis=0)
+    bands = {s: (lo[:, j], hi[:, j]) for j, s in enumerate(("u", "v", "r"))}
+    return bands, sum(int(sim.diverged) for sim in runs)
+
+
+def index_intervals(samples: Sequence[Mapping[str, float]], level: float = LEVEL
+                    ) -> dict[str, tuple[float, float]]:  # fmt: skip
+    """Per index name: the percentile interval over the replicates' indices."""
+    names = sorted({k for s in samples for k, v in s.items() if isinstance(v, int | float)})
+    return {k: interval([s.get(k, math.nan) for s in samples], level) for k in names}

@@ -1,0 +1,125 @@
+"""Uncertainty (issue #10): the moving-block bootstrap against the closed-form standard error of
+an autocorrelated mean, the ensemble in model files, and its intervals through the CLI."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+from cli_helpers import run
+
+from shipid.data.io import write_log
+from shipid.dynamics.model import ManoeuvringModel
+from shipid.errors import ShipidError
+from shipid.identification.identify import identify
+from shipid.identification.uncertainty import Ensemble, block_weights, bootstrap, interval
+from shipid.reporting.modelfile import ensemble_from_document, load_document, model_from_document
+from shipid.trials.manoeuvres import zigzag
+from shipid.vessels import scale_ship
+
+
+def test_blocks_stay_inside_their_log():
+    rng = np.random.default_rng(1)
+    for _ in range(200):
+        # Blocks as long as the logs: each replicate takes whole logs, so its weights are
+        # constant over each log.
+        w = block_weights([40, 40, 40], 40, rng)
+        assert w.sum() == 120
+        assert all(len(set(w[i * 40:(i + 1) * 40])) == 1 for i in range(3))
+        w = block_weights([7, 30], 10, rng)
+        assert w.sum() >= 37 and w[:7].sum() % 7 == 0  # the short log only as a whole
+
+
+def test_block_bootstrap_of_an_autocorrelated_mean_matches_the_closed_form():
+    """AR(1) noise, φ = 0.8: the standard error of the mean is σ_e/(1 − φ)/√n, three times the
+    i.i.d. formula. Blocks much longer than the correlation time recover it; single samples
+    (blocks of one) give the i.i.d. value."""
+    phi, n, sigma = 0.8, 4000, 1.0
+    rng = np.random.default_rng(7)
+    e = np.zeros(n)
+    for k in range(1, n):
+        e[k] = phi * e[k - 1] + sigma * rng.normal()
+    log = __import__("pandas").DataFrame({"t": np.arange(n + 1) * 0.1})
+    data = e
+
+    class Mean:
+        theta = None
+
+    def fit(weights):
+        w = np.ones(n) if weights is None else weights
+        m = Mean()
+        m.theta = np.array([[np.sum(w * data) / np.sum(w)]])
+        return m
+
+    closed = sigma / (1 - phi) / math.sqrt(n)
+    iid = np.std(data) / math.sqrt(n)
+    long_blocks = bootstrap([log], fit, replicates=400, block_s=5.0, seed=2).thetas[:, 0, 0]
+    single = bootstrap([log], fit, replicates=400, block_s=0.1, seed=2).thetas[:, 0, 0]
+    assert np.std(long_blocks) == pytest.approx(closed, rel=0.25)
+    assert np.std(single) == pytest.approx(iid, rel=0.2)
+    assert interval([1.0, 2.0, math.nan, 3.0], 0.5) == (1.5, 2.5)
+
+
+@pytest.fixture(scope="module")
+def noisy_zigzag():
+    log = zigzag(scale_ship(), 20, 20, duration=40, dt=0.2).log
+    rng = np.random.default_rng(5)
+    for c, s in (("u", 0.005), ("v", 0.005), ("r", 0.003)):
+        log[c] = log[c] + s * rng.normal(size=len(log))
+    return log
+
+
+def test_ensemble_round_trips_and_is_validated(noisy_zigzag):
+    ens = bootstrap([noisy_zigzag], lambda w: identify(noisy_zigzag, sample_weight=w,
+                                                       force=True).model, replicates=12)  # fmt: skip
+    assert ens.thetas.shape == (12, *ens.model.theta.shape)
+    again = Ensemble.from_dict(json.loads(json.dumps(ens.to_dict())), ens.model)
+    np.testing.assert_array_equal(again.thetas, ens.thetas)
+    table = ens.coefficient_table()
+    assert (table["lower"] <= table["upper"]).all() and len(table) == 17
+    members = ens.members()
+    np.testing.assert_array_equal(members[3].theta, ens.thetas[3])
+    other = ManoeuvringModel("nomoto1", {"r": {"r": -1.0, "delta": 0.1}})
+    with pytest.raises(ShipidError, match="not the model's"):
+        Ensemble.from_dict(ens.to_dict(), other)
+    bad = ens.to_dict()
+    bad["thetas"][0][0][0] = float("nan")
+    with pytest.raises(ShipidError, match="non-finite"):
+        Ensemble.from_dict(bad, ens.model)
+
+
+def test_cli_bootstrap_bands_and_intervals(tmp_path, capsys, noisy_zigzag):
+    log = write_log(noisy_zigzag, tmp_path / "zz.csv")
+    model = tmp_path / "m.json"
+    code, out, err = run(["identify", log, "--bootstrap", "20", "--block", "4", "-o", model],
+                         capsys)  # fmt: skip
+    assert code == 0, err
+    assert "95 % intervals of the coefficients" in out
+    doc = load_document(model)
+    ens = ensemble_from_document(doc, model, model_from_document(doc, model))
+    assert ens.replicates == 20 and ens.block_s == 4.0
+    code, out, err = run(["validate", model, log, "--json", tmp_path / "v.json", "--quiet"],
+                         capsys)  # fmt: skip
+    assert code == 0, err
+    assert "closed loop 95 %" in out
+    rec = json.loads((tmp_path / "v.json").read_text())["logs"][0]
+    lo, hi = rec["index_intervals"]["closed_loop"]["first_overshoot_deg"]
+    assert lo <= hi and rec["ensemble_diverged"] == 0
+    code, out, err = run(["manoeuvre", model, "turning", "--rudder", "20", "--duration", "40"],
+                         capsys)  # fmt: skip
+    assert code == 0, err
+    line = next(ln for ln in out.splitlines() if ln.startswith("tactical_diameter:"))
+    value = float(line.split()[1])
+    lo, hi = (float(x) for x in line.split("[")[1].rstrip("]").split(","))
+    width = hi - lo
+    assert width > 0 and lo - width <= value <= hi + width
+    code, out, err = run(["criteria", model, "--length", "4.389", "--json", tmp_path / "c.json"],
+                         capsys)  # fmt: skip
+    assert code == 0, err
+    assert "pass_share" in out
+    rows = json.loads((tmp_path / "c.json").read_text())["criteria"]
+    assert all(0.0 <= r["pass_share"] <= 1.0 and r["lower"] <= r["upper"] for r in rows
+               if r["value"] is not None)  # fmt: skip
+    code, _, err = run(["identify", log, "--bootstrap", "20", "--refine", "-o",
+                        tmp_path / "x.json"], capsys)  # fmt: skip
+    assert code == 1 and "does not go with --refine" in err
