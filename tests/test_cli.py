@@ -184,3 +184,15 @@ def test_a_failing_demo_leaves_no_partial_folder(tmp_path, capsys, monkeypatch):
     code, _, err = run(["demo", "--out", tmp_path / "demo"], capsys)
     assert code == 1 and err.splitlines()[-1] == "shipid: error: No space left on device"
     assert "Traceback" not in err and not (tmp_path / "demo").exists()
+
+
+def test_a_closed_stdout_does_not_lose_the_model(tmp_path, trial):
+    """`shipid identify ... | head -1`: the reader goes away, the model file is still written."""
+    exe = Path(sys.executable).parent / "shipid"
+    trial_log = write_log(trial, tmp_path / "zz.csv")
+    out = tmp_path / "m.json"
+    script = f"'{exe}' identify '{trial_log}' --bootstrap 10 -o '{out}' | head -1"
+    res = subprocess.run(["bash", "-c", script], capture_output=True, text=True, timeout=120)
+    assert res.returncode == 0, res.stderr
+    assert "Broken pipe" not in res.stderr and "Traceback" not in res.stderr
+    assert json.loads(out.read_text())["uncertainty"]["replicates"] == 10

@@ -153,7 +153,8 @@ def test_cli_identify_refine_keeps_both_models(tmp_path, trial):
     path = tmp_path / "trial.csv"
     noisy.to_csv(path, index=False)
     out = tmp_path / "m.json"
-    assert main(["identify", str(path), "--refine", "--refine-evals", "40", "-o", str(out)]) == 0
+    assert main(["identify", str(path), "--refine", "--refine-evals", "40", "--filter", "none",
+                 "-o", str(out)]) == 0
     doc = json.loads(out.read_text())
     ref = doc["identification"]["refinement"]
     assert ref["cost_final"] <= ref["cost_initial"]

@@ -112,6 +112,16 @@ def _number_or_auto(text: str) -> float | str:
     return _time_or_auto(text)
 
 
+def _number_or_auto_or_none(text: str) -> float | str:
+    if text in ("auto", "none"):
+        return text
+    try:
+        return float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, 'auto' or 'none', got {text!r}") \
+            from None
+
+
 def _time_or_auto(text: str) -> float | str:
     if text == "auto":
         return text
@@ -301,10 +311,27 @@ def cmd_identify(args) -> int:
     if args.bootstrap is not None and args.refine:
         raise ShipidError("--bootstrap describes the LS-SVM fit; it does not go with --refine")
     logs = _read_logs(args)
-    if args.filter is not None:
-        logs = [lowpass(log, args.filter) for log in logs]
     names = [str(p) for p in args.logs]
     physics = _physics(args, logs, _structure(args))
+    cutoff, filter_by = args.filter, "given"
+    if cutoff == "auto":
+        from shipid.identification.prefilter import choose_prefilter
+
+        def fit(candidate_logs):
+            return identify(candidate_logs, model=args.model, form=args.form,
+                            gamma=1e4 if args.gamma == "auto" else args.gamma,
+                            drop=_parse_drop(args.drop), names=names, force=True,
+                            estimator=args.estimator, physics=physics).model  # fmt: skip
+
+        cutoff, table = choose_prefilter(logs, fit)
+        filter_by = "free-run error, one-standard-error rule"
+        shown = "none" if cutoff is None else f"{cutoff:.4g} Hz"
+        print(f"prefilter of u, v, r: {shown} (chosen by the free-run error on the logs; "
+              "--filter HZ|none to set it)")  # fmt: skip
+    elif cutoff == "none":
+        cutoff = None
+    if cutoff is not None:
+        logs = [lowpass(log, cutoff) for log in logs]
     gamma, gamma_report = args.gamma, None
     if gamma == "auto":
         gamma, gamma_report = _auto_gamma(args, logs, names, physics)
@@ -313,7 +340,8 @@ def cmd_identify(args) -> int:
                      estimator=args.estimator, physics=physics)  # fmt: skip
     speed, rps = _approach(logs[0], "u"), _approach(logs[0], "n")
     prep = {"dt": args.dt, "start": args.start, "end": args.end, "lead": args.lead,
-            "filter_hz": args.filter, "columns": args.columns, "degrees": args.degrees,
+            "filter_hz": cutoff, "filter_by": filter_by if cutoff is not None else None,
+            "columns": args.columns, "degrees": args.degrees,
             "format": args.format, "scale": args.scale,
             "approach_speed": speed, "approach_rps": rps, "rudder_rate": _rudder_rate(logs),
             "rudder_positive": logs[0].attrs.get("rudder_positive")}  # fmt: skip
@@ -1122,7 +1150,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--cv", help="with --gamma auto: logo, kfold:K or blocks:K (default: logo, "
                    "blocks:4 for one log)")
     p.add_argument("--drop", help="terms to drop, e.g. u:r^2 (the paper drops r²)")
-    p.add_argument("--filter", type=float, metavar="HZ", help="zero-phase low-pass of u, v, r")
+    p.add_argument("--filter", type=_number_or_auto_or_none, default="auto", metavar="HZ|auto|none",
+                   help="zero-phase low-pass of u, v, r against the errors-in-variables bias: a "
+                   "cut-off, 'none', or 'auto' (default): the cut-off whose model has the "
+                   "smallest free-run error on the logs (one-standard-error rule, so clean data "
+                   "keep none)")
     p.add_argument("--force", action="store_true",
                    help="keep a fit whose regressors are nearly dependent (still reported)")
     p.add_argument("--refine", action="store_true",
@@ -1344,11 +1376,51 @@ def build_parser() -> argparse.ArgumentParser:
     return ap
 
 
+class _ClosableStdout:
+    """stdout that goes quiet once its reader has gone (``shipid identify ... | head``): the
+    command still finishes and writes its files instead of failing on a broken pipe."""
+
+    def __init__(self, stream):
+        self._stream = stream
+        self._closed = False
+
+    def write(self, text: str) -> int:
+        if not self._closed:
+            try:
+                return self._stream.write(text)
+            except BrokenPipeError:
+                self._close()
+        return len(text)
+
+    def flush(self) -> None:
+        if not self._closed:
+            try:
+                self._stream.flush()
+            except BrokenPipeError:
+                self._close()
+
+    def _close(self) -> None:
+        import os
+
+        self._closed = True
+        try:  # what is still buffered goes nowhere, not into an error at exit
+            null = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(null, self._stream.fileno())
+            os.close(null)
+        except (OSError, ValueError, AttributeError):
+            pass
+
+    def __getattr__(self, name):
+        return getattr(self._stream, name)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit code (0, 1, 2 usage, 130 interrupted)."""
     args = build_parser().parse_args(argv)
     previous = signal.signal(signal.SIGTERM, _on_sigterm)
     caught: list[warnings.WarningMessage] = []
+    stdout = sys.stdout
+    sys.stdout = _ClosableStdout(stdout)
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", ShipidWarning)
@@ -1378,6 +1450,7 @@ def main(argv: list[str] | None = None) -> int:
         code = 1
     finally:
         signal.signal(signal.SIGTERM, previous)
+        sys.stdout = stdout
     seen = set()
     for w in caught:
         if issubclass(w.category, ShipidWarning) and str(w.message) not in seen:

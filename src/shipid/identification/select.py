@@ -288,11 +288,13 @@ def _model_from_theta(data: _Data, terms, theta: np.ndarray, name: str) -> Manoe
 
 
 # ---------------------------------------------------------------------------- scoring
-def normalised_error(measured: np.ndarray, simulated: np.ndarray, penalty: float) -> np.ndarray:
+def normalised_error(measured: np.ndarray, simulated: np.ndarray, penalty: float,
+                     scale: np.ndarray | None = None) -> np.ndarray:  # fmt: skip
     """Per state: RMS of (simulated − measured)/σ(measured) over the whole log, the samples after
-    a divergence (simulated is shorter) counting ``penalty`` each. 1 ≈ predicting the mean."""
+    a divergence (simulated is shorter) counting ``penalty`` each. 1 ≈ predicting the mean.
+    ``scale``: σ per state to use instead (e.g. the whole log's, for a part of it)."""
     n, m = len(measured), len(simulated)
-    sigma = np.maximum(measured.std(axis=0), 1e-9)
+    sigma = np.maximum(measured.std(axis=0) if scale is None else scale, 1e-9)
     err = (simulated - measured[:m]) / sigma
     return np.sqrt((np.sum(err * err, axis=0) + (n - m) * penalty * penalty) / n)
 
