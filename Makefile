@@ -27,6 +27,8 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_simulate.py
 	$(BIN)/python benchmarks/bench_select.py
 	$(BIN)/python benchmarks/bench_long_logs.py
+	$(BIN)/python benchmarks/bench_physics.py
+	$(BIN)/python benchmarks/study_uncertainty.py
 
 clean:
 	rm -rf $(VENV) shipid-demo build *.egg-info src/*.egg-info

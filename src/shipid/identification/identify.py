@@ -17,7 +17,7 @@ from shipid.dynamics.model import (
     coefficients_from_gamma,
     get_structure,
 )
-from shipid.dynamics.terms import parse_term
+from shipid.dynamics.terms import parse_term, term_matrix
 from shipid.errors import ShipidError
 from shipid.evaluation.envelope import envelope
 from shipid.identification.estimators import check_estimator_name, fit_linear
@@ -110,6 +110,40 @@ def _diagnose(p: RegressionProblem, coef: np.ndarray, bias: float, gamma: float
         "one_step_r2": r2,
         "residual_std": math.sqrt(sigma2),
     }, notes
+
+
+# Residual growth from the steady-speed equalities above which they are reported as a misfit.
+EQUALITY_COST = 1.25
+EQUALITY_TIME_CONSTANT_LOGS = 10.0
+
+
+def _equality_cost(p: RegressionProblem, g, b, estimator, gamma, extra) -> list[str]:
+    """A note when the equalities (steady speed) cost much of the equation's fit: the logs'
+    approaches are then not steady states of one such equation."""
+    import dataclasses
+
+    free = dataclasses.replace(extra, equalities=None)
+    g0, b0 = fit_linear(p.X, p.y, estimator, gamma, physics=free)
+    ss = float(np.sum((p.y - p.X @ g - b) ** 2))
+    ss0 = float(np.sum((p.y - p.X @ g0 - b0) ** 2))
+    hint = ("the logs' approaches are not steady states of one surge equation (start the logs "
+            "on a steady approach, or give one with --speed/--rps)")  # fmt: skip
+    if ss0 > 0 and ss > EQUALITY_COST * ss0:
+        return [f"{p.dof}: the steady-speed constraint raises the equation's residual "
+                f"{ss / ss0:.3g}-fold: {hint}"]
+    # Speed stability: ∂u̇/∂u < 0 on each approach, with a time constant 1/|∂u̇/∂u| within ten
+    # times the logs' duration; else the speed has no equilibrium to return to.
+    h = 1e-4
+    longest = EQUALITY_TIME_CONSTANT_LOGS * p.dt * len(p.y)
+    for u0, n0 in extra.approaches:
+        given = {"delta": np.zeros(2), "n": np.full(2, n0), "wind_speed": np.zeros(2),
+                 "wind_angle": np.zeros(2)}  # fmt: skip
+        rows = term_matrix(p.names, np.array([u0 + h, u0 - h]), np.zeros(2), np.zeros(2), given)
+        slope = float((rows[0] - rows[1]) @ g / (2 * h))
+        if not slope < -1.0 / longest:
+            return [f"{p.dof}: with the steady-speed constraint the surge equation has no speed "
+                    f"stability at {u0:.4g} m/s (∂u̇/∂u = {slope:.3g} 1/s): {hint}"]
+    return []
 
 
 def _check_sample_count(p: RegressionProblem, logs) -> list[str]:
@@ -232,6 +266,8 @@ def identify(
         notes += extra.notes + [f"{dof}: {_display(n)} held at its bound {g[p.names.index(n)]:.4g} "
                                 f"({extra.reasons.get(n, 'bound')}): the unconstrained fit goes "
                                 "past it" for n in held]  # fmt: skip
+        if extra.equalities is not None and sample_weight is None:
+            notes += _equality_cost(p, g, b, estimator, gamma, extra)
         cond = diagnostics[dof]["condition_number"]
         if not cond <= MAX_CONDITION:
             message = (f"{dof}: the regressors {', '.join(_display(n) for n in p.names)} are "

@@ -1,9 +1,9 @@
 """What physics adds to the regression (issue #10): a prior model the LS-SVM is drawn toward,
-sign constraints on damping and rudder terms, user bounds, and steady speed on the approach.
+sign constraints on damping and rudder terms, user bounds, and steady speed on the approaches.
 
 All act on the continuous-time coefficients of the increment form (the default), inside the
 solver (``shipid.lssvm.solvers.solve_primal_constrained``): bounds by bounded least squares, the
-steady-speed condition by eliminating the bias exactly. Nothing is clipped after the fit.
+steady-speed conditions as linear equalities. Nothing is clipped after the fit.
 
 Sign table (``SIGN_RULES``; accelerations in the body frame, forward speed u > 0, "rudder sign"
 s = +1 when a positive rudder angle turns the ship to starboard, −1 when to port):
@@ -65,9 +65,10 @@ class PhysicsOptions:
         ``shipid.identification.priors`` (Clarke et al. 1983 from the particulars, or a model).
     signs : apply ``SIGN_RULES``.
     bounds : {dof: {term: (lower, upper)}} further bounds (use ±inf for one-sided).
-    steady_speed : u̇ = 0 on the straight approach (u0, n0, rudder amidships, no wind): the
-        surge equation's constant term is tied to the others.
-    approach : {"u": u0, "n": n0} for ``steady_speed`` (default: the first training log's start).
+    steady_speed : u̇ = 0 on the straight approach (u0, n0, rudder amidships, no wind) of every
+        training log: the surge equation reproduces the speed each propeller speed holds.
+    approach : {"u": u0, "n": n0}: the one approach for ``steady_speed`` (default: each
+        training log's start).
     rudder_positive : 'port' or 'starboard' (default: the logs' metadata).
     """
 
@@ -112,8 +113,8 @@ class DofPhysics:
     prior: np.ndarray | None
     lower: np.ndarray
     upper: np.ndarray
-    bias_row: np.ndarray | None = None
-    bias_offset: float = 0.0
+    equalities: tuple[np.ndarray, np.ndarray] | None = None  # (E over [ω; b], f)
+    approaches: list[tuple[float, float]] = field(default_factory=list)  # (u0, n0) of the above
     reasons: dict[str, str] = field(default_factory=dict)  # term → why it is bounded
     notes: list[str] = field(default_factory=list)
     active: np.ndarray | None = None  # after the fit: which coefficients sit on a bound
@@ -143,28 +144,34 @@ def _sign_bounds(dof: str, term: str, s: float | None) -> tuple[float, float, st
     return None
 
 
-def _approach_row(dof_terms: Sequence[str], fixed: Mapping[str, float], options: PhysicsOptions,
-                  logs: Sequence[pd.DataFrame]) -> tuple[np.ndarray, float, str]:  # fmt: skip
-    start = dict(options.approach or {})
-    first = logs[0].iloc[0]
-    u0 = float(start.get("u", first["u"]))
-    n0 = float(start.get("n", first["n"] if "n" in logs[0].columns else 0.0))
-    if not u0 > 0:
-        raise ShipidError("steady-speed constraint: the approach speed must be > 0 (give it with "
-                          "--speed)")  # fmt: skip
+def _approach_rows(dof_terms: Sequence[str], fixed: Mapping[str, float], has_constant: bool,
+                   options: PhysicsOptions, logs: Sequence[pd.DataFrame],
+                   ) -> tuple[np.ndarray, np.ndarray, list]:  # fmt: skip
+    """Equalities u̇ = 0 at the approach state (u0, n0, rudder amidships, no wind) of every
+    training log (or at ``options.approach``): rows over [free terms; bias], targets."""
     texts = list(dof_terms) + list(fixed)
     needs = {i for t in texts for i in parse_term(t).inputs}
     if "thrust" in needs:
         raise ShipidError("steady-speed constraint: the surge equation has a thrust term, whose "
                           "value on the approach is not known; identify with propeller-speed "
                           "(n) terms")  # fmt: skip
-    given = {"delta": np.zeros(1), "n": np.full(1, n0), "wind_speed": np.zeros(1),
-             "wind_angle": np.zeros(1)}  # fmt: skip
-    row = term_matrix(texts, np.full(1, u0), np.zeros(1), np.zeros(1), given)[0]
+    if options.approach:
+        states = [(float(options.approach["u"]), float(options.approach.get("n", 0.0)))]
+    else:
+        states = sorted({(float(log["u"].iloc[0]),
+                          float(log["n"].iloc[0]) if "n" in log.columns else 0.0) for log in logs})
+    if not all(u0 > 0 for u0, _ in states):
+        raise ShipidError("steady-speed constraint: a training log starts without headway; trim "
+                          "it to the approach (--start) or give the approach with --speed")  # fmt: skip
+    u0 = np.array([s[0] for s in states])
+    n0 = np.array([s[1] for s in states])
+    zero = np.zeros(len(states))
+    given = {"delta": zero, "n": n0, "wind_speed": zero, "wind_angle": zero}
+    rows = term_matrix(texts, u0, zero, zero, given)
     k = len(dof_terms)
-    offset = float(row[k:] @ np.array([fixed[t] for t in fixed])) if fixed else 0.0
-    where = f"u0 = {u0:.4g} m/s" + (f", n0 = {n0:.4g} rps" if "n" in needs else "")
-    return row[:k], offset, where
+    E = np.column_stack([rows[:, :k], np.full(len(states), 1.0 if has_constant else 0.0)])
+    f = -(rows[:, k:] @ np.array([fixed[t] for t in fixed])) if fixed else np.zeros(len(states))
+    return E, f, states
 
 
 def dof_physics(options: PhysicsOptions | None, dof: str, names: Sequence[str], has_constant: bool,
@@ -209,9 +216,8 @@ def dof_physics(options: PhysicsOptions | None, dof: str, names: Sequence[str], 
         # A prior outside the bounds would pull against them: start from the feasible point.
         out.prior = np.clip(out.prior, out.lower, out.upper)
     if options.steady_speed and dof == "u":
-        if not has_constant:
-            raise ShipidError("steady-speed constraint: the surge equation needs its constant "
-                              "term '1' (it carries the thrust at the approach)")  # fmt: skip
-        out.bias_row, out.bias_offset, where = _approach_row(names, fixed, options, logs)
-        out.notes.append(f"u: steady speed on the approach ({where}) imposed")
+        E, f, out.approaches = _approach_rows(names, fixed, has_constant, options, logs)
+        out.equalities = (E, f)
+        where = ", ".join(f"{a:.4g} m/s at {b:.4g} rps" for a, b in out.approaches)
+        out.notes.append(f"u: steady speed imposed on the approach ({where})")
     return out

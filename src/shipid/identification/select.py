@@ -268,7 +268,7 @@ def _fit_theta(data: _Data, terms: Mapping[str, Sequence[str]], gamma: float, tr
             b = sum(data.cross[j][dof][sel] for j in train)
             w, bias, _ = solve_primal_constrained(
                 A, b, gamma if estimator == "lssvm" else math.inf, extra.prior, extra.lower,
-                extra.upper, extra.bias_row, extra.bias_offset)
+                extra.upper, extra.equalities)
         else:
             X = np.vstack([data.phi[j][:, cols] for j in train])
             y = np.concatenate([data.targets[j][dof] for j in train])

@@ -149,6 +149,11 @@ def solve_primal(
     return x[:p].T.copy(), x[p].copy(), condition
 
 
+# Weight of the equality rows, relative to the equilibrated normal equations (unit diagonal), when
+# bounds force the penalty form: equalities then hold to about 1e-8 of the data's scale.
+EQUALITY_PENALTY = 1e8
+
+
 def solve_primal_constrained(
     A: np.ndarray,
     b: np.ndarray,
@@ -156,28 +161,31 @@ def solve_primal_constrained(
     prior: np.ndarray | None = None,
     lower: np.ndarray | None = None,
     upper: np.ndarray | None = None,
-    bias_row: np.ndarray | None = None,
-    bias_offset: float = 0.0,
+    equalities: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> tuple[np.ndarray, float, np.ndarray]:
-    """One output of the primal LS-SVM with physics: a prior, bounds and a tied bias.
+    """One output of the primal LS-SVM with physics: a prior, bounds and linear equalities.
 
     Solves ``min ½‖ω − ω₀‖² + ½ Σ γ wᵢ eᵢ²`` (the LS-SVM regularisation drawn toward the prior
-    ω₀ instead of 0) subject to ``lower ≤ ω ≤ upper`` and, with ``bias_row`` φ₀,
-    ``b = −φ₀ᵀω − bias_offset`` (the fitted equation, plus terms held fixed worth
-    ``bias_offset`` there, vanishes at the state φ₀: e.g. steady speed on the approach).
+    ω₀ instead of 0) subject to ``lower ≤ ω ≤ upper`` and ``E [ω; b] = f`` (e.g. the fitted
+    equation vanishing at approach states: steady speed).
 
     Parameters
     ----------
     A, b : the bordered normal equations of ``accumulate_normal_equations`` (without I/γ), A
         (p+1, p+1) and b (p+1,); the last row is the bias.
     gamma : γ > 0; ``math.inf`` for least squares (no regularisation, the prior unused).
+    equalities : (E (k, p+1), f (k,)), the last column of E multiplying the bias.
 
     Returns
     -------
     coef (p,), bias, and the boolean mask of the coefficients held at a bound.
 
-    The bounded problem is the quadratic program of the equilibrated normal equations, solved as
-    the least-squares problem of its Cholesky factor by SciPy's bounded-variable least squares.
+    Without bounds the problem is solved exactly (the KKT system of the equilibrated normal
+    equations, least-squares in case equalities repeat). With bounds it is the quadratic program
+    of the equilibrated normal equations, solved as the least-squares problem of its square root
+    by SciPy's bounded-variable least squares (the equalities as rows of weight
+    ``EQUALITY_PENALTY``), then solved exactly again with the bounds it found active held as
+    equalities (kept if it stays within the other bounds).
     """
     from scipy.optimize import lsq_linear
 
@@ -188,38 +196,49 @@ def solve_primal_constrained(
         M[np.arange(p), np.arange(p)] += 1.0 / gamma
         if prior is not None:
             c[:p] += np.asarray(prior, dtype=float) / gamma
-    lo = np.full(p, -np.inf) if lower is None else np.asarray(lower, dtype=float)
-    hi = np.full(p, np.inf) if upper is None else np.asarray(upper, dtype=float)
-    if bias_row is not None:
-        # x = T ω + e with T = [I; −φ₀ᵀ], e = (0, …, 0, −offset): the bias is eliminated exactly.
-        T = np.vstack([np.eye(p), -np.asarray(bias_row, dtype=float)[None, :]])
-        e = np.zeros(p + 1)
-        e[p] = -bias_offset
-        M, c = T.T @ M @ T, T.T @ (c - M @ e)
-    else:
-        lo, hi = np.append(lo, -np.inf), np.append(hi, np.inf)
-    n = M.shape[0]
+    lo = np.append(np.full(p, -np.inf) if lower is None else np.asarray(lower, dtype=float), -np.inf)
+    hi = np.append(np.full(p, np.inf) if upper is None else np.asarray(upper, dtype=float), np.inf)
     d = 1.0 / np.sqrt(np.maximum(np.diag(M), 1e-300))
     Ms, cs = M * d[:, None] * d[None, :], c * d
-    if np.all(np.isneginf(lo)) and np.all(np.isposinf(hi)):
+    E = f = None
+    if equalities is not None:
+        E = np.atleast_2d(np.asarray(equalities[0], dtype=float)) * d[None, :]
+        f = np.atleast_1d(np.asarray(equalities[1], dtype=float))
+    bounded = not (np.all(np.isneginf(lo)) and np.all(np.isposinf(hi)))
+    active = np.zeros(p + 1, dtype=bool)
+    if bounded:
+        Mp, cp = Ms, cs
+        if E is not None:
+            Mp = Ms + EQUALITY_PENALTY * E.T @ E
+            cp = cs + EQUALITY_PENALTY * E.T @ f
+        # ½ zᵀ M z − cᵀ z = ½ ‖R z − R⁻ᵀ c‖² + const with M = RᵀR (eigen-square-root if M is
+        # only semi-definite, as least squares with dependent regressors can be).
+        vals, vecs = np.linalg.eigh(Mp)
+        keep = vals > vals[-1] * 1e-15
+        R = np.sqrt(vals[keep])[:, None] * vecs[:, keep].T
+        rhs = (vecs[:, keep].T @ cp) / np.sqrt(vals[keep])
+        res = lsq_linear(R, rhs, bounds=(lo / d, hi / d), method="bvls", tol=1e-13)
+        z, active = res.x, res.active_mask != 0
+        if E is None:
+            x = z * d
+            return x[:p], float(x[p]), active[:p]
+    # Exact: the KKT system with the equalities and the bounds found active held as equalities.
+    held = np.flatnonzero(active)
+    rows = [] if E is None else [E]
+    rhs_eq = [] if E is None else [f]
+    if held.size:
+        rows.append(np.eye(p + 1)[held])
+        rhs_eq.append(np.where(z[held] <= (lo / d)[held], (lo / d)[held], (hi / d)[held]))
+    if rows:
+        C, g = np.vstack(rows), np.concatenate(rhs_eq)
+        K = np.block([[Ms, C.T], [C, np.zeros((len(g), len(g)))]])
+        exact = linalg.lstsq(K, np.concatenate([cs, g]), check_finite=False)[0][: p + 1]
+        if not bounded or np.all((exact >= lo / d - 1e-9) & (exact <= hi / d + 1e-9)):
+            z = exact
+    else:
         try:
             z = linalg.solve(Ms, cs, assume_a="pos", check_finite=False)
         except linalg.LinAlgError:
             z = linalg.lstsq(Ms, cs, check_finite=False)[0]
-        active = np.zeros(n, dtype=bool)
-    else:
-        # ½ zᵀ Ms z − csᵀ z = ½ ‖R z − R⁻ᵀ cs‖² + const with Ms = RᵀR (eigen-square-root if Ms is
-        # only semi-definite, as least squares with dependent regressors can be).
-        vals, vecs = np.linalg.eigh(Ms)
-        keep = vals > vals[-1] * 1e-14
-        R = np.sqrt(vals[keep])[:, None] * vecs[:, keep].T
-        rhs = (vecs[:, keep].T @ cs) / np.sqrt(vals[keep])
-        res = lsq_linear(R, rhs, bounds=(lo / d, hi / d), method="bvls", tol=1e-12)
-        z = res.x
-        active = res.active_mask != 0
     x = z * d
-    if bias_row is not None:
-        coef = x
-        bias = float(-np.asarray(bias_row, dtype=float) @ coef) - bias_offset
-        return coef, bias, active
     return x[:p], float(x[p]), active[:p]
