@@ -217,7 +217,8 @@ COMMANDS = {
     "plot": ["plot", "{log}", "-o", "{out}/p.png"],
 }
 OPTIONS = {
-    "identify": ["--gamma", "--dt", "--filter", "--lead", "--start", "--end"],
+    "identify": ["--gamma", "--dt", "--filter", "--lead", "--start", "--end", "--bootstrap",
+                 "--block"],
     "validate": ["--dt", "--smooth", "--start", "--end"],
     "manoeuvre": ["--rudder", "--heading", "--duration", "--dt", "--speed", "--rps",
                   "--wind-speed", "--wind-from"],

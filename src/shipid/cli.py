@@ -370,7 +370,7 @@ def cmd_identify(args) -> int:
         how = "whole logs" if args.segment is None else f"{args.segment:g} s segments"
         print(f"refining by output error ({how})…", file=sys.stderr)
         refinement = refine(ident.model, logs, segment_s=args.segment, gamma=gamma,
-                            max_nfev=args.refine_evals, names=names)  # fmt: skip
+                            max_nfev=args.refine_evals, names=names, progress=True)  # fmt: skip
         print()
         print("refined by output error:")
         print(refinement.model.equations())

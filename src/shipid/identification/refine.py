@@ -165,6 +165,7 @@ def refine(
     method: str = "euler",
     max_nfev: int = 100,
     names: Sequence[str] | None = None,
+    progress: bool = False,
 ) -> Refinement:
     """Refine ``model`` (e.g. ``identify(...).model``) by output-error fitting to ``logs``.
 
@@ -180,6 +181,7 @@ def refine(
         states of the validation metrics). Adding "psi" also weighs the heading.
     method : 'euler' (the paper's scheme and ``validate``'s default) or 'rk4'.
     max_nfev : cap on the number of cost evaluations of ``least_squares``.
+    progress : a progress bar of the free-run simulations (on a terminal only).
     """
     if isinstance(logs, pd.DataFrame):
         logs = [logs]
@@ -219,7 +221,14 @@ def refine(
     speed_lim, yaw_lim = DivergenceBounds().resolved(float(np.max(np.abs(seg.shot0[:, 0]))))
     alive_grid = np.arange(L)[None, :]
 
+    from tqdm.auto import tqdm
+
+    # Each cost evaluation and each column of the finite-difference Jacobian is one simulation.
+    bar = tqdm(total=max_nfev * (len(x0) + 1), desc="refinement", unit="sim",
+               disable=None if progress else True)  # fmt: skip
+
     def residuals(x: np.ndarray) -> np.ndarray:
+        bar.update()
         theta = np.zeros_like(model.theta)
         theta[rows, cols] = x
         out, n_valid = run_kernel(model.code, theta, seg.t, seg.inputs, s0, method, speed_lim,
@@ -232,7 +241,10 @@ def refine(
     # Relative steps and scales: coefficients span orders of magnitude (|n|n ~ 1e-5, δ ~ 1e-2).
     scale = np.maximum(np.abs(x0), 1e-3 * (np.abs(x0).max() or 1.0))
     cost_initial = 0.5 * float(np.sum(residuals(x0) ** 2))
-    fit = least_squares(residuals, x0, method="trf", x_scale=scale, max_nfev=max_nfev)
+    try:
+        fit = least_squares(residuals, x0, method="trf", x_scale=scale, max_nfev=max_nfev)
+    finally:
+        bar.close()
     coefs = {dof: {} for dof in dofs}
     for (i, j), value in zip(slots, fit.x, strict=True):
         coefs[DOFS[i]][model.term_texts[j]] = float(value)
