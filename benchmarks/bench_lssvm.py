@@ -13,18 +13,10 @@ import time
 import numpy as np
 from scipy import linalg
 from sklearn.kernel_ridge import KernelRidge
+from timing import best_of
 
 from shipid.lssvm import LSSVR, LSSVRCV, kernel_matrix
 from shipid.lssvm.selection import DualLOOPath, PrimalLOOPath
-
-
-def best_time(fn, repeats: int) -> float:
-    times = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return min(times)
 
 
 def smooth_target(X: np.ndarray) -> np.ndarray:
@@ -38,9 +30,9 @@ def linear_kernel_rows(sizes, repeats):
         X = rng.normal(size=(n, 8))
         Y = X @ rng.normal(size=(8, 3)) + 0.1 * rng.normal(size=(n, 3))
         Xb = np.column_stack([X, np.ones(n)])
-        t_ls = best_time(lambda: np.linalg.lstsq(Xb, Y, rcond=None), repeats)  # noqa: B023
+        t_ls = best_of(lambda: np.linalg.lstsq(Xb, Y, rcond=None), repeats)  # noqa: B023
         est = LSSVR(gamma=1e4, kernel="linear")
-        t_fit = best_time(lambda: est.fit(X, Y), repeats)  # noqa: B023
+        t_fit = best_of(lambda: est.fit(X, Y), repeats)  # noqa: B023
         rows.append(
             (f"linear kernel fit, N={n:.0e}, p=8, 3 outputs", t_fit, "numpy.linalg.lstsq", t_ls,
              "≤ 3×")
@@ -56,9 +48,9 @@ def dense_rbf_rows(sizes, repeats):
         X = rng.normal(size=(n, 8))
         y = smooth_target(X) + 0.1 * rng.normal(size=n)
         kr = KernelRidge(alpha=1.0 / gamma, kernel="rbf", gamma=1.0 / sigma**2)
-        t_kr = best_time(lambda: kr.fit(X, y), repeats)  # noqa: B023
+        t_kr = best_of(lambda: kr.fit(X, y), repeats)  # noqa: B023
         est = LSSVR(gamma=gamma, sigma=sigma)
-        t_fit = best_time(lambda: est.fit(X, y), repeats)  # noqa: B023
+        t_fit = best_of(lambda: est.fit(X, y), repeats)  # noqa: B023
         rows.append((f"dense RBF fit, N={n}", t_fit, "sklearn KernelRidge", t_kr, "≤ 1.0×"))
     return rows
 
@@ -138,19 +130,19 @@ def loo_grid_rows(repeats):
     Y = X @ rng.normal(size=(8, 3)) + 0.1 * rng.normal(size=(100_000, 3))
     w = np.ones(len(X))
     PrimalLOOPath(X[:100], Y[:100], w[:100]).mse(1.0)  # compile / load the cached kernel
-    t_one = best_time(lambda: LSSVR(gamma=1e4, kernel="linear").fit(X, Y), repeats)
-    t_grid = best_time(lambda: grid_only(lambda: PrimalLOOPath(X, Y, w), gammas), repeats)
-    t_cv = best_time(lambda: LSSVRCV(gammas=gammas, kernel="linear").fit(X, Y), repeats)
+    t_one = best_of(lambda: LSSVR(gamma=1e4, kernel="linear").fit(X, Y), repeats)
+    t_grid = best_of(lambda: grid_only(lambda: PrimalLOOPath(X, Y, w), gammas), repeats)
+    t_cv = best_of(lambda: LSSVRCV(gammas=gammas, kernel="linear").fit(X, Y), repeats)
     rows.append(("20-γ exact-LOO grid, linear N=1e5 p=8, 3 outputs", t_grid, "one fit", t_one,
                  "≤ 3×"))
     rows.append(("LSSVRCV (grid + validation + refit), same", t_cv, "one fit", t_one, "–"))
     X = rng.normal(size=(2000, 8))
     y = smooth_target(X)
     w = np.ones(len(X))
-    t_one = best_time(lambda: LSSVR(gamma=10.0, sigma=2.0).fit(X, y), repeats)
+    t_one = best_of(lambda: LSSVR(gamma=10.0, sigma=2.0).fit(X, y), repeats)
     K_path = lambda: DualLOOPath(kernel_matrix(X, X, "rbf", sigma=2.0), y[:, None], w)  # noqa: E731
-    t_grid = best_time(lambda: grid_only(K_path, gammas), repeats)
-    t_naive = best_time(lambda: naive_dense_loo_grid(X, y, gammas, 2.0), 1)
+    t_grid = best_of(lambda: grid_only(K_path, gammas), repeats)
+    t_naive = best_of(lambda: naive_dense_loo_grid(X, y, gammas, 2.0), 1)
     rows.append(("20-γ exact-LOO grid, dense RBF N=2000", t_grid, "one fit", t_one, "≤ 3×"))
     rows.append(("20-γ exact-LOO grid, dense RBF N=2000", t_grid,
                  "per-γ Cholesky + inverse", t_naive, "–"))

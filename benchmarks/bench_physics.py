@@ -8,7 +8,8 @@ Run: .venv/bin/python benchmarks/bench_physics.py
 from __future__ import annotations
 
 import os
-import time
+
+from timing import best_of
 
 from shipid.data.preprocess import lowpass
 from shipid.identification.identify import identify
@@ -17,15 +18,6 @@ from shipid.identification.prefilter import choose_prefilter
 from shipid.identification.uncertainty import bootstrap
 from shipid.trials.manoeuvres import zigzag
 from shipid.vessels import PAPER_IMU, scale_ship, scale_ship_model
-
-
-def best_of(fn, repeat: int = 3) -> float:
-    times = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return min(times)
 
 
 def main() -> None:

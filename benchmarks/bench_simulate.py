@@ -15,10 +15,10 @@ from __future__ import annotations
 
 import math
 import os
-import time
 
 import numba
 import numpy as np
+from timing import best_of
 
 from shipid.dynamics.model import ManoeuvringModel, ModelStructure
 from shipid.dynamics.simulate import input_array, run_kernel, simulate, simulate_batch
@@ -108,13 +108,6 @@ def numba_loop(a, b, c, t, delta, u0, rk4, out):
         out[k + 1, 3], out[k + 1, 4], out[k + 1, 5] = psi, x, y
 
 
-def best_of(fn, repeat=3) -> float:
-    times = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return min(times)
 
 
 def main() -> None:

@@ -20,7 +20,7 @@ from shipid.identification.physics import PhysicsOptions, parse_constraints
 from shipid.identification.priors import clarke_derivatives, clarke_linear, clarke_prior
 from shipid.lssvm.solvers import accumulate_normal_equations, solve_primal_constrained
 from shipid.trials.manoeuvres import zigzag
-from shipid.vessels import scale_ship
+from shipid.vessels import SensorModel, scale_ship
 from shipid.vessels.kvlcc2 import accelerations, trimmed_revolutions
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
@@ -97,10 +97,7 @@ def test_constrained_solver_equals_an_independent_minimiser(regression, case):
 def short_zigzag():
     """A short 20/20 zig-zag of the scale ship (positive rudder turns it to port), noisy."""
     log = zigzag(scale_ship(), 20, 20, duration=25, dt=0.2).log
-    rng = np.random.default_rng(0)
-    for c, s in (("u", 0.01), ("v", 0.01), ("r", 0.005)):
-        log[c] = log[c] + s * rng.normal(size=len(log))
-    return log
+    return SensorModel(white={"u": 0.01, "v": 0.01, "r": 0.005}).apply(log, seed=0)
 
 
 def test_sign_constraints_hold_and_are_reported(short_zigzag):

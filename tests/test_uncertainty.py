@@ -15,7 +15,7 @@ from shipid.identification.identify import identify
 from shipid.identification.uncertainty import Ensemble, block_weights, bootstrap, interval
 from shipid.reporting.modelfile import ensemble_from_document, load_document, model_from_document
 from shipid.trials.manoeuvres import zigzag
-from shipid.vessels import scale_ship
+from shipid.vessels import SensorModel, scale_ship
 
 
 def test_blocks_stay_inside_their_log():
@@ -63,10 +63,7 @@ def test_block_bootstrap_of_an_autocorrelated_mean_matches_the_closed_form():
 @pytest.fixture(scope="module")
 def noisy_zigzag():
     log = zigzag(scale_ship(), 20, 20, duration=40, dt=0.2).log
-    rng = np.random.default_rng(5)
-    for c, s in (("u", 0.005), ("v", 0.005), ("r", 0.003)):
-        log[c] = log[c] + s * rng.normal(size=len(log))
-    return log
+    return SensorModel(white={"u": 0.005, "v": 0.005, "r": 0.003}).apply(log, seed=5)
 
 
 def test_ensemble_round_trips_and_is_validated(noisy_zigzag):
