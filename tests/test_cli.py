@@ -168,6 +168,36 @@ def test_sigterm_gives_one_line_exit_130_and_no_temporaries(tmp_path):
     assert os.listdir(tmp_path) == []
 
 
+INTERRUPTED_INSIDE_A_COMPILE = """
+import sys
+import shipid.cli as cli
+
+class HalfBuilt:  # as llvmlite's objects left by an interrupted numba compile
+    def __del__(self):
+        raise AttributeError("'ValueRef' object has no attribute '_as_parameter_'")
+
+def interrupted(args):
+    held_by_the_traceback = HalfBuilt()
+    in_a_cycle = [HalfBuilt()]
+    in_a_cycle.append(in_a_cycle)
+    global kept_to_teardown
+    kept_to_teardown = HalfBuilt()
+    raise KeyboardInterrupt
+
+cli.check_options = interrupted
+sys.argv = ["shipid", "criteria", "kvlcc2"]
+cli.run()
+"""
+
+
+def test_an_interrupt_inside_a_compile_still_gives_one_line(tmp_path):
+    # CI once sent SIGTERM during a cold numba compile: finalisers printed tracebacks after the line
+    proc = subprocess.run([sys.executable, "-c", INTERRUPTED_INSIDE_A_COMPILE], capture_output=True,
+                          text=True, cwd=tmp_path, timeout=120)  # fmt: skip
+    assert proc.returncode == 130, proc.stderr
+    assert proc.stderr == "shipid: interrupted\n"
+
+
 def test_a_failing_demo_leaves_no_partial_folder(tmp_path, capsys, monkeypatch):
     import shipid.demo as demo
 

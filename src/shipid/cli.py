@@ -55,6 +55,10 @@ def _on_sigterm(signum, frame) -> None:
     raise Interrupted()
 
 
+def _ignore_unraisable(unraisable) -> None:
+    """``sys.unraisablehook`` while an interrupt unwinds: finaliser errors are not the user's."""
+
+
 def check_options(args) -> None:
     """Range checks of the numeric options (``OPTION_RULES``) before any work."""
     for dest, (rule, option) in OPTION_RULES.items():
@@ -1418,6 +1422,7 @@ def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit code (0, 1, 2 usage, 130 interrupted)."""
     args = build_parser().parse_args(argv)
     previous = signal.signal(signal.SIGTERM, _on_sigterm)
+    unraisablehook = sys.unraisablehook
     caught: list[warnings.WarningMessage] = []
     stdout = sys.stdout
     sys.stdout = _ClosableStdout(stdout)
@@ -1432,6 +1437,9 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("shipid: interrupted", file=sys.stderr)
         code = 130
+        # What the interrupted work leaves half-built (a JIT compile's LLVM objects) may fail in
+        # its finaliser when the traceback is dropped at the end of this clause: stay one line.
+        sys.unraisablehook = _ignore_unraisable
     except MemoryError:
         print("shipid: error: out of memory (ask for fewer samples: a shorter run, a larger "
               "step or --dt)", file=sys.stderr)  # fmt: skip
@@ -1451,6 +1459,11 @@ def main(argv: list[str] | None = None) -> int:
     finally:
         signal.signal(signal.SIGTERM, previous)
         sys.stdout = stdout
+        if sys.unraisablehook is _ignore_unraisable:
+            import gc
+
+            gc.collect()  # the finalisers of cycles, while they are still ignored
+            sys.unraisablehook = unraisablehook
     seen = set()
     for w in caught:
         if issubclass(w.category, ShipidWarning) and str(w.message) not in seen:
@@ -1466,5 +1479,25 @@ def _one_line(exc) -> str:
     return text.splitlines()[0] if text else type(exc).__name__
 
 
+def run() -> None:
+    """Console entry point: :func:`main`, then exit with its code.
+
+    After an interrupt the process ends at once (``os._exit``) once the streams are flushed:
+    the temporaries are already removed while unwinding, and an interrupted JIT compile
+    leaves objects whose finalisers would print tracebacks during interpreter teardown.
+    """
+    code = main()
+    if code == 130:
+        import os
+
+        for stream in (sys.stdout, sys.stderr):
+            try:
+                stream.flush()
+            except (OSError, ValueError):
+                pass
+        os._exit(code)
+    sys.exit(code)
+
+
 if __name__ == "__main__":
-    sys.exit(main())
+    run()
