@@ -29,6 +29,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_long_logs.py
 	$(BIN)/python benchmarks/bench_physics.py
 	$(BIN)/python benchmarks/study_uncertainty.py
+	$(BIN)/python benchmarks/bench_study.py
 
 clean:
 	rm -rf $(VENV) shipid-demo build *.egg-info src/*.egg-info

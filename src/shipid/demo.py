@@ -21,7 +21,7 @@ from shipid.outputs import OutputSet
 from shipid.reporting.plots import measured_vs_simulated, rudder_and_heading, tracks
 from shipid.reporting.report import error_table, indices_table
 from shipid.trials.manoeuvres import turning_circle, zigzag
-from shipid.vessels import PAPER_IMU, scale_ship
+from shipid.vessels import PAPER_IMU, SensorModel, scale_ship
 
 DT = 0.2
 GAMMA = 1e4
@@ -48,7 +48,7 @@ class DemoResult:
     text: str
 
 
-def synthesise_trials(seed: int = 0) -> dict[str, pd.DataFrame]:
+def synthesise_trials(seed: int = 0, sensor: SensorModel = PAPER_IMU) -> dict[str, pd.DataFrame]:
     """The four noisy trials of the paper's experiment; each its own noise realisation."""
     ship = scale_ship(rudder_rate_deg=RUDDER_RATE_DEG)
     kw = {"dt": DT, "method": "euler", "approach": APPROACH_S}
@@ -61,7 +61,7 @@ def synthesise_trials(seed: int = 0) -> dict[str, pd.DataFrame]:
     }
     out = {}
     for i, (name, log) in enumerate(clean.items()):
-        noisy = PAPER_IMU.apply(log, seed=seed * 100 + i)
+        noisy = sensor.apply(log, seed=seed * 100 + i)
         noisy.attrs["name"] = name
         out[name] = noisy
     return out

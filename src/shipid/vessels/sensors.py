@@ -46,6 +46,14 @@ class SensorModel:
         if not self.bias_tau > 0:
             raise ValueError(f"bias_tau must be > 0, got {self.bias_tau!r}")
 
+    def scaled(self, factor: float) -> SensorModel:
+        """The same sensors with every noise one-sigma multiplied by ``factor`` ≥ 0."""
+        if not (np.isfinite(factor) and factor >= 0):
+            raise ValueError(f"noise factor must be finite and ≥ 0, got {factor!r}")
+        return SensorModel(white={k: v * factor for k, v in self.white.items()},
+                           bias={k: v * factor for k, v in self.bias.items()},
+                           bias_tau=self.bias_tau)  # fmt: skip
+
     def apply(self, log: pd.DataFrame, seed: int | None = 0) -> pd.DataFrame:
         """A noisy copy of ``log``; the same seed gives the same trial."""
         rng = np.random.default_rng(seed)
