@@ -43,7 +43,8 @@ OPTION_RULES = {
     "max_evaluations": ("int>=1", "--max-evaluations"), "show": ("int>=1", "--show"),
     "max_lag": ("int>=1", "--max-lag"), "omega": (">0", "--omega"),
     "lookahead": (">0", "--lookahead"), "bootstrap": ("int>=10", "--bootstrap"),
-    "block": (">0", "--block"), "workers": ("int>=1", "--workers"),
+    "block": (">0", "--block"), "workers": ("int>=1", "--workers"), "factor": (">0", "--factor"),
+    "rho": (">0", "--rho"),
 }  # fmt: skip
 
 
@@ -224,9 +225,10 @@ def _physics(args, logs, structure):
 
 
 def _term_display(text: str) -> str:
+    """A term as printed in a Markdown table cell (its bars escaped: ``\\|u\\|u``)."""
     from shipid.dynamics.terms import parse_term
 
-    return parse_term(text).display() or "1"
+    return (parse_term(text).display() or "1").replace("|", "\\|")
 
 
 def _json_text(data) -> str:
@@ -409,11 +411,23 @@ def cmd_identify(args) -> int:
                       plausibility=plausibility, model=final, selection=gamma_report,
                       particulars=_log_particulars(logs),
                       uncertainty=ensemble.to_dict() if ensemble else None)  # fmt: skip
+    _print_prime(json.loads(text)["prime"])
     atomic_write_text(args.output, text)
     for w in ident.warnings:
         _warn(w)
     print(f"model written to {args.output}")
     return 0
+
+
+def _print_prime(record: dict | None) -> None:
+    """The prime (non-dimensional) coefficients next to the dimensional ones."""
+    if not record:
+        return
+    print(f"\nPrime form (L = {record['length']:g} m, U = {record['speed']:.4g} m/s, the "
+          f"{record['speed_basis']}; ρ = {record['rho']:g} kg/m³; u̇′ = u̇ L/U², ṙ′ = ṙ L²/U²):")
+    rows = [{"equation": f"{dof}̇′", "term": _term_display(t), "prime": c}
+            for dof, terms in record["coefficients"].items() for t, c in terms.items()]
+    print(_pd().DataFrame(rows).to_markdown(index=False, floatfmt=".5g"))
 
 
 def _structure(args):
@@ -561,6 +575,38 @@ def cmd_compare(args) -> int:
             doc = {"structure": args.model, "cv": args.cv, "gamma": args.gamma,
                    "rows": table.to_dict(orient="records")}  # fmt: skip
             out.write(args.json, lambda p: p.write_text(_json_text(doc), "utf-8"))
+    return 0
+
+
+def cmd_rescale(args) -> int:
+    """``shipid rescale``: a model file carried to a similar ship of another length (Froude)."""
+    from shipid.data.particulars import Particulars
+    from shipid.outputs import atomic_write_text, check_outputs
+    from shipid.reporting.modelfile import load_document, model_from_document, rescaled_document
+
+    check_outputs({"-o": (args.output, "json")}, [args.model])
+    doc = load_document(args.model)
+    length = Particulars.from_mapping(doc["particulars"]).length if doc.get("particulars") else None
+    if (args.factor is None) == (args.length is None):
+        raise ShipidError("give the scale factor --factor F (new length / old) or the new --length")
+    factor = args.factor
+    if args.length is not None:
+        if length is None:
+            raise ShipidError(f"{args.model}: --length needs the model's particulars (its length); "
+                              "give --factor instead")  # fmt: skip
+        factor = args.length / length
+    out = rescaled_document(doc, factor, args.rho, args.model)
+    model = model_from_document(out, args.output)
+    k = math.sqrt(factor)
+    what = f"{length:g} m → {length * factor:g} m" if length else f"× {factor:g} in length"
+    print(f"Froude scaling {what}: speeds × {k:.4g}, times × {k:.4g}, rates ÷ {k:.4g}")
+    speed = ((out.get("identification") or {}).get("preprocessing") or {}).get("approach_speed")
+    if speed:
+        print(f"approach speed {speed:.4g} m/s")
+    print(model.equations())
+    _print_prime(out.get("prime"))
+    atomic_write_text(args.output, _json_text(out))
+    print(f"model written to {args.output}")
     return 0
 
 
@@ -1401,6 +1447,18 @@ def build_parser() -> argparse.ArgumentParser:
             p.add_argument("-o", "--output", metavar="FIG.png", help="figure of the tracks")
             p.add_argument("--json", metavar="OUT.json")
             p.set_defaults(func=cmd_follow)
+
+    p = sub.add_parser("rescale", help="a model carried to a geometrically similar ship of "
+                       "another length (Froude scaling, equal prime coefficients)")
+    p.add_argument("model", metavar="MODEL.json")
+    p.add_argument("--factor", type=float, help="new length / old length (e.g. 45.7: model "
+                   "basin to full scale)")
+    p.add_argument("--length", type=float, help="the new Lpp [m] (the model file's particulars "
+                   "give the old one)")
+    p.add_argument("--rho", type=float, help="the new water density [kg/m³] (default: the "
+                   "particulars', else 1025; matters for thrust terms only)")
+    p.add_argument("-o", "--output", required=True, metavar="OUT.json")
+    p.set_defaults(func=cmd_rescale)
 
     p = sub.add_parser("study", help="Monte Carlo identifiability study of the paper's "
                        "experiment (seeds × noise × γ × structure), on Dask")

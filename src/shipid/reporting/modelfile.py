@@ -66,6 +66,7 @@ def model_document(ident: Identification, training_files: Sequence[str | Path] =
         "format": FORMAT, "version": VERSION, "shipid": __version__,
         "model": model.to_dict(),
         "particulars": particulars,
+        "prime": prime_record(model, particulars, (preprocessing or {}).get("approach_speed")),
         "uncertainty": uncertainty,
         "identification": {"form": ident.form, "gamma": ident.gamma, "dt": ident.dt,
                            "estimator": ident.estimator, "selection": selection,
@@ -78,6 +79,26 @@ def model_document(ident: Identification, training_files: Sequence[str | Path] =
         "provenance": {"training_files": [{"path": str(p), "sha256": sha256(p)}
                                           for p in training_files]},
     })  # fmt: skip
+
+
+def prime_record(model: ManoeuvringModel, particulars: dict | None,
+                 approach_speed: float | None) -> dict | None:  # fmt: skip
+    """The model's coefficients in prime form (``shipid.dynamics.prime``), for the length of the
+    particulars and their design speed, else the training approach speed; None without them.
+    Written for reading and for transfer to other ships; the dimensional coefficients rule."""
+    if not particulars:
+        return None
+    from shipid.data.particulars import Particulars
+    from shipid.dynamics.prime import prime_coefficients
+
+    p = Particulars.from_mapping(particulars)
+    speed, basis = p.design_speed, "design speed"
+    if speed is None:
+        speed, basis = approach_speed, "training approach speed"
+    if speed is None or not speed > 0:
+        return None
+    return {"length": p.length, "speed": speed, "speed_basis": basis, "rho": p.rho,
+            "coefficients": prime_coefficients(model, p.length, speed, p.rho)}
 
 
 def model_text(ident: Identification, training_files: Sequence[str | Path] = (), **kw) -> str:
@@ -237,6 +258,82 @@ def ensemble_from_document(doc: Mapping, path: str | Path, model: ManoeuvringMod
     if not isinstance(data, Mapping):
         raise ShipidError(f"{path}: uncertainty must be a mapping")
     return Ensemble.from_dict(data, model, f"{path}: uncertainty")
+
+
+def rescaled_document(doc: Mapping, factor: float, to_rho: float | None = None,
+                      path: str | Path = "model file") -> dict:  # fmt: skip
+    """The model file of a geometrically similar ship ``factor`` times as long (Froude scaling,
+    ``shipid.dynamics.prime``): coefficients (the refinement's and every bootstrap replicate's
+    too), particulars, approach speed and rps, rudder rate, Δk and the training envelope, so
+    that manoeuvres and criteria run at the new scale. The fit's own records (discrete
+    coefficients, diagnostics) stay those of the original scale; ``scaling`` says what was done."""
+    import copy
+
+    import numpy as np
+
+    from shipid.data.particulars import Particulars
+    from shipid.dynamics.model import DOFS
+    from shipid.dynamics.prime import RHO, froude_ratios, signal_scale
+
+    particulars = Particulars.from_mapping(doc["particulars"]) if doc.get("particulars") else None
+    rho = particulars.rho if particulars is not None else RHO
+    to_rho = rho if to_rho is None else to_rho
+    model = model_from_document(dict(doc), path)
+    ratios = froude_ratios(model.structure, factor, rho, to_rho)
+    k = math.sqrt(factor)
+    out = copy.deepcopy(dict(doc))
+
+    def scale_model(data: dict) -> dict:
+        m = model_from_document({"model": data}, path)
+        coefs = {d: {t: c * ratios[d][t] for t, c in terms.items()}
+                 for d, terms in m.coefficients.items()}  # fmt: skip
+        return ManoeuvringModel(m.structure, coefs, name=m.name).to_dict()
+
+    out["model"] = scale_model(doc["model"])
+    ident = out.get("identification") or {}
+    refinement = ident.get("refinement")
+    if refinement:
+        for key in ("initial_model", "refined_model"):
+            if refinement.get(key):
+                refinement[key] = scale_model(refinement[key])
+    if out.get("uncertainty"):
+        unc = out["uncertainty"]
+        thetas = np.asarray(unc["thetas"], dtype=float)
+        for dof, terms in model.structure.terms.items():
+            for t in terms:
+                thetas[:, DOFS.index(dof), unc["terms"].index(t)] *= ratios[dof][t]
+        unc["thetas"] = thetas.tolist()
+    if particulars is not None:
+        p = dict(out["particulars"])
+        for key, power in (("length", 1), ("beam", 1), ("draught", 1), ("propeller_diameter", 1),
+                           ("xg", 1), ("rudder_area", 2), ("design_speed", 0.5)):  # fmt: skip
+            if p.get(key) is not None:
+                p[key] = p[key] * factor**power
+        if p.get("mass") is not None:
+            p["mass"] = p["mass"] * factor**3 * to_rho / rho
+        if p.get("scale") is not None:
+            p["scale"] = p["scale"] / factor
+        p["rho"] = to_rho
+        out["particulars"] = p
+    prep = ident.get("preprocessing") or {}
+    for key, scale in (("approach_speed", k), ("approach_rps", 1 / k), ("rudder_rate", 1 / k),
+                       ("dt", k)):  # fmt: skip
+        if isinstance(prep.get(key), int | float):
+            prep[key] = prep[key] * scale
+    if isinstance(ident.get("dt"), int | float):
+        ident["dt"] = ident["dt"] * k
+    envelope = ident.get("envelope") or {}
+    for signal, bounds in envelope.items():
+        scale = signal_scale(signal, factor, rho, to_rho)
+        envelope[signal] = [b * scale for b in bounds]
+    model_out = model_from_document(out, path)
+    out["prime"] = prime_record(model_out, out.get("particulars"), prep.get("approach_speed"))
+    out.setdefault("scaling", []).append({
+        "method": "Froude: equal prime coefficients at equal Froude number",
+        "factor": factor, "rho": [rho, to_rho],
+        "note": "viscous (Reynolds) effects are not scaled; identification.discrete and "
+                "diagnostics are those of the fit at the original scale"})  # fmt: skip
+    return json_safe(out)
 
 
 def training_conditions(doc: Mapping) -> dict:
