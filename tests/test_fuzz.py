@@ -215,6 +215,7 @@ COMMANDS = {
     "autopilot": ["autopilot", "{model}", "-o", "{out}/a.png"],
     "follow": ["follow", "{model}", "--json", "{out}/f.json"],
     "plot": ["plot", "{log}", "-o", "{out}/p.png"],
+    "rescale": ["rescale", "{model}", "-o", "{out}/r.json"],
 }
 OPTIONS = {
     "identify": ["--gamma", "--dt", "--filter", "--lead", "--start", "--end", "--bootstrap",
@@ -230,6 +231,7 @@ OPTIONS = {
     "autopilot": ["--omega", "--dt", "--heading", "--duration", "--speed"],
     "follow": ["--omega", "--dt", "--lookahead", "--speed"],
     "plot": ["--dt", "--start", "--end"],
+    "rescale": ["--factor", "--length", "--rho"],
 }
 
 

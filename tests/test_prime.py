@@ -196,6 +196,10 @@ def test_a_rescaled_model_turns_the_similar_circle(model_files, capsys):
     (["--factor", "2", "--length", "9"], "--factor F"),
     ([], "--factor F"),
     (["--factor", "-3"], "--factor"),
+    (["--factor", "1e308"], "not between two ships"),
+    (["--factor", "1e-300"], "not between two ships"),
+    (["--length", "0"], "--length"),
+    (["--factor", "2", "--rho", "nan"], "--rho"),
 ])  # fmt: skip
 def test_rescale_refuses_bad_options(model_files, capsys, args, message):
     from cli_helpers import run

@@ -29,6 +29,7 @@ SPEEDS = ("u", "v", "U", "wind_speed")
 RATES = ("r", "n")
 ANGLES = ("beta", "delta", "wind_angle")
 RHO = 1025.0
+MIN_FACTOR = 1e-4  # a 4 cm model of a 400 m ship, and back
 
 
 def _factor_scale(name: str, op: str, power: int, length: float, speed: float,
@@ -88,6 +89,9 @@ def froude_ratios(structure: ModelStructure, factor: float, rho: float = RHO,
     over its value on this one, at equal Froude number and prime coefficients."""
     if not (math.isfinite(factor) and factor > 0):
         raise ShipidError(f"scale factor must be > 0, got {factor!r}")
+    if not MIN_FACTOR <= factor <= 1 / MIN_FACTOR:
+        raise ShipidError(f"scale factor {factor:g} is not between two ships: use "
+                          f"{MIN_FACTOR:g}…{1 / MIN_FACTOR:g}")  # fmt: skip
     to_rho = rho if to_rho is None else to_rho
     # Any reference length and speed: they cancel between the two ships.
     return {dof: {t: prime_factor(dof, t, 1.0, 1.0, rho)
