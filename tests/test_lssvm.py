@@ -275,3 +275,31 @@ def test_works_in_pipeline_and_grid_search():
     search.fit(X, y)
     assert search.best_score_ > 0.5
     assert set(search.best_params_) == {"lssvr__gamma", "lssvr__sigma"}
+
+
+@pytest.mark.parametrize("sigma", [0.3, 1.0, 5.0])
+def test_rbf_kernel_is_the_brute_force_distance(sigma):
+    rng = np.random.default_rng(11)
+    X = rng.normal(size=(37, 4))
+    Z = np.vstack([rng.normal(size=(20, 4)), X[:5]])  # identical points: distance exactly 0
+    brute = np.exp(-((X[:, None, :] - Z[None, :, :]) ** 2).sum(axis=-1) / sigma**2)
+    K = kernel_matrix(X, Z, "rbf", sigma=sigma)
+    np.testing.assert_allclose(K, brute, rtol=1e-12, atol=1e-300)
+    assert np.all(K <= 1.0)
+    np.testing.assert_allclose(np.diag(kernel_matrix(X, X, "rbf", sigma=sigma)), 1.0, rtol=1e-13)
+
+
+@pytest.mark.parametrize("weights", ["ones", "bootstrap", "real"])
+def test_normal_equations_are_the_weighted_products(weights):
+    from shipid.lssvm.solvers import accumulate_normal_equations
+
+    rng = np.random.default_rng(12)
+    F, Y = rng.normal(size=(300, 6)), rng.normal(size=(300, 2))
+    w = {"ones": np.ones(300), "bootstrap": rng.poisson(1.0, 300).astype(float),
+         "real": rng.uniform(0, 3, 300)}[weights]  # fmt: skip
+    blocks = [(F[s], Y[s], w[s]) for s in (slice(0, 120), slice(120, 300))]
+    A, B = accumulate_normal_equations(blocks, 6, 2)
+    Fb = np.column_stack([F, np.ones(300)])
+    np.testing.assert_allclose(A, Fb.T @ (w[:, None] * Fb), rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(B, Fb.T @ (w[:, None] * Y), rtol=1e-12, atol=1e-12)
+    assert np.array_equal(A, A.T)

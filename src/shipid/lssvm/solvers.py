@@ -106,11 +106,18 @@ def accumulate_normal_equations(
     A = np.zeros((p + 1, p + 1))
     B = np.zeros((p + 1, n_outputs))
     for F, Yb, w in blocks:
-        Fw = F * w[:, None]
-        A[:p, :p] += F.T @ Fw
-        A[:p, p] += Fw.sum(axis=0)
+        # FᵀWF as (√W F)ᵀ(√W F): NumPy computes a product of an array with its own transpose
+        # by a symmetric rank-k update, half the work of a general product. Weights are ≥ 0,
+        # and unit weights (the common case) skip the scaling pass.
+        if np.all(w == 1.0):
+            Fs, Ys, s = F, Yb, w
+        else:
+            s = np.sqrt(w)
+            Fs, Ys = F * s[:, None], Yb * s[:, None]
+        A[:p, :p] += Fs.T @ Fs
+        A[:p, p] += s @ Fs
         A[p, p] += w.sum()
-        B[:p] += Fw.T @ Yb
+        B[:p] += Fs.T @ Ys
         B[p] += w @ Yb
     A[p, :p] = A[:p, p]
     return A, B
