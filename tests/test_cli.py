@@ -201,17 +201,16 @@ def test_an_interrupt_inside_a_compile_still_gives_one_line(tmp_path):
 def test_a_failing_demo_leaves_no_partial_folder(tmp_path, capsys, monkeypatch):
     import shipid.demo as demo
 
-    calls = {"n": 0}
-    real = demo.write_log
+    written = []
 
-    def fail_on_third(log, path, out=None):
-        calls["n"] += 1
-        if calls["n"] == 3:
-            raise OSError(28, "No space left on device")
-        return real(log, path, out=out)
+    def first_figure_then_full_disk(out, logs, validations, files):
+        # one real file of the set is written, then the disk fills up
+        written.append(files.write(out / "first.png", lambda p: p.write_bytes(b"png")))
+        raise OSError(28, "No space left on device")
 
-    monkeypatch.setattr(demo, "write_log", fail_on_third)
+    monkeypatch.setattr(demo, "_figures", first_figure_then_full_disk)
     code, _, err = run(["demo", "--out", tmp_path / "demo"], capsys)
+    assert written
     assert code == 1 and err.splitlines()[-1] == "shipid: error: No space left on device"
     assert "Traceback" not in err and not (tmp_path / "demo").exists()
 
