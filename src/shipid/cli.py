@@ -309,7 +309,6 @@ def cmd_identify(args) -> int:
     from shipid.data.preprocess import lowpass
     from shipid.identification.identify import identify
     from shipid.identification.plausibility import check_plausibility
-    from shipid.identification.refine import refine
     from shipid.outputs import atomic_write_text, check_outputs
     from shipid.reporting.modelfile import model_text
 
@@ -373,6 +372,8 @@ def cmd_identify(args) -> int:
               f"{ensemble.replicates} replicates, {ensemble.block_s:g} s blocks):")
         print(table.to_markdown(index=False, floatfmt=".4g"))
     if args.refine:
+        from shipid.identification.refine import refine  # scipy.optimize: only when asked
+
         how = "whole logs" if args.segment is None else f"{args.segment:g} s segments"
         print(f"refining by output error ({how})…", file=sys.stderr)
         refinement = refine(ident.model, logs, segment_s=args.segment, gamma=gamma,
