@@ -612,16 +612,20 @@ def cmd_rescale(args) -> int:
 
 
 def cmd_study(args) -> int:
-    """``shipid study``: a Monte Carlo identifiability study, on Dask by default."""
+    """``shipid study``: a Monte Carlo study, or the identification of many log sets, on Dask."""
     from shipid.data.io import write_table
-    from shipid.evaluation.study import GRID_KEYS, StudySpec, run_study, summary
+    from shipid.evaluation.study import GRID_KEYS, read_spec, run_study, summary
     from shipid.outputs import OutputSet, check_outputs
 
     check_outputs({"-o": (args.output, "log")}, [args.spec])
-    spec = StudySpec.read(args.spec)
-    n = len(spec.trials())
+    spec = read_spec(args.spec)
     where = ("this process" if args.scheduler == "serial" else args.scheduler
              or f"a local Dask cluster of {args.workers or _cores()} workers")  # fmt: skip
+    if hasattr(spec, "jobs"):
+        return _study_logs(args, spec, where)
+    if args.models:
+        raise ShipidError("--models is for a study of kind logs (model files of its jobs)")
+    n = len(spec.trials())
     print(f"{n} trials ({len(spec.seeds)} seeds × {n // len(spec.seeds)} grid points) on {where}")
     start = time.perf_counter()
     results = run_study(spec, scheduler=args.scheduler, workers=args.workers,
@@ -646,6 +650,36 @@ def cmd_study(args) -> int:
               f"{failed['error'].iloc[0]}); their rows have the error")  # fmt: skip
     print(f"results written to {args.output}")
     return 0
+
+
+def _study_logs(args, spec, where: str) -> int:
+    """A study of kind logs: every job's model file into --models, the table to -o."""
+    from shipid.data.io import write_table
+    from shipid.identification.batch import run_batch
+    from shipid.outputs import OutputSet, check_outputs
+
+    if not args.models:
+        raise ShipidError(f"{args.spec}: a study of kind logs writes model files: give --models DIR")
+    inputs = [args.spec, *(p for job in spec.jobs for p in job.logs)]
+    check_outputs({"-o": (args.output, "log"), "--models": (args.models, "dir")}, inputs)
+    print(f"{len(spec.jobs)} jobs ({sum(len(j.logs) for j in spec.jobs)} logs) on {where}")
+    start = time.perf_counter()
+    table, texts = run_batch(spec, scheduler=args.scheduler, workers=args.workers,
+                             progress=not args.quiet)  # fmt: skip
+    cols = ["name", "command", "logs", "terms", "gamma", "prefilter_hz", "cv_score", "seconds",
+            "error"]
+    print(table[[c for c in cols if c in table]].to_markdown(index=False, floatfmt=".4g"))
+    print(f"\n{len(spec.jobs)} jobs in {time.perf_counter() - start:.1f} s wall")
+    models = Path(args.models)
+    with OutputSet() as out:
+        for name, text in texts.items():
+            out.write(models / f"{name}.json", lambda p, t=text: p.write_text(t, encoding="utf-8"))
+        write_table(table, args.output, out)
+    failed = table[table["error"] != ""]
+    print(f"{len(texts)} model files written to {models}, the table to {args.output}")
+    for _, row in failed.iterrows():  # as validate's batch: the others are written, exit 1
+        print(f"shipid: error: job {row['name']}: {row['error']}", file=sys.stderr)
+    return 1 if len(failed) else 0
 
 
 def _cores() -> int:
@@ -1462,7 +1496,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_rescale)
 
     p = sub.add_parser("study", help="Monte Carlo identifiability study of the paper's "
-                       "experiment (seeds × noise × γ × structure), on Dask")
+                       "experiment (seeds × noise × γ × structure), or identify many log sets "
+                       "(kind: logs), on Dask")
     p.add_argument("spec", metavar="SPEC.yml", help="the grid and seeds (see docs/study.yml)")
     p.add_argument("-o", "--output", required=True, metavar="RESULTS.parquet|RESULTS.csv",
                    help="one row per trial")
@@ -1471,6 +1506,8 @@ def build_parser() -> argparse.ArgumentParser:
                    "cluster)")
     p.add_argument("--workers", type=int, help="worker processes of the local cluster "
                    "(default: the machine's cores)")
+    p.add_argument("--models", metavar="DIR", help="kind logs: the folder of the jobs' model "
+                   "files")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_study)
 
@@ -1536,7 +1573,11 @@ class _ClosableStdout:
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit code (0, 1, 2 usage, 130 interrupted)."""
     args = build_parser().parse_args(argv)
-    previous = signal.signal(signal.SIGTERM, _on_sigterm)
+    import threading
+
+    # Only the main thread may handle signals; a Dask worker runs jobs in its own threads.
+    in_main = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGTERM, _on_sigterm) if in_main else None
     unraisablehook = sys.unraisablehook
     caught: list[warnings.WarningMessage] = []
     stdout = sys.stdout
@@ -1572,7 +1613,8 @@ def main(argv: list[str] | None = None) -> int:
               file=sys.stderr)  # fmt: skip
         code = 1
     finally:
-        signal.signal(signal.SIGTERM, previous)
+        if in_main:
+            signal.signal(signal.SIGTERM, previous)
         sys.stdout = stdout
         if sys.unraisablehook is _ignore_unraisable:
             import gc

@@ -26,9 +26,8 @@ from __future__ import annotations
 
 import itertools
 import math
-import os
 import time
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable
 from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 
@@ -108,6 +107,7 @@ class StudySpec:
         if not isinstance(spec, dict):
             raise ShipidError(f"{where}a study specification is a mapping of keys to values")
         known = {f.name for f in fields(cls)} - {"source"}
+        spec = {k: v for k, v in spec.items() if k != "kind"}
         unknown = sorted(set(spec) - known)
         if unknown:
             raise ShipidError(f"{where}unknown key {unknown[0]!r} (known: {', '.join(sorted(known))})")
@@ -132,19 +132,11 @@ class StudySpec:
 
     @classmethod
     def read(cls, path: str | Path) -> StudySpec:
-        """Read a YAML study specification."""
-        import yaml
-
-        path = Path(path)
-        try:
-            text = path.read_text(encoding="utf-8")
-        except OSError as exc:
-            raise ShipidError(f"{path}: {exc.strerror or exc}") from None
-        try:
-            spec = yaml.safe_load(text)
-        except yaml.YAMLError as exc:
-            raise ShipidError(f"{path}: not valid YAML ({str(exc).splitlines()[0]})") from None
-        return cls.from_dict(spec if spec is not None else {}, source=str(path))
+        """Read a YAML study specification (a Monte Carlo one)."""
+        spec = read_spec(path)
+        if not isinstance(spec, cls):
+            raise ShipidError(f"{path}: a study of kind logs, not a Monte Carlo study")
+        return spec
 
     def trials(self) -> list[Trial]:
         """Every grid point × seed, grid point outermost, in a fixed order."""
@@ -152,6 +144,36 @@ class StudySpec:
         combos = [(point, seed) for point in grid for seed in self.seeds]
         return [Trial(i, seed, *point, bootstrap=self.bootstrap)
                 for i, (point, seed) in enumerate(combos)]  # fmt: skip
+
+
+KINDS = ("monte-carlo", "logs")
+
+
+def read_spec(path: str | Path):
+    """A YAML study file: a ``StudySpec`` (kind monte-carlo, the default) or, with
+    ``kind: logs``, a ``shipid.identification.batch.BatchSpec`` (paths relative to the file)."""
+    import yaml
+
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ShipidError(f"{path}: {exc.strerror or exc}") from None
+    try:
+        spec = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        raise ShipidError(f"{path}: not valid YAML ({str(exc).splitlines()[0]})") from None
+    spec = {} if spec is None else spec
+    if not isinstance(spec, dict):
+        raise ShipidError(f"{path}: a study specification is a mapping of keys to values")
+    kind = spec.get("kind", "monte-carlo")
+    if kind not in KINDS:
+        raise ShipidError(f"{path}: kind {kind!r} is not one of {', '.join(KINDS)}")
+    if kind == "logs":
+        from shipid.identification.batch import BatchSpec
+
+        return BatchSpec.from_dict(spec, source=str(path), base=path.parent)
+    return StudySpec.from_dict(spec, source=str(path))
 
 
 def _typed(value, kind, key: str, where: str):
@@ -192,22 +214,14 @@ def run_trial(trial: Trial) -> dict:
     whether it beats the paper's table, every identified coefficient and, with bootstrap, the
     coverage of the true coefficients.
     """
-    import numba
-    from threadpoolctl import threadpool_limits
+    from shipid.parallel import single_threaded
 
     start = time.perf_counter()
     row: dict = asdict(trial) | {"error": ""}
-    # One thread per trial (BLAS and numba's batched kernels): parallelism comes from running
-    # trials side by side, and two workers each spinning two threads on two cores run at half speed.
-    threads = numba.get_num_threads()
-    numba.set_num_threads(1)
     try:
-        with threadpool_limits(limits=1):
-            row |= _trial_results(trial)
+        row |= single_threaded(_trial_results, trial)
     except Exception as exc:  # one failed trial must not lose the study; its row says why
         row["error"] = f"{type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}"
-    finally:
-        numba.set_num_threads(threads)
     row["seconds"] = time.perf_counter() - start
     return row
 
@@ -276,70 +290,14 @@ def run_study(
     ----------
     scheduler : None (a ``LocalCluster`` of ``workers`` processes), 'serial' (this process,
         no Dask) or the address of a running Dask scheduler (``tcp://host:8786``), whose
-        workers must have shipid installed.
+        workers must have shipid installed (``shipid.parallel.run_tasks``).
     workers : worker processes of the local cluster (default: the machine's cores).
     progress : a progress bar on standard error.
     """
-    if workers is not None and (scheduler is not None or workers < 1):
-        raise ShipidError("workers: a count ≥ 1, for the local cluster only (not with a scheduler)")
-    trials = spec.trials()
-    if scheduler == "serial":
-        rows = _run_serial(trials, progress)
-    else:
-        rows = _run_on_dask(trials, scheduler, workers, progress)
-    table = pd.DataFrame(sorted(rows, key=lambda r: r["index"]))
-    return table.drop(columns="index")
+    from shipid.parallel import run_tasks
 
-
-def _bar(total: int, progress: bool):
-    from tqdm import tqdm
-
-    return tqdm(total=total, desc="trials", unit="trial", disable=not progress, leave=False)
-
-
-def _run_serial(trials: Sequence[Trial], progress: bool) -> list[dict]:
-    rows = []
-    with _bar(len(trials), progress) as bar:
-        for t in trials:
-            rows.append(run_trial(t))
-            bar.update()
-    return rows
-
-
-def _run_on_dask(trials: Sequence[Trial], scheduler: str | None, workers: int | None,
-                 progress: bool) -> list[dict]:  # fmt: skip
-    import logging
-
-    import dask
-    from dask.distributed import Client, LocalCluster, as_completed
-
-    # The workers' statistical profiler samples every thread's stack each 10 ms under the GIL;
-    # a study times its trials itself.
-    with dask.config.set({"distributed.worker.profile.enabled": False}):
-        cluster = None
-        try:
-            if scheduler is None:
-                cluster = LocalCluster(n_workers=workers or os.cpu_count() or 1,
-                                       threads_per_worker=1, processes=True,
-                                       dashboard_address=None, silence_logs=logging.ERROR)
-                client = Client(cluster)
-            else:
-                client = Client(scheduler, timeout=10)
-        except (OSError, RuntimeError, TimeoutError) as exc:
-            what = f"reach the Dask scheduler {scheduler}" if scheduler else "start a local Dask cluster"
-            raise ShipidError(f"cannot {what}: {exc}") from None
-        try:
-            futures = client.map(run_trial, trials, pure=False)
-            rows = []
-            with _bar(len(trials), progress) as bar:
-                for future in as_completed(futures):
-                    rows.append(future.result())
-                    bar.update()
-            return rows
-        finally:
-            client.close()
-            if cluster is not None:
-                cluster.close()
+    rows = run_tasks(run_trial, spec.trials(), scheduler, workers, progress, unit="trial")
+    return pd.DataFrame(rows).drop(columns="index")
 
 
 def summary(results: pd.DataFrame) -> pd.DataFrame:
