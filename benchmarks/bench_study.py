@@ -43,10 +43,12 @@ def main(seeds: int = 200) -> None:
     runs["process pool of 2 (concurrent.futures)"] = (process_pool(spec, 2),
                                                        time.perf_counter() - t0)  # fmt: skip
     base = runs["Dask LocalCluster, 1 worker"][1]
-    print("| run | wall [s] | trial time [s] | speed-up vs 1 worker |")
-    print("|---|---|---|---|")
+    serial = runs["serial (this process, no Dask)"][1]
+    print("| run | wall [s] | trial time [s] | speed-up vs 1 Dask worker | vs serial |")
+    print("|---|---|---|---|---|")
     for label, (res, wall) in runs.items():
-        print(f"| {label} | {wall:.1f} | {res['seconds'].sum():.1f} | {base / wall:.2f}× |")
+        print(f"| {label} | {wall:.1f} | {res['seconds'].sum():.1f} | {base / wall:.2f}× | "
+              f"{serial / wall:.2f}× |")
     ref = runs["serial (this process, no Dask)"][0].drop(columns="seconds")
     same = all(r.drop(columns="seconds").equals(ref) for r, _ in runs.values())
     print(f"\nResults identical to the serial run: {same}")

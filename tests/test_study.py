@@ -111,13 +111,24 @@ def test_a_failed_trial_keeps_its_row_and_the_others_run(monkeypatch):
     assert table.loc[0, "failed"] == 1 and table.loc[0, "zigzag 10/10: beats paper"].endswith(" of 2")
 
 
-def test_bootstrap_coverage_is_a_share_of_the_coefficients():
+def test_bootstrap_coverage_counts_the_true_coefficients_inside_their_intervals():
+    from shipid.data.preprocess import lowpass
+    from shipid.demo import TRAINING, synthesise_trials
+    from shipid.identification.identify import identify
+    from shipid.identification.uncertainty import bootstrap
+    from shipid.vessels import scale_ship_model
+
     row = run_trial(Trial(0, seed=1, filter="0.5", bootstrap=10))
     assert row["error"] == ""
-    n = sum(1 for k in row if k[:3] in ("u: ", "v: ", "r: "))
-    assert 0 <= row["coverage"] <= 1 and round(row["coverage"] * n) == pytest.approx(
-        row["coverage"] * n, abs=1e-9)
-    assert row["wrong sign outside"] >= 0
+    train = lowpass(synthesise_trials(1)[TRAINING], 0.5)
+    ens = bootstrap([train], lambda w: identify(train, drop={"u": ["r^2"]}, force=True,
+                                                sample_weight=w).model, replicates=10, seed=1)
+    truth = scale_ship_model().coefficients
+    inside = [lo <= truth[d].get(t, 0.0) <= hi for d, t, lo, hi in
+              ens.coefficient_table()[["equation", "term", "lower", "upper"]].itertuples(
+                  index=False)]  # fmt: skip
+    assert len(inside) == 16 and row["coverage"] == pytest.approx(np.mean(inside))
+    assert 0 < row["coverage"] < 1  # this seed: some inside, some not (the bias of issue #10)
 
 
 def test_workers_only_for_the_local_cluster():

@@ -269,10 +269,9 @@ def cmd_demo(args) -> int:
 
 
 def _approach(log, column: str) -> float | None:
-    """Mean of a column over the first 2 % of a log (the approach), None if absent."""
-    if column not in log.columns:
-        return None
-    return float(log[column].iloc[: max(1, len(log) // 50)].mean())
+    from shipid.data.log import approach
+
+    return approach(log, column)
 
 
 def _free_run_table(refinement) -> str:
@@ -412,7 +411,9 @@ def cmd_identify(args) -> int:
                       plausibility=plausibility, model=final, selection=gamma_report,
                       particulars=_log_particulars(logs),
                       uncertainty=ensemble.to_dict() if ensemble else None)  # fmt: skip
-    _print_prime(json.loads(text)["prime"])
+    from shipid.reporting.modelfile import prime_record
+
+    _print_prime(prime_record(final, _log_particulars(logs), speed))
     atomic_write_text(args.output, text)
     for w in ident.warnings:
         _warn(w)

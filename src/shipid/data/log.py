@@ -46,6 +46,13 @@ def log_name(log: pd.DataFrame, default: str = "log") -> str:
     return str(log.attrs.get("name", default))
 
 
+def approach(log: pd.DataFrame, column: str) -> float | None:
+    """Mean of a column over the first 2 % of a log (the approach), None if absent."""
+    if column not in log.columns:
+        return None
+    return float(log[column].iloc[: max(1, len(log) // 50)].mean())
+
+
 def rudder_positive(log: pd.DataFrame, default: str = "port") -> str:
     """Where a positive rudder angle turns the ship: 'port' or 'starboard'."""
     side = log.attrs.get("rudder_positive", default)

@@ -104,7 +104,11 @@ def froude_scaled(model: ManoeuvringModel, factor: float, rho: float = RHO,
     """The model of a geometrically similar ship ``factor`` times as long, at equal Froude
     number (speeds × √factor, times × √factor); ``to_rho`` the other water's density (thrust
     terms only)."""
-    ratios = froude_ratios(model.structure, factor, rho, to_rho)
+    return scaled(model, froude_ratios(model.structure, factor, rho, to_rho))
+
+
+def scaled(model: ManoeuvringModel, ratios: Mapping[str, Mapping[str, float]]) -> ManoeuvringModel:
+    """The model with each coefficient multiplied by its ratio ({dof: {term: ratio}})."""
     coefs = {dof: {t: c * ratios[dof][t] for t, c in terms.items()}
              for dof, terms in model.coefficients.items()}  # fmt: skip
     return ManoeuvringModel(model.structure, coefs, name=model.name)

@@ -38,7 +38,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from shipid.data.log import input_columns
+from shipid.data.log import approach, input_columns
 from shipid.dynamics.model import DOFS, ManoeuvringModel, ModelStructure, get_structure
 from shipid.dynamics.simulate import DivergenceBounds, input_array, run_kernel
 from shipid.dynamics.terms import INPUT_SIGNALS, parse_term, term_code
@@ -505,8 +505,8 @@ def select(
     logs, names, data, folds, scorer = _setup(logs, names, options)
     library = data.library
     notes: list[str] = []
-    speed = options.speed if options.speed is not None else _approach(logs[0], "u")
-    rps = options.rps if options.rps is not None else _approach(logs[0], "n")
+    speed = options.speed if options.speed is not None else approach(logs[0], "u")
+    rps = options.rps if options.rps is not None else approach(logs[0], "n")
     if speed is None or not speed > 0:
         raise ShipidError(f"{names[0]}: starts without headway; give the plausibility condition "
                           "(speed=..., --speed)")  # fmt: skip
@@ -598,26 +598,10 @@ def _one_standard_error(cands, best: Candidate, plausible) -> Candidate:
     return next((c for c in pool if plausible(c)), best)
 
 
-def _approach(log: pd.DataFrame, column: str) -> float | None:
-    if column not in log.columns:
-        return None
-    return float(log[column].iloc[: max(1, len(log) // 50)].mean())
-
-
-class _NoBar:
-    def update(self, n=1):
-        pass
-
-    def close(self):
-        pass
-
-
 def _progress(options: SelectOptions):
-    if not options.progress:
-        return _NoBar()
     from tqdm.auto import tqdm
 
-    return tqdm(desc="candidates", unit="cand", total=None)
+    return tqdm(desc="candidates", unit="cand", total=None, disable=not options.progress)
 
 
 def _stacked(data: _Data, dof: str, terms) -> tuple[list[str], np.ndarray, np.ndarray]:

@@ -166,19 +166,10 @@ def bootstrap(
 
 
 def _bar(progress: bool, total: int):
-    if progress:
-        from tqdm.auto import tqdm
+    from tqdm.auto import tqdm
 
-        return tqdm(total=total, desc="bootstrap", unit="fit", disable=None)  # None: off if no TTY
-
-    class _No:
-        def update(self, n=1):
-            pass
-
-        def close(self):
-            pass
-
-    return _No()
+    # disable=None: shown only on a terminal
+    return tqdm(total=total, desc="bootstrap", unit="fit", disable=None if progress else True)
 
 
 Bands = dict[str, tuple[np.ndarray, np.ndarray]]

@@ -273,7 +273,7 @@ def rescaled_document(doc: Mapping, factor: float, to_rho: float | None = None,
 
     from shipid.data.particulars import Particulars
     from shipid.dynamics.model import DOFS
-    from shipid.dynamics.prime import RHO, froude_ratios, signal_scale
+    from shipid.dynamics.prime import RHO, froude_ratios, scaled, signal_scale
 
     particulars = Particulars.from_mapping(doc["particulars"]) if doc.get("particulars") else None
     rho = particulars.rho if particulars is not None else RHO
@@ -284,10 +284,7 @@ def rescaled_document(doc: Mapping, factor: float, to_rho: float | None = None,
     out = copy.deepcopy(dict(doc))
 
     def scale_model(data: dict) -> dict:
-        m = model_from_document({"model": data}, path)
-        coefs = {d: {t: c * ratios[d][t] for t, c in terms.items()}
-                 for d, terms in m.coefficients.items()}  # fmt: skip
-        return ManoeuvringModel(m.structure, coefs, name=m.name).to_dict()
+        return scaled(model_from_document({"model": data}, path), ratios).to_dict()
 
     out["model"] = scale_model(doc["model"])
     ident = out.get("identification") or {}
