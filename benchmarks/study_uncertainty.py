@@ -1,7 +1,8 @@
 """Identifiability study on the paper's ship (issue #10): over seeds of the demo's noisy trials,
-how well the default identification (prefilter chosen from the data) predicts the held-out
-manoeuvres against the true model's own error, and how often the bootstrap's 95 % intervals
-cover the true coefficients.
+the default identification (LS-SVM, prefilter chosen from the data, bootstrap intervals) against
+maximum-likelihood output error from it (covariance intervals): how well each predicts the
+held-out manoeuvres against the true model's own error, and how often its 95 % intervals cover
+the true coefficients. Runs as a ``shipid study`` (``shipid.evaluation.study``).
 
 Run: .venv/bin/python benchmarks/study_uncertainty.py [SEEDS] [REPLICATES]
 """
@@ -12,71 +13,31 @@ import os
 import sys
 import time
 
-import numpy as np
-
-from shipid.data.preprocess import lowpass
-from shipid.demo import GAMMA, PAPER_TABLE, TRAINING, synthesise_trials
-from shipid.evaluation.validate import validate
-from shipid.identification.identify import identify
-from shipid.identification.prefilter import choose_prefilter
-from shipid.identification.uncertainty import bootstrap
-from shipid.vessels import scale_ship_model
-
-DROP = {"u": ["r^2"]}
+from shipid.evaluation.study import StudySpec, run_study, summary
 
 
-def fit(logs):
-    return identify(logs, gamma=GAMMA, drop=DROP).model
-
-
-def main(seeds: int = 20, replicates: int = 100) -> None:
-    truth = scale_ship_model()
+def main(seeds: int = 40, replicates: int = 100) -> None:
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores; {seeds} seeds, "
-          f"{replicates} bootstrap replicates each\n")  # fmt: skip
+          f"{replicates} bootstrap replicates for the LS-SVM\n")  # fmt: skip
     t0 = time.perf_counter()
-    ratios, beats, covered, wrong_sign_outside, widths = [], [], [], 0, []
-    cutoffs = []
-    for seed in range(seeds):
-        logs = synthesise_trials(seed)
-        cutoff, _ = choose_prefilter([logs[TRAINING]], fit)
-        cutoffs.append(cutoff)
-        train = logs[TRAINING] if cutoff is None else lowpass(logs[TRAINING], cutoff)
-        model = fit([train])
-        held = [k for k in logs if k != TRAINING]
-        ours = validate(model, [logs[k] for k in held], held)
-        true = validate(truth, [logs[k] for k in held], held)
-        ratios.append([[a.metrics[s]["std"] / b.metrics[s]["std"] for s in "uvr"]
-                       for a, b in zip(ours, true, strict=True)])  # fmt: skip
-        beats.append([all(v.metrics[s]["std"] <= p for s, p in zip("uvr", PAPER_TABLE[v.name],
-                                                                   strict=True)) for v in ours])
-        ens = bootstrap([train], lambda w, t=train: identify(t, gamma=GAMMA, drop=DROP,
-                                                             sample_weight=w).model,
-                        replicates=replicates, seed=seed)  # fmt: skip
-        table = ens.coefficient_table()
-        for _, row in table.iterrows():
-            if row["term"] == "r^2":
-                continue
-            true_value = truth.coefficients[row["equation"]][row["term"]]
-            inside = row["lower"] <= true_value <= row["upper"]
-            covered.append(inside)
-            widths.append(row["upper"] - row["lower"])
-            if not inside and np.sign(row["value"]) != np.sign(true_value):
-                wrong_sign_outside += 1
-    ratios = np.array(ratios)
-    beats = np.array(beats)
-    names = [k for k in synthesise_trials(0) if k != TRAINING]
-    print("| held-out manoeuvre | error std / true model's, u v r (median) | (largest) | "
-          "seeds beating the paper |")
-    print("|---|---|---|---|")
-    for i, name in enumerate(names):
-        med = " / ".join(f"{x:.2f}" for x in np.median(ratios[:, i], axis=0))
-        big = " / ".join(f"{x:.2f}" for x in ratios[:, i].max(axis=0))
-        print(f"| {name} | {med} | {big} | {int(beats[:, i].sum())} of {seeds} |")
-    print(f"\nPrefilter cut-offs chosen: {sorted({c for c in cutoffs}, key=str)}")
-    print(f"95 % bootstrap intervals cover the true coefficient in {np.mean(covered):.0%} of "
-          f"{len(covered)} coefficient × seed pairs; wrong sign outside the interval: "
-          f"{wrong_sign_outside}")  # fmt: skip
-    print(f"time {time.perf_counter() - t0:.1f} s")
+    spec = StudySpec(seeds=tuple(range(seeds)), estimator=("lssvm", "output-error"),
+                     bootstrap=replicates)  # fmt: skip
+    results = run_study(spec, workers=2, progress=False)
+    table = summary(results).drop(columns=["noise", "gamma", "structure", "filter"])
+    print(table.set_index("estimator").T.to_markdown())
+    from shipid.demo import PAPER_TABLE
+
+    one = results[results["estimator"] == "lssvm"]
+    for name in [k for k in PAPER_TABLE if f"{k}: beats paper" in results]:
+        truth_beats = sum(all(row[f"{name}: {s} truth error std"] <= p
+                              for s, p in zip("uvr", PAPER_TABLE[name], strict=True))
+                          for _, row in one.iterrows())  # fmt: skip
+        print(f"\nthe true model itself beats the paper on {name} in {truth_beats} of {len(one)}",
+              end="")
+    print()
+    cutoffs = sorted(set(results["cutoff_hz"].round(3)))
+    print(f"\nPrefilter cut-offs chosen (LS-SVM and the output-error start): {cutoffs}")
+    print(f"time {time.perf_counter() - t0:.1f} s (2 Dask workers)")
 
 
 if __name__ == "__main__":

@@ -40,6 +40,8 @@ _EXPORTS = {
     "stopping": "shipid.trials.manoeuvres",
     "spiral": "shipid.trials.manoeuvres",
     "refine": "shipid.identification.refine",
+    "output_error": "shipid.identification.output_error",
+    "coefficient_intervals": "shipid.identification.output_error",
     "PhysicsOptions": "shipid.identification.physics",
     "clarke_prior": "shipid.identification.priors",
     "prior_from_model": "shipid.identification.priors",

@@ -314,7 +314,11 @@ def cmd_identify(args) -> int:
     check_outputs({"-o": (args.output, "json")}, args.logs)
     if args.bootstrap is not None and args.refine:
         raise ShipidError("--bootstrap describes the LS-SVM fit; it does not go with --refine")
+    if args.output_error and (args.refine or args.bootstrap is not None):
+        raise ShipidError("--output-error is its own fit with its own intervals; it does not go "
+                          "with --refine or --bootstrap")  # fmt: skip
     logs = _read_logs(args)
+    raw_logs = logs  # the output-error fit needs the noise as measured, not prefiltered
     names = [str(p) for p in args.logs]
     physics = _physics(args, logs, _structure(args))
     cutoff, filter_by = args.filter, "given"
@@ -383,6 +387,8 @@ def cmd_identify(args) -> int:
         print(f"cost {refinement.cost_initial:.4g} → {refinement.cost_final:.4g} in "
               f"{refinement.nfev} evaluations ({refinement.message})")
         print(_free_run_table(refinement))
+    if args.output_error:
+        refinement, ensemble = _output_error(ident, raw_logs, names, args)
     final = ident.model
     if speed is None or not speed > 0:
         raise ShipidError(f"{names[0]}: the first training log starts without headway (u = "
@@ -397,6 +403,8 @@ def cmd_identify(args) -> int:
                 "refinement: the refined model fails plausibility checks the LS-SVM model passes ("
                 + "; ".join(refined_notes[:2]) + "); the model file's model is the LS-SVM one, the "
                 "refined one is kept under identification.refinement.refined_model")
+            if args.output_error:
+                ensemble = None  # its draws describe the output-error model, not this one
         else:
             final, plausibility, notes = refinement.model, refined_report, refined_notes
     sl = plausibility["straight_line"]
@@ -419,6 +427,30 @@ def cmd_identify(args) -> int:
         _warn(w)
     print(f"model written to {args.output}")
     return 0
+
+
+def _output_error(ident, logs, names, args):
+    """``identify --output-error``: the maximum-likelihood output-error fit from the LS-SVM model,
+    printed with its standard errors and intervals; returns the fit and its ensemble."""
+    from shipid.identification.output_error import coefficient_intervals, output_error
+
+    print("fitting by maximum-likelihood output error (unfiltered logs)…", file=sys.stderr)
+    fit, ensemble = output_error(ident.model, logs, max_nfev=args.refine_evals, names=names,
+                                 seed=args.seed)  # fmt: skip
+    st = fit.statistics
+    print("\nmaximum-likelihood output error (± standard error):")
+    print(fit.model.equations(std_errors=st["standard_errors"]))
+    noise = ", ".join(f"{s} {v:.3g}" for s, v in st["noise"].items())
+    print(f"measurement noise from the residuals: {noise}; cost {fit.cost_initial:.4g} → "
+          f"{fit.cost_final:.4g} in {fit.nfev} evaluations; covariance inflation for residual "
+          f"correlation ×{st['covariance_inflation']:.3g}")  # fmt: skip
+    table = coefficient_intervals(fit)
+    table["term"] = [_term_display(t) for t in table["term"]]
+    print(f"\n{st['level']:.0%} intervals of the coefficients (estimate ± 1.96 standard errors; "
+          f"the LS-SVM start beside them):")  # fmt: skip
+    print(table.to_markdown(index=False, floatfmt=".4g"))
+    print(_free_run_table(fit))
+    return fit, ensemble
 
 
 def _print_prime(record: dict | None) -> None:
@@ -728,7 +760,7 @@ def cmd_criteria(args) -> int:
     print(table.to_markdown(index=False, floatfmt=".3g"))
     if "pass_share" in table:
         print(f"lower, upper: 95 % interval of the value and pass_share: the share of passes "
-              f"over the model's {ensemble.replicates} bootstrap replicates")
+              f"over the model's {ensemble.replicates} {ensemble.members_label}")
     print("all criteria met" if crit.passed else "NOT all criteria met")
     for n in crit.notes:
         _warn(n)
@@ -1156,7 +1188,7 @@ def cmd_manoeuvre(args) -> int:
         runs = [run(member) for member in ensemble.members()]
         intervals = index_intervals([r.indices for r in runs if not r.diverged])
         diverged = sum(r.diverged for r in runs)
-        print(f"95 % intervals over the {ensemble.replicates} bootstrap replicates"
+        print(f"95 % intervals over the model's {ensemble.replicates} {ensemble.members_label}"
               + (f" ({diverged} diverged, left out)" if diverged else "") + ":")
     if res.diverged:
         print(res.reason, file=sys.stderr)
@@ -1289,17 +1321,25 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--refine", action="store_true",
                    help="refine the LS-SVM model by output error (free-run fit to the logs); the "
                    "model file holds the refined model and keeps the LS-SVM one")
+    p.add_argument("--output-error", action="store_true",
+                   help="fit the coefficients by maximum-likelihood output error (free runs from "
+                   "estimated initial states against the unfiltered logs; consistent under "
+                   "measurement noise, unlike any equation-error fit), with standard errors, "
+                   "95 %% intervals and 200 covariance draws stored for prediction bands and "
+                   "index intervals; the LS-SVM model is its start and stays in the file")
     p.add_argument("--segment", type=float, metavar="S",
                    help="with --refine: simulate segments of S seconds (default: whole logs)")
     p.add_argument("--refine-evals", type=int, default=200, metavar="N",
-                   help="with --refine: cap on cost evaluations (default %(default)s)")
+                   help="with --refine or --output-error: cap on cost evaluations (default "
+                   "%(default)s)")
     p.add_argument("--bootstrap", type=int, metavar="N",
                    help="uncertainty: N moving-block bootstrap refits (≥ 10; e.g. 200), stored in "
                    "the model file: coefficient intervals here, prediction bands and index "
                    "intervals in validate, manoeuvre and criteria")
     p.add_argument("--block", type=float, default=10.0, metavar="S",
                    help="with --bootstrap: block length [s] (default %(default)g)")
-    p.add_argument("--seed", type=int, default=0, help="with --bootstrap: random seed "
+    p.add_argument("--seed", type=int, default=0, help="with --bootstrap or --output-error: "
+                   "random seed "
                    "(default %(default)s)")
     p.add_argument("-o", "--output", required=True, metavar="MODEL.json")
     _add_physics_options(p)

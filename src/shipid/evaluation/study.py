@@ -4,8 +4,10 @@ A study is a grid (noise level × γ × structure × estimator × prefilter) cro
 Each trial synthesises the paper's four noisy trials on the scale ship (``shipid.demo``) with
 its own noise realisation, identifies a model from the 20/20 zig-zag and predicts the three
 held-out manoeuvres in free run; the true model predicts the same noisy logs, which gives the
-noise floor each error is measured against. With ``bootstrap`` replicates the trial also
-records whether the 95 % intervals cover the true coefficients.
+noise floor each error is measured against. With ``bootstrap`` replicates, or with the
+``output-error`` estimator (maximum-likelihood output error from the LS-SVM start, on the
+unfiltered log, with standard errors), the trial also records whether the 95 % intervals cover
+the true coefficients.
 
 Every trial is a pure function of its parameters (its seed fixes the noise and the
 bootstrap), and runs with one BLAS thread, so the results do not depend on where it ran:
@@ -17,7 +19,7 @@ Specification (YAML; every key optional)::
     noise: [1.0]            # multiples of the paper's sensor noise (``PAPER_IMU``)
     gamma: [1.0e4]          # LS-SVM regularisation γ
     structure: [blanke]     # named term libraries (blanke: r² dropped from surge, as the paper)
-    estimator: [lssvm]      # lssvm, ols, ridge, lasso, svr
+    estimator: [lssvm]      # lssvm, ols, ridge, lasso, svr, output-error
     filter: [auto]          # prefilter of u, v, r: auto (chosen from the data), none, or Hz
     bootstrap: 0            # replicates per trial for coefficient intervals (0: none)
 """
@@ -36,7 +38,8 @@ import pandas as pd
 
 from shipid.errors import ShipidError
 
-ESTIMATORS = ("lssvm", "ols", "ridge", "lasso", "svr")
+ESTIMATORS = ("lssvm", "ols", "ridge", "lasso", "svr", "output-error")
+OUTPUT_ERROR = "output-error"
 LEVEL = 0.95
 
 
@@ -237,9 +240,12 @@ def _trial_results(trial: Trial) -> dict:
     logs = synthesise_trials(trial.seed, sensor=PAPER_IMU.scaled(trial.noise))
     drop = {"u": ["r^2"]} if trial.structure == "blanke" else None
 
+    # The output-error fit starts from the LS-SVM model (chosen and prefiltered as usual).
+    equation_error = "lssvm" if trial.estimator == OUTPUT_ERROR else trial.estimator
+
     def fit(train, weights=None):
         return identify(train, model=trial.structure, gamma=trial.gamma, drop=drop,
-                        estimator=trial.estimator, force=True, sample_weight=weights).model  # fmt: skip
+                        estimator=equation_error, force=True, sample_weight=weights).model  # fmt: skip
 
     cutoff = _cutoff(trial.filter)
     out: dict = {}
@@ -250,6 +256,12 @@ def _trial_results(trial: Trial) -> dict:
     out["cutoff_hz"] = math.nan if cutoff is None else float(cutoff)
     train = logs[TRAINING] if cutoff is None else lowpass(logs[TRAINING], cutoff)
     model = fit(train)
+    table = None
+    if trial.estimator == OUTPUT_ERROR:
+        from shipid.identification.output_error import coefficient_intervals, output_error
+
+        fitted, _ = output_error(model, logs[TRAINING], draws=10, seed=trial.seed)
+        model, table = fitted.model, coefficient_intervals(fitted, LEVEL)
     held = [k for k in logs if k != TRAINING]
     ours = validate(model, [logs[k] for k in held], held)
     true = validate(truth, [logs[k] for k in held], held)
@@ -262,13 +274,15 @@ def _trial_results(trial: Trial) -> dict:
     for dof, terms in model.coefficients.items():
         for term, value in terms.items():
             out[f"{dof}: {term}"] = float(value)
-    if trial.bootstrap:
+    if trial.bootstrap and table is None:
         from shipid.identification.uncertainty import bootstrap
 
         ens = bootstrap([train], lambda w: fit(train, w), replicates=trial.bootstrap,
                         seed=trial.seed)  # fmt: skip
+        table = ens.coefficient_table(LEVEL)
+    if table is not None:
         covered, wrong_sign = [], 0
-        for _, c in ens.coefficient_table(LEVEL).iterrows():
+        for _, c in table.iterrows():
             true_value = truth.coefficients.get(c["equation"], {}).get(c["term"], 0.0)
             inside = bool(c["lower"] <= true_value <= c["upper"])
             covered.append(inside)

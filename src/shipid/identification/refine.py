@@ -40,6 +40,7 @@ from shipid.evaluation.validate import free_run
 from shipid.identification.regression import common_sampling_time
 
 SHOT_STATES = ("u", "v", "r")
+METHOD = "output error, measured initial states, LS-SVM prior"
 # Residual given to every state of every sample after a segment diverged: far beyond any fit.
 DIVERGED_RESIDUAL = 100.0
 
@@ -60,6 +61,8 @@ class Refinement:
     message: str
     free_run: list[dict] = field(default_factory=list)  # per training log: both models' errors
     warnings: list[str] = field(default_factory=list)
+    method: str = METHOD
+    statistics: dict | None = None  # maximum likelihood only: noise, standard errors, covariance
 
     def to_dict(self) -> dict:
         """The refinement as JSON-ready data (kept in the model file)."""
@@ -68,7 +71,8 @@ class Refinement:
                 "n_segments": self.n_segments, "states": list(self.states),
                 "cost_initial": self.cost_initial, "cost_final": self.cost_final,
                 "nfev": self.nfev, "success": self.success, "message": self.message,
-                "free_run": self.free_run, "warnings": self.warnings}  # fmt: skip
+                "free_run": self.free_run, "warnings": self.warnings, "method": self.method,
+                "statistics": self.statistics}  # fmt: skip
 
 
 @dataclass
@@ -84,13 +88,15 @@ class _Segments:
     sigma: np.ndarray  # (n_states,)
 
 
-def _cut(
+def cut_logs(
     logs: Sequence[pd.DataFrame],
     names: Sequence[str],
     segment_s: float | None,
     states: tuple[str, ...],
     model: ManoeuvringModel,
 ) -> tuple[_Segments, float, float]:
+    """The logs cut into segments of ``segment_s`` seconds (None: each log whole), padded to one
+    length for the batch simulator; returns them, the logs' Δk and the segment length [s]."""
     dt = common_sampling_time(logs, names)
     longest = max(len(log) for log in logs) - 1
     if segment_s is None:
@@ -202,7 +208,7 @@ def refine(
         missing = [n for n, log in zip(names, logs, strict=True) if s not in log.columns]
         if missing:
             raise ShipidError(f"{missing[0]}: no {s!r} column to fit")
-    seg, dt, seg_len = _cut(logs, names, segment_s, states, model)
+    seg, dt, seg_len = cut_logs(logs, names, segment_s, states, model)
     B, L = seg.inputs.shape[:2]
 
     # Parameters: the model's coefficients, in the compiled simulator's coefficient matrix.
@@ -254,9 +260,18 @@ def refine(
     if fit.status == 0:
         notes.append(f"refinement stopped at the evaluation cap ({max_nfev}) before converging; "
                      "raise max_nfev or shorten the segments")  # fmt: skip
+    runs = compare_free_runs(model, refined, logs, names, method, notes)
+    return Refinement(refined, model, seg_len, B, states, cost_initial, float(fit.cost),
+                      int(fit.nfev), bool(fit.success), str(fit.message), runs, notes)  # fmt: skip
+
+
+def compare_free_runs(initial: ManoeuvringModel, refined: ManoeuvringModel,
+                      logs: Sequence[pd.DataFrame], names: Sequence[str], method: str,
+                      notes: list[str]) -> list[dict]:  # fmt: skip
+    """Per training log, both models' free-run error std; a refined run that diverges is noted."""
     runs = []
     for name, log in zip(names, logs, strict=True):
-        (sim0, m0), (sim1, m1) = free_run(model, log, method), free_run(refined, log, method)
+        (sim0, m0), (sim1, m1) = free_run(initial, log, method), free_run(refined, log, method)
         runs.append({"name": name,
                      "initial": {s: m0[s]["std"] for s in SHOT_STATES},
                      "refined": {s: m1[s]["std"] for s in SHOT_STATES},
@@ -264,5 +279,4 @@ def refine(
         if sim1.diverged:
             notes.append(f"{name}: the refined model diverges in a free run over the whole log "
                          f"({sim1.reason})")  # fmt: skip
-    return Refinement(refined, model, seg_len, B, states, cost_initial, float(fit.cost),
-                      int(fit.nfev), bool(fit.success), str(fit.message), runs, notes)  # fmt: skip
+    return runs

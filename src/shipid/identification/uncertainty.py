@@ -49,6 +49,11 @@ class Ensemble:
         """Number of replicates R."""
         return int(self.thetas.shape[0])
 
+    @property
+    def members_label(self) -> str:
+        """What the members are, for messages: bootstrap replicates or covariance draws."""
+        return "bootstrap replicates" if self.method == METHOD else "draws of its covariance"
+
     def members(self) -> list[ManoeuvringModel]:
         """The replicates as models (same structure as the point estimate)."""
         index = {t: j for j, t in enumerate(self.model.term_texts)}
@@ -60,7 +65,7 @@ class Ensemble:
         return out
 
     def coefficient_table(self, level: float = LEVEL) -> pd.DataFrame:
-        """One row per coefficient: estimate, bootstrap standard deviation and interval."""
+        """One row per coefficient: estimate, the replicates' standard deviation and interval."""
         index = {t: j for j, t in enumerate(self.model.term_texts)}
         rows = []
         for dof, terms in self.model.structure.terms.items():
@@ -70,7 +75,7 @@ class Ensemble:
                 lo, hi = interval(values, level)
                 rows.append({"equation": dof, "term": t,
                              "value": float(self.model.coefficients[dof][t]),
-                             "bootstrap_std": float(np.std(values, ddof=1)), "lower": lo,
+                             "std": float(np.std(values, ddof=1)), "lower": lo,
                              "upper": hi})  # fmt: skip
         return pd.DataFrame(rows)
 

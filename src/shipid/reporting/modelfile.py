@@ -293,6 +293,8 @@ def rescaled_document(doc: Mapping, factor: float, to_rho: float | None = None,
         for key in ("initial_model", "refined_model"):
             if refinement.get(key):
                 refinement[key] = scale_model(refinement[key])
+        if refinement.get("statistics"):
+            _scale_statistics(refinement["statistics"], ratios, factor, rho, to_rho)
     if out.get("uncertainty"):
         unc = out["uncertainty"]
         thetas = np.asarray(unc["thetas"], dtype=float)
@@ -331,6 +333,28 @@ def rescaled_document(doc: Mapping, factor: float, to_rho: float | None = None,
         "note": "viscous (Reynolds) effects are not scaled; identification.discrete and "
                 "diagnostics are those of the fit at the original scale"})  # fmt: skip
     return json_safe(out)
+
+
+def _scale_statistics(stats: dict, ratios: Mapping, factor: float, rho: float, to_rho: float
+                      ) -> None:  # fmt: skip
+    """An output-error fit's statistics at the new scale: standard errors and covariance scale
+    with their coefficients, the noise and initial states with their signals."""
+    from shipid.dynamics.prime import signal_scale
+
+    for dof, terms in stats.get("standard_errors", {}).items():
+        for t in terms:
+            terms[t] = terms[t] * abs(ratios[dof][t])
+    cov = stats.get("covariance")
+    if cov:
+        r = [ratios[d][t] for d, t in cov["terms"]]
+        cov["matrix"] = [[c * r[i] * r[j] for j, c in enumerate(row)]
+                         for i, row in enumerate(cov["matrix"])]  # fmt: skip
+    for s in list(stats.get("noise", {})):
+        stats["noise"][s] *= signal_scale(s, factor, rho, to_rho)
+    for x0 in stats.get("initial_states", []):
+        for s in ("u", "v", "r"):
+            if s in x0:
+                x0[s] *= signal_scale(s, factor, rho, to_rho)
 
 
 def training_conditions(doc: Mapping) -> dict:

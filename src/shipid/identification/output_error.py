@@ -1,0 +1,296 @@
+"""Maximum-likelihood output error: coefficients, their standard errors and an ensemble for
+prediction bands, from the free-run fit of the model to the measured states.
+
+The LS-SVM (paper eqs. 11–12) regresses accelerations differenced from the measured states on
+regressors built from the same noisy states. Noise in the regressors biases every such estimate
+(errors in variables), and no prefilter removes the bias without adding its own; a bootstrap of
+the equations then measures the variance around the biased value, so its intervals miss the truth
+(36 % coverage on the paper's ship; ``benchmarks/study_uncertainty.py``).
+
+Output error has no noisy regressor. The model is simulated from estimated initial states, driven
+by the measured rudder (and propeller) inputs, and compared with the measured states: with white
+measurement noise ε on state ξ,
+
+    ξ_meas(k) = ξ_sim(k; θ, x₀) + ε_ξ(k),    ε_ξ ~ N(0, σ_ξ²)
+
+and the maximum-likelihood estimate minimises
+
+    J(θ, x₀) = Σ_logs Σ_k Σ_ξ ((ξ_meas(k) − ξ_sim(k; θ, x₀)) / σ_ξ)²
+
+with each log's initial state x₀ = (u, v, r)(t₀) a nuisance parameter (a measured initial state
+carries its noise into the whole run). σ_ξ is estimated from the residuals (two passes: first
+from the first differences of the measurements). Started from the LS-SVM model, minimised by
+Levenberg–Marquardt (``scipy.optimize.least_squares``) with a finite-difference Jacobian whose
+columns are simulated in one compiled batch.
+
+Standard errors are those of the Gauss–Newton covariance s² (JᵀJ)⁻¹ (s² the residual variance
+per degree of freedom). They assume white residuals; where the residuals are correlated (model
+error rather than sensor noise, e.g. on real ships) the covariance is multiplied by
+(1 + ρ)/(1 − ρ), ρ the largest lag-1 autocorrelation of the states' residuals, the variance
+inflation of a mean of AR(1) errors, and a warning says so. Ensemble members for prediction bands
+and index intervals are Gaussian draws from the coefficient covariance.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+import pandas as pd
+
+from shipid.dynamics.model import DOFS, ManoeuvringModel
+from shipid.dynamics.simulate import METHODS, DivergenceBounds, run_kernel
+from shipid.errors import ShipidError
+from shipid.identification.refine import (
+    DIVERGED_RESIDUAL,
+    SHOT_STATES,
+    Refinement,
+    compare_free_runs,
+    cut_logs,
+)
+from shipid.identification.uncertainty import LEVEL, Ensemble
+
+METHOD = "maximum-likelihood output error"
+DRAWS_METHOD = "Gaussian draws from the output-error covariance"
+# Covariance inflation above which the residuals are reported as model error, not noise.
+INFLATION_WARNING = 2.0
+# Relative forward-difference step of the Jacobian (coefficients; initial states absolute).
+REL_STEP = 1e-6
+
+
+def _noise_from_differences(measured: np.ndarray, mask: np.ndarray) -> np.ndarray:
+    """First guess of the noise std per state: first differences of a smooth signal are noise
+    (√2 σ) plus a small change of the state itself."""
+    d = np.concatenate([np.diff(measured[b, mask[b]], axis=0) for b in range(measured.shape[0])])
+    return np.maximum(np.std(d, axis=0) / math.sqrt(2.0), 1e-12)
+
+
+def output_error(
+    model: ManoeuvringModel,
+    logs: Sequence[pd.DataFrame] | pd.DataFrame,
+    method: str = "euler",
+    max_nfev: int = 200,
+    names: Sequence[str] | None = None,
+    draws: int = 200,
+    seed: int = 0,
+) -> tuple[Refinement, Ensemble]:
+    """Maximum-likelihood output-error estimate of ``model``'s coefficients from ``logs``.
+
+    Parameters
+    ----------
+    model : the starting model (the LS-SVM fit); its structure is kept, all coefficients fitted.
+    logs : the training logs, unfiltered (the estimate needs the noise as it was measured).
+    method : the model's integration scheme, 'euler' (the paper's, eq. 11) or 'rk4'.
+    max_nfev : cap on cost evaluations of each of the two passes.
+    draws : members of the ensemble drawn from the coefficient covariance (≥ 10).
+    seed : random seed of the draws.
+
+    Returns
+    -------
+    The fit as a ``Refinement`` (``method`` and ``statistics``: noise, standard errors,
+    covariance, initial states, residual autocorrelation) and the ensemble of draws.
+    """
+    if isinstance(logs, pd.DataFrame):
+        logs = [logs]
+    if not logs:
+        raise ShipidError("no training logs given for the output-error fit")
+    if method not in METHODS:
+        raise ShipidError(f"method must be one of {METHODS}, got {method!r}")
+    if not (isinstance(draws, int) and draws >= 10):
+        raise ShipidError(f"the output-error ensemble needs at least 10 draws, got {draws!r}")
+    names = list(names or [log.attrs.get("name", f"log {i}") for i, log in enumerate(logs)])
+    states = tuple(d for d in SHOT_STATES if d in model.structure.dofs)
+    if not states:
+        raise ShipidError("the model fits none of u, v, r: nothing to compare a free run with")
+    for s in states:
+        missing = [n for n, log in zip(names, logs, strict=True) if s not in log.columns]
+        if missing:
+            raise ShipidError(f"{missing[0]}: no {s!r} column to fit")
+    seg, dt, seg_len = cut_logs(logs, names, None, states, model)
+    B, L = seg.inputs.shape[:2]
+    n_states = len(states)
+    state_col = [SHOT_STATES.index(s) for s in states]
+
+    index = {t: j for j, t in enumerate(model.term_texts)}
+    slots = [(i, index[n]) for i, dof in enumerate(DOFS)
+             for n in model.coefficients.get(dof, {})]  # fmt: skip
+    rows = np.array([i for i, _ in slots], dtype=int)
+    cols = np.array([j for _, j in slots], dtype=int)
+    n_coef = len(slots)
+    x0 = np.concatenate([model.theta[rows, cols], seg.shot0[:, state_col].ravel()])
+    p = x0.size
+    n_obs = int(seg.mask.sum()) * n_states
+    if n_obs <= p:
+        raise ShipidError(f"the logs hold {n_obs} measured values for {p} parameters (the "
+                          "coefficients and each log's initial state); give longer logs")  # fmt: skip
+    s0_base = np.zeros((B, 6))
+    s0_base[:, :3] = seg.shot0
+    s0_base[:, 3] = seg.psi0
+    speed_lim, yaw_lim = DivergenceBounds().resolved(float(np.max(np.abs(seg.shot0[:, 0]))))
+    alive_grid = np.arange(L)[None, None, :]
+
+    def simulate(X: np.ndarray) -> np.ndarray:
+        """States (K, B, L, n_states) of K parameter vectors; diverged samples NaN."""
+        K = X.shape[0]
+        theta = np.zeros((K, B, *model.theta.shape))
+        theta[:, :, rows, cols] = X[:, None, :n_coef]
+        s0 = np.broadcast_to(s0_base, (K, B, 6)).copy()
+        s0[:, :, state_col] = X[:, n_coef:].reshape(K, B, n_states)
+        inputs = np.broadcast_to(seg.inputs, (K, *seg.inputs.shape)).reshape(K * B, L, -1)
+        out, n_valid = run_kernel(model.code, theta.reshape(K * B, *model.theta.shape), seg.t,
+                                  inputs, s0.reshape(K * B, 6), method, speed_lim,
+                                  yaw_lim)  # fmt: skip
+        sim = out.reshape(K, B, L, 6)[..., state_col]
+        sim[alive_grid >= n_valid.reshape(K, B)[:, :, None]] = np.nan
+        return sim
+
+    def weighted(sim: np.ndarray, sigma: np.ndarray) -> np.ndarray:
+        res = (sim - seg.measured) / sigma
+        res[np.isnan(res)] = DIVERGED_RESIDUAL
+        res[..., ~seg.mask, :] = 0.0
+        return res.reshape(sim.shape[0], -1)
+
+    def steps(x: np.ndarray) -> np.ndarray:
+        return np.concatenate([REL_STEP * np.maximum(np.abs(x[:n_coef]), 1e-3),
+                               np.full(p - n_coef, 1e-7)])  # fmt: skip
+
+    from scipy.optimize import least_squares  # 0.2 s of import: only when asked
+
+    sigma = _noise_from_differences(seg.measured, seg.mask)
+    x, nfev, fit = x0, 0, None
+    for _ in range(2):  # the second pass with the noise the first one's residuals show
+
+        def residuals(z: np.ndarray, s=sigma) -> np.ndarray:
+            return weighted(simulate(z[None]), s)[0]
+
+        def jacobian(z: np.ndarray, s=sigma) -> np.ndarray:
+            h = steps(z)
+            r = weighted(simulate(np.vstack([z, z + np.diag(h)])), s)
+            return ((r[1:] - r[0]) / h[:, None]).T
+
+        fit = least_squares(residuals, x, jac=jacobian, method="lm", x_scale="jac",
+                            max_nfev=max_nfev)  # fmt: skip
+        x, nfev = fit.x, nfev + int(fit.nfev)
+        raw = simulate(x[None])[0] - seg.measured
+        raw[..., ~seg.mask, :] = np.nan
+        per_state = np.sum(seg.mask) - p / n_states
+        sigma = np.maximum(np.sqrt(np.nansum(raw**2, axis=(0, 1)) / per_state), 1e-12)
+
+    res = weighted(simulate(x[None]), sigma)[0]
+    # Both costs with the final noise estimate: the start's from its measured initial states.
+    cost_initial = 0.5 * float(np.sum(weighted(simulate(x0[None]), sigma) ** 2))
+    jac = ((weighted(simulate(np.vstack([x, x + np.diag(steps(x))])), sigma)[1:] - res)
+           / steps(x)[:, None]).T  # fmt: skip
+    s2 = float(res @ res) / (n_obs - p)
+    rho = _lag1_autocorrelation(raw, seg.mask)
+    worst = float(np.clip(max(rho.values()), 0.0, 0.99))
+    inflation = (1.0 + worst) / (1.0 - worst)
+    notes: list[str] = []
+    cov, undetermined, rank_notes = _covariance(jac, s2 * inflation, slots, model)
+    notes += rank_notes
+    cov_coef = cov[:n_coef, :n_coef]
+    se = np.where(undetermined[:n_coef], np.inf, np.sqrt(np.clip(np.diag(cov_coef), 0.0, None)))
+
+    coefs: dict[str, dict[str, float]] = {dof: {} for dof in model.structure.dofs}
+    std_errors: dict[str, dict[str, float]] = {dof: {} for dof in model.structure.dofs}
+    labels = []
+    for k, (i, j) in enumerate(slots):
+        term = model.term_texts[j]
+        coefs[DOFS[i]][term] = float(x[k])
+        std_errors[DOFS[i]][term] = float(se[k])
+        labels.append([DOFS[i], term])
+    fitted = ManoeuvringModel(model.structure, coefs, name=f"output error ({model.structure.name})")
+
+    if fit is not None and fit.status == 0:
+        notes.append(f"output error stopped at the evaluation cap ({max_nfev}) before converging")
+    if inflation > INFLATION_WARNING:
+        notes.append(f"the free-run residuals are correlated (lag-1 ρ = {worst:.2f}): model error, "
+                     f"not sensor noise, dominates; the standard errors are widened "
+                     f"×{math.sqrt(inflation):.2g} for it")  # fmt: skip
+    runs = compare_free_runs(model, fitted, logs, names, method, notes)
+    x0_fit = x[n_coef:].reshape(B, n_states)
+    statistics = {
+        "level": LEVEL, "observations": n_obs, "parameters": p,
+        "noise": {s: float(sigma[j]) for j, s in enumerate(states)},
+        "residual_autocorrelation": rho, "covariance_inflation": inflation,
+        "standard_errors": std_errors,
+        "covariance": {"terms": labels, "matrix": cov_coef.tolist()},
+        "initial_states": [{"log": n, **{s: float(x0_fit[b, j]) for j, s in enumerate(states)}}
+                           for b, n in enumerate(names)],
+    }  # fmt: skip
+    result = Refinement(fitted, model, seg_len, B, states, cost_initial, float(fit.cost), nfev,
+                        bool(fit.success), str(fit.message), runs, notes, METHOD,
+                        statistics)  # fmt: skip
+    return result, gaussian_ensemble(fitted, slots, cov_coef, draws, seed)
+
+
+def _lag1_autocorrelation(raw: np.ndarray, mask: np.ndarray) -> dict[str, float]:
+    """Lag-1 autocorrelation of each state's residual, pooled over the logs."""
+    out = {}
+    for j, s in enumerate(s for s in SHOT_STATES[: raw.shape[-1]]):
+        num = den = 0.0
+        for b in range(raw.shape[0]):
+            e = raw[b, mask[b], j]
+            e = e[np.isfinite(e)]
+            if e.size < 3:
+                continue
+            e = e - e.mean()
+            num += float(e[1:] @ e[:-1])
+            den += float(e @ e)
+        out[s] = num / den if den > 0 else 0.0
+    return out
+
+
+def _covariance(jac: np.ndarray, scale: float, slots, model: ManoeuvringModel
+                ) -> tuple[np.ndarray, np.ndarray, list[str]]:  # fmt: skip
+    """scale · (JᵀJ)⁺ by eigendecomposition, and which parameters the logs do not determine
+    (a loading on a direction of (numerically) zero information): their variance is infinite."""
+    # Columns scaled to unit norm: coefficients span orders of magnitude.
+    norms = np.linalg.norm(jac, axis=0)
+    norms[norms == 0] = 1.0
+    w, V = np.linalg.eigh((jac / norms).T @ (jac / norms))
+    tiny = w <= max(w.max(), 0.0) * 1e-12
+    undetermined = np.any(np.abs(V[:, tiny]) > 0.1, axis=1)
+    notes = []
+    if np.any(undetermined[: len(slots)]):
+        which = [f"{DOFS[slots[j][0]]}: {model.term_texts[slots[j][1]]}"
+                 for j in np.flatnonzero(undetermined[: len(slots)])]  # fmt: skip
+        notes.append("the logs do not determine " + ", ".join(which) + " (the output-error "
+                     "information matrix is singular); their standard errors are infinite")
+    inv_w = np.where(tiny, 0.0, 1.0 / np.where(tiny, 1.0, w))
+    cov = scale * ((V * inv_w) @ V.T) / np.outer(norms, norms)
+    return cov, undetermined, notes
+
+
+def gaussian_ensemble(model: ManoeuvringModel, slots, cov: np.ndarray, draws: int, seed: int
+                      ) -> Ensemble:  # fmt: skip
+    """``draws`` coefficient sets θ ~ N(θ̂, cov) over the fitted slots (the rest as θ̂)."""
+    rng = np.random.default_rng(seed)
+    w, V = np.linalg.eigh(cov)
+    root = V * np.sqrt(np.clip(w, 0.0, None))
+    delta = rng.standard_normal((draws, len(slots))) @ root.T
+    thetas = np.broadcast_to(model.theta, (draws, *model.theta.shape)).copy()
+    rows = np.array([i for i, _ in slots], dtype=int)
+    cols = np.array([j for _, j in slots], dtype=int)
+    thetas[:, rows, cols] += delta
+    return Ensemble(model, thetas, 0.0, int(seed), DRAWS_METHOD)
+
+
+def coefficient_intervals(fit: Refinement, level: float = LEVEL) -> pd.DataFrame:
+    """One row per coefficient of an output-error fit: estimate, standard error and the normal
+    interval estimate ± z·SE (z = 1.96 at 95 %)."""
+    from statistics import NormalDist
+
+    if not fit.statistics:
+        raise ShipidError("not a maximum-likelihood output-error fit: it has no standard errors")
+    z = NormalDist().inv_cdf(0.5 + level / 2.0)
+    se = fit.statistics["standard_errors"]
+    rows = []
+    for dof, terms in fit.model.coefficients.items():
+        for term, value in terms.items():
+            s = se[dof][term]
+            rows.append({"equation": dof, "term": term, "value": value,
+                         "lssvm": fit.initial.coefficients[dof].get(term, math.nan),
+                         "std_error": s, "lower": value - z * s, "upper": value + z * s})  # fmt: skip
+    return pd.DataFrame(rows)

@@ -1,0 +1,188 @@
+"""Maximum-likelihood output error against independent truths: the closed-form least-squares line
+of a constant-acceleration model, the known coefficients of the paper's ship under its sensor
+noise, and the command line's files."""
+
+import json
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+from cli_helpers import run
+
+from shipid.data.io import write_log
+from shipid.demo import TRAINING, synthesise_trials
+from shipid.dynamics.model import ManoeuvringModel, ModelStructure
+from shipid.errors import ShipidError
+from shipid.evaluation.study import Trial, run_trial
+from shipid.identification.identify import identify
+from shipid.identification.output_error import (
+    DRAWS_METHOD,
+    METHOD,
+    coefficient_intervals,
+    output_error,
+)
+from shipid.vessels import PAPER_IMU, scale_ship_model
+
+DROP = {"u": ["r^2"]}
+
+
+def constant_model(c=(0.01, -0.002, 0.001)) -> ManoeuvringModel:
+    structure = ModelStructure("constant", {"u": ("1",), "v": ("1",), "r": ("1",)})
+    return ManoeuvringModel(structure, {d: {"1": x} for d, x in zip("uvr", c, strict=True)})
+
+
+def test_a_constant_acceleration_is_the_least_squares_line_with_its_textbook_errors():
+    # u̇ = c integrates exactly to the line u0 + c t: output error is then ordinary least squares
+    # of the measurements on [1, t], whose estimate and standard errors have closed forms.
+    rng = np.random.default_rng(3)
+    t = np.arange(200) * 0.2
+    true = {"u": (1.5, 0.01), "v": (0.1, -0.002), "r": (-0.02, 0.001)}
+    noise = {"u": 0.03, "v": 0.01, "r": 0.004}
+    log = pd.DataFrame({"t": t, "delta": np.zeros_like(t)})
+    for s, (x0, c) in true.items():
+        log[s] = x0 + c * t + noise[s] * rng.standard_normal(t.size)
+    fit, ensemble = output_error(constant_model((0.0, 0.0, 0.0)), log, draws=50)
+    X = np.column_stack([np.ones_like(t), t])
+    xtx_inv = np.linalg.inv(X.T @ X)
+    inflation = fit.statistics["covariance_inflation"]
+    for s in "uvr":
+        beta, rss = np.linalg.lstsq(X, log[s].to_numpy(), rcond=None)[:2]
+        sigma2 = float(rss[0]) / (t.size - 2)
+        assert fit.model.coefficients[s]["1"] == pytest.approx(beta[1], rel=1e-5)
+        assert fit.statistics["initial_states"][0][s] == pytest.approx(beta[0], rel=1e-5, abs=1e-9)
+        assert fit.statistics["noise"][s] == pytest.approx(math.sqrt(sigma2), rel=1e-4)
+        se = fit.statistics["standard_errors"][s]["1"] / math.sqrt(inflation)
+        assert se == pytest.approx(math.sqrt(sigma2 * xtx_inv[1, 1]), rel=1e-3)
+    assert 1.0 <= inflation < 1.5  # white noise: hardly any correlation to widen for
+    assert fit.method == METHOD and ensemble.method == DRAWS_METHOD
+    assert ensemble.thetas.shape == (50, 3, 1)
+
+
+@pytest.fixture(scope="module")
+def paper_fit():
+    logs = synthesise_trials(0)
+    start = identify(logs[TRAINING], drop=DROP, force=True).model
+    return output_error(start, logs[TRAINING]), logs
+
+
+def test_the_paper_ships_coefficients_lie_within_their_intervals(paper_fit):
+    (fit, ensemble), _ = paper_fit
+    truth = scale_ship_model().coefficients
+    table = coefficient_intervals(fit)
+    assert len(table) == 16
+    z = (table["value"] - [truth[d][t] for d, t in zip(table["equation"], table["term"],
+                                                        strict=True)]) / table["std_error"]
+    assert np.all(np.abs(z) < 2.5), table.assign(z=z)
+    # The equation-error start is biased by the noisy regressors (EIV): output error is not.
+    assert fit.model.coefficients["r"]["u*r"] == pytest.approx(-1.1699, rel=0.15)
+    assert abs(fit.initial.coefficients["r"]["u*r"] / -1.1699 - 1) > 0.25
+    # The noise it finds is the sensor model's.
+    for s in "uvr":
+        assert fit.statistics["noise"][s] == pytest.approx(PAPER_IMU.white[s], rel=0.1)
+    spread = ensemble.coefficient_table()
+    assert np.allclose(spread["std"], table["std_error"], rtol=0.3)
+
+
+def test_output_error_predicts_held_out_trials_at_the_noise_floor(paper_fit):
+    from shipid.evaluation.validate import validate
+
+    (fit, _), logs = paper_fit
+    held = [k for k in logs if k != TRAINING]
+    ours = validate(fit.model, [logs[k] for k in held], held)
+    truth = validate(scale_ship_model(), [logs[k] for k in held], held)
+    for a, b in zip(ours, truth, strict=True):
+        for s in "uvr":
+            assert a.metrics[s]["std"] <= 1.05 * b.metrics[s]["std"], (a.name, s)
+
+
+def test_an_undetermined_coefficient_is_named_and_gets_an_infinite_error():
+    # δ never moves: nothing in the log tells its coefficient.
+    t = np.arange(100) * 0.2
+    rng = np.random.default_rng(0)
+    log = pd.DataFrame({"t": t, "delta": np.zeros_like(t), "u": 1.0 + 0.01 * rng.standard_normal(100),
+                        "v": 0.01 * rng.standard_normal(100), "r": 0.001 * rng.standard_normal(100)})
+    structure = ModelStructure("c", {"u": ("1",), "v": ("1", "delta"), "r": ("1",)})
+    model = ManoeuvringModel(structure, {"u": {"1": 0.0}, "v": {"1": 0.0, "delta": 0.1},
+                                         "r": {"1": 0.0}})  # fmt: skip
+    fit, _ = output_error(model, log)
+    assert math.isinf(fit.statistics["standard_errors"]["v"]["delta"])
+    assert math.isfinite(fit.statistics["standard_errors"]["v"]["1"])
+    assert any("do not determine v: delta" in w for w in fit.warnings)
+
+
+def test_correlated_residuals_widen_the_errors_and_say_so():
+    # A slow oscillation the constant model cannot follow: model error, not noise.
+    t = np.arange(300) * 0.2
+    wobble = 0.05 * np.sin(2 * np.pi * t / 20)
+    log = pd.DataFrame({"t": t, "delta": np.zeros_like(t), "u": 1.0 + wobble, "v": wobble,
+                        "r": 0.1 * wobble})  # fmt: skip
+    fit, _ = output_error(constant_model(), log)
+    assert fit.statistics["covariance_inflation"] > 10
+    assert any("correlated" in w for w in fit.warnings)
+
+
+@pytest.mark.parametrize("kwargs, message", [({"draws": 3}, "at least 10 draws"),
+                                             ({"method": "rk45"}, "method must be")])
+def test_bad_arguments_are_refused(paper_fit, kwargs, message):
+    (fit, _), logs = paper_fit
+    with pytest.raises(ShipidError, match=message):
+        output_error(fit.initial, logs[TRAINING], **kwargs)
+
+
+def test_too_short_a_log_is_refused():
+    # 12 measured values for the Blanke model's 17 coefficients and 3 initial states.
+    t = np.arange(4) * 0.2
+    log = pd.DataFrame({"t": t, "delta": [0.0, 0.1, 0.2, 0.3], "u": [1.0, 1.1, 1.0, 1.1],
+                        "v": [0.0, 0.01, 0.0, 0.01], "r": [0.0, 0.001, 0.0, 0.001]})  # fmt: skip
+    with pytest.raises(ShipidError, match="12 measured values for 20 parameters"):
+        output_error(scale_ship_model(), log)
+
+
+def test_the_command_writes_errors_draws_and_the_lssvm_start(tmp_path, capsys, paper_fit):
+    _, logs = paper_fit
+    train, held = tmp_path / "train.csv", tmp_path / "zz10.csv"
+    write_log(logs[TRAINING], train)
+    write_log(logs["zigzag 10/10"], held)
+    out = tmp_path / "oe.json"
+    code, text, err = run(["identify", train, "--drop", "u:r^2", "--output-error", "-o", out],
+                          capsys)  # fmt: skip
+    assert code == 0, err
+    assert "± 1.96 standard errors" in text and "measurement noise from the residuals" in text
+    doc = json.loads(out.read_text())
+    ref = doc["identification"]["refinement"]
+    assert ref["method"] == METHOD
+    assert doc["model"] == ref["refined_model"]
+    assert doc["uncertainty"]["method"] == DRAWS_METHOD and doc["uncertainty"]["replicates"] == 200
+    se = ref["statistics"]["standard_errors"]
+    assert se["r"]["delta"] > 0 and len(ref["statistics"]["covariance"]["matrix"]) == 16
+    code, text, err = run(["validate", out, held], capsys)
+    assert code == 0, err
+    assert "95 %" in text
+    # Rescaled with the model: every standard error in proportion to its coefficient.
+    big = tmp_path / "big.json"
+    assert run(["rescale", out, "--factor", "4", "-o", big], capsys)[0] == 0
+    doc2 = json.loads(big.read_text())
+    ref2 = doc2["identification"]["refinement"]
+    for dof, terms in se.items():
+        for term, s in terms.items():
+            ratio = doc2["model"]["coefficients"][dof][term] / doc["model"]["coefficients"][dof][term]
+            assert ref2["statistics"]["standard_errors"][dof][term] == pytest.approx(s * abs(ratio))
+
+
+@pytest.mark.parametrize("extra", [["--refine"], ["--bootstrap", "20"]])
+def test_the_command_refuses_two_fits_at_once(tmp_path, capsys, paper_fit, extra):
+    _, logs = paper_fit
+    train = tmp_path / "train.csv"
+    write_log(logs[TRAINING], train)
+    out = tmp_path / "oe.json"
+    code, _, err = run(["identify", train, "--output-error", *extra, "-o", out], capsys)
+    assert code == 1 and "--output-error is its own fit" in err and len(err.splitlines()) == 1
+    assert not out.exists()
+
+
+def test_a_study_trial_counts_the_output_error_coverage():
+    row = run_trial(Trial(0, seed=0, estimator="output-error"))
+    assert row["error"] == ""
+    assert row["coverage"] == 1.0  # seed 0: every true coefficient inside (see the test above)
+    assert row["turning δ = +20°: u error std"] <= 1.05 * row["turning δ = +20°: u truth error std"]
