@@ -20,6 +20,7 @@ import numba
 import numpy as np
 from timing import best_of
 
+from shipid.dynamics import codegen, kernel
 from shipid.dynamics.model import ManoeuvringModel, ModelStructure
 from shipid.dynamics.simulate import input_array, run_kernel, simulate, simulate_batch
 from shipid.vessels import scale_ship_model
@@ -118,9 +119,11 @@ def main() -> None:
     b = np.array([cv[k] for k in ("u*r", "u*v", "|v|*v", "|v|*r", "delta", "1")])
     c = np.array([cr[k] for k in ("u*r", "u*v", "|v|*v", "|v|*r", "delta", "1")])
     s0 = np.array([[1.9, 0, 0, 0, 0, 0]])
-    for m in (blanke, user):  # compile or load the caches
-        simulate(m, np.arange(0, 1, 0.2), np.zeros(5), {"u": 1.9})
-        simulate_batch(m, np.arange(0, 1, 0.2), np.zeros((2, 5)), {"u": 1.9})
+    for m in (blanke, user):  # compile or load the caches (the generated kernels too)
+        for engine in ("interpreted", "generated"):
+            with codegen.use(engine):
+                simulate(m, np.arange(0, 1, 0.2), np.zeros(5), {"u": 1.9})
+                simulate_batch(m, np.arange(0, 1, 0.2), np.zeros((2, 5)), {"u": 1.9})
     numba_loop(a, b, c, np.arange(5) * 0.2, np.zeros(5), 1.9, True, np.zeros((5, 6)))
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores\n")
     print("| case | method | steps | time (s) | steps/s | vs plain Python loop | "
@@ -142,12 +145,14 @@ def main() -> None:
         print(f"| Blanke, hand-written numba loop | {method} | {n:.0e} | – | {nb_rate:.3g} | "
               f"{nb_rate / py_rate:.0f}× | 1× | baseline |")
         for model, label in ((blanke, "Blanke (6 terms)"), (user, "user library (20 terms)")):
-            kt = best_of(lambda m=model, t=t, inp=inp, method=method: run_kernel(
-                m.code, m.theta, t, inp, s0, method, 20.0, 5.0))
-            rate = (n - 1) / kt
-            target = "≥ 1e6 steps/s" if "20" in label else "≥ 50× Python"
-            print(f"| {label}, free-run kernel | {method} | {n:.0e} | {kt:.3f} | {rate:.3g} | "
-                  f"{rate / py_rate:.0f}× | {rate / nb_rate:.2f}× | {target} |")
+            for engine in ("interpreted", "generated"):
+                kt = best_of(lambda m=model, t=t, inp=inp, method=method, e=engine: run_kernel(
+                    m.code, m.theta, t, inp, s0, method, 20.0, 5.0, engine=e))
+                rate = (n - 1) / kt
+                target = ("≥ 0.8× numba" if engine == "generated" and "6" in label
+                          else "≥ 1e6 steps/s" if "20" in label else "≥ 50× Python")
+                print(f"| {label}, free-run kernel, {engine} | {method} | {n:.0e} | {kt:.3f} | "
+                      f"{rate:.3g} | {rate / py_rate:.0f}× | {rate / nb_rate:.2f}× | {target} |")
             st = best_of(lambda m=model: simulate(m, t, d, {"u": 1.9}, method=method))  # noqa: B023
             print(f"| {label}, simulate() with its log | {method} | {n:.0e} | {st:.3f} | "
                   f"{(n - 1) / st:.3g} | {(n - 1) / st / py_rate:.0f}× | "
@@ -157,11 +162,152 @@ def main() -> None:
         deltas = np.tile(zig(t), (B, 1)) * np.linspace(0.5, 1.0, B)[:, None]
         init = np.column_stack([np.linspace(1.5, 2.0, B), np.zeros((B, 5))])
         for model, label in ((blanke, "Blanke"), (user, "user library")):
-            bt = best_of(lambda m=model: simulate_batch(m, t, deltas, init, method=method))  # noqa: B023
-            rate = B * (nb - 1) / bt
-            target = "≥ 1e7 state-steps/s" if label == "Blanke" else "–"
-            print(f"| {label}, batch of {B} | {method} | {B}×{nb} | {bt:.3f} | {rate:.3g} | "
-                  f"{rate / py_rate:.0f}× | {rate / nb_rate:.2f}× | {target} |")
+            for engine in ("interpreted", "generated"):
+                with codegen.use(engine):
+                    bt = best_of(lambda m=model: simulate_batch(m, t, deltas, init, method=method))  # noqa: B023
+                rate = B * (nb - 1) / bt
+                target = "≥ 1e7 state-steps/s" if label == "Blanke" else "–"
+                print(f"| {label}, batch of {B}, {engine} | {method} | {B}×{nb} | {bt:.3f} | "
+                      f"{rate:.3g} | {rate / py_rate:.0f}× | {rate / nb_rate:.2f}× | {target} |")
+
+
+def python_zigzag(a, b, c, n, dt, u0, rk4, rudder, switch, rate, stbd):
+    """Plain Python closed-loop zig-zag of the Blanke model: the rudder reversed at ±switch of
+    heading, a rate-limited steering machine, states and rudder recorded every step; ``stbd``
+    the sign of a starboard rudder angle."""
+    def rhs(u, v, r, psi, d):
+        av = abs(v)
+        return (a[0] * abs(u) * u + a[1] * v * r + a[2] * r * r + a[3] * d * d + a[4],
+                b[0] * u * r + b[1] * u * v + b[2] * av * v + b[3] * av * r + b[4] * d + b[5],
+                c[0] * u * r + c[1] * u * v + c[2] * av * v + c[3] * av * r + c[4] * d + c[5],
+                r, u * math.cos(psi) - v * math.sin(psi), u * math.sin(psi) + v * math.cos(psi))
+
+    s = [u0, 0.0, 0.0, 0.0, 0.0, 0.0]
+    delta, side, lim = 0.0, 1.0, rate * dt
+    states, rudders = [], []
+    for _ in range(n):
+        if side > 0 and s[3] >= switch:
+            side = -1.0
+        elif side < 0 and s[3] <= -switch:
+            side = 1.0
+        delta += min(max(side * stbd * rudder - delta, -lim), lim)
+        states.append(tuple(s))
+        rudders.append(delta)
+        k1 = rhs(*s[:4], delta)
+        if not rk4:
+            s = [x + dt * y for x, y in zip(s, k1, strict=True)]
+            continue
+        k2 = rhs(*[x + 0.5 * dt * y for x, y in zip(s[:4], k1[:4], strict=True)], delta)
+        k3 = rhs(*[x + 0.5 * dt * y for x, y in zip(s[:4], k2[:4], strict=True)], delta)
+        k4 = rhs(*[x + dt * y for x, y in zip(s[:4], k3[:4], strict=True)], delta)
+        s = [x + dt / 6 * (p + 2 * q + 2 * w + z)
+             for x, p, q, w, z in zip(s, k1, k2, k3, k4, strict=True)]  # fmt: skip
+    return states, rudders
+
+
+@numba.njit(cache=True)
+def numba_zigzag(a, b, c, n, dt, u0, rk4, rudder, switch, rate, stbd, states, rudders):
+    """The same zig-zag hand-written in numba (terms typed in): the practical limit."""
+    u, v, r, psi, x, y = u0, 0.0, 0.0, 0.0, 0.0, 0.0
+    delta, side, lim = 0.0, 1.0, rate * dt
+    for k in range(n):
+        if side > 0 and psi >= switch:
+            side = -1.0
+        elif side < 0 and psi <= -switch:
+            side = 1.0
+        delta += min(max(side * stbd * rudder - delta, -lim), lim)
+        states[k, 0], states[k, 1], states[k, 2] = u, v, r
+        states[k, 3], states[k, 4], states[k, 5] = psi, x, y
+        rudders[k] = delta
+        k1 = _blanke_rhs(a, b, c, u, v, r, psi, delta)
+        if not rk4:
+            u += dt * k1[0]
+            v += dt * k1[1]
+            r += dt * k1[2]
+            psi += dt * k1[3]
+            x += dt * k1[4]
+            y += dt * k1[5]
+            continue
+        g = 0.5 * dt
+        k2 = _blanke_rhs(a, b, c, u + g * k1[0], v + g * k1[1], r + g * k1[2], psi + g * k1[3], delta)
+        k3 = _blanke_rhs(a, b, c, u + g * k2[0], v + g * k2[1], r + g * k2[2], psi + g * k2[3], delta)
+        h = dt
+        k4 = _blanke_rhs(a, b, c, u + h * k3[0], v + h * k3[1], r + h * k3[2], psi + h * k3[3], delta)
+        w = dt / 6.0
+        u += w * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0])
+        v += w * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1])
+        r += w * (k1[2] + 2 * k2[2] + 2 * k3[2] + k4[2])
+        psi += w * (k1[3] + 2 * k2[3] + 2 * k3[3] + k4[3])
+        x += w * (k1[4] + 2 * k2[4] + 2 * k3[4] + k4[4])
+        y += w * (k1[5] + 2 * k2[5] + 2 * k3[5] + k4[5])
+
+
+def closed_loop() -> None:
+    """Closed-loop 20/20 zig-zags of the Blanke model (scale ship, 9.6 °/s rudder): the term
+    interpreter and the generated kernel (``kernel``-level entries, no log built) against a
+    plain Python loop and a hand-written numba loop of the same manoeuvre."""
+    from shipid.trials.manoeuvres import _params, as_vessel, run_closed_loop
+    from shipid.vessels import scale_ship
+
+    ship = scale_ship(rudder_rate_deg=9.6)
+    model = ship.dynamics
+    cu, cv, cr = (model.coefficients[d] for d in "uvr")
+    a = np.array([cu["|u|*u"], cu["v*r"], cu["r^2"], cu["delta^2"], cu["1"]])
+    b = np.array([cv[k] for k in ("u*r", "u*v", "|v|*v", "|v|*r", "delta", "1")])
+    c = np.array([cr[k] for k in ("u*r", "u*v", "|v|*v", "|v|*r", "delta", "1")])
+    rudder, switch, rate = math.radians(20), math.radians(20), math.radians(9.6)
+    vessel = as_vessel(ship)
+    params = _params(vessel, kernel.MODE_ZIGZAG, rudder, 0.0, 0.0, switch=switch, side=1.0)
+    stbd = params[kernel.P_STBD]  # positive rudder turns this ship to port: −1
+    dt, n = 0.05, 2_000_000
+    u0 = vessel.approach_speed
+    s0 = np.array([[u0, 0, 0, 0, 0, 0]])
+    print(f"\nClosed-loop 20/20 zig-zag, {n:.0e} steps at {dt} s (load average "
+          f"{os.getloadavg()[0]:.2f})\n")
+    print("| method | engine | time (s) | steps/s | vs plain Python loop | vs hand-written numba "
+          "| target |")
+    print("|---|---|---|---|---|---|---|")
+    gen = codegen.load(model.code)
+    for method in ("euler", "rk4"):
+        rk4 = method == "rk4"
+        n_py = 200_000
+        py_rate = n_py / best_of(lambda: python_zigzag(a, b, c, n_py, dt, u0, rk4, rudder,  # noqa: B023
+                                                       switch, rate, stbd), 1)
+        states, rudders = np.zeros((n, 6)), np.zeros(n)
+        numba_zigzag(a, b, c, 10, dt, u0, rk4, rudder, switch, rate, stbd, states, rudders)
+        nb_rate = n / best_of(lambda: numba_zigzag(a, b, c, n, dt, u0, rk4, rudder, switch,  # noqa: B023
+                                                   rate, stbd, states, rudders))  # noqa: B023
+        print(f"| {method} | plain Python loop | – | {py_rate:.3g} | 1× | "
+              f"{py_rate / nb_rate:.3f}× | baseline |")
+        print(f"| {method} | hand-written numba | – | {nb_rate:.3g} | {nb_rate / py_rate:.0f}× | "
+              f"1× | baseline |")
+
+        def run(engine, rk4=rk4):
+            out, rud, nv = np.zeros((1, n, 6)), np.zeros((1, n)), np.zeros(1, dtype=np.int64)
+            args = (dt, n, s0, params[None].copy(), rk4, np.array([20.0]), np.array([5.0]), out,
+                    rud, nv)  # fmt: skip
+            if engine == "generated":
+                gen.integrate_closed(model.theta[None].copy(), *args)
+            else:
+                kernel.integrate_closed(model.theta[None].copy(), *model.code.arrays(),
+                                        model.code.uses_derived, *args)  # fmt: skip
+            return out
+
+        for engine in ("interpreted", "generated"):
+            run(engine)
+            rate_e = n / best_of(lambda e=engine: run(e))
+            target = "≥ 50× Python, ≥ 0.8× numba" if engine == "generated" else "–"
+            print(f"| {method} | {engine} | {n / rate_e:.3f} | {rate_e:.3g} | "
+                  f"{rate_e / py_rate:.0f}× | {rate_e / nb_rate:.2f}× | {target} |")
+        check = np.zeros((n, 6))
+        numba_zigzag(a, b, c, n, dt, u0, rk4, rudder, switch, rate, stbd, check, rudders)
+        ours = run("generated")[0]
+        print(f"| {method} | (generated − hand-written numba, largest state difference) | "
+              f"{np.abs(ours[:, :3] - check[:, :3]).max():.1e} | | | | |")
+        with codegen.use("generated"):
+            whole = best_of(lambda m=method: run_closed_loop(vessel, params, (n - 1) * dt, dt, m))
+        print(f"| {method} | generated, run_closed_loop() with its log | {whole:.3f} | "
+              f"{n / whole:.3g} | {n / whole / py_rate:.0f}× | {n / whole / nb_rate:.2f}× | – |")
 
 
 class NumpyPath:
@@ -201,4 +347,5 @@ def reference_ships() -> None:
 
 if __name__ == "__main__":
     main()
+    closed_loop()
     reference_ships()

@@ -214,21 +214,28 @@ def initial_states(initial, n_traj: int) -> np.ndarray:
 
 def run_kernel(code: TermCode, theta: np.ndarray, t: np.ndarray, inputs: np.ndarray,
                s0: np.ndarray, method: str, speed_lim, yaw_lim,
-               n_steps: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+               n_steps: np.ndarray | None = None,
+               engine: str | None = None) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
     """The compiled open-loop kernel on raw arrays: θ (3, T) or (B, 3, T), inputs (B, N, 5) in
     ``INPUT_SIGNALS`` order, s0 (B, 6); bounds scalars or (B,). Returns states (B, N, 6) and the
     valid samples per run. No input checks: for inner loops (refinement, selection) that reuse
-    validated arrays; everything else goes through ``simulate_batch``."""
+    validated arrays; everything else goes through ``simulate_batch``. ``engine``: 'interpreted',
+    'generated' (for ``code``), 'auto'; None: ``shipid.dynamics.codegen.use``'s."""
+    from shipid.dynamics import codegen
+
     B, N = inputs.shape[0], t.size
     theta = kernel.c_array(np.broadcast_to(theta, (B, *theta.shape[-2:])))
     steps = np.full(B, N, dtype=np.int64) if n_steps is None else kernel.c_array(n_steps, np.int64)
     out = np.zeros((B, N, 6))
     n_valid = np.zeros(B, dtype=np.int64)
-    kernel.integrate_open(theta, *code.arrays(), code.uses_derived, kernel.c_array(t),
-                          kernel.c_array(inputs), steps, kernel.c_array(s0), method == "rk4",
-                          kernel.c_array(np.broadcast_to(np.asarray(speed_lim, float), B)),
-                          kernel.c_array(np.broadcast_to(np.asarray(yaw_lim, float), B)), out,
-                          n_valid)  # fmt: skip
+    args = (kernel.c_array(t), kernel.c_array(inputs), steps, kernel.c_array(s0), method == "rk4",
+            kernel.c_array(np.broadcast_to(np.asarray(speed_lim, float), B)),
+            kernel.c_array(np.broadcast_to(np.asarray(yaw_lim, float), B)), out, n_valid)
+    generated = codegen.choose(code, B * N, engine)
+    if generated is not None:
+        generated.integrate_open(theta, *args)
+    else:
+        kernel.integrate_open(theta, *code.arrays(), code.uses_derived, *args)
     return out, n_valid
 
 

@@ -113,11 +113,13 @@ def run_closed_loop(
     bounds: DivergenceBounds | None = None,
     initial: Mapping[str, float] | None = None,
     rps: float | None = None,
+    engine: str | None = None,
 ) -> ManoeuvreResult:
     """Integrate from a straight approach at ``vessel.approach_speed`` (or from ``initial``, a
     mapping of u, v, r, psi, x, y) with the rudder command of ``params`` (``kernel.command``)
     through the vessel's steering machine. ``rps`` is the propeller speed held during the
-    manoeuvre, needed by models with propeller-speed terms."""
+    manoeuvre, needed by models with propeller-speed terms. ``engine``: a term-set model's
+    kernel, 'auto', 'generated' or 'interpreted'; None: ``shipid.dynamics.codegen.use``'s."""
     if method not in METHODS:
         raise ShipidError(f"method must be one of {METHODS}, got {method!r}")
     dt = _positive(dt, "step dt")
@@ -138,13 +140,19 @@ def run_closed_loop(
         if dyn.uses_thrust:
             raise ShipidError("manoeuvres on a model with a thrust term need a thrust model; "
                               "identify with propeller speed (n) terms instead")  # fmt: skip
+        from shipid.dynamics import codegen
+
         states = np.zeros((1, n, 6))
         rudder = np.zeros((1, n))
         n_valid = np.zeros(1, dtype=np.int64)
-        kernel.integrate_closed(dyn.theta[None].copy(), *dyn.code.arrays(), dyn.code.uses_derived,
-                                dt, n, s0, params[None].copy(), method == "rk4",
-                                np.array([speed_lim]), np.array([yaw_lim]), states, rudder,
-                                n_valid)  # fmt: skip
+        generated = codegen.choose(dyn.code, n, engine)
+        args = (dt, n, s0, params[None].copy(), method == "rk4", np.array([speed_lim]),
+                np.array([yaw_lim]), states, rudder, n_valid)  # fmt: skip
+        if generated is not None:
+            generated.integrate_closed(dyn.theta[None].copy(), *args)
+        else:
+            kernel.integrate_closed(dyn.theta[None].copy(), *dyn.code.arrays(),
+                                    dyn.code.uses_derived, *args)  # fmt: skip
         m = int(n_valid[0])
         states, rudder = states[0], rudder[0]
     elif hasattr(dyn, "integrate_closed"):  # a compiled reference ship
