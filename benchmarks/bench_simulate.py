@@ -41,12 +41,9 @@ def user_model() -> ManoeuvringModel:
     return ManoeuvringModel(ModelStructure("user-20", {d: TERMS_20 for d in "uvr"}), coefs)
 
 
-def python_loop(model, t, delta, u0, method):
-    """Plain Python, scalar math: the Blanke model's terms written out."""
-    cu, cv, cr = (model.coefficients[d] for d in "uvr")
-    a = (cu["|u|*u"], cu["v*r"], cu["r^2"], cu["delta^2"], cu["1"])
-    b = (cv["u*r"], cv["u*v"], cv["|v|*v"], cv["|v|*r"], cv["delta"], cv["1"])
-    c = (cr["u*r"], cr["u*v"], cr["|v|*v"], cr["|v|*r"], cr["delta"], cr["1"])
+def python_rhs(a, b, c):
+    """The Blanke model's state derivative in plain Python (coefficients as Python floats)."""
+    a, b, c = ([float(x) for x in coefs] for coefs in (a, b, c))
 
     def rhs(u, v, r, psi, d):
         av = abs(v)
@@ -55,18 +52,36 @@ def python_loop(model, t, delta, u0, method):
                 c[0] * u * r + c[1] * u * v + c[2] * av * v + c[3] * av * r + c[4] * d + c[5],
                 r, u * math.cos(psi) - v * math.sin(psi), u * math.sin(psi) + v * math.cos(psi))
 
+    return rhs
+
+
+def python_step(rhs, s, d, h, rk4):
+    """One Euler or RK4 step of the state list ``s`` with the rudder ``d`` held."""
+    k1 = rhs(s[0], s[1], s[2], s[3], d)
+    if not rk4:
+        return [x + h * y for x, y in zip(s, k1, strict=True)]
+    k2 = rhs(*[x + 0.5 * h * y for x, y in zip(s[:4], k1[:4], strict=True)], d)
+    k3 = rhs(*[x + 0.5 * h * y for x, y in zip(s[:4], k2[:4], strict=True)], d)
+    k4 = rhs(*[x + h * y for x, y in zip(s[:4], k3[:4], strict=True)], d)
+    return [x + h / 6 * (p + 2 * q + 2 * w + z)
+            for x, p, q, w, z in zip(s, k1, k2, k3, k4, strict=True)]  # fmt: skip
+
+
+def blanke_arrays(model):
+    """The Blanke model's coefficients in the hand-written loops' order."""
+    cu, cv, cr = (model.coefficients[d] for d in "uvr")
+    return (np.array([cu["|u|*u"], cu["v*r"], cu["r^2"], cu["delta^2"], cu["1"]]),
+            np.array([cv[k] for k in ("u*r", "u*v", "|v|*v", "|v|*r", "delta", "1")]),
+            np.array([cr[k] for k in ("u*r", "u*v", "|v|*v", "|v|*r", "delta", "1")]))
+
+
+def python_loop(model, t, delta, u0, method):
+    """Plain Python, scalar math: the Blanke model's terms written out."""
+    rhs = python_rhs(*blanke_arrays(model))
+    t, delta = [float(x) for x in t], [float(x) for x in delta]
     s = [u0, 0.0, 0.0, 0.0, 0.0, 0.0]
     for k in range(len(t) - 1):
-        h, d = t[k + 1] - t[k], delta[k]
-        k1 = rhs(s[0], s[1], s[2], s[3], d)
-        if method == "euler":
-            s = [x + h * y for x, y in zip(s, k1, strict=True)]
-            continue
-        k2 = rhs(*[x + 0.5 * h * y for x, y in zip(s[:4], k1[:4], strict=True)], d)
-        k3 = rhs(*[x + 0.5 * h * y for x, y in zip(s[:4], k2[:4], strict=True)], d)
-        k4 = rhs(*[x + h * y for x, y in zip(s[:4], k3[:4], strict=True)], d)
-        s = [x + h / 6 * (p + 2 * q + 2 * w + z)
-             for x, p, q, w, z in zip(s, k1, k2, k3, k4, strict=True)]  # fmt: skip
+        s = python_step(rhs, s, delta[k], t[k + 1] - t[k], method == "rk4")
     return s
 
 
@@ -114,10 +129,7 @@ def numba_loop(a, b, c, t, delta, u0, rk4, out):
 def main() -> None:
     blanke, user = scale_ship_model(), user_model()
     zig = lambda t: 0.35 * np.sign(np.sin(2 * np.pi * t / 30) + 1e-9)  # noqa: E731
-    cu, cv, cr = (blanke.coefficients[d] for d in "uvr")
-    a = np.array([cu["|u|*u"], cu["v*r"], cu["r^2"], cu["delta^2"], cu["1"]])
-    b = np.array([cv[k] for k in ("u*r", "u*v", "|v|*v", "|v|*r", "delta", "1")])
-    c = np.array([cr[k] for k in ("u*r", "u*v", "|v|*v", "|v|*r", "delta", "1")])
+    a, b, c = blanke_arrays(blanke)
     s0 = np.array([[1.9, 0, 0, 0, 0, 0]])
     for m in (blanke, user):  # compile or load the caches (the generated kernels too)
         for engine in ("interpreted", "generated"):
@@ -175,13 +187,7 @@ def python_zigzag(a, b, c, n, dt, u0, rk4, rudder, switch, rate, stbd):
     """Plain Python closed-loop zig-zag of the Blanke model: the rudder reversed at ±switch of
     heading, a rate-limited steering machine, states and rudder recorded every step; ``stbd``
     the sign of a starboard rudder angle."""
-    def rhs(u, v, r, psi, d):
-        av = abs(v)
-        return (a[0] * abs(u) * u + a[1] * v * r + a[2] * r * r + a[3] * d * d + a[4],
-                b[0] * u * r + b[1] * u * v + b[2] * av * v + b[3] * av * r + b[4] * d + b[5],
-                c[0] * u * r + c[1] * u * v + c[2] * av * v + c[3] * av * r + c[4] * d + c[5],
-                r, u * math.cos(psi) - v * math.sin(psi), u * math.sin(psi) + v * math.cos(psi))
-
+    rhs = python_rhs(a, b, c)
     s = [u0, 0.0, 0.0, 0.0, 0.0, 0.0]
     delta, side, lim = 0.0, 1.0, rate * dt
     states, rudders = [], []
@@ -193,15 +199,7 @@ def python_zigzag(a, b, c, n, dt, u0, rk4, rudder, switch, rate, stbd):
         delta += min(max(side * stbd * rudder - delta, -lim), lim)
         states.append(tuple(s))
         rudders.append(delta)
-        k1 = rhs(*s[:4], delta)
-        if not rk4:
-            s = [x + dt * y for x, y in zip(s, k1, strict=True)]
-            continue
-        k2 = rhs(*[x + 0.5 * dt * y for x, y in zip(s[:4], k1[:4], strict=True)], delta)
-        k3 = rhs(*[x + 0.5 * dt * y for x, y in zip(s[:4], k2[:4], strict=True)], delta)
-        k4 = rhs(*[x + dt * y for x, y in zip(s[:4], k3[:4], strict=True)], delta)
-        s = [x + dt / 6 * (p + 2 * q + 2 * w + z)
-             for x, p, q, w, z in zip(s, k1, k2, k3, k4, strict=True)]  # fmt: skip
+        s = python_step(rhs, s, delta, dt, rk4)
     return states, rudders
 
 
@@ -251,10 +249,7 @@ def closed_loop() -> None:
 
     ship = scale_ship(rudder_rate_deg=9.6)
     model = ship.dynamics
-    cu, cv, cr = (model.coefficients[d] for d in "uvr")
-    a = np.array([cu["|u|*u"], cu["v*r"], cu["r^2"], cu["delta^2"], cu["1"]])
-    b = np.array([cv[k] for k in ("u*r", "u*v", "|v|*v", "|v|*r", "delta", "1")])
-    c = np.array([cr[k] for k in ("u*r", "u*v", "|v|*v", "|v|*r", "delta", "1")])
+    a, b, c = blanke_arrays(model)
     rudder, switch, rate = math.radians(20), math.radians(20), math.radians(9.6)
     vessel = as_vessel(ship)
     params = _params(vessel, kernel.MODE_ZIGZAG, rudder, 0.0, 0.0, switch=switch, side=1.0)
