@@ -94,36 +94,35 @@ def _blanke_rhs(a, b, c, u, v, r, psi, d):
             r, u * math.cos(psi) - v * math.sin(psi), u * math.sin(psi) + v * math.cos(psi))
 
 
+@numba.njit(cache=True, inline="always")
+def _blanke_step(a, b, c, u, v, r, psi, x, y, d, h, rk4):
+    """One Euler or RK4 step of the typed-in Blanke model with the rudder d held."""
+    k1 = _blanke_rhs(a, b, c, u, v, r, psi, d)
+    if not rk4:
+        return (u + h * k1[0], v + h * k1[1], r + h * k1[2], psi + h * k1[3], x + h * k1[4],
+                y + h * k1[5])
+    g = 0.5 * h
+    k2 = _blanke_rhs(a, b, c, u + g * k1[0], v + g * k1[1], r + g * k1[2], psi + g * k1[3], d)
+    k3 = _blanke_rhs(a, b, c, u + g * k2[0], v + g * k2[1], r + g * k2[2], psi + g * k2[3], d)
+    k4 = _blanke_rhs(a, b, c, u + h * k3[0], v + h * k3[1], r + h * k3[2], psi + h * k3[3], d)
+    w = h / 6.0
+    return (u + w * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0]),
+            v + w * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1]),
+            r + w * (k1[2] + 2 * k2[2] + 2 * k3[2] + k4[2]),
+            psi + w * (k1[3] + 2 * k2[3] + 2 * k3[3] + k4[3]),
+            x + w * (k1[4] + 2 * k2[4] + 2 * k3[4] + k4[4]),
+            y + w * (k1[5] + 2 * k2[5] + 2 * k3[5] + k4[5]))
+
+
 @numba.njit(cache=True)
 def numba_loop(a, b, c, t, delta, u0, rk4, out):
     """Hand-written numba loop of the Blanke model (terms typed in): the practical limit."""
     u, v, r, psi, x, y = u0, 0.0, 0.0, 0.0, 0.0, 0.0
     for k in range(t.size - 1):
-        h, d = t[k + 1] - t[k], delta[k]
-        k1 = _blanke_rhs(a, b, c, u, v, r, psi, d)
-        if not rk4:
-            u += h * k1[0]
-            v += h * k1[1]
-            r += h * k1[2]
-            psi += h * k1[3]
-            x += h * k1[4]
-            y += h * k1[5]
-        else:
-            g = 0.5 * h
-            k2 = _blanke_rhs(a, b, c, u + g * k1[0], v + g * k1[1], r + g * k1[2], psi + g * k1[3], d)
-            k3 = _blanke_rhs(a, b, c, u + g * k2[0], v + g * k2[1], r + g * k2[2], psi + g * k2[3], d)
-            k4 = _blanke_rhs(a, b, c, u + h * k3[0], v + h * k3[1], r + h * k3[2], psi + h * k3[3], d)
-            w = h / 6.0
-            u += w * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0])
-            v += w * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1])
-            r += w * (k1[2] + 2 * k2[2] + 2 * k3[2] + k4[2])
-            psi += w * (k1[3] + 2 * k2[3] + 2 * k3[3] + k4[3])
-            x += w * (k1[4] + 2 * k2[4] + 2 * k3[4] + k4[4])
-            y += w * (k1[5] + 2 * k2[5] + 2 * k3[5] + k4[5])
+        u, v, r, psi, x, y = _blanke_step(a, b, c, u, v, r, psi, x, y, delta[k], t[k + 1] - t[k],
+                                          rk4)  # fmt: skip
         out[k + 1, 0], out[k + 1, 1], out[k + 1, 2] = u, v, r
         out[k + 1, 3], out[k + 1, 4], out[k + 1, 5] = psi, x, y
-
-
 
 
 def main() -> None:
@@ -217,27 +216,7 @@ def numba_zigzag(a, b, c, n, dt, u0, rk4, rudder, switch, rate, stbd, states, ru
         states[k, 0], states[k, 1], states[k, 2] = u, v, r
         states[k, 3], states[k, 4], states[k, 5] = psi, x, y
         rudders[k] = delta
-        k1 = _blanke_rhs(a, b, c, u, v, r, psi, delta)
-        if not rk4:
-            u += dt * k1[0]
-            v += dt * k1[1]
-            r += dt * k1[2]
-            psi += dt * k1[3]
-            x += dt * k1[4]
-            y += dt * k1[5]
-            continue
-        g = 0.5 * dt
-        k2 = _blanke_rhs(a, b, c, u + g * k1[0], v + g * k1[1], r + g * k1[2], psi + g * k1[3], delta)
-        k3 = _blanke_rhs(a, b, c, u + g * k2[0], v + g * k2[1], r + g * k2[2], psi + g * k2[3], delta)
-        h = dt
-        k4 = _blanke_rhs(a, b, c, u + h * k3[0], v + h * k3[1], r + h * k3[2], psi + h * k3[3], delta)
-        w = dt / 6.0
-        u += w * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0])
-        v += w * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1])
-        r += w * (k1[2] + 2 * k2[2] + 2 * k3[2] + k4[2])
-        psi += w * (k1[3] + 2 * k2[3] + 2 * k3[3] + k4[3])
-        x += w * (k1[4] + 2 * k2[4] + 2 * k3[4] + k4[4])
-        y += w * (k1[5] + 2 * k2[5] + 2 * k3[5] + k4[5])
+        u, v, r, psi, x, y = _blanke_step(a, b, c, u, v, r, psi, x, y, delta, dt, rk4)
 
 
 def closed_loop() -> None:

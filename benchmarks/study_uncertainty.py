@@ -4,6 +4,8 @@ maximum-likelihood output error from it (covariance intervals): how well each pr
 held-out manoeuvres against the true model's own error, and how often its 95 % intervals cover
 the true coefficients. Runs as a ``shipid study`` (``shipid.evaluation.study``).
 
+Then the same comparison on real data: the KVLCC2's held-out zig-zags (``real_data``).
+
 Run: .venv/bin/python benchmarks/study_uncertainty.py [SEEDS] [REPLICATES]
 """
 
@@ -40,5 +42,55 @@ def main(seeds: int = 40, replicates: int = 100) -> None:
     print(f"time {time.perf_counter() - t0:.1f} s (2 Dask workers)")
 
 
+def real_data() -> None:
+    """KVLCC2 (MARIN zz 20°, ``blanke-speed``, prefilter chosen from the data, as ``identify``):
+    the LS-SVM against output error from it, free-run error std on the two held-out zig-zags,
+    and the plausibility of each model (35° rudder held)."""
+    from pathlib import Path
+
+    from shipid.data.io import read_log
+    from shipid.data.preprocess import lowpass
+    from shipid.evaluation.validate import validate
+    from shipid.identification.identify import identify
+    from shipid.identification.output_error import output_error
+    from shipid.identification.plausibility import check_plausibility
+    from shipid.identification.prefilter import choose_prefilter
+
+    data = Path(__file__).resolve().parents[2] / "shared" / "data"
+    if not data.is_dir():
+        print("\n../shared/data is absent: no real-data rows")
+        return
+    marin = dict(fmt="simman-marin", scale=45.7, dt=0.2)
+    train = read_log(data / "kvlcc2-marin/MARIN_FREE_KVLCC2_zz_20_m.dat", **marin)
+    held = {"MARIN zz −20°": read_log(data / "kvlcc2-marin/MARIN_FREE_KVLCC2_zz_-20_m.dat",
+                                      **marin),
+            "HSVA zz 20/10": read_log(data / "kvlcc2-hsva/HSVA_CPMC_KVLCC2_Z_20_10_P.dat",
+                                      fmt="simman-hsva", dt=0.2)}  # fmt: skip
+
+    def fit(logs):
+        return identify(logs, model="blanke-speed", force=True).model
+
+    cutoff, _ = choose_prefilter([train], fit)
+    lssvm = fit(train if cutoff is None else lowpass(train, cutoff))
+    oe, _ = output_error(lssvm, train)
+    st = oe.statistics
+    print(f"\nKVLCC2, trained on MARIN zz 20° (prefilter {cutoff:.3g} Hz); output error: residual "
+          f"lag-1 ρ {max(st['residual_autocorrelation'].values()):.2f}, standard errors widened "
+          f"×{st['covariance_inflation'] ** 0.5:.3g}\n")  # fmt: skip
+    print("| held out | LS-SVM u / v / r error std | output error |")
+    print("|---|---|---|")
+    runs = {name: validate(m, list(held.values()), list(held)) for name, m in
+            (("lssvm", lssvm), ("oe", oe.model))}  # fmt: skip
+    for k, name in enumerate(held):
+        cells = [" / ".join(f"{runs[m][k].metrics[s]['std']:.4f}" for s in "uvr")
+                 for m in ("lssvm", "oe")]  # fmt: skip
+        print(f"| {name} | {cells[0]} | {cells[1]} |")
+    speed = float(train["u"].iloc[:25].mean())
+    for name, m in (("LS-SVM", lssvm), ("output error", oe.model)):
+        notes = check_plausibility(m, speed)[1]
+        print(f"\nplausibility of the {name} model: " + ("; ".join(notes) or "passes"))
+
+
 if __name__ == "__main__":
     main(*(int(a) for a in sys.argv[1:3]))
+    real_data()

@@ -96,6 +96,19 @@ def test_output_error_predicts_held_out_trials_at_the_noise_floor(paper_fit):
             assert a.metrics[s]["std"] <= 1.05 * b.metrics[s]["std"], (a.name, s)
 
 
+def test_a_model_without_surge_fits_and_labels_sway_and_yaw(paper_fit):
+    # Surge held: only v and r are compared, and every per-state figure is theirs.
+    _, logs = paper_fit
+    start = identify(logs[TRAINING], model="linear-sway-yaw", force=True).model
+    fit, _ = output_error(start, logs[TRAINING])
+    st = fit.statistics
+    assert fit.states == ("v", "r")
+    assert set(st["noise"]) == set(st["residual_autocorrelation"]) == {"v", "r"}
+    assert st["noise"]["v"] == pytest.approx(PAPER_IMU.white["v"], rel=0.5)
+    assert st["noise"]["r"] < 0.1 * st["noise"]["v"] + PAPER_IMU.white["r"] * 3
+    assert set(st["initial_states"][0]) == {"log", "v", "r"}
+
+
 def test_an_undetermined_coefficient_is_named_and_gets_an_infinite_error():
     # δ never moves: nothing in the log tells its coefficient.
     t = np.arange(100) * 0.2

@@ -446,8 +446,8 @@ def _output_error(ident, logs, names, args):
           f"correlation ×{st['covariance_inflation']:.3g}")  # fmt: skip
     table = coefficient_intervals(fit)
     table["term"] = [_term_display(t) for t in table["term"]]
-    print(f"\n{st['level']:.0%} intervals of the coefficients (estimate ± 1.96 standard errors; "
-          f"the LS-SVM start beside them):")  # fmt: skip
+    print(f"\n{st['level'] * 100:g} % intervals of the coefficients (estimate ± 1.96 standard "
+          "errors; the LS-SVM start beside them):")  # fmt: skip
     print(table.to_markdown(index=False, floatfmt=".4g"))
     print(_free_run_table(fit))
     return fit, ensemble

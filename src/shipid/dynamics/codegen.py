@@ -22,8 +22,6 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
-import hashlib
-import importlib.util
 import os
 import sys
 import threading
@@ -39,7 +37,8 @@ ENGINES = ("auto", "generated", "interpreted")
 GENERATED_MIN_STEPS = 2_000_000
 
 _engine: contextvars.ContextVar[str] = contextvars.ContextVar("shipid_engine", default="auto")
-_loaded: dict[str, ModuleType] = {}
+_loaded: dict[tuple[str, ...], ModuleType] = {}  # by term set: the integrators cannot change
+
 _lock = threading.Lock()
 _unwritable = False
 
@@ -135,31 +134,26 @@ def integrate_closed(theta, dt, n_steps, s0, params, rk4, speed_lim, yaw_lim, st
 '''
 
 
-_keys: dict[tuple[str, ...], str] = {}
-
-
 def _key(code: TermCode) -> str:
-    key = _keys.get(code.texts)
-    if key is None:
-        # The integrators are compiled into the generated module's cache: a change to them (or
-        # to shipid) must give a new module, since numba does not track a cached callee.
-        kernel_src = (Path(__file__).parent / "kernel.py").read_bytes()
-        h = hashlib.sha256(source(code).encode() + kernel_src + __version__.encode())
-        key = _keys[code.texts] = h.hexdigest()[:20]
-    return key
+    """The generated module's name suffix: a hash of its source, the integrators it compiles in
+    (numba does not track a cached function's callees) and shipid's version."""
+    import hashlib  # 3 ms: on first use, not on every command's start-up
+
+    kernel_src = (Path(__file__).parent / "kernel.py").read_bytes()
+    h = hashlib.sha256(source(code).encode() + kernel_src + __version__.encode())
+    return h.hexdigest()[:20]
 
 
 def load(code: TermCode) -> ModuleType | None:
     """The generated kernels of ``code`` (written and imported on first use), or None where the
     cache folder cannot be written."""
     global _unwritable
-    key = _key(code)
     with _lock:
-        if key in _loaded:
-            return _loaded[key]
+        if code.texts in _loaded:
+            return _loaded[code.texts]
         if _unwritable:
             return None
-        name = f"shipid_terms_{key}"
+        name = f"shipid_terms_{_key(code)}"
         folder = cache_dir()
         path = folder / f"{name}.py"
         try:
@@ -171,11 +165,13 @@ def load(code: TermCode) -> ModuleType | None:
         except OSError:
             _unwritable = True
             return None
+        import importlib.util
+
         spec = importlib.util.spec_from_file_location(name, path)
         module = importlib.util.module_from_spec(spec)
         sys.modules[name] = module
         spec.loader.exec_module(module)
-        _loaded[key] = module
+        _loaded[code.texts] = module
         return module
 
 
@@ -204,6 +200,6 @@ def choose(code: TermCode, steps: int, engine: str | None = None) -> ModuleType 
     engine = _check(_engine.get() if engine is None else engine)
     if engine == "interpreted":
         return None
-    if engine == "auto" and steps < GENERATED_MIN_STEPS and _key(code) not in _loaded:
+    if engine == "auto" and steps < GENERATED_MIN_STEPS and code.texts not in _loaded:
         return None
     return load(code)

@@ -21,7 +21,7 @@ import numpy as np
 import pandas as pd
 
 from shipid.data.log import input_columns, make_log
-from shipid.dynamics import kernel
+from shipid.dynamics import codegen, kernel
 from shipid.dynamics.model import ManoeuvringModel
 from shipid.dynamics.terms import INPUT_SIGNALS, TermCode
 from shipid.errors import ShipidError
@@ -221,8 +221,6 @@ def run_kernel(code: TermCode, theta: np.ndarray, t: np.ndarray, inputs: np.ndar
     valid samples per run. No input checks: for inner loops (refinement, selection) that reuse
     validated arrays; everything else goes through ``simulate_batch``. ``engine``: 'interpreted',
     'generated' (for ``code``), 'auto'; None: ``shipid.dynamics.codegen.use``'s."""
-    from shipid.dynamics import codegen
-
     B, N = inputs.shape[0], t.size
     theta = kernel.c_array(np.broadcast_to(theta, (B, *theta.shape[-2:])))
     steps = np.full(B, N, dtype=np.int64) if n_steps is None else kernel.c_array(n_steps, np.int64)

@@ -46,8 +46,10 @@ from shipid.identification.refine import (
     DIVERGED_RESIDUAL,
     SHOT_STATES,
     Refinement,
+    coefficient_slots,
     compare_free_runs,
     cut_logs,
+    with_coefficients,
 )
 from shipid.identification.uncertainty import LEVEL, Ensemble
 
@@ -112,12 +114,8 @@ def output_error(
     n_states = len(states)
     state_col = [SHOT_STATES.index(s) for s in states]
 
-    index = {t: j for j, t in enumerate(model.term_texts)}
-    slots = [(i, index[n]) for i, dof in enumerate(DOFS)
-             for n in model.coefficients.get(dof, {})]  # fmt: skip
-    rows = np.array([i for i, _ in slots], dtype=int)
-    cols = np.array([j for _, j in slots], dtype=int)
-    n_coef = len(slots)
+    rows, cols = coefficient_slots(model)
+    n_coef = len(rows)
     x0 = np.concatenate([model.theta[rows, cols], seg.shot0[:, state_col].ravel()])
     p = x0.size
     n_obs = int(seg.mask.sum()) * n_states
@@ -151,58 +149,54 @@ def output_error(
         res[..., ~seg.mask, :] = 0.0
         return res.reshape(sim.shape[0], -1)
 
-    def steps(x: np.ndarray) -> np.ndarray:
-        return np.concatenate([REL_STEP * np.maximum(np.abs(x[:n_coef]), 1e-3),
-                               np.full(p - n_coef, 1e-7)])  # fmt: skip
+    def residuals(z: np.ndarray, sigma: np.ndarray) -> np.ndarray:
+        return weighted(simulate(z[None]), sigma)[0]
+
+    def jacobian(z: np.ndarray, sigma: np.ndarray) -> np.ndarray:
+        """Forward differences, every column's free run in one batch."""
+        h = np.concatenate([REL_STEP * np.maximum(np.abs(z[:n_coef]), 1e-3),
+                            np.full(p - n_coef, 1e-7)])  # fmt: skip
+        r = weighted(simulate(np.vstack([z, z + np.diag(h)])), sigma)
+        return ((r[1:] - r[0]) / h[:, None]).T
 
     from scipy.optimize import least_squares  # 0.2 s of import: only when asked
 
     sigma = _noise_from_differences(seg.measured, seg.mask)
-    x, nfev, fit = x0, 0, None
+    x, nfev = x0, 0
     for _ in range(2):  # the second pass with the noise the first one's residuals show
-
-        def residuals(z: np.ndarray, s=sigma) -> np.ndarray:
-            return weighted(simulate(z[None]), s)[0]
-
-        def jacobian(z: np.ndarray, s=sigma) -> np.ndarray:
-            h = steps(z)
-            r = weighted(simulate(np.vstack([z, z + np.diag(h)])), s)
-            return ((r[1:] - r[0]) / h[:, None]).T
-
         fit = least_squares(residuals, x, jac=jacobian, method="lm", x_scale="jac",
-                            max_nfev=max_nfev)  # fmt: skip
+                            max_nfev=max_nfev, args=(sigma,))  # fmt: skip
         x, nfev = fit.x, nfev + int(fit.nfev)
         raw = simulate(x[None])[0] - seg.measured
         raw[..., ~seg.mask, :] = np.nan
         per_state = np.sum(seg.mask) - p / n_states
         sigma = np.maximum(np.sqrt(np.nansum(raw**2, axis=(0, 1)) / per_state), 1e-12)
 
-    res = weighted(simulate(x[None]), sigma)[0]
-    # Both costs with the final noise estimate: the start's from its measured initial states.
-    cost_initial = 0.5 * float(np.sum(weighted(simulate(x0[None]), sigma) ** 2))
-    jac = ((weighted(simulate(np.vstack([x, x + np.diag(steps(x))])), sigma)[1:] - res)
-           / steps(x)[:, None]).T  # fmt: skip
+    # Costs, Jacobian and covariance with the final noise estimate; the start's cost from its
+    # measured initial states.
+    res = residuals(x, sigma)
+    cost_initial = 0.5 * float(np.sum(residuals(x0, sigma) ** 2))
+    cost_final = 0.5 * float(res @ res)
     s2 = float(res @ res) / (n_obs - p)
-    rho = _lag1_autocorrelation(raw, seg.mask)
+    rho = _lag1_autocorrelation(raw, seg.mask, states)
     worst = float(np.clip(max(rho.values()), 0.0, 0.99))
     inflation = (1.0 + worst) / (1.0 - worst)
     notes: list[str] = []
-    cov, undetermined, rank_notes = _covariance(jac, s2 * inflation, slots, model)
+    cov, undetermined, rank_notes = _covariance(jacobian(x, sigma), s2 * inflation, rows, cols,
+                                                model)  # fmt: skip
     notes += rank_notes
     cov_coef = cov[:n_coef, :n_coef]
     se = np.where(undetermined[:n_coef], np.inf, np.sqrt(np.clip(np.diag(cov_coef), 0.0, None)))
 
-    coefs: dict[str, dict[str, float]] = {dof: {} for dof in model.structure.dofs}
+    fitted = with_coefficients(model, rows, cols, x[:n_coef],
+                               f"output error ({model.structure.name})")  # fmt: skip
     std_errors: dict[str, dict[str, float]] = {dof: {} for dof in model.structure.dofs}
     labels = []
-    for k, (i, j) in enumerate(slots):
-        term = model.term_texts[j]
-        coefs[DOFS[i]][term] = float(x[k])
-        std_errors[DOFS[i]][term] = float(se[k])
-        labels.append([DOFS[i], term])
-    fitted = ManoeuvringModel(model.structure, coefs, name=f"output error ({model.structure.name})")
+    for i, j, value in zip(rows, cols, se, strict=True):
+        std_errors[DOFS[i]][model.term_texts[j]] = float(value)
+        labels.append([DOFS[i], model.term_texts[j]])
 
-    if fit is not None and fit.status == 0:
+    if fit.status == 0:
         notes.append(f"output error stopped at the evaluation cap ({max_nfev}) before converging")
     if inflation > INFLATION_WARNING:
         notes.append(f"the free-run residuals are correlated (lag-1 ρ = {worst:.2f}): model error, "
@@ -219,16 +213,18 @@ def output_error(
         "initial_states": [{"log": n, **{s: float(x0_fit[b, j]) for j, s in enumerate(states)}}
                            for b, n in enumerate(names)],
     }  # fmt: skip
-    result = Refinement(fitted, model, seg_len, B, states, cost_initial, float(fit.cost), nfev,
+    result = Refinement(fitted, model, seg_len, B, states, cost_initial, cost_final, nfev,
                         bool(fit.success), str(fit.message), runs, notes, METHOD,
                         statistics)  # fmt: skip
-    return result, gaussian_ensemble(fitted, slots, cov_coef, draws, seed)
+    return result, gaussian_ensemble(fitted, rows, cols, cov_coef, draws, seed)
 
 
-def _lag1_autocorrelation(raw: np.ndarray, mask: np.ndarray) -> dict[str, float]:
-    """Lag-1 autocorrelation of each state's residual, pooled over the logs."""
+def _lag1_autocorrelation(raw: np.ndarray, mask: np.ndarray, states: Sequence[str]
+                          ) -> dict[str, float]:  # fmt: skip
+    """Lag-1 autocorrelation of each fitted state's residual (raw[..., j] is ``states[j]``),
+    pooled over the logs."""
     out = {}
-    for j, s in enumerate(s for s in SHOT_STATES[: raw.shape[-1]]):
+    for j, s in enumerate(states):
         num = den = 0.0
         for b in range(raw.shape[0]):
             e = raw[b, mask[b], j]
@@ -242,8 +238,8 @@ def _lag1_autocorrelation(raw: np.ndarray, mask: np.ndarray) -> dict[str, float]
     return out
 
 
-def _covariance(jac: np.ndarray, scale: float, slots, model: ManoeuvringModel
-                ) -> tuple[np.ndarray, np.ndarray, list[str]]:  # fmt: skip
+def _covariance(jac: np.ndarray, scale: float, rows: np.ndarray, cols: np.ndarray,
+                model: ManoeuvringModel) -> tuple[np.ndarray, np.ndarray, list[str]]:  # fmt: skip
     """scale · (JᵀJ)⁺ by eigendecomposition, and which parameters the logs do not determine
     (a loading on a direction of (numerically) zero information): their variance is infinite."""
     # Columns scaled to unit norm: coefficients span orders of magnitude.
@@ -253,9 +249,9 @@ def _covariance(jac: np.ndarray, scale: float, slots, model: ManoeuvringModel
     tiny = w <= max(w.max(), 0.0) * 1e-12
     undetermined = np.any(np.abs(V[:, tiny]) > 0.1, axis=1)
     notes = []
-    if np.any(undetermined[: len(slots)]):
-        which = [f"{DOFS[slots[j][0]]}: {model.term_texts[slots[j][1]]}"
-                 for j in np.flatnonzero(undetermined[: len(slots)])]  # fmt: skip
+    if np.any(undetermined[: len(rows)]):
+        which = [f"{DOFS[rows[j]]}: {model.term_texts[cols[j]]}"
+                 for j in np.flatnonzero(undetermined[: len(rows)])]  # fmt: skip
         notes.append("the logs do not determine " + ", ".join(which) + " (the output-error "
                      "information matrix is singular); their standard errors are infinite")
     inv_w = np.where(tiny, 0.0, 1.0 / np.where(tiny, 1.0, w))
@@ -263,16 +259,15 @@ def _covariance(jac: np.ndarray, scale: float, slots, model: ManoeuvringModel
     return cov, undetermined, notes
 
 
-def gaussian_ensemble(model: ManoeuvringModel, slots, cov: np.ndarray, draws: int, seed: int
-                      ) -> Ensemble:  # fmt: skip
-    """``draws`` coefficient sets θ ~ N(θ̂, cov) over the fitted slots (the rest as θ̂)."""
+def gaussian_ensemble(model: ManoeuvringModel, rows: np.ndarray, cols: np.ndarray,
+                      cov: np.ndarray, draws: int, seed: int) -> Ensemble:  # fmt: skip
+    """``draws`` coefficient sets θ ~ N(θ̂, cov) over the fitted coefficients (at ``rows``,
+    ``cols`` of θ; the rest as θ̂)."""
     rng = np.random.default_rng(seed)
     w, V = np.linalg.eigh(cov)
     root = V * np.sqrt(np.clip(w, 0.0, None))
-    delta = rng.standard_normal((draws, len(slots))) @ root.T
+    delta = rng.standard_normal((draws, len(rows))) @ root.T
     thetas = np.broadcast_to(model.theta, (draws, *model.theta.shape)).copy()
-    rows = np.array([i for i, _ in slots], dtype=int)
-    cols = np.array([j for _, j in slots], dtype=int)
     thetas[:, rows, cols] += delta
     return Ensemble(model, thetas, 0.0, int(seed), DRAWS_METHOD)
 

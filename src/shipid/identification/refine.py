@@ -211,12 +211,7 @@ def refine(
     seg, dt, seg_len = cut_logs(logs, names, segment_s, states, model)
     B, L = seg.inputs.shape[:2]
 
-    # Parameters: the model's coefficients, in the compiled simulator's coefficient matrix.
-    index = {t: j for j, t in enumerate(model.term_texts)}
-    slots = [(i, index[n]) for i, dof in enumerate(DOFS)
-             for n in model.coefficients.get(dof, {})]  # fmt: skip
-    rows = np.array([i for i, _ in slots], dtype=int)
-    cols = np.array([j for _, j in slots], dtype=int)
+    rows, cols = coefficient_slots(model)
     x0 = model.theta[rows, cols].copy()
     sigma_e = _equation_error_spread(model, logs, dt)
     prior_scale = np.array([1.0 / (math.sqrt(gamma) * sigma_e[DOFS[i]]) for i in rows])
@@ -251,10 +246,7 @@ def refine(
         fit = least_squares(residuals, x0, method="trf", x_scale=scale, max_nfev=max_nfev)
     finally:
         bar.close()
-    coefs = {dof: {} for dof in dofs}
-    for (i, j), value in zip(slots, fit.x, strict=True):
-        coefs[DOFS[i]][model.term_texts[j]] = float(value)
-    refined = ManoeuvringModel(model.structure, coefs, name=f"refined ({model.structure.name})")
+    refined = with_coefficients(model, rows, cols, fit.x, f"refined ({model.structure.name})")
 
     notes = []
     if fit.status == 0:
@@ -263,6 +255,24 @@ def refine(
     runs = compare_free_runs(model, refined, logs, names, method, notes)
     return Refinement(refined, model, seg_len, B, states, cost_initial, float(fit.cost),
                       int(fit.nfev), bool(fit.success), str(fit.message), runs, notes)  # fmt: skip
+
+
+def coefficient_slots(model: ManoeuvringModel) -> tuple[np.ndarray, np.ndarray]:
+    """Where the model's coefficients sit in its θ (3, T), in ``model.coefficients`` order:
+    the rows (DOFs) and columns (terms) of the fitted parameters."""
+    index = {t: j for j, t in enumerate(model.term_texts)}
+    slots = [(i, index[n]) for i, dof in enumerate(DOFS) for n in model.coefficients.get(dof, {})]
+    return (np.array([i for i, _ in slots], dtype=int),
+            np.array([j for _, j in slots], dtype=int))  # fmt: skip
+
+
+def with_coefficients(model: ManoeuvringModel, rows: np.ndarray, cols: np.ndarray,
+                      values: np.ndarray, name: str) -> ManoeuvringModel:  # fmt: skip
+    """``model``'s structure with the coefficients at ``coefficient_slots`` set to ``values``."""
+    coefs: dict[str, dict[str, float]] = {dof: {} for dof in model.structure.dofs}
+    for i, j, value in zip(rows, cols, values, strict=True):
+        coefs[DOFS[i]][model.term_texts[j]] = float(value)
+    return ManoeuvringModel(model.structure, coefs, name=name)
 
 
 def compare_free_runs(initial: ManoeuvringModel, refined: ManoeuvringModel,

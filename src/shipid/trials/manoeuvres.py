@@ -23,7 +23,7 @@ import numpy as np
 import pandas as pd
 
 from shipid.data.log import make_log, starboard_sign
-from shipid.dynamics import kernel
+from shipid.dynamics import codegen, kernel
 from shipid.dynamics.model import ManoeuvringModel
 from shipid.dynamics.simulate import (
     METHODS,
@@ -140,8 +140,6 @@ def run_closed_loop(
         if dyn.uses_thrust:
             raise ShipidError("manoeuvres on a model with a thrust term need a thrust model; "
                               "identify with propeller speed (n) terms instead")  # fmt: skip
-        from shipid.dynamics import codegen
-
         states = np.zeros((1, n, 6))
         rudder = np.zeros((1, n))
         n_valid = np.zeros(1, dtype=np.int64)
