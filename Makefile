@@ -17,7 +17,7 @@ demo: $(STAMP)
 	$(BIN)/shipid demo --out shipid-demo
 
 test: $(STAMP)
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -n 2  # the machines have 2 cores
 
 lint: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks
