@@ -164,6 +164,29 @@ def test_clarke_derivatives_by_hand():
     assert d["Nrdot"] == pytest.approx(-S * (1 / 12 + 0.017 * 0.7 * 16 / 6 - 0.33 * 0.16))
 
 
+
+@pytest.mark.parametrize("structure", ["blanke-speed", "blanke-race", "abkowitz3"])
+def test_a_clarke_prior_linearises_to_the_clarke_derivatives_once(structure):
+    """Whatever forms of v, r and δ a structure has (abkowitz3 has v and u·v, blanke-race u²δ
+    and δ), the prior model's sway–yaw linearisation at the approach speed is the Clarke linear
+    model: each derivative is given once, not once per form (it was given twice)."""
+    from shipid.dynamics.model import ManoeuvringModel
+
+    p = Particulars(length=100.0, beam=16.0, draught=6.0, block_coefficient=0.7, rudder_area=25.0)
+    U = 7.0
+    prior = clarke_prior(p, get_structure(structure), U, "starboard")
+    linear = clarke_linear(p, "starboard")
+    model = ManoeuvringModel(get_structure(structure), prior)
+    h = 1e-6
+    for k, (signal, scale) in enumerate((("v", U), ("r", U), ("delta", U**2))):
+        e = np.zeros(3)
+        e[k] = h
+        up = np.ravel(model.accelerations(U, *e))
+        down = np.ravel(model.accelerations(U, *-e))
+        for i, dof in ((1, "v"), (2, "r")):
+            slope = (up[i] - down[i]) / (2 * h)
+            assert slope == pytest.approx(linear[dof][signal] * scale, rel=1e-6), (dof, signal)
+
 @needs_data
 def test_clarke_prior_of_the_kvlcc2_is_close_to_its_mmg_linearisation():
     """The MARIN particulars file through Clarke's regressions against the linearised MMG model

@@ -100,10 +100,13 @@ def clarke_prior(p: Particulars, structure: ModelStructure, speed: float,
         for signal, options in SPEED_TERMS.items():
             if signal not in linear[dof]:
                 continue
+            # The first form the structure has takes the whole derivative: a structure with
+            # two (u²δ and δ, u·v and v) would otherwise get it twice.
             for text, power in options:
                 if parse_term(text).text in texts:
                     prior.setdefault(dof, {})[parse_term(text).text] = \
                         linear[dof][signal] * speed**power
+                    break
     if not prior:
         raise ShipidError(f"the Clarke prior gives the u·v, u·r and u²·δ terms (or v, r, δ) of "
                           f"v̇ and ṙ; the structure {structure.name} has none of them")
