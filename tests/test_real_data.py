@@ -66,7 +66,8 @@ def test_truncated_and_wrong_format_files(tmp_path):
 
 
 @needs_data
-@pytest.mark.parametrize("structure, r_std", [("blanke", 0.0065), ("blanke-speed", 0.004)])
+@pytest.mark.parametrize("structure, r_std", [("blanke", 0.0065), ("blanke-speed", 0.004),
+                                              ("blanke-race", 0.0022)])
 def test_kvlcc2_identified_on_zz20_predicts_zz_minus20_and_turns_plausibly(structure, r_std):
     kw = {"fmt": "simman-marin", "scale": LAMBDA, "dt": 0.2}
     train = read_log(MARIN / "MARIN_FREE_KVLCC2_zz_20_m.dat", **kw)
@@ -74,13 +75,22 @@ def test_kvlcc2_identified_on_zz20_predicts_zz_minus20_and_turns_plausibly(struc
     fit = identify(train, model=structure, gamma=1e4)
     v = validate(fit.model, test)[0]
     assert not v.simulation.diverged
-    assert v.metrics["r"]["std"] < r_std  # rad/s; measured 0.0058 (blanke), 0.0033 (u² δ)
+    assert v.metrics["r"]["std"] < r_std  # rad/s; measured 0.0058 (blanke), 0.0033 (u² δ),
+    # 0.0018 (the race: u²δ, δ, δ³)
+    measured, predicted = v.indices["measured"], v.indices["closed_loop"]
     if structure == "blanke-speed":
         # The zig-zag run closed loop on the model from the trial's start: overshoots within 1°
         # (measured 12.9° and 16.1°, predicted 13.0° and 15.6°).
-        measured, predicted = v.indices["measured"], v.indices["closed_loop"]
         for key in ("first_overshoot_deg", "second_overshoot_deg"):
             assert predicted[key] == pytest.approx(measured[key], abs=1.0)
+    if structure == "blanke-race":
+        # Half the free-run error, but the second overshoot 1.7° low (13.6°, 14.4°); and its δ³,
+        # fitted on 20° of rudder, is not to be run at 35° (benchmarks/study_structure.py).
+        assert predicted["first_overshoot_deg"] == pytest.approx(measured["first_overshoot_deg"],
+                                                                 abs=1.0)  # fmt: skip
+        assert predicted["second_overshoot_deg"] == pytest.approx(
+            measured["second_overshoot_deg"], abs=2.0)
+        return
     tc = turning_circle(fit.model, 35, duration=200, dt=0.05, speed=float(train["u"].iloc[0]))
     assert not tc.diverged
     assert 2 * 7.0 < tc.indices["tactical_diameter"] < 6 * 7.0

@@ -1298,7 +1298,8 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("identify", help="identify a model from trial logs")
     p.add_argument("logs", nargs="+", metavar="LOG")
     p.add_argument("--model", default="blanke",
-                   help="structure: blanke (default), blanke-thrust, blanke-speed, blanke-rps, "
+                   help="structure: blanke (default), blanke-thrust, blanke-speed, blanke-race, "
+                   "blanke-rps, "
                    "abkowitz3, low-speed, wind, linear-sway-yaw, nomoto1; combine with + "
                    "(blanke-rps+wind) or write terms: 'u: |u|u, v*r, 1; v: ...; r: ...'")
     p.add_argument("--form", default="increment", choices=("increment", "paper"),

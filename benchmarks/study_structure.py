@@ -1,0 +1,159 @@
+"""Structure against a truth of another structure (issue #10, the principal push): the KVLCC2's MMG
+model (propeller, rudder in its race, cubic hull forces; checked against an independent MMG code)
+is observed through the zig-zags a basin gives (20/20 to both sides and a 20/10, with sensor
+noise), each structure is identified as ``identify`` does (prefilter chosen from the data), and
+judged on what it was not fitted to: the 10/10 zig-zags and the 35° turning circles.
+
+Then the real KVLCC2: trained on the MARIN zig-zag 20/20, judged on the MARIN −20° run (free-run
+errors, the zig-zag closed loop from its start) and the 35° turn against the MMG model, over the
+prefilter cut-offs ``identify`` chooses among.
+
+Run: .venv/bin/python benchmarks/study_structure.py [SEEDS] [NOISE]
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import sys
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from shipid.data.preprocess import lowpass
+from shipid.identification.identify import identify
+from shipid.identification.prefilter import candidate_cutoffs, choose_prefilter
+from shipid.trials.manoeuvres import turning_circle, zigzag
+from shipid.vessels import PAPER_IMU, kvlcc2
+
+STRUCTURES = ("blanke-speed", "blanke-race", "abkowitz3")
+TRAINING = ((20, 20, "starboard"), (20, 20, "port"), (20, 10, "starboard"))
+HELD_ZIGZAGS = ((10, 10, "starboard"), (10, 10, "port"))
+DT = 0.2
+OVERSHOOTS = ("first_overshoot_deg", "second_overshoot_deg")
+
+
+def _zigzag(ship, rudder, heading, side, **kw):
+    return zigzag(ship, rudder, heading, first=side, duration=300, dt=DT, approach=5, **kw)
+
+
+def _turn(ship, side, **kw):
+    return turning_circle(ship, 35, side=side, duration=600, dt=DT, approach=5, **kw)
+
+
+def fit_as_identify(logs, structure):
+    """``identify``'s default: the prefilter cut-off chosen by free-run error on the logs."""
+
+    def fit(train, weights=None):
+        return identify(train, model=structure, force=True).model
+
+    cutoff, _ = choose_prefilter(logs, fit)
+    return fit(logs if cutoff is None else [lowpass(log, cutoff) for log in logs]), cutoff
+
+
+def held_out_errors(model, ship, truth_zz, truth_tc) -> list[float]:
+    """Overshoot errors [deg] of the held-out zig-zags, then tactical diameter and steady yaw rate
+    errors [%] of the 35° turns (nan where the model diverges)."""
+    kw = {"speed": ship.approach_speed, "steering": ship.steering}
+    out = []
+    for case in HELD_ZIGZAGS:
+        ind = _zigzag(model, *case, **kw).indices
+        out += [(ind.get(k) or math.nan) - truth_zz[case][k] for k in OVERSHOOTS]
+    for side in ("starboard", "port"):
+        res = _turn(model, side, **kw)
+        ind = {} if res.diverged or not res.indices else res.indices
+        for k in ("tactical_diameter", "steady_yaw_rate"):
+            value = ind.get(k)
+            out.append(math.nan if value is None else 100 * (value / truth_tc[side][k] - 1))
+    return out
+
+
+def mmg(seeds: int, noise: float) -> None:
+    ship = kvlcc2()
+    truth_zz = {c: _zigzag(ship, *c).indices for c in HELD_ZIGZAGS}
+    truth_tc = {s: _turn(ship, s).indices for s in ("starboard", "port")}
+    sensor = PAPER_IMU.scaled(noise)
+    print(f"MMG KVLCC2 at {ship.approach_speed:.3f} m/s, rudder rate "
+          f"{math.degrees(ship.steering.max_rate):.1f} °/s; trained on zig-zags "
+          f"{', '.join(f'{a}/{h} {s}' for a, h, s in TRAINING)}; sensor noise {noise:g} × the "
+          f"paper's IMU; {seeds} seeds\n")  # fmt: skip
+    print("truth: 10/10 overshoots " + ", ".join(
+        f"{s} first {truth_zz[(10, 10, s)][OVERSHOOTS[0]]:.1f}° / "
+        f"{truth_zz[(10, 10, s)][OVERSHOOTS[1]]:.1f}°" for s in ("starboard", "port"))
+        + "; 35° tactical diameter " + ", ".join(
+        f"{truth_tc[s]['tactical_diameter'] / ship.length:.2f} L" for s in truth_tc) + "\n")
+    errors: dict[str, list[list[float]]] = {s: [] for s in STRUCTURES}
+    t0 = time.perf_counter()
+    for seed in range(seeds):
+        logs = [sensor.apply(_zigzag(ship, *case).log, seed=100 * seed + i)
+                for i, case in enumerate(TRAINING)]  # fmt: skip
+        for structure in STRUCTURES:
+            model, _ = fit_as_identify(logs, structure)
+            errors[structure].append(held_out_errors(model, ship, truth_zz, truth_tc))
+    head = ["10/10 stbd 1st", "10/10 stbd 2nd", "10/10 port 1st", "10/10 port 2nd",
+            "TD stbd", "r stbd", "TD port", "r port"]  # fmt: skip
+    print("Mean error (largest |error|) over the seeds; overshoots in degrees, the 35° turn's "
+          "tactical diameter and steady yaw rate in %; diverged turns counted apart.\n")
+    print("| structure | " + " | ".join(head) + " | turns diverged |")
+    print("|---" * (len(head) + 2) + "|")
+    for structure, rows in errors.items():
+        e = np.array(rows)
+        cells = []
+        for j in range(e.shape[1]):
+            col = e[:, j][np.isfinite(e[:, j])]
+            cells.append("–" if col.size == 0 else f"{col.mean():+.1f} ({np.abs(col).max():.1f})")
+        diverged = int(np.isnan(e[:, 4:]).any(axis=1).sum())
+        print(f"| {structure} | " + " | ".join(cells) + f" | {diverged} of {len(rows)} |")
+    print(f"\n{time.perf_counter() - t0:.1f} s")
+
+
+def _same(a: float | None, b: float | None) -> bool:
+    return a is None and b is None or None not in (a, b) and math.isclose(a, b, rel_tol=1e-9)
+
+
+def real_data() -> None:
+    from shipid.data.io import read_log
+    from shipid.evaluation.validate import validate
+
+    data = Path(__file__).resolve().parents[2] / "shared" / "data" / "kvlcc2-marin"
+    if not data.is_dir():
+        print("\n../shared/data is absent: no real-data rows")
+        return
+    kw = {"fmt": "simman-marin", "scale": 45.7, "dt": DT}
+    train = read_log(data / "MARIN_FREE_KVLCC2_zz_20_m.dat", **kw)
+    held = read_log(data / "MARIN_FREE_KVLCC2_zz_-20_m.dat", **kw)
+    mmg_turn = _turn(kvlcc2(), "starboard").indices
+    print("\nKVLCC2 MARIN, trained on zz 20/20, held out: zz −20/−20 (measured overshoots "
+          "12.9°, 16.1°), and the 35° turn to starboard against the MMG model (tactical "
+          f"diameter {mmg_turn['tactical_diameter']:.1f} m, steady yaw rate "
+          f"{mmg_turn['steady_yaw_rate']:.4f} rad/s)\n")  # fmt: skip
+    print("| structure | prefilter | chosen by identify | u / v / r error std | overshoots "
+          "(closed loop) | 35° TD (m) | 35° steady r (rad/s) |")
+    print("|---|---|---|---|---|---|---|")
+    for structure in STRUCTURES[:2]:
+        _, chosen = fit_as_identify([train], structure)
+        for cutoff in (None, *candidate_cutoffs(DT)[:4]):
+            model = identify(train if cutoff is None else lowpass(train, cutoff),
+                             model=structure, force=True).model  # fmt: skip
+            v = validate(model, held)[0]
+            closed = v.indices["closed_loop"]
+            tc = _turn(model, "starboard", speed=float(train["u"].iloc[0]),
+                       steering=kvlcc2().steering)  # fmt: skip
+            ind = {} if tc.diverged or not tc.indices else tc.indices
+            td, r = ind.get("tactical_diameter"), ind.get("steady_yaw_rate")
+            print(f"| {structure} | {'none' if cutoff is None else f'{cutoff:g} Hz'} | "
+                  f"{'yes' if _same(cutoff, chosen) else ''} | "
+                  + " / ".join(f"{v.metrics[s]['std']:.4f}" for s in "uvr")
+                  + f" | {closed['first_overshoot_deg']:.1f}°, {closed['second_overshoot_deg']:.1f}° | "
+                  + ("diverged" if td is None else f"{td:.1f}") + " | "
+                  + ("–" if r is None else f"{r:.4f}") + " |")
+
+
+if __name__ == "__main__":
+    warnings.simplefilter("ignore")  # envelope and plausibility warnings of the candidates
+    print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores\n")
+    mmg(int(sys.argv[1]) if len(sys.argv) > 1 else 10,
+        float(sys.argv[2]) if len(sys.argv) > 2 else 0.25)  # fmt: skip
+    real_data()
