@@ -38,11 +38,13 @@ DOF_DISPLAY = {"u": "u̇", "v": "v̇", "r": "ṙ"}
 
 _BLANKE_SWAY_YAW = ("ur", "uv", "|v|v", "|v|r", "delta", "1")
 _BLANKE_SPEED = ("ur", "uv", "|v|v", "|v|r", "u^2*delta", "1")
-# A rudder in the race of a propeller turning at constant speed: its inflow u_R² has a part in u²
-# and a part the propeller throws on it, which does not fall with the ship's speed (MMG, Yasukawa
-# & Yoshimura 2015: u_R = ε u_P √(η {1 + κ(√(1 + 8K_T/πJ²) − 1)}² + 1 − η), 8K_T u_P²/πJ² ∝ n²).
-# So the rudder force is u²δ plus δ, and its lift saturates with the angle (sin α_R: δ³).
-_BLANKE_RACE = ("ur", "uv", "|v|v", "|v|r", "u^2*delta", "delta", "delta^3", "1")
+# A rudder in the race of a propeller at constant rps n (most model-basin trials), in the MMG
+# form (Yasukawa & Yoshimura 2015): its inflow u_R = ε u_P √(η {1 + κ(√(1 + 8K_T/πJ²) − 1)}² +
+# 1 − η), J ∝ u/n, has a square close to a quadratic form a u² + b u n + c n². At constant n the
+# rudder force is u²δ, uδ and δ, and part of it does not fall as the ship slows in a turn, as u²δ
+# alone would have it. (The thrust is such a form too, but a u term beside |u|u is collinear with
+# it on one zig-zag (ρ 0.999 on the KVLCC2's), so the surge stays Blanke's.)
+_RACE_LATERAL = ("ur", "uv", "|v|v", "|v|r", "u^2*delta", "u*delta", "delta", "1")
 # Third-order Taylor expansion about straight running (Abkowitz 1964; the Mariner model's set):
 # surge even in v, r, δ; sway and yaw odd, with the speed-dependent couplings.
 _ABK_SURGE = ("u", "u^2", "u^3", "v^2", "r^2", "v*r", "delta^2", "u*delta^2", "v*delta",
@@ -76,10 +78,10 @@ STRUCTURES: dict[str, dict[str, tuple[str, ...]]] = {
                      "r": _BLANKE_SPEED},
     # Trials at different propeller speeds (e.g. Esso Osaka at 10, 12 and 16.7 rps): the thrust
     # ∝ |n|n enters the surge equation; needs the log column n [rps].
-    # A rudder behind a propeller at constant rps (most model-basin zig-zags): see _BLANKE_RACE.
-    # Logs at several propeller speeds need the race as n²δ instead (the low-speed library).
-    "blanke-race": {"u": ("|u|u", "vr", "r^2", "delta^2", "1"), "v": _BLANKE_RACE,
-                    "r": _BLANKE_RACE},
+    # The rudder in the race of a propeller at constant rps (see _RACE_LATERAL); logs at several
+    # propeller speeds need the race in n (pos(n)^2*delta, the low-speed library).
+    "blanke-race": {"u": ("|u|u", "vr", "r^2", "delta^2", "1"), "v": _RACE_LATERAL,
+                    "r": _RACE_LATERAL},
     "blanke-rps": {"u": ("|u|u", "vr", "r^2", "delta^2", "|n|n", "1"), "v": _BLANKE_SPEED,
                    "r": _BLANKE_SPEED},
     "abkowitz3": {"u": _ABK_SURGE, "v": _ABK_LATERAL, "r": _ABK_LATERAL},
