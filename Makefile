@@ -17,7 +17,7 @@ demo: $(STAMP)
 	$(BIN)/shipid demo --out shipid-demo
 
 test: $(STAMP)
-	$(BIN)/python -m pytest -q -n 2  # the machines have 2 cores
+	$(BIN)/python -m pytest -q -n 2 --dist loadfile  # 2 cores; a file's tests on one worker, in order
 
 lint: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks
@@ -29,6 +29,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_long_logs.py
 	$(BIN)/python benchmarks/bench_physics.py
 	$(BIN)/python benchmarks/study_uncertainty.py
+	$(BIN)/python benchmarks/study_structure.py
 	$(BIN)/python benchmarks/bench_study.py
 
 clean:

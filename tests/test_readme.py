@@ -21,6 +21,8 @@ ROOT = Path(__file__).resolve().parents[1]
 README = (ROOT / "README.md").read_text(encoding="utf-8")
 DATA = ROOT.parent / "shared" / "data"
 BLOCKS = re.findall(r"^```(\w+)\n(.*?)^```", README, flags=re.S | re.M)
+# The blocks build on each other's files (import, then select, then validate) in one folder: under
+# pytest-xdist they must run on one worker, in order: make test passes --dist loadfile.
 
 
 def test_the_readme_has_runnable_blocks():
