@@ -14,6 +14,7 @@ from shipid.evaluation.validate import trial_zigzag, validate
 from shipid.identification.identify import identify
 from shipid.identification.plausibility import (
     check_plausibility,
+    new_failures,
     straight_line_stability,
     surge_equilibrium,
 )
@@ -107,6 +108,38 @@ def test_plausibility_flags_an_unstable_diverging_model():
     assert "straight-line unstable" in text and "no steady straight speed" in text
     assert "rudder held to starboard" in text
 
+
+
+def test_a_refined_model_is_judged_check_by_check_not_by_the_number_of_failures():
+    """The refined model replaced the LS-SVM one when it failed no *more* checks. A refined model
+    failing the same number of other checks (e.g. turning the wrong way where the LS-SVM model was
+    only straight-line unstable) was handed out; and the warning named checks both models fail."""
+    model = scale_ship_model()
+    good, _ = check_plausibility(model, 1.93, duration=120)
+
+    def variant(**changes):
+        report = json.loads(json.dumps(good))
+        for key, value in changes.items():
+            if key.startswith("held_"):
+                report["held_rudder"][key[5:]].update(value)
+            else:
+                report[key] = value
+        return report
+
+    unstable = variant(straight_line={**good["straight_line"], "stable": False,
+                                      "max_real_part": 0.07})  # fmt: skip
+    wrong_way = variant(held_starboard={"steady_yaw_rate": -0.01})
+    both = variant(straight_line=unstable["straight_line"], held_starboard={"settled": False})
+    diverged = variant(straight_line=unstable["straight_line"],
+                       held_starboard={"diverged": True, "reason": "diverged at 12 s"})  # fmt: skip
+    assert new_failures(good, good, model) == []
+    assert new_failures(unstable, unstable, model) == []  # the same failure is no new one
+    worse = new_failures(unstable, wrong_way, model)  # one failure each, but another one
+    assert len(worse) == 1 and "turns the other way" in worse[0]
+    worse = new_failures(unstable, both, model)
+    assert len(worse) == 1 and "no steady turn" in worse[0]  # straight-line not named again
+    assert "diverged at 12 s" in new_failures(both, diverged, model)[0]  # worse on one check
+    assert new_failures(diverged, both, model) == []  # better on it
 
 def test_propeller_speed_terms_are_identified_from_runs_at_two_rps():
     # The paper's scale ship with its surge constant 0.12 as a thrust |n|n at 15 rps.

@@ -307,7 +307,7 @@ def cmd_identify(args) -> int:
     """``shipid identify``: a model from logs (LS-SVM, optional refinement, checks)."""
     from shipid.data.preprocess import lowpass
     from shipid.identification.identify import identify
-    from shipid.identification.plausibility import check_plausibility
+    from shipid.identification.plausibility import check_plausibility, new_failures
     from shipid.outputs import atomic_write_text, check_outputs
     from shipid.reporting.modelfile import model_text
 
@@ -397,11 +397,12 @@ def cmd_identify(args) -> int:
     plausibility, notes = check_plausibility(ident.model, speed, n)
     if refinement:
         refined_report, refined_notes = check_plausibility(refinement.model, speed, n)
-        if len(refined_notes) > len(notes):
-            # Never hand out a model that fails checks the LS-SVM model passes.
+        worse = new_failures(plausibility, refined_report, ident.model)
+        if worse:
+            # Never hand out a model that fails checks the LS-SVM model passes, or fails worse.
             ident.warnings.append(
                 "refinement: the refined model fails plausibility checks the LS-SVM model passes ("
-                + "; ".join(refined_notes[:2]) + "); the model file's model is the LS-SVM one, the "
+                + "; ".join(worse[:2]) + "); the model file's model is the LS-SVM one, the "
                 "refined one is kept under identification.refinement.refined_model")
             if args.output_error:
                 ensemble = None  # its draws describe the output-error model, not this one

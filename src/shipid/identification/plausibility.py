@@ -97,27 +97,50 @@ def check_plausibility(
     report = {"approach_speed": speed, "rps": rps,
               "straight_line": straight_line_stability(model, speed, rps),
               "surge_equilibrium": surge_equilibrium(model, speed, rps),
-              "held_rudder": held_rudder(model, speed, rps, rudder_deg, duration)}  # fmt: skip
-    notes = []
-    sl = report["straight_line"]
+              "held_rudder": held_rudder(model, speed, rps, rudder_deg, duration),
+              "rudder_deg": rudder_deg, "duration": duration}  # fmt: skip
+    return report, [note for _, note in failed_checks(report, model).values()]
+
+
+# How badly a check fails, to compare two models check by check: a rudder held to a side that
+# diverges is worse than one that turns the wrong way, which is worse than one still settling.
+UNSETTLED, WRONG_WAY, DIVERGED = 1, 2, 3
+
+
+def failed_checks(report: dict, model: ManoeuvringModel) -> dict[str, tuple[int, str]]:
+    """{check: (severity ≥ 1, warning)} of the checks ``report`` fails."""
+    rudder_deg, duration = report.get("rudder_deg", 35.0), report.get("duration", 300.0)
+    speed = report["approach_speed"]
+    out: dict[str, tuple[int, str]] = {}
+    sl = report.get("straight_line")
     if sl and not sl["stable"]:
-        notes.append(f"straight-line unstable: a sway–yaw eigenvalue has real part "
-                     f"{sl['max_real_part']:.3g} 1/s > 0 (possible for full-form ships, but a "
-                     "rudder offset grows into a turn)")  # fmt: skip
-    eq = report["surge_equilibrium"]
+        out["straight_line"] = (1, f"straight-line unstable: a sway–yaw eigenvalue has real part "
+                                   f"{sl['max_real_part']:.3g} 1/s > 0 (possible for full-form "
+                                   "ships, but a rudder offset grows into a turn)")  # fmt: skip
+    eq = report.get("surge_equilibrium")
     if "u" in model.structure.dofs and (eq is None or eq <= 0):
-        notes.append("no steady straight speed with the rudder amidships: the surge equation "
-                     f"does not balance between 0 and {3 * speed:.3g} m/s")  # fmt: skip
-    for side, entry in report["held_rudder"].items():
+        out["surge_equilibrium"] = (1, "no steady straight speed with the rudder amidships: the "
+                                       f"surge equation does not balance between 0 and "
+                                       f"{3 * speed:.3g} m/s")  # fmt: skip
+    for side, entry in (report.get("held_rudder") or {}).items():
+        where, key = f"{rudder_deg:g}° rudder held to {side}", f"held_rudder_{side}"
         if entry["diverged"]:
-            notes.append(f"{rudder_deg:g}° rudder held to {side}: {entry['reason']}")
+            out[key] = (DIVERGED, f"{where}: {entry['reason']}")
         elif not entry["settled"]:
-            notes.append(f"{rudder_deg:g}° rudder held to {side}: no steady turn after "
-                         f"{duration:g} s (yaw rate or speed still changing)")  # fmt: skip
+            out[key] = (UNSETTLED, f"{where}: no steady turn after {duration:g} s (yaw rate or "
+                                   "speed still changing)")  # fmt: skip
         elif math.copysign(1.0, entry["steady_yaw_rate"]) != (1.0 if side == "starboard" else -1.0):
-            notes.append(f"{rudder_deg:g}° rudder held to {side}: the model turns the other way "
-                         f"(steady yaw rate {entry['steady_yaw_rate']:.3g} rad/s)")  # fmt: skip
-    return report, notes
+            out[key] = (WRONG_WAY, f"{where}: the model turns the other way (steady yaw rate "
+                                   f"{entry['steady_yaw_rate']:.3g} rad/s)")  # fmt: skip
+    return out
+
+
+def new_failures(reference: dict, candidate: dict, model: ManoeuvringModel) -> list[str]:
+    """The warnings of the checks ``candidate`` fails worse than ``reference`` (both reports of
+    ``check_plausibility`` on models of one structure): what a refined model must not add."""
+    before = failed_checks(reference, model)
+    return [note for check, (severity, note) in failed_checks(candidate, model).items()
+            if severity > before.get(check, (0, ""))[0]]  # fmt: skip
 
 
 def disqualifying(report: dict, model: ManoeuvringModel) -> list[str]:
