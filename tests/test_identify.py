@@ -107,6 +107,11 @@ def test_cli_end_to_end(tmp_path, trial_csv, capsys):
     model = tmp_path / "model.json"
     code, out, _ = run(["identify", trial_csv, "--drop", "u:r^2", "-o", model], capsys)
     assert code == 0 and "u̇ =" in out and model.exists()
+    # --out, which argparse took for --output until --output-error made it ambiguous.
+    code, _, _ = run(["identify", trial_csv, "--drop", "u:r^2", "--out", tmp_path / "out.json"],
+                     capsys)  # fmt: skip
+    assert code == 0 and (tmp_path / "out.json").read_text() == model.read_text().replace(
+        str(model), str(tmp_path / "out.json"))
     doc = json.loads(model.read_text())
     assert doc["provenance"]["training_files"][0]["sha256"]
     code, out, _ = run(["validate", model, trial_csv, "--json", tmp_path / "v.json",

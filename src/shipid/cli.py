@@ -1343,7 +1343,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=0, help="with --bootstrap or --output-error: "
                    "random seed "
                    "(default %(default)s)")
-    p.add_argument("-o", "--output", required=True, metavar="MODEL.json")
+    # --out spelled out: since --output-error, argparse no longer takes it for --output.
+    p.add_argument("-o", "--output", "--out", required=True, metavar="MODEL.json")
     _add_physics_options(p)
     _add_log_options(p)
     p.set_defaults(func=cmd_identify)
