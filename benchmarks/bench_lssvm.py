@@ -145,9 +145,7 @@ def fixed_size_rows(sizes):
 
 
 def grid_only(path_factory, gammas) -> None:
-    path = path_factory()
-    for g in gammas:
-        path.mse(float(g))
+    path_factory().mse_grid(gammas)
 
 
 def naive_dense_loo_grid(X, y, gammas, sigma) -> None:

@@ -195,13 +195,19 @@ def test_lssvrcv_picks_the_gamma_with_smallest_brute_force_loo_error():
     assert cv.predict(X).shape == y.shape
 
 
-def test_fused_loo_mse_equals_mean_of_residuals():
+@pytest.mark.parametrize("block", [4096, 16])  # one block of rows, and several with a rest
+def test_fused_loo_mse_equals_mean_of_residuals(monkeypatch, block):
+    from shipid.lssvm import selection
     from shipid.lssvm.selection import PrimalLOOPath
 
+    monkeypatch.setattr(selection, "ROW_BLOCK", block)
     X, Y, w = problem(n=50, q=3, seed=12)
     path = PrimalLOOPath(X, Y, w)
-    for g in (0.1, 10.0, 1e5):
-        assert path.mse(g) == pytest.approx(np.mean(path.residuals(g) ** 2), rel=1e-12)
+    gammas = (0.1, 10.0, 1e5)
+    grid = path.mse_grid(gammas)
+    for g, mse in zip(gammas, grid, strict=True):
+        assert mse == pytest.approx(np.mean(path.residuals(g) ** 2), rel=1e-12)
+        assert path.mse(g) == pytest.approx(mse, rel=1e-12)
 
 
 def test_lssvrcv_kfold_and_linear_kernel():

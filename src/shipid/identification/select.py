@@ -429,8 +429,8 @@ def _loo_gamma_scores(data: _Data, terms, gammas) -> dict[float, float]:
             continue
         var = float(np.var(y)) or 1.0
         path = PrimalLOOPath(X, y[:, None], np.ones(len(y)))
-        for g in gammas:
-            scores[g] += path.mse(float(g)) / var
+        for g, mse in zip(gammas, path.mse_grid(gammas), strict=True):
+            scores[g] += mse / var
     return scores
 
 
