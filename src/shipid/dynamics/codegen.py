@@ -7,12 +7,16 @@ a branch on each factor's operation and a check for all-zero coefficients. That 
 about 3× against a loop with the terms typed in (``benchmarks/bench_simulate.py``). A generated
 kernel is that typed-in loop: the source of ``rhs(ctx, u, v, r, ψ)`` for one term set is written
 to a module in the cache folder, imported, and compiled with numba's on-disk cache, so each term
-set is compiled once per machine (about 2–4 s) and then loads in a fraction of a second. Its
-arithmetic is the interpreter's, in the same order, so the two agree to the last bit or two.
+set is compiled once per machine (about 2–4 s) and then loads in a fraction of a second. Only
+the (equation, term) coefficients that are non-zero in the run's coefficient sets are compiled
+into the sums: the equations of most structures have different terms, and the products by zero
+cost 10–20 % of the speed (benchmarks/README.md). Its arithmetic is otherwise the
+interpreter's, in the same order, so the two agree to the last bit or two.
 
 ``engine="auto"`` (the default; ``with codegen.use("generated"):`` sets another) uses a
 generated kernel for runs long enough to repay the compilation (``GENERATED_MIN_STEPS``
-state-steps), or when this process has already compiled or loaded that term set; short runs
+state-steps), or when this process has already compiled or loaded that term set with those
+non-zero coefficients; short runs
 (selection's thousands of candidate structures, each run once) stay on the interpreter. The
 cache folder is ``$SHIPID_CACHE_DIR``, else ``$XDG_CACHE_HOME/shipid/kernels`` or
 ``~/.cache/shipid/kernels``; where it cannot be written, the interpreter runs.
@@ -28,6 +32,8 @@ import threading
 from pathlib import Path
 from types import ModuleType
 
+import numpy as np
+
 from shipid import __version__
 from shipid.dynamics.terms import SIGNALS, TermCode
 
@@ -37,7 +43,8 @@ ENGINES = ("auto", "generated", "interpreted")
 GENERATED_MIN_STEPS = 2_000_000
 
 _engine: contextvars.ContextVar[str] = contextvars.ContextVar("shipid_engine", default="auto")
-_loaded: dict[tuple[str, ...], ModuleType] = {}  # by term set: the integrators cannot change
+# By term set and non-zero (equation, term) pairs: the integrators cannot change.
+_loaded: dict[tuple[tuple[str, ...], bytes], ModuleType] = {}
 
 _lock = threading.Lock()
 _unwritable = False
@@ -62,8 +69,11 @@ def _factor_expr(signal: int, op: int, k: float, power: int, name: str) -> list[
     return [f"{name}_b = {base}", f"{name} = " + " * ".join([f"{name}_b"] * power)]
 
 
-def source(code: TermCode) -> str:
-    """The generated module's source for the term set ``code``."""
+def source(code: TermCode, pairs: np.ndarray | None = None) -> str:
+    """The generated module's source for the term set ``code``; ``pairs`` (3, T) bool: the
+    (equation, term) coefficients that can be non-zero (None: all). The others are left out of
+    the sums, which is what brings a structure whose equations have different terms (most of
+    them) to a loop with its terms typed in."""
     used = set(int(s) for s in code.signal)
     body = ["th, inp, wind_true, vw, dw = ctx", "c = math.cos(psi)", "sn = math.sin(psi)",
             "xd = u * c - v * sn", "yd = u * sn + v * c", "s0, s1, s2 = u, v, r"]  # fmt: skip
@@ -90,7 +100,8 @@ def source(code: TermCode) -> str:
             names.append(name)
         body.append(f"phi{j} = " + (" * ".join(names) if names else "1.0"))
     for i in range(3):
-        terms = " + ".join(f"th[{i}, {j}] * phi{j}" for j in range(code.n_terms)) or "0.0"
+        js = [j for j in range(code.n_terms) if pairs is None or pairs[i, j]]
+        terms = " + ".join(f"th[{i}, {j}] * phi{j}" for j in js) or "0.0"
         body.append(f"a{i} = {terms}")
     body.append("return a0, a1, a2, r, xd, yd")
     rhs = "\n".join("    " + line for line in body)
@@ -134,33 +145,45 @@ def integrate_closed(theta, dt, n_steps, s0, params, rk4, speed_lim, yaw_lim, st
 '''
 
 
-def _key(code: TermCode) -> str:
+def _key(text: str) -> str:
     """The generated module's name suffix: a hash of its source, the integrators it compiles in
     (numba does not track a cached function's callees) and shipid's version."""
     import hashlib  # 3 ms: on first use, not on every command's start-up
 
     kernel_src = (Path(__file__).parent / "kernel.py").read_bytes()
-    h = hashlib.sha256(source(code).encode() + kernel_src + __version__.encode())
+    h = hashlib.sha256(text.encode() + kernel_src + __version__.encode())
     return h.hexdigest()[:20]
 
 
-def load(code: TermCode) -> ModuleType | None:
-    """The generated kernels of ``code`` (written and imported on first use), or None where the
-    cache folder cannot be written."""
+def nonzero_pairs(code: TermCode, theta: np.ndarray) -> np.ndarray:
+    """(3, T) bool: the (equation, term) pairs non-zero in any of the coefficient sets ``theta``
+    ((3, T) or (B, 3, T))."""
+    return np.any(np.asarray(theta).reshape(-1, 3, code.n_terms) != 0.0, axis=0)
+
+
+def _loaded_key(code: TermCode, pairs: np.ndarray | None) -> tuple[tuple[str, ...], bytes]:
+    return code.texts, b"" if pairs is None else np.packbits(pairs).tobytes()
+
+
+def load(code: TermCode, pairs: np.ndarray | None = None) -> ModuleType | None:
+    """The generated kernels of ``code`` with the non-zero coefficient ``pairs`` (None: all)
+    (written and imported on first use), or None where the cache folder cannot be written."""
     global _unwritable
+    key = _loaded_key(code, pairs)
     with _lock:
-        if code.texts in _loaded:
-            return _loaded[code.texts]
+        if key in _loaded:
+            return _loaded[key]
         if _unwritable:
             return None
-        name = f"shipid_terms_{_key(code)}"
+        text = source(code, pairs)
+        name = f"shipid_terms_{_key(text)}"
         folder = cache_dir()
         path = folder / f"{name}.py"
         try:
             folder.mkdir(parents=True, exist_ok=True)
             if not path.exists():
                 tmp = folder / f".{name}.{os.getpid()}.tmp"
-                tmp.write_text(source(code), encoding="utf-8")
+                tmp.write_text(text, encoding="utf-8")
                 os.replace(tmp, path)  # atomic: concurrent processes write the same text
         except OSError:
             _unwritable = True
@@ -171,7 +194,7 @@ def load(code: TermCode) -> ModuleType | None:
         module = importlib.util.module_from_spec(spec)
         sys.modules[name] = module
         spec.loader.exec_module(module)
-        _loaded[code.texts] = module
+        _loaded[key] = module
         return module
 
 
@@ -194,12 +217,15 @@ def use(engine: str):
         _engine.reset(token)
 
 
-def choose(code: TermCode, steps: int, engine: str | None = None) -> ModuleType | None:
-    """The generated kernels to run ``steps`` state-steps of ``code`` with, or None for the
+def choose(code: TermCode, steps: int, engine: str | None = None,
+           theta: np.ndarray | None = None) -> ModuleType | None:  # fmt: skip
+    """The generated kernels to run ``steps`` state-steps of ``code`` with the coefficient sets
+    ``theta`` (their non-zero pairs are compiled in; None: every pair), or None for the
     interpreter; ``engine`` None is the one ``use`` set ('auto' by default)."""
     engine = _check(_engine.get() if engine is None else engine)
     if engine == "interpreted":
         return None
-    if engine == "auto" and steps < GENERATED_MIN_STEPS and code.texts not in _loaded:
+    pairs = None if theta is None else nonzero_pairs(code, theta)
+    if engine == "auto" and steps < GENERATED_MIN_STEPS and _loaded_key(code, pairs) not in _loaded:
         return None
-    return load(code)
+    return load(code, pairs)

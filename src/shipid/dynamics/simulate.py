@@ -229,7 +229,7 @@ def run_kernel(code: TermCode, theta: np.ndarray, t: np.ndarray, inputs: np.ndar
     args = (kernel.c_array(t), kernel.c_array(inputs), steps, kernel.c_array(s0), method == "rk4",
             kernel.c_array(np.broadcast_to(np.asarray(speed_lim, float), B)),
             kernel.c_array(np.broadcast_to(np.asarray(yaw_lim, float), B)), out, n_valid)
-    generated = codegen.choose(code, B * N, engine)
+    generated = codegen.choose(code, B * N, engine, theta)
     if generated is not None:
         generated.integrate_open(theta, *args)
     else:

@@ -143,7 +143,7 @@ def run_closed_loop(
         states = np.zeros((1, n, 6))
         rudder = np.zeros((1, n))
         n_valid = np.zeros(1, dtype=np.int64)
-        generated = codegen.choose(dyn.code, n, engine)
+        generated = codegen.choose(dyn.code, n, engine, dyn.theta)
         args = (dt, n, s0, params[None].copy(), method == "rk4", np.array([speed_lim]),
                 np.array([yaw_lim]), states, rudder, n_valid)  # fmt: skip
         if generated is not None:
