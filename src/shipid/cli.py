@@ -23,6 +23,7 @@ from pathlib import Path
 
 from shipid import __version__
 from shipid.errors import ShipidError, ShipidWarning
+from shipid.outputs import Interrupted, check_stop, clear_stop, request_stop
 
 VESSEL_NAMES = ("scale-ship", "mariner", "kvlcc2")
 LINEAR_ESTIMATORS = ("lssvm", "ols", "ridge", "lasso", "svr")
@@ -48,16 +49,29 @@ OPTION_RULES = {
 }  # fmt: skip
 
 
-class Interrupted(KeyboardInterrupt):
-    """SIGTERM, handled like Ctrl-C: temporaries removed, one line, exit 130."""
-
-
 def _on_sigterm(signum, frame) -> None:
+    request_stop()
     raise Interrupted()
+
+
+def _on_sigint(signum, frame) -> None:
+    request_stop()
+    raise KeyboardInterrupt()
 
 
 def _ignore_unraisable(unraisable) -> None:
     """``sys.unraisablehook`` while an interrupt unwinds: finaliser errors are not the user's."""
+
+
+def _quiet_lost_interrupts(hook):
+    """``sys.unraisablehook`` while a command runs: an interrupt raised inside a finaliser is
+    dropped by Python; it is recorded (``request_stop``) and acted on, so it is not printed."""
+
+    def unraisable(info) -> None:
+        if not isinstance(info.exc_value, KeyboardInterrupt):
+            hook(info)
+
+    return unraisable
 
 
 def check_options(args) -> None:
@@ -1621,8 +1635,13 @@ def main(argv: list[str] | None = None) -> int:
 
     # Only the main thread may handle signals; a Dask worker runs jobs in its own threads.
     in_main = threading.current_thread() is threading.main_thread()
-    previous = signal.signal(signal.SIGTERM, _on_sigterm) if in_main else None
+    if in_main:
+        clear_stop()
+        previous = signal.signal(signal.SIGTERM, _on_sigterm)
+        previous_int = signal.signal(signal.SIGINT, _on_sigint)
     unraisablehook = sys.unraisablehook
+    if in_main:
+        sys.unraisablehook = _quiet_lost_interrupts(unraisablehook)
     caught: list[warnings.WarningMessage] = []
     stdout = sys.stdout
     sys.stdout = _ClosableStdout(stdout)
@@ -1631,6 +1650,8 @@ def main(argv: list[str] | None = None) -> int:
             warnings.simplefilter("always", ShipidWarning)
             check_options(args)
             code = args.func(args)
+            if in_main:
+                check_stop()  # an interrupt whose exception a finaliser dropped
     except ShipidError as exc:
         print(f"shipid: error: {_one_line(exc)}", file=sys.stderr)
         code = 1
@@ -1659,12 +1680,13 @@ def main(argv: list[str] | None = None) -> int:
     finally:
         if in_main:
             signal.signal(signal.SIGTERM, previous)
+            signal.signal(signal.SIGINT, previous_int)
         sys.stdout = stdout
         if sys.unraisablehook is _ignore_unraisable:
             import gc
 
             gc.collect()  # the finalisers of cycles, while they are still ignored
-            sys.unraisablehook = unraisablehook
+        sys.unraisablehook = unraisablehook
     seen = set()
     for w in caught:
         if issubclass(w.category, ShipidWarning) and str(w.message) not in seen:

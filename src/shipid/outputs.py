@@ -14,10 +14,37 @@ from __future__ import annotations
 
 import os
 import tempfile
+import threading
 from collections.abc import Callable, Iterable, Mapping
 from pathlib import Path
 
 from shipid.errors import ShipidError
+
+
+class Interrupted(KeyboardInterrupt):
+    """SIGTERM, handled like Ctrl-C: temporaries removed, one line, exit 130."""
+
+
+# Set by the command line's signal handlers. Their exception can land where Python drops it (a
+# finaliser, e.g. of a JIT compile's LLVM objects): the command would then run on and write its
+# files. The flag outlives the dropped exception, and no file is committed once it is set.
+_stop = threading.Event()
+
+
+def request_stop() -> None:
+    """Record an interrupt (SIGINT/SIGTERM) for ``check_stop``, in case its exception is lost."""
+    _stop.set()
+
+
+def clear_stop() -> None:
+    """Forget an earlier interrupt (a new command starts)."""
+    _stop.clear()
+
+
+def check_stop() -> None:
+    """Raise ``Interrupted`` if an interrupt was recorded."""
+    if _stop.is_set():
+        raise Interrupted()
 
 LOG_EXTENSIONS = (".csv", ".parquet", ".pq")
 JSON_EXTENSIONS = (".json",)
@@ -142,7 +169,9 @@ class OutputSet:
         return final
 
     def commit(self) -> list[Path]:
-        """Rename every staged file into place (mode of the umask or of the file replaced)."""
+        """Rename every staged file into place (mode of the umask or of the file replaced);
+        after an interrupt, nothing (``Interrupted``; the caller discards the set)."""
+        check_stop()
         mask = _umask()
         for tmp, final in self._staged:
             try:
@@ -174,7 +203,11 @@ class OutputSet:
 
     def __exit__(self, exc_type, exc, tb) -> bool:
         if exc_type is None:
-            self.commit()
+            try:
+                self.commit()
+            except BaseException:
+                self.abort()
+                raise
         else:
             self.abort()
         return False
