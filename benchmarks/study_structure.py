@@ -151,9 +151,39 @@ def real_data() -> None:
                   + ("–" if r is None else f"{r:.4f}") + " |")
 
 
+def leave_one_log_out() -> None:
+    """The three real KVLCC2 zig-zags (MARIN ±20/20, HSVA 20/10): each structure identified on
+    two, judged on the third (free-run error std and the zig-zag run closed loop from its start)."""
+    from shipid.data.io import read_log
+    from shipid.evaluation.validate import validate
+
+    data = Path(__file__).resolve().parents[2] / "shared" / "data"
+    if not data.is_dir():
+        return
+    marin = {"fmt": "simman-marin", "scale": 45.7, "dt": DT}
+    logs = {"MARIN zz 20/20": read_log(data / "kvlcc2-marin/MARIN_FREE_KVLCC2_zz_20_m.dat", **marin),
+            "MARIN zz −20/−20": read_log(data / "kvlcc2-marin/MARIN_FREE_KVLCC2_zz_-20_m.dat",
+                                         **marin),
+            "HSVA zz 20/10": read_log(data / "kvlcc2-hsva/HSVA_CPMC_KVLCC2_Z_20_10_P.dat",
+                                      fmt="simman-hsva", dt=DT)}  # fmt: skip
+    print("\nKVLCC2, leave one real log out: identified (as identify does) on the other two\n")
+    print("| structure | held out | u / v / r error std | overshoots measured | closed loop |")
+    print("|---|---|---|---|---|")
+    for structure in STRUCTURES[:2]:
+        for held, log in logs.items():
+            model, _ = fit_as_identify([x for k, x in logs.items() if k != held], structure)
+            v = validate(model, [log])[0]
+            me, cl = v.indices["measured"], v.indices["closed_loop"]
+            print(f"| {structure} | {held} | "
+                  + " / ".join(f"{v.metrics[s]['std']:.4f}" for s in "uvr")
+                  + f" | {me[OVERSHOOTS[0]]:.1f}°, {me[OVERSHOOTS[1]]:.1f}° | "
+                  f"{cl[OVERSHOOTS[0]]:.1f}°, {cl[OVERSHOOTS[1]]:.1f}° |")
+
+
 if __name__ == "__main__":
     warnings.simplefilter("ignore")  # envelope and plausibility warnings of the candidates
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores\n")
     mmg(int(sys.argv[1]) if len(sys.argv) > 1 else 10,
         float(sys.argv[2]) if len(sys.argv) > 2 else 0.25)  # fmt: skip
     real_data()
+    leave_one_log_out()
