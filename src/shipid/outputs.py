@@ -46,6 +46,7 @@ def check_stop() -> None:
     if _stop.is_set():
         raise Interrupted()
 
+
 LOG_EXTENSIONS = (".csv", ".parquet", ".pq")
 JSON_EXTENSIONS = (".json",)
 FIGURE_EXTENSIONS = (".png", ".svg", ".pdf")
