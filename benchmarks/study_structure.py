@@ -70,6 +70,22 @@ def held_out_errors(model, ship, truth_zz, truth_tc) -> list[float]:
     return out
 
 
+DERIVATIVES = ("∂v̇/∂v", "∂v̇/∂r", "∂v̇/∂δ", "∂ṙ/∂v", "∂ṙ/∂r", "∂ṙ/∂δ")
+
+
+def sway_yaw_derivatives(accelerations, speed: float, h: float = 1e-5) -> np.ndarray:
+    """(6,) ∂(v̇, ṙ)/∂(v, r, δ) at straight running at ``speed`` by central differences of
+    ``accelerations(u, v, r, δ) → (u̇, v̇, ṙ)``."""
+    out = np.zeros((2, 3))
+    for k in range(3):
+        e = np.zeros(4)
+        e[k + 1] = h
+        up = np.ravel(accelerations(speed + e[0], e[1], e[2], e[3]))
+        down = np.ravel(accelerations(speed - e[0], -e[1], -e[2], -e[3]))
+        out[:, k] = (up[1:3] - down[1:3]) / (2 * h)
+    return out.ravel()
+
+
 def mmg(seeds: int, noise: float) -> None:
     ship = kvlcc2()
     truth_zz = {c: _zigzag(ship, *c).indices for c in HELD_ZIGZAGS}
@@ -84,7 +100,13 @@ def mmg(seeds: int, noise: float) -> None:
         f"{truth_zz[(10, 10, s)][OVERSHOOTS[1]]:.1f}°" for s in ("starboard", "port"))
         + "; 35° tactical diameter " + ", ".join(
         f"{truth_tc[s]['tactical_diameter'] / ship.length:.2f} L" for s in truth_tc) + "\n")
+    from shipid.vessels.kvlcc2 import accelerations, trimmed_revolutions
+
+    rps = trimmed_revolutions(ship.approach_speed)
+    truth_lin = sway_yaw_derivatives(lambda u, v, r, d: accelerations(u, v, r, d, rps),
+                                     ship.approach_speed)  # fmt: skip
     errors: dict[str, list[list[float]]] = {s: [] for s in STRUCTURES}
+    linear: dict[str, list[np.ndarray]] = {s: [] for s in STRUCTURES}
     t0 = time.perf_counter()
     for seed in range(seeds):
         logs = [sensor.apply(_zigzag(ship, *case).log, seed=100 * seed + i)
@@ -92,6 +114,8 @@ def mmg(seeds: int, noise: float) -> None:
         for structure in STRUCTURES:
             model, _ = fit_as_identify(logs, structure)
             errors[structure].append(held_out_errors(model, ship, truth_zz, truth_tc))
+            linear[structure].append(
+                sway_yaw_derivatives(model.accelerations, ship.approach_speed) / truth_lin - 1)
     head = ["10/10 stbd 1st", "10/10 stbd 2nd", "10/10 port 1st", "10/10 port 2nd",
             "TD stbd", "r stbd", "TD port", "r port"]  # fmt: skip
     print("Mean error (largest |error|) over the seeds; overshoots in degrees, the 35° turn's "
@@ -106,6 +130,17 @@ def mmg(seeds: int, noise: float) -> None:
             cells.append("–" if col.size == 0 else f"{col.mean():+.1f} ({np.abs(col).max():.1f})")
         diverged = int(np.isnan(e[:, 4:]).any(axis=1).sum())
         print(f"| {structure} | " + " | ".join(cells) + f" | {diverged} of {len(rows)} |")
+    print("\nThe identified models' linear sway–yaw derivatives at the approach speed against the "
+          "MMG model's (the truth the issue asks for within 30 %): mean relative error (largest "
+          "|error|) over the seeds.\n")
+    print("| structure | " + " | ".join(DERIVATIVES) + " | all within 30 % |")
+    print("|---" * (len(DERIVATIVES) + 2) + "|")
+    for structure, rows in linear.items():
+        e = 100 * np.array(rows)
+        within = int((np.abs(e) <= 30).all(axis=1).sum())
+        print(f"| {structure} | " + " | ".join(f"{e[:, j].mean():+.0f} % ({np.abs(e[:, j]).max():.0f} %)"
+                                               for j in range(e.shape[1]))
+              + f" | {within} of {len(rows)} seeds |")  # fmt: skip
     print(f"\n{time.perf_counter() - t0:.1f} s")
 
 
