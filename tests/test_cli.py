@@ -185,6 +185,20 @@ def test_an_interrupt_lost_in_a_finaliser_still_stops_the_command(tmp_path, file
     code, _, _ = run(["import", log, "-o", tmp_path / "out.csv"], capsys)
     assert code == 0 and (tmp_path / "out.csv").exists()  # the next command starts afresh
 
+
+def test_one_file_imported_into_an_existing_folder_keeps_its_name(tmp_path, files, capsys):
+    """One input with -o an existing folder was refused ('is a folder, not a file'); it is now
+    written into it, as several inputs are (and as cp does), with the same content as -o FILE."""
+    log, _ = files
+    folder = tmp_path / "logs"
+    folder.mkdir()
+    code, out, err = run(["import", log, "-o", folder], capsys)
+    assert code == 0, err
+    written = folder / (Path(log).stem + ".csv")
+    assert written.exists() and str(written) in out
+    code, _, _ = run(["import", log, "-o", tmp_path / "direct.csv"], capsys)
+    assert code == 0 and written.read_text() == (tmp_path / "direct.csv").read_text()
+
 def test_sigterm_gives_one_line_exit_130_and_no_temporaries(tmp_path):
     exe = Path(sys.executable).parent / "shipid"
     out = tmp_path / "long.csv"

@@ -1260,9 +1260,10 @@ def cmd_import(args) -> int:
     from shipid.data.io import write_log
     from shipid.outputs import OutputSet, check_outputs
 
-    several = len(args.logs) > 1
+    # Several files, or one into an existing folder (as cp does): -o is a folder; each file
+    # keeps its name with the extension of --ext.
+    several = len(args.logs) > 1 or Path(args.output).is_dir()
     if several:
-        # Several files: -o is a folder; each file keeps its name with the extension of --ext.
         check_outputs({"-o": (args.output, "dir")}, args.logs)
         targets = [Path(args.output) / (Path(p).stem + args.ext) for p in args.logs]
         check_outputs({f"-o {t.name}": (t, "log") for t in targets}, args.logs)
@@ -1572,9 +1573,10 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("import", help="convert trial files to canonical logs")
     p.add_argument("logs", nargs="+", metavar="FILE")
     p.add_argument("-o", "--output", required=True, metavar="LOG.csv|LOG.parquet|DIR",
-                   help="the canonical log; with several files, a folder")
+                   help="the canonical log; with several files, or into an existing folder, a "
+                   "folder (each file keeps its name)")
     p.add_argument("--ext", default=".csv", choices=(".csv", ".parquet"),
-                   help="with several files: the output format (default %(default)s)")
+                   help="into a folder: the output format (default %(default)s)")
     _add_log_options(p)
     p.set_defaults(func=cmd_import)
 
