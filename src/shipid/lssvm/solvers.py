@@ -20,6 +20,8 @@ import warnings
 from collections.abc import Iterable
 
 import numpy as np
+from scipy import linalg
+from threadpoolctl import threadpool_limits
 
 from shipid.limits import available_memory_bytes
 
@@ -69,10 +71,6 @@ def solve_dual(
     -------
     alpha : (N, q) support values; intercept : (q,) bias b.
     """
-    # 0.17 s of imports, paid only by the dense solver (the primal one needs neither).
-    from scipy import linalg
-    from threadpoolctl import threadpool_limits
-
     n, q = Y.shape
     K.flat[:: n + 1] += inv_reg
     rhs = np.empty((n, q + 1))
@@ -150,20 +148,12 @@ def solve_primal(
             NumericalWarning,
             stacklevel=3,
         )
-    z = _solve_spd(Ms, B * d[:, None])
+    try:
+        z = linalg.solve(Ms, B * d[:, None], assume_a="pos", check_finite=False)
+    except linalg.LinAlgError:
+        z = linalg.lstsq(Ms, B * d[:, None], check_finite=False)[0]
     x = z * d[:, None]
     return x[:p].T.copy(), x[p].copy(), condition
-
-
-def _solve_spd(M: np.ndarray, rhs: np.ndarray) -> np.ndarray:
-    """M⁻¹ rhs for a symmetric positive definite M (Cholesky), in least squares where M is not
-    positive definite to working precision. NumPy's LAPACK: importing scipy.linalg for these
-    (p+1)² systems cost every fit 0.13 s of start-up."""
-    try:
-        L = np.linalg.cholesky(M)
-    except np.linalg.LinAlgError:
-        return np.linalg.lstsq(M, rhs, rcond=None)[0]
-    return np.linalg.solve(L.T, np.linalg.solve(L, rhs))
 
 
 # Weight of the equality rows, relative to the equilibrated normal equations (unit diagonal), when
@@ -249,10 +239,13 @@ def solve_primal_constrained(
     if rows:
         C, g = np.vstack(rows), np.concatenate(rhs_eq)
         K = np.block([[Ms, C.T], [C, np.zeros((len(g), len(g)))]])
-        exact = np.linalg.lstsq(K, np.concatenate([cs, g]), rcond=None)[0][: p + 1]
+        exact = linalg.lstsq(K, np.concatenate([cs, g]), check_finite=False)[0][: p + 1]
         if not bounded or np.all((exact >= lo / d - 1e-9) & (exact <= hi / d + 1e-9)):
             z = exact
     else:
-        z = _solve_spd(Ms, cs)
+        try:
+            z = linalg.solve(Ms, cs, assume_a="pos", check_finite=False)
+        except linalg.LinAlgError:
+            z = linalg.lstsq(Ms, cs, check_finite=False)[0]
     x = z * d
     return x[:p], float(x[p]), active[:p]
