@@ -57,7 +57,9 @@ def test_block_bootstrap_of_an_autocorrelated_mean_matches_the_closed_form():
     single = bootstrap([log], fit, replicates=400, block_s=0.1, seed=2).thetas[:, 0, 0]
     assert np.std(long_blocks) == pytest.approx(closed, rel=0.25)
     assert np.std(single) == pytest.approx(iid, rel=0.2)
-    assert interval([1.0, 2.0, math.nan, 3.0], 0.5) == (1.5, 2.5)
+    assert interval([1.0, 2.0, 3.0], 0.5) == (1.5, 2.5)
+    # One of four without a value is more than the 25 % tail of a 50 % interval.
+    assert interval([1.0, 2.0, math.nan, 3.0], 0.5) == (-math.inf, math.inf)
 
 
 @pytest.fixture(scope="module")
@@ -120,3 +122,69 @@ def test_cli_bootstrap_bands_and_intervals(tmp_path, capsys, noisy_zigzag):
     code, _, err = run(["identify", log, "--bootstrap", "20", "--refine", "-o",
                         tmp_path / "x.json"], capsys)  # fmt: skip
     assert code == 1 and "does not go with --refine" in err
+
+
+@pytest.mark.parametrize("n", [40, 100, 401])
+@pytest.mark.parametrize("missing", [0, 1, 2, 3, 6])
+def test_interval_counts_replicates_without_a_value_at_the_worst_end(n, missing):
+    """Against a brute force: NumPy's percentile with each missing replicate replaced by a huge
+    value below every other (for the lower bound) or above (for the upper one). Whatever the
+    sentinel touches is unbounded; the rest is NumPy's interval."""
+    rng = np.random.default_rng(n + missing)
+    values = rng.normal(size=n)
+    values[rng.choice(n, missing, replace=False)] = np.nan
+    big = 1e300
+    lo_ref = np.percentile(np.where(np.isnan(values), -big, values), 2.5)
+    hi_ref = np.percentile(np.where(np.isnan(values), big, values), 97.5)
+    lo, hi = interval(values)
+    for got, ref, worst in ((lo, lo_ref, -math.inf), (hi, hi_ref, math.inf)):
+        if abs(ref) > 1e200:
+            assert got == worst
+        else:
+            assert got == pytest.approx(ref, rel=1e-12, abs=1e-12)
+    if missing == 0:
+        assert (lo, hi) == pytest.approx(tuple(np.percentile(values, [2.5, 97.5])))
+    # More missing than the tail (2.5 %) holds: not bounded at either end.
+    assert math.isinf(lo) == (missing > 0.025 * (n - 1))
+
+
+def test_diverged_replicates_unbound_the_index_intervals_and_the_bands():
+    from types import SimpleNamespace
+
+    import pandas as pd
+
+    from shipid.identification.uncertainty import free_run_bands, index_intervals
+
+    # 10 of 100 replicates diverged: leaving them out gave a narrow interval that could
+    # exclude the model's own value (found on the KVLCC2's 35° turn).
+    samples = [{"tactical_diameter": 20.0 + 0.01 * k} for k in range(90)] + [{}] * 10
+    assert index_intervals(samples)["tactical_diameter"] == (-math.inf, math.inf)
+    assert index_intervals(samples[:90] + [{}])["tactical_diameter"] == pytest.approx(
+        interval([20.0 + 0.01 * k for k in range(90)] + [math.nan]))
+    frame = pd.DataFrame({"u": np.ones(50), "v": np.zeros(50), "r": np.zeros(50)})
+    runs = [SimpleNamespace(log=frame, diverged=False)] * 90 + [
+        SimpleNamespace(log=frame.iloc[:20], diverged=True)] * 10
+    bands, diverged = free_run_bands(runs, 50)
+    lo, hi = bands["u"]
+    assert diverged == 10
+    np.testing.assert_array_equal(lo[:20], 1.0)
+    assert np.all(np.isneginf(lo[20:])) and np.all(np.isposinf(hi[20:]))
+
+
+def test_cli_manoeuvre_says_not_bounded_when_replicates_diverge(tmp_path, capsys, noisy_zigzag):
+    log = write_log(noisy_zigzag, tmp_path / "zz.csv")
+    model = tmp_path / "m.json"
+    code, _, err = run(["identify", log, "--bootstrap", "20", "-o", model], capsys)
+    assert code == 0, err
+    doc = json.loads(model.read_text())
+    thetas = np.array(doc["uncertainty"]["thetas"])
+    # Four of twenty replicates with an explosive yaw equation (every coefficient ×1e4).
+    thetas[:4, 2, :] *= 1e4
+    doc["uncertainty"]["thetas"] = thetas.tolist()
+    model.write_text(json.dumps(doc))
+    code, out, err = run(["manoeuvre", model, "turning", "--rudder", "20", "--duration", "40"],
+                         capsys)  # fmt: skip
+    assert code == 0, err
+    assert "(4 diverged" in out
+    line = next(ln for ln in out.splitlines() if ln.startswith("tactical_diameter:"))
+    assert line.endswith("[not bounded]")

@@ -1201,10 +1201,12 @@ def cmd_manoeuvre(args) -> int:
         from shipid.identification.uncertainty import index_intervals
 
         runs = [run(member) for member in ensemble.members()]
-        intervals = index_intervals([r.indices for r in runs if not r.diverged])
+        # A diverged replicate has no indices; it widens the intervals rather than vanishing.
+        intervals = index_intervals([{} if r.diverged else r.indices for r in runs])
         diverged = sum(r.diverged for r in runs)
         print(f"95 % intervals over the model's {ensemble.replicates} {ensemble.members_label}"
-              + (f" ({diverged} diverged, left out)" if diverged else "") + ":")
+              + (f" ({diverged} diverged: an index is not bounded where more than 2.5 % of "
+                 "them diverged or lack it)" if diverged else "") + ":")
     if res.diverged:
         print(res.reason, file=sys.stderr)
     notes = outside_envelope(cond["envelope"], res.log)
@@ -1217,7 +1219,15 @@ def cmd_manoeuvre(args) -> int:
             continue
         text = f"{k}: {v:.4g}" if isinstance(v, float) else f"{k}: {v}"
         lo, hi = intervals.get(k, (math.nan, math.nan))
-        print(text + (f"  [{lo:.4g}, {hi:.4g}]" if math.isfinite(lo) else ""))
+        if math.isinf(lo) or math.isinf(hi):
+            text += "  [not bounded]"
+        elif math.isfinite(lo):
+            text += f"  [{lo:.4g}, {hi:.4g}]"
+            if isinstance(v, float) and not lo <= v <= hi:
+                notes.append(f"{k} {v:.4g} lies outside the interval of the model's "
+                             f"{ensemble.members_label}: they disagree with the fit, and the "
+                             "interval does not describe it")  # fmt: skip
+        print(text)
     for n in notes:
         _warn(n)
     with OutputSet() as out:

@@ -13,7 +13,6 @@ structure that lacks a term) is not in them.
 from __future__ import annotations
 
 import math
-import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
@@ -106,14 +105,42 @@ class Ensemble:
         return cls(model, thetas, block_s, seed, str(data.get("method", METHOD)))
 
 
+def conservative_percentiles(values: np.ndarray, level: float = LEVEL, axis: int = 0
+                             ) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """Central percentile bounds of ``values`` along ``axis`` where a replicate without a value
+    (NaN: its run diverged, or never reached the event) counts as below every value for the
+    lower bound and above every value for the upper one. Leaving such replicates out would
+    make the interval narrower than the ensemble says; counted this way, a share of them larger
+    than the tail (1 − level) / 2 makes the bounds −∞ and +∞: not bounded. NaN where no
+    replicate has a value."""
+    v = np.moveaxis(np.asarray(values, dtype=float), axis, 0)
+    n = v.shape[0]
+    missing = ~np.isfinite(v)
+    lower_sorted = np.sort(np.where(missing, -np.inf, v), axis=0)
+    upper_sorted = np.sort(np.where(missing, np.inf, v), axis=0)
+    a = 0.5 * (1.0 - level)
+    out = []
+    for q, s, worst in ((a, lower_sorted, -np.inf), (1.0 - a, upper_sorted, np.inf)):
+        # NumPy's default (linear) percentile, and the infinite bound wherever it would take
+        # or interpolate with a missing replicate.
+        p = q * (n - 1)
+        i = int(math.floor(p))
+        f = p - i
+        below, above = s[i], s[min(i + 1, n - 1)]
+        reached = np.isinf(below) | (f > 0) & np.isinf(above)
+        with np.errstate(invalid="ignore"):
+            x = np.where(reached, worst, below + f * (above - below))
+        out.append(np.where(missing.all(axis=0), np.nan, x))
+    return out[0], out[1]
+
+
 def interval(values: Sequence[float], level: float = LEVEL) -> tuple[float, float]:
-    """Central percentile interval of ``values`` (NaN ignored; NaN if none is finite)."""
-    v = np.asarray(values, dtype=float)
-    v = v[np.isfinite(v)]
+    """Central percentile interval of ``values`` (NaN: a replicate without a value, counted as
+    ``conservative_percentiles`` does, so many of them give (−∞, +∞); NaN if none is finite)."""
+    v = np.asarray(values, dtype=float).reshape(-1)
     if v.size == 0:
         return math.nan, math.nan
-    a = 50.0 * (1.0 - level)
-    lo, hi = np.percentile(v, [a, 100.0 - a])
+    lo, hi = conservative_percentiles(v, level)
     return float(lo), float(hi)
 
 
@@ -190,22 +217,21 @@ def ensemble_runs(ensemble: Ensemble, log: pd.DataFrame, method: str = "euler") 
 def free_run_bands(runs: Sequence, n: int, level: float = LEVEL) -> tuple[Bands, int]:
     """Prediction bands from the replicates' free runs (``ensemble_runs``) on a log of ``n``
     samples: per state u, v, r the pointwise percentile interval, and how many replicates
-    diverged (their samples after the divergence are left out)."""
+    diverged. A diverged replicate has no value after its divergence, which counts as
+    ``conservative_percentiles`` does: where more than the tail's share of replicates have
+    diverged, the band is not bounded (±∞)."""
     values = np.full((len(runs), n, 3), np.nan)
     for k, sim in enumerate(runs):
         m = len(sim.log)
         values[k, :m] = sim.log[["u", "v", "r"]].to_numpy()
-    a = 50.0 * (1.0 - level)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)  # samples after every replicate diverged
-        lo = np.nanpercentile(values, a, axis=0)
-        hi = np.nanpercentile(values, 100.0 - a, axis=0)
+    lo, hi = conservative_percentiles(values, level)
     bands = {s: (lo[:, j], hi[:, j]) for j, s in enumerate(("u", "v", "r"))}
     return bands, sum(int(sim.diverged) for sim in runs)
 
 
 def index_intervals(samples: Sequence[Mapping[str, float]], level: float = LEVEL
                     ) -> dict[str, tuple[float, float]]:  # fmt: skip
-    """Per index name: the percentile interval over the replicates' indices."""
+    """Per index name: the percentile interval over the replicates' indices (a replicate that
+    diverged or lacks the index counts as ``interval`` says: too many give (−∞, +∞))."""
     names = sorted({k for s in samples for k, v in s.items() if isinstance(v, int | float)})
     return {k: interval([s.get(k, math.nan) for s in samples], level) for k in names}

@@ -88,9 +88,13 @@ def measured_vs_simulated(measured: pd.DataFrame, simulated: pd.DataFrame, path:
         ax.plot(measured["t"], measured[s], lw=0.8, color="0.5", label="measured")
         ax.plot(t_sim, simulated[s], lw=1.4, color="C0", label="simulated")
         if bands and s in bands:
-            lo, hi = bands[s]
-            ax.fill_between(t_sim, lo[:n], hi[:n], color="C0", alpha=0.2, lw=0,
-                            label="95 % prediction band")  # fmt: skip
+            lo, hi = bands[s][0][:n], bands[s][1][:n]
+            bounded = np.isfinite(lo) & np.isfinite(hi)
+            ax.fill_between(t_sim, np.where(bounded, lo, np.nan), np.where(bounded, hi, np.nan),
+                            color="C0", alpha=0.2, lw=0, label="95 % prediction band")
+            if not bounded.all():  # too many replicates diverged: the band has no edge there
+                ax.fill_between(t_sim, 0, 1, where=~bounded, transform=ax.get_xaxis_transform(),
+                                color="C3", alpha=0.08, lw=0, label="band not bounded")
         ax.set_ylabel(LABELS[s])
         ax.grid(alpha=0.3)
         err_ax = fig.add_subplot(grid[i, 1], sharex=first)

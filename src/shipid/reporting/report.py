@@ -99,6 +99,9 @@ def indices_frame(validations: Sequence[Validation]) -> pd.DataFrame:
 
 
 def _bracket(bounds) -> str | None:
-    if bounds is None or not all(math.isfinite(b) for b in bounds):
+    """"[lower, upper]"; "not bounded" where too many replicates diverged or lack the index."""
+    if bounds is None or any(math.isnan(b) for b in bounds):
         return None
+    if any(math.isinf(b) for b in bounds):
+        return "not bounded"
     return f"[{bounds[0]:.4g}, {bounds[1]:.4g}]"
