@@ -1326,8 +1326,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--model", default="blanke",
                    help="structure: blanke (default), blanke-thrust, blanke-speed, blanke-race, "
                    "blanke-rps, "
-                   "abkowitz3, low-speed, wind, linear-sway-yaw, nomoto1; combine with + "
-                   "(blanke-rps+wind) or write terms: 'u: |u|u, v*r, 1; v: ...; r: ...'")
+                   "abkowitz3, low-speed, wind, race-damping, linear-sway-yaw, nomoto1; combine "
+                   "with + (blanke-rps+wind, blanke-race+race-damping) or write terms: "
+                   "'u: |u|u, v*r, 1; v: ...; r: ...'")
     p.add_argument("--form", default="increment", choices=("increment", "paper"),
                    help="regression form (default %(default)s)")
     p.add_argument("--gamma", type=_number_or_auto, default=1e4, metavar="G|auto",

@@ -82,6 +82,12 @@ STRUCTURES: dict[str, dict[str, tuple[str, ...]]] = {
     # propeller speeds need the race in n (pos(n)^2*delta, the low-speed library).
     "blanke-race": {"u": ("|u|u", "vr", "r^2", "delta^2", "1"), "v": _RACE_LATERAL,
                     "r": _RACE_LATERAL},
+    # The rudder's share of sway and yaw damping in the race of a propeller at constant rps,
+    # added to a structure (blanke-race+race-damping): its angle of attack falls by γ_R β_R (the
+    # hull-straightened drift at the rudder, β_R = β − ℓ_R r′) at an inflow the race keeps up as
+    # the ship slows, so part of the damping goes as n v and n r, not u v and u r (the
+    # low-speed library's v|n|, r|n|; at constant n, v and r).
+    "race-damping": {"v": ("v", "r"), "r": ("v", "r")},
     "blanke-rps": {"u": ("|u|u", "vr", "r^2", "delta^2", "|n|n", "1"), "v": _BLANKE_SPEED,
                    "r": _BLANKE_SPEED},
     "abkowitz3": {"u": _ABK_SURGE, "v": _ABK_LATERAL, "r": _ABK_LATERAL},
