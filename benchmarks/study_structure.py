@@ -175,8 +175,9 @@ def real_data() -> None:
         f"{name}: error std, overshoots" for name in held)
         + " | 35° TD (m) | steady speed (m/s) | steady r (rad/s) |")
     print("|---" * (6 + len(held)) + "|")
+    chosen_models = {}
     for structure in REAL:
-        _, chosen = fit_as_identify([train], structure)
+        chosen_models[structure], chosen = fit_as_identify([train], structure)
         for cutoff in (None, *candidate_cutoffs(DT)[:4]):
             model = identify(train if cutoff is None else lowpass(train, cutoff),
                              model=structure, force=True).model  # fmt: skip
@@ -192,6 +193,22 @@ def real_data() -> None:
             print(f"| {structure} | {'none' if cutoff is None else f'{cutoff:g} Hz'} | "
                   f"{'yes' if _same(cutoff, chosen) else ''} | " + " | ".join(cells) + " | "
                   + " | ".join("diverged" if x is None else f"{x:.4g}" for x in turn) + " |")
+    ship = kvlcc2()
+    truth = {c: _zigzag(ship, *c).indices for c in HELD_ZIGZAGS}
+    print("\nThe 10/10 zig-zags (no real one here) predicted by the models above (the prefilter "
+          "identify chooses) from the MARIN run's approach speed, against the MMG model of the "
+          "same ship: first / second overshoot [deg]\n")  # fmt: skip
+    print("| model | 10/10 starboard first | 10/10 port first |")
+    print("|---|---|---|")
+    print("| MMG model | " + " | ".join(f"{truth[c][OVERSHOOTS[0]]:.1f}, {truth[c][OVERSHOOTS[1]]:.1f}"
+                                     for c in HELD_ZIGZAGS) + " |")  # fmt: skip
+    kw = {"speed": float(train["u"].iloc[0]), "steering": ship.steering}
+    for structure, model in chosen_models.items():
+        cells = []
+        for c in HELD_ZIGZAGS:
+            ind = _zigzag(model, *c, **kw).indices
+            cells.append(", ".join(f"{ind.get(k) or math.nan:.1f}" for k in OVERSHOOTS))
+        print(f"| {structure} | " + " | ".join(cells) + " |")
 
 
 def prior_effect(seeds: int = 3, noise: float = 1.0) -> None:

@@ -1156,6 +1156,32 @@ def cmd_simulate(args) -> int:
     return 0
 
 
+def _manoeuvre_steering(target, cond: dict, rate_deg_s: float | None):
+    """The steering machine of a manoeuvre and a line saying which: ``--rudder-rate``, else a
+    reference ship's own gear, else the rate of the model's training logs (overshoots depend on
+    it as much as on the model), else an instantaneous rudder, said so."""
+    import dataclasses
+
+    from shipid.dynamics.steering import SteeringMachine
+
+    own = getattr(target, "steering", None)
+    if rate_deg_s is not None:
+        rate, source = math.radians(rate_deg_s), "--rudder-rate"
+    elif own is not None:
+        rate = own.max_rate
+        return None, ("rudder: the ship's own steering gear" + (
+            f", {math.degrees(rate):.3g} °/s" if rate else ", instantaneous"))
+    elif cond.get("rudder_rate"):
+        rate, source = float(cond["rudder_rate"]), "the training logs' rudder rate"
+    else:
+        return SteeringMachine(), ("rudder: instantaneous (the model file has no training rudder "
+                                   "rate; give one with --rudder-rate DEG/S)")  # fmt: skip
+    max_angle = own.max_angle if own is not None else math.radians(35.0)
+    steering = SteeringMachine(max_angle, rate) if own is None else dataclasses.replace(
+        own, max_rate=rate)  # fmt: skip
+    return steering, f"rudder rate {math.degrees(rate):.3g} °/s ({source})"
+
+
 def cmd_manoeuvre(args) -> int:
     """``shipid manoeuvre``: a standard manoeuvre on a model or vessel."""
     from shipid.evaluation.envelope import implausible_indices, outside_envelope
@@ -1167,7 +1193,8 @@ def cmd_manoeuvre(args) -> int:
     target, cond = _ship_or_model(args.model)
     speed = args.speed if args.speed is not None else cond["speed"]
     rps = args.rps if args.rps is not None else cond["rps"]
-    kw = {"dt": args.step, "speed": speed, "rps": rps}
+    steering, rudder_note = _manoeuvre_steering(target, cond, args.rudder_rate)
+    kw = {"dt": args.step, "speed": speed, "rps": rps, "steering": steering}
     if args.wind_speed is not None:
         kw["wind"] = (args.wind_speed, math.radians(args.wind_from or 0.0))
     if args.duration is not None:
@@ -1195,6 +1222,7 @@ def cmd_manoeuvre(args) -> int:
         kw.pop("rps")
         run = partial(stopping, rps=rps, astern_rps=args.astern_rps, **kw)
     res = run(target)
+    print(rudder_note)
     intervals = {}
     ensemble = cond.get("ensemble")
     if ensemble is not None and not args.no_bands and args.kind != "spiral":
@@ -1235,6 +1263,8 @@ def cmd_manoeuvre(args) -> int:
             doc = {"manoeuvre": res.log.attrs.get("manoeuvre"), "diverged": res.diverged,
                    "diverged_at": res.diverged_at, "reason": res.reason,
                    "indices": res.indices, "index_intervals": intervals or None,
+                   "rudder_rate_deg_s": (math.degrees(steering.max_rate) if steering
+                                         and steering.max_rate else None),
                    "warnings": notes}  # fmt: skip
             out.write(args.json, lambda p: p.write_text(_json_text(doc), "utf-8"))
         if args.output:
@@ -1482,6 +1512,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--rps", type=float,
                    help="propeller speed [rps] for models with n terms (default from training)")
     p.add_argument("--astern-rps", type=float, help="stopping: the full-astern order (default −rps)")
+    p.add_argument("--rudder-rate", type=float, metavar="DEG/S",
+                   help="steering machine rate (default: a reference ship's own, else the model "
+                   "file's training rudder rate, else instantaneous)")
     p.add_argument("--wind-speed", type=float, metavar="M/S",
                    help="constant true wind for models with wind terms (default: still air)")
     p.add_argument("--wind-from", type=float, metavar="DEG",
