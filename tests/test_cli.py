@@ -318,3 +318,35 @@ def test_manoeuvre_on_a_model_runs_its_training_rudder_rate(files, tmp_path, cap
     out, doc_out = cli()
     assert "rudder: instantaneous" in out and doc_out["rudder_rate_deg_s"] is None
     assert doc_out["indices"]["first_overshoot_deg"] == pytest.approx(instant["first_overshoot_deg"])
+
+
+def test_autopilot_and_follow_run_the_model_at_its_training_rudder_rate(files, capsys):
+    """The model side of ``autopilot`` and ``follow`` ran with an instantaneous rudder while
+    the true ship had its gear: the comparison flattered the model. Both now run the training
+    logs' rate, as ``manoeuvre`` does; the heading step equals the API's with that gear."""
+    import math
+
+    from shipid.control.autopilot import heading_step, pid_from_nomoto
+    from shipid.control.linear import nomoto
+    from shipid.dynamics.steering import SteeringMachine
+    from shipid.reporting.modelfile import load_document, model_from_document
+
+    _, model_path = files
+    doc = load_document(model_path)
+    model = model_from_document(doc, model_path)
+    prep = doc["identification"]["preprocessing"]
+    code, out, err = run(["autopilot", model_path, "--heading", "30", "--duration", "60"], capsys)
+    assert code == 0, err
+    assert "(the training logs' rudder rate)" in out
+    nm = nomoto(model, prep["approach_speed"], None)
+    pid = pid_from_nomoto(nm["K"], nm["T"], None)
+    for rate, expected_in_output in ((prep["rudder_rate"], True), (None, False)):
+        log = heading_step(model, pid, 30.0, 60.0, 0.1, prep["approach_speed"], None,
+                           steering=SteeringMachine(math.radians(35.0), rate))  # fmt: skip
+        psi = [math.degrees(x) for x in log["psi"]]
+        line = f"overshoot {max(psi) - 30.0:.3g}°, final heading {psi[-1]:.4g}°"
+        assert (line in out) == expected_in_output, (line, out)
+    code, out, err = run(["follow", model_path, "--waypoints", "0,0;40,0;40,40",
+                          "--rudder-rate", "5"], capsys)  # fmt: skip
+    assert code == 0, err
+    assert "rudder rate 5 °/s (--rudder-rate)" in out

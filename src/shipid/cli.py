@@ -795,7 +795,9 @@ def _controlled(args):
     truth = get_vessel(args.truth) if args.truth else None
     if truth is not None and args.truth not in VESSEL_NAMES:
         raise ShipidError(f"--truth must be a reference ship ({', '.join(VESSEL_NAMES)})")
-    return target, truth, speed, rps
+    steering, note = _manoeuvre_steering(target, cond, args.rudder_rate)
+    print(f"{args.model}: {note}")
+    return target, truth, speed, rps, steering
 
 
 def _tuned(ship, speed, rps, omega):
@@ -850,12 +852,12 @@ def cmd_autopilot(args) -> int:
     from shipid.outputs import check_outputs
 
     check_outputs({"-o": (args.output, "figure")}, [])
-    target, truth, speed, rps = _controlled(args)
+    target, truth, speed, rps, steering = _controlled(args)
     nm, pid = _tuned(target, speed, rps, args.omega)
     print(f"PID tuned on {args.model} (Nomoto K = {nm['K']:.4g} 1/s, T = {nm['T']:.4g} s): "
           f"Kp = {pid.kp:.4g}, Ki = {pid.ki:.4g} 1/s, Kd = {pid.kd:.4g} s")
     runs = {args.model: heading_step(target, pid, args.heading, args.duration, args.dt,
-                                     speed, rps)}  # fmt: skip
+                                     speed, rps, steering=steering)}  # fmt: skip
     if truth is not None:
         runs[f"{args.truth} (truth)"] = heading_step(truth, pid, args.heading, args.duration,
                                                      args.dt)  # fmt: skip
@@ -888,19 +890,20 @@ def cmd_follow(args) -> int:
     from shipid.outputs import OutputSet, check_outputs
 
     check_outputs({"-o": (args.output, "figure"), "--json": (args.json, "json")}, [])
-    target, truth, speed, rps = _controlled(args)
+    target, truth, speed, rps, steering = _controlled(args)
     waypoints = _parse_waypoints(args.waypoints)
     length = getattr(target, "length", None)
     lookahead = args.lookahead or 2.0 * (length if length and length == length else 10.0)
     nm, pid = _tuned(target, speed, rps, args.omega)
     runs, rows = {}, []
-    cases = [("model", target, pid, speed, rps)]
+    cases = [("model", target, pid, speed, rps, steering)]
     if truth is not None:
         _, pid_truth = _tuned(truth, truth.approach_speed, None, args.omega)
-        cases += [("truth, model-tuned PID", truth, pid, None, None),
-                  ("truth, truth-tuned PID", truth, pid_truth, None, None)]
-    for label, ship, gains, sp, n in cases:
-        res = follow_path(ship, gains, waypoints, lookahead, dt=args.dt, speed=sp, rps=n)
+        cases += [("truth, model-tuned PID", truth, pid, None, None, None),
+                  ("truth, truth-tuned PID", truth, pid_truth, None, None, None)]
+    for label, ship, gains, sp, n, gear in cases:
+        res = follow_path(ship, gains, waypoints, lookahead, dt=args.dt, speed=sp, rps=n,
+                          steering=gear)  # fmt: skip
         runs[label] = res.log
         rows.append({"run": label, "rms cross-track [m]": res.rms_cross_track,
                      "max cross-track [m]": res.max_cross_track, "completed": res.completed,
@@ -1568,6 +1571,9 @@ def build_parser() -> argparse.ArgumentParser:
                        "on (scale-ship, mariner, kvlcc2)")
         p.add_argument("--speed", type=float, help="approach speed [m/s] (default: training)")
         p.add_argument("--rps", type=float, help="propeller speed for models with n terms")
+        p.add_argument("--rudder-rate", type=float, metavar="DEG/S",
+                       help="the model's steering machine rate (default: its training logs' "
+                       "rudder rate; a reference ship: its own gear)")
         p.add_argument("--omega", type=float, help="closed-loop natural frequency [rad/s] "
                        "(default 1/T)")
         p.add_argument("--dt", type=float, default=0.1, help="step [s] (default %(default)s)")
