@@ -23,7 +23,7 @@ from pathlib import Path
 
 from shipid import __version__
 from shipid.errors import ShipidError, ShipidWarning
-from shipid.outputs import Interrupted, check_stop, clear_stop, request_stop
+from shipid.outputs import Interrupted, check_stop, clear_stop, request_stop, stop_requested
 
 VESSEL_NAMES = ("scale-ship", "mariner", "kvlcc2")
 LINEAR_ESTIMATORS = ("lssvm", "ols", "ridge", "lasso", "svr")
@@ -1701,7 +1701,14 @@ def main(argv: list[str] | None = None) -> int:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", ShipidWarning)
             check_options(args)
-            code = args.func(args)
+            try:
+                code = args.func(args)
+            except Exception:
+                # An error after an interrupt is the interrupt's doing (it broke a JIT compile,
+                # which then fails with its own RuntimeError), not a bug: exit 130 all the same.
+                if in_main and stop_requested():
+                    raise Interrupted() from None
+                raise
             if in_main:
                 check_stop()  # an interrupt whose exception a finaliser dropped
     except ShipidError as exc:

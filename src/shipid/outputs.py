@@ -47,6 +47,12 @@ def check_stop() -> None:
         raise Interrupted()
 
 
+def stop_requested() -> bool:
+    """Whether an interrupt was recorded: an error raised after it (e.g. numba's "no compiled
+    object yet" once the interrupt broke its compile) is the interrupt's doing, not a bug."""
+    return _stop.is_set()
+
+
 LOG_EXTENSIONS = (".csv", ".parquet", ".pq")
 JSON_EXTENSIONS = (".json",)
 FIGURE_EXTENSIONS = (".png", ".svg", ".pdf")
