@@ -9,6 +9,7 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 from cli_helpers import run
 
@@ -381,3 +382,32 @@ def test_autopilot_and_follow_run_the_model_at_its_training_rudder_rate(files, c
                           "--rudder-rate", "5"], capsys)  # fmt: skip
     assert code == 0, err
     assert "rudder rate 5 °/s (--rudder-rate)" in out
+
+
+def test_logs_in_the_other_rudder_convention_are_converted_not_mirrored(tmp_path, trial, files,
+                                                                        capsys):  # fmt: skip
+    """A log whose positive rudder turns the ship the other way (the MARIN KVLCC2 files against
+    the MMG reference ship's simulated logs) was fitted and run as it was: the rudder mirrored,
+    the model turning the wrong way with no warning (fit of r −95 %). The same trial written in
+    the other convention must give the same model and the same validation, with a note."""
+    from shipid.data.log import in_rudder_convention
+
+    log, model = files
+    assert trial.attrs["rudder_positive"] == "port"
+    mirrored, note = in_rudder_convention(trial, "starboard")
+    assert np.array_equal(mirrored["delta"], -trial["delta"]) and "negated" in note
+    assert in_rudder_convention(mirrored, None)[1] is None  # no convention asked: as it is
+    other = write_log(mirrored, tmp_path / "other.csv")
+    np.testing.assert_allclose(identify([trial, mirrored]).model.theta,
+                               identify([trial, trial]).model.theta, rtol=1e-9, atol=1e-12)
+    results = {}
+    for name, path in (("same", log), ("other", other)):
+        code, out, err = run(["validate", model, path, "--json", tmp_path / f"{name}.json"],
+                             capsys)  # fmt: skip
+        assert code == 0, err
+        results[name] = json.loads((tmp_path / f"{name}.json").read_text())["logs"][0]["metrics"]
+        assert ("negated to the port-positive convention" in err) == (name == "other")
+    for state in ("u", "v", "r"):
+        assert results["other"][state] == pytest.approx(results["same"][state], rel=1e-9)
+    code, out, err = run(["simulate", model, other, "-o", tmp_path / "sim.csv"], capsys)
+    assert code == 0 and "negated" in err

@@ -965,8 +965,10 @@ def cmd_validate(args) -> int:
               "validates")  # fmt: skip
     model = model_from_document(doc, args.model, "lssvm" if args.lssvm else "model")
     ensemble = None if args.no_bands else ensemble_from_document(doc, args.model, model)
-    env = training_conditions(doc)["envelope"]
+    cond = training_conditions(doc)
+    env = cond["envelope"]
     from shipid.data.io import read_log
+    from shipid.data.log import common_rudder_convention
 
     options = _read_options(args)
     logs, names, failed = [], [], []
@@ -976,6 +978,9 @@ def cmd_validate(args) -> int:
             names.append(str(p))
         except ShipidError as exc:
             failed.append(str(exc))
+    logs, notes = common_rudder_convention(logs, cond["rudder_positive"])
+    for note in notes:
+        _warn(note)
     from tqdm.auto import tqdm
 
     vals = [validate(model, log, [name], method=args.method, kind=args.kind,
@@ -1127,7 +1132,7 @@ def _ship_or_model(name: str):
 
     if name in VESSEL_NAMES:
         return get_vessel(name), {"speed": None, "rps": None, "envelope": {}, "particulars": None,
-                                  "rudder_rate": None}  # fmt: skip
+                                  "rudder_rate": None, "rudder_positive": None}  # fmt: skip
     if not Path(name).exists():
         raise ShipidError(f"{name}: neither a model file nor a known vessel "
                           f"({', '.join(VESSEL_NAMES)})")  # fmt: skip
@@ -1148,9 +1153,15 @@ def cmd_simulate(args) -> int:
 
     log_path = args.log
     check_outputs({"-o": (args.output, "log")}, [args.model, log_path])
-    target, _ = _ship_or_model(args.model)
+    from shipid.data.log import in_rudder_convention
+
+    target, cond = _ship_or_model(args.model)
     dynamics = getattr(target, "dynamics", target)
-    log = read_log(log_path, _read_options(args))
+    log, note = in_rudder_convention(read_log(log_path, _read_options(args)),
+                                     getattr(target, "rudder_positive", None)
+                                     or cond.get("rudder_positive"))  # fmt: skip
+    if note:
+        _warn(note)
     res = simulate_log(dynamics, log, method=args.method)
     write_log(res.log, args.output)
     if res.diverged:

@@ -62,6 +62,40 @@ def rudder_positive(log: pd.DataFrame, default: str = "port") -> str:
     return side
 
 
+def in_rudder_convention(log: pd.DataFrame, side: str | None) -> tuple[pd.DataFrame, str | None]:
+    """``log`` with its rudder angle in ``side``'s convention ('port' or 'starboard': where a
+    positive angle turns the ship), and a note when it had to be converted (δ → −δ, the
+    metadata with it). A log without the metadata, or no ``side``, is taken as it is: nothing
+    says which convention it has."""
+    own = log.attrs.get("rudder_positive")
+    if side is None or own is None or own == side:
+        return log, None
+    rudder_positive(log)  # a malformed value is an error, not a convention
+    out = log.copy()
+    out["delta"] = -out["delta"]
+    out.attrs = {**log.attrs, "rudder_positive": side}
+    return out, (f"{log_name(log)}: a positive rudder angle turns it to {own}; its rudder angle "
+                 f"is negated to the {side}-positive convention of the "
+                 "model/other logs")  # fmt: skip
+
+
+def common_rudder_convention(logs: list[pd.DataFrame], side: str | None = None
+                             ) -> tuple[list[pd.DataFrame], list[str]]:  # fmt: skip
+    """Logs in one rudder convention: ``side`` (a model's), else the first log's that states one;
+    the notes say which logs were converted. Mixing conventions unconverted mirrors the rudder
+    of some logs: a model fitted across them, or run on them, turns the wrong way."""
+    if side is None:
+        side = next((log.attrs["rudder_positive"] for log in logs
+                     if log.attrs.get("rudder_positive")), None)  # fmt: skip
+    out, notes = [], []
+    for log in logs:
+        converted, note = in_rudder_convention(log, side)
+        out.append(converted)
+        if note:
+            notes.append(note)
+    return out, notes
+
+
 def starboard_sign(rudder_positive_turns: str) -> float:
     """Sign of the rudder angle that turns the ship to starboard (r > 0)."""
     return 1.0 if rudder_positive_turns == "starboard" else -1.0

@@ -19,6 +19,7 @@ from collections.abc import Sequence
 import numpy as np
 import pandas as pd
 
+from shipid.data.log import common_rudder_convention
 from shipid.dynamics.model import DOFS, ModelStructure, get_structure
 from shipid.dynamics.simulate import simulate_log
 from shipid.errors import ShipidError
@@ -63,7 +64,7 @@ def compare(
     progress: bool = False,
 ) -> pd.DataFrame:
     """One row per (method, held-out log): normalised error per state, score, diverged."""
-    logs = list(logs)
+    logs, _ = common_rudder_convention(list(logs))  # one rudder convention for all folds
     names = list(names or [log.attrs.get("name", f"log {i}") for i, log in enumerate(logs)])
     if len(logs) < 2:
         raise ShipidError("compare needs at least 2 logs (each is held out in turn)")

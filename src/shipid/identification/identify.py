@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
+from shipid.data.log import common_rudder_convention
 from shipid.dynamics.model import (
     ManoeuvringModel,
     ModelStructure,
@@ -216,6 +217,7 @@ def identify(
         logs = [logs]
     if not logs:
         raise ShipidError("no training logs given")
+    logs, convention_notes = common_rudder_convention(list(logs))
     if form not in FORMS:
         raise ShipidError(f"unknown form {form!r}; use one of {', '.join(FORMS)}")
     if not (isinstance(gamma, int | float) and math.isfinite(gamma) and gamma > 0):
@@ -232,7 +234,7 @@ def identify(
         raise ShipidError(str(exc)) from None
     fixed = {d: {parse_term(k).text: float(c) for k, c in v.items()}
              for d, v in (fixed or {}).items()}  # fmt: skip
-    notes: list[str] = []
+    notes: list[str] = list(convention_notes)
     problems = {}
     for dof in structure.dofs:
         p = regression_problem(logs, structure, dof, form, fixed.get(dof), names)

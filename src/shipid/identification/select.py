@@ -38,7 +38,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from shipid.data.log import approach, input_columns
+from shipid.data.log import approach, common_rudder_convention, input_columns
 from shipid.dynamics.model import DOFS, ManoeuvringModel, ModelStructure, get_structure
 from shipid.dynamics.simulate import DivergenceBounds, input_array, run_kernel
 from shipid.dynamics.terms import INPUT_SIGNALS, parse_term, term_code
@@ -466,7 +466,7 @@ def cross_validate(
 def _setup(logs, names, options: SelectOptions):
     if isinstance(logs, pd.DataFrame):
         logs = [logs]
-    logs = list(logs)
+    logs, _ = common_rudder_convention(list(logs))  # select() reports the conversions
     names = list(names or [log.attrs.get("name", f"log {i}") for i, log in enumerate(logs)])
     kind, k = _parse_cv(options.cv)
     if kind == "blocks":
@@ -502,9 +502,9 @@ def select(
     from shipid.identification.plausibility import check_plausibility, disqualifying
 
     options = dataclasses.replace(options or SelectOptions(), **overrides)
+    _, notes = common_rudder_convention([logs] if isinstance(logs, pd.DataFrame) else list(logs))
     logs, names, data, folds, scorer = _setup(logs, names, options)
     library = data.library
-    notes: list[str] = []
     speed = options.speed if options.speed is not None else approach(logs[0], "u")
     rps = options.rps if options.rps is not None else approach(logs[0], "n")
     if speed is None or not speed > 0:

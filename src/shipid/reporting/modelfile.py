@@ -363,7 +363,8 @@ def training_conditions(doc: Mapping) -> dict:
     prep = ident.get("preprocessing") or {}
     out = {"speed": prep.get("approach_speed"), "rps": prep.get("approach_rps"),
            "envelope": ident.get("envelope") or {}, "particulars": None,
-           "rudder_rate": prep.get("rudder_rate")}  # fmt: skip
+           "rudder_rate": prep.get("rudder_rate"),
+           "rudder_positive": prep.get("rudder_positive")}  # fmt: skip
     if doc.get("particulars"):
         from shipid.data.particulars import Particulars
 
