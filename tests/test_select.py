@@ -168,18 +168,30 @@ def test_cli_select_compare_and_gamma_auto(paper_trials, tmp_path, capsys):
     model = tmp_path / "selected.json"
     table = tmp_path / "candidates.csv"
     code = main(["select", *map(str, paths), "--library", "blanke", "--quiet", "-o", str(model),
-                 "--table", str(table)])  # fmt: skip
+                 "--table", str(table), "--bootstrap", "12"])  # fmt: skip
     out, err = capsys.readouterr()
     assert code == 0, err
     assert "free-run CV score" in out and "Held-out logs" in out
+    assert "95 % intervals of the selected model's coefficients" in out
     import json
+
+    from shipid.reporting.modelfile import ensemble_from_document, model_from_document
 
     doc = json.loads(model.read_text())
     assert doc["identification"]["selection"]["candidates"]
     assert pd.read_csv(table)["chosen"].sum() == 1
-    code = main(["validate", str(model), str(paths[0])])
+    # The ensemble is of the selected model: its point refit is the file's model, to the bit.
+    selected = model_from_document(doc, model)
+    ens = ensemble_from_document(doc, model, selected)
+    assert ens.replicates == 12 and ens.model.term_texts == selected.term_texts
+    again = identify(training[:4], model=selected.structure, force=True,
+                     gamma=doc["identification"]["gamma"]).model  # fmt: skip
+    np.testing.assert_array_equal(again.theta, selected.theta)
+    code = main(["validate", str(model), str(paths[0]), "--json", str(tmp_path / "v.json")])
     assert code == 0
     capsys.readouterr()
+    rec = json.loads((tmp_path / "v.json").read_text())["logs"][0]
+    assert rec["ensemble_diverged"] == 0  # bands drawn from the 12 replicates, none diverged
     code = main(["identify", *map(str, paths), "--gamma", "auto", "-o", str(tmp_path / "g.json")])
     out, err = capsys.readouterr()
     assert code == 0, err and "γ chosen by free-run cross-validation" in out

@@ -560,8 +560,27 @@ def cmd_select(args) -> int:
             "scale": args.scale, "approach_speed": speed, "approach_rps": rps,
             "rudder_rate": _rudder_rate(logs),
             "rudder_positive": logs[0].attrs.get("rudder_positive")}  # fmt: skip
+    ensemble = None
+    if args.bootstrap is not None:
+        from shipid.identification.identify import identify
+        from shipid.identification.uncertainty import bootstrap
+
+        def refit(weights):  # the selected terms and γ, refitted as select fitted them
+            return identify(logs, model=sel.model.structure, gamma=sel.gamma, names=names,
+                            force=True, estimator=options.estimator, physics=options.physics,
+                            sample_weight=weights).model  # fmt: skip
+
+        ensemble = bootstrap(logs, refit, args.bootstrap, args.block, args.seed,
+                             progress=not args.quiet)  # fmt: skip
+        table = ensemble.coefficient_table()
+        table["term"] = [_term_display(t) for t in table["term"]]
+        print(f"\n95 % intervals of the selected model's coefficients ({ensemble.method}, "
+              f"{ensemble.replicates} replicates, {ensemble.block_s:g} s blocks; the structure "
+              "and γ held at the selection's):")  # fmt: skip
+        print(table.to_markdown(index=False, floatfmt=".4g"))
     text = model_text(ident, args.logs, preprocessing=prep, plausibility=plausibility,
-                      selection=sel.to_dict(), particulars=_log_particulars(logs))  # fmt: skip
+                      selection=sel.to_dict(), particulars=_log_particulars(logs),
+                      uncertainty=ensemble.to_dict() if ensemble else None)  # fmt: skip
     with OutputSet() as out:
         out.write(args.output, lambda p: p.write_text(text, encoding="utf-8"))
         if args.table:
@@ -1444,6 +1463,13 @@ def build_parser() -> argparse.ArgumentParser:
                    "(default: the first log's approach)")
     p.add_argument("--rps", type=float, help="... and this propeller speed [rps]")
     p.add_argument("--show", type=int, default=10, metavar="N", help="candidates printed (default 10)")
+    p.add_argument("--bootstrap", type=int, metavar="N",
+                   help="uncertainty of the selected model: N moving-block bootstrap refits of "
+                   "its terms at its γ (≥ 10), stored in the model file for bands and intervals")
+    p.add_argument("--block", type=float, default=10.0, metavar="S",
+                   help="with --bootstrap: block length [s] (default %(default)g)")
+    p.add_argument("--seed", type=int, default=0, help="with --bootstrap: random seed "
+                   "(default %(default)s)")
     p.add_argument("--table", metavar="OUT.csv", help="write every candidate with its scores")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("-o", "--output", required=True, metavar="MODEL.json")
