@@ -322,6 +322,37 @@ def nested_selection() -> None:
                   + " / ".join(f"{ref[s]['std']:.4f}" for s in "uvr") + " |")
 
 
+def all_logs() -> None:
+    """Each structure identified on all three real KVLCC2 zig-zags (as identify does): the
+    predictions no log here can check, the 10/10 zig-zags and the 35° turn, against the
+    predictions from the MARIN 20/20 run alone (``real_data``): how much they rest on the
+    training set."""
+    data = Path(__file__).resolve().parents[2] / "shared" / "data"
+    if not data.is_dir():
+        return
+    logs = _real_logs(data)
+    ship = kvlcc2()
+    kw = {"speed": float(logs["MARIN zz 20/20"]["u"].iloc[0]), "steering": ship.steering}
+    print("\nKVLCC2 identified on all three real zig-zags: the 10/10 zig-zags (first / second "
+          "overshoot [deg]) and the 35° turn to starboard\n")  # fmt: skip
+    print("| structure | prefilter | 10/10 starboard first | 10/10 port first | 35° advance (m) | "
+          "TD (m) | steady speed (m/s) | steady r (rad/s) |")  # fmt: skip
+    print("|---|---|---|---|---|---|---|---|")
+    for structure in REAL:
+        model, cutoff = fit_as_identify(list(logs.values()), structure)
+        cells = []
+        for c in HELD_ZIGZAGS:
+            ind = _zigzag(model, *c, **kw).indices
+            cells.append(", ".join(f"{ind.get(k) or math.nan:.1f}" for k in OVERSHOOTS))
+        tc = _turn(model, "starboard", **kw)
+        ind = {} if tc.diverged or not tc.indices else tc.indices
+        turn = [ind.get(k) for k in ("advance", "tactical_diameter", "steady_speed",
+                                     "steady_yaw_rate")]  # fmt: skip
+        print(f"| {structure} | {'none' if cutoff is None else f'{cutoff:.3g} Hz'} | "
+              + " | ".join(cells) + " | "
+              + " | ".join("diverged" if x is None else f"{x:.4g}" for x in turn) + " |")
+
+
 if __name__ == "__main__":
     warnings.simplefilter("ignore")  # envelope and plausibility warnings of the candidates
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores\n")
@@ -330,4 +361,5 @@ if __name__ == "__main__":
     real_data()
     leave_one_log_out()
     nested_selection()
+    all_logs()
     prior_effect()
