@@ -217,7 +217,9 @@ def test_cli_select_refuses_one_log(tmp_path, capsys, paper_trials):
 @needs_data
 def test_esso_selected_on_zigzags_and_random_runs_predicts_the_turns_and_a_random_run():
     """Acceptance (#9): trained on the nine shared zig-zags and three random runs, the two ±35°
-    turning circles and one random run (12_29_58) held out."""
+    turning circles and one random run (12_29_58) held out. With the single propeller's
+    asymmetry in the library the tactical diameters come within 10 % (measured +7 %, −1 %;
+    without it +13 %, +10 %) and the steady yaw rates within 15 % (+3 %, +2 %)."""
     esso = DATA / "esso-osaka"
 
     def log(path, trim):
@@ -227,7 +229,7 @@ def test_esso_selected_on_zigzags_and_random_runs_predicts_the_turns_and_a_rando
     zigzags = [log(p, True) for p in sorted((esso / "zigzag").glob("*.csv"))]
     held = esso / "random" / "random_31-Jul-2020_12_29_58.csv"
     randoms = [log(p, False) for p in sorted((esso / "random").glob("*.csv")) if p != held]
-    sel = select(zigzags + randoms, library="low-speed+wind")
+    sel = select(zigzags + randoms, library="low-speed+wind+propeller-asymmetry")
     turns = [log(p, True) for p in sorted((esso / "turning").glob("*.csv"))]
     random = log(held, False)
     results = validate(sel.model, turns + [random])
@@ -235,7 +237,7 @@ def test_esso_selected_on_zigzags_and_random_runs_predicts_the_turns_and_a_rando
         assert v.error is None and not v.simulation.diverged, v.name
     for v in results[:2]:
         meas, pred = v.indices["measured"], v.indices["simulated"]
-        assert pred["tactical_diameter"] == pytest.approx(meas["tactical_diameter"], rel=0.15)
+        assert pred["tactical_diameter"] == pytest.approx(meas["tactical_diameter"], rel=0.10)
         assert np.sign(pred["steady_yaw_rate"]) == np.sign(meas["steady_yaw_rate"])
         assert pred["steady_yaw_rate"] == pytest.approx(meas["steady_yaw_rate"], rel=0.15)
     assert results[2].metrics["r"]["std"] < 0.5 * float(np.std(random["r"]))

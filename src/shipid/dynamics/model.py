@@ -93,6 +93,14 @@ STRUCTURES: dict[str, dict[str, tuple[str, ...]]] = {
     "abkowitz3": {"u": _ABK_SURGE, "v": _ABK_LATERAL, "r": _ABK_LATERAL},
     "low-speed": {"u": _LOW_SPEED_SURGE, "v": _LOW_SPEED_LATERAL, "r": _LOW_SPEED_LATERAL},
     "wind": {"u": _WIND_SURGE, "v": _WIND_LATERAL, "r": _WIND_LATERAL},
+    # A single propeller makes the flow at the rudder asymmetric (its race swirls): a side force
+    # and moment with the propeller alone (n⁺², why a single-screw ship holds a few degrees of
+    # rudder to go straight; the Esso Osaka's rests near −6°), a rudder lift that differs to
+    # port and starboard (n⁺²|δ|), and so a drag that does too (n⁺²δ, and n⁺²|δ|³ for its growth
+    # at large angles). Added to a library (low-speed+wind+propeller-asymmetry).
+    "propeller-asymmetry": {"u": ("pos(n)^2*delta", "pos(n)^2*|delta|^3"),
+                            "v": ("pos(n)^2", "pos(n)^2*|delta|"),
+                            "r": ("pos(n)^2", "pos(n)^2*|delta|")},
     # Linear sway–yaw (Davidson–Schiff) model at the held surge speed; its yaw transfer function is
     # Nomoto's second-order model, see ``nomoto_parameters``.
     "linear-sway-yaw": {"v": ("v", "r", "delta", "1"), "r": ("v", "r", "delta", "1")},
