@@ -188,3 +188,31 @@ def test_cli_manoeuvre_says_not_bounded_when_replicates_diverge(tmp_path, capsys
     assert "(4 diverged" in out
     line = next(ln for ln in out.splitlines() if ln.startswith("tactical_diameter:"))
     assert line.endswith("[not bounded]")
+
+
+@pytest.mark.parametrize("kw", [
+    {},
+    {"form": "paper", "drop": {"u": ["r^2"]}},
+    {"model": "blanke-race+race-damping", "gamma": 1e2},
+    {"estimator": "ols", "fixed": {"u": {"delta^2": 0.0}}},
+    {"physics": "signs"},
+])  # fmt: skip
+def test_weighted_refit_is_identify_with_sample_weight_to_the_bit(noisy_zigzag, kw):
+    """The bootstrap's refits build the regression problems once (they were three quarters of
+    a refit's time); each must still be identify's model for its weights, exactly."""
+    from shipid.identification.identify import weighted_refit
+    from shipid.identification.physics import PhysicsOptions
+
+    kw = dict(kw)
+    if kw.get("physics") == "signs":
+        kw["physics"] = PhysicsOptions(signs=True)
+    refit = weighted_refit(noisy_zigzag, **kw)
+    rng = np.random.default_rng(3)
+    for weights in (None, block_weights([len(noisy_zigzag) - 1], 25, rng),
+                    rng.uniform(0, 2, len(noisy_zigzag) - 1)):  # fmt: skip
+        ours = refit(weights)
+        theirs = identify(noisy_zigzag, force=True, sample_weight=weights, **kw).model
+        assert ours.term_texts == theirs.term_texts and ours.name == theirs.name
+        np.testing.assert_array_equal(ours.theta, theirs.theta)
+    with pytest.raises(ShipidError, match="sample_weight must be"):
+        refit(np.ones(3))

@@ -374,14 +374,12 @@ def cmd_identify(args) -> int:
               f"{d['one_step_r2']:.4f}, bias b = {ident.discrete[dof]['bias']:.4g}")
     ensemble = None
     if args.bootstrap is not None:
+        from shipid.identification.identify import weighted_refit
         from shipid.identification.uncertainty import bootstrap
 
-        def refit(weights):
-            return identify(logs, model=args.model, form=args.form, gamma=gamma,
-                            drop=_parse_drop(args.drop), names=names, force=True,
-                            estimator=args.estimator, physics=physics,
-                            sample_weight=weights).model  # fmt: skip
-
+        refit = weighted_refit(logs, model=args.model, form=args.form, gamma=gamma,
+                               drop=_parse_drop(args.drop), names=names,
+                               estimator=args.estimator, physics=physics)  # fmt: skip
         ensemble = bootstrap(logs, refit, args.bootstrap, args.block, args.seed, progress=True)
         table = ensemble.coefficient_table()
         table["term"] = [_term_display(t) for t in table["term"]]
@@ -562,14 +560,12 @@ def cmd_select(args) -> int:
             "rudder_positive": logs[0].attrs.get("rudder_positive")}  # fmt: skip
     ensemble = None
     if args.bootstrap is not None:
-        from shipid.identification.identify import identify
+        from shipid.identification.identify import weighted_refit
         from shipid.identification.uncertainty import bootstrap
 
-        def refit(weights):  # the selected terms and γ, refitted as select fitted them
-            return identify(logs, model=sel.model.structure, gamma=sel.gamma, names=names,
-                            force=True, estimator=options.estimator, physics=options.physics,
-                            sample_weight=weights).model  # fmt: skip
-
+        # The selected terms and γ, refitted as select fitted them.
+        refit = weighted_refit(logs, model=sel.model.structure, gamma=sel.gamma, names=names,
+                               estimator=options.estimator, physics=options.physics)  # fmt: skip
         ensemble = bootstrap(logs, refit, args.bootstrap, args.block, args.seed,
                              progress=not args.quiet)  # fmt: skip
         table = ensemble.coefficient_table()

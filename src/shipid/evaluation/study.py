@@ -275,10 +275,12 @@ def _trial_results(trial: Trial) -> dict:
         for term, value in terms.items():
             out[f"{dof}: {term}"] = float(value)
     if trial.bootstrap and table is None:
+        from shipid.identification.identify import weighted_refit
         from shipid.identification.uncertainty import bootstrap
 
-        ens = bootstrap([train], lambda w: fit(train, w), replicates=trial.bootstrap,
-                        seed=trial.seed)  # fmt: skip
+        refit = weighted_refit(train, model=trial.structure, gamma=trial.gamma, drop=drop,
+                               estimator=equation_error)  # fmt: skip
+        ens = bootstrap([train], refit, replicates=trial.bootstrap, seed=trial.seed)
         table = ens.coefficient_table(LEVEL)
     if table is not None:
         covered, wrong_sign = [], 0

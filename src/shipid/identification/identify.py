@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -179,6 +179,113 @@ def _check_rudder_excitation(logs, structure: ModelStructure, fixed: Mapping) ->
                           "the rudder terms")
 
 
+def _prepare(logs, model, form, gamma, drop, fixed, names, estimator, physics):
+    """identify's checks and its per-equation regression problems: (logs in one rudder
+    convention, structure, fixed terms, problems by DOF, notes)."""
+    if isinstance(logs, pd.DataFrame):
+        logs = [logs]
+    if not logs:
+        raise ShipidError("no training logs given")
+    logs, convention_notes = common_rudder_convention(list(logs))
+    if form not in FORMS:
+        raise ShipidError(f"unknown form {form!r}; use one of {', '.join(FORMS)}")
+    if not (isinstance(gamma, int | float) and math.isfinite(gamma) and gamma > 0):
+        raise ShipidError(f"--gamma must be > 0, got {gamma!r}")
+    check_estimator_name(estimator)
+    if physics is not None and physics.active and form != "increment":
+        raise ShipidError("priors and constraints act on the continuous-time coefficients of "
+                          "the increment form; use --form increment")  # fmt: skip
+    try:
+        structure = get_structure(model) if isinstance(model, str) else model
+        if drop:
+            structure = structure.without(drop)
+    except ValueError as exc:
+        raise ShipidError(str(exc)) from None
+    fixed = {d: {parse_term(k).text: float(c) for k, c in v.items()}
+             for d, v in (fixed or {}).items()}  # fmt: skip
+    notes: list[str] = list(convention_notes)
+    problems = {}
+    for dof in structure.dofs:
+        p = regression_problem(logs, structure, dof, form, fixed.get(dof), names)
+        if p.X.shape[1] == 0:
+            raise ShipidError(f"{dof}: no free terms to identify")
+        notes += _check_sample_count(p, logs)
+        problems[dof] = p
+    _check_rudder_excitation(logs, structure, fixed)
+    return logs, structure, fixed, problems, notes
+
+
+def _check_weights(sample_weight, problems) -> np.ndarray | None:
+    if sample_weight is None:
+        return None
+    rows = next(iter(problems.values())).X.shape[0]
+    sample_weight = np.asarray(sample_weight, dtype=float)
+    if sample_weight.shape != (rows,) or not np.all(np.isfinite(sample_weight)) \
+            or np.any(sample_weight < 0):
+        raise ShipidError(f"sample_weight must be {rows} finite weights ≥ 0 (one per "
+                          "equation), got shape " + str(sample_weight.shape))  # fmt: skip
+    return sample_weight
+
+
+def _model_name(structure: ModelStructure, form: str) -> str:
+    return f"identified ({structure.name}, {form} form)"
+
+
+def _dof_coefficients(dof: str, p: RegressionProblem, g: np.ndarray, b: float, form: str,
+                      fixed_dof: Mapping[str, float] | None, structure: ModelStructure,
+                      ) -> tuple[tuple[str, ...], dict[str, float], float]:  # fmt: skip
+    """One equation's terms and continuous-time coefficients from the fitted Γ and b (eq. 14:
+    the paper form's Γ divided by Δk), and the constant the bias gives."""
+    c: dict[str, float] = dict(fixed_dof or {})
+    if form == "paper":
+        c.update(coefficients_from_gamma(dof, p.names, g, p.dt))
+        bias_const = b / p.dt
+    else:
+        c.update(dict(zip(p.names, g.tolist(), strict=True)))
+        bias_const = b
+    if p.has_constant:
+        c["1"] = bias_const
+    order = list(structure.terms[dof])
+    if dof in c and dof not in order:
+        order.insert(0, dof)
+    return tuple(order), {n: c.get(n, 0.0) for n in order}, bias_const
+
+
+def weighted_refit(
+    logs: Sequence[pd.DataFrame] | pd.DataFrame,
+    model: str | ModelStructure = "blanke",
+    form: str = "increment",
+    gamma: float = 1e4,
+    drop: Mapping[str, Sequence[str]] | None = None,
+    fixed: Mapping[str, Mapping[str, float]] | None = None,
+    names: Sequence[str] | None = None,
+    estimator="lssvm",
+    physics: PhysicsOptions | None = None,
+) -> Callable[[np.ndarray | None], ManoeuvringModel]:
+    """The ``fit(weights) -> model`` a bootstrap calls (``shipid.identification.uncertainty``):
+    ``identify(..., force=True, sample_weight=weights).model`` to the bit, with the checks, the
+    regression problems and the physics built once and no diagnostics per refit (they were
+    three quarters of a refit's time)."""
+    logs, structure, fixed, problems, _ = _prepare(logs, model, form, gamma, drop, fixed, names,
+                                                   estimator, physics)  # fmt: skip
+    extras = {dof: dof_physics(physics, dof, p.names, p.has_constant, p.fixed, logs)
+              for dof, p in problems.items()}  # fmt: skip
+
+    def fit(weights: np.ndarray | None) -> ManoeuvringModel:
+        weights = _check_weights(weights, problems)
+        terms, coefs = {}, {}
+        for dof, p in problems.items():
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", NumericalWarning)  # the point fit reports them
+                g, b = fit_linear(p.X, p.y, estimator, gamma, weights, physics=extras[dof])
+            terms[dof], coefs[dof], _ = _dof_coefficients(dof, p, g, b, form, fixed.get(dof),
+                                                          structure)  # fmt: skip
+        return ManoeuvringModel(ModelStructure(structure.name, terms), coefs,
+                                name=_model_name(structure, form))  # fmt: skip
+
+    return fit
+
+
 def identify(
     logs: Sequence[pd.DataFrame] | pd.DataFrame,
     model: str | ModelStructure = "blanke",
@@ -213,43 +320,9 @@ def identify(
 
     Fewer than ``MIN_EQUATIONS_PER_UNKNOWN`` equations per unknown are always refused.
     """
-    if isinstance(logs, pd.DataFrame):
-        logs = [logs]
-    if not logs:
-        raise ShipidError("no training logs given")
-    logs, convention_notes = common_rudder_convention(list(logs))
-    if form not in FORMS:
-        raise ShipidError(f"unknown form {form!r}; use one of {', '.join(FORMS)}")
-    if not (isinstance(gamma, int | float) and math.isfinite(gamma) and gamma > 0):
-        raise ShipidError(f"--gamma must be > 0, got {gamma!r}")
-    check_estimator_name(estimator)
-    if physics is not None and physics.active and form != "increment":
-        raise ShipidError("priors and constraints act on the continuous-time coefficients of "
-                          "the increment form; use --form increment")  # fmt: skip
-    try:
-        structure = get_structure(model) if isinstance(model, str) else model
-        if drop:
-            structure = structure.without(drop)
-    except ValueError as exc:
-        raise ShipidError(str(exc)) from None
-    fixed = {d: {parse_term(k).text: float(c) for k, c in v.items()}
-             for d, v in (fixed or {}).items()}  # fmt: skip
-    notes: list[str] = list(convention_notes)
-    problems = {}
-    for dof in structure.dofs:
-        p = regression_problem(logs, structure, dof, form, fixed.get(dof), names)
-        if p.X.shape[1] == 0:
-            raise ShipidError(f"{dof}: no free terms to identify")
-        notes += _check_sample_count(p, logs)
-        problems[dof] = p
-    _check_rudder_excitation(logs, structure, fixed)
-    if sample_weight is not None:
-        rows = next(iter(problems.values())).X.shape[0]
-        sample_weight = np.asarray(sample_weight, dtype=float)
-        if sample_weight.shape != (rows,) or not np.all(np.isfinite(sample_weight)) \
-                or np.any(sample_weight < 0):
-            raise ShipidError(f"sample_weight must be {rows} finite weights ≥ 0 (one per "
-                              "equation), got shape " + str(sample_weight.shape))  # fmt: skip
+    logs, structure, fixed, problems, notes = _prepare(logs, model, form, gamma, drop, fixed,
+                                                       names, estimator, physics)  # fmt: skip
+    sample_weight = _check_weights(sample_weight, problems)
     coefs: dict[str, dict[str, float]] = {}
     terms: dict[str, tuple[str, ...]] = {}
     discrete: dict[str, dict] = {}
@@ -281,29 +354,17 @@ def identify(
             notes.append(message + " (kept: --force)")
         notes += dof_notes + [f"{dof}: {w.message}" for w in caught
                               if issubclass(w.category, NumericalWarning)]  # fmt: skip
-        c: dict[str, float] = dict(fixed.get(dof, {}))
-        if form == "paper":
-            c.update(coefficients_from_gamma(dof, p.names, g, p.dt))
-            bias_const = b / p.dt
-        else:
-            c.update(dict(zip(p.names, g.tolist(), strict=True)))
-            bias_const = b
-        if p.has_constant:
-            c["1"] = bias_const
-        elif abs(bias_const) > 0:
+        terms[dof], coefs[dof], bias_const = _dof_coefficients(dof, p, g, b, form,
+                                                               fixed.get(dof), structure)
+        if not p.has_constant and abs(bias_const) > 0:
             notes.append(f"{dof}: the model has no constant term; the LS-SVM bias "
                          f"b = {b:.4g} is reported but not part of the model")
-        order = list(structure.terms[dof])
-        if dof in c and dof not in order:
-            order.insert(0, dof)
-        terms[dof] = tuple(order)
-        coefs[dof] = {n: c.get(n, 0.0) for n in order}
         # Γ as fitted; the constant regressor's weight is Σα = 0, the bias b carries it (eq. 5).
         const = ["1"] if p.has_constant else []
         discrete[dof] = {"names": list(p.names) + const, "gamma": g.tolist() + [0.0] * len(const),
                          "bias": b}  # fmt: skip
     model = ManoeuvringModel(ModelStructure(structure.name, terms), coefs,
-                             name=f"identified ({structure.name}, {form} form)")  # fmt: skip
+                             name=_model_name(structure, form))  # fmt: skip
     return Identification(model, form, float(gamma), dt, discrete, diagnostics, notes,
                           envelope(logs), estimator if isinstance(estimator, str)
                           else type(estimator).__name__,
