@@ -32,8 +32,9 @@ held_out = "random_31-Jul-2020_12_29_58.csv"
 training = zigzags + [log for name, log in randoms.items() if name != held_out]
 print(f"{len(training)} training logs, {len(turns)} turns and {held_out} held out")
 
-# 2. Choose the terms and γ by leave-one-log-out free-run error (the held-out logs are not seen).
-selection = shipid.select(training, library="low-speed+wind")
+# 2. Choose the terms and γ by leave-one-log-out free-run error (the held-out logs are not seen)
+#    from the low-speed, wind and single-propeller asymmetry terms (see the README).
+selection = shipid.select(training, library="low-speed+wind+propeller-asymmetry")
 print(f"selected {selection.candidates.loc[selection.candidates['chosen'], 'n_terms'].item()} "
       f"terms, γ = {selection.gamma:g}, CV score {selection.score:.3f}")
 print(selection.model.equations())
