@@ -3,6 +3,7 @@
 import runpy
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -11,9 +12,23 @@ DATA = ROOT.parent / "shared" / "data"
 
 @pytest.mark.skipif(not DATA.is_dir(), reason="../shared/data is not present")
 def test_tutorial_runs_to_the_imo_table(capsys):
+    """The tutorial is the README's Esso recipe through the API, so its numbers are the
+    acceptance of #9 and #10: trained on the nine zig-zags and three random runs, the two ±35°
+    turning circles and one random run (12_29_58) held out. With the single propeller's
+    asymmetry in the library the tactical diameters come within 10 % (measured +7 %, −1 %;
+    without it +13 %, +10 %), the steady yaw rates within 15 % (+3 %, +2 %) and the random
+    run's r error under half its spread (0.42)."""
     ns = runpy.run_path(str(ROOT / "docs" / "tutorial.py"), run_name="__main__")
     out = capsys.readouterr().out
     assert "stopping track reach" in out and "tactical diameter" in out
     crit = ns["criteria"]
     assert len(crit.table) == 13 and crit.conditions["scale"] == 108.3
-    assert ns["results"][-1].metrics["r"]["std"] < 0.5 * ns["r_spread"]
+    results = ns["results"]
+    for v in results:
+        assert v.error is None and not v.simulation.diverged, v.name
+    for v in results[:2]:
+        meas, pred = v.indices["measured"], v.indices["simulated"]
+        assert pred["tactical_diameter"] == pytest.approx(meas["tactical_diameter"], rel=0.10)
+        assert np.sign(pred["steady_yaw_rate"]) == np.sign(meas["steady_yaw_rate"])
+        assert pred["steady_yaw_rate"] == pytest.approx(meas["steady_yaw_rate"], rel=0.15)
+    assert results[-1].metrics["r"]["std"] < 0.5 * ns["r_spread"]
