@@ -33,6 +33,8 @@ _EXPORTS = {
     "pull_out": "shipid.trials.manoeuvres",
     "manoeuvre_indices": "shipid.trials.indices",
     "identify": "shipid.identification.identify",
+    "weighted_refit": "shipid.identification.identify",
+    "common_rudder_convention": "shipid.data.log",
     "select": "shipid.identification.select",
     "imo_criteria": "shipid.trials.criteria",
     "Particulars": "shipid.data.particulars",
