@@ -993,9 +993,10 @@ def cmd_validate(args) -> int:
             names.append(str(p))
         except ShipidError as exc:
             failed.append(str(exc))
-    logs, notes = common_rudder_convention(logs, cond["rudder_positive"])
-    for note in notes:
-        _warn(note)
+    if cond["rudder_positive"]:  # a file that does not say its convention: no guess
+        logs, notes = common_rudder_convention(logs, cond["rudder_positive"])
+        for note in notes:
+            _warn(note)
     from tqdm.auto import tqdm
 
     vals = [validate(model, log, [name], method=args.method, kind=args.kind,
