@@ -31,6 +31,8 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/study_uncertainty.py
 	$(BIN)/python benchmarks/study_structure.py
 	$(BIN)/python benchmarks/bench_study.py
+	$(BIN)/python benchmarks/bench_figures.py
+	$(BIN)/python benchmarks/study_esso.py
 
 clean:
 	rm -rf $(VENV) shipid-demo build *.egg-info src/*.egg-info

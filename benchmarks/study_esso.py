@@ -1,7 +1,9 @@
 """The Esso Osaka's unseen manoeuvres (issue #10, the principal push): ``select`` on the nine
 zig-zags and three of the four random runs, judged on the two ±35° turning circles and the
 random run left out, each random run left out in turn; for the README's library and with the
-single propeller's asymmetry added (``propeller-asymmetry``).
+single propeller's asymmetry added (``propeller-asymmetry``). For the README's fold (random run
+12_29_58 held out), the turns' 95 % intervals over a 100-replicate bootstrap of the selected
+model, as ``select --bootstrap 100`` and ``validate`` give them.
 
 Run: .venv/bin/python benchmarks/study_esso.py
 """
@@ -17,9 +19,27 @@ import numpy as np
 
 from shipid.data.io import read_log
 from shipid.evaluation.validate import validate
+from shipid.identification.identify import weighted_refit
 from shipid.identification.select import select
+from shipid.identification.uncertainty import bootstrap
+from shipid.trials.trial import describe_trial
 
 LIBRARIES = ("low-speed+wind", "low-speed+wind+propeller-asymmetry")
+README_FOLD = "random_31-Jul-2020_12_29_58.csv"
+TURN_KEYS = ("tactical_diameter", "steady_yaw_rate", "advance")
+
+
+def _error(v, key: str) -> float:
+    meas, pred = v.indices["measured"], v.indices["simulated"]
+    return 100 * (pred[key] / meas[key] - 1)
+
+
+def _early_yaw_ratio(v, log, after_s: float = 10.0) -> float:
+    """Measured over simulated yaw rate ``after_s`` after the rudder execute: how much faster
+    the ship answers the rudder than the model."""
+    t = log["t"].to_numpy()
+    i = int(np.searchsorted(t, describe_trial(log, "turning").execute_time + after_s))
+    return float(log["r"].iloc[i] / v.simulation.log["r"].iloc[i])
 
 
 def main() -> None:
@@ -36,44 +56,65 @@ def main() -> None:
     randoms = {p.name: log(p, False) for p in sorted((esso / "random").glob("*.csv"))}
     turns = [log(p, True) for p in sorted((esso / "turning").glob("*.csv"))]
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores\n")
-    print("Held out: the ±35° turns (errors of the tactical diameter and the steady yaw rate) "
-          "and one random run (free-run r error std over the run's r spread); select on the "
-          "nine zig-zags and the other three random runs\n")  # fmt: skip
+    print("Held out: the ±35° turns (errors of the tactical diameter, steady yaw rate and "
+          "advance) and one random run (free-run r and u error std over the run's spread); "
+          "select on the nine zig-zags and the other three random runs\n")  # fmt: skip
     print("| library | held-out random run | terms | TD +35°, −35° | steady r +35°, −35° | "
-          "random run: r error / spread | u error / spread |")  # fmt: skip
-    print("|---|---|---|---|---|---|---|")
+          "advance +35°, −35° | random run: r error / spread | u error / spread |")  # fmt: skip
+    print("|---|---|---|---|---|---|---|---|")
     t0 = time.perf_counter()
-    summary = {}
+    summary, readme = {}, {}
     for library in LIBRARIES:
         rows = []
         for held, random in randoms.items():
             train = zigzags + [x for k, x in randoms.items() if k != held]
             sel = select(train, library=library, cv="logo")
             results = validate(sel.model, turns + [random])
-            td, yr = [], []
-            for v in results[:2]:
-                meas, pred = v.indices["measured"], v.indices["simulated"]
-                td.append(100 * (pred["tactical_diameter"] / meas["tactical_diameter"] - 1))
-                yr.append(100 * (pred["steady_yaw_rate"] / meas["steady_yaw_rate"] - 1))
+            errors = {k: [_error(v, k) for v in results[:2]] for k in TURN_KEYS}
             m = results[2].metrics
             r_ratio = m["r"]["std"] / float(np.std(random["r"]))
             u_ratio = m["u"]["std"] / float(np.std(random["u"]))
-            rows.append((td, yr, r_ratio, u_ratio))
+            early = [_early_yaw_ratio(v, lg) for v, lg in zip(results[:2], turns, strict=True)]
+            rows.append((errors, r_ratio, u_ratio, early))
             n_terms = sum(len(t) for t in sel.model.structure.terms.values())
             print(f"| {library} | {held[7:-4]} | {n_terms} | "
-                  + ", ".join(f"{x:+.0f} %" for x in td) + " | "
-                  + ", ".join(f"{x:+.0f} %" for x in yr)
+                  + " | ".join(", ".join(f"{x:+.0f} %" for x in errors[k]) for k in TURN_KEYS)
                   + f" | {r_ratio:.2f} | {u_ratio:.2f} |")  # fmt: skip
+            if held == README_FOLD:
+                readme[library] = (train, sel, results)
         summary[library] = rows
-    print("\nMean over the four folds: |TD error|, |steady r error|, r error / spread, "
-          "u error / spread\n")  # fmt: skip
-    print("| library | TD | steady r | r / spread | u / spread |")
-    print("|---|---|---|---|---|")
+    print("\nMean over the four folds: |TD error|, |steady r error|, advance error of each turn, "
+          "r and u error / spread, and the measured yaw rate 10 s after the execute over the "
+          "model's (each turn)\n")  # fmt: skip
+    print("| library | TD | steady r | advance +35°, −35° | r / spread | u / spread | "
+          "yaw rate at 10 s, measured / model, +35°, −35° |")  # fmt: skip
+    print("|---|---|---|---|---|---|---|")
     for library, rows in summary.items():
-        td = np.mean([abs(x) for r in rows for x in r[0]])
-        yr = np.mean([abs(x) for r in rows for x in r[1]])
-        print(f"| {library} | {td:.1f} % | {yr:.1f} % | {np.mean([r[2] for r in rows]):.2f} | "
-              f"{np.mean([r[3] for r in rows]):.2f} |")
+        td = np.mean([abs(x) for r in rows for x in r[0]["tactical_diameter"]])
+        yr = np.mean([abs(x) for r in rows for x in r[0]["steady_yaw_rate"]])
+        adv = [[r[0]["advance"][i] for r in rows] for i in range(2)]
+        early = [[r[3][i] for r in rows] for i in range(2)]
+        print(f"| {library} | {td:.1f} % | {yr:.1f} % | "
+              + ", ".join(f"{min(a):+.0f}…{max(a):+.0f} %" for a in adv)
+              + f" | {np.mean([r[1] for r in rows]):.2f} | {np.mean([r[2] for r in rows]):.2f} | "
+              + ", ".join(f"{min(e):.2f}…{max(e):.2f}" for e in early) + " |")  # fmt: skip
+    print(f"\nThe README's fold ({README_FOLD[7:-4]} held out): the turns' indices with the 95 % "
+          "intervals of a 100-replicate bootstrap of the selected model (select --bootstrap "
+          "100, then validate)\n")  # fmt: skip
+    print("| library | turn | tactical diameter: measured, predicted [95 %] | steady yaw rate: "
+          "measured, predicted [95 %] |")  # fmt: skip
+    print("|---|---|---|---|")
+    for library, (train, sel, results) in readme.items():
+        refit = weighted_refit(train, model=sel.model.structure, gamma=sel.gamma)
+        ens = bootstrap(train, refit, replicates=100)
+        for v, turn, side in zip(results[:2], turns, ("+35°", "−35°"), strict=True):
+            again = validate(sel.model, [turn], ensemble=ens)[0]
+            cells = []
+            for key, fmt in (("tactical_diameter", ".2f"), ("steady_yaw_rate", ".4f")):
+                lo, hi = again.intervals["simulated"][key]
+                cells.append(f"{v.indices['measured'][key]:{fmt}}, "
+                             f"{v.indices['simulated'][key]:{fmt}} [{lo:{fmt}}, {hi:{fmt}}]")
+            print(f"| {library} | {side} | " + " | ".join(cells) + " |")
     print(f"\n{time.perf_counter() - t0:.0f} s")
 
 

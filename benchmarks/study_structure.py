@@ -202,13 +202,18 @@ def real_data() -> None:
     print("|---|---|---|")
     print("| MMG model | " + " | ".join(f"{truth[c][OVERSHOOTS[0]]:.1f}, {truth[c][OVERSHOOTS[1]]:.1f}"
                                      for c in HELD_ZIGZAGS) + " |")  # fmt: skip
-    kw = {"speed": float(train["u"].iloc[0]), "steering": ship.steering}
+    from shipid.dynamics.steering import SteeringMachine
+
     for structure, model in chosen_models.items():
-        cells = []
-        for c in HELD_ZIGZAGS:
-            ind = _zigzag(model, *c, **kw).indices
-            cells.append(", ".join(f"{ind.get(k) or math.nan:.1f}" for k in OVERSHOOTS))
-        print(f"| {structure} | " + " | ".join(cells) + " |")
+        # The KVLCC2's gear, and a rudder that moves at once (what `manoeuvre` gave model
+        # files before it used their training rudder rate).
+        for label, gear in (("", ship.steering), (", instantaneous rudder", SteeringMachine())):
+            kw = {"speed": float(train["u"].iloc[0]), "steering": gear}
+            cells = []
+            for c in HELD_ZIGZAGS:
+                ind = _zigzag(model, *c, **kw).indices
+                cells.append(", ".join(f"{ind.get(k) or math.nan:.1f}" for k in OVERSHOOTS))
+            print(f"| {structure}{label} | " + " | ".join(cells) + " |")
 
 
 def prior_effect(seeds: int = 3, noise: float = 1.0) -> None:

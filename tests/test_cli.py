@@ -411,3 +411,23 @@ def test_logs_in_the_other_rudder_convention_are_converted_not_mirrored(tmp_path
         assert results["other"][state] == pytest.approx(results["same"][state], rel=1e-9)
     code, out, err = run(["simulate", model, other, "-o", tmp_path / "sim.csv"], capsys)
     assert code == 0 and "negated" in err
+
+
+def test_manoeuvre_and_criteria_choose_the_rudder_rate_one_way(tmp_path, capsys):
+    """One choice of steering gear for manoeuvre and criteria (they had two): a reference
+    ship's own gear, or its gear at --rudder-rate; the rate used is the one recorded."""
+    import math
+
+    from shipid.vessels import kvlcc2
+
+    own = math.degrees(kvlcc2().steering.max_rate)
+    code, out, err = run(["manoeuvre", "kvlcc2", "turning", "--duration", "30", "--json",
+                          tmp_path / "m.json"], capsys)  # fmt: skip
+    assert code == 0, err
+    assert json.loads((tmp_path / "m.json").read_text())["rudder_rate_deg_s"] == \
+        pytest.approx(own)  # fmt: skip
+    code, out, err = run(["criteria", "kvlcc2", "--rudder-rate", "5", "--json",
+                          tmp_path / "c.json"], capsys)  # fmt: skip
+    assert code == 0, err
+    rec = json.loads((tmp_path / "c.json").read_text())
+    assert rec["conditions"]["rudder_rate_deg_s"] == pytest.approx(5.0)

@@ -198,7 +198,7 @@ def test_cli_manoeuvre_says_not_bounded_when_replicates_diverge(tmp_path, capsys
     {"physics": "signs"},
 ])  # fmt: skip
 def test_weighted_refit_is_identify_with_sample_weight_to_the_bit(noisy_zigzag, kw):
-    """The bootstrap's refits build the regression problems once (they were three quarters of
+    """The bootstrap's refits build the regression problems once (rebuilding them was most of
     a refit's time); each must still be identify's model for its weights, exactly."""
     from shipid.identification.identify import weighted_refit
     from shipid.identification.physics import PhysicsOptions

@@ -753,10 +753,8 @@ def _cores() -> int:
 
 def cmd_criteria(args) -> int:
     """``shipid criteria``: the IMO MSC.137(76) criteria of a model or vessel."""
-    import math
 
     from shipid.data.particulars import read_particulars
-    from shipid.dynamics.steering import SteeringMachine
     from shipid.outputs import OutputSet, check_outputs
     from shipid.trials.criteria import imo_criteria
 
@@ -766,10 +764,8 @@ def cmd_criteria(args) -> int:
     particulars = read_particulars(args.particulars) if args.particulars else cond["particulars"]
     speed = args.speed or cond["speed"]
     rps = args.rps or cond["rps"]
-    steering = None
-    rate = math.radians(args.rudder_rate) if args.rudder_rate is not None else cond["rudder_rate"]
-    if rate:  # given, else the rate of the training logs' rudder
-        steering = SteeringMachine(math.radians(35.0), rate)
+    # Given, else the ship's gear or the training logs' rate, else imo_criteria's SOLAS rate.
+    steering, _ = _steering(target, cond, args.rudder_rate, fallback="caller")
     run = partial(imo_criteria, particulars=particulars, length=args.length, speed=speed,
                   scale=args.scale, rps=rps, steering=steering, astern_rps=args.astern_rps,
                   dt=args.dt)  # fmt: skip
@@ -810,7 +806,7 @@ def _controlled(args):
     truth = get_vessel(args.truth) if args.truth else None
     if truth is not None and args.truth not in VESSEL_NAMES:
         raise ShipidError(f"--truth must be a reference ship ({', '.join(VESSEL_NAMES)})")
-    steering, note = _manoeuvre_steering(target, cond, args.rudder_rate)
+    steering, note = _steering(target, cond, args.rudder_rate)
     print(f"{args.model}: {note}")
     return target, truth, speed, rps, steering
 
@@ -1186,10 +1182,12 @@ def cmd_simulate(args) -> int:
     return 0
 
 
-def _manoeuvre_steering(target, cond: dict, rate_deg_s: float | None):
-    """The steering machine of a manoeuvre and a line saying which: ``--rudder-rate``, else a
-    reference ship's own gear, else the rate of the model's training logs (overshoots depend on
-    it as much as on the model), else an instantaneous rudder, said so."""
+def _steering(target, cond: dict, rate_deg_s: float | None, fallback: str = "instantaneous"):
+    """The steering machine of a run and a line saying which: ``--rudder-rate`` (a reference
+    ship keeps its gear's other limits), else a reference ship's own gear (None: the ship's),
+    else the rate of the model's training logs (overshoots depend on it as much as on the
+    model), else ``fallback``: an instantaneous rudder, said so, or 'caller' (None: the caller
+    chooses, as the IMO criteria take the SOLAS rate)."""
     import dataclasses
 
     from shipid.dynamics.steering import SteeringMachine
@@ -1203,12 +1201,13 @@ def _manoeuvre_steering(target, cond: dict, rate_deg_s: float | None):
             f", {math.degrees(rate):.3g} °/s" if rate else ", instantaneous"))
     elif cond.get("rudder_rate"):
         rate, source = float(cond["rudder_rate"]), "the training logs' rudder rate"
+    elif fallback == "caller":
+        return None, None
     else:
         return SteeringMachine(), ("rudder: instantaneous (the model file has no training rudder "
                                    "rate; give one with --rudder-rate DEG/S)")  # fmt: skip
-    max_angle = own.max_angle if own is not None else math.radians(35.0)
-    steering = SteeringMachine(max_angle, rate) if own is None else dataclasses.replace(
-        own, max_rate=rate)  # fmt: skip
+    steering = (SteeringMachine(math.radians(35.0), rate) if own is None
+                else dataclasses.replace(own, max_rate=rate))  # fmt: skip
     return steering, f"rudder rate {math.degrees(rate):.3g} °/s ({source})"
 
 
@@ -1223,7 +1222,7 @@ def cmd_manoeuvre(args) -> int:
     target, cond = _ship_or_model(args.model)
     speed = args.speed if args.speed is not None else cond["speed"]
     rps = args.rps if args.rps is not None else cond["rps"]
-    steering, rudder_note = _manoeuvre_steering(target, cond, args.rudder_rate)
+    steering, rudder_note = _steering(target, cond, args.rudder_rate)
     kw = {"dt": args.step, "speed": speed, "rps": rps, "steering": steering}
     if args.wind_speed is not None:
         kw["wind"] = (args.wind_speed, math.radians(args.wind_from or 0.0))
@@ -1253,6 +1252,7 @@ def cmd_manoeuvre(args) -> int:
         run = partial(stopping, rps=rps, astern_rps=args.astern_rps, **kw)
     res = run(target)
     print(rudder_note)
+    gear = steering or getattr(target, "steering", None)  # the one the run used
     intervals = {}
     ensemble = cond.get("ensemble")
     if ensemble is not None and not args.no_bands and args.kind != "spiral":
@@ -1293,8 +1293,8 @@ def cmd_manoeuvre(args) -> int:
             doc = {"manoeuvre": res.log.attrs.get("manoeuvre"), "diverged": res.diverged,
                    "diverged_at": res.diverged_at, "reason": res.reason,
                    "indices": res.indices, "index_intervals": intervals or None,
-                   "rudder_rate_deg_s": (math.degrees(steering.max_rate) if steering
-                                         and steering.max_rate else None),
+                   "rudder_rate_deg_s": (math.degrees(gear.max_rate) if gear and gear.max_rate
+                                         else None),
                    "warnings": notes}  # fmt: skip
             out.write(args.json, lambda p: p.write_text(_json_text(doc), "utf-8"))
         if args.output:

@@ -41,16 +41,16 @@ def clear_stop() -> None:
     _stop.clear()
 
 
-def check_stop() -> None:
-    """Raise ``Interrupted`` if an interrupt was recorded."""
-    if _stop.is_set():
-        raise Interrupted()
-
-
 def stop_requested() -> bool:
     """Whether an interrupt was recorded: an error raised after it (e.g. numba's "no compiled
     object yet" once the interrupt broke its compile) is the interrupt's doing, not a bug."""
     return _stop.is_set()
+
+
+def check_stop() -> None:
+    """Raise ``Interrupted`` if an interrupt was recorded."""
+    if stop_requested():
+        raise Interrupted()
 
 
 LOG_EXTENSIONS = (".csv", ".parquet", ".pq")

@@ -264,8 +264,8 @@ def weighted_refit(
 ) -> Callable[[np.ndarray | None], ManoeuvringModel]:
     """The ``fit(weights) -> model`` a bootstrap calls (``shipid.identification.uncertainty``):
     ``identify(..., force=True, sample_weight=weights).model`` to the bit, with the checks, the
-    regression problems and the physics built once and no diagnostics per refit (they were
-    three quarters of a refit's time)."""
+    regression problems and the physics built once (rebuilding the problems from the logs'
+    columns was most of a refit's time) and no diagnostics per refit."""
     logs, structure, fixed, problems, _ = _prepare(logs, model, form, gamma, drop, fixed, names,
                                                    estimator, physics)  # fmt: skip
     extras = {dof: dof_physics(physics, dof, p.names, p.has_constant, p.fixed, logs)

@@ -466,7 +466,7 @@ def cross_validate(
 def _setup(logs, names, options: SelectOptions):
     if isinstance(logs, pd.DataFrame):
         logs = [logs]
-    logs, _ = common_rudder_convention(list(logs))  # select() reports the conversions
+    logs, _ = common_rudder_convention(list(logs))  # select() converts first, with notes
     names = list(names or [log.attrs.get("name", f"log {i}") for i, log in enumerate(logs)])
     kind, k = _parse_cv(options.cv)
     if kind == "blocks":
@@ -502,7 +502,8 @@ def select(
     from shipid.identification.plausibility import check_plausibility, disqualifying
 
     options = dataclasses.replace(options or SelectOptions(), **overrides)
-    _, notes = common_rudder_convention([logs] if isinstance(logs, pd.DataFrame) else list(logs))
+    # Converted once here, for the notes; _setup's own pass then finds one convention.
+    logs, notes = common_rudder_convention([logs] if isinstance(logs, pd.DataFrame) else list(logs))
     logs, names, data, folds, scorer = _setup(logs, names, options)
     library = data.library
     speed = options.speed if options.speed is not None else approach(logs[0], "u")
