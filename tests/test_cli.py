@@ -431,3 +431,33 @@ def test_manoeuvre_and_criteria_choose_the_rudder_rate_one_way(tmp_path, capsys)
     assert code == 0, err
     rec = json.loads((tmp_path / "c.json").read_text())
     assert rec["conditions"]["rudder_rate_deg_s"] == pytest.approx(5.0)
+
+
+@pytest.mark.parametrize("kind", ["zigzag", "turning", "pull-out", "spiral"])
+def test_every_manoeuvre_runs_on_a_model_file(files, tmp_path, capsys, kind):
+    """``manoeuvre MODEL.json spiral`` stopped with an internal error: the spiral took no
+    steering machine, which every model file now passes. Each kind runs on a model file, and
+    the spiral's r(δ) table is the API's with the training logs' gear."""
+    import math
+
+    from shipid.dynamics.steering import SteeringMachine
+    from shipid.reporting.modelfile import load_document, model_from_document
+    from shipid.trials.manoeuvres import spiral
+
+    _, model_path = files
+    code, _, err = run(["manoeuvre", model_path, kind, "--duration", "40", "--json",
+                        tmp_path / "out.json"], capsys)  # fmt: skip
+    assert code == 0, err
+    assert "internal error" not in err
+    doc = json.loads((tmp_path / "out.json").read_text())
+    assert not doc["diverged"] and doc["indices"]
+    if kind == "spiral":
+        model_doc = load_document(model_path)
+        prep = model_doc["identification"]["preprocessing"]
+        gear = SteeringMachine(math.radians(35.0), prep["rudder_rate"])
+        api = spiral(model_from_document(model_doc, model_path), hold=40.0,
+                     speed=prep["approach_speed"], steering=gear, dt=0.05)  # fmt: skip
+        got = [row["steady_yaw_rate"] for row in doc["indices"]["table"]]
+        want = [row["steady_yaw_rate"] for row in api.indices["table"]]
+        assert got == pytest.approx(want, abs=1e-12)
+        assert doc["rudder_rate_deg_s"] == pytest.approx(math.degrees(prep["rudder_rate"]))

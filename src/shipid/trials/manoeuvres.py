@@ -398,13 +398,14 @@ def spiral(
     speed: float | None = None,
     method: str = "rk4",
     rps: float | None = None,
+    steering: SteeringMachine | None = None,
 ) -> ManoeuvreResult:
     """Dieudonné spiral: each rudder angle (positive = to starboard, in degrees) held ``hold`` s
     from the state the previous one left; the steady yaw rate of each (mean over the last fifth)
     traces r(δ). A straight-line unstable ship shows a loop: at the same small rudder, a
     different steady rate coming from each side. Indices: the r(δ) table, ``loop`` (whether any
     rudder angle gave steady turns both ways) and ``loop_rudders_deg`` (those angles)."""
-    vessel = as_vessel(ship, speed, None, rps)
+    vessel = as_vessel(ship, speed, steering, rps)
     angles = [float(a) for a in rudders_deg]
     if not angles or any(not math.isfinite(a) or abs(math.radians(a)) > vessel.steering.max_angle
                          for a in angles):  # fmt: skip
