@@ -23,6 +23,11 @@ def test_tutorial_runs_to_the_imo_table(capsys):
     assert "stopping track reach" in out and "tactical diameter" in out
     crit = ns["criteria"]
     assert len(crit.table) == 13 and crit.conditions["scale"] == 108.3
+    # From a steady approach: the model holds the criteria's speed at their rps.
+    model, app = ns["selection"].model, ns["approach"]
+    udot = model.accelerations([app.speed], [0.0], [0.0], [0.0], None, [app.rps],
+                               wind_speed=[app.speed], wind_angle=[0.0])[0, 0]  # fmt: skip
+    assert abs(udot) * 10 < 1e-3 * app.speed and crit.conditions["speed"] == app.speed
     results = ns["results"]
     for v in results:
         assert v.error is None and not v.simulation.diverged, v.name

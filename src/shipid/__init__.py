@@ -51,6 +51,7 @@ _EXPORTS = {
     "Ensemble": "shipid.identification.uncertainty",
     "choose_prefilter": "shipid.identification.prefilter",
     "check_plausibility": "shipid.identification.plausibility",
+    "steady_approach": "shipid.dynamics.equilibrium",
     "validate": "shipid.evaluation.validate",
     "load_model": "shipid.reporting.modelfile",
     "save_model": "shipid.reporting.modelfile",

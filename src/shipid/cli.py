@@ -762,8 +762,7 @@ def cmd_criteria(args) -> int:
                   [args.model] if Path(args.model).exists() else [])  # fmt: skip
     target, cond = _ship_or_model(args.model)
     particulars = read_particulars(args.particulars) if args.particulars else cond["particulars"]
-    speed = args.speed or cond["speed"]
-    rps = args.rps or cond["rps"]
+    speed, rps, unsteady = _run_approach(target, cond, args.speed, args.rps)
     # Given, else the ship's gear or the training logs' rate, else imo_criteria's SOLAS rate.
     steering, _ = _steering(target, cond, args.rudder_rate, fallback="caller")
     run = partial(imo_criteria, particulars=particulars, length=args.length, speed=speed,
@@ -788,7 +787,7 @@ def cmd_criteria(args) -> int:
         print(f"lower, upper: 95 % interval of the value and pass_share: the share of passes "
               f"over the model's {ensemble.replicates} {ensemble.members_label}")
     print("all criteria met" if crit.passed else "NOT all criteria met")
-    for n in crit.notes:
+    for n in ([unsteady] if unsteady else []) + crit.notes:
         _warn(n)
     with OutputSet() as out:
         if args.json:
@@ -801,8 +800,10 @@ def _controlled(args):
     from shipid.vessels import get_vessel
 
     target, cond = _ship_or_model(args.model)
-    speed = args.speed or cond["speed"] or getattr(target, "approach_speed", None)
-    rps = args.rps or cond["rps"]
+    speed, rps, unsteady = _run_approach(target, cond, args.speed, args.rps)
+    if unsteady:
+        _warn(unsteady)
+    speed = speed or getattr(target, "approach_speed", None)
     truth = get_vessel(args.truth) if args.truth else None
     if truth is not None and args.truth not in VESSEL_NAMES:
         raise ShipidError(f"--truth must be a reference ship ({', '.join(VESSEL_NAMES)})")
@@ -824,10 +825,13 @@ def cmd_linearise(args) -> int:
     from shipid.control.linear import nomoto
 
     target, cond = _ship_or_model(args.model)
-    speed = args.speed or cond["speed"] or getattr(target, "approach_speed", None)
+    speed, rps, unsteady = _run_approach(target, cond, args.speed, args.rps)
+    speed = speed or getattr(target, "approach_speed", None)
     if not speed:
         raise ShipidError("give the speed to linearise at (--speed)")
-    nm = nomoto(target, speed, args.rps or cond["rps"])
+    if unsteady:
+        _warn(unsteady)
+    nm = nomoto(target, speed, rps)
     pd = _pd()
     print(f"Linearised about straight running at u = {speed:.4g} m/s (states u, v, r; input δ):")
     print("A =")
@@ -1157,6 +1161,22 @@ def _ship_or_model(name: str):
     return model, cond
 
 
+def _run_approach(target, cond: dict, speed: float | None, rps: float | None):
+    """Approach speed and rps of a run on ``target``: a reference ship's own trim, or a model's
+    steady straight approach (``shipid.dynamics.equilibrium.steady_approach``), printed, with a
+    warning when it is not steady. Returns (speed, rps, warning or None)."""
+    from shipid.dynamics.equilibrium import steady_approach
+    from shipid.dynamics.model import ManoeuvringModel
+
+    if not isinstance(target, ManoeuvringModel):
+        return speed, rps, None
+    if speed is None and not cond["speed"]:
+        return None, rps if rps is not None else cond["rps"], None  # the run names what is missing
+    app = steady_approach(target, cond["speed"], cond["rps"], speed, rps)
+    print(app.describe())
+    return app.speed, app.rps, app.warning
+
+
 def cmd_simulate(args) -> int:
     """``shipid simulate``: drive a model or vessel with a log's inputs."""
     from shipid.data.io import read_log, write_log
@@ -1220,8 +1240,7 @@ def cmd_manoeuvre(args) -> int:
     check_outputs({"--json": (args.json, "json"), "-o": (args.output, "log")},
                   [args.model] if Path(args.model).exists() else [])  # fmt: skip
     target, cond = _ship_or_model(args.model)
-    speed = args.speed if args.speed is not None else cond["speed"]
-    rps = args.rps if args.rps is not None else cond["rps"]
+    speed, rps, unsteady = _run_approach(target, cond, args.speed, args.rps)
     steering, rudder_note = _steering(target, cond, args.rudder_rate)
     kw = {"dt": args.step, "speed": speed, "rps": rps, "steering": steering}
     if args.wind_speed is not None:
@@ -1267,7 +1286,7 @@ def cmd_manoeuvre(args) -> int:
                  "them diverged or lack it)" if diverged else "") + ":")
     if res.diverged:
         print(res.reason, file=sys.stderr)
-    notes = outside_envelope(cond["envelope"], res.log)
+    notes = ([unsteady] if unsteady else []) + outside_envelope(cond["envelope"], res.log)
     if args.kind == "turning" and not res.diverged:
         notes += implausible_indices(res.indices, speed or getattr(target, "approach_speed", None),
                                      getattr(target, "length", None))  # fmt: skip
@@ -1291,6 +1310,7 @@ def cmd_manoeuvre(args) -> int:
     with OutputSet() as out:
         if args.json:
             doc = {"manoeuvre": res.log.attrs.get("manoeuvre"), "diverged": res.diverged,
+                   "approach": {"speed": speed, "rps": rps},
                    "diverged_at": res.diverged_at, "reason": res.reason,
                    "indices": res.indices, "index_intervals": intervals or None,
                    "rudder_rate_deg_s": (math.degrees(gear.max_rate) if gear and gear.max_rate

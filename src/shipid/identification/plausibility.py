@@ -18,20 +18,11 @@ import math
 
 import numpy as np
 
+from shipid.dynamics.equilibrium import still_air_accelerations, surge_equilibrium
 from shipid.dynamics.model import ManoeuvringModel
 from shipid.trials.manoeuvres import turning_circle
 
 SETTLED_FRACTION = 0.02  # of the steady value, over the last 10 % of the run
-
-
-def _accelerations(model: ManoeuvringModel, u, v, r, delta, rps):
-    u = np.atleast_1d(np.asarray(u, dtype=float))
-    n = None if rps is None else np.full(u.shape, rps)
-    wind = {}
-    if model.uses_wind:  # still air: the apparent wind of the ship's own motion
-        v_ = np.broadcast_to(np.asarray(v, dtype=float), u.shape)
-        wind = {"wind_speed": np.hypot(u, v_), "wind_angle": np.arctan2(v_, u)}
-    return model.accelerations(u, v, r, delta, None, n, **wind)
 
 
 def straight_line_stability(model: ManoeuvringModel, speed: float, rps: float | None = None) -> dict:
@@ -41,28 +32,13 @@ def straight_line_stability(model: ManoeuvringModel, speed: float, rps: float | 
     h = 1e-7 * max(speed, 1.0)
     A = np.zeros((2, 2))
     for j, (dv, dr) in enumerate(((h, 0.0), (0.0, h))):
-        plus = _accelerations(model, speed, dv, dr, 0.0, rps)[0]
-        minus = _accelerations(model, speed, -dv, -dr, 0.0, rps)[0]
+        plus = still_air_accelerations(model, speed, dv, dr, 0.0, rps)[0]
+        minus = still_air_accelerations(model, speed, -dv, -dr, 0.0, rps)[0]
         A[:, j] = (plus[1:] - minus[1:]) / (2 * h)
     eig = np.linalg.eigvals(A)
     return {"eigenvalues": [complex(e).real if abs(complex(e).imag) < 1e-12 else str(complex(e))
                             for e in eig],  # fmt: skip
             "stable": bool(np.all(eig.real < 0)), "max_real_part": float(np.max(eig.real))}
-
-
-def surge_equilibrium(model: ManoeuvringModel, speed: float, rps: float | None = None) -> float | None:
-    """Steady straight speed with the rudder amidships: the root of u̇(u, 0, 0, 0) with u̇
-    falling through it, searched up to 3 × the approach speed; None if there is none."""
-    if "u" not in model.structure.dofs:
-        return None
-    grid = np.linspace(0.0, 3.0 * speed, 3001)
-    udot = _accelerations(model, grid, np.zeros_like(grid), np.zeros_like(grid),
-                          np.zeros_like(grid), rps)[:, 0]  # fmt: skip
-    falling = np.flatnonzero((udot[:-1] > 0) & (udot[1:] <= 0))
-    if falling.size == 0:
-        return None
-    k = int(falling[np.argmin(np.abs(grid[falling] - speed))])
-    return float(grid[k] + (grid[k + 1] - grid[k]) * udot[k] / (udot[k] - udot[k + 1]))
 
 
 def held_rudder(model: ManoeuvringModel, speed: float, rps: float | None = None,

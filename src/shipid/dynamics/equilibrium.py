@@ -1,0 +1,118 @@
+"""Steady straight running of a model: the speed at which its surge equation balances, and the
+approach condition of a manoeuvre run on it.
+
+An IMO manoeuvre starts from a steady straight approach (MSC.137(76)): the ship runs at the test
+speed with its propeller at the rpm that holds it there. A model with propeller terms has two
+knobs, the approach speed and the rps, and they must agree: started at 0.26 m/s with the
+propeller of a 0.55 m/s run, the Esso Osaka model of the README accelerated by 41 % in the first
+10 s of every "turning circle", and its advance and tactical diameter were those of an
+accelerating ship (issue #10).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from shipid.dynamics.model import ManoeuvringModel
+
+# An approach is steady when the model's speed changes by less than this share in STEADY_WINDOW s.
+STEADY_SHARE = 0.05
+STEADY_WINDOW = 10.0
+# Another rps than the training logs' can put the steady speed far from their approach.
+SEARCH_SPAN = 10.0
+
+
+def still_air_accelerations(model: ManoeuvringModel, u, v, r, delta, rps) -> np.ndarray:
+    """(u̇, v̇, ṙ) rows at the given states, the propeller at ``rps`` and, for models with wind
+    terms, still air (the apparent wind of the ship's own motion)."""
+    u = np.atleast_1d(np.asarray(u, dtype=float))
+    n = None if rps is None else np.full(u.shape, rps)
+    wind = {}
+    if model.uses_wind:
+        v_ = np.broadcast_to(np.asarray(v, dtype=float), u.shape)
+        wind = {"wind_speed": np.hypot(u, v_), "wind_angle": np.arctan2(v_, u)}
+    return model.accelerations(u, v, r, delta, None, n, **wind)
+
+
+def surge_equilibrium(model: ManoeuvringModel, speed: float, rps: float | None = None,
+                      span: float = 3.0) -> float | None:  # fmt: skip
+    """Steady straight speed with the rudder amidships: the root of u̇(u, 0, 0, 0) with u̇
+    falling through it, searched up to ``span`` × ``speed``, the one nearest ``speed``; None if
+    there is none."""
+    if "u" not in model.structure.dofs:
+        return None
+    grid = np.linspace(0.0, span * speed, int(1000 * span) + 1)
+    zeros = np.zeros_like(grid)
+    udot = still_air_accelerations(model, grid, zeros, zeros, zeros, rps)[:, 0]
+    falling = np.flatnonzero((udot[:-1] > 0) & (udot[1:] <= 0))
+    if falling.size == 0:
+        return None
+    k = int(falling[np.argmin(np.abs(grid[falling] - speed))])
+    return float(grid[k] + (grid[k + 1] - grid[k]) * udot[k] / (udot[k] - udot[k + 1]))
+
+
+@dataclass(frozen=True)
+class Approach:
+    """The approach of a manoeuvre: speed [m/s], propeller speed [rps] (None for models without
+    propeller terms), where the speed came from, and a warning when it is not a steady state."""
+
+    speed: float
+    rps: float | None
+    source: str
+    warning: str | None = None
+
+    def describe(self) -> str:
+        """One line for the user: the speed, the rps and where they came from."""
+        at = f" at {self.rps:.4g} rps" if self.rps is not None else ""
+        return f"approach: {self.speed:.4g} m/s{at} ({self.source})"
+
+
+def steady_approach(model: ManoeuvringModel, trained_speed: float | None,
+                    trained_rps: float | None, speed: float | None = None,
+                    rps: float | None = None) -> Approach:  # fmt: skip
+    """The approach of a manoeuvre on ``model``.
+
+    ``rps`` (else the training logs') drives a model with propeller terms. A given ``speed`` is
+    kept, with a warning when the model does not hold it (its speed changes by more than 5 % in
+    10 s). Without one, a model whose surge depends on the propeller approaches at its own steady
+    straight speed at that rps, found near the training approach speed: the two knobs agree. A
+    model without propeller terms approaches at the training logs' speed, whose thrust its
+    constant absorbed.
+    """
+    uses_rps = model.uses_rps
+    n = (rps if rps is not None else trained_rps) if uses_rps else None
+    if speed is not None:
+        return Approach(speed, n, "--speed", _unsteady(model, speed, n))
+    if trained_speed is None or not trained_speed > 0:
+        raise ValueError("the training approach speed is unknown")
+    if uses_rps and n is not None and "u" in model.structure.dofs:
+        steady = surge_equilibrium(model, trained_speed, n, SEARCH_SPAN)
+        if steady is not None and steady > 0:
+            return Approach(steady, n, f"the model's steady straight speed at {n:.4g} rps")
+        return Approach(trained_speed, n, "the training logs' approach speed",
+                        f"the model has no steady straight speed at {n:.4g} rps: the "
+                        f"manoeuvre starts from the training approach, {trained_speed:.4g} m/s, "
+                        "and its speed drifts")  # fmt: skip
+    return Approach(trained_speed, n, "the training logs' approach speed",
+                    _unsteady(model, trained_speed, n))  # fmt: skip
+
+
+def _unsteady(model: ManoeuvringModel, speed: float, rps: float | None) -> str | None:
+    """A warning when ``model`` does not hold ``speed`` straight ahead with the rudder amidships."""
+    if "u" not in model.structure.dofs:
+        return None
+    udot = float(still_air_accelerations(model, speed, 0.0, 0.0, 0.0, rps)[0, 0])
+    change = udot * STEADY_WINDOW / speed
+    if not math.isfinite(change) or abs(change) <= STEADY_SHARE:
+        return None
+    at = f" at {rps:.4g} rps" if rps is not None else ""
+    steady = surge_equilibrium(model, speed, rps, SEARCH_SPAN)
+    hint = (f"; its steady straight speed{at} is {steady:.4g} m/s" if steady
+            else f"; it has no steady straight speed{at}")  # fmt: skip
+    return (f"the approach at {speed:.4g} m/s{at} is not steady: the model's speed changes by "
+            f"{100 * change:+.0f} % in the first {STEADY_WINDOW:g} s{hint}, so the manoeuvre's "
+            "indices are those of a ship still "
+            + ("accelerating" if change > 0 else "slowing down"))

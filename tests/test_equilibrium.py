@@ -1,0 +1,96 @@
+"""The approach of a manoeuvre on a model is a steady state (issue #10): a model with propeller
+terms ran its manoeuvres from the training logs' first speed with the propeller of another
+speed. The README's Esso model started its turning circles at 0.26 m/s with the 16.7 rps of a
+0.55 m/s run, and its advance and tactical diameter were those of an accelerating ship."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+from cli_helpers import run
+
+from shipid.data.io import write_log
+from shipid.dynamics.equilibrium import steady_approach, surge_equilibrium
+from shipid.dynamics.model import ManoeuvringModel, ModelStructure
+from shipid.trials.manoeuvres import turning_circle, zigzag
+from shipid.vessels import scale_ship
+
+LATERAL = ("u*r", "u*v", "delta")
+# u̇ = a |u|u + b n⁺²: the steady speed at n is n √(−b/a), a closed form to test against.
+A_UU, B_NN = -0.05, 2e-4
+PROPELLED = ManoeuvringModel(
+    ModelStructure("propelled", {"u": ("|u|*u", "pos(n)^2"), "v": LATERAL, "r": LATERAL}),
+    {"u": {"|u|*u": A_UU, "pos(n)^2": B_NN},
+     "v": {"u*r": -0.3, "u*v": -0.6, "delta": 0.01},
+     "r": {"u*r": -0.8, "u*v": -0.2, "delta": -0.05}})  # fmt: skip
+
+
+def steady(n):
+    return n * math.sqrt(-B_NN / A_UU)
+
+
+@pytest.mark.parametrize("n", [6.0, 10.0, 16.7])
+def test_a_propelled_model_approaches_at_its_steady_speed_for_the_rps(n):
+    assert surge_equilibrium(PROPELLED, 0.3, n, span=10) == pytest.approx(steady(n), rel=1e-6)
+    app = steady_approach(PROPELLED, trained_speed=0.3, trained_rps=16.7, rps=n)
+    assert app.speed == pytest.approx(steady(n), rel=1e-6) and app.rps == n
+    assert app.warning is None and "steady straight speed" in app.describe()
+    # The run starts steady: with the rudder held amidships the speed does not move.
+    res = turning_circle(PROPELLED, 1e-9, duration=30, speed=app.speed, rps=n)
+    assert np.ptp(res.log["u"]) < 1e-6 * app.speed
+
+
+def test_a_given_speed_that_the_model_cannot_hold_is_kept_with_a_warning():
+    app = steady_approach(PROPELLED, trained_speed=0.3, trained_rps=16.7, speed=0.26)
+    assert app.speed == 0.26 and app.rps == 16.7
+    # u̇ = a u² + b n² at 0.26 m/s, over 10 s, relative to the speed
+    change = (A_UU * 0.26**2 + B_NN * 16.7**2) * 10 / 0.26
+    assert f"{100 * change:+.0f} %" in app.warning
+    assert f"{steady(16.7):.4g} m/s" in app.warning and "accelerating" in app.warning
+    held = steady_approach(PROPELLED, 0.3, 16.7, speed=steady(16.7))
+    assert held.warning is None
+
+
+def test_a_model_without_propeller_terms_keeps_the_training_approach():
+    ship = scale_ship(rudder_rate_deg=9.6)
+    from shipid.identification.identify import identify
+
+    fit = identify(zigzag(ship, 20, 20, duration=90, dt=0.2, method="euler").log)
+    app = steady_approach(fit.model, trained_speed=1.93, trained_rps=None)
+    assert app.speed == 1.93 and app.rps is None and app.warning is None
+
+
+def test_manoeuvre_runs_a_propelled_model_file_from_a_steady_approach(tmp_path, capsys):
+    """Through the CLI: a model identified from a zig-zag at 10 rps, run at 13 rps, starts at
+    its own steady speed for 13 rps (the identified coefficients' closed form), says so, and
+    records it; at the training speed and 13 rps it warns that the approach is not steady."""
+    ship = scale_ship(rudder_rate_deg=9.6)
+    log = zigzag(ship, 20, 20, duration=120, dt=0.2, method="euler").log
+    log["n"] = 10.0
+    path = write_log(log, tmp_path / "zz.csv")
+    model_path = tmp_path / "m.json"
+    spec = ("u: |u|u, vr, r^2, delta^2, pos(n)^2; v: ur, uv, |v|v, |v|r, delta, 1; "
+            "r: ur, uv, |v|v, |v|r, delta, 1")  # fmt: skip
+    code, _, err = run(["identify", path, "--model", spec, "--filter", "none", "-o", model_path],
+                       capsys)  # fmt: skip
+    assert code == 0, err
+    coef = json.loads(model_path.read_text())["model"]["coefficients"]["u"]
+    want = 13.0 * math.sqrt(-coef["pos(n)^2"] / coef["|u|*u"])
+    out_json = tmp_path / "turn.json"
+    code, out, err = run(["manoeuvre", model_path, "turning", "--rudder", "20", "--rps", "13",
+                          "--duration", "30", "--no-bands", "--json", out_json], capsys)  # fmt: skip
+    assert code == 0, err
+    doc = json.loads(out_json.read_text())
+    assert doc["approach"]["speed"] == pytest.approx(want, rel=1e-3)
+    assert doc["approach"]["rps"] == 13.0
+    assert "steady straight speed at 13 rps" in out
+    assert not any("not steady" in w for w in doc["warnings"])
+    trained = json.loads(model_path.read_text())["identification"]["preprocessing"]
+    code, out, err = run(["manoeuvre", model_path, "turning", "--rudder", "20", "--rps", "13",
+                          "--speed", str(trained["approach_speed"]), "--duration", "30",
+                          "--no-bands", "--json", out_json], capsys)  # fmt: skip
+    assert code == 0, err
+    doc = json.loads(out_json.read_text())
+    assert any("is not steady" in w for w in doc["warnings"]), doc["warnings"]
+    assert "is not steady" in err
