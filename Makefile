@@ -33,6 +33,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_study.py
 	$(BIN)/python benchmarks/bench_figures.py
 	$(BIN)/python benchmarks/study_esso.py
+	$(BIN)/python benchmarks/study_esso_extrapolation.py
 
 clean:
 	rm -rf $(VENV) shipid-demo build *.egg-info src/*.egg-info
