@@ -44,6 +44,12 @@ ZIGZAGS = {"13_04_24": (20, 16.7), "13_14_21": (30, 16.7), "13_22_52": (15, 10),
 README_HELD = "31-Jul-2020_12_29_58"
 
 
+def _ratio(validations, logs, state: str) -> float:
+    """Mean over the logs of the free-run error std of ``state`` over its spread."""
+    return float(np.mean([v.metrics[state]["std"] / np.std(lg[state])
+                          for v, lg in zip(validations, logs, strict=True)]))  # fmt: skip
+
+
 def main() -> None:
     esso = Path(__file__).resolve().parents[2] / "shared" / "data" / "esso-osaka"
     if not esso.is_dir():
@@ -78,14 +84,11 @@ def main() -> None:
             res = validate(sel.model, held)
             diverged = sum(v.error is not None or v.simulation.diverged for v in res)
 
-            def ratio(vs, logs, s):
-                return np.mean([v.metrics[s]["std"] / np.std(lg[s]) for v, lg in zip(vs, logs)])
-
             n_zz = len(zig_held)
             cells = []
             for a, b in ((0, n_zz), (n_zz, n_zz + len(rnd_held))):
                 vs, logs = res[a:b], held[a:b]
-                cells.append(f"{ratio(vs, logs, 'r'):.2f} / {ratio(vs, logs, 'u'):.2f}"
+                cells.append(f"{_ratio(vs, logs, 'r'):.2f} / {_ratio(vs, logs, 'u'):.2f}"
                              if vs else "–")  # fmt: skip
             for key in ("tactical_diameter", "steady_yaw_rate"):
                 errs = []
