@@ -94,3 +94,16 @@ def test_manoeuvre_runs_a_propelled_model_file_from_a_steady_approach(tmp_path, 
     doc = json.loads(out_json.read_text())
     assert any("is not steady" in w for w in doc["warnings"]), doc["warnings"]
     assert "is not steady" in err
+
+
+def test_the_criteria_of_a_model_say_when_their_approach_is_not_steady():
+    """The tutorial called ``imo_criteria`` on the Esso model at the first log's speed with the
+    rps of another: nothing said so. The criteria's notes now do, for API users too."""
+    from shipid.trials.criteria import imo_criteria
+
+    def notes(speed):
+        crit = imo_criteria(PROPELLED, length=3.0, speed=speed, rps=10.0, dt=0.2)
+        return [n for n in crit.notes if "is not steady" in n]
+
+    assert notes(0.5 * steady(10.0)) and f"{steady(10.0):.4g} m/s" in notes(0.5 * steady(10.0))[0]
+    assert notes(steady(10.0)) == []

@@ -762,7 +762,7 @@ def cmd_criteria(args) -> int:
                   [args.model] if Path(args.model).exists() else [])  # fmt: skip
     target, cond = _ship_or_model(args.model)
     particulars = read_particulars(args.particulars) if args.particulars else cond["particulars"]
-    speed, rps, unsteady = _run_approach(target, cond, args.speed, args.rps)
+    speed, rps, _ = _run_approach(target, cond, args.speed, args.rps)  # imo_criteria notes it
     # Given, else the ship's gear or the training logs' rate, else imo_criteria's SOLAS rate.
     steering, _ = _steering(target, cond, args.rudder_rate, fallback="caller")
     run = partial(imo_criteria, particulars=particulars, length=args.length, speed=speed,
@@ -787,7 +787,7 @@ def cmd_criteria(args) -> int:
         print(f"lower, upper: 95 % interval of the value and pass_share: the share of passes "
               f"over the model's {ensemble.replicates} {ensemble.members_label}")
     print("all criteria met" if crit.passed else "NOT all criteria met")
-    for n in ([unsteady] if unsteady else []) + crit.notes:
+    for n in crit.notes:
         _warn(n)
     with OutputSet() as out:
         if args.json:

@@ -85,7 +85,7 @@ def steady_approach(model: ManoeuvringModel, trained_speed: float | None,
     uses_rps = model.uses_rps
     n = (rps if rps is not None else trained_rps) if uses_rps else None
     if speed is not None:
-        return Approach(speed, n, "--speed", _unsteady(model, speed, n))
+        return Approach(speed, n, "given", unsteady_warning(model, speed, n))
     if trained_speed is None or not trained_speed > 0:
         raise ValueError("the training approach speed is unknown")
     if uses_rps and n is not None and "u" in model.structure.dofs:
@@ -97,10 +97,10 @@ def steady_approach(model: ManoeuvringModel, trained_speed: float | None,
                         f"manoeuvre starts from the training approach, {trained_speed:.4g} m/s, "
                         "and its speed drifts")  # fmt: skip
     return Approach(trained_speed, n, "the training logs' approach speed",
-                    _unsteady(model, trained_speed, n))  # fmt: skip
+                    unsteady_warning(model, trained_speed, n))  # fmt: skip
 
 
-def _unsteady(model: ManoeuvringModel, speed: float, rps: float | None) -> str | None:
+def unsteady_warning(model: ManoeuvringModel, speed: float, rps: float | None) -> str | None:
     """A warning when ``model`` does not hold ``speed`` straight ahead with the rudder amidships."""
     if "u" not in model.structure.dofs:
         return None

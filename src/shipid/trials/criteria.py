@@ -24,6 +24,7 @@ import numpy as np
 import pandas as pd
 
 from shipid.data.particulars import Particulars
+from shipid.dynamics.equilibrium import unsteady_warning
 from shipid.dynamics.model import ManoeuvringModel
 from shipid.dynamics.steering import SteeringMachine
 from shipid.errors import ShipidError
@@ -116,6 +117,9 @@ def imo_criteria(
     duration = max(60.0, 40.0 * L / V)
     kw = {"dt": dt, "speed": V, "steering": steering, "method": method, "rps": rps}
     rows, runs, notes = [], {}, []
+    if isinstance(ship, ManoeuvringModel):  # a reference ship's approach is trimmed
+        unsteady = unsteady_warning(ship, V, rps if ship.uses_rps else None)
+        notes += [unsteady] if unsteady else []
 
     for side in SIDES:
         res = turning_circle(ship, 35.0, side=side, duration=duration, **kw)
