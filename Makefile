@@ -34,6 +34,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_figures.py
 	$(BIN)/python benchmarks/study_esso.py
 	$(BIN)/python benchmarks/study_esso_extrapolation.py
+	$(BIN)/python benchmarks/study_selection_uncertainty.py
 
 clean:
 	rm -rf $(VENV) shipid-demo build *.egg-info src/*.egg-info

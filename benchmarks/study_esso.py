@@ -2,8 +2,9 @@
 zig-zags and three of the four random runs, judged on the two ±35° turning circles and the
 random run left out, each random run left out in turn; for the README's library and with the
 single propeller's asymmetry added (``propeller-asymmetry``). For the README's fold (random run
-12_29_58 held out), the turns' 95 % intervals over a 100-replicate bootstrap of the selected
-model, as ``select --bootstrap 100`` and ``validate`` give them.
+12_29_58 held out), the turns' 95 % intervals over 100 replicates of the selected model: its
+terms refitted on block resamples, and ``select --bootstrap 100``'s ensemble, whose replicates
+also draw their terms (as ``validate`` gives them).
 
 Run: .venv/bin/python benchmarks/study_esso.py
 """
@@ -13,19 +14,18 @@ from __future__ import annotations
 import os
 import time
 import warnings
-from pathlib import Path
 
 import numpy as np
+from esso_logs import README_HELD, esso_logs
 
-from shipid.data.io import read_log
 from shipid.evaluation.validate import validate
 from shipid.identification.identify import weighted_refit
 from shipid.identification.select import select
+from shipid.identification.selection_ensemble import selection_ensemble
 from shipid.identification.uncertainty import bootstrap
 from shipid.trials.trial import describe_trial
 
 LIBRARIES = ("low-speed+wind", "low-speed+wind+propeller-asymmetry")
-README_FOLD = "random_31-Jul-2020_12_29_58.csv"
 TURN_KEYS = ("tactical_diameter", "steady_yaw_rate", "advance")
 
 
@@ -43,18 +43,12 @@ def _early_yaw_ratio(v, log, after_s: float = 10.0) -> float:
 
 
 def main() -> None:
-    esso = Path(__file__).resolve().parents[2] / "shared" / "data" / "esso-osaka"
-    if not esso.is_dir():
+    data = esso_logs()
+    if data is None:
         print("../shared/data is absent")
         return
-
-    def log(path, trim):
-        kw = {"start": "auto", "end": "auto"} if trim else {}
-        return read_log(path, fmt="osaka-frt", dt=0.5, **kw)
-
-    zigzags = [log(p, True) for p in sorted((esso / "zigzag").glob("*.csv"))]
-    randoms = {p.name: log(p, False) for p in sorted((esso / "random").glob("*.csv"))}
-    turns = [log(p, True) for p in sorted((esso / "turning").glob("*.csv"))]
+    zz, randoms, turns = data
+    zigzags = list(zz.values())
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores\n")
     print("Held out: the ±35° turns (errors of the tactical diameter, steady yaw rate and "
           "advance) and one random run (free-run r and u error std over the run's spread); "
@@ -77,10 +71,10 @@ def main() -> None:
             early = [_early_yaw_ratio(v, lg) for v, lg in zip(results[:2], turns, strict=True)]
             rows.append((errors, r_ratio, u_ratio, early))
             n_terms = sum(len(t) for t in sel.model.structure.terms.values())
-            print(f"| {library} | {held[7:-4]} | {n_terms} | "
+            print(f"| {library} | {held} | {n_terms} | "
                   + " | ".join(", ".join(f"{x:+.0f} %" for x in errors[k]) for k in TURN_KEYS)
                   + f" | {r_ratio:.2f} | {u_ratio:.2f} |")  # fmt: skip
-            if held == README_FOLD:
+            if held == README_HELD:
                 readme[library] = (train, sel, results)
         summary[library] = rows
     print("\nMean over the four folds: |TD error|, |steady r error|, advance error of each turn, "
@@ -98,23 +92,26 @@ def main() -> None:
               + ", ".join(f"{min(a):+.0f}…{max(a):+.0f} %" for a in adv)
               + f" | {np.mean([r[1] for r in rows]):.2f} | {np.mean([r[2] for r in rows]):.2f} | "
               + ", ".join(f"{min(e):.2f}…{max(e):.2f}" for e in early) + " |")  # fmt: skip
-    print(f"\nThe README's fold ({README_FOLD[7:-4]} held out): the turns' indices with the 95 % "
-          "intervals of a 100-replicate bootstrap of the selected model (select --bootstrap "
-          "100, then validate)\n")  # fmt: skip
-    print("| library | turn | tactical diameter: measured, predicted [95 %] | steady yaw rate: "
-          "measured, predicted [95 %] |")  # fmt: skip
-    print("|---|---|---|---|")
+    print(f"\nThe README's fold ({README_HELD} held out): the turns' indices with the 95 % "
+          "intervals of 100 replicates: the selected terms refitted on block resamples (terms "
+          "held), and select --bootstrap 100's ensemble, whose replicates also draw their terms "
+          "from the choices on resampled held-out logs (terms resampled)\n")  # fmt: skip
+    print("| library | replicates | turn | tactical diameter: measured, predicted [95 %] | "
+          "steady yaw rate: measured, predicted [95 %] |")  # fmt: skip
+    print("|---|---|---|---|---|")
     for library, (train, sel, results) in readme.items():
         refit = weighted_refit(train, model=sel.model.structure, gamma=sel.gamma)
-        ens = bootstrap(train, refit, replicates=100)
-        for v, turn, side in zip(results[:2], turns, ("+35°", "−35°"), strict=True):
-            again = validate(sel.model, [turn], ensemble=ens)[0]
-            cells = []
-            for key, fmt in (("tactical_diameter", ".2f"), ("steady_yaw_rate", ".4f")):
-                lo, hi = again.intervals["simulated"][key]
-                cells.append(f"{v.indices['measured'][key]:{fmt}}, "
-                             f"{v.indices['simulated'][key]:{fmt}} [{lo:{fmt}}, {hi:{fmt}}]")
-            print(f"| {library} | {side} | " + " | ".join(cells) + " |")
+        ensembles = {"terms held": bootstrap(train, refit, replicates=100),
+                     "terms resampled": selection_ensemble(train, sel, replicates=100)}
+        for label, ens in ensembles.items():
+            for v, turn, side in zip(results[:2], turns, ("+35°", "−35°"), strict=True):
+                again = validate(sel.model, [turn], ensemble=ens)[0]
+                cells = []
+                for key, fmt in (("tactical_diameter", ".2f"), ("steady_yaw_rate", ".4f")):
+                    lo, hi = again.intervals["simulated"][key]
+                    cells.append(f"{v.indices['measured'][key]:{fmt}}, "
+                                 f"{v.indices['simulated'][key]:{fmt}} [{lo:{fmt}}, {hi:{fmt}}]")
+                print(f"| {library} | {label} | {side} | " + " | ".join(cells) + " |")
     print(f"\n{time.perf_counter() - t0:.0f} s")
 
 

@@ -27,21 +27,15 @@ from __future__ import annotations
 import os
 import time
 import warnings
-from pathlib import Path
 
 import numpy as np
+from esso_logs import condition_folds, esso_logs
 
-from shipid.data.io import read_log
 from shipid.evaluation.validate import validate
 from shipid.identification.select import select
 
 LIBRARY = "low-speed+wind+propeller-asymmetry"
 SEARCHES = ("stepwise", "frols", "none")
-# Rudder amplitude [deg] and propeller speed [rps] of each zig-zag (the data README's table).
-ZIGZAGS = {"13_04_24": (20, 16.7), "13_14_21": (30, 16.7), "13_22_52": (15, 10),
-           "13_29_19": (15, 12), "13_42_53": (30, 10), "13_50_28": (30, 12),
-           "13_57_45": (20, 15), "14_03_39": (20, 12), "14_10_05": (20, 12)}  # fmt: skip
-README_HELD = "31-Jul-2020_12_29_58"
 
 
 def _ratio(validations, logs, state: str) -> float:
@@ -51,26 +45,12 @@ def _ratio(validations, logs, state: str) -> float:
 
 
 def main() -> None:
-    esso = Path(__file__).resolve().parents[2] / "shared" / "data" / "esso-osaka"
-    if not esso.is_dir():
+    data = esso_logs()
+    if data is None:
         print("../shared/data is absent")
         return
-
-    def read(path, trim):
-        kw = {"start": "auto", "end": "auto"} if trim else {}
-        return read_log(path, fmt="osaka-frt", dt=0.5, **kw)
-
-    zz = {p.stem[-8:]: read(p, True) for p in sorted((esso / "zigzag").glob("*.csv"))}
-    rnd = {p.stem[7:]: read(p, False) for p in sorted((esso / "random").glob("*.csv"))}
-    turns = [read(p, True) for p in sorted((esso / "turning").glob("*.csv"))]
-    folds = {
-        "30° zig-zags": ([k for k, (a, _) in ZIGZAGS.items() if a < 30], list(rnd),
-                         [k for k, (a, _) in ZIGZAGS.items() if a == 30], []),
-        "15-16.7 rps": ([k for k, (_, n) in ZIGZAGS.items() if n < 14], list(rnd),
-                        [k for k, (_, n) in ZIGZAGS.items() if n > 14], []),
-        "zig-zags only": (list(ZIGZAGS), [], [], list(rnd)),
-        "README": (list(ZIGZAGS), [k for k in rnd if k != README_HELD], [], [README_HELD]),
-    }  # fmt: skip
+    zz, rnd, turns = data
+    folds = condition_folds(rnd)
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores; library {LIBRARY}\n")
     print("| fold | search | terms | held-out zig-zags r / u error over spread | held-out random "
           "runs r / u | turns: TD +35°, −35° | steady r +35°, −35° | diverged |")  # fmt: skip

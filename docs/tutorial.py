@@ -38,9 +38,14 @@ selection = shipid.select(training, library="low-speed+wind+propeller-asymmetry"
 print(f"selected {selection.candidates.loc[selection.candidates['chosen'], 'n_terms'].item()} "
       f"terms, γ = {selection.gamma:g}, CV score {selection.score:.3f}")
 print(selection.model.equations())
+print(f"chosen on {100 * selection.chosen_share:.0f} % of resampled held-out logs")
+# Its uncertainty, the choice of terms included: each replicate a candidate drawn by its
+# share, refitted on moving-block resamples of the equations (select --bootstrap 100).
+ensemble = shipid.selection_ensemble(training, selection, replicates=100)
 
-# 3. Predict what was held out: free-run errors (rmse, fit %) and the turning indices.
-results = validate(selection.model, turns + [randoms[held_out]])
+# 3. Predict what was held out: free-run errors (rmse, fit %) and the turning indices with
+#    their 95 % intervals over the ensemble.
+results = validate(selection.model, turns + [randoms[held_out]], ensemble=ensemble)
 print(metrics_frame(results).to_markdown(index=False, floatfmt=".3g"))
 print(indices_frame(results).dropna(subset=["measured"]).to_markdown(index=False, floatfmt=".3g"))
 r_spread = float(np.std(randoms[held_out]["r"]))

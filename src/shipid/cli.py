@@ -517,7 +517,7 @@ def _parse_gammas(text: str | None) -> tuple[float, ...] | None:
 def cmd_select(args) -> int:
     """``shipid select``: structure and γ by cross-validated free-run error."""
     from shipid.identification.plausibility import check_plausibility
-    from shipid.identification.select import SelectOptions, select
+    from shipid.identification.select import RESAMPLES, SelectOptions, select
     from shipid.outputs import OutputSet, check_outputs
     from shipid.reporting.modelfile import model_text
 
@@ -543,7 +543,7 @@ def cmd_select(args) -> int:
     print(f"\nγ = {sel.gamma:g}; free-run CV score {sel.score:.4f} ({options.cv}; 1 ≈ predicting "
           f"the mean); {len(sel.candidates)} candidates")
     cols = ["chosen", "score", "score_se", "score_u", "score_v", "score_r", "gamma", "n_terms",
-            "folds_diverged", "plausible", "stage", "note"]
+            "folds_diverged", "plausible", "share", "stage", "note"]
     shown = sel.candidates.head(args.show)
     if not shown["chosen"].any():
         shown = _pd().concat([shown, sel.candidates[sel.candidates["chosen"]]])
@@ -559,20 +559,20 @@ def cmd_select(args) -> int:
             "rudder_rate": _rudder_rate(logs),
             "rudder_positive": logs[0].attrs.get("rudder_positive")}  # fmt: skip
     ensemble = None
+    others = len(sel.shares) - (sel.chosen_share > 0)
+    print(f"\nThe choice on {RESAMPLES} resamples of the held-out logs: this candidate "
+          f"{100 * sel.chosen_share:.0f} %, {others} other(s) the rest (column share)")
     if args.bootstrap is not None:
-        from shipid.identification.identify import weighted_refit
-        from shipid.identification.uncertainty import bootstrap
+        from shipid.identification.selection_ensemble import selection_ensemble
 
-        # The selected terms and γ, refitted as select fitted them.
-        refit = weighted_refit(logs, model=sel.model.structure, gamma=sel.gamma, names=names,
-                               estimator=options.estimator, physics=options.physics)  # fmt: skip
-        ensemble = bootstrap(logs, refit, args.bootstrap, args.block, args.seed,
-                             progress=not args.quiet)  # fmt: skip
+        # Each replicate: a candidate drawn by its share, refitted on a block resample.
+        ensemble = selection_ensemble(logs, sel, args.bootstrap, args.block, args.seed,
+                                      names=names, progress=not args.quiet)  # fmt: skip
         table = ensemble.coefficient_table()
         table["term"] = [_term_display(t) for t in table["term"]]
-        print(f"\n95 % intervals of the selected model's coefficients ({ensemble.method}, "
-              f"{ensemble.replicates} replicates, {ensemble.block_s:g} s blocks; the structure "
-              "and γ held at the selection's):")  # fmt: skip
+        print(f"\n95 % intervals of the coefficients ({ensemble.replicates} replicates: "
+              f"{ensemble.method}, {ensemble.block_s:g} s blocks; a term outside the model "
+              "has value 0, inclusion the share of replicates that hold it):")  # fmt: skip
         print(table.to_markdown(index=False, floatfmt=".4g"))
     text = model_text(ident, args.logs, preprocessing=prep, plausibility=plausibility,
                       selection=sel.to_dict(), particulars=_log_particulars(logs),
@@ -1482,8 +1482,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--rps", type=float, help="... and this propeller speed [rps]")
     p.add_argument("--show", type=int, default=10, metavar="N", help="candidates printed (default 10)")
     p.add_argument("--bootstrap", type=int, metavar="N",
-                   help="uncertainty of the selected model: N moving-block bootstrap refits of "
-                   "its terms at its γ (≥ 10), stored in the model file for bands and intervals")
+                   help="uncertainty of the selected model: N replicates (≥ 10), each a "
+                   "candidate drawn by how often it is chosen on resampled held-out logs, "
+                   "refitted on a moving-block resample; stored in the model file for bands "
+                   "and intervals")
     p.add_argument("--block", type=float, default=10.0, metavar="S",
                    help="with --bootstrap: block length [s] (default %(default)g)")
     p.add_argument("--seed", type=int, default=0, help="with --bootstrap: random seed "

@@ -26,6 +26,12 @@ the full library and again for the chosen structure.
 Candidates must be plausible (``plausibility.disqualifying``): the chosen one, fitted on all logs,
 has a steady speed and turns the right way, bounded, with the rudder held; implausible candidates
 stay in the table, marked, and are not chosen.
+
+How firm the choice is: the choice rule (the best plausible score, then the one-standard-error
+rule) is repeated on ``RESAMPLES`` bootstrap resamples of the held-out logs, among the candidates
+the search evaluated (bagging the selection, Breiman 1996; as E-SINDy bags SINDy's). Each
+candidate's ``share`` is how often it is chosen; ``shipid.identification.selection_ensemble``
+draws the terms of its replicates from these shares.
 """
 
 from __future__ import annotations
@@ -50,6 +56,7 @@ from shipid.lssvm.solvers import solve_primal_constrained
 
 SEARCHES = ("stepwise", "frols", "stlsq", "none")
 STATES = ("u", "v", "r")
+RESAMPLES = 200  # resamples of the held-out logs for the choice's shares
 RHO_GRID = (0.3, 0.1, 0.03, 0.01, 3e-3, 1e-3, 3e-4, 1e-4, 1e-5, 0.0)
 STLSQ_GRID = (0.0, 0.01, 0.02, 0.05, 0.1, 0.2, 0.3)
 
@@ -133,6 +140,7 @@ class Candidate:
     plausible: bool | None = None
     note: str = ""
     stage: str = ""
+    share: float = 0.0  # how often the choice rule picks it on resampled held-out logs
 
     @property
     def standard_error(self) -> float:
@@ -164,6 +172,13 @@ class Selection:
     library: ModelStructure
     ranking: dict[str, list[tuple[str, float]]]
     warnings: list[str] = field(default_factory=list)
+    shares: list[Candidate] = field(default_factory=list)  # share > 0, most often chosen first
+
+    @property
+    def chosen_share(self) -> float:
+        """How often the chosen candidate is chosen again on resampled held-out logs."""
+        keyed = self.candidates[self.candidates["chosen"]]
+        return float(keyed["share"].iloc[0]) if len(keyed) else 0.0
 
     def to_dict(self) -> dict:
         """The search record as JSON-ready data (kept in the model file)."""
@@ -576,6 +591,9 @@ def select(
     bar.close()
     if options.one_standard_error:
         current = _one_standard_error(scorer.cache.values(), current, plausible)
+    shares = selection_shares(list(scorer.cache.values()), plausible, options.one_standard_error)
+    for cand in scorer.cache.values():
+        cand.share = shares.get(cand.key, 0.0)
     if not plausible(current):
         notes.append(f"the chosen model is implausible ({current.note}); no candidate passed "
                      "the checks")  # fmt: skip
@@ -587,8 +605,40 @@ def select(
     failed = [c for c in scorer.cache.values() if c.folds_diverged == len(scorer.held)]
     if failed:
         notes.append(f"{len(failed)} candidate(s) diverged in every fold (kept in the table)")
+    shared = sorted((c for c in scorer.cache.values() if c.share > 0), key=lambda c: -c.share)
     return Selection(ident.model, ident, current.gamma, current.score, table, folds_report,
-                     options, library, ranking, notes + ident.warnings)  # fmt: skip
+                     options, library, ranking, notes + ident.warnings, shared)  # fmt: skip
+
+
+def selection_shares(cands: Sequence[Candidate], plausible, one_standard_error: bool = True,
+                     resamples: int = RESAMPLES, seed: int = 0) -> dict[tuple, float]:
+    """Per candidate key: the share of ``resamples`` bootstrap resamples of the held-out logs
+    (folds drawn with replacement; each candidate's score the mean of its resampled fold scores)
+    on which the choice rule picks it: the best plausible score, then, with
+    ``one_standard_error``, the sparsest plausible candidate within one standard error of it."""
+    pool = [c for c in cands if c.score < math.inf and c.fold_scores]
+    if not pool:
+        return {}
+    F = np.array([c.fold_scores for c in pool])  # (C, K)
+    K = F.shape[1]
+    sizes = np.array([c.n_terms() for c in pool])
+    rng = np.random.default_rng(seed)
+    counts = np.zeros(len(pool))
+    for _ in range(resamples):
+        f = F[:, rng.integers(0, K, K)]
+        score = f.mean(axis=1)
+        best = next((i for i in np.argsort(score, kind="stable") if plausible(pool[i])), None)
+        if best is None:
+            continue
+        if one_standard_error and K > 1:
+            limit = score[best] + f[best].std(ddof=1) / math.sqrt(K)
+            within = np.flatnonzero(score <= limit)
+            within = within[np.lexsort((score[within], sizes[within]))]
+            best = next(i for i in within if plausible(pool[i]))
+        counts[best] += 1
+    total = counts.sum()
+    return {c.key: float(n / total) for c, n in zip(pool, counts, strict=True) if n} if total \
+        else {}  # fmt: skip
 
 
 def _one_standard_error(cands, best: Candidate, plausible) -> Candidate:
@@ -679,7 +729,7 @@ def _table(cands, chosen: Candidate) -> pd.DataFrame:
                      "gamma": c.gamma, "n_terms": c.n_terms(),
                      **{f"terms_{d}": ", ".join(t) for d, t in c.terms.items()},
                      "folds_diverged": c.folds_diverged, "plausible": c.plausible,
-                     "stage": c.stage, "note": c.note})  # fmt: skip
+                     "share": c.share, "stage": c.stage, "note": c.note})  # fmt: skip
     df = pd.DataFrame(rows)
     return df.sort_values("score", kind="stable").reset_index(drop=True)
 

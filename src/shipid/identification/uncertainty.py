@@ -7,7 +7,10 @@ with the equations resampled in blocks of ``block_s`` seconds within each log (K
 blocks keep the equation errors' autocorrelation, which resampling single equations would
 ignore. The intervals are percentile intervals of the replicates. They cover what the equation
 error makes uncertain; a bias common to all replicates (errors in the measured states, a
-structure that lacks a term) is not in them.
+structure that lacks a term) is not in them, unless the structure is resampled too: the
+ensemble of ``shipid.identification.selection_ensemble`` draws each replicate's terms from the
+choices ``select`` makes on resamples of its held-out logs, so its members may hold terms the
+point estimate does not (``Ensemble.structure``, a superset of the model's).
 """
 
 from __future__ import annotations
@@ -19,10 +22,11 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from shipid.dynamics.model import DOFS, ManoeuvringModel
+from shipid.dynamics.model import DOFS, ManoeuvringModel, ModelStructure
 from shipid.errors import ShipidError
 
 METHOD = "moving-block bootstrap of the regression equations"
+SELECTION_METHOD = "selection on resampled held-out logs, then a moving-block bootstrap"
 LEVEL = 0.95
 
 
@@ -33,8 +37,10 @@ class Ensemble:
     Attributes
     ----------
     model : the point estimate (the fit of all equations).
-    thetas : (R, 3, T) coefficients of the replicates, columns ``model.term_texts``.
+    thetas : (R, 3, T) coefficients of the replicates, columns ``structure.all_terms``.
     block_s, seed : the resampling.
+    structure : the members' structure: the model's (default) or, when the replicates' terms
+        vary, a superset of it per equation (a member's coefficient of a term it lacks is 0).
     """
 
     model: ManoeuvringModel
@@ -42,6 +48,28 @@ class Ensemble:
     block_s: float
     seed: int
     method: str = METHOD
+    structure: ModelStructure | None = None
+
+    def __post_init__(self) -> None:
+        if self.structure is None:
+            self.structure = getattr(self.model, "structure", None)  # bootstrap takes any fit
+            return
+        missing = [(d, t) for d, terms in self.model.structure.terms.items() for t in terms
+                   if t not in self.structure.terms.get(d, ())]  # fmt: skip
+        if missing:
+            d, t = missing[0]
+            raise ShipidError(f"the ensemble's structure lacks the model's term {t!r} of "
+                              f"equation {d}")  # fmt: skip
+
+    @property
+    def term_texts(self) -> tuple[str, ...]:
+        """The columns of ``thetas``."""
+        return self.structure.all_terms
+
+    @property
+    def varies_structure(self) -> bool:
+        """Whether the members' terms differ from the point estimate's."""
+        return dict(self.structure.terms) != dict(self.model.structure.terms)
 
     @property
     def replicates(self) -> int:
@@ -51,38 +79,53 @@ class Ensemble:
     @property
     def members_label(self) -> str:
         """What the members are, for messages: bootstrap replicates or covariance draws."""
-        return "bootstrap replicates" if self.method == METHOD else "draws of its covariance"
+        if self.method == METHOD:
+            return "bootstrap replicates"
+        if self.method == SELECTION_METHOD:
+            return "replicates (terms chosen on resampled held-out logs, refitted on block " \
+                   "resamples)"
+        return "draws of its covariance"
 
     def members(self) -> list[ManoeuvringModel]:
-        """The replicates as models (same structure as the point estimate)."""
-        index = {t: j for j, t in enumerate(self.model.term_texts)}
+        """The replicates as models (of ``structure``)."""
+        index = {t: j for j, t in enumerate(self.term_texts)}
         out = []
         for theta in self.thetas:
             coefs = {d: {t: float(theta[DOFS.index(d), index[t]]) for t in terms}
-                     for d, terms in self.model.structure.terms.items()}  # fmt: skip
-            out.append(ManoeuvringModel(self.model.structure, coefs, name=self.model.name))
+                     for d, terms in self.structure.terms.items()}  # fmt: skip
+            out.append(ManoeuvringModel(self.structure, coefs, name=self.model.name))
         return out
 
     def coefficient_table(self, level: float = LEVEL) -> pd.DataFrame:
-        """One row per coefficient: estimate, the replicates' standard deviation and interval."""
-        index = {t: j for j, t in enumerate(self.model.term_texts)}
+        """One row per coefficient: estimate, the replicates' standard deviation and interval.
+        When the members' terms vary, also the terms only some members hold (estimate 0, not in
+        the model) and each term's inclusion: the share of members that hold it."""
+        index = {t: j for j, t in enumerate(self.term_texts)}
         rows = []
-        for dof, terms in self.model.structure.terms.items():
+        for dof, terms in self.structure.terms.items():
             i = DOFS.index(dof)
+            in_model = self.model.structure.terms.get(dof, ())
             for t in terms:
                 values = self.thetas[:, i, index[t]]
                 lo, hi = interval(values, level)
-                rows.append({"equation": dof, "term": t,
-                             "value": float(self.model.coefficients[dof][t]),
-                             "std": float(np.std(values, ddof=1)), "lower": lo,
-                             "upper": hi})  # fmt: skip
+                row = {"equation": dof, "term": t,
+                       "value": float(self.model.coefficients[dof][t]) if t in in_model else 0.0,
+                       "std": float(np.std(values, ddof=1)), "lower": lo,
+                       "upper": hi}  # fmt: skip
+                if self.varies_structure:
+                    row["in_model"] = t in in_model
+                    row["inclusion"] = float(np.mean(values != 0.0))
+                rows.append(row)
         return pd.DataFrame(rows)
 
     def to_dict(self) -> dict:
         """The model file's ``uncertainty`` record."""
-        return {"method": self.method, "replicates": self.replicates, "block_s": self.block_s,
-                "seed": self.seed, "terms": list(self.model.term_texts),
-                "thetas": self.thetas.tolist()}  # fmt: skip
+        out = {"method": self.method, "replicates": self.replicates, "block_s": self.block_s,
+               "seed": self.seed, "terms": list(self.term_texts),
+               "thetas": self.thetas.tolist()}  # fmt: skip
+        if self.varies_structure:
+            out["structure"] = {d: list(t) for d, t in self.structure.terms.items()}
+        return out
 
     @classmethod
     def from_dict(cls, data: Mapping, model: ManoeuvringModel, where: str = "uncertainty"
@@ -92,17 +135,26 @@ class Ensemble:
             terms = [str(t) for t in data["terms"]]
             thetas = np.asarray(data["thetas"], dtype=float)
             block_s, seed = float(data["block_s"]), int(data["seed"])
-        except (KeyError, TypeError, ValueError) as exc:
+            structure = model.structure
+            if data.get("structure") is not None:
+                structure = ModelStructure(f"{model.structure.name} (ensemble)",
+                                           {str(d): tuple(str(t) for t in ts)
+                                            for d, ts in dict(data["structure"]).items()})  # fmt: skip
+        except (KeyError, TypeError, ValueError, AttributeError) as exc:
             raise ShipidError(f"{where}: not a bootstrap ensemble ({exc})") from None
-        if terms != list(model.term_texts):
-            raise ShipidError(f"{where}: the ensemble's terms {terms} are not the model's "
-                              f"{list(model.term_texts)}")  # fmt: skip
+        if terms != list(structure.all_terms):
+            whose = "its structure's" if data.get("structure") is not None else "the model's"
+            raise ShipidError(f"{where}: the ensemble's terms {terms} are not {whose} "
+                              f"{list(structure.all_terms)}")  # fmt: skip
         if thetas.ndim != 3 or thetas.shape[1:] != (3, len(terms)) or thetas.shape[0] < 2:
             raise ShipidError(f"{where}: thetas must be R ≥ 2 coefficient sets of shape "
                               f"(3, {len(terms)}), got {thetas.shape}")  # fmt: skip
         if not np.all(np.isfinite(thetas)):
             raise ShipidError(f"{where}: the ensemble contains a non-finite coefficient")
-        return cls(model, thetas, block_s, seed, str(data.get("method", METHOD)))
+        try:
+            return cls(model, thetas, block_s, seed, str(data.get("method", METHOD)), structure)
+        except ShipidError as exc:
+            raise ShipidError(f"{where}: {exc}") from None
 
 
 def conservative_percentiles(values: np.ndarray, level: float = LEVEL, axis: int = 0

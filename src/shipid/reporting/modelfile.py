@@ -297,10 +297,13 @@ def rescaled_document(doc: Mapping, factor: float, to_rho: float | None = None,
             _scale_statistics(refinement["statistics"], ratios, factor, rho, to_rho)
     if out.get("uncertainty"):
         unc = out["uncertainty"]
+        # The members' structure: the model's, or a superset of it (select --bootstrap).
+        members = ensemble_from_document(doc, path, model).structure
+        member_ratios = froude_ratios(members, factor, rho, to_rho)
         thetas = np.asarray(unc["thetas"], dtype=float)
-        for dof, terms in model.structure.terms.items():
+        for dof, terms in members.terms.items():
             for t in terms:
-                thetas[:, DOFS.index(dof), unc["terms"].index(t)] *= ratios[dof][t]
+                thetas[:, DOFS.index(dof), unc["terms"].index(t)] *= member_ratios[dof][t]
         unc["thetas"] = thetas.tolist()
     if particulars is not None:
         p = dict(out["particulars"])

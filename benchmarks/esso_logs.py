@@ -1,0 +1,53 @@
+"""The Esso Osaka logs of ``../shared/data`` as the README's commands read them (Δk 0.5 s;
+zig-zags and turns trimmed to the manoeuvre, random runs whole), and the folds by condition the
+Esso studies train and judge on."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from shipid.data.io import read_log
+
+DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "esso-osaka"
+# Rudder amplitude [deg] and propeller speed [rps] of each zig-zag (the data README's table).
+ZIGZAGS = {"13_04_24": (20, 16.7), "13_14_21": (30, 16.7), "13_22_52": (15, 10),
+           "13_29_19": (15, 12), "13_42_53": (30, 10), "13_50_28": (30, 12),
+           "13_57_45": (20, 15), "14_03_39": (20, 12), "14_10_05": (20, 12)}  # fmt: skip
+README_HELD = "31-Jul-2020_12_29_58"
+
+
+def read(path: Path, trim: bool):
+    """One log, as ``shipid import --format osaka-frt [--start auto --end auto]`` and
+    ``--dt 0.5`` give it."""
+    kw = {"start": "auto", "end": "auto"} if trim else {}
+    return read_log(path, fmt="osaka-frt", dt=0.5, **kw)
+
+
+def esso_logs():
+    """(zig-zags by time of day, random runs by date and time, the two turns), or None when
+    ``../shared/data`` is absent."""
+    if not DATA.is_dir():
+        return None
+    zz = {p.stem[-8:]: read(p, True) for p in sorted((DATA / "zigzag").glob("*.csv"))}
+    rnd = {p.stem[7:]: read(p, False) for p in sorted((DATA / "random").glob("*.csv"))}
+    turns = [read(p, True) for p in sorted((DATA / "turning").glob("*.csv"))]
+    return zz, rnd, turns
+
+
+def condition_folds(rnd) -> dict[str, tuple[list[str], list[str], list[str], list[str]]]:
+    """Per fold: (training zig-zags, training random runs, held-out zig-zags, held-out random
+    runs); the turns are held out in every fold. Three folds reach beyond the training
+    conditions (rudder amplitude, propeller speed, zig-zags only), then the README's fold."""
+    return {
+        "30° zig-zags": ([k for k, (a, _) in ZIGZAGS.items() if a < 30], list(rnd),
+                         [k for k, (a, _) in ZIGZAGS.items() if a == 30], []),
+        "15-16.7 rps": ([k for k, (_, n) in ZIGZAGS.items() if n < 14], list(rnd),
+                        [k for k, (_, n) in ZIGZAGS.items() if n > 14], []),
+        "zig-zags only": (list(ZIGZAGS), [], [], list(rnd)),
+        "README": (list(ZIGZAGS), [k for k in rnd if k != README_HELD], [], [README_HELD]),
+    }  # fmt: skip
+
+
+def random_run_folds(rnd) -> dict[str, tuple[list[str], list[str], list[str], list[str]]]:
+    """Each random run held out in turn (with the turns), the rest and every zig-zag trained on."""
+    return {f"random {k}": (list(ZIGZAGS), [j for j in rnd if j != k], [], [k]) for k in rnd}

@@ -1,0 +1,103 @@
+"""Do the intervals of a selected model cover what it was not trained on? (issue #10, item 5)
+
+On the Esso Osaka logs, in seven folds (three beyond the training conditions, each random run
+held out in turn; ``esso_logs.py``), ``select`` (the README's library) and two ensembles of 100
+replicates of its model:
+
+* ``terms held``: the selected terms and γ refitted on moving-block resamples of the equations
+  (``bootstrap`` of ``weighted_refit``; what ``select --bootstrap`` gave before);
+* ``terms resampled``: ``select --bootstrap``'s ensemble now (``selection_ensemble``): each
+  replicate draws a candidate by how often the choice rule picks it on resampled held-out logs,
+  then refits it on a block resample.
+
+Judged on the held-out logs: whether the measured tactical diameter and steady yaw rate of each
+±35° turn lie in the 95 % intervals (28 checks in all), the intervals' mean width over the
+prediction, and the share of the held-out zig-zags' and random runs' samples whose measured r
+and u lie in the 95 % prediction bands. A calibrated 95 % interval covers 95 % of them.
+
+Run: .venv/bin/python benchmarks/study_selection_uncertainty.py
+"""
+
+from __future__ import annotations
+
+import os
+import time
+import warnings
+
+import numpy as np
+from esso_logs import condition_folds, esso_logs, random_run_folds
+
+from shipid.evaluation.validate import validate
+from shipid.identification.identify import weighted_refit
+from shipid.identification.select import select
+from shipid.identification.selection_ensemble import selection_ensemble
+from shipid.identification.uncertainty import bootstrap
+
+LIBRARY = "low-speed+wind+propeller-asymmetry"
+REPLICATES = 100
+KEYS = ("tactical_diameter", "steady_yaw_rate")
+
+
+def _band_share(v, log, state: str) -> float:
+    lo, hi = v.bands[state]
+    x = log[state].to_numpy()[: len(lo)]
+    return float(np.mean((x >= lo) & (x <= hi)))
+
+
+def main() -> None:
+    data = esso_logs()
+    if data is None:
+        print("../shared/data is absent")
+        return
+    zz, rnd, turns = data
+    folds = {**condition_folds(rnd), **random_run_folds(rnd)}
+    folds.pop("README")  # the same fold as "random 31-Jul-2020_12_29_58"
+    print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores; library {LIBRARY}; "
+          f"{REPLICATES} replicates\n")  # fmt: skip
+    print("| fold | chosen share | replicates | turns' TD and steady r in the 95 % interval | "
+          "interval width / prediction (TD, steady r) | held-out samples in the r, u bands |")
+    print("|---|---|---|---|---|---|")
+    t0 = time.perf_counter()
+    totals = {"terms held": [], "terms resampled": []}
+    widths = {k: [] for k in totals}
+    bands = {k: [] for k in totals}
+    for fold, (zk, rk, zig_held, rnd_held) in folds.items():
+        train = [zz[k] for k in zk] + [rnd[k] for k in rk]
+        held = [zz[k] for k in zig_held] + [rnd[k] for k in rnd_held]
+        sel = select(train, library=LIBRARY, cv="logo")
+        refit = weighted_refit(train, model=sel.model.structure, gamma=sel.gamma)
+        ensembles = {"terms held": bootstrap(train, refit, replicates=REPLICATES),
+                     "terms resampled": selection_ensemble(train, sel, replicates=REPLICATES)}
+        for label, ens in ensembles.items():
+            inside, width = [], []
+            for v in validate(sel.model, turns, ensemble=ens):
+                meas, pred = v.indices["measured"], v.indices["simulated"]
+                for key in KEYS:
+                    lo, hi = v.intervals["simulated"][key]
+                    inside.append(bool(lo <= meas[key] <= hi))
+                    width.append(abs((hi - lo) / pred[key]))
+            runs = validate(sel.model, held, ensemble=ens) if held else []
+            r_share, u_share = (float(np.mean([_band_share(v, lg, s)
+                                                for v, lg in zip(runs, held, strict=True)]))
+                                if held else float("nan") for s in ("r", "u"))  # fmt: skip
+            totals[label] += inside
+            widths[label] += width
+            bands[label].append((r_share, u_share))
+            print(f"| {fold} | {100 * sel.chosen_share:.0f} % | {label} | {sum(inside)} of "
+                  f"{len(inside)} | {np.mean(width[0::2]):.2f}, {np.mean(width[1::2]):.2f} | "
+                  f"{r_share:.2f}, {u_share:.2f} |")  # fmt: skip
+    print("\n| replicates | turns' indices in the 95 % interval | mean width / prediction "
+          "(TD, steady r) | held-out samples in the r, u bands (mean over folds) |")
+    print("|---|---|---|---|")
+    for label, inside in totals.items():
+        w = widths[label]
+        b = np.array(bands[label])
+        print(f"| {label} | {sum(inside)} of {len(inside)} ({100 * np.mean(inside):.0f} %) | "
+              f"{np.mean(w[0::2]):.2f}, {np.mean(w[1::2]):.2f} | {np.mean(b[:, 0]):.2f}, "
+              f"{np.mean(b[:, 1]):.2f} |")  # fmt: skip
+    print(f"\n{time.perf_counter() - t0:.0f} s")
+
+
+if __name__ == "__main__":
+    warnings.simplefilter("ignore")  # envelope and plausibility warnings of the candidates
+    main()

@@ -1,0 +1,93 @@
+"""Uncertainty of a selected model that includes the choice of its terms.
+
+A bootstrap of the selected structure (``shipid.identification.uncertainty.bootstrap``) holds the
+terms and γ at the selection's: its intervals say what the equation error leaves uncertain in
+*those* coefficients, not that other structures fitted the held-out logs almost as well and
+predict differently beyond them. Here each replicate first draws a candidate of the search (its
+terms and γ) with the probability ``select`` chose it on resampled held-out logs
+(``Candidate.share``, ``shipid.identification.select.selection_shares``), then refits it on a
+moving-block resample of the equations, as ``bootstrap`` does. A member's coefficient of a term
+its candidate lacks is 0, so every member is a model of the union of the drawn structures.
+
+When one candidate is always chosen, the ensemble is ``bootstrap`` of it, replicate for
+replicate (the block resamples come from the same random stream).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+import pandas as pd
+
+from shipid.dynamics.model import DOFS, ModelStructure
+from shipid.errors import ShipidError
+from shipid.identification.uncertainty import SELECTION_METHOD, Ensemble, _bar, block_weights
+
+
+def selection_ensemble(
+    logs: Sequence[pd.DataFrame],
+    selection,
+    replicates: int = 200,
+    block_s: float = 10.0,
+    seed: int = 0,
+    names: Sequence[str] | None = None,
+    progress: bool = False,
+) -> Ensemble:
+    """Ensemble of ``selection`` (a ``Selection``) over the choice of terms and the equations.
+
+    Parameters
+    ----------
+    logs : the logs ``select`` was given (the same ones, in the same rudder convention).
+    selection : what ``select`` returned; its ``shares`` say how often each candidate is chosen.
+    replicates, block_s, seed : as ``bootstrap``.
+    names : log names for messages.
+    """
+    import math
+
+    from shipid.identification.identify import weighted_refit
+
+    if not (isinstance(replicates, int) and replicates >= 10):
+        raise ShipidError(f"--bootstrap needs at least 10 replicates, got {replicates!r}")
+    if not (math.isfinite(block_s) and block_s > 0):
+        raise ShipidError(f"--block must be > 0 s, got {block_s!r}")
+    logs = [logs] if isinstance(logs, pd.DataFrame) else list(logs)
+    cands = list(selection.shares)
+    if not cands:
+        raise ShipidError("the selection has no candidate chosen on resampled held-out logs "
+                          "(no plausible candidate); no ensemble over its terms")  # fmt: skip
+    p = np.array([c.share for c in cands], dtype=float)
+    p /= p.sum()
+    point = selection.model
+    structure = _union(point.structure, [c.terms for c in cands])
+    columns = {t: j for j, t in enumerate(structure.all_terms)}
+    options = selection.options
+    dt = float(np.median(np.diff(logs[0]["t"].to_numpy())))
+    block = max(1, int(round(block_s / dt)))
+    lengths = [len(log) - 1 for log in logs]
+    rng = np.random.default_rng(seed)  # the block resamples: bootstrap's stream
+    draws = np.random.default_rng([seed, 1]).choice(len(cands), size=replicates, p=p)
+    refits: dict[int, object] = {}
+    thetas = np.zeros((replicates, 3, len(columns)))
+    bar = _bar(progress, replicates)
+    for k, i in enumerate(draws):
+        if i not in refits:
+            refits[i] = weighted_refit(logs, model=ModelStructure("candidate", cands[i].terms),
+                                       gamma=cands[i].gamma, names=names,
+                                       estimator=options.estimator, physics=options.physics)  # fmt: skip
+        member = refits[i](block_weights(lengths, block, rng))
+        for dof, coefs in member.coefficients.items():
+            for t, value in coefs.items():
+                thetas[k, DOFS.index(dof), columns[t]] = value
+        bar.update()
+    bar.close()
+    return Ensemble(point, thetas, float(block_s), int(seed), SELECTION_METHOD, structure)
+
+
+def _union(first: ModelStructure, others) -> ModelStructure:
+    """Per equation the terms of ``first``, then those of ``others`` it lacks, in order."""
+    terms = {d: list(first.terms.get(d, ())) for d in DOFS}
+    for t_map in others:
+        for d, ts in t_map.items():
+            terms[d] += [t for t in ts if t not in terms[d]]
+    return ModelStructure(f"{first.name} (ensemble)", {d: tuple(t) for d, t in terms.items() if t})

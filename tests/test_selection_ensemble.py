@@ -1,0 +1,126 @@
+"""How firm select's choice is, and an ensemble over the choice of terms (issue #10): the shares
+against an exhaustive count of the resamples, the one-candidate case against the plain
+bootstrap, the varied structure in model files and through rescaling."""
+
+import itertools
+import json
+import math
+
+import numpy as np
+import pytest
+from cli_helpers import run
+
+from shipid.data.io import write_log
+from shipid.data.preprocess import lowpass
+from shipid.dynamics.prime import froude_ratios
+from shipid.errors import ShipidError
+from shipid.identification.identify import weighted_refit
+from shipid.identification.select import Candidate, select, selection_shares
+from shipid.identification.selection_ensemble import selection_ensemble
+from shipid.identification.uncertainty import Ensemble, bootstrap
+from shipid.reporting.modelfile import ensemble_from_document, model_from_document
+from shipid.trials.manoeuvres import zigzag
+from shipid.vessels import PAPER_IMU, scale_ship
+
+
+def _cand(n_terms: int, folds) -> Candidate:
+    c = Candidate({"r": tuple(f"v^{k + 1}" for k in range(n_terms))}, 1e4)
+    c.fold_scores = list(folds)
+    c.score = float(np.mean(folds))
+    return c
+
+
+def _exhaustive(cands, plausible, one_se) -> dict:
+    """The choice rule over every one of the K^K equally likely resamples of K folds."""
+    K = len(cands[0].fold_scores)
+    counts: dict = {}
+    for idx in itertools.product(range(K), repeat=K):
+        f = {c.key: np.array(c.fold_scores)[list(idx)] for c in cands}
+        ok = [c for c in cands if plausible(c)]
+        best = min(ok, key=lambda c: f[c.key].mean())
+        if one_se:
+            limit = f[best.key].mean() + f[best.key].std(ddof=1) / math.sqrt(K)
+            within = [c for c in ok if f[c.key].mean() <= limit]
+            best = min(within, key=lambda c: (c.n_terms(), f[c.key].mean()))
+        counts[best.key] = counts.get(best.key, 0) + 1
+    return {k: v / K**K for k, v in counts.items()}
+
+
+@pytest.mark.parametrize("one_se", [False, True])
+def test_shares_match_an_exhaustive_count_of_the_resamples(one_se):
+    cands = [_cand(3, [0.30, 0.50, 0.20]), _cand(2, [0.35, 0.40, 0.28]),
+             _cand(1, [0.60, 0.30, 0.25]), _cand(4, [0.10, 0.20, 0.10])]  # fmt: skip
+    plausible = lambda c: c.n_terms() != 4  # noqa: E731 (the best-scoring one is implausible)
+    shares = selection_shares(cands, plausible, one_se, resamples=20000, seed=3)
+    exact = _exhaustive(cands, plausible, one_se)
+    assert cands[3].key not in shares
+    assert sum(shares.values()) == pytest.approx(1.0)
+    assert set(shares) == set(exact)
+    for key, p in exact.items():
+        assert shares[key] == pytest.approx(p, abs=0.01)
+
+
+def test_a_candidate_best_on_every_log_is_always_chosen():
+    cands = [_cand(2, [0.2, 0.3, 0.1, 0.2]), _cand(3, [0.4, 0.5, 0.3, 0.6])]
+    assert selection_shares(cands, lambda c: True, True) == {cands[0].key: 1.0}
+
+
+@pytest.fixture(scope="module")
+def zigzags():
+    ship = scale_ship(rudder_rate_deg=9.6)
+    out = []
+    for i, (a, first) in enumerate(((20, "port"), (15, "starboard"), (25, "port"))):
+        log = zigzag(ship, a, a, duration=60, dt=0.2, method="euler", approach=2.0,
+                     first=first).log  # fmt: skip
+        out.append(lowpass(PAPER_IMU.apply(log, seed=20 + i), 0.5))
+    return out
+
+
+def test_one_candidate_gives_the_bootstrap_of_it_to_the_bit(zigzags):
+    sel = select(zigzags, library="blanke", search="none", gammas=(1e4,))
+    assert len(sel.shares) == 1 and sel.chosen_share == 1.0
+    ens = selection_ensemble(zigzags, sel, replicates=12, seed=5)
+    plain = bootstrap(zigzags, weighted_refit(zigzags, model=sel.model.structure,
+                                              gamma=sel.gamma), replicates=12, seed=5)  # fmt: skip
+    assert not ens.varies_structure and ens.term_texts == plain.model.term_texts
+    np.testing.assert_array_equal(ens.thetas, plain.thetas)
+
+
+def test_varied_structure_members_file_and_rescale(zigzags, tmp_path, capsys):
+    paths = [write_log(log, tmp_path / f"zz{i}.csv") for i, log in enumerate(zigzags)]
+    code, out, err = run(["select", *paths, "--library", "blanke+abkowitz3", "--quiet",
+                          "--bootstrap", "40", "-o", tmp_path / "m.json"], capsys)  # fmt: skip
+    assert code == 0, err
+    assert "resamples of the held-out logs: this candidate" in out and "inclusion" in out
+    doc = json.loads((tmp_path / "m.json").read_text(encoding="utf-8"))
+    model = model_from_document(doc, "m.json")
+    ens = ensemble_from_document(doc, "m.json", model)
+    shares = [c for c in doc["identification"]["selection"]["candidates"] if c["share"] > 0]
+    assert sum(c["share"] for c in shares) == pytest.approx(1.0)
+    assert len(shares) > 1 and ens.varies_structure  # these logs leave the choice open
+    # Every member holds the terms of one shared candidate and nothing else (0 elsewhere).
+    allowed = [{(d, t) for d in "uvr" for t in c[f"terms_{d}"].split(", ")} for c in shares]
+    for member in ens.members():
+        held = {(d, t) for d, cs in member.coefficients.items() for t, x in cs.items() if x != 0}
+        assert any(held <= a and len(a - held) == 0 for a in allowed)
+    # The file's ensemble: the same members after a round trip.
+    again = Ensemble.from_dict(json.loads(json.dumps(ens.to_dict())), model)
+    np.testing.assert_array_equal(again.thetas, ens.thetas)
+    assert again.structure == ens.structure
+    broken = dict(ens.to_dict(), structure={"u": ["1"], "v": ["1"], "r": ["1"]}, terms=["1"],
+                  thetas=ens.thetas[:, :, :1].tolist())  # fmt: skip
+    with pytest.raises(ShipidError, match="lacks the model's term"):
+        Ensemble.from_dict(broken, model)
+    # Rescaled: every member term, in the model or not, by its own Froude ratio.
+    code, out, err = run(["rescale", tmp_path / "m.json", "--factor", "10", "-o",
+                          tmp_path / "big.json"], capsys)  # fmt: skip
+    assert code == 0, err
+    big = json.loads((tmp_path / "big.json").read_text(encoding="utf-8"))["uncertainty"]
+    ratios = froude_ratios(ens.structure, 10.0)
+    t0, t1 = np.asarray(doc["uncertainty"]["thetas"]), np.asarray(big["thetas"])
+    outside = [(d, t) for d, ts in ens.structure.terms.items() for t in ts
+               if t not in model.structure.terms[d]]  # fmt: skip
+    assert outside
+    for d, t in outside + [("r", model.structure.terms["r"][0])]:
+        i, j = "uvr".index(d), ens.term_texts.index(t)
+        np.testing.assert_allclose(t1[:, i, j], t0[:, i, j] * ratios[d][t], rtol=1e-12)
