@@ -44,8 +44,11 @@ print(f"chosen on {100 * selection.chosen_share:.0f} % of resampled held-out log
 ensemble = shipid.selection_ensemble(training, selection, replicates=100)
 
 # 3. Predict what was held out: free-run errors (rmse, fit %) and the turning indices with
-#    their 95 % intervals over the ensemble.
-results = validate(selection.model, turns + [randoms[held_out]], ensemble=ensemble)
+#    their 95 % intervals over the ensemble; each log's share of samples inside the error band
+#    that select measured on its own held-out folds.
+print(selection.error_band.describe())
+results = validate(selection.model, turns + [randoms[held_out]], ensemble=ensemble,
+                   error_band=selection.error_band)
 print(metrics_frame(results).to_markdown(index=False, floatfmt=".3g"))
 print(indices_frame(results).dropna(subset=["measured"]).to_markdown(index=False, floatfmt=".3g"))
 r_spread = float(np.std(randoms[held_out]["r"]))

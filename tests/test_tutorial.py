@@ -45,3 +45,5 @@ def test_tutorial_runs_to_the_imo_table(capsys):
             assert lo <= meas[key] <= hi, (v.name, key)
     assert ns["ensemble"].varies_structure and ns["selection"].chosen_share < 0.5
     assert results[-1].metrics["r"]["std"] < 0.5 * ns["r_spread"]
+    # The README: 97 % of the held-out random run's r inside the cross-validated band.
+    assert results[-1].band_shares["r"] == pytest.approx(0.97, abs=0.005)

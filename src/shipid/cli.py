@@ -550,6 +550,9 @@ def cmd_select(args) -> int:
     print(shown[cols].to_markdown(index=False, floatfmt=".4g"))
     print("\nHeld-out logs (the chosen structure fitted without each):")
     print(_fold_table(sel.folds))
+    if sel.error_band is not None:
+        print(f"Their {sel.error_band.describe()}; stored in the model file, validate reports "
+              "each log's share of samples inside it.")  # fmt: skip
     speed, rps = _approach(logs[0], "u"), _approach(logs[0], "n")
     plausibility, notes = check_plausibility(sel.model, speed, rps if sel.model.uses_rps else None)
     ident.warnings.extend(f"plausibility: {n}" for n in notes)
@@ -965,6 +968,7 @@ def cmd_validate(args) -> int:
     from shipid.outputs import OutputSet, check_outputs
     from shipid.reporting.modelfile import (
         ensemble_from_document,
+        error_band_from_document,
         has_refinement,
         load_document,
         model_from_document,
@@ -980,6 +984,7 @@ def cmd_validate(args) -> int:
               "validates")  # fmt: skip
     model = model_from_document(doc, args.model, "lssvm" if args.lssvm else "model")
     ensemble = None if args.no_bands else ensemble_from_document(doc, args.model, model)
+    band = None if args.no_bands or args.lssvm else error_band_from_document(doc, args.model)
     cond = training_conditions(doc)
     env = cond["envelope"]
     from shipid.data.io import read_log
@@ -1000,7 +1005,7 @@ def cmd_validate(args) -> int:
     from tqdm.auto import tqdm
 
     vals = [validate(model, log, [name], method=args.method, kind=args.kind,
-                     smooth_s=args.smooth, ensemble=ensemble)[0]
+                     smooth_s=args.smooth, ensemble=ensemble, error_band=band)[0]
             for log, name in tqdm(list(zip(logs, names, strict=True)), desc="logs", unit="log",
                                   disable=args.quiet or len(logs) < 3)]  # fmt: skip
     for v, log in zip(vals, logs, strict=True):
@@ -1008,6 +1013,9 @@ def cmd_validate(args) -> int:
             v.warnings.extend(outside_envelope(env, log))
     good = [v for v in vals if v.error is None]
     if good:
+        if band is not None:
+            print(f"The model's {band.describe()}: a log like those is inside it for about "
+                  f"{100 * band.level:g} % of its samples (columns 'in CV band').")  # fmt: skip
         print(metrics_frame(good).to_markdown(index=False, floatfmt=".4g"))
         table = indices_frame(good)
         if len(table):
@@ -1069,7 +1077,8 @@ def cmd_validate(args) -> int:
                 title = Path(v.name).name
                 jobs = [("fit", stem + ext, partial(plots.measured_vs_simulated, log,
                                                    v.simulation.log, title=title,
-                                                   bands=v.bands))]  # fmt: skip
+                                                   bands=v.bands,
+                                                   error_band=v.error_band))]  # fmt: skip
                 if args.resid:
                     jobs.append(("resid", stem + "-resid" + ext, partial(
                         plots.residuals, residuals[v.name], title=f"{title}: residual analysis")))
@@ -1527,7 +1536,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="validate the LS-SVM model a refined model file keeps")
     p.add_argument("--no-bands", action="store_true",
                    help="skip the bootstrap ensemble of the model file (its prediction bands and "
-                   "index intervals cost one free run per replicate)")
+                   "index intervals cost one free run per replicate) and its cross-validated "
+                   "error band")
     p.add_argument("--plot-format", default="png", choices=("png", "svg", "pdf"),
                    help="format of the --plots figures (default %(default)s)")
     p.add_argument("--resid", action="store_true",

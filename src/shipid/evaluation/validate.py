@@ -29,6 +29,7 @@ from shipid.dynamics.model import ManoeuvringModel
 from shipid.dynamics.simulate import SimulationResult, simulate_log
 from shipid.dynamics.steering import SteeringMachine
 from shipid.errors import ShipidError
+from shipid.evaluation.error_band import ErrorBand
 from shipid.evaluation.metrics import error_metrics
 from shipid.identification.uncertainty import (
     Ensemble,
@@ -60,6 +61,9 @@ class Validation:
     bands: dict | None = None
     ensemble_diverged: int = 0
     intervals: dict[str, dict] = field(default_factory=dict)
+    # With a cross-validated error band: the band and, per state, the share of samples in it.
+    error_band: ErrorBand | None = None
+    band_shares: dict[str, float] | None = None
 
     def to_frame(self):
         """The metrics as a DataFrame: one row per state (u, v, r), one column per metric."""
@@ -78,6 +82,7 @@ class Validation:
                 "index_intervals": {k: {i: list(b) for i, b in v.items()}
                                     for k, v in self.intervals.items()},
                 "ensemble_diverged": self.ensemble_diverged if self.bands else None,
+                "within_error_band": self.band_shares,
                 "warnings": self.warnings}  # fmt: skip
 
 
@@ -91,9 +96,11 @@ def free_run(model, log: pd.DataFrame, method: str = "euler") -> tuple[Simulatio
 
 def validate_log(model, log: pd.DataFrame, name: str, method: str = "euler",
                  kind: str | None = None, smooth_s: float = 0.0,
-                 ensemble: Ensemble | None = None) -> Validation:  # fmt: skip
+                 ensemble: Ensemble | None = None,
+                 error_band: ErrorBand | None = None) -> Validation:  # fmt: skip
     """Validate ``model`` on one log (raises ``ShipidError`` when it cannot). With a bootstrap
-    ``ensemble`` of the model: prediction bands and intervals on the predicted indices."""
+    ``ensemble`` of the model: prediction bands and intervals on the predicted indices; with a
+    cross-validated ``error_band``: the share of the log's samples within it."""
     sim, metrics = free_run(model, log, method)
     trial = describe_trial(log, kind)
     indices: dict[str, dict] = {}
@@ -103,6 +110,10 @@ def validate_log(model, log: pd.DataFrame, name: str, method: str = "euler",
         if trial.kind == "zigzag" and isinstance(model, ManoeuvringModel | Vessel):
             indices["closed_loop"] = _replica_indices(model, log, method, trial)
     out = Validation(name, sim, metrics, indices, trial.kind)
+    if error_band is not None:
+        out.error_band = error_band
+        out.band_shares = error_band.shares_within(log[list(STATES)].to_numpy(dtype=float),
+                                                   sim.log[list(STATES)].to_numpy())  # fmt: skip
     if ensemble is not None:
         runs = ensemble_runs(ensemble, log, method)
         out.bands, out.ensemble_diverged = free_run_bands(runs, len(log))
@@ -135,18 +146,21 @@ def validate(
     kind: str | None = None,
     smooth_s: float = 0.0,
     ensemble: Ensemble | None = None,
+    error_band: ErrorBand | None = None,
 ) -> list[Validation]:
     """Validate ``model`` on each log; errors are over the simulated (not diverged) part. A log
     that cannot be validated gets a ``Validation`` with ``error`` set; the others go on. With a
     bootstrap ``ensemble`` of the model (``shipid.identification.uncertainty``): bands and
-    intervals."""
+    intervals; with a cross-validated ``error_band`` (``Selection.error_band``): each log's share
+    of samples within it."""
     if isinstance(logs, pd.DataFrame):
         logs = [logs]
     names = names or [log.attrs.get("name", f"log {i}") for i, log in enumerate(logs)]
     out = []
     for log, name in zip(logs, names, strict=True):
         try:
-            out.append(validate_log(model, log, name, method, kind, smooth_s, ensemble))
+            out.append(validate_log(model, log, name, method, kind, smooth_s, ensemble,
+                                    error_band))
         except ShipidError as exc:
             message = str(exc)
             out.append(Validation(name, None, {}, {}, None,

@@ -49,6 +49,7 @@ from shipid.dynamics.model import DOFS, ManoeuvringModel, ModelStructure, get_st
 from shipid.dynamics.simulate import DivergenceBounds, input_array, run_kernel
 from shipid.dynamics.terms import INPUT_SIGNALS, parse_term, term_code
 from shipid.errors import ShipidError
+from shipid.evaluation.error_band import ErrorBand, error_band
 from shipid.identification.estimators import LINEAR_ESTIMATORS, check_estimator_name, fit_linear
 from shipid.identification.physics import PhysicsOptions, dof_physics
 from shipid.identification.regression import common_sampling_time, log_terms
@@ -173,6 +174,8 @@ class Selection:
     ranking: dict[str, list[tuple[str, float]]]
     warnings: list[str] = field(default_factory=list)
     shares: list[Candidate] = field(default_factory=list)  # share > 0, most often chosen first
+    # What the chosen structure's free runs missed on the logs it was not fitted to.
+    error_band: ErrorBand | None = None
 
     @property
     def chosen_share(self) -> float:
@@ -188,7 +191,8 @@ class Selection:
                 "score": self.score, "ranking": {d: [[t, e] for t, e in r]
                                                  for d, r in self.ranking.items()},
                 "candidates": self.candidates.to_dict(orient="records"), "folds": self.folds,
-                "warnings": self.warnings}  # fmt: skip
+                "warnings": self.warnings,
+                "error_band": self.error_band.to_dict() if self.error_band else None}  # fmt: skip
 
 
 # ---------------------------------------------------------------------------- the data, once
@@ -600,14 +604,15 @@ def select(
     structure = ModelStructure(f"selected from {library.name}", current.terms)
     ident = identify(logs, model=structure, gamma=current.gamma, names=names, force=True,
                      estimator=options.estimator, physics=options.physics)  # fmt: skip
-    folds_report = _fold_report(data, scorer, current, logs, names)
+    folds_report, held_out_runs = _fold_report(data, scorer, current, logs, names)
     table = _table(scorer.cache.values(), current)
     failed = [c for c in scorer.cache.values() if c.folds_diverged == len(scorer.held)]
     if failed:
         notes.append(f"{len(failed)} candidate(s) diverged in every fold (kept in the table)")
     shared = sorted((c for c in scorer.cache.values() if c.share > 0), key=lambda c: -c.share)
+    band = error_band(held_out_runs) if held_out_runs else None
     return Selection(ident.model, ident, current.gamma, current.score, table, folds_report,
-                     options, library, ranking, notes + ident.warnings, shared)  # fmt: skip
+                     options, library, ranking, notes + ident.warnings, shared, band)  # fmt: skip
 
 
 def selection_shares(cands: Sequence[Candidate], plausible, one_standard_error: bool = True,
@@ -734,12 +739,12 @@ def _table(cands, chosen: Candidate) -> pd.DataFrame:
     return df.sort_values("score", kind="stable").reset_index(drop=True)
 
 
-def _fold_report(data, scorer: _Scorer, chosen: Candidate, logs, names) -> list[dict]:
+def _fold_report(data, scorer: _Scorer, chosen: Candidate, logs, names):
     """Per held-out log: the chosen candidate fitted without it, its free-run errors (the
-    ``validate`` metrics) and indices."""
+    ``validate`` metrics) and indices; and the (measured, simulated) u, v, r of those runs."""
     from shipid.evaluation.validate import validate_log
 
-    out = []
+    out, runs = [], []
     n_logs = len(logs)
     for fold in scorer.folds:
         train = [j for j in range(n_logs) if j not in fold]
@@ -753,6 +758,7 @@ def _fold_report(data, scorer: _Scorer, chosen: Candidate, logs, names) -> list[
                             "metrics": {s: v.metrics[s]["std"] for s in STATES},
                             "spread": {s: float(np.std(logs[h][s])) for s in STATES},
                             "kind": v.kind, "indices": v.indices})  # fmt: skip
+                runs.append((data.measured[h], v.simulation.log[list(STATES)].to_numpy()))
             except ShipidError as exc:
                 out.append({"held_out": names[h], "error": str(exc)})
-    return out
+    return out, runs

@@ -84,7 +84,8 @@ def validation_report(
         drawn = (figures or {}).get(v.name, {})
         parts += [f"<h2>{html.escape(name)}</h2>",
                   _figure_html(lambda p, v=v, log=log, name=name: plots.measured_vs_simulated(
-                      log, v.simulation.log, p, name), drawn.get("fit"))]
+                      log, v.simulation.log, p, name, bands=v.bands, error_band=v.error_band),
+                      drawn.get("fit"))]
         if residuals and v.name in residuals:
             parts.append(_figure_html(lambda p, v=v, name=name: plots.residuals(
                 residuals[v.name], p, f"{name}: residual analysis"), drawn.get("resid")))

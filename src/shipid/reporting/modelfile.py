@@ -260,6 +260,21 @@ def ensemble_from_document(doc: Mapping, path: str | Path, model: ManoeuvringMod
     return Ensemble.from_dict(data, model, f"{path}: uncertainty")
 
 
+def error_band_from_document(doc: Mapping, path: str | Path):
+    """The cross-validated error band of a model file (``shipid select``), or None. It describes
+    the file's model: a refined model has not been cross-validated, so it has none."""
+    ident = doc.get("identification") or {}
+    selection = ident.get("selection") if isinstance(ident, Mapping) else None
+    data = selection.get("error_band") if isinstance(selection, Mapping) else None
+    if not data or has_refinement(doc):
+        return None
+    from shipid.evaluation.error_band import ErrorBand
+
+    if not isinstance(data, Mapping):
+        raise ShipidError(f"{path}: identification.selection.error_band must be a mapping")
+    return ErrorBand.from_dict(data, f"{path}: identification.selection.error_band")
+
+
 def rescaled_document(doc: Mapping, factor: float, to_rho: float | None = None,
                       path: str | Path = "model file") -> dict:  # fmt: skip
     """The model file of a geometrically similar ship ``factor`` times as long (Froude scaling,
@@ -295,6 +310,9 @@ def rescaled_document(doc: Mapping, factor: float, to_rho: float | None = None,
                 refinement[key] = scale_model(refinement[key])
         if refinement.get("statistics"):
             _scale_statistics(refinement["statistics"], ratios, factor, rho, to_rho)
+    band = error_band_from_document(doc, path)
+    if band is not None:  # in m/s and rad/s: a Froude-similar ship's speeds are k times these
+        out["identification"]["selection"]["error_band"] = band.scaled(k).to_dict()
     if out.get("uncertainty"):
         unc = out["uncertainty"]
         # The members' structure: the model's, or a superset of it (select --bootstrap).

@@ -83,9 +83,11 @@ def rudder_and_heading(log: pd.DataFrame, path: str | Path, title: str = "",
 def measured_vs_simulated(measured: pd.DataFrame, simulated: pd.DataFrame, path: str | Path,
                           title: str = "", out: OutputSet | None = None,
                           bands: Mapping[str, tuple[np.ndarray, np.ndarray]] | None = None,
-                          ) -> Path:  # fmt: skip
+                          error_band=None) -> Path:  # fmt: skip
     """u, v, r measured and simulated with their errors; rudder and heading; x–y tracks.
-    ``bands``: {state: (lower, upper)} prediction band drawn around the simulation."""
+    ``bands``: {state: (lower, upper)} prediction band drawn around the simulation;
+    ``error_band`` (``shipid.evaluation.error_band.ErrorBand``): its ± half-widths drawn on the
+    errors."""
     fig = plt.figure(figsize=(12, 11))
     grid = fig.add_gridspec(4, 2, height_ratios=[1, 1, 1, 1.3])
     n = len(simulated)
@@ -110,6 +112,14 @@ def measured_vs_simulated(measured: pd.DataFrame, simulated: pd.DataFrame, path:
         err = measured[s].to_numpy()[:n] - simulated[s].to_numpy()
         err_ax.plot(t_sim, err, lw=0.8, color="C3")
         err_ax.axhline(0.0, color="0.3", lw=0.6)
+        width = None if error_band is None else error_band.half_width[s]
+        if width is not None and np.isfinite(width):
+            for sign in (1, -1):
+                err_ax.axhline(sign * width, color="C1", lw=0.9, ls="--",
+                               label=f"cross-validated {100 * error_band.level:g} % error band"
+                               if sign > 0 else None)  # fmt: skip
+            if i == 0:
+                err_ax.legend(loc="best", fontsize=8)
         err_ax.set_ylabel(ERROR_LABELS[s])
         err_ax.grid(alpha=0.3)
         if i == 0:

@@ -69,6 +69,8 @@ def metrics_frame(validations: Sequence[Validation]) -> pd.DataFrame:
         row.update({f"fit {s} [%]": m[s]["fit_percent"] for s in STATES})
         row.update({f"bias {s}": m[s]["mean"] for s in STATES})
         row.update({f"std {s}": m[s]["std"] for s in STATES})
+        if v.band_shares is not None:
+            row.update({f"in CV band {s} [%]": 100 * v.band_shares[s] for s in STATES})
         row["diverged"] = (f"at {v.simulation.diverged_at:.1f} s" if v.simulation.diverged
                            else "no")  # fmt: skip
         rows.append(row)

@@ -1,0 +1,117 @@
+"""The cross-validated error band (issue #10): the conformal quantile against its definition and
+its coverage of new errors from a known distribution; select's band against held-out free runs
+recomputed by hand; the band in model files, validate and rescale."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+from cli_helpers import run
+
+from shipid.data.io import write_log
+from shipid.data.preprocess import lowpass
+from shipid.dynamics.simulate import simulate_log
+from shipid.errors import ShipidError
+from shipid.evaluation.error_band import ErrorBand, conformal_quantile, error_band
+from shipid.evaluation.validate import validate
+from shipid.identification.identify import identify
+from shipid.identification.select import select
+from shipid.trials.manoeuvres import zigzag
+from shipid.vessels import PAPER_IMU, scale_ship
+
+
+def test_conformal_quantile_is_the_rank_of_its_definition():
+    e = np.arange(1.0, 20.0)  # 19 errors: the ⌈20 · 0.95⌉ = 19th smallest
+    assert conformal_quantile(e[::-1], 0.95) == 19.0
+    assert conformal_quantile(e, 0.5) == 10.0  # ⌈20 · 0.5⌉ = 10th
+    assert conformal_quantile(np.arange(10.0), 0.95) == math.inf  # ⌈11 · 0.95⌉ = 11 > 10
+
+
+@pytest.mark.parametrize("level", [0.8, 0.95])
+def test_the_band_holds_its_level_of_new_exchangeable_errors(level):
+    rng = np.random.default_rng(4)
+    runs = []
+    for _ in range(20):  # 20 held-out "logs" of 300 samples, heavy-tailed errors per state
+        measured = rng.normal(size=(300, 3))
+        runs.append((measured, measured + rng.laplace(scale=[0.1, 0.02, 0.005], size=(300, 3))))
+    band = error_band(runs, level)
+    assert band.logs == 20 and band.samples == 6000
+    fresh = rng.normal(size=(200_000, 3))
+    shares = band.shares_within(fresh, fresh + rng.laplace(scale=[0.1, 0.02, 0.005],
+                                                            size=(200_000, 3)))  # fmt: skip
+    for s in "uvr":
+        assert shares[s] == pytest.approx(level, abs=0.01)
+    # Closed form of the Laplace quantile: |e| ≤ b ln(1 / (1 − level)) with probability level.
+    assert band.half_width["u"] == pytest.approx(0.1 * math.log(1 / (1 - level)), rel=0.06)
+
+
+def test_samples_after_a_divergence_are_outside():
+    measured = np.zeros((100, 3))
+    band = error_band([(measured, np.zeros((90, 3)))], 0.95)  # 10 % of the samples diverged
+    assert band.half_width == {"u": math.inf, "v": math.inf, "r": math.inf}
+    band = error_band([(measured, np.zeros((99, 3)))], 0.95)
+    assert band.half_width["r"] == 0.0
+    assert band.shares_within(measured, np.zeros((80, 3)))["u"] == 0.8
+
+
+@pytest.fixture(scope="module")
+def zigzags():
+    ship = scale_ship(rudder_rate_deg=9.6)
+    out = []
+    for i, (a, first) in enumerate(((20, "port"), (15, "starboard"), (25, "port"))):
+        log = zigzag(ship, a, a, duration=60, dt=0.2, method="euler", approach=2.0,
+                     first=first).log  # fmt: skip
+        out.append(lowpass(PAPER_IMU.apply(log, seed=30 + i), 0.5))
+    return out
+
+
+def test_select_band_is_the_quantile_of_its_held_out_free_runs(zigzags):
+    sel = select(zigzags, library="blanke", search="none", gammas=(1e4,))
+    runs = []
+    for i, log in enumerate(zigzags):
+        fold = identify([x for j, x in enumerate(zigzags) if j != i], model=sel.model.structure,
+                        gamma=sel.gamma, force=True).model  # fmt: skip
+        runs.append(np.abs(simulate_log(fold, log).log[["u", "v", "r"]].to_numpy()
+                           - log[["u", "v", "r"]].to_numpy()))  # fmt: skip
+    errors = np.vstack(runs)
+    k = math.ceil((len(errors) + 1) * 0.95)
+    for j, s in enumerate("uvr"):
+        assert sel.error_band.half_width[s] == pytest.approx(np.sort(errors[:, j])[k - 1],
+                                                             rel=1e-9)  # fmt: skip
+    assert sel.error_band.logs == 3 and sel.error_band.samples == len(errors)
+    # Validated with it: each log's share of samples inside, as counted here.
+    v = validate(sel.model, zigzags[:1], error_band=sel.error_band)[0]
+    err = np.abs(v.simulation.log[["u", "v", "r"]].to_numpy() - zigzags[0][["u", "v", "r"]].to_numpy())
+    assert v.band_shares["r"] == pytest.approx(np.mean(err[:, 2] <= sel.error_band.half_width["r"]))
+
+
+def test_band_in_the_model_file_validate_and_rescale(zigzags, tmp_path, capsys):
+    paths = [write_log(log, tmp_path / f"zz{i}.csv") for i, log in enumerate(zigzags)]
+    code, out, err = run(["select", *paths, "--library", "blanke", "--quiet", "-o",
+                          tmp_path / "m.json"], capsys)  # fmt: skip
+    assert code == 0, err
+    assert "cross-validated 95 % error band (free runs of 3 held-out logs" in out
+    doc = json.loads((tmp_path / "m.json").read_text(encoding="utf-8"))
+    band = ErrorBand.from_dict(doc["identification"]["selection"]["error_band"])
+    code, out, err = run(["validate", tmp_path / "m.json", paths[0], "--json",
+                          tmp_path / "v.json"], capsys)  # fmt: skip
+    assert code == 0, err
+    assert "in CV band r [%]" in out and f"r ±{band.half_width['r']:.4g} rad/s" in out
+    record = json.loads((tmp_path / "v.json").read_text(encoding="utf-8"))["logs"][0]
+    assert 0.5 < record["within_error_band"]["r"] <= 1.0
+    # A ship 16 times as long: speeds ×4, yaw rates ÷4.
+    code, out, err = run(["rescale", tmp_path / "m.json", "--factor", "16", "-o",
+                          tmp_path / "big.json"], capsys)  # fmt: skip
+    assert code == 0, err
+    big = json.loads((tmp_path / "big.json").read_text(encoding="utf-8"))
+    scaled = big["identification"]["selection"]["error_band"]["half_width"]
+    assert scaled["u"] == pytest.approx(4 * band.half_width["u"], rel=1e-12)
+    assert scaled["r"] == pytest.approx(band.half_width["r"] / 4, rel=1e-12)
+    # A malformed band: one line naming the file and the field, exit 1.
+    doc["identification"]["selection"]["error_band"]["level"] = 2
+    (tmp_path / "bad.json").write_text(json.dumps(doc), encoding="utf-8")
+    code, out, err = run(["validate", tmp_path / "bad.json", paths[0]], capsys)
+    assert code == 1 and "bad.json: identification.selection.error_band" in err
+    with pytest.raises(ShipidError, match="not an error band"):
+        ErrorBand.from_dict({"level": 0.95})
