@@ -115,3 +115,13 @@ def test_band_in_the_model_file_validate_and_rescale(zigzags, tmp_path, capsys):
     assert code == 1 and "bad.json: identification.selection.error_band" in err
     with pytest.raises(ShipidError, match="not an error band"):
         ErrorBand.from_dict({"level": 0.95})
+
+
+def test_a_band_from_blocks_says_so(zigzags):
+    sel = select(zigzags[:1], library="blanke", search="none", gammas=(1e4,), cv="blocks:3")
+    band = sel.error_band
+    assert band.held_out == "blocks" and band.logs == 3
+    assert "held-out blocks" in band.describe() and "whole logs stray further" in band.describe()
+    assert ErrorBand.from_dict(band.to_dict()) == band
+    with pytest.raises(ShipidError, match="held_out must be"):
+        ErrorBand.from_dict(dict(band.to_dict(), held_out="folds"))

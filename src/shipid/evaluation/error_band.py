@@ -40,6 +40,8 @@ class ErrorBand:
     logs: int
     samples: int
     method: str = METHOD
+    # What was held out: "logs", or "blocks" (cut from logs: shorter runs that stray less)
+    held_out: str = "logs"
 
     def shares_within(self, measured: np.ndarray, simulated: np.ndarray) -> dict[str, float]:
         """Per state, the share of a log's samples (``measured`` (n, 3) u, v, r) whose free run
@@ -58,21 +60,23 @@ class ErrorBand:
         w = self.half_width
         return ErrorBand({"u": w["u"] * speed_ratio, "v": w["v"] * speed_ratio,
                           "r": w["r"] / speed_ratio}, self.level, self.logs, self.samples,
-                         self.method)  # fmt: skip
+                         self.method, self.held_out)  # fmt: skip
 
     def describe(self) -> str:
         """One line: the half-widths and where they come from."""
         def fmt(x: float) -> str:
             return "not bounded" if math.isinf(x) else f"±{x:.4g}"
 
+        caveat = "; whole logs stray further" if self.held_out == "blocks" else ""
         return (f"cross-validated {100 * self.level:g} % error band (free runs of "
-                f"{self.logs} held-out logs, {self.samples} samples): u {fmt(self.half_width['u'])} "
-                f"m/s, v {fmt(self.half_width['v'])} m/s, r {fmt(self.half_width['r'])} rad/s")
+                f"{self.logs} held-out {self.held_out}, {self.samples} samples{caveat}): "
+                f"u {fmt(self.half_width['u'])} m/s, v {fmt(self.half_width['v'])} m/s, "
+                f"r {fmt(self.half_width['r'])} rad/s")
 
     def to_dict(self) -> dict:
         """JSON-ready (∞ as null)."""
         return {"level": self.level, "logs": self.logs, "samples": self.samples,
-                "method": self.method,
+                "method": self.method, "held_out": self.held_out,
                 "half_width": {s: None if math.isinf(x) else float(x)
                                for s, x in self.half_width.items()}}  # fmt: skip
 
@@ -87,7 +91,10 @@ class ErrorBand:
             raise ShipidError(f"{where}: not an error band ({exc})") from None
         if not 0 < level < 1 or any(not w >= 0 for w in widths.values()):
             raise ShipidError(f"{where}: level must be in (0, 1) and half-widths ≥ 0")
-        return cls(widths, level, logs, samples, str(data.get("method", METHOD)))
+        held_out = str(data.get("held_out", "logs"))
+        if held_out not in ("logs", "blocks"):
+            raise ShipidError(f"{where}: held_out must be 'logs' or 'blocks', got {held_out!r}")
+        return cls(widths, level, logs, samples, str(data.get("method", METHOD)), held_out)
 
 
 def conformal_quantile(errors: np.ndarray, level: float = LEVEL) -> float:
@@ -98,9 +105,11 @@ def conformal_quantile(errors: np.ndarray, level: float = LEVEL) -> float:
     return float(e[k - 1]) if 1 <= k <= e.size else math.inf
 
 
-def error_band(runs: Sequence[tuple[np.ndarray, np.ndarray]], level: float = LEVEL) -> ErrorBand:
+def error_band(runs: Sequence[tuple[np.ndarray, np.ndarray]], level: float = LEVEL,
+               held_out: str = "logs") -> ErrorBand:  # fmt: skip
     """The band from held-out free runs: pairs of ``measured`` (n, 3) and ``simulated`` (m ≤ n,
-    3) u, v, r; the n − m samples after a divergence count as infinite errors."""
+    3) u, v, r; the n − m samples after a divergence count as infinite errors. ``held_out``:
+    what the runs are ("logs", or "blocks" of logs)."""
     if not runs:
         raise ShipidError("an error band needs at least one held-out free run")
     per_state = {s: [] for s in STATES}
@@ -110,4 +119,5 @@ def error_band(runs: Sequence[tuple[np.ndarray, np.ndarray]], level: float = LEV
         for j, s in enumerate(STATES):
             per_state[s].append(np.concatenate([err[:, j], np.full(n - m, np.inf)]))
     widths = {s: conformal_quantile(np.concatenate(per_state[s]), level) for s in STATES}
-    return ErrorBand(widths, level, len(runs), int(sum(len(m) for m, _ in runs)))
+    return ErrorBand(widths, level, len(runs), int(sum(len(m) for m, _ in runs)), METHOD,
+                     held_out)

@@ -610,7 +610,8 @@ def select(
     if failed:
         notes.append(f"{len(failed)} candidate(s) diverged in every fold (kept in the table)")
     shared = sorted((c for c in scorer.cache.values() if c.share > 0), key=lambda c: -c.share)
-    band = error_band(held_out_runs) if held_out_runs else None
+    held = "blocks" if _parse_cv(options.cv)[0] == "blocks" else "logs"
+    band = error_band(held_out_runs, held_out=held) if held_out_runs else None
     return Selection(ident.model, ident, current.gamma, current.score, table, folds_report,
                      options, library, ranking, notes + ident.warnings, shared, band)  # fmt: skip
 
