@@ -107,3 +107,28 @@ def test_the_criteria_of_a_model_say_when_their_approach_is_not_steady():
 
     assert notes(0.5 * steady(10.0)) and f"{steady(10.0):.4g} m/s" in notes(0.5 * steady(10.0))[0]
     assert notes(steady(10.0)) == []
+
+
+def test_plausibility_is_judged_about_a_straight_run_the_model_can_hold():
+    """Straight-line stability of a propelled model was judged at the first log's speed, which
+    its propeller had not yet brought it to: ṙ = −0.8 u r + 0.25 r is unstable below 0.3125 m/s
+    and stable at the steady speed, eigenvalues −0.6 u and −0.8 u + 0.25 in closed form."""
+    from shipid.identification.plausibility import check_plausibility, plausibility_at_approach
+
+    model = ManoeuvringModel(
+        ModelStructure("speed-stabilised", {"u": ("|u|*u", "pos(n)^2"), "v": ("u*v", "delta"),
+                                            "r": ("u*r", "r", "delta")}),
+        {"u": {"|u|*u": A_UU, "pos(n)^2": B_NN}, "v": {"u*v": -0.6, "delta": 0.01},
+         "r": {"u*r": -0.8, "r": 0.25, "delta": -0.05}})  # fmt: skip
+    before, _ = check_plausibility(model, 0.26, 16.7)
+    assert not before["straight_line"]["stable"]
+    report, notes = plausibility_at_approach(model, 0.26, 16.7)
+    us = steady(16.7)
+    assert report["approach_speed"] == pytest.approx(us, rel=1e-6) and report["rps"] == 16.7
+    assert "steady straight speed" in report["approach"]
+    assert sorted(report["straight_line"]["eigenvalues"]) == pytest.approx(
+        sorted([-0.6 * us, -0.8 * us + 0.25]), rel=1e-5)
+    assert report["straight_line"]["stable"] and not any("straight-line" in n for n in notes)
+    # A speed given for the checks is kept.
+    given, _ = plausibility_at_approach(model, 0.26, 16.7, speed=0.26)
+    assert given["approach_speed"] == 0.26 and not given["straight_line"]["stable"]

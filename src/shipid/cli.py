@@ -321,7 +321,7 @@ def cmd_identify(args) -> int:
     """``shipid identify``: a model from logs (LS-SVM, optional refinement, checks)."""
     from shipid.data.preprocess import lowpass
     from shipid.identification.identify import identify
-    from shipid.identification.plausibility import check_plausibility, new_failures
+    from shipid.identification.plausibility import new_failures, plausibility_at_approach
     from shipid.outputs import atomic_write_text, check_outputs
     from shipid.reporting.modelfile import model_text
 
@@ -405,10 +405,9 @@ def cmd_identify(args) -> int:
     if speed is None or not speed > 0:
         raise ShipidError(f"{names[0]}: the first training log starts without headway (u = "
                           f"{speed}); trim it to the manoeuvre (--start)")  # fmt: skip
-    n = rps if ident.model.uses_rps else None
-    plausibility, notes = check_plausibility(ident.model, speed, n)
+    plausibility, notes = plausibility_at_approach(ident.model, speed, rps)
     if refinement:
-        refined_report, refined_notes = check_plausibility(refinement.model, speed, n)
+        refined_report, refined_notes = plausibility_at_approach(refinement.model, speed, rps)
         worse = new_failures(plausibility, refined_report, ident.model)
         if worse:
             # Never hand out a model that fails checks the LS-SVM model passes, or fails worse.
@@ -424,7 +423,8 @@ def cmd_identify(args) -> int:
     if sl:
         print(f"straight-line {'stable' if sl['stable'] else 'UNSTABLE'} (largest sway–yaw "
               f"eigenvalue real part {sl['max_real_part']:.3g} 1/s); surge equilibrium "
-              f"{_fmt_speed(plausibility['surge_equilibrium'])}")  # fmt: skip
+              f"{_fmt_speed(plausibility['surge_equilibrium'])}; checked from the "
+              f"{plausibility['approach']}")  # fmt: skip
     ident.warnings.extend(f"plausibility: {n}" for n in notes)
     if refinement:
         ident.warnings.extend(f"refinement: {n}" for n in refinement.warnings)
@@ -516,7 +516,7 @@ def _parse_gammas(text: str | None) -> tuple[float, ...] | None:
 
 def cmd_select(args) -> int:
     """``shipid select``: structure and γ by cross-validated free-run error."""
-    from shipid.identification.plausibility import check_plausibility
+    from shipid.identification.plausibility import plausibility_at_approach
     from shipid.identification.select import RESAMPLES, SelectOptions, select
     from shipid.outputs import OutputSet, check_outputs
     from shipid.reporting.modelfile import model_text
@@ -554,7 +554,7 @@ def cmd_select(args) -> int:
         print(f"Their {sel.error_band.describe()}; stored in the model file, validate reports "
               "each log's share of samples inside it.")  # fmt: skip
     speed, rps = _approach(logs[0], "u"), _approach(logs[0], "n")
-    plausibility, notes = check_plausibility(sel.model, speed, rps if sel.model.uses_rps else None)
+    plausibility, notes = plausibility_at_approach(sel.model, speed, rps, args.speed, args.rps)
     ident.warnings.extend(f"plausibility: {n}" for n in notes)
     prep = {"dt": args.dt, "start": args.start, "end": args.end, "lead": args.lead,
             "columns": args.columns, "degrees": args.degrees, "format": args.format,

@@ -78,6 +78,22 @@ def check_plausibility(
     return report, [note for _, note in failed_checks(report, model).values()]
 
 
+def plausibility_at_approach(model: ManoeuvringModel, trained_speed: float,
+                             trained_rps: float | None, speed: float | None = None,
+                             rps: float | None = None) -> tuple[dict, list[str]]:  # fmt: skip
+    """``check_plausibility`` from the approach the model's manoeuvres start from
+    (``shipid.dynamics.equilibrium.steady_approach``): a model with propeller terms at its own
+    steady straight speed at the training rps, so that straight-line stability is judged about
+    a straight run the model can hold, not about a speed it is still gaining or losing. A given
+    ``speed`` or ``rps`` is used as given. The report says which approach (``approach``)."""
+    from shipid.dynamics.equilibrium import steady_approach
+
+    app = steady_approach(model, trained_speed, trained_rps, speed=speed, rps=rps)
+    report, notes = check_plausibility(model, app.speed, app.rps)
+    report["approach"] = app.describe()
+    return report, notes
+
+
 # How badly a check fails, to compare two models check by check: a rudder held to a side that
 # diverges is worse than one that turns the wrong way, which is worse than one still settling.
 UNSETTLED, WRONG_WAY, DIVERGED = 1, 2, 3

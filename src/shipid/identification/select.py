@@ -78,7 +78,8 @@ class SelectOptions:
     plausibility : restrict the choice to plausible models.
     one_standard_error : choose the sparsest candidate within one standard error of the best
         CV score (else the best).
-    speed, rps : condition of the plausibility checks (default: the first log's approach).
+    speed, rps : condition of the plausibility checks (default: each candidate's steady approach
+        at the first log's rps, near its approach speed; ``plausibility_at_approach``).
     progress : show a progress bar.
     physics : prior, sign constraints, bounds, steady speed (``PhysicsOptions``) in every fit.
     """
@@ -518,13 +519,14 @@ def select(
     import dataclasses
 
     from shipid.identification.identify import identify
-    from shipid.identification.plausibility import check_plausibility, disqualifying
+    from shipid.identification.plausibility import disqualifying, plausibility_at_approach
 
     options = dataclasses.replace(options or SelectOptions(), **overrides)
     # Converted once here, for the notes; _setup's own pass then finds one convention.
     logs, notes = common_rudder_convention([logs] if isinstance(logs, pd.DataFrame) else list(logs))
     logs, names, data, folds, scorer = _setup(logs, names, options)
     library = data.library
+    # The first log's approach; each candidate is checked from its own steady approach there.
     speed = options.speed if options.speed is not None else approach(logs[0], "u")
     rps = options.rps if options.rps is not None else approach(logs[0], "n")
     if speed is None or not speed > 0:
@@ -550,7 +552,7 @@ def select(
             theta = _fit_theta(data, cand.terms, cand.gamma, range(len(logs)), options.estimator,
                                options.physics)
             model = _model_from_theta(data, cand.terms, theta, "candidate")
-            report, _ = check_plausibility(model, speed, rps if model.uses_rps else None)
+            report, _ = plausibility_at_approach(model, speed, rps, options.speed, options.rps)
             reasons = disqualifying(report, model)
             plausibility_cache[cand.key] = (not reasons, "; ".join(reasons))
         ok, why = plausibility_cache[cand.key]
