@@ -1,6 +1,6 @@
 """The Esso Osaka logs of ``../shared/data`` as the README's commands read them (Δk 0.5 s;
-zig-zags and turns trimmed to the manoeuvre, random runs whole), and the folds by condition the
-Esso studies train and judge on."""
+zig-zags and turns trimmed to the manoeuvre, random runs up to a propulsion dropout), and the
+folds by condition the Esso studies train and judge on."""
 
 from __future__ import annotations
 
@@ -17,9 +17,9 @@ README_HELD = "31-Jul-2020_12_29_58"
 
 
 def read(path: Path, trim: bool):
-    """One log, as ``shipid import --format osaka-frt [--start auto --end auto]`` and
-    ``--dt 0.5`` give it."""
-    kw = {"start": "auto", "end": "auto"} if trim else {}
+    """One log, as ``shipid import --format osaka-frt`` with ``--start auto --end auto`` (the
+    zig-zags and turns) or ``--end dropout`` (the random runs), and ``--dt 0.5`` give it."""
+    kw = {"start": "auto", "end": "auto"} if trim else {"end": "dropout"}
     return read_log(path, fmt="osaka-frt", dt=0.5, **kw)
 
 

@@ -19,9 +19,10 @@ DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "esso-osaka"
 
 # 1. Read the trials. The Osaka reader converts units, unwraps the heading, keeps the relative
 #    wind and the rudder convention (positive δ turns this ship to starboard). Zig-zags and turns
-#    are trimmed to the manoeuvre; the random runs are used whole. Everything at Δk = 0.5 s.
+#    are trimmed to the manoeuvre; the random runs are used up to a propulsion dropout (the last
+#    minute of 31-Jul 14_52_18 logs n = 0 while the ship speeds up). Everything at Δk = 0.5 s.
 def read(path, trim):
-    kw = {"start": "auto", "end": "auto"} if trim else {}
+    kw = {"start": "auto", "end": "auto"} if trim else {"end": "dropout"}
     return shipid.read_log(path, fmt="osaka-frt", dt=0.5, **kw)
 
 

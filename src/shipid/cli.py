@@ -114,9 +114,10 @@ def _add_log_options(p: argparse.ArgumentParser) -> None:
                    help="trim: first time [s], or 'auto': --lead s before the detected rudder execute")
     g.add_argument("--lead", type=float, default=5.0, metavar="S",
                    help="with --start auto: seconds kept before the execute (default %(default)s)")
-    g.add_argument("--end", type=_time_or_auto, metavar="S|auto",
+    g.add_argument("--end", type=_end_time, metavar="S|auto|dropout",
                    help="trim: last time [s], or 'auto': the end of the manoeuvre (last large rudder, "
-                   "propeller still running)")
+                   "propeller still running), or 'dropout': before the first span where the "
+                   "ship gains headway with the propeller stopped (its logging dropped out)")
     g.add_argument("--fill-gaps", action="store_true",
                    help="interpolate missing values inside signals (default: refuse the log)")
     g.add_argument("--rudder-positive", choices=("port", "starboard"),
@@ -148,6 +149,10 @@ def _time_or_auto(text: str) -> float | str:
         return float(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected seconds or 'auto', got {text!r}") from None
+
+
+def _end_time(text: str) -> float | str:
+    return text if text == "dropout" else _time_or_auto(text)
 
 
 def _read_options(args):

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
@@ -24,6 +25,14 @@ SPEED_PLAUSIBLE = 40.0  # m/s on |u| and |v|: 78 kn, beyond any displacement shi
 # No manoeuvre can be identified from samples this far apart: the time is not in seconds.
 MAX_SAMPLING_S = 30.0
 DEG = 180.0 / math.pi
+# Propulsion dropouts: the propeller at most this share of its largest |n| (stopped or astern)...
+STOPPED_SHARE = 0.05
+# ... while the speed, median-smoothed over this window (GNSS jumps are not headway) ...
+DROPOUT_SMOOTH_S = 5.0
+# ... rises by this share of its largest value: no ship gains that much headway without thrust
+# (the Esso Osaka's random runs: 0.05 m/s of 0.28 with a stern wind of 3-5 m/s; 0.19 of 0.25 at
+# the end of 31-Jul 14_52_18, where n and δ read 0 while the ship sped up and turned).
+DROPOUT_GAIN_SHARE = 0.3
 
 
 def true_runs(mask: np.ndarray) -> list[tuple[int, int]]:
@@ -173,3 +182,51 @@ def _check_heading_against_yaw_rate(df: pd.DataFrame, name: str) -> None:
                           "positive turning to starboard); negate one of them")  # fmt: skip
     warnings.warn(f"{name}: the heading 'psi' changes {ratio:.3g} times as fast as the yaw rate "
                   "'r' says (expected 1): check their units", ShipidWarning, stacklevel=3)
+
+
+@dataclass(frozen=True)
+class Dropout:
+    """A span in which the logged propeller speed cannot be the one that drove the ship."""
+
+    start: float  # [s] first sample with the propeller stopped or astern
+    end: float  # [s] last such sample
+    gain: float  # [m/s] the speed gained meanwhile
+    share: float  # gain over the log's largest (smoothed) speed
+    before: float | None  # [s] the last sample before the span (None: the log starts in it)
+
+
+def propulsion_dropouts(log: pd.DataFrame) -> list[Dropout]:
+    """Spans where the propeller is stopped or astern (n ≤ ``STOPPED_SHARE`` of the largest |n|)
+    yet the ship gains headway: the median-smoothed u rises, while ahead, by more than
+    ``DROPOUT_GAIN_SHARE`` of its largest value. The inputs do not describe the motion there, as
+    when their logging drops out. Empty without columns n and u, or without an ahead propeller."""
+    if "n" not in log.columns or len(log) < 3:
+        return []
+    t, n = log["t"].to_numpy(dtype=float), log["n"].to_numpy(dtype=float)
+    top = float(np.max(np.abs(n)))
+    if not top > 0 or not np.any(n > STOPPED_SHARE * top):
+        return []
+    dt = float(np.median(np.diff(t)))
+    window = max(1, int(round(DROPOUT_SMOOTH_S / dt)))
+    u = log["u"].rolling(window, center=True, min_periods=1).median().to_numpy(dtype=float)
+    largest = float(np.max(np.abs(u)))
+    out = []
+    for a, b in true_runs(n <= STOPPED_SHARE * top):
+        ahead = np.maximum(u[a:b + 1], 0.0)
+        gain = float(np.max(ahead - np.minimum.accumulate(ahead)))
+        if largest > 0 and gain > DROPOUT_GAIN_SHARE * largest:
+            out.append(Dropout(float(t[a]), float(t[b]), gain, gain / largest,
+                               float(t[a - 1]) if a > 0 else None))  # fmt: skip
+    return out
+
+
+def check_propulsion(log: pd.DataFrame, name: str) -> None:
+    """Warn of every propulsion dropout (``propulsion_dropouts``), naming the file and times."""
+    for d in propulsion_dropouts(log):
+        cut = (f"end the log before it (--end {d.before:g}, or --end dropout)"
+               if d.before is not None else "start the log after it (--start)")
+        warnings.warn(f"{name}: the propeller is stopped or astern from t = {d.start:g} s to "
+                      f"{d.end:g} s, yet the ship gains {d.gain:.3g} m/s of headway "
+                      f"({100 * d.share:.0f} % of its largest speed): the logged n (and δ) "
+                      f"cannot have driven it there, as when their logging drops out; {cut}",
+                      ShipidWarning, stacklevel=3)  # fmt: skip

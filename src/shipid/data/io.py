@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from shipid.data.checks import ANGLE_COLUMNS, check_log, check_units
+from shipid.data.checks import ANGLE_COLUMNS, check_log, check_propulsion, check_units
 from shipid.data.formats import FORMATS, detect_format, read_format
 from shipid.data.log import COLUMNS, REQUIRED, csv_metadata_line, metadata, parse_csv_metadata
 from shipid.data.preprocess import resample
@@ -42,7 +42,7 @@ class ReadOptions:
     columns : file column name → canonical name (canonical format).
     degrees : canonical angle columns given in degrees (delta, psi, wind_angle in deg; r in deg/s).
     dt : resample to this Δk [s].
-    start, end : trim [s], or 'auto' (``shipid.data.trim.trim``).
+    start, end : trim [s], or 'auto'; end also 'dropout' (``shipid.data.trim.trim``).
     lead : with ``start='auto'``, seconds kept before the rudder execute.
     rudder_positive : overrides the file's rudder convention ('port' or 'starboard').
     scale : Froude scale λ (simman formats).
@@ -199,6 +199,7 @@ def read_log(path: str | Path, options: ReadOptions | None = None, **overrides) 
         log.attrs["rudder_positive"] = options.rudder_positive
     if options.start is not None or options.end is not None:
         log = trim(log, options.start, options.end, name, options.lead)
+    check_propulsion(log, name)
     if options.dt is not None:
         log = resample(log, options.dt, name)
     return log

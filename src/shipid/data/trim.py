@@ -89,18 +89,37 @@ def manoeuvre_end_time(log: pd.DataFrame, name: str = "log", execute: float | No
 
 def _auto_time(value, option: str) -> bool:
     if isinstance(value, str):
-        if value != "auto":
-            raise ShipidError(f"{option} must be a time in seconds or 'auto', got {value!r}")
-        return True
+        allowed = ("auto", "dropout") if option == "--end" else ("auto",)
+        if value not in allowed:
+            raise ShipidError(f"{option} must be a time in seconds or "
+                              f"{' or '.join(repr(a) for a in allowed)}, got {value!r}")
+        return value == "auto"
     return False
+
+
+def dropout_end(log: pd.DataFrame, name: str = "log") -> float | None:
+    """The last sample before the first propulsion dropout
+    (``shipid.data.checks.propulsion_dropouts``), or None when there is none."""
+    from shipid.data.checks import propulsion_dropouts
+
+    found = propulsion_dropouts(log)
+    if not found:
+        return None
+    if found[0].before is None:
+        raise ShipidError(f"{name}: --end dropout: the log starts in a propulsion dropout "
+                          f"(t = {found[0].start:g}–{found[0].end:g} s); give --start")  # fmt: skip
+    return found[0].before
 
 
 def trim(log: pd.DataFrame, start: float | str | None = None, end: float | str | None = None,
          name: str = "log", lead: float = 5.0) -> pd.DataFrame:  # fmt: skip
     """Rows with start ≤ t ≤ end, time kept as is. ``start="auto"`` starts ``lead`` seconds
     before the detected rudder execute (``rudder_execute_time``); ``end="auto"`` ends with the
-    manoeuvre (``manoeuvre_end_time``)."""
+    manoeuvre (``manoeuvre_end_time``); ``end="dropout"`` before the first span whose logged
+    propeller speed cannot have driven the ship (``dropout_end``; the whole log if none)."""
     t = log["t"]
+    if isinstance(end, str) and end == "dropout":
+        end = dropout_end(log, name)
     for option, value in (("--start", start), ("--end", end)):
         if isinstance(value, int | float) and not math.isfinite(value):
             raise ShipidError(f"{option} must be a finite time in seconds or 'auto', got {value!r}")
