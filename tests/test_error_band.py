@@ -8,17 +8,15 @@ import math
 import numpy as np
 import pytest
 from cli_helpers import run
+from generated_logs import noisy_zigzags
 
 from shipid.data.io import write_log
-from shipid.data.preprocess import lowpass
 from shipid.dynamics.simulate import simulate_log
 from shipid.errors import ShipidError
 from shipid.evaluation.error_band import ErrorBand, conformal_quantile, error_band
 from shipid.evaluation.validate import validate
 from shipid.identification.identify import identify
 from shipid.identification.select import select
-from shipid.trials.manoeuvres import zigzag
-from shipid.vessels import PAPER_IMU, scale_ship
 
 
 def test_conformal_quantile_is_the_rank_of_its_definition():
@@ -57,13 +55,7 @@ def test_samples_after_a_divergence_are_outside():
 
 @pytest.fixture(scope="module")
 def zigzags():
-    ship = scale_ship(rudder_rate_deg=9.6)
-    out = []
-    for i, (a, first) in enumerate(((20, "port"), (15, "starboard"), (25, "port"))):
-        log = zigzag(ship, a, a, duration=60, dt=0.2, method="euler", approach=2.0,
-                     first=first).log  # fmt: skip
-        out.append(lowpass(PAPER_IMU.apply(log, seed=30 + i), 0.5))
-    return out
+    return noisy_zigzags(30)
 
 
 def test_select_band_is_the_quantile_of_its_held_out_free_runs(zigzags):

@@ -9,9 +9,9 @@ import math
 import numpy as np
 import pytest
 from cli_helpers import run
+from generated_logs import noisy_zigzags
 
 from shipid.data.io import write_log
-from shipid.data.preprocess import lowpass
 from shipid.dynamics.prime import froude_ratios
 from shipid.errors import ShipidError
 from shipid.identification.identify import weighted_refit
@@ -19,8 +19,6 @@ from shipid.identification.select import Candidate, select, selection_shares
 from shipid.identification.selection_ensemble import selection_ensemble
 from shipid.identification.uncertainty import Ensemble, bootstrap
 from shipid.reporting.modelfile import ensemble_from_document, model_from_document
-from shipid.trials.manoeuvres import zigzag
-from shipid.vessels import PAPER_IMU, scale_ship
 
 
 def _cand(n_terms: int, folds) -> Candidate:
@@ -67,13 +65,7 @@ def test_a_candidate_best_on_every_log_is_always_chosen():
 
 @pytest.fixture(scope="module")
 def zigzags():
-    ship = scale_ship(rudder_rate_deg=9.6)
-    out = []
-    for i, (a, first) in enumerate(((20, "port"), (15, "starboard"), (25, "port"))):
-        log = zigzag(ship, a, a, duration=60, dt=0.2, method="euler", approach=2.0,
-                     first=first).log  # fmt: skip
-        out.append(lowpass(PAPER_IMU.apply(log, seed=20 + i), 0.5))
-    return out
+    return noisy_zigzags(20)
 
 
 def test_one_candidate_gives_the_bootstrap_of_it_to_the_bit(zigzags):
