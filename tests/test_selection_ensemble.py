@@ -116,3 +116,71 @@ def test_varied_structure_members_file_and_rescale(zigzags, tmp_path, capsys):
     for d, t in outside + [("r", model.structure.terms["r"][0])]:
         i, j = "uvr".index(d), ens.term_texts.index(t)
         np.testing.assert_allclose(t1[:, i, j], t0[:, i, j] * ratios[d][t], rtol=1e-12)
+
+
+def _share_average(logs, shares):
+    """Σ share · coefficient over the candidates, each identified on ``logs``, by hand."""
+    from shipid.dynamics.model import ModelStructure
+    from shipid.identification.identify import identify
+
+    total: dict = {}
+    for c in shares:
+        fit = identify(logs, model=ModelStructure("c", c.terms), gamma=c.gamma, force=True).model
+        for d, cs in fit.coefficients.items():
+            for t, x in cs.items():
+                total[(d, t)] = total.get((d, t), 0.0) + c.share * x
+    return total
+
+
+def test_average_is_the_share_weighted_mean_and_so_is_its_band(zigzags):
+    from shipid.dynamics.model import ManoeuvringModel, ModelStructure
+    from shipid.dynamics.simulate import simulate_log
+
+    plain = select(zigzags, library="blanke+abkowitz3")
+    sel = select(zigzags, library="blanke+abkowitz3", average=True)
+    assert len(sel.shares) > 1
+    np.testing.assert_array_equal(sel.chosen_model.theta, plain.model.theta)
+    expected = _share_average(zigzags, sel.shares)
+    got = {(d, t): x for d, cs in sel.model.coefficients.items() for t, x in cs.items()}
+    assert set(got) == set(expected)
+    for key, x in expected.items():
+        assert got[key] == pytest.approx(x, rel=1e-7, abs=1e-12), key
+    # The error band describes the averaged model: its folds averaged the same way.
+    errors = []
+    for i, log in enumerate(zigzags):
+        mean = _share_average([x for j, x in enumerate(zigzags) if j != i], sel.shares)
+        terms = {d: tuple(t for dd, t in mean if dd == d) for d in "uvr"}
+        fold = ManoeuvringModel(ModelStructure("fold", terms),
+                                {d: {t: x for (dd, t), x in mean.items() if dd == d}
+                                 for d in "uvr"})  # fmt: skip
+        errors.append(np.abs(simulate_log(fold, log).log[["u", "v", "r"]].to_numpy()
+                             - log[["u", "v", "r"]].to_numpy()))  # fmt: skip
+    errors = np.vstack(errors)
+    k = math.ceil((len(errors) + 1) * 0.95)
+    assert sel.error_band.half_width["r"] == pytest.approx(np.sort(errors[:, 2])[k - 1], rel=1e-6)
+    assert sel.to_dict()["chosen_model"] is not None and plain.to_dict()["chosen_model"] is None
+
+
+def test_cli_average_writes_the_average_and_keeps_the_chosen(zigzags, tmp_path, capsys):
+    paths = [write_log(log, tmp_path / f"zz{i}.csv") for i, log in enumerate(zigzags)]
+    code, out, err = run(["select", *paths, "--library", "blanke+abkowitz3", "--quiet",
+                          "--average", "--bootstrap", "20", "-o", tmp_path / "m.json"], capsys)
+    assert code == 0, err
+    assert "The chosen candidate:" in out and "(--average)" in out
+    doc = json.loads((tmp_path / "m.json").read_text(encoding="utf-8"))
+    model = model_from_document(doc, "m.json")
+    chosen = model_from_document({"model": doc["identification"]["selection"]["chosen_model"]},
+                                 "m.json")  # fmt: skip
+    assert doc["identification"]["selection"]["options"]["average"] is True
+    assert sum(len(t) for t in model.structure.terms.values()) > \
+        sum(len(t) for t in chosen.structure.terms.values())
+    assert ensemble_from_document(doc, "m.json", model).replicates == 20
+    code, out, err = run(["rescale", tmp_path / "m.json", "--factor", "4", "-o",
+                          tmp_path / "big.json"], capsys)  # fmt: skip
+    assert code == 0, err
+    big = json.loads((tmp_path / "big.json").read_text(encoding="utf-8"))
+    big_chosen = big["identification"]["selection"]["chosen_model"]["coefficients"]
+    ratios = froude_ratios(chosen.structure, 4.0)
+    for d, cs in chosen.coefficients.items():
+        for t, x in cs.items():
+            assert big_chosen[d][t] == pytest.approx(x * ratios[d][t], rel=1e-12)

@@ -541,9 +541,14 @@ def cmd_select(args) -> int:
                             plausibility=not args.no_plausibility, speed=args.speed,
                             rps=args.rps, one_standard_error=not args.best,
                             progress=not args.quiet, physics=_physics(args, logs, library),
+                            average=args.average,
                             **({"gammas": _parse_gammas(args.gammas)} if args.gammas else {}))
     sel = select(logs, options, names=names)
     ident = sel.identification
+    if sel.model is not sel.chosen_model:
+        print(f"The chosen candidate:\n{sel.chosen_model.equations()}\n\nThe model written, "
+              f"the average of {len(sel.shares)} candidates weighted by how often the choice "
+              "rule picks them on resampled held-out logs (--average):")  # fmt: skip
     print(sel.model.equations())
     print(f"\nγ = {sel.gamma:g}; free-run CV score {sel.score:.4f} ({options.cv}; 1 ≈ predicting "
           f"the mean); {len(sel.candidates)} candidates")
@@ -583,7 +588,7 @@ def cmd_select(args) -> int:
               "has value 0, inclusion the share of replicates that hold it):")  # fmt: skip
         print(table.to_markdown(index=False, floatfmt=".4g"))
     text = model_text(ident, args.logs, preprocessing=prep, plausibility=plausibility,
-                      selection=sel.to_dict(), particulars=_log_particulars(logs),
+                      model=sel.model, selection=sel.to_dict(), particulars=_log_particulars(logs),
                       uncertainty=ensemble.to_dict() if ensemble else None)  # fmt: skip
     with OutputSet() as out:
         out.write(args.output, lambda p: p.write_text(text, encoding="utf-8"))
@@ -1489,6 +1494,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="cap on candidates evaluated (default %(default)s)")
     p.add_argument("--best", action="store_true",
                    help="take the best CV score instead of the sparsest within one standard error")
+    p.add_argument("--average", action="store_true",
+                   help="write the average of the candidates the choice picks on resampled "
+                   "held-out logs, weighted by how often (bagging), instead of the chosen one")
     p.add_argument("--no-plausibility", action="store_true",
                    help="do not restrict the choice to plausible models")
     p.add_argument("--speed", type=float, help="plausibility checks at this speed [m/s] "

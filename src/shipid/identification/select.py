@@ -82,6 +82,9 @@ class SelectOptions:
         at the first log's rps, near its approach speed; ``plausibility_at_approach``).
     progress : show a progress bar.
     physics : prior, sign constraints, bounds, steady speed (``PhysicsOptions``) in every fit.
+    average : the model is the average of the candidates the choice rule picks on resampled
+        held-out logs, each fitted on all logs and weighted by its share (bagging the selection),
+        instead of the chosen candidate alone (kept as ``Selection.chosen_model``).
     """
 
     library: str | ModelStructure = "low-speed+wind"
@@ -98,6 +101,7 @@ class SelectOptions:
     one_standard_error: bool = True
     progress: bool = False
     physics: PhysicsOptions | None = None
+    average: bool = False
 
     def __post_init__(self) -> None:
         if self.search not in SEARCHES:
@@ -175,8 +179,10 @@ class Selection:
     ranking: dict[str, list[tuple[str, float]]]
     warnings: list[str] = field(default_factory=list)
     shares: list[Candidate] = field(default_factory=list)  # share > 0, most often chosen first
-    # What the chosen structure's free runs missed on the logs it was not fitted to.
+    # What the model's free runs missed on the logs it was not fitted to.
     error_band: ErrorBand | None = None
+    # The chosen candidate fitted on all logs (``model`` too, unless ``options.average``).
+    chosen_model: ManoeuvringModel | None = None
 
     @property
     def chosen_share(self) -> float:
@@ -187,13 +193,16 @@ class Selection:
     def to_dict(self) -> dict:
         """The search record as JSON-ready data (kept in the model file)."""
         opts = {k: getattr(self.options, k) for k in ("search", "gammas", "cv", "estimator",
-                                                       "method", "divergence_penalty")}
+                                                       "method", "divergence_penalty", "average")}
         return {"options": {**opts, "library": self.library.to_dict()}, "gamma": self.gamma,
                 "score": self.score, "ranking": {d: [[t, e] for t, e in r]
                                                  for d, r in self.ranking.items()},
                 "candidates": self.candidates.to_dict(orient="records"), "folds": self.folds,
                 "warnings": self.warnings,
-                "error_band": self.error_band.to_dict() if self.error_band else None}  # fmt: skip
+                "error_band": self.error_band.to_dict() if self.error_band else None,
+                "chosen_model": (self.chosen_model.to_dict()
+                                 if self.chosen_model is not None
+                                 and self.chosen_model is not self.model else None)}  # fmt: skip
 
 
 # ---------------------------------------------------------------------------- the data, once
@@ -606,16 +615,45 @@ def select(
     structure = ModelStructure(f"selected from {library.name}", current.terms)
     ident = identify(logs, model=structure, gamma=current.gamma, names=names, force=True,
                      estimator=options.estimator, physics=options.physics)  # fmt: skip
-    folds_report, held_out_runs = _fold_report(data, scorer, current, logs, names)
+    shared = sorted((c for c in scorer.cache.values() if c.share > 0), key=lambda c: -c.share)
+    weights = [(current, 1.0)]
+    model = ident.model
+    if options.average and shared:
+        weights = [(c, c.share) for c in shared]
+        averaged = _averaged_model(data, weights, current, range(len(logs)), options,
+                                   f"average of {len(shared)} candidates from {library.name}")
+        report, _ = plausibility_at_approach(averaged, speed, rps, options.speed, options.rps)
+        reasons = disqualifying(report, averaged) if options.plausibility else []
+        if reasons:
+            notes.append(f"the average of the candidates is implausible ({'; '.join(reasons)}); "
+                         "the model is the chosen candidate")  # fmt: skip
+            weights = [(current, 1.0)]
+        else:
+            model = averaged
+    folds_report, held_out_runs = _fold_report(data, scorer, weights, current, logs, names)
     table = _table(scorer.cache.values(), current)
     failed = [c for c in scorer.cache.values() if c.folds_diverged == len(scorer.held)]
     if failed:
         notes.append(f"{len(failed)} candidate(s) diverged in every fold (kept in the table)")
-    shared = sorted((c for c in scorer.cache.values() if c.share > 0), key=lambda c: -c.share)
     held = "blocks" if _parse_cv(options.cv)[0] == "blocks" else "logs"
     band = error_band(held_out_runs, held_out=held) if held_out_runs else None
-    return Selection(ident.model, ident, current.gamma, current.score, table, folds_report,
-                     options, library, ranking, notes + ident.warnings, shared, band)  # fmt: skip
+    return Selection(model, ident, current.gamma, current.score, table, folds_report,
+                     options, library, ranking, notes + ident.warnings, shared, band,
+                     ident.model)  # fmt: skip
+
+
+def _averaged_model(data: _Data, weights, first: Candidate, train, options: SelectOptions,
+                    name: str) -> ManoeuvringModel:  # fmt: skip
+    """The candidates fitted on the logs ``train``, their coefficients averaged with the weights
+    (a candidate's coefficient of a term it lacks is 0); terms: ``first``'s, then the others'."""
+    theta = sum(w * _fit_theta(data, c.terms, c.gamma, train, options.estimator, options.physics)
+                for c, w in weights) / sum(w for _, w in weights)  # fmt: skip
+    terms = {d: list(first.terms.get(d, ())) for d in DOFS if d in first.terms}
+    for c, _ in weights:
+        for d, ts in c.terms.items():
+            terms.setdefault(d, [])
+            terms[d] += [t for t in ts if t not in terms[d]]
+    return _model_from_theta(data, {d: tuple(t) for d, t in terms.items()}, theta, name)
 
 
 def selection_shares(cands: Sequence[Candidate], plausible, one_standard_error: bool = True,
@@ -742,18 +780,17 @@ def _table(cands, chosen: Candidate) -> pd.DataFrame:
     return df.sort_values("score", kind="stable").reset_index(drop=True)
 
 
-def _fold_report(data, scorer: _Scorer, chosen: Candidate, logs, names):
-    """Per held-out log: the chosen candidate fitted without it, its free-run errors (the
-    ``validate`` metrics) and indices; and the (measured, simulated) u, v, r of those runs."""
+def _fold_report(data, scorer: _Scorer, weights, chosen: Candidate, logs, names):
+    """Per held-out log: the model (the candidates of ``weights`` averaged; the chosen one
+    alone: [(chosen, 1)]) fitted without it, its free-run errors (the ``validate`` metrics) and
+    indices; and the (measured, simulated) u, v, r of those runs."""
     from shipid.evaluation.validate import validate_log
 
     out, runs = [], []
     n_logs = len(logs)
     for fold in scorer.folds:
         train = [j for j in range(n_logs) if j not in fold]
-        theta = _fit_theta(data, chosen.terms, chosen.gamma, train, scorer.options.estimator,
-                           scorer.options.physics)
-        model = _model_from_theta(data, chosen.terms, theta, "fold model")
+        model = _averaged_model(data, weights, chosen, train, scorer.options, "fold model")
         for h in fold:
             try:
                 v = validate_log(model, logs[h], names[h], scorer.options.method)

@@ -313,6 +313,12 @@ def rescaled_document(doc: Mapping, factor: float, to_rho: float | None = None,
     band = error_band_from_document(doc, path)
     if band is not None:  # in m/s and rad/s: a Froude-similar ship's speeds are k times these
         out["identification"]["selection"]["error_band"] = band.scaled(k).to_dict()
+    chosen = ((ident.get("selection") or {}) if isinstance(ident, Mapping) else {}).get(
+        "chosen_model")
+    if chosen:  # select --average keeps the chosen candidate beside the averaged model
+        sparse = model_from_document({"model": chosen}, path)
+        out["identification"]["selection"]["chosen_model"] = scaled(
+            sparse, froude_ratios(sparse.structure, factor, rho, to_rho)).to_dict()
     if out.get("uncertainty"):
         unc = out["uncertainty"]
         # The members' structure: the model's, or a superset of it (select --bootstrap).
