@@ -15,9 +15,10 @@ Judged on the held-out logs: whether the measured tactical diameter and steady y
 prediction, and the share of the held-out zig-zags' and random runs' samples whose measured r
 and u lie in the 95 % prediction bands. A calibrated 95 % interval covers 95 % of them.
 
-Then the cross-validated 95 % error band of each fold's model (``Selection.error_band``: the
-conformal quantile of the free-run errors of select's leave-one-log-out folds) and the share of
-the held-out logs' samples inside it, as ``validate`` reports it.
+Then the cross-validated 95 % error band of each fold's model, the chosen candidate and the
+average of ``select --average`` (``Selection.error_band``: the conformal quantile of the
+free-run errors of select's leave-one-log-out folds) and the share of the held-out logs' samples
+inside it, as ``validate`` reports it.
 
 Run: .venv/bin/python benchmarks/study_selection_uncertainty.py
 """
@@ -70,9 +71,11 @@ def main() -> None:
         train = [zz[k] for k in zk] + [rnd[k] for k in rk]
         held = [zz[k] for k in zig_held] + [rnd[k] for k in rnd_held]
         sel = select(train, library=LIBRARY, cv="logo")
-        band = sel.error_band
-        cv_rows.append((fold, band, [validate(sel.model, [lg], error_band=band)[0].band_shares
-                                     for lg in held + turns]))  # fmt: skip
+        for label, model_of in (("chosen", sel), ("--average", select(train, library=LIBRARY,
+                                                                        average=True))):
+            band = model_of.error_band
+            cv_rows.append((fold, label, band, [validate(model_of.model, [lg], error_band=band)[0]
+                                                .band_shares for lg in held + turns]))  # fmt: skip
         refit = weighted_refit(train, model=sel.model.structure, gamma=sel.gamma)
         ensembles = {"terms held": bootstrap(train, refit, replicates=REPLICATES),
                      "terms resampled": selection_ensemble(train, sel, replicates=REPLICATES)}
@@ -106,22 +109,23 @@ def main() -> None:
     print("\nThe cross-validated 95 % error band of each fold's model (select's leave-one-log-"
           "out free runs; ± half-width of r and u) and the share of the held-out logs' samples "
           "inside it\n")  # fmt: skip
-    print("| fold | band r [rad/s], u [m/s] | held-out zig-zags and random runs: r, u | "
+    print("| fold | model | band r [rad/s], u [m/s] | held-out zig-zags and random runs: r, u | "
           "turns: r, u |")
-    print("|---|---|---|---|")
-    inside = {"runs": [], "turns": []}
-    for fold, band, shares in cv_rows:
+    print("|---|---|---|---|---|")
+    inside = {(m, k): [] for m in ("chosen", "--average") for k in ("runs", "turns")}
+    for fold, label, band, shares in cv_rows:
         runs, turn_shares = shares[:-2], shares[-2:]
         cells = []
         for key, group in (("runs", runs), ("turns", turn_shares)):
-            inside[key] += group
+            inside[label, key] += group
             cells.append(f"{np.mean([g['r'] for g in group]):.2f}, "
                          f"{np.mean([g['u'] for g in group]):.2f}" if group else "–")
-        print(f"| {fold} | ±{band.half_width['r']:.4f}, ±{band.half_width['u']:.3f} | "
+        print(f"| {fold} | {label} | ±{band.half_width['r']:.4f}, ±{band.half_width['u']:.3f} | "
               + " | ".join(cells) + " |")
-    print("| all folds | | " + " | ".join(
-        f"{np.mean([g['r'] for g in inside[k]]):.2f}, {np.mean([g['u'] for g in inside[k]]):.2f}"
-        for k in ("runs", "turns")) + " |")
+    for label in ("chosen", "--average"):
+        print(f"| all folds | {label} | | " + " | ".join(
+            f"{np.mean([g['r'] for g in inside[label, k]]):.2f}, "
+            f"{np.mean([g['u'] for g in inside[label, k]]):.2f}" for k in ("runs", "turns")) + " |")
     print(f"\n{time.perf_counter() - t0:.0f} s")
 
 

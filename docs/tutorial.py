@@ -35,7 +35,9 @@ print(f"{len(training)} training logs, {len(turns)} turns and {held_out} held ou
 
 # 2. Choose the terms and γ by leave-one-log-out free-run error (the held-out logs are not seen)
 #    from the low-speed, wind and single-propeller asymmetry terms (see the README).
-selection = shipid.select(training, library="low-speed+wind+propeller-asymmetry")
+#    The model is the average of the candidates the choice picks on resampled held-out logs,
+#    weighted by how often (select --average); the chosen one is selection.chosen_model.
+selection = shipid.select(training, library="low-speed+wind+propeller-asymmetry", average=True)
 print(f"selected {selection.candidates.loc[selection.candidates['chosen'], 'n_terms'].item()} "
       f"terms, γ = {selection.gamma:g}, CV score {selection.score:.3f}")
 print(selection.model.equations())

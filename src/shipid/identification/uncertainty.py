@@ -68,8 +68,9 @@ class Ensemble:
 
     @property
     def varies_structure(self) -> bool:
-        """Whether the members' terms differ from the point estimate's."""
-        return dict(self.structure.terms) != dict(self.model.structure.terms)
+        """Whether the members hold different terms (their zero coefficients differ)."""
+        held = self.thetas != 0.0
+        return bool(np.any(held != held[:1]))
 
     @property
     def replicates(self) -> int:
@@ -123,7 +124,7 @@ class Ensemble:
         out = {"method": self.method, "replicates": self.replicates, "block_s": self.block_s,
                "seed": self.seed, "terms": list(self.term_texts),
                "thetas": self.thetas.tolist()}  # fmt: skip
-        if self.varies_structure:
+        if dict(self.structure.terms) != dict(self.model.structure.terms):
             out["structure"] = {d: list(t) for d, t in self.structure.terms.items()}
         return out
 
