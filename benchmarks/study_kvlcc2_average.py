@@ -1,0 +1,59 @@
+"""``select --average`` on the KVLCC2's three real zig-zags (issue #10): trained on two, judged
+on the third, for two libraries, the chosen candidate against the average of the candidates the
+choice rule picks on resampled held-out logs (weighted by how often). Columns: free-run error
+std of u, v, r on the held-out log and its overshoots, measured and from the zig-zag run closed
+loop on the model.
+
+Run: .venv/bin/python benchmarks/study_kvlcc2_average.py
+"""
+
+from __future__ import annotations
+
+import os
+import time
+import warnings
+from pathlib import Path
+
+from shipid.data.io import read_log
+from shipid.evaluation.validate import validate
+from shipid.identification.select import select
+
+DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
+LIBRARIES = ("blanke-race+race-damping", "blanke-speed+abkowitz3")
+
+
+def main() -> None:
+    if not DATA.is_dir():
+        print("../shared/data is absent")
+        return
+    marin = DATA / "kvlcc2-marin"
+    logs = {"MARIN zz 20°": read_log(marin / "MARIN_FREE_KVLCC2_zz_20_m.dat", fmt="simman-marin",
+                                     scale=45.7, dt=0.2),
+            "MARIN zz −20°": read_log(marin / "MARIN_FREE_KVLCC2_zz_-20_m.dat",
+                                      fmt="simman-marin", scale=45.7, dt=0.2),
+            "HSVA zz 20/10": read_log(DATA / "kvlcc2-hsva" / "HSVA_CPMC_KVLCC2_Z_20_10_P.dat",
+                                      fmt="simman-hsva", dt=0.2)}  # fmt: skip
+    print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores\n")
+    print("| library | held out | overshoots measured | chosen: u / v / r error std, overshoots | "
+          "--average: u / v / r error std, overshoots |")
+    print("|---|---|---|---|---|")
+    t0 = time.perf_counter()
+    for library in LIBRARIES:
+        for held, log in logs.items():
+            train = [x for k, x in logs.items() if k != held]
+            cells, measured = [], None
+            for average in (False, True):
+                v = validate(select(train, library=library, average=average).model, [log])[0]
+                m, closed = v.metrics, v.indices["closed_loop"]
+                measured = v.indices["measured"]
+                cells.append(f"{m['u']['std']:.4f} / {m['v']['std']:.4f} / {m['r']['std']:.4f}, "
+                             f"{closed['first_overshoot_deg']:.1f}°, "
+                             f"{closed['second_overshoot_deg']:.1f}°")  # fmt: skip
+            print(f"| {library} | {held} | {measured['first_overshoot_deg']:.1f}°, "
+                  f"{measured['second_overshoot_deg']:.1f}° | " + " | ".join(cells) + " |")
+    print(f"\n{time.perf_counter() - t0:.0f} s")
+
+
+if __name__ == "__main__":
+    warnings.simplefilter("ignore")  # envelope and plausibility warnings of the candidates
+    main()
