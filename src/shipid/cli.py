@@ -550,15 +550,17 @@ def cmd_select(args) -> int:
               f"the average of {len(sel.shares)} candidates weighted by how often the choice "
               "rule picks them on resampled held-out logs (--average):")  # fmt: skip
     print(sel.model.equations())
-    print(f"\nγ = {sel.gamma:g}; free-run CV score {sel.score:.4f} ({options.cv}; 1 ≈ predicting "
-          f"the mean); {len(sel.candidates)} candidates")
+    whose = " of the chosen candidate" if sel.model is not sel.chosen_model else ""
+    print(f"\nγ = {sel.gamma:g}; free-run CV score{whose} {sel.score:.4f} ({options.cv}; 1 ≈ "
+          f"predicting the mean); {len(sel.candidates)} candidates")
     cols = ["chosen", "score", "score_se", "score_u", "score_v", "score_r", "gamma", "n_terms",
             "folds_diverged", "plausible", "share", "stage", "note"]
     shown = sel.candidates.head(args.show)
     if not shown["chosen"].any():
         shown = _pd().concat([shown, sel.candidates[sel.candidates["chosen"]]])
     print(shown[cols].to_markdown(index=False, floatfmt=".4g"))
-    print("\nHeld-out logs (the chosen structure fitted without each):")
+    fitted = "the average" if sel.model is not sel.chosen_model else "the chosen structure"
+    print(f"\nHeld-out logs ({fitted} fitted without each):")
     print(_fold_table(sel.folds))
     if sel.error_band is not None:
         print(f"Their {sel.error_band.describe()}; stored in the model file, validate reports "

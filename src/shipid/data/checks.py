@@ -206,12 +206,15 @@ def propulsion_dropouts(log: pd.DataFrame) -> list[Dropout]:
     top = float(np.max(np.abs(n)))
     if not top > 0 or not np.any(n > STOPPED_SHARE * top):
         return []
+    stopped = true_runs(n <= STOPPED_SHARE * top)
+    if not stopped:
+        return []
     dt = float(np.median(np.diff(t)))
     window = max(1, int(round(DROPOUT_SMOOTH_S / dt)))
     u = log["u"].rolling(window, center=True, min_periods=1).median().to_numpy(dtype=float)
     largest = float(np.max(np.abs(u)))
     out = []
-    for a, b in true_runs(n <= STOPPED_SHARE * top):
+    for a, b in stopped:
         ahead = np.maximum(u[a:b + 1], 0.0)
         gain = float(np.max(ahead - np.minimum.accumulate(ahead)))
         if largest > 0 and gain > DROPOUT_GAIN_SHARE * largest:
