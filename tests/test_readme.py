@@ -31,8 +31,14 @@ def test_the_readme_has_runnable_blocks():
     assert set(kinds) <= {"python", "sh", "text"}, kinds
 
 
+# What the blocks that read ../shared/data write (-o): a later block that uses one needs the data
+# too, though it does not name it (without the data those files are never written).
+DATA_OUTPUTS = {out for _, code in BLOCKS if "shared/data" in code
+                for out in re.findall(r"-o\s+(\S+)", code)}  # fmt: skip
+
+
 def _needs_data(code: str) -> bool:
-    return "shared/data" in code
+    return "shared/data" in code or any(out in code for out in DATA_OUTPUTS)
 
 
 @pytest.fixture(scope="module")
