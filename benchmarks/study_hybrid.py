@@ -1,33 +1,40 @@
 """Does a kernel residual help? (issue #10 item 4, measured before building it into the tool.)
 
 The grey-box idea taken further: the physical model plus an RBF LS-SVM per equation fitted on
-the physical model's one-step equation residual, inputs (u, v, r, δ[, n]) standardised, γ and σ
-by the LS-SVM's exact leave-one-out. The hybrid is run free (NumPy path) on held-out logs and
-compared with the physical model alone.
+the physical model's one-step equation residual, inputs (u, v, r, δ[, n]) standardised. The
+hybrid is run free (NumPy path) on held-out logs and compared with the physical model alone, with
+the residual's γ and σ chosen two ways:
+
+* by the LS-SVM's exact leave-one-out of the one-step residual (what the LS-SVM offers by itself);
+* by free-run cross-validation, as ``select`` chooses terms: over a grid of γ and σ and "no
+  residual", the physical model and the residual are fitted without each training log (KVLCC2:
+  each of four blocks of its one log) and run free over it; the lowest mean normalised error
+  (``shipid.identification.select.normalised_error``) wins.
 
 KVLCC2: blanke-speed from the MARIN zz 20° (1.25 Hz prefilter), held out zz −20° and HSVA 20/10.
-Esso Osaka: the model of ``shipid select`` in the README (``esso.json``, from the zig-zags and three
-random runs), held out the two turns and the fourth random run. Needs ../shared/data and, for
-the Esso part, the README's ``esso/`` folder and ``esso.json`` in the working directory.
+Esso Osaka: the structure and γ ``select`` chooses in the README's fold (nine zig-zags and three
+random runs, read as ``esso_logs.py`` reads them), held out the two turns and the fourth random
+run.
 
 Run: .venv/bin/python benchmarks/study_hybrid.py
 """
 
 from __future__ import annotations
 
-import glob
 import os
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
+from esso_logs import README_HELD, esso_logs
 
 from shipid.data.io import read_log
 from shipid.data.preprocess import lowpass
 from shipid.dynamics.simulate import simulate_log
 from shipid.identification.identify import identify
-from shipid.lssvm import LSSVRCV
-from shipid.reporting.modelfile import load_model
+from shipid.identification.select import normalised_error, select
+from shipid.lssvm import LSSVR, LSSVRCV
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
 
@@ -50,7 +57,8 @@ class Hybrid:
         return base + np.column_stack([e.predict(z) for e in self.estimators])
 
 
-def fit_hybrid(physical, logs, features):
+def residual_data(physical, logs, features):
+    """Standardisation-free features and the one-step acceleration residual of ``physical``."""
     X, Y = [], []
     for log in logs:
         dt = float(np.median(np.diff(log["t"])))
@@ -60,7 +68,12 @@ def fit_hybrid(physical, logs, features):
                                      rps=log["n"].to_numpy() if "n" in log else None, **given)
         X.append(np.column_stack([log[f].to_numpy() for f in features])[:-1])
         Y.append(np.column_stack([np.diff(log[s].to_numpy()) / dt for s in "uvr"]) - acc[:-1])
-    X, Y = np.vstack(X), np.vstack(Y)
+    return np.vstack(X), np.vstack(Y)
+
+
+def fit_hybrid(physical, logs, features):
+    """The residual's γ and σ by the exact leave-one-out of the one-step residual."""
+    X, Y = residual_data(physical, logs, features)
     mu, sd = X.mean(axis=0), X.std(axis=0)
     solver = {"solver": "fixed-size", "n_landmarks": 300, "random_state": 0} if len(X) > 3000 else {}
     estimators, loo = [], []
@@ -72,21 +85,63 @@ def fit_hybrid(physical, logs, features):
     return Hybrid(physical, features, mu, sd, estimators), loo
 
 
+GAMMAS, SIGMAS = (1e-3, 1e-2, 1e-1, 1.0, 10.0), (1.0, 2.0, 4.0)
+
+
+def fit_residual(physical, logs, features, gamma, sigma):
+    """The hybrid with a residual of given γ and σ (fixed-size, 300 landmarks, over 3000
+    samples); None γ: the physical model alone."""
+    if gamma is None:
+        return physical
+    X, Y = residual_data(physical, logs, features)
+    mu, sd = X.mean(axis=0), X.std(axis=0)
+    solver = {"solver": "fixed-size", "n_landmarks": 300, "random_state": 0} if len(X) > 3000 else {}
+    estimators = [LSSVR(gamma=gamma, sigma=sigma, kernel="rbf", **solver).fit((X - mu) / sd, Y[:, j])
+                  for j in range(3)]  # fmt: skip
+    return Hybrid(physical, features, mu, sd, estimators)
+
+
+def free_run_cv(structure, gamma_phys, logs, features, prefilter=None):
+    """(γ, σ) of the residual (None: none) with the lowest mean normalised free-run error over
+    the folds (each log held out in turn), and the table of scores."""
+    scores = {}
+    for g in (None, *GAMMAS):
+        for sig in (SIGMAS if g is not None else (None,)):
+            fold_scores = []
+            for k, held in enumerate(logs):
+                train = [x for j, x in enumerate(logs) if j != k]
+                fit_on = [lowpass(x, prefilter) for x in train] if prefilter else train
+                physical = identify(fit_on, structure, gamma=gamma_phys, force=True).model
+                model = fit_residual(physical, fit_on, features, g, sig)
+                sim = simulate_log(model, held, "euler").log
+                measured = held[["u", "v", "r"]].to_numpy()
+                fold_scores.append(float(np.mean(normalised_error(
+                    measured, sim[["u", "v", "r"]].to_numpy(), 2.0))))
+            scores[(g, sig)] = float(np.mean(fold_scores))
+    return min(scores, key=scores.get), scores
+
+
 def errors(model, log):
     sim = simulate_log(model, log, "euler")
     n = len(sim.log)
     return [float(np.std(log[s].to_numpy()[:n] - sim.log[s].to_numpy())) for s in "uvr"]
 
 
-def report(name, physical, hybrid, loo, held):
+def report(name, physical, hybrid, loo, held, chosen, scores, cv_hybrid):
     print(f"\n{name}: one-step LOO error of the residual models / residual variance (u, v, r): "
           + " / ".join(f"{x:.2f}" for x in loo))
-    print("\n| held out | physical u / v / r error std | hybrid |")
-    print("|---|---|---|")
+    none, best = scores[(None, None)], scores[chosen]
+    largest = min(v for (g, _), v in scores.items() if g == GAMMAS[-1])
+    what = "no residual" if chosen[0] is None else f"γ = {chosen[0]:g}, σ = {chosen[1]:g}"
+    print(f"free-run CV over {len(scores)} settings: {what} (score {best:.4f}; no residual "
+          f"{none:.4f}; the largest γ tried {largest:.4f})")
+    print("\n| held out | physical u / v / r error std | hybrid, γ σ by one-step LOO | "
+          "hybrid, γ σ by free-run CV |")
+    print("|---|---|---|---|")
     for label, log in held:
-        p, h = errors(physical, log), errors(hybrid, log)
-        print(f"| {label} | " + " / ".join(f"{x:.4f}" for x in p) + " | "
-              + " / ".join(f"{x:.4f}" for x in h) + " |")
+        cells = [errors(m, log) for m in (physical, hybrid, cv_hybrid)]
+        print(f"| {label} | " + " | ".join(" / ".join(f"{x:.4f}" for x in c) for c in cells)
+              + " |")
 
 
 def main() -> None:
@@ -100,20 +155,28 @@ def main() -> None:
                     dt=0.2)  # fmt: skip
     train = lowpass(zz20, 1.25)
     physical = identify(train, "blanke-speed").model
-    hybrid, loo = fit_hybrid(physical, [train], ["u", "v", "r", "delta"])
-    report("KVLCC2", physical, hybrid, loo, [("MARIN zz −20°", zzm20), ("HSVA zz 20/10", hsva)])
-    if Path("esso.json").exists():
-        zz = [read_log(f, dt=0.5) for f in sorted(glob.glob("esso/zigzag/*.csv"))]
-        runs = {Path(f).name: read_log(f, dt=0.5) for f in sorted(glob.glob("esso/random/*.csv"))}
-        held_run = "random_31-Jul-2020_12_29_58.csv"
-        physical = load_model("esso.json")
-        hybrid, loo = fit_hybrid(physical, zz + [v for k, v in runs.items() if k != held_run],
-                                 ["u", "v", "r", "delta", "n"])  # fmt: skip
-        turns = [(Path(f).name, read_log(f, dt=0.5))
-                 for f in sorted(glob.glob("esso/turning/*.csv"))]  # fmt: skip
-        report("Esso Osaka", physical, hybrid, loo, turns + [(held_run, runs[held_run])])
+    features = ["u", "v", "r", "delta"]
+    hybrid, loo = fit_hybrid(physical, [train], features)
+    edges = np.linspace(0, len(zz20), 5).round().astype(int)
+    blocks = [zz20.iloc[a:b].reset_index(drop=True) for a, b in zip(edges[:-1], edges[1:], strict=True)]
+    chosen, scores = free_run_cv("blanke-speed", 1e4, blocks, features, prefilter=1.25)
+    cv_hybrid = fit_residual(physical, [train], features, *chosen)
+    report("KVLCC2", physical, hybrid, loo, [("MARIN zz −20°", zzm20), ("HSVA zz 20/10", hsva)],
+           chosen, scores, cv_hybrid)
+    data = esso_logs()
+    if data is not None:
+        zz, rnd, turns = data
+        train = list(zz.values()) + [x for k, x in rnd.items() if k != README_HELD]
+        sel = select(train, library="low-speed+wind+propeller-asymmetry")
+        physical, features = sel.chosen_model, ["u", "v", "r", "delta", "n"]
+        hybrid, loo = fit_hybrid(physical, train, features)
+        chosen, scores = free_run_cv(physical.structure, sel.gamma, train, features)
+        cv_hybrid = fit_residual(physical, train, features, *chosen)
+        held = [("turn +35°", turns[0]), ("turn −35°", turns[1]), (README_HELD, rnd[README_HELD])]
+        report("Esso Osaka", physical, hybrid, loo, held, chosen, scores, cv_hybrid)
     print(f"\ntime {time.perf_counter() - t0:.1f} s")
 
 
 if __name__ == "__main__":
+    warnings.simplefilter("ignore")  # envelope warnings of the free runs
     main()
