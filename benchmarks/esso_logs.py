@@ -24,9 +24,10 @@ def read(path: Path, trim: bool):
 
 
 def esso_logs():
-    """(zig-zags by time of day, random runs by date and time, the two turns), or None when
-    ``../shared/data`` is absent."""
+    """(zig-zags by time of day, random runs by date and time, the two turns), or None (and a
+    line saying so) when ``../shared/data`` is absent."""
     if not DATA.is_dir():
+        print("../shared/data is absent")
         return None
     zz = {p.stem[-8:]: read(p, True) for p in sorted((DATA / "zigzag").glob("*.csv"))}
     rnd = {p.stem[7:]: read(p, False) for p in sorted((DATA / "random").glob("*.csv"))}

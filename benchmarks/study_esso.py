@@ -50,7 +50,6 @@ def _early_yaw_ratio(v, log, after_s: float = 10.0) -> float:
 def main() -> None:
     data = esso_logs()
     if data is None:
-        print("../shared/data is absent")
         return
     zz, randoms, turns = data
     zigzags = list(zz.values())

@@ -49,7 +49,6 @@ def _ratio(validations, logs, state: str) -> float:
 def main() -> None:
     data = esso_logs()
     if data is None:
-        print("../shared/data is absent")
         return
     zz, rnd, turns = data
     folds = condition_folds(rnd)

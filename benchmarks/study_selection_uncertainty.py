@@ -52,7 +52,6 @@ def _band_share(v, log, state: str) -> float:
 def main() -> None:
     data = esso_logs()
     if data is None:
-        print("../shared/data is absent")
         return
     zz, rnd, turns = data
     folds = {**condition_folds(rnd), **random_run_folds(rnd)}

@@ -22,7 +22,13 @@ import pandas as pd
 
 from shipid.dynamics.model import DOFS, ModelStructure
 from shipid.errors import ShipidError
-from shipid.identification.uncertainty import SELECTION_METHOD, Ensemble, _bar, block_weights
+from shipid.identification.uncertainty import (
+    SELECTION_METHOD,
+    Ensemble,
+    _bar,
+    block_weights,
+    resampling_blocks,
+)
 
 
 def selection_ensemble(
@@ -43,15 +49,10 @@ def selection_ensemble(
     replicates, block_s, seed : as ``bootstrap``.
     names : log names for messages.
     """
-    import math
-
     from shipid.identification.identify import weighted_refit
 
-    if not (isinstance(replicates, int) and replicates >= 10):
-        raise ShipidError(f"--bootstrap needs at least 10 replicates, got {replicates!r}")
-    if not (math.isfinite(block_s) and block_s > 0):
-        raise ShipidError(f"--block must be > 0 s, got {block_s!r}")
     logs = [logs] if isinstance(logs, pd.DataFrame) else list(logs)
+    block, lengths = resampling_blocks(logs, replicates, block_s)
     cands = list(selection.shares)
     if not cands:
         raise ShipidError("the selection has no candidate chosen on resampled held-out logs "
@@ -62,9 +63,6 @@ def selection_ensemble(
     structure = _union(point.structure, [c.terms for c in cands])
     columns = {t: j for j, t in enumerate(structure.all_terms)}
     options = selection.options
-    dt = float(np.median(np.diff(logs[0]["t"].to_numpy())))
-    block = max(1, int(round(block_s / dt)))
-    lengths = [len(log) - 1 for log in logs]
     rng = np.random.default_rng(seed)  # the block resamples: bootstrap's stream
     draws = np.random.default_rng([seed, 1]).choice(len(cands), size=replicates, p=p)
     refits: dict[int, object] = {}

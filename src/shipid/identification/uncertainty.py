@@ -222,6 +222,18 @@ def block_weights(lengths: Sequence[int], block: int, rng: np.random.Generator) 
     return np.cumsum(edges[:-1])
 
 
+def resampling_blocks(logs: Sequence[pd.DataFrame], replicates: int, block_s: float
+                      ) -> tuple[int, list[int]]:  # fmt: skip
+    """The block length in equations and the equations per log of a moving-block bootstrap,
+    after checking the number of replicates (≥ 10) and the block length (> 0 s)."""
+    if not (isinstance(replicates, int) and replicates >= 10):
+        raise ShipidError(f"--bootstrap needs at least 10 replicates, got {replicates!r}")
+    if not (math.isfinite(block_s) and block_s > 0):
+        raise ShipidError(f"--block must be > 0 s, got {block_s!r}")
+    dt = float(np.median(np.diff(logs[0]["t"].to_numpy())))
+    return max(1, int(round(block_s / dt))), [len(log) - 1 for log in logs]
+
+
 def bootstrap(
     logs: Sequence[pd.DataFrame],
     fit: Callable[[np.ndarray | None], ManoeuvringModel],
@@ -232,13 +244,7 @@ def bootstrap(
 ) -> Ensemble:
     """Bootstrap ensemble of the fit ``fit(weights) -> model`` (e.g. ``identify`` with
     ``sample_weight``) over the equations of ``logs`` (one per sample but the last of each)."""
-    if not (isinstance(replicates, int) and replicates >= 10):
-        raise ShipidError(f"--bootstrap needs at least 10 replicates, got {replicates!r}")
-    if not (math.isfinite(block_s) and block_s > 0):
-        raise ShipidError(f"--block must be > 0 s, got {block_s!r}")
-    dt = float(np.median(np.diff(logs[0]["t"].to_numpy())))
-    block = max(1, int(round(block_s / dt)))
-    lengths = [len(log) - 1 for log in logs]
+    block, lengths = resampling_blocks(logs, replicates, block_s)
     rng = np.random.default_rng(seed)
     point = fit(None)
     thetas = np.empty((replicates, *point.theta.shape))
