@@ -1502,7 +1502,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--no-plausibility", action="store_true",
                    help="do not restrict the choice to plausible models")
     p.add_argument("--speed", type=float, help="plausibility checks at this speed [m/s] "
-                   "(default: the first log's approach)")
+                   "(default: each candidate's steady straight speed at the first log's rps, "
+                   "or the first log's approach without propeller terms)")
     p.add_argument("--rps", type=float, help="... and this propeller speed [rps]")
     p.add_argument("--show", type=int, default=10, metavar="N", help="candidates printed (default 10)")
     p.add_argument("--bootstrap", type=int, metavar="N",
