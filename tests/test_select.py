@@ -208,3 +208,11 @@ def test_cli_select_refuses_one_log(tmp_path, capsys, paper_trials):
     code = main(["select", str(path), "-o", str(tmp_path / "m.json"), "--library", "blanke"])
     err = capsys.readouterr().err
     assert code == 1 and "at least 2 logs" in err and not (tmp_path / "m.json").exists()
+
+
+def test_a_choice_from_few_folds_is_reported_as_weak(paper_trials):
+    training, _ = paper_trials
+    few = select(training[:3], library="blanke", search="none", gammas=(1e4,))
+    assert any("only 3 folds" in w and "--cv blocks:K" in w for w in few.warnings)
+    enough = select(training[:4], library="blanke", search="none", gammas=(1e4,))
+    assert not any("folds:" in w for w in enough.warnings)

@@ -58,6 +58,7 @@ from shipid.lssvm.solvers import solve_primal_constrained
 SEARCHES = ("stepwise", "frols", "stlsq", "none")
 STATES = ("u", "v", "r")
 RESAMPLES = 200  # resamples of the held-out logs for the choice's shares
+FEW_FOLDS = 4  # fewer folds than this: the choice is reported as weak
 RHO_GRID = (0.3, 0.1, 0.03, 0.01, 3e-3, 1e-3, 3e-4, 1e-4, 1e-5, 0.0)
 STLSQ_GRID = (0.0, 0.01, 0.02, 0.05, 0.1, 0.2, 0.3)
 
@@ -633,6 +634,11 @@ def select(
     folds_report, held_out_runs = _fold_report(data, scorer, weights, current, logs, names)
     table = _table(scorer.cache.values(), current)
     failed = [c for c in scorer.cache.values() if c.folds_diverged == len(scorer.held)]
+    if len(scorer.folds) < FEW_FOLDS:
+        notes.append(f"only {len(scorer.folds)} folds: the CV scores and their standard error "
+                     "rest on so few held-out runs that the choice among close candidates is "
+                     "weak (the KVLCC2 from two logs chose worse than its fixed structure); give "
+                     "more logs, or cut long ones with --cv blocks:K")  # fmt: skip
     if failed:
         notes.append(f"{len(failed)} candidate(s) diverged in every fold (kept in the table)")
     held = "blocks" if _parse_cv(options.cv)[0] == "blocks" else "logs"
