@@ -117,3 +117,25 @@ def test_a_band_from_blocks_says_so(zigzags):
     assert ErrorBand.from_dict(band.to_dict()) == band
     with pytest.raises(ShipidError, match="held_out must be"):
         ErrorBand.from_dict(dict(band.to_dict(), held_out="folds"))
+
+
+def test_the_report_draws_its_own_figures_with_both_bands(zigzags, monkeypatch):
+    """The HTML report drew its own figures (no --plots PNGs to share) without the bootstrap
+    bands; they carry both bands now."""
+    from shipid.identification.selection_ensemble import selection_ensemble
+    from shipid.reporting import plots
+    from shipid.reporting.html import validation_report
+
+    sel = select(zigzags, library="blanke+abkowitz3")
+    ens = selection_ensemble(zigzags, sel, replicates=10)
+    vals = validate(sel.model, zigzags[:1], ensemble=ens, error_band=sel.error_band)
+    seen = []
+
+    def record(measured, simulated, path, title="", out=None, bands=None, error_band=None):
+        seen.append((bands, error_band))
+        path.write(b"png")
+
+    monkeypatch.setattr(plots, "measured_vs_simulated", record)
+    text = validation_report(sel.model, vals, zigzags[:1], "report")
+    assert "in CV band r" in text
+    assert seen and seen[0][0] is vals[0].bands and seen[0][1] is sel.error_band
