@@ -10,7 +10,7 @@ import pytest
 from cli_helpers import run
 from generated_logs import noisy_zigzags
 
-from shipid.data.io import write_log
+from shipid.data.io import read_log, write_log
 from shipid.dynamics.simulate import simulate_log
 from shipid.errors import ShipidError
 from shipid.evaluation.error_band import ErrorBand, conformal_quantile, error_band
@@ -139,3 +139,40 @@ def test_the_report_draws_its_own_figures_with_both_bands(zigzags, monkeypatch):
     text = validation_report(sel.model, vals, zigzags[:1], "report")
     assert "in CV band r" in text
     assert seen and seen[0][0] is vals[0].bands and seen[0][1] is sel.error_band
+
+
+def test_identify_error_band_is_its_fit_without_each_log(zigzags, tmp_path, capsys):
+    paths = [write_log(log, tmp_path / f"zz{i}.csv") for i, log in enumerate(zigzags)]
+    code, out, err = run(["identify", *paths, "--model", "blanke", "--filter", "none",
+                          "--error-band", "-o", tmp_path / "m.json"], capsys)  # fmt: skip
+    assert code == 0, err
+    assert "cross-validated 95 % error band (free runs of 3 held-out logs" in out
+    doc = json.loads((tmp_path / "m.json").read_text(encoding="utf-8"))
+    band = ErrorBand.from_dict(doc["identification"]["error_band"])
+    logs = [read_log(p) for p in paths]
+    errors = []
+    for i, log in enumerate(logs):
+        fit = identify([x for j, x in enumerate(logs) if j != i], model="blanke", force=True).model
+        errors.append(np.abs(simulate_log(fit, log).log[["u", "v", "r"]].to_numpy()
+                             - log[["u", "v", "r"]].to_numpy()))  # fmt: skip
+    errors = np.vstack(errors)
+    k = math.ceil((len(errors) + 1) * 0.95)
+    assert band.half_width["v"] == pytest.approx(np.sort(errors[:, 1])[k - 1], rel=1e-9)
+    code, out, err = run(["validate", tmp_path / "m.json", paths[0]], capsys)
+    assert code == 0 and "in CV band r [%]" in out, err
+    code, out, err = run(["rescale", tmp_path / "m.json", "--factor", "4", "-o",
+                          tmp_path / "big.json"], capsys)  # fmt: skip
+    big = json.loads((tmp_path / "big.json").read_text(encoding="utf-8"))["identification"]
+    assert code == 0 and big["error_band"]["half_width"]["r"] == pytest.approx(
+        band.half_width["r"] / 2, rel=1e-12)
+    # One log: four blocks of it; with --refine: refused (the band describes the LS-SVM fit).
+    code, out, err = run(["identify", paths[0], "--filter", "none", "--error-band", "-o",
+                          tmp_path / "one.json"], capsys)  # fmt: skip
+    assert code == 0 and "4 held-out blocks" in out, err
+    code, out, err = run(["identify", paths[0], "--refine", "--error-band", "-o",
+                          tmp_path / "r.json"], capsys)  # fmt: skip
+    assert code == 1 and "--error-band describes the LS-SVM fit" in err
+    assert not (tmp_path / "r.json").exists()
+    code, out, err = run(["identify", paths[0], "--error-band", "kfold:2", "-o",
+                          tmp_path / "k.json"], capsys)  # fmt: skip
+    assert code == 1 and "--error-band must be" in err and not (tmp_path / "k.json").exists()

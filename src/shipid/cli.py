@@ -336,6 +336,9 @@ def cmd_identify(args) -> int:
     if args.output_error and (args.refine or args.bootstrap is not None):
         raise ShipidError("--output-error is its own fit with its own intervals; it does not go "
                           "with --refine or --bootstrap")  # fmt: skip
+    if args.error_band is not None and (args.refine or args.output_error):
+        raise ShipidError("--error-band describes the LS-SVM fit; it does not go with --refine "
+                          "or --output-error")  # fmt: skip
     logs = _read_logs(args)
     raw_logs = logs  # the output-error fit needs the noise as measured, not prefiltered
     names = [str(p) for p in args.logs]
@@ -377,6 +380,19 @@ def cmd_identify(args) -> int:
     for dof, d in ident.diagnostics.items():
         print(f"{dof}: condition number {d['condition_number']:.3g}, one-step R² "
               f"{d['one_step_r2']:.4f}, bias b = {ident.discrete[dof]['bias']:.4g}")
+    band = None
+    if args.error_band is not None:
+        from shipid.evaluation.error_band import cross_validated_band
+
+        def refit_without(train):  # the same prefilter, structure, γ and physics
+            return identify([lowpass(x, cutoff) for x in train] if cutoff is not None else train,
+                            model=args.model, form=args.form, gamma=gamma,
+                            drop=_parse_drop(args.drop), force=True, estimator=args.estimator,
+                            physics=physics).model  # fmt: skip
+
+        band = cross_validated_band(refit_without, raw_logs, names, args.error_band)
+        print(f"{band.describe()} (γ and the prefilter as chosen on all logs); stored for "
+              "validate")  # fmt: skip
     ensemble = None
     if args.bootstrap is not None:
         from shipid.identification.identify import weighted_refit
@@ -436,7 +452,8 @@ def cmd_identify(args) -> int:
     text = model_text(ident, args.logs, preprocessing=prep, refinement=refinement,
                       plausibility=plausibility, model=final, selection=gamma_report,
                       particulars=_log_particulars(logs),
-                      uncertainty=ensemble.to_dict() if ensemble else None)  # fmt: skip
+                      uncertainty=ensemble.to_dict() if ensemble else None,
+                      error_band=band.to_dict() if band else None)  # fmt: skip
     from shipid.reporting.modelfile import prime_record
 
     _print_prime(prime_record(final, _log_particulars(logs), speed))
@@ -1471,6 +1488,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=0, help="with --bootstrap or --output-error: "
                    "random seed "
                    "(default %(default)s)")
+    p.add_argument("--error-band", nargs="?", const="auto", metavar="CV",
+                   help="the cross-validated 95 %% error band of the free runs, stored for "
+                   "validate: the same fit without each log (logo) or block (blocks:K), run free "
+                   "over it (default auto: logo from two logs, blocks:4 of one)")
     # --out spelled out: since --output-error, argparse no longer takes it for --output.
     p.add_argument("-o", "--output", "--out", required=True, metavar="MODEL.json")
     _add_physics_options(p)

@@ -121,3 +121,39 @@ def error_band(runs: Sequence[tuple[np.ndarray, np.ndarray]], level: float = LEV
     widths = {s: conformal_quantile(np.concatenate(per_state[s]), level) for s in STATES}
     return ErrorBand(widths, level, len(runs), int(sum(len(m) for m, _ in runs)), METHOD,
                      held_out)
+
+
+def cross_validated_band(fit, logs, names, cv: str = "auto", method: str = "euler",
+                         level: float = LEVEL) -> ErrorBand:  # fmt: skip
+    """The band of a fixed fit (``fit(training logs) -> model``, e.g. ``identify`` with its
+    structure, γ and prefilter): each log fitted without and run free over (``cv='logo'``), or,
+    with ``'blocks:K'``, every log cut into K blocks and each block left out. ``'auto'``: logo
+    from two logs, four blocks of one."""
+    from shipid.dynamics.simulate import simulate_log
+    from shipid.identification.select import split_blocks
+
+    logs, names = list(logs), list(names)
+    if cv == "auto":
+        cv = "logo" if len(logs) >= 2 else "blocks:4"
+    held_out = "logs"
+    if cv.startswith("blocks:"):
+        try:
+            k = int(cv.split(":", 1)[1])
+        except ValueError:
+            k = 0
+        if k < 2:
+            raise ShipidError(f"--error-band must be 'auto', 'logo' or 'blocks:K' with K ≥ 2, "
+                              f"got {cv!r}")  # fmt: skip
+        logs, names = split_blocks(logs, names, k)
+        held_out = "blocks"
+    elif cv != "logo":
+        raise ShipidError(f"--error-band must be 'auto', 'logo' or 'blocks:K', got {cv!r}")
+    if len(logs) < 2:
+        raise ShipidError("an error band needs two logs to hold one out; give --error-band "
+                          "blocks:K to cut one")  # fmt: skip
+    runs = []
+    for k, held in enumerate(logs):
+        model = fit([x for j, x in enumerate(logs) if j != k])
+        sim = simulate_log(model, held, method).log
+        runs.append((held[list(STATES)].to_numpy(dtype=float), sim[list(STATES)].to_numpy()))
+    return error_band(runs, level, held_out)

@@ -254,7 +254,8 @@ def _prepare(logs: Sequence[pd.DataFrame], names: Sequence[str], library: ModelS
 
 
 # ---------------------------------------------------------------------------- folds
-def _split_blocks(logs, names, k: int) -> tuple[list[pd.DataFrame], list[str]]:
+def split_blocks(logs, names, k: int) -> tuple[list[pd.DataFrame], list[str]]:
+    """Every log cut into ``k`` contiguous blocks (each a log of its own, named after it)."""
     out, out_names = [], []
     for log, name in zip(logs, names, strict=True):
         edges = np.linspace(0, len(log), k + 1).round().astype(int)
@@ -500,7 +501,7 @@ def _setup(logs, names, options: SelectOptions):
     names = list(names or [log.attrs.get("name", f"log {i}") for i, log in enumerate(logs)])
     kind, k = _parse_cv(options.cv)
     if kind == "blocks":
-        logs, names = _split_blocks(logs, names, k)
+        logs, names = split_blocks(logs, names, k)
     if len(logs) < 2:
         raise ShipidError("cross-validation needs at least 2 logs to hold one out; give more "
                           "logs, or cut one into blocks with --cv blocks:K")  # fmt: skip

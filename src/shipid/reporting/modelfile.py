@@ -56,7 +56,8 @@ def model_document(ident: Identification, training_files: Sequence[str | Path] =
                    preprocessing: dict | None = None, refinement: Refinement | None = None,
                    plausibility: dict | None = None, model: ManoeuvringModel | None = None,
                    selection: dict | None = None, particulars: dict | None = None,
-                   uncertainty: dict | None = None) -> dict:  # fmt: skip
+                   uncertainty: dict | None = None, error_band: dict | None = None
+                   ) -> dict:  # fmt: skip
     """The model file. ``model`` is the one users get (default: the refined model when there is a
     refinement, else the LS-SVM one); the LS-SVM model stays in ``refinement.initial_model`` and
     the refined one in ``refinement.refined_model``."""
@@ -75,7 +76,7 @@ def model_document(ident: Identification, training_files: Sequence[str | Path] =
                            "warnings": ident.warnings, "preprocessing": preprocessing or {},
                            "envelope": ident.envelope,
                            "refinement": refinement.to_dict() if refinement else None,
-                           "plausibility": plausibility},
+                           "plausibility": plausibility, "error_band": error_band},
         "provenance": {"training_files": [{"path": str(p), "sha256": sha256(p)}
                                           for p in training_files]},
     })  # fmt: skip
@@ -260,19 +261,30 @@ def ensemble_from_document(doc: Mapping, path: str | Path, model: ManoeuvringMod
     return Ensemble.from_dict(data, model, f"{path}: uncertainty")
 
 
-def error_band_from_document(doc: Mapping, path: str | Path):
-    """The cross-validated error band of a model file (``shipid select``), or None. It describes
-    the file's model: a refined model has not been cross-validated, so it has none."""
+def _error_band_record(doc: Mapping) -> tuple[dict | None, str, object]:
+    """(the mapping that holds the band, its key path, the band's raw record): ``select``
+    keeps it in its selection record, ``identify --error-band`` beside it."""
     ident = doc.get("identification") or {}
-    selection = ident.get("selection") if isinstance(ident, Mapping) else None
-    data = selection.get("error_band") if isinstance(selection, Mapping) else None
+    if not isinstance(ident, Mapping):
+        return None, "", None
+    selection = ident.get("selection")
+    if isinstance(selection, Mapping) and selection.get("error_band"):
+        return selection, "identification.selection.error_band", selection["error_band"]
+    return ident, "identification.error_band", ident.get("error_band")
+
+
+def error_band_from_document(doc: Mapping, path: str | Path):
+    """The cross-validated error band of a model file (``shipid select``, ``shipid identify
+    --error-band``), or None. It describes the file's model: a refined model has not been
+    cross-validated, so it has none."""
+    _, where, data = _error_band_record(doc)
     if not data or has_refinement(doc):
         return None
     from shipid.evaluation.error_band import ErrorBand
 
     if not isinstance(data, Mapping):
-        raise ShipidError(f"{path}: identification.selection.error_band must be a mapping")
-    return ErrorBand.from_dict(data, f"{path}: identification.selection.error_band")
+        raise ShipidError(f"{path}: {where} must be a mapping")
+    return ErrorBand.from_dict(data, f"{path}: {where}")
 
 
 def rescaled_document(doc: Mapping, factor: float, to_rho: float | None = None,
@@ -312,7 +324,8 @@ def rescaled_document(doc: Mapping, factor: float, to_rho: float | None = None,
             _scale_statistics(refinement["statistics"], ratios, factor, rho, to_rho)
     band = error_band_from_document(doc, path)
     if band is not None:  # in m/s and rad/s: a Froude-similar ship's speeds are k times these
-        out["identification"]["selection"]["error_band"] = band.scaled(k).to_dict()
+        holder, _, _ = _error_band_record(out)
+        holder["error_band"] = band.scaled(k).to_dict()
     chosen = ((ident.get("selection") or {}) if isinstance(ident, Mapping) else {}).get(
         "chosen_model")
     if chosen:  # select --average keeps the chosen candidate beside the averaged model
