@@ -16,7 +16,7 @@ terms per DOF), or written out: ``"u: |u|u, v*r, 1; v: u*r, u*v, delta, 1; r: u*
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -151,6 +151,16 @@ class ModelStructure:
         for dof in self.dofs:
             seen.update(dict.fromkeys(self.terms[dof]))
         return tuple(seen)
+
+    def union(self, *others: Mapping[str, Sequence[str]], name: str | None = None
+              ) -> ModelStructure:  # fmt: skip
+        """Per equation this structure's terms, then those of ``others`` ({dof: terms}) it
+        lacks, in order: the structure of an average or ensemble of structures."""
+        terms = {d: list(self.terms.get(d, ())) for d in DOFS}
+        for other in others:
+            for d, ts in other.items():
+                terms[d] += [t for t in ts if t not in terms[d]]
+        return ModelStructure(name or self.name, {d: tuple(t) for d, t in terms.items() if t})
 
     @property
     def inputs(self) -> tuple[str, ...]:

@@ -655,12 +655,8 @@ def _averaged_model(data: _Data, weights, first: Candidate, train, options: Sele
     (a candidate's coefficient of a term it lacks is 0); terms: ``first``'s, then the others'."""
     theta = sum(w * _fit_theta(data, c.terms, c.gamma, train, options.estimator, options.physics)
                 for c, w in weights) / sum(w for _, w in weights)  # fmt: skip
-    terms = {d: list(first.terms.get(d, ())) for d in DOFS if d in first.terms}
-    for c, _ in weights:
-        for d, ts in c.terms.items():
-            terms.setdefault(d, [])
-            terms[d] += [t for t in ts if t not in terms[d]]
-    return _model_from_theta(data, {d: tuple(t) for d, t in terms.items()}, theta, name)
+    structure = ModelStructure("first", first.terms).union(*(c.terms for c, _ in weights))
+    return _model_from_theta(data, structure.terms, theta, name)
 
 
 def selection_shares(cands: Sequence[Candidate], plausible, one_standard_error: bool = True,

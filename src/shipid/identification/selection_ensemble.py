@@ -60,7 +60,8 @@ def selection_ensemble(
     p = np.array([c.share for c in cands], dtype=float)
     p /= p.sum()
     point = selection.model
-    structure = _union(point.structure, [c.terms for c in cands])
+    structure = point.structure.union(*(c.terms for c in cands),
+                                      name=f"{point.structure.name} (ensemble)")
     columns = {t: j for j, t in enumerate(structure.all_terms)}
     options = selection.options
     rng = np.random.default_rng(seed)  # the block resamples: bootstrap's stream
@@ -81,11 +82,3 @@ def selection_ensemble(
     bar.close()
     return Ensemble(point, thetas, float(block_s), int(seed), SELECTION_METHOD, structure)
 
-
-def _union(first: ModelStructure, others) -> ModelStructure:
-    """Per equation the terms of ``first``, then those of ``others`` it lacks, in order."""
-    terms = {d: list(first.terms.get(d, ())) for d in DOFS}
-    for t_map in others:
-        for d, ts in t_map.items():
-            terms[d] += [t for t in ts if t not in terms[d]]
-    return ModelStructure(f"{first.name} (ensemble)", {d: tuple(t) for d, t in terms.items() if t})
