@@ -130,24 +130,16 @@ def cross_validated_band(fit, logs, names, cv: str = "auto", method: str = "eule
     with ``'blocks:K'``, every log cut into K blocks and each block left out. ``'auto'``: logo
     from two logs, four blocks of one."""
     from shipid.dynamics.simulate import simulate_log
-    from shipid.identification.select import split_blocks
+    from shipid.identification.select import parse_cv, split_blocks
 
     logs, names = list(logs), list(names)
     if cv == "auto":
         cv = "logo" if len(logs) >= 2 else "blocks:4"
+    kind, k = parse_cv(cv, "--error-band", kinds=("blocks",))
     held_out = "logs"
-    if cv.startswith("blocks:"):
-        try:
-            k = int(cv.split(":", 1)[1])
-        except ValueError:
-            k = 0
-        if k < 2:
-            raise ShipidError(f"--error-band must be 'auto', 'logo' or 'blocks:K' with K ≥ 2, "
-                              f"got {cv!r}")  # fmt: skip
+    if kind == "blocks":
         logs, names = split_blocks(logs, names, k)
         held_out = "blocks"
-    elif cv != "logo":
-        raise ShipidError(f"--error-band must be 'auto', 'logo' or 'blocks:K', got {cv!r}")
     if len(logs) < 2:
         raise ShipidError("an error band needs two logs to hold one out; give --error-band "
                           "blocks:K to cut one")  # fmt: skip

@@ -115,17 +115,20 @@ class SelectOptions:
         if self.estimator not in LINEAR_ESTIMATORS:
             raise ShipidError(f"select fits named terms: estimator must be one of "
                               f"{', '.join(LINEAR_ESTIMATORS)}, got {self.estimator!r}")
-        _parse_cv(self.cv)
+        parse_cv(self.cv)
         if not (isinstance(self.max_evaluations, int) and self.max_evaluations >= 1):
             raise ShipidError(f"--max-evaluations must be ≥ 1, got {self.max_evaluations!r}")
         if not (math.isfinite(self.divergence_penalty) and self.divergence_penalty > 0):
             raise ShipidError("divergence_penalty must be > 0")
 
 
-def _parse_cv(cv: str) -> tuple[str, int]:
+def parse_cv(cv: str, option: str = "--cv", kinds: tuple[str, ...] = ("kfold", "blocks")
+             ) -> tuple[str, int]:  # fmt: skip
+    """('logo', 0) or (kind, K) of 'kind:K' with K ≥ 2 for a kind of ``kinds``; else a one-line
+    error naming ``option``."""
     if cv == "logo":
         return "logo", 0
-    for kind in ("kfold", "blocks"):
+    for kind in kinds:
         if isinstance(cv, str) and cv.startswith(kind + ":"):
             try:
                 k = int(cv.split(":", 1)[1])
@@ -133,7 +136,8 @@ def _parse_cv(cv: str) -> tuple[str, int]:
                 k = 0
             if k >= 2:
                 return kind, k
-    raise ShipidError(f"--cv must be 'logo', 'kfold:K' or 'blocks:K' with K ≥ 2, got {cv!r}")
+    forms = " or ".join(["'logo'", *(f"'{kind}:K'" for kind in kinds)])
+    raise ShipidError(f"{option} must be {forms} with K ≥ 2, got {cv!r}")
 
 
 @dataclass
@@ -271,7 +275,7 @@ def split_blocks(logs, names, k: int) -> tuple[list[pd.DataFrame], list[str]]:
 
 def _folds(n_logs: int, cv: str) -> list[list[int]]:
     """Held-out log indices of each fold."""
-    kind, k = _parse_cv(cv)
+    kind, k = parse_cv(cv)
     if kind == "kfold":
         if k > n_logs:
             raise ShipidError(f"--cv kfold:{k} needs at least {k} logs, got {n_logs}")
@@ -499,7 +503,7 @@ def _setup(logs, names, options: SelectOptions):
         logs = [logs]
     logs, _ = common_rudder_convention(list(logs))  # select() converts first, with notes
     names = list(names or [log.attrs.get("name", f"log {i}") for i, log in enumerate(logs)])
-    kind, k = _parse_cv(options.cv)
+    kind, k = parse_cv(options.cv)
     if kind == "blocks":
         logs, names = split_blocks(logs, names, k)
     if len(logs) < 2:
@@ -638,11 +642,10 @@ def select(
     if len(scorer.folds) < FEW_FOLDS:
         notes.append(f"only {len(scorer.folds)} folds: the CV scores and their standard error "
                      "rest on so few held-out runs that the choice among close candidates is "
-                     "weak (the KVLCC2 from two logs chose worse than its fixed structure); give "
-                     "more logs, or cut long ones with --cv blocks:K")  # fmt: skip
+                     "weak; give more logs, or cut long ones with --cv blocks:K")  # fmt: skip
     if failed:
         notes.append(f"{len(failed)} candidate(s) diverged in every fold (kept in the table)")
-    held = "blocks" if _parse_cv(options.cv)[0] == "blocks" else "logs"
+    held = "blocks" if parse_cv(options.cv)[0] == "blocks" else "logs"
     band = error_band(held_out_runs, held_out=held) if held_out_runs else None
     return Selection(model, ident, current.gamma, current.score, table, folds_report,
                      options, library, ranking, notes + ident.warnings, shared, band,
