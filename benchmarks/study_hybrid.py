@@ -88,12 +88,12 @@ def fit_hybrid(physical, logs, features):
 GAMMAS, SIGMAS = (1e-3, 1e-2, 1e-1, 1.0, 10.0), (1.0, 2.0, 4.0)
 
 
-def fit_residual(physical, logs, features, gamma, sigma):
+def fit_residual(physical, logs, features, gamma, sigma, data=None):
     """The hybrid with a residual of given γ and σ (fixed-size, 300 landmarks, over 3000
-    samples); None γ: the physical model alone."""
+    samples); None γ: the physical model alone. ``data``: ``residual_data`` already computed."""
     if gamma is None:
         return physical
-    X, Y = residual_data(physical, logs, features)
+    X, Y = data if data is not None else residual_data(physical, logs, features)
     mu, sd = X.mean(axis=0), X.std(axis=0)
     solver = {"solver": "fixed-size", "n_landmarks": 300, "random_state": 0} if len(X) > 3000 else {}
     estimators = [LSSVR(gamma=gamma, sigma=sigma, kernel="rbf", **solver).fit((X - mu) / sd, Y[:, j])
@@ -103,21 +103,22 @@ def fit_residual(physical, logs, features, gamma, sigma):
 
 def free_run_cv(structure, gamma_phys, logs, features, prefilter=None):
     """(γ, σ) of the residual (None: none) with the lowest mean normalised free-run error over
-    the folds (each log held out in turn), and the table of scores."""
-    scores = {}
-    for g in (None, *GAMMAS):
-        for sig in (SIGMAS if g is not None else (None,)):
-            fold_scores = []
-            for k, held in enumerate(logs):
-                train = [x for j, x in enumerate(logs) if j != k]
-                fit_on = [lowpass(x, prefilter) for x in train] if prefilter else train
-                physical = identify(fit_on, structure, gamma=gamma_phys, force=True).model
-                model = fit_residual(physical, fit_on, features, g, sig)
-                sim = simulate_log(model, held, "euler").log
-                measured = held[["u", "v", "r"]].to_numpy()
-                fold_scores.append(float(np.mean(normalised_error(
-                    measured, sim[["u", "v", "r"]].to_numpy(), 2.0))))
-            scores[(g, sig)] = float(np.mean(fold_scores))
+    the folds (each log held out in turn), and the table of scores. Each fold's physical model
+    and residual data are computed once for the whole grid."""
+    settings = [(None, None)] + [(g, sig) for g in GAMMAS for sig in SIGMAS]
+    fold_scores = {key: [] for key in settings}
+    for k, held in enumerate(logs):
+        train = [x for j, x in enumerate(logs) if j != k]
+        fit_on = [lowpass(x, prefilter) for x in train] if prefilter else train
+        physical = identify(fit_on, structure, gamma=gamma_phys, force=True).model
+        data = residual_data(physical, fit_on, features)
+        measured = held[["u", "v", "r"]].to_numpy()
+        for g, sig in settings:
+            model = fit_residual(physical, fit_on, features, g, sig, data)
+            sim = simulate_log(model, held, "euler").log
+            fold_scores[(g, sig)].append(float(np.mean(normalised_error(
+                measured, sim[["u", "v", "r"]].to_numpy(), 2.0))))
+    scores = {key: float(np.mean(v)) for key, v in fold_scores.items()}
     return min(scores, key=scores.get), scores
 
 
