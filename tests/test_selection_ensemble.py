@@ -159,6 +159,14 @@ def test_average_is_the_share_weighted_mean_and_so_is_its_band(zigzags):
     k = math.ceil((len(errors) + 1) * 0.95)
     assert sel.error_band.half_width["r"] == pytest.approx(np.sort(errors[:, 2])[k - 1], rel=1e-6)
     assert sel.to_dict()["chosen_model"] is not None and plain.to_dict()["chosen_model"] is None
+    # Its plausibility record is the averaged model's, as the checks give it afresh.
+    from shipid.data.log import approach
+    from shipid.identification.plausibility import plausibility_at_approach
+
+    again, notes = plausibility_at_approach(sel.model, approach(zigzags[0], "u"), None)
+    assert sel.plausibility["straight_line"] == again["straight_line"]
+    assert sel.plausibility["held_rudder"] == again["held_rudder"]
+    assert sel.plausibility_notes == notes
 
 
 def test_cli_average_writes_the_average_and_keeps_the_chosen(zigzags, tmp_path, capsys):

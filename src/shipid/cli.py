@@ -538,7 +538,6 @@ def _parse_gammas(text: str | None) -> tuple[float, ...] | None:
 
 def cmd_select(args) -> int:
     """``shipid select``: structure and γ by cross-validated free-run error."""
-    from shipid.identification.plausibility import plausibility_at_approach
     from shipid.identification.select import RESAMPLES, SelectOptions, select
     from shipid.outputs import OutputSet, check_outputs
     from shipid.reporting.modelfile import model_text
@@ -583,7 +582,7 @@ def cmd_select(args) -> int:
         print(f"Their {sel.error_band.describe()}; stored in the model file, validate reports "
               "each log's share of samples inside it.")  # fmt: skip
     speed, rps = _approach(logs[0], "u"), _approach(logs[0], "n")
-    plausibility, notes = plausibility_at_approach(sel.model, speed, rps, args.speed, args.rps)
+    plausibility, notes = sel.plausibility, sel.plausibility_notes
     ident.warnings.extend(f"plausibility: {n}" for n in notes)
     prep = {"dt": args.dt, "start": args.start, "end": args.end, "lead": args.lead,
             "columns": args.columns, "degrees": args.degrees, "format": args.format,

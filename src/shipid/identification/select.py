@@ -188,6 +188,9 @@ class Selection:
     error_band: ErrorBand | None = None
     # The chosen candidate fitted on all logs (``model`` too, unless ``options.average``).
     chosen_model: ManoeuvringModel | None = None
+    # The plausibility checks of ``model`` from its steady approach, and their warnings.
+    plausibility: dict | None = None
+    plausibility_notes: list[str] = field(default_factory=list)
 
     @property
     def chosen_share(self) -> float:
@@ -624,18 +627,22 @@ def select(
     shared = sorted((c for c in scorer.cache.values() if c.share > 0), key=lambda c: -c.share)
     weights = [(current, 1.0)]
     model = ident.model
+    checked = None  # (report, notes) of the model's plausibility, when computed here
     if options.average and shared:
         weights = [(c, c.share) for c in shared]
         averaged = _averaged_model(data, weights, current, range(len(logs)), options,
                                    f"average of {len(shared)} candidates from {library.name}")
-        report, _ = plausibility_at_approach(averaged, speed, rps, options.speed, options.rps)
-        reasons = disqualifying(report, averaged) if options.plausibility else []
+        checked = plausibility_at_approach(averaged, speed, rps, options.speed, options.rps)
+        reasons = disqualifying(checked[0], averaged) if options.plausibility else []
         if reasons:
             notes.append(f"the average of the candidates is implausible ({'; '.join(reasons)}); "
                          "the model is the chosen candidate")  # fmt: skip
             weights = [(current, 1.0)]
+            checked = None
         else:
             model = averaged
+    if checked is None:
+        checked = plausibility_at_approach(model, speed, rps, options.speed, options.rps)
     folds_report, held_out_runs = _fold_report(data, scorer, weights, current, logs, names)
     table = _table(scorer.cache.values(), current)
     failed = [c for c in scorer.cache.values() if c.folds_diverged == len(scorer.held)]
@@ -649,7 +656,7 @@ def select(
     band = error_band(held_out_runs, held_out=held) if held_out_runs else None
     return Selection(model, ident, current.gamma, current.score, table, folds_report,
                      options, library, ranking, notes + ident.warnings, shared, band,
-                     ident.model)  # fmt: skip
+                     ident.model, *checked)  # fmt: skip
 
 
 def _averaged_model(data: _Data, weights, first: Candidate, train, options: SelectOptions,
