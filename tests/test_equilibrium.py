@@ -132,3 +132,37 @@ def test_plausibility_is_judged_about_a_straight_run_the_model_can_hold():
     # A speed given for the checks is kept.
     given, _ = plausibility_at_approach(model, 0.26, 16.7, speed=0.26)
     assert given["approach_speed"] == 0.26 and not given["straight_line"]["stable"]
+
+
+def test_manoeuvre_stopping_runs_on_a_propelled_model_file(tmp_path, capsys):
+    """``manoeuvre MODEL.json stopping`` stopped with an internal error (the stopping test was
+    handed the steering machine the other manoeuvres take). It runs from the model's steady
+    approach and gives the API's track reach."""
+    from shipid.reporting.modelfile import load_model
+    from shipid.trials.manoeuvres import stopping
+
+    truth = ManoeuvringModel(
+        ModelStructure("reversing", {"u": ("|u|*u", "pos(n)^2", "neg(n)^2"), "v": LATERAL,
+                                     "r": LATERAL}),
+        {"u": {"|u|*u": A_UU, "pos(n)^2": B_NN, "neg(n)^2": -B_NN},
+         "v": PROPELLED.coefficients["v"], "r": PROPELLED.coefficients["r"]})  # fmt: skip
+    # Two propeller speeds ahead and one astern: n⁺² and n⁻² are not collinear with the bias.
+    paths = [write_log(zigzag(truth, 20, 20, duration=120, dt=0.2, speed=steady(n),
+                              rps=n).log, tmp_path / f"zz{n:g}.csv") for n in (10.0, 14.0)]
+    paths.append(write_log(stopping(truth, 10.0, duration=120, dt=0.2, speed=steady(10.0)).log,
+                           tmp_path / "stop.csv"))
+    model_path = tmp_path / "m.json"
+    code, _, err = run(["identify", *paths, "--model", "u: |u|u, pos(n)^2, neg(n)^2; "
+                        "v: u*r, u*v, delta; r: u*r, u*v, delta", "--filter", "none",
+                        "-o", model_path], capsys)  # fmt: skip
+    assert code == 0, err
+    code, out, err = run(["manoeuvre", model_path, "stopping", "--rps", "10", "--no-bands",
+                          "--json", tmp_path / "stop.json"], capsys)  # fmt: skip
+    assert code == 0, err
+    assert "internal error" not in err
+    doc = json.loads((tmp_path / "stop.json").read_text())
+    api = stopping(load_model(model_path), 10.0, speed=doc["approach"]["speed"])
+    assert doc["indices"]["track_reach"] == pytest.approx(api.indices["track_reach"], rel=1e-9)
+    # Noise-free logs: the identified model stops as the truth does.
+    assert doc["indices"]["track_reach"] == pytest.approx(
+        stopping(truth, 10.0, speed=steady(10.0)).indices["track_reach"], rel=1e-2)

@@ -1305,6 +1305,7 @@ def cmd_manoeuvre(args) -> int:
             raise ShipidError("stopping needs the approach propeller speed (--rps, or a model "
                               "trained with the n column)")  # fmt: skip
         kw.pop("rps")
+        kw.pop("steering")  # the rudder stays amidships
         run = partial(stopping, rps=rps, astern_rps=args.astern_rps, **kw)
     res = run(target)
     print(rudder_note)
