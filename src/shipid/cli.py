@@ -1284,6 +1284,8 @@ def cmd_manoeuvre(args) -> int:
         kw["wind"] = (args.wind_speed, math.radians(args.wind_from or 0.0))
     if args.duration is not None:
         kw["duration"] = args.duration
+    if args.rudder_deg is None:
+        args.rudder_deg = 35.0 if args.kind == "turning" else 20.0
     if args.kind == "zigzag":
         heading = args.heading if args.heading is not None else args.rudder_deg
         run = partial(zigzag, rudder_deg=args.rudder_deg, heading_deg=heading, first=args.first,
@@ -1325,6 +1327,9 @@ def cmd_manoeuvre(args) -> int:
     if res.diverged:
         print(res.reason, file=sys.stderr)
     notes = ([unsteady] if unsteady else []) + outside_envelope(cond["envelope"], res.log)
+    if res.incomplete and not res.diverged:
+        notes.append(f"{res.incomplete}: indices that need it are missing or those of a "
+                     "transient; give a longer --duration")  # fmt: skip
     if args.kind == "turning" and not res.diverged:
         notes += implausible_indices(res.indices, speed or getattr(target, "approach_speed", None),
                                      getattr(target, "length", None))  # fmt: skip
@@ -1606,13 +1611,17 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("manoeuvre", help="run a standard manoeuvre on a model or vessel")
     p.add_argument("model", metavar="MODEL.json|VESSEL")
     p.add_argument("kind", choices=("zigzag", "turning", "pull-out", "spiral", "stopping"))
-    p.add_argument("--rudder", dest="rudder_deg", type=float, default=20.0, metavar="DEG",
-                   help="rudder angle [deg] (default %(default)s)")
+    p.add_argument("--rudder", dest="rudder_deg", type=float, metavar="DEG",
+                   help="rudder angle [deg] (default 35 for the turning circle, 20 otherwise)")
     p.add_argument("--heading", type=float, metavar="DEG",
                    help="zig-zag switch heading [deg] (default = rudder)")
     p.add_argument("--first", default="starboard", choices=("starboard", "port"),
                    help="first rudder (zig-zag) or turn side (default %(default)s)")
-    p.add_argument("--duration", type=float, help="length of the run [s]")
+    p.add_argument("--duration", type=float,
+                   help="length of the run [s] (default: from 90 s for a zig-zag, 240 s for a "
+                        "turning circle, 60 + 60 s for a pull-out, 120 s per spiral step, "
+                        "doubled until the run is complete and its yaw rate settled; a full-"
+                        "scale ship takes ten times a 1:100 model)")
     p.add_argument("--dt", "--step", dest="step", type=float, default=0.05,
                    help="integration step [s] (default %(default)s)")
     p.add_argument("--speed", type=float, help="approach speed [m/s] (models: default from training)")

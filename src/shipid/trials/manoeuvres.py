@@ -49,6 +49,37 @@ class ManoeuvreResult:
     diverged: bool = False
     diverged_at: float | None = None
     reason: str = ""
+    incomplete: str = ""  # what the run did not reach (its indices need it), with the remedy
+
+
+# Run lengths at model scale. A larger or slower ship takes longer (√λ at Froude scale: a full-scale
+# turn lasts ten times a 1:100 model's), so a run without a given length is doubled until its
+# indices are complete or its yaw rate settled, up to EXTEND_MAX times the first length; a run
+# still incomplete then says so (``incomplete``) instead of returning indices of a transient.
+ZIGZAG_DURATION, TURNING_DURATION, PULL_OUT_PHASE, SPIRAL_HOLD = 90.0, 240.0, 60.0, 120.0
+EXTEND_MAX = 64
+# A yaw rate is settled when it moves less than this share of its scale over the last fifth of
+# a phase (the spiral's steady rate is that fifth's mean).
+SETTLED_SHARE = 0.01
+
+
+def _extended(run, first: float) -> ManoeuvreResult:
+    """``run(length)`` from ``first``, doubled while its result is incomplete (not diverged)."""
+    length = first
+    while True:
+        res = run(length)
+        if res.diverged or not res.incomplete or length >= EXTEND_MAX * first:
+            return res
+        length *= 2
+
+
+def _settled(r: np.ndarray, scale: float) -> bool:
+    """Whether a yaw-rate record has settled: its last fifth moves less than SETTLED_SHARE of
+    ``scale`` (and of itself)."""
+    tail = r[int(0.8 * len(r)):]
+    if len(tail) < 2:
+        return False
+    return bool(np.ptp(tail) <= SETTLED_SHARE * max(scale, float(np.max(np.abs(tail))), 1e-12))
 
 
 def _positive(value, what: str) -> float:
@@ -244,7 +275,7 @@ def zigzag(
     rudder_deg: float = 20.0,
     heading_deg: float = 20.0,
     first: str = "starboard",
-    duration: float = 90.0,
+    duration: float | None = None,
     dt: float = 0.05,
     approach: float = 0.0,
     speed: float | None = None,
@@ -261,6 +292,7 @@ def zigzag(
     straight approach; the rudder is held at its initial ``delta`` until ``approach`` and the
     heading change is taken from the initial ψ. ``wind``: constant true wind (speed [m/s],
     direction it blows from [rad], clockwise from north) for models with wind terms.
+    ``duration`` [s]: by default 90 s, doubled until the second overshoot is reached.
     """
     vessel = as_vessel(ship, speed, steering, rps)
     rudder = _check_rudder(vessel, rudder_deg)
@@ -269,18 +301,24 @@ def zigzag(
     held = float((initial or {}).get("delta", 0.0))
     params = _params(vessel, kernel.MODE_ZIGZAG, rudder, held, approach, switch=switch,
                      side=_side_sign(first), psi_ref=psi_ref, rps=rps, wind=_check_wind(wind))
-    res = run_closed_loop(vessel, params, duration, dt, method, initial=initial, rps=rps)
-    res.log.attrs["manoeuvre"] = f"zigzag {rudder_deg:g}/{heading_deg:g}, first {first}"
-    res.indices = zigzag_indices(res.log, heading_deg, t_order=approach,
-                                 length=_finite_or_none(vessel.length))  # fmt: skip
-    return res
+
+    def run(length: float) -> ManoeuvreResult:
+        res = run_closed_loop(vessel, params, length, dt, method, initial=initial, rps=rps)
+        res.log.attrs["manoeuvre"] = f"zigzag {rudder_deg:g}/{heading_deg:g}, first {first}"
+        res.indices = zigzag_indices(res.log, heading_deg, t_order=approach,
+                                     length=_finite_or_none(vessel.length))  # fmt: skip
+        if res.indices.get("second_overshoot_deg") is None:
+            res.incomplete = f"no second overshoot within {length:g} s"
+        return res
+
+    return run(duration) if duration is not None else _extended(run, ZIGZAG_DURATION)
 
 
 def turning_circle(
     ship: Vessel | ManoeuvringModel,
     rudder_deg: float = 35.0,
     side: str = "starboard",
-    duration: float = 240.0,
+    duration: float | None = None,
     dt: float = 0.05,
     approach: float = 0.0,
     speed: float | None = None,
@@ -289,25 +327,36 @@ def turning_circle(
     rps: float | None = None,
     wind: tuple[float, float] | None = None,
 ) -> ManoeuvreResult:
-    """Turning circle: rudder to ``side`` at t = ``approach`` (the rudder execute), held."""
+    """Turning circle: rudder to ``side`` at t = ``approach`` (the rudder execute), held.
+    ``duration`` [s]: by default 240 s, doubled until the heading has turned 180° and the turn is
+    steady."""
     vessel = as_vessel(ship, speed, steering, rps)
     value = _rudder_to(side, vessel, rudder_deg)
     params = _params(vessel, kernel.MODE_HOLD, value, 0.0, approach, rps=rps,
                      wind=_check_wind(wind))  # fmt: skip
-    res = run_closed_loop(vessel, params, duration, dt, method, rps=rps)
-    res.log.attrs["manoeuvre"] = f"turning circle {rudder_deg:g}° to {side}"
-    if not res.diverged:
-        res.indices = turning_indices(res.log, t_order=approach,
-                                      length=_finite_or_none(vessel.length))  # fmt: skip
-    return res
+
+    def run(length: float) -> ManoeuvreResult:
+        res = run_closed_loop(vessel, params, length, dt, method, rps=rps)
+        res.log.attrs["manoeuvre"] = f"turning circle {rudder_deg:g}° to {side}"
+        if not res.diverged:
+            res.indices = turning_indices(res.log, t_order=approach,
+                                          length=_finite_or_none(vessel.length))  # fmt: skip
+            if res.indices.get("time_to_180") is None:
+                res.incomplete = f"the heading has not turned 180° within {length:g} s"
+            elif (res.indices.get("steady_yaw_rate") is None
+                  or not _settled(res.log["r"].to_numpy(), abs(res.indices["steady_yaw_rate"]))):
+                res.incomplete = f"the turn is not steady within {length:g} s"  # fmt: skip
+        return res
+
+    return run(duration) if duration is not None else _extended(run, TURNING_DURATION)
 
 
 def pull_out(
     ship: Vessel | ManoeuvringModel,
     rudder_deg: float = 20.0,
     side: str = "starboard",
-    hold: float = 60.0,
-    release: float = 60.0,
+    hold: float | None = None,
+    release: float | None = None,
     dt: float = 0.05,
     speed: float | None = None,
     steering: SteeringMachine | None = None,
@@ -316,22 +365,35 @@ def pull_out(
     wind: tuple[float, float] | None = None,
 ) -> ManoeuvreResult:
     """Pull-out: rudder held for ``hold`` s, then returned to midships for ``release`` s. A
-    straight-line stable ship's yaw rate decays to zero; an unstable one keeps a residual rate."""
+    straight-line stable ship's yaw rate decays to zero; an unstable one keeps a residual rate.
+    A phase not given lasts 60 s, doubled until the yaw rate has settled in both phases."""
     vessel = as_vessel(ship, speed, steering, rps)
     value = _rudder_to(side, vessel, rudder_deg)
-    hold = _positive(hold, "hold time")
-    release = _positive(release, "release time")
-    params = _params(vessel, kernel.MODE_HOLD, value, 0.0, 0.0, release=hold, rps=rps,
-                     wind=_check_wind(wind))  # fmt: skip
-    res = run_closed_loop(vessel, params, hold + release, dt, method, rps=rps)
-    res.log.attrs["manoeuvre"] = f"pull-out {rudder_deg:g}° to {side}"
-    if not res.diverged:
-        r = res.log["r"].to_numpy()
-        t = res.log["t"].to_numpy()
-        res.indices = {"yaw_rate_at_release": float(np.interp(hold, t, r)),
-                       "residual_yaw_rate": float(r[-1]),
-                       "residual_fraction": float(r[-1] / np.interp(hold, t, r))}  # fmt: skip
-    return res
+    given_hold = None if hold is None else _positive(hold, "hold time")
+    given_release = None if release is None else _positive(release, "release time")
+    wind = _check_wind(wind)
+
+    def run(length: float) -> ManoeuvreResult:
+        held = given_hold or length
+        res = run_closed_loop(vessel, _params(vessel, kernel.MODE_HOLD, value, 0.0, 0.0,
+                                              release=held, rps=rps, wind=wind),
+                              held + (given_release or length), dt, method, rps=rps)  # fmt: skip
+        res.log.attrs["manoeuvre"] = f"pull-out {rudder_deg:g}° to {side}"
+        if not res.diverged:
+            r = res.log["r"].to_numpy()
+            t = res.log["t"].to_numpy()
+            at_release = float(np.interp(held, t, r))
+            res.indices = {"yaw_rate_at_release": at_release, "residual_yaw_rate": float(r[-1]),
+                           "residual_fraction": float(r[-1] / at_release)}  # fmt: skip
+            if not (_settled(r[t <= held], abs(at_release))
+                    and _settled(r[t >= held], abs(at_release))):  # fmt: skip
+                res.incomplete = (f"the yaw rate has not settled within {held:g} s held and "
+                                  f"{t[-1] - held:g} s released")  # fmt: skip
+        return res
+
+    if given_hold is not None and given_release is not None:
+        return run(given_hold)
+    return _extended(run, PULL_OUT_PHASE)
 
 
 def stopping(
@@ -393,7 +455,7 @@ def stopping(
 def spiral(
     ship: Vessel | ManoeuvringModel,
     rudders_deg=(25, 15, 10, 5, 2, 0, -2, -5, -10, -15, -25, -15, -10, -5, -2, 0, 2, 5, 10, 15, 25),
-    hold: float = 120.0,
+    hold: float | None = None,
     dt: float = 0.05,
     speed: float | None = None,
     method: str = "rk4",
@@ -404,7 +466,10 @@ def spiral(
     from the state the previous one left; the steady yaw rate of each (mean over the last fifth)
     traces r(δ). A straight-line unstable ship shows a loop: at the same small rudder, a
     different steady rate coming from each side. Indices: the r(δ) table, ``loop`` (whether any
-    rudder angle gave steady turns both ways) and ``loop_rudders_deg`` (those angles)."""
+    rudder angle gave steady turns both ways) and ``loop_rudders_deg`` (those angles). Without a
+    given ``hold`` each angle is held 120 s, doubled until its yaw rate settles (a loop drawn
+    from unsettled rates is a transient, not an instability); a row says whether it settled,
+    ``unsettled_rudders_deg`` lists the angles that did not."""
     vessel = as_vessel(ship, speed, steering, rps)
     angles = [float(a) for a in rudders_deg]
     if not angles or any(not math.isfinite(a) or abs(math.radians(a)) > vessel.steering.max_angle
@@ -416,17 +481,30 @@ def spiral(
     logs, table = [], []
     t0 = 0.0
     res = None
+    if hold is not None:
+        hold = _positive(hold, "hold time")
+    peak = 0.0
     for a in angles:
         value = stbd * math.radians(a)
         params = _params(vessel, kernel.MODE_HOLD, value, initial.get("delta", 0.0), 0.0,
                          rps=rps)  # fmt: skip
-        res = run_closed_loop(vessel, params, hold, dt, method, initial=initial, rps=rps)
+        length = hold or SPIRAL_HOLD
+        while True:
+            res = run_closed_loop(vessel, params, length, dt, method, initial=initial, rps=rps)
+            # Within 1 % of the rate itself, or of a tenth of the largest (near 0 rudder).
+            settled = _settled(res.log["r"].to_numpy(), 0.1 * peak)
+            if (hold is not None or res.diverged or settled
+                    or length >= EXTEND_MAX * SPIRAL_HOLD):  # fmt: skip
+                break
+            length *= 2
         seg = res.log
         seg["t"] = seg["t"] + t0
         logs.append(seg.iloc[:-1] if len(logs) < len(angles) - 1 else seg)
         tail = seg.iloc[int(0.8 * len(seg)):]
         table.append({"rudder_deg": a, "steady_yaw_rate": float(tail["r"].mean()),
-                      "steady_speed": float(np.hypot(tail["u"], tail["v"]).mean())})  # fmt: skip
+                      "steady_speed": float(np.hypot(tail["u"], tail["v"]).mean()),
+                      "hold": length, "settled": settled})  # fmt: skip
+        peak = max(peak, abs(table[-1]["steady_yaw_rate"]))
         if res.diverged:
             break
         last = seg.iloc[-1]
@@ -438,7 +516,13 @@ def spiral(
     log.attrs["manoeuvre"] = "spiral"
     out = ManoeuvreResult(log, diverged=res.diverged, diverged_at=res.diverged_at, reason=res.reason)
     loop = _loop_rudders(table)
-    out.indices = {"table": table, "loop": bool(loop), "loop_rudders_deg": loop}
+    out.indices = {"table": table, "loop": bool(loop), "loop_rudders_deg": loop,
+                   "unsettled_rudders_deg": [row["rudder_deg"] for row in table
+                                             if not row["settled"]]}  # fmt: skip
+    if out.indices["unsettled_rudders_deg"]:
+        out.incomplete = ("no steady yaw rate at rudder "
+                          + ", ".join(f"{a:g}°" for a in out.indices["unsettled_rudders_deg"])
+                          + f" within {max(row['hold'] for row in table):g} s")  # fmt: skip
     return out
 
 
