@@ -83,3 +83,19 @@ def test_the_cli_warns_of_a_run_too_short(capsys):
     code, out, err = run(["manoeuvre", "scale-ship", "turning"], capsys)
     assert code == 0, err
     assert "longer --duration" not in err and "tactical_diameter: None" not in out
+
+
+def test_plausibility_holds_the_rudder_until_a_full_scale_turn_settles():
+    """The plausibility check held the rudder 300 s: the full-scale KVLCC2 (identified from
+    MARIN's full-scale files) was 'not settled' to both sides where its model-scale twin was."""
+    from shipid.identification.plausibility import check_plausibility
+
+    small, small_notes = check_plausibility(MODEL, SMALL["speed"])
+    large, large_notes = check_plausibility(LARGE_MODEL, LARGE["speed"])
+    assert not any("no steady turn" in n for n in small_notes + large_notes)
+    for side in ("starboard", "port"):
+        a, b = small["held_rudder"][side], large["held_rudder"][side]
+        assert a["settled"] and b["settled"] and b["duration"] > 300.0
+        assert b["steady_yaw_rate"] == pytest.approx(a["steady_yaw_rate"] / K, rel=2e-2)
+    _, notes = check_plausibility(LARGE_MODEL, LARGE["speed"], duration=300.0)
+    assert any("no steady turn after 300 s" in n for n in notes)
