@@ -145,3 +145,52 @@ def test_cli_linearise_export_autopilot_follow(tmp_path, capsys):
     assert "truth, model-tuned PID" in out and (tmp_path / "f.png").exists()
     code, _, err = run(["follow", path, "--speed", "1.93", "--waypoints", "0,0"], capsys)
     assert code == 1 and "two 'x,y' pairs" in err
+
+
+@pytest.mark.parametrize(("K", "T"), [(0.131, -18.58), (-31.24, -2401.0)])
+def test_pid_from_nomoto_stabilises_a_straight_line_unstable_ship(K, T):
+    """KVLCC2 models have T < 0 (the MARIN-identified one −18.6 s, the MMG one −2401 s): tuning
+    refused them. The placement holds for T < 0, at ω = max(1/|T|, √|K/T|) by default."""
+    pid = pid_from_nomoto(K, T)
+    w = max(1 / abs(T), math.sqrt(abs(K / T)))
+    # Without the integral: T s² + (1 + K Kd) s + K Kp = T (s² + 2ζω s + ω²).
+    assert np.allclose(np.roots([T, 1 + K * pid.kd, K * pid.kp]),
+                       np.roots([1, 2 * 0.9 * w, w * w]))  # fmt: skip
+    assert np.all(np.roots([T, 1 + K * pid.kd, K * pid.kp, K * pid.ki]).real < 0)
+    # Nomoto's model run free under the controller: ṙ = (Kδ − r)/T, δ = −(Kp ψ̃ + Ki∫ψ̃ + Kd r).
+    model = ManoeuvringModel("nomoto1", {"r": {"r": -1 / T, "delta": K / T}})
+    log = heading_step(model, pid, 20.0, speed=1.0, dt=0.2)
+    assert not log.attrs["incomplete"]
+    assert math.degrees(log["psi"].iloc[-1]) == pytest.approx(20.0, abs=0.4)
+
+
+def test_a_heading_step_runs_until_a_full_scale_ship_settles():
+    from shipid.dynamics.prime import froude_scaled
+
+    big = froude_scaled(scale_ship_model(), 100.0)
+    nm = nomoto(big, 19.3)
+    pid = pid_from_nomoto(nm["K"], nm["T"])
+    log = heading_step(big, pid, 20.0, speed=19.3, dt=0.5)
+    assert not log.attrs["incomplete"] and log["t"].iloc[-1] > 120.0
+    assert math.degrees(log["psi"].iloc[-1]) == pytest.approx(20.0, abs=0.4)
+    short = heading_step(big, pid, 20.0, duration=60.0, speed=19.3, dt=0.5)
+    assert "not settled within 60 s" in short.attrs["incomplete"]
+
+
+def test_the_model_tuned_autopilot_is_mirrored_for_a_truth_of_the_other_rudder_sign(tmp_path,
+                                                                                     capsys):
+    """The scale ship's model turns to port with positive rudder, the reference KVLCC2 to
+    starboard: its gains, unmirrored, steered the KVLCC2 to −149° for a 20° step."""
+    import re
+
+    path = tmp_path / "m.json"
+    scale_ship_model().save(path)
+    code, out, err = run(["autopilot", path, "--speed", "1.93", "--truth", "kvlcc2",
+                          "--duration", "100"], capsys)  # fmt: skip
+    assert code == 0, err
+    assert "mirrored" in out
+    over, final = re.search(r"kvlcc2 \(truth\): overshoot ([-\d.]+)°, final heading ([-\d.]+)°",
+                            out).groups()  # fmt: skip
+    # Steered toward the ordered heading (a controller for a faster ship: it overshoots), not
+    # away from it (overshoot −20°, that is never beyond 0°).
+    assert float(over) > 0 and float(final) > 0

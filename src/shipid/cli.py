@@ -843,6 +843,22 @@ def _controlled(args):
     return target, truth, speed, rps, steering
 
 
+def _for_truth(pid, target, truth, speed, rps):
+    """The model-tuned PID as it acts on the truth, and a note when it differs: its gains carry
+    the model's rudder sign, so they are mirrored where the truth's positive rudder turns the
+    other way (the MARIN KVLCC2 logs turn to port with positive rudder, the reference KVLCC2 to
+    starboard; unmirrored, the truth was steered away from the ordered heading)."""
+    from shipid.control.autopilot import PID
+    from shipid.trials.manoeuvres import as_vessel
+
+    side = as_vessel(target, speed, None, rps).rudder_positive
+    if side == truth.rudder_positive:
+        return pid, None
+    return PID(-pid.kp, -pid.ki, -pid.kd), (
+        f"the truth's positive rudder turns it to {truth.rudder_positive}, the model's to "
+        f"{side}: the model-tuned controller's rudder is mirrored for the truth")
+
+
 def _tuned(ship, speed, rps, omega):
     from shipid.control.autopilot import pid_from_nomoto
     from shipid.control.linear import nomoto
@@ -905,9 +921,21 @@ def cmd_autopilot(args) -> int:
     runs = {args.model: heading_step(target, pid, args.heading, args.duration, args.dt,
                                      speed, rps, steering=steering)}  # fmt: skip
     if truth is not None:
-        runs[f"{args.truth} (truth)"] = heading_step(truth, pid, args.heading, args.duration,
-                                                     args.dt)  # fmt: skip
+        pid_truth, note = _for_truth(pid, target, truth, speed, rps)
+        if note:
+            print(note)
+        runs[f"{args.truth} (truth)"] = heading_step(truth, pid_truth, args.heading,
+                                                     args.duration, args.dt)  # fmt: skip
+        longest = max(float(log["t"].iloc[-1]) for log in runs.values())
+        if args.duration is None and any(log["t"].iloc[-1] < longest for log in runs.values()):
+            # One length for both, so that the figure compares them over the same time.
+            runs = {args.model: heading_step(target, pid, args.heading, longest, args.dt, speed,
+                                             rps, steering=steering),
+                    f"{args.truth} (truth)": heading_step(truth, pid_truth, args.heading,
+                                                          longest, args.dt)}  # fmt: skip
     for name, log in runs.items():
+        if log.attrs.get("incomplete") and log.attrs["incomplete"] != "diverged":
+            _warn(f"{name}: {log.attrs['incomplete']}; give a longer --duration")
         psi = _np().degrees(log["psi"].to_numpy())
         over = float(psi.max() - args.heading) if args.heading > 0 else float(args.heading - psi.min())
         print(f"{name}: overshoot {over:.3g}°, final heading {psi[-1]:.4g}°, max rudder "
@@ -945,7 +973,10 @@ def cmd_follow(args) -> int:
     cases = [("model", target, pid, speed, rps, steering)]
     if truth is not None:
         _, pid_truth = _tuned(truth, truth.approach_speed, None, args.omega)
-        cases += [("truth, model-tuned PID", truth, pid, None, None, None),
+        pid_mirrored, note = _for_truth(pid, target, truth, speed, rps)
+        if note:
+            print(note)
+        cases += [("truth, model-tuned PID", truth, pid_mirrored, None, None, None),
                   ("truth, truth-tuned PID", truth, pid_truth, None, None, None)]
     for label, ship, gains, sp, n, gear in cases:
         res = follow_path(ship, gains, waypoints, lookahead, dt=args.dt, speed=sp, rps=n,
@@ -1693,7 +1724,8 @@ def build_parser() -> argparse.ArgumentParser:
         if name == "autopilot":
             p.add_argument("--heading", type=float, default=20.0, metavar="DEG",
                            help="heading step (default %(default)s; positive to starboard)")
-            p.add_argument("--duration", type=float, default=120.0, help="[s] (default %(default)s)")
+            p.add_argument("--duration", type=float,
+                           help="[s] (default: from 120 s, doubled until the heading settles)")
             p.add_argument("-o", "--output", metavar="FIG.png", help="figure of the responses")
             p.set_defaults(func=cmd_autopilot)
         else:

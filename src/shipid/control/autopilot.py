@@ -48,10 +48,17 @@ class PID:
 
 def pid_from_nomoto(K: float, T: float, omega: float | None = None, zeta: float = 0.9) -> PID:
     """Pole placement on Nomoto's first-order model; ``omega`` (closed-loop natural frequency,
-    rad/s) defaults to 1/T (as fast as the ship's own yaw response)."""
-    if not (math.isfinite(K) and K != 0 and math.isfinite(T) and T > 0):
-        raise ShipidError(f"PID tuning needs a finite K ≠ 0 and T > 0, got K = {K}, T = {T}")
-    w = omega if omega is not None else 1.0 / T
+    rad/s) defaults to 1/T (as fast as the ship's own yaw response).
+
+    A straight-line unstable ship (T < 0: KVLCC2) is stabilised by the same placement (the
+    closed-loop polynomial T s² + (1 + K Kd) s + K Kp divides by T either way); its default
+    ``omega`` is the larger of 1/|T| (faster than the divergence) and √|K/T|, the frequency at
+    which Kp = 1 (a degree of rudder per degree of heading error): a nearly neutral ship's 1/|T|
+    (1/2400 s for the MMG KVLCC2) would barely steer it."""
+    if not (math.isfinite(K) and K != 0 and math.isfinite(T) and T != 0):
+        raise ShipidError(f"PID tuning needs a finite K ≠ 0 and T ≠ 0, got K = {K}, T = {T}")
+    w = omega if omega is not None else (
+        1.0 / T if T > 0 else max(1.0 / abs(T), math.sqrt(abs(K / T))))
     return PID(kp=w * w * T / K, ki=w**3 * T / (10.0 * K), kd=(2.0 * zeta * w * T - 1.0) / K)
 
 
@@ -112,14 +119,35 @@ def _run(ship, pid: PID, desired, duration: float, dt: float, speed: float | Non
     return log, done, m < n and not done
 
 
-def heading_step(ship, pid: PID, heading_deg: float, duration: float = 120.0, dt: float = 0.1,
-                 speed: float | None = None, rps: float | None = None,
+# A heading step runs from HEADING_STEP_DURATION s, doubled (up to 16 times) until the heading
+# has settled within SETTLED_SHARE of the step: a full-scale ship answers ten times slower than
+# its 1:100 model, and a fixed 120 s showed the full-scale KVLCC2 a sixth of the way there.
+HEADING_STEP_DURATION, HEADING_STEP_MAX_DOUBLINGS, SETTLED_SHARE = 120.0, 4, 0.02
+
+
+def heading_step(ship, pid: PID, heading_deg: float, duration: float | None = None,
+                 dt: float = 0.1, speed: float | None = None, rps: float | None = None,
                  steering: SteeringMachine | None = None,
                  method: str = "rk4") -> pd.DataFrame:  # fmt: skip
-    """The autopilot ordered from the initial heading to ``heading_deg`` (positive: starboard)."""
+    """The autopilot ordered from the initial heading to ``heading_deg`` (positive: starboard),
+    for ``duration`` s or, by default, until the heading settles (see HEADING_STEP_DURATION).
+    ``log.attrs['incomplete']`` says when it has not settled (or the run diverged)."""
     target = math.radians(heading_deg)
-    log, _, _ = _run(ship, pid, lambda t, s: (target, math.nan, False), duration, dt, speed, rps,
-                     steering, method)  # fmt: skip
+    length = duration or HEADING_STEP_DURATION
+    while True:
+        log, _, diverged = _run(ship, pid, lambda t, s: (target, math.nan, False), length, dt,
+                                speed, rps, steering, method)  # fmt: skip
+        psi = log["psi"].to_numpy()
+        tail = psi[int(0.8 * len(psi)):]
+        tol = SETTLED_SHARE * max(abs(target), math.radians(1.0))
+        settled = bool(np.ptp(tail) <= tol and abs(psi[-1] - target) <= tol)
+        if (duration is not None or diverged or settled
+                or length >= HEADING_STEP_DURATION * 2**HEADING_STEP_MAX_DOUBLINGS):  # fmt: skip
+            break
+        length *= 2
+    log.attrs["incomplete"] = ("" if settled else
+                               "diverged" if diverged else
+                               f"the heading has not settled within {length:g} s")  # fmt: skip
     return log
 
 
