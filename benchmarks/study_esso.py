@@ -1,7 +1,8 @@
 """The Esso Osaka's unseen manoeuvres (issue #10, the principal push): ``select`` on the nine
 zig-zags and three of the four random runs, judged on the two ±35° turning circles and the
 random run left out, each random run left out in turn; for the README's library, with the
-single propeller's asymmetry added (``propeller-asymmetry``), and with it and ``--average``
+single propeller's asymmetry added (``propeller-asymmetry``), with the hull's astern terms
+(``astern``), and each with ``--average``
 (the README's recipe: the candidates averaged by how often the choice rule picks them on
 resampled held-out logs). For the README's fold (random run 12_29_58 held out), the turns' 95 %
 intervals over 100 replicates of the model: its terms refitted on block resamples, and
@@ -30,7 +31,9 @@ from shipid.trials.trial import describe_trial
 # (library, select --average): the README's library before and after the asymmetry terms, and
 # the README's recipe, which writes the average of the candidates by their shares.
 CONFIGURATIONS = (("low-speed+wind", False), ("low-speed+wind+propeller-asymmetry", False),
-                  ("low-speed+wind+propeller-asymmetry", True))
+                  ("low-speed+wind+propeller-asymmetry", True),
+                  ("low-speed+wind+propeller-asymmetry+astern", False),
+                  ("low-speed+wind+propeller-asymmetry+astern", True))
 TURN_KEYS = ("tactical_diameter", "steady_yaw_rate", "advance")
 
 

@@ -20,12 +20,13 @@ zig-zags or random runs; 1 ≈ predicting the mean), the same for u, and the tur
 diameter and steady yaw rate errors (+35°, −35°). The Esso zig-zags were switched by hand at
 irregular headings, so their overshoots are not compared.
 
-Run: .venv/bin/python benchmarks/study_esso_extrapolation.py
+Run: .venv/bin/python benchmarks/study_esso_extrapolation.py [LIBRARY]
 """
 
 from __future__ import annotations
 
 import os
+import sys
 import time
 import warnings
 
@@ -35,7 +36,7 @@ from esso_logs import condition_folds, esso_logs
 from shipid.evaluation.validate import validate
 from shipid.identification.select import select
 
-LIBRARY = "low-speed+wind+propeller-asymmetry"
+LIBRARY = sys.argv[1] if len(sys.argv) > 1 else "low-speed+wind+propeller-asymmetry"
 # (search, --average): each search of select, and the README's recipe (stepwise, averaged).
 CONFIGURATIONS = (("stepwise", False), ("stepwise", True), ("frols", False), ("none", False))
 

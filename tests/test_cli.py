@@ -136,7 +136,14 @@ def test_version_and_defaults_in_help(capsys):
     assert exc.value.code == 0 and capsys.readouterr().out.startswith("shipid 0.")
     with pytest.raises(SystemExit):
         main(["identify", "--help"])
-    assert "default 10000" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert "default 10000" in out
+    from shipid.dynamics.model import STRUCTURES
+
+    # The help names every structure (it is written out, not imported, for a fast start);
+    # argparse may break a name at its hyphen.
+    text = "".join(out.split())
+    assert all(name in text for name in STRUCTURES), [n for n in STRUCTURES if n not in text]
 
 
 # ---------------------------------------------------------------------------- 20: interruption

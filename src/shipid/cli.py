@@ -1479,9 +1479,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("logs", nargs="+", metavar="LOG")
     p.add_argument("--model", default="blanke",
                    help="structure: blanke (default), blanke-thrust, blanke-speed, blanke-race, "
-                   "blanke-rps, "
-                   "abkowitz3, low-speed, wind, race-damping, propeller-asymmetry, linear-sway-yaw, "
-                   "nomoto1; combine "
+                   "blanke-rps, abkowitz3, low-speed, wind, race-damping, propeller-asymmetry, "
+                   "astern, linear-sway-yaw, nomoto1; combine "
                    "with + (blanke-rps+wind, blanke-race+race-damping) or write terms: "
                    "'u: |u|u, v*r, 1; v: ...; r: ...'")
     p.add_argument("--form", default="increment", choices=("increment", "paper"),

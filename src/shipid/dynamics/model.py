@@ -101,6 +101,10 @@ STRUCTURES: dict[str, dict[str, tuple[str, ...]]] = {
     "propeller-asymmetry": {"u": ("pos(n)^2*delta", "pos(n)^2*|delta|^3"),
                             "v": ("pos(n)^2", "pos(n)^2*|delta|"),
                             "r": ("pos(n)^2", "pos(n)^2*|delta|")},
+    # Going astern the hull meets the water stern first: its resistance (neg(u)², beside |u|u)
+    # and the lift of its drift (neg(u) v, neg(u) r, beside u v and |u| r) are those of another
+    # body. Added to a library (low-speed+wind+propeller-asymmetry+astern).
+    "astern": {"u": ("neg(u)^2",), "v": ("neg(u)*v", "neg(u)*r"), "r": ("neg(u)*v", "neg(u)*r")},
     # Linear sway–yaw (Davidson–Schiff) model at the held surge speed; its yaw transfer function is
     # Nomoto's second-order model, see ``nomoto_parameters``.
     "linear-sway-yaw": {"v": ("v", "r", "delta", "1"), "r": ("v", "r", "delta", "1")},
