@@ -224,7 +224,7 @@ def closed_loop() -> None:
     """Closed-loop 20/20 zig-zags of the Blanke model (scale ship, 9.6 °/s rudder): the term
     interpreter and the generated kernel (``kernel``-level entries, no log built) against a
     plain Python loop and a hand-written numba loop of the same manoeuvre."""
-    from shipid.trials.manoeuvres import _params, as_vessel, run_closed_loop
+    from shipid.trials.manoeuvres import as_vessel, manoeuvre_params, run_closed_loop
     from shipid.vessels import scale_ship
 
     ship = scale_ship(rudder_rate_deg=9.6)
@@ -232,7 +232,8 @@ def closed_loop() -> None:
     a, b, c = blanke_arrays(model)
     rudder, switch, rate = math.radians(20), math.radians(20), math.radians(9.6)
     vessel = as_vessel(ship)
-    params = _params(vessel, kernel.MODE_ZIGZAG, rudder, 0.0, 0.0, switch=switch, side=1.0)
+    params = manoeuvre_params(vessel, kernel.MODE_ZIGZAG, rudder, 0.0, 0.0, switch=switch,
+                              side=1.0)
     stbd = params[kernel.P_STBD]  # positive rudder turns this ship to port: −1
     dt, n = 0.05, 2_000_000
     u0 = vessel.approach_speed
@@ -323,6 +324,33 @@ def reference_ships() -> None:
               f"{slow / fast:.0f}× |")
 
 
+def heading_autopilot() -> None:
+    """The PID heading step (``shipid autopilot``): the compiled closed loop it runs in now
+    (``kernel.MODE_HEADING``) against the Python loop it ran in before, which ``follow_path``
+    still runs (NumPy per step; its states are the reference the tests check), same step."""
+    from shipid.control.autopilot import heading_loop, heading_step, pid_from_nomoto
+    from shipid.control.linear import nomoto
+    from shipid.vessels import kvlcc2, scale_ship_model
+
+    print(f"\nHeading autopilot, a 20° step for 600 s at 0.1 s, RK4 (load average "
+          f"{os.getloadavg()[0]:.2f})\n")
+    print("| ship | steps | compiled (ms) | Python loop (ms) | speed-up | largest state "
+          "difference |")  # fmt: skip
+    print("|---|---|---|---|---|---|")
+    for name, ship, speed in (("identified model (paper eq. 16)", scale_ship_model(), 1.93),
+                              ("KVLCC2 (MMG)", kvlcc2(), None)):  # fmt: skip
+        nm = nomoto(ship, speed or ship.approach_speed)
+        pid = pid_from_nomoto(nm["K"], nm["T"])
+        heading_step(ship, pid, 20.0, duration=1.0, speed=speed)  # compile or load the caches
+        fast = best_of(lambda s=ship, p=pid, v=speed: heading_step(s, p, 20.0, 600.0, speed=v))
+        slow = best_of(lambda s=ship, p=pid, v=speed: heading_loop(s, p, 20.0, 600.0, speed=v), 1)
+        a = heading_step(ship, pid, 20.0, 600.0, speed=speed)
+        b = heading_loop(ship, pid, 20.0, 600.0, speed=speed)
+        diff = max(float(np.abs(a[c] - b[c]).max()) for c in ("u", "v", "r", "psi", "x", "y"))
+        print(f"| {name} | {len(a)} | {1e3 * fast:.1f} | {1e3 * slow:.0f} | {slow / fast:.0f}× | "
+              f"{diff:.1e} |")
+
+
 def kvlcc2_against_solve_ivp() -> None:
     """The KVLCC2's 35° turning circle the way shipmmg runs it (issue #13 names it as the
     baseline): scipy's ``solve_ivp`` (RK45, its default tolerances, as shipmmg calls it) on the
@@ -395,4 +423,5 @@ if __name__ == "__main__":
     main()
     closed_loop()
     reference_ships()
+    heading_autopilot()
     kvlcc2_against_solve_ivp()

@@ -194,3 +194,23 @@ def test_the_model_tuned_autopilot_is_mirrored_for_a_truth_of_the_other_rudder_s
     # Steered toward the ordered heading (a controller for a faster ship: it overshoots), not
     # away from it (overshoot −20°, that is never beyond 0°).
     assert float(over) > 0 and float(final) > 0
+
+
+@pytest.mark.parametrize("ship", ["model", "kvlcc2", "mariner"])
+def test_the_compiled_heading_step_is_the_python_loop(ship):
+    """The heading autopilot runs in the compiled closed loop (``kernel.MODE_HEADING``); the
+    Python loop ``follow_path`` uses is its reference: same states to rounding (a 60° step)."""
+    from shipid.control.autopilot import heading_loop
+    from shipid.vessels import get_vessel
+
+    target = scale_ship_model() if ship == "model" else get_vessel(ship)
+    speed = 1.93 if ship == "model" else None
+    nm = nomoto(target, speed or target.approach_speed)
+    pid = pid_from_nomoto(nm["K"], nm["T"])
+    fast = heading_step(target, pid, 60.0, duration=150, speed=speed)
+    slow = heading_loop(target, pid, 60.0, duration=150, speed=speed)
+    assert len(fast) == len(slow) == 1501
+    if ship == "model":  # its rudder saturates and the integral is frozen on the way
+        assert np.degrees(np.abs(slow["delta"]).max()) == pytest.approx(35.0)
+    for col in ("u", "v", "r", "psi", "x", "y", "delta"):
+        np.testing.assert_allclose(fast[col], slow[col], rtol=1e-9, atol=1e-10, err_msg=col)

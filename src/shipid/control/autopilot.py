@@ -23,11 +23,12 @@ import numpy as np
 import pandas as pd
 
 from shipid.data.log import make_log
+from shipid.dynamics import kernel
 from shipid.dynamics.simulate import DivergenceBounds, initial_states, step_state, within_bounds
 from shipid.dynamics.steering import SteeringMachine
 from shipid.errors import ShipidError
 from shipid.limits import check_samples
-from shipid.trials.manoeuvres import as_vessel
+from shipid.trials.manoeuvres import as_vessel, manoeuvre_params, run_closed_loop
 
 
 @dataclass(frozen=True)
@@ -131,23 +132,42 @@ def heading_step(ship, pid: PID, heading_deg: float, duration: float | None = No
                  method: str = "rk4") -> pd.DataFrame:  # fmt: skip
     """The autopilot ordered from the initial heading to ``heading_deg`` (positive: starboard),
     for ``duration`` s or, by default, until the heading settles (see HEADING_STEP_DURATION).
-    ``log.attrs['incomplete']`` says when it has not settled (or the run diverged)."""
+    ``log.attrs['incomplete']`` says when it has not settled (or the run diverged). It runs in
+    the compiled closed loop of the manoeuvres (``kernel.MODE_HEADING``), as ``heading_loop``
+    does step by step in Python (the reference its tests check it against)."""
+    vessel = as_vessel(ship, speed, steering, rps)
     target = math.radians(heading_deg)
+    params = manoeuvre_params(vessel, kernel.MODE_HEADING, target, 0.0, 0.0, rps=rps)
+    params[kernel.P_KP], params[kernel.P_KI], params[kernel.P_KD] = pid.kp, pid.ki, pid.kd
     length = duration or HEADING_STEP_DURATION
     while True:
-        log, _, diverged = _run(ship, pid, lambda t, s: (target, math.nan, False), length, dt,
-                                speed, rps, steering, method)  # fmt: skip
-        psi = log["psi"].to_numpy()
+        res = run_closed_loop(vessel, params, length, dt, method, rps=rps)
+        psi = res.log["psi"].to_numpy()
         tail = psi[int(0.8 * len(psi)):]
         tol = SETTLED_SHARE * max(abs(target), math.radians(1.0))
         settled = bool(np.ptp(tail) <= tol and abs(psi[-1] - target) <= tol)
-        if (duration is not None or diverged or settled
+        if (duration is not None or res.diverged or settled
                 or length >= HEADING_STEP_DURATION * 2**HEADING_STEP_MAX_DOUBLINGS):  # fmt: skip
             break
         length *= 2
+    log = res.log
+    log["psi_d"] = target
+    log["cross_track"] = math.nan
     log.attrs["incomplete"] = ("" if settled else
-                               "diverged" if diverged else
+                               "diverged" if res.diverged else
                                f"the heading has not settled within {length:g} s")  # fmt: skip
+    return log
+
+
+def heading_loop(ship, pid: PID, heading_deg: float, duration: float, dt: float = 0.1,
+                 speed: float | None = None, rps: float | None = None,
+                 steering: SteeringMachine | None = None,
+                 method: str = "rk4") -> pd.DataFrame:  # fmt: skip
+    """``heading_step`` stepped in Python (the loop ``follow_path`` runs): the reference the
+    compiled heading step is tested against, and its baseline in the benchmarks."""
+    target = math.radians(heading_deg)
+    log, _, _ = _run(ship, pid, lambda t, s: (target, math.nan, False), duration, dt, speed, rps,
+                     steering, method)  # fmt: skip
     return log
 
 

@@ -22,6 +22,7 @@ velocity at every evaluation.
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numba
 import numpy as np
@@ -37,8 +38,36 @@ P_MODE, P_VALUE, P_SWITCH, P_SIDE, P_STBD, P_APPROACH, P_RELEASE, P_HELD, P_PSI_
 P_MAX_ANGLE, P_MAX_RATE, P_TIME_CONST, P_RPS, P_THRUST, P_WIND_SPEED, P_WIND_DIR = range(9, 16)
 # Propeller order: from P_RPS to P_RPS_TO, linearly over P_RPS_RAMP seconds from P_RPS_AT.
 P_RPS_TO, P_RPS_AT, P_RPS_RAMP = range(16, 19)
-N_PARAMS = 19
-MODE_HOLD, MODE_ZIGZAG = 0, 1
+# Heading autopilot: PID gains on the heading error (P_VALUE is the ordered heading).
+P_KP, P_KI, P_KD = range(19, 22)
+N_PARAMS = 22
+MODE_HOLD, MODE_ZIGZAG, MODE_HEADING = 0, 1, 2
+
+
+def drop_stale_caches(module_file: str) -> None:
+    """Delete numba's cache of the module at ``module_file`` when this file has changed since it
+    was written. numba stamps a cached function with its own file only, not its callees': a
+    reference ship's closed loop, compiled with this module's ``closed_run`` inlined, came back
+    from the cache with the old one after an edit here (a new command mode ran as a zig-zag).
+    Called at the top of such modules, before their entries are compiled or loaded."""
+    import hashlib
+
+    path = Path(module_file)
+    folder = path.parent / "__pycache__"
+    marker = folder / f"{path.stem}.kernel-sha256"
+    digest = hashlib.sha256(Path(__file__).read_bytes()).hexdigest()
+    try:
+        if marker.read_text() == digest:
+            return
+    except OSError:
+        pass
+    try:
+        for stale in [*folder.glob(f"{path.stem}.*.nbi"), *folder.glob(f"{path.stem}.*.nbc")]:
+            stale.unlink()
+        folder.mkdir(exist_ok=True)
+        marker.write_text(digest)
+    except OSError:
+        pass  # a read-only install: its caches were written with its own kernel
 
 
 def c_array(a, dtype=np.float64) -> np.ndarray:
@@ -200,22 +229,31 @@ def steer(delta, command, dt, max_angle, max_rate, time_constant):
 
 
 @numba.njit(cache=True)
-def command(p, t, psi, side):
-    """Rudder command of a manoeuvre at time t and heading ψ; returns (command, side).
+def command(p, t, psi, r, side, integral, dt):
+    """Rudder command of a manoeuvre at time t, heading ψ and yaw rate r; returns (command,
+    side, integral).
 
     Hold mode: the held rudder before ``approach``, ``value`` until ``release``, then 0.
     Zig-zag: the held rudder before ``approach``, then ``side``·``stbd``·``value``, the side
-    reversed when the heading change from ψ_ref reaches ±switch on the side the ship turns to."""
+    reversed when the heading change from ψ_ref reaches ±switch on the side the ship turns to.
+    Heading: the PID autopilot δc = −(Kp ψ̃ + Ki ∫ψ̃ dt + Kd r), ψ̃ = ψ − ``value`` wrapped to
+    [−π, π), the integral frozen while the command exceeds the rudder limit (anti-windup)."""
     if t < p[P_APPROACH] - 1e-9:
-        return p[P_HELD], side
+        return p[P_HELD], side, integral
     if p[P_MODE] == MODE_HOLD:
-        return (p[P_VALUE] if t < p[P_RELEASE] - 1e-9 else 0.0), side
+        return (p[P_VALUE] if t < p[P_RELEASE] - 1e-9 else 0.0), side, integral
+    if p[P_MODE] == MODE_HEADING:
+        err = (psi - p[P_VALUE] + math.pi) % (2.0 * math.pi) - math.pi
+        cmd = -(p[P_KP] * err + p[P_KI] * integral + p[P_KD] * r)
+        if -p[P_MAX_ANGLE] <= cmd <= p[P_MAX_ANGLE]:
+            integral += err * dt
+        return cmd, side, integral
     dpsi = psi - p[P_PSI_REF]
     if side > 0 and dpsi >= p[P_SWITCH]:
         side = -1.0
     elif side < 0 and dpsi <= -p[P_SWITCH]:
         side = 1.0
-    return side * p[P_STBD] * p[P_VALUE], side
+    return side * p[P_STBD] * p[P_VALUE], side, integral
 
 
 @numba.njit(cache=True)
@@ -235,9 +273,10 @@ def closed_run(rhs, ctx, inp, p, dt, n_steps, s0, rk4, speed_lim, yaw_lim, state
     st = (s0[0], s0[1], s0[2], s0[3], s0[4], s0[5])
     delta = p[P_HELD]
     side = p[P_SIDE]
+    integral = 0.0
     inp[2] = p[P_THRUST]
     for k in range(n_steps):
-        cmd, side = command(p, k * dt, st[3], side)
+        cmd, side, integral = command(p, k * dt, st[3], st[2], side, integral, dt)
         delta = steer(delta, cmd, dt, p[P_MAX_ANGLE], p[P_MAX_RATE], p[P_TIME_CONST])
         for j in range(6):
             states[k, j] = st[j]

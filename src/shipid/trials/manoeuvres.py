@@ -115,10 +115,12 @@ def as_vessel(ship: Vessel | ManoeuvringModel, speed: float | None = None,
     return vessel
 
 
-def _params(vessel: Vessel, mode: int, value: float, held: float, approach: float,
-            release: float = math.inf, switch: float = 0.0, side: float = 1.0, psi_ref: float = 0.0,
-            rps: float | None = None, wind: tuple[float, float] | None = None,
-            ) -> np.ndarray:  # fmt: skip
+def manoeuvre_params(vessel: Vessel, mode: int, value: float, held: float, approach: float,
+                     release: float = math.inf, switch: float = 0.0, side: float = 1.0,
+                     psi_ref: float = 0.0, rps: float | None = None,
+                     wind: tuple[float, float] | None = None) -> np.ndarray:  # fmt: skip
+    """One row of closed-loop parameters (``shipid.dynamics.kernel``'s P_* layout) for a
+    manoeuvre of ``mode`` on ``vessel``: its steering machine, rudder convention, propeller."""
     p = np.zeros(kernel.N_PARAMS)
     st = vessel.steering
     p[kernel.P_MODE], p[kernel.P_VALUE], p[kernel.P_HELD] = mode, value, held
@@ -222,10 +224,12 @@ def _generic_closed_loop(dyn, params, n, dt, s0, method, speed_lim, yaw_lim, rps
     s = s0
     delta = float(params[kernel.P_HELD])
     side = float(params[kernel.P_SIDE])
+    integral = 0.0
     prop = None if rps is None else np.array([float(rps)])
     st = (params[kernel.P_MAX_ANGLE], params[kernel.P_MAX_RATE], params[kernel.P_TIME_CONST])
     for k in range(n):
-        cmd, side = kernel.command(params, k * dt, s[0, 3], side)
+        cmd, side, integral = kernel.command(params, k * dt, s[0, 3], s[0, 2], side, integral,
+                                             dt)  # fmt: skip
         delta = kernel.steer(delta, cmd, dt, *st)
         states[k], rudder[k] = s[0], delta
         if k == n - 1:
@@ -299,8 +303,9 @@ def zigzag(
     switch = math.radians(_positive(heading_deg, "heading switch angle [deg]"))
     psi_ref = float((initial or {}).get("psi", 0.0))
     held = float((initial or {}).get("delta", 0.0))
-    params = _params(vessel, kernel.MODE_ZIGZAG, rudder, held, approach, switch=switch,
-                     side=_side_sign(first), psi_ref=psi_ref, rps=rps, wind=_check_wind(wind))
+    params = manoeuvre_params(vessel, kernel.MODE_ZIGZAG, rudder, held, approach, switch=switch,
+                              side=_side_sign(first), psi_ref=psi_ref, rps=rps,
+                              wind=_check_wind(wind))  # fmt: skip
 
     def run(length: float) -> ManoeuvreResult:
         res = run_closed_loop(vessel, params, length, dt, method, initial=initial, rps=rps)
@@ -332,8 +337,8 @@ def turning_circle(
     steady."""
     vessel = as_vessel(ship, speed, steering, rps)
     value = _rudder_to(side, vessel, rudder_deg)
-    params = _params(vessel, kernel.MODE_HOLD, value, 0.0, approach, rps=rps,
-                     wind=_check_wind(wind))  # fmt: skip
+    params = manoeuvre_params(vessel, kernel.MODE_HOLD, value, 0.0, approach, rps=rps,
+                              wind=_check_wind(wind))  # fmt: skip
 
     def run(length: float) -> ManoeuvreResult:
         res = run_closed_loop(vessel, params, length, dt, method, rps=rps)
@@ -375,9 +380,10 @@ def pull_out(
 
     def run(length: float) -> ManoeuvreResult:
         held = given_hold or length
-        res = run_closed_loop(vessel, _params(vessel, kernel.MODE_HOLD, value, 0.0, 0.0,
-                                              release=held, rps=rps, wind=wind),
-                              held + (given_release or length), dt, method, rps=rps)  # fmt: skip
+        params = manoeuvre_params(vessel, kernel.MODE_HOLD, value, 0.0, 0.0, release=held,
+                                  rps=rps, wind=wind)  # fmt: skip
+        res = run_closed_loop(vessel, params, held + (given_release or length), dt, method,
+                              rps=rps)  # fmt: skip
         res.log.attrs["manoeuvre"] = f"pull-out {rudder_deg:g}° to {side}"
         if not res.diverged:
             r = res.log["r"].to_numpy()
@@ -422,7 +428,8 @@ def stopping(
     if not (math.isfinite(reversal_time) and reversal_time >= 0):
         raise ShipidError(f"stopping: reversal time must be ≥ 0 s, got {reversal_time!r}")
     vessel = as_vessel(ship, speed, None, rps)
-    params = _params(vessel, kernel.MODE_HOLD, 0.0, 0.0, 0.0, rps=rps, wind=_check_wind(wind))
+    params = manoeuvre_params(vessel, kernel.MODE_HOLD, 0.0, 0.0, 0.0, rps=rps,
+                              wind=_check_wind(wind))  # fmt: skip
     params[kernel.P_RPS_TO], params[kernel.P_RPS_AT] = astern, 0.0
     params[kernel.P_RPS_RAMP] = reversal_time
     res = run_closed_loop(vessel, params, duration, dt, method, rps=rps)
@@ -486,8 +493,8 @@ def spiral(
     peak = 0.0
     for a in angles:
         value = stbd * math.radians(a)
-        params = _params(vessel, kernel.MODE_HOLD, value, initial.get("delta", 0.0), 0.0,
-                         rps=rps)  # fmt: skip
+        params = manoeuvre_params(vessel, kernel.MODE_HOLD, value, initial.get("delta", 0.0),
+                                  0.0, rps=rps)  # fmt: skip
         length = hold or SPIRAL_HOLD
         while True:
             res = run_closed_loop(vessel, params, length, dt, method, initial=initial, rps=rps)

@@ -19,6 +19,8 @@ from shipid.dynamics.steering import SteeringMachine
 
 from .vessel import CompiledDynamics, Vessel
 
+kernel.drop_stale_caches(__file__)
+
 RHO = 1025.0
 L, B, D_DRAUGHT, VOLUME, XG = 7.00, 1.27, 0.46, 3.27, 0.25
 DP, HR, AR = 0.216, 0.345, 0.0539

@@ -18,6 +18,8 @@ from shipid.dynamics.steering import SteeringMachine
 
 from .vessel import CompiledDynamics, Vessel
 
+kernel.drop_stale_caches(__file__)
+
 L = 160.93
 U0 = 7.7175
 E5 = 1e-5
