@@ -216,3 +216,35 @@ def test_a_choice_from_few_folds_is_reported_as_weak(paper_trials):
     assert any("only 3 folds" in w and "--cv blocks:K" in w for w in few.warnings)
     enough = select(training[:4], library="blanke", search="none", gammas=(1e4,))
     assert not any("folds:" in w for w in enough.warnings)
+
+
+def test_the_default_library_leaves_out_what_the_logs_cannot_give(tmp_path, capsys):
+    """``shipid select LOGS`` refused every log without the relative wind (a basin's: the
+    MARIN KVLCC2's) with the default library, which has wind terms. The default now leaves out
+    the terms whose columns the logs lack, and says so; a library asked for by name still
+    refuses them."""
+    from generated_logs import noisy_zigzags
+
+    from shipid.dynamics.model import get_structure
+    from shipid.identification.select import DEFAULT_LIBRARY, default_library
+
+    logs = noisy_zigzags(5)
+    for log in logs:
+        log["n"] = 12.0
+    library, note = default_library(logs)
+    full = get_structure(DEFAULT_LIBRARY)
+    dropped = {t for d in full.terms for t in full.terms[d]} - set(library.all_terms)
+    assert dropped and all("wind" in t for t in dropped)
+    assert "wind_angle, wind_speed" in note
+    windy = [log.assign(wind_speed=1.0, wind_angle=0.3) for log in logs]
+    kept, note = default_library(windy)
+    assert note == "" and kept.all_terms == full.all_terms
+    paths = [write_log(log, tmp_path / f"zz{i}.csv") for i, log in enumerate(logs)]
+    code = main(["select", *map(str, paths), "--quiet", "--search", "none", "--dt", "0.4",
+                 "-o", str(tmp_path / "m.json")])  # fmt: skip
+    out = capsys.readouterr()
+    assert code == 0, out.err
+    assert "default library's" in out.err and "left out" in out.err
+    code = main(["select", *map(str, paths), "--quiet", "--library", "low-speed+wind",
+                 "-o", str(tmp_path / "m2.json")])  # fmt: skip
+    assert code == 1 and "needs the log column" in capsys.readouterr().err

@@ -546,12 +546,16 @@ def cmd_select(args) -> int:
     logs = _read_logs(args)
     names = [str(p) for p in args.logs]
     from shipid.dynamics.model import get_structure
+    from shipid.identification.select import default_library
 
     try:
-        library = get_structure(args.library)
+        library = (get_structure(args.library) if args.library is not None
+                   else default_library(logs)[0])  # fmt: skip
     except ValueError as exc:
         raise ShipidError(str(exc)) from None
-    options = SelectOptions(library=library, search=args.search, cv=args.cv,
+    # The default library is passed as None: select trims it to the logs and says so.
+    options = SelectOptions(library=library if args.library is not None else None,
+                            search=args.search, cv=args.cv,
                             estimator=args.estimator, method=args.method,
                             max_evaluations=args.max_evaluations,
                             plausibility=not args.no_plausibility, speed=args.speed,
@@ -1536,9 +1540,10 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("select", help="choose the structure and γ by cross-validated free-run "
                        "error over several logs")
     p.add_argument("logs", nargs="+", metavar="LOG")
-    p.add_argument("--library", default="low-speed+wind",
+    p.add_argument("--library",
                    help="candidate terms: a structure name, a sum (abkowitz3+blanke) or written "
-                   "terms 'u: ...; v: ...; r: ...' (default %(default)s)")
+                   "terms 'u: ...; v: ...; r: ...' (default low-speed+wind+propeller-asymmetry, "
+                   "less the terms whose log columns the logs lack, said so)")
     p.add_argument("--search", default="stepwise", choices=("stepwise", "frols", "stlsq", "none"),
                    help="how candidates are generated (default %(default)s)")
     p.add_argument("--gammas", metavar="G,G,...", help="γ grid (default 1e2,1e3,1e4,1e5,1e6)")

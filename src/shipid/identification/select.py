@@ -67,7 +67,9 @@ STLSQ_GRID = (0.0, 0.01, 0.02, 0.05, 0.1, 0.2, 0.3)
 class SelectOptions:
     """How ``select`` searches.
 
-    library : term library (a structure name, sum or spec; see ``shipid.dynamics.model``).
+    library : term library (a structure name, sum or spec; see ``shipid.dynamics.model``);
+        None (default): ``DEFAULT_LIBRARY`` less the terms whose log columns the logs lack
+        (``default_library``, said in the notes).
     search : 'stepwise', 'frols', 'stlsq' or 'none'.
     gammas : the γ grid.
     cv : 'logo' (leave one log out), 'kfold:K' (K folds of whole logs) or 'blocks:K' (every log
@@ -88,7 +90,7 @@ class SelectOptions:
         instead of the chosen candidate alone (kept as ``Selection.chosen_model``).
     """
 
-    library: str | ModelStructure = "low-speed+wind"
+    library: str | ModelStructure | None = None
     search: str = "stepwise"
     gammas: tuple[float, ...] = (1e2, 1e3, 1e4, 1e5, 1e6)
     cv: str = "logo"
@@ -228,6 +230,7 @@ class _Data:
     measured: list[np.ndarray]  # per log (N_i, 3) u, v, r
     s0: np.ndarray  # (L, 6)
     logs: list[pd.DataFrame] = field(default_factory=list)  # for the physics (rudder sign, approach)
+    library_note: str = ""  # the default library's terms left out for the logs' columns
 
 
 def _prepare(logs: Sequence[pd.DataFrame], names: Sequence[str], library: ModelStructure) -> _Data:
@@ -501,6 +504,28 @@ def cross_validate(
     return pd.DataFrame(rows)
 
 
+# The README's library for free-running trials: four-quadrant propeller and rudder, wind, and a
+# single propeller's asymmetry (``shipid.dynamics.model``).
+DEFAULT_LIBRARY = "low-speed+wind+propeller-asymmetry"
+
+
+def default_library(logs: Sequence[pd.DataFrame]) -> tuple[ModelStructure, str]:
+    """``DEFAULT_LIBRARY`` less the terms that need a log column some log lacks (the wind of a
+    basin's logs, the propeller speed of a log without it), and a note saying which were left
+    out ('' when none): the library asked for by name refuses such logs instead."""
+    library = get_structure(DEFAULT_LIBRARY)
+    missing = sorted({c for log in logs for c in library.inputs if c not in log.columns})
+    if not missing:
+        return library, ""
+    drop = {d: [t for t in ts if set(parse_term(t).inputs) & set(missing)]
+            for d, ts in library.terms.items()}  # fmt: skip
+    trimmed = library.without({d: ts for d, ts in drop.items() if ts})
+    n = sum(len(ts) for ts in drop.values())
+    return trimmed, (f"the default library's {n} term(s) that need the log column(s) "
+                     f"{', '.join(missing)}, which these logs lack, are left out (--library "
+                     "chooses the candidates)")  # fmt: skip
+
+
 def _setup(logs, names, options: SelectOptions):
     if isinstance(logs, pd.DataFrame):
         logs = [logs]
@@ -512,12 +537,18 @@ def _setup(logs, names, options: SelectOptions):
     if len(logs) < 2:
         raise ShipidError("cross-validation needs at least 2 logs to hold one out; give more "
                           "logs, or cut one into blocks with --cv blocks:K")  # fmt: skip
+    note = ""
     try:
-        library = (get_structure(options.library) if isinstance(options.library, str)
-                   else options.library)  # fmt: skip
+        if options.library is None:
+            library, note = default_library(logs)
+        elif isinstance(options.library, str):
+            library = get_structure(options.library)
+        else:
+            library = options.library
     except ValueError as exc:
         raise ShipidError(str(exc)) from None
     data = _prepare(logs, names, library)
+    data.library_note = note
     folds = _folds(len(logs), options.cv)
     return logs, names, data, folds, _Scorer(data, options, folds)
 
@@ -544,6 +575,8 @@ def select(
     logs, notes = common_rudder_convention([logs] if isinstance(logs, pd.DataFrame) else list(logs))
     logs, names, data, folds, scorer = _setup(logs, names, options)
     library = data.library
+    if data.library_note:
+        notes.append(data.library_note)
     # The first log's approach; each candidate is checked from its own steady approach there.
     speed = options.speed if options.speed is not None else approach(logs[0], "u")
     rps = options.rps if options.rps is not None else approach(logs[0], "n")
