@@ -377,6 +377,10 @@ def cmd_identify(args) -> int:
             "rudder_positive": logs[0].attrs.get("rudder_positive")}  # fmt: skip
     refinement = None
     print(ident.model.equations(std_errors=_std_errors(ident)))
+    print("(± standard errors of the equation-error fit: they hold the scatter of the fitted "
+          "accelerations, not the bias that noise in u, v, r leaves in the coefficients; "
+          "--output-error gives intervals that hold the true values, --bootstrap N intervals "
+          "of the predictions)")  # fmt: skip
     for dof, d in ident.diagnostics.items():
         print(f"{dof}: condition number {d['condition_number']:.3g}, one-step R² "
               f"{d['one_step_r2']:.4f}, bias b = {ident.discrete[dof]['bias']:.4g}")
