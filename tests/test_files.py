@@ -316,3 +316,18 @@ def test_missing_column_from_the_api_is_a_named_error(trial):
 
     with pytest.raises(ShipidError, match="column 'n'"):
         identify(trial, model="blanke-rps")
+
+
+def test_a_log_that_cannot_be_validated_is_named_once(tmp_path):
+    """A model with wind terms on a log without the wind: the message named the file twice
+    (its path, then its file name), 'DIR/zz.csv: zz.csv: the model needs ...'."""
+    from shipid.dynamics.model import ManoeuvringModel
+    from shipid.evaluation.validate import validate
+
+    model = ManoeuvringModel("u: |u|*u, U_A^2*cos(gamma_A); v: u*v, delta; r: u*r, delta",
+                             {"u": {"|u|*u": -0.05}, "v": {"u*v": -0.5, "delta": 0.05},
+                              "r": {"u*r": -0.8, "delta": -0.1}})  # fmt: skip
+    path = write_log(zigzag(scale_ship(), 20, 20, duration=30, dt=0.2).log, tmp_path / "zz.csv")
+    (v,) = validate(model, [read_log(path)], names=[str(path)])
+    assert v.error.startswith(f"{path}: the model needs the log column 'wind_speed'"), v.error
+    assert v.error.count("zz.csv") == 1

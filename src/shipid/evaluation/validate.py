@@ -20,6 +20,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -163,6 +164,10 @@ def validate(
                                     error_band))
         except ShipidError as exc:
             message = str(exc)
+            # Messages from deeper down may name the log by its file name alone.
+            short = f"{Path(name).name}: "
+            if message.startswith(short) and not message.startswith(name):
+                message = message[len(short):]
             out.append(Validation(name, None, {}, {}, None,
                                   message if message.startswith(name) else f"{name}: {message}"))
     return out
