@@ -324,31 +324,117 @@ def reference_ships() -> None:
               f"{slow / fast:.0f}× |")
 
 
+def python_heading(a, b, c, n, dt, u0, rk4, target, gains, max_angle, rate):
+    """Plain Python heading autopilot on the Blanke model: PID on the wrapped heading error
+    (integral frozen while the command exceeds the rudder limit), a rate-limited steering
+    machine, states and rudder recorded every step."""
+    rhs = python_rhs(a, b, c)
+    kp, ki, kd = gains
+    s = [u0, 0.0, 0.0, 0.0, 0.0, 0.0]
+    delta, integral, lim = 0.0, 0.0, rate * dt
+    states, rudders = [], []
+    for _ in range(n):
+        err = (s[3] - target + math.pi) % (2 * math.pi) - math.pi
+        cmd = -(kp * err + ki * integral + kd * s[2])
+        if -max_angle <= cmd <= max_angle:
+            integral += err * dt
+        cmd = min(max(cmd, -max_angle), max_angle)
+        delta += min(max(cmd - delta, -lim), lim)
+        states.append(tuple(s))
+        rudders.append(delta)
+        s = python_step(rhs, s, delta, dt, rk4)
+    return states, rudders
+
+
+@numba.njit(cache=True)
+def numba_heading(a, b, c, n, dt, u0, rk4, target, kp, ki, kd, max_angle, rate, states, rudders):
+    """The same autopilot hand-written in numba (terms typed in): the practical limit."""
+    u, v, r, psi, x, y = u0, 0.0, 0.0, 0.0, 0.0, 0.0
+    delta, integral, lim = 0.0, 0.0, rate * dt
+    for k in range(n):
+        err = (psi - target + math.pi) % (2 * math.pi) - math.pi
+        cmd = -(kp * err + ki * integral + kd * r)
+        if -max_angle <= cmd <= max_angle:
+            integral += err * dt
+        cmd = min(max(cmd, -max_angle), max_angle)
+        delta += min(max(cmd - delta, -lim), lim)
+        states[k, 0], states[k, 1], states[k, 2] = u, v, r
+        states[k, 3], states[k, 4], states[k, 5] = psi, x, y
+        rudders[k] = delta
+        u, v, r, psi, x, y = _blanke_step(a, b, c, u, v, r, psi, x, y, delta, dt, rk4)
+
+
 def heading_autopilot() -> None:
-    """The PID heading step (``shipid autopilot``): the compiled closed loop it runs in now
-    (``kernel.MODE_HEADING``) against the Python loop it ran in before, which ``follow_path``
-    still runs (NumPy per step; its states are the reference the tests check), same step."""
+    """The PID heading step (``shipid autopilot``) in the compiled closed loop
+    (``kernel.MODE_HEADING``), kernel entries without a log, against a plain Python loop and a
+    hand-written numba loop of the same autopilot on the same Blanke model; and
+    ``heading_step`` with its log against the NumPy-per-step loop it ran in before
+    (``heading_loop``, which ``follow_path`` still runs)."""
     from shipid.control.autopilot import heading_loop, heading_step, pid_from_nomoto
     from shipid.control.linear import nomoto
-    from shipid.vessels import kvlcc2, scale_ship_model
+    from shipid.trials.manoeuvres import as_vessel, manoeuvre_params
+    from shipid.vessels import scale_ship
 
-    print(f"\nHeading autopilot, a 20° step for 600 s at 0.1 s, RK4 (load average "
+    ship = scale_ship(rudder_rate_deg=9.6)
+    model = ship.dynamics
+    a, b, c = blanke_arrays(model)
+    nm = nomoto(ship, ship.approach_speed)
+    pid = pid_from_nomoto(nm["K"], nm["T"])
+    target, dt, n = math.radians(20.0), 0.05, 2_000_000
+    vessel = as_vessel(ship)
+    params = manoeuvre_params(vessel, kernel.MODE_HEADING, target, 0.0, 0.0)
+    params[kernel.P_KP], params[kernel.P_KI], params[kernel.P_KD] = pid.kp, pid.ki, pid.kd
+    max_angle, rate = ship.steering.max_angle, ship.steering.max_rate
+    u0 = vessel.approach_speed
+    s0 = np.array([[u0, 0, 0, 0, 0, 0]])
+    print(f"\nHeading autopilot, a 20° step, {n:.0e} steps at {dt} s (load average "
           f"{os.getloadavg()[0]:.2f})\n")
-    print("| ship | steps | compiled (ms) | Python loop (ms) | speed-up | largest state "
-          "difference |")  # fmt: skip
-    print("|---|---|---|---|---|---|")
-    for name, ship, speed in (("identified model (paper eq. 16)", scale_ship_model(), 1.93),
-                              ("KVLCC2 (MMG)", kvlcc2(), None)):  # fmt: skip
-        nm = nomoto(ship, speed or ship.approach_speed)
-        pid = pid_from_nomoto(nm["K"], nm["T"])
-        heading_step(ship, pid, 20.0, duration=1.0, speed=speed)  # compile or load the caches
-        fast = best_of(lambda s=ship, p=pid, v=speed: heading_step(s, p, 20.0, 600.0, speed=v))
-        slow = best_of(lambda s=ship, p=pid, v=speed: heading_loop(s, p, 20.0, 600.0, speed=v), 1)
-        a = heading_step(ship, pid, 20.0, 600.0, speed=speed)
-        b = heading_loop(ship, pid, 20.0, 600.0, speed=speed)
-        diff = max(float(np.abs(a[c] - b[c]).max()) for c in ("u", "v", "r", "psi", "x", "y"))
-        print(f"| {name} | {len(a)} | {1e3 * fast:.1f} | {1e3 * slow:.0f} | {slow / fast:.0f}× | "
-              f"{diff:.1e} |")
+    print("| method | engine | time (s) | steps/s | vs plain Python loop | vs hand-written numba "
+          "| target |")
+    print("|---|---|---|---|---|---|---|")
+    gen = codegen.load(model.code, codegen.nonzero_pairs(model.code, model.theta))
+    for method in ("euler", "rk4"):
+        rk4 = method == "rk4"
+        n_py = 200_000
+        py_rate = n_py / best_of(lambda: python_heading(a, b, c, n_py, dt, u0, rk4, target,  # noqa: B023
+                                                        (pid.kp, pid.ki, pid.kd), max_angle,
+                                                        rate), 1)  # fmt: skip
+        states, rudders = np.zeros((n, 6)), np.zeros(n)
+        args_nb = (a, b, c, n, dt, u0, rk4, target, pid.kp, pid.ki, pid.kd, max_angle, rate,
+                   states, rudders)  # fmt: skip
+        numba_heading(*args_nb)
+        nb_rate = n / best_of(lambda: numba_heading(*args_nb))  # noqa: B023
+        print(f"| {method} | plain Python loop | – | {py_rate:.3g} | 1× | "
+              f"{py_rate / nb_rate:.3f}× | baseline |")
+        print(f"| {method} | hand-written numba | – | {nb_rate:.3g} | {nb_rate / py_rate:.0f}× | "
+              f"1× | baseline |")
+        out, rud, nv = np.zeros((1, n, 6)), np.zeros((1, n)), np.zeros(1, dtype=np.int64)
+
+        def run(engine, rk4=rk4, out=out, rud=rud, nv=nv):
+            args = (dt, n, s0, params[None].copy(), rk4, np.array([20.0]), np.array([5.0]), out,
+                    rud, nv)  # fmt: skip
+            if engine == "generated":
+                gen.integrate_closed(model.theta[None].copy(), *args)
+            else:
+                kernel.integrate_closed(model.theta[None].copy(), *model.code.arrays(),
+                                        model.code.uses_derived, *args)  # fmt: skip
+            return out
+
+        for engine in ("interpreted", "generated"):
+            run(engine)
+            rate_e = n / best_of(lambda e=engine: run(e))
+            print(f"| {method} | {engine} | {n / rate_e:.3f} | {rate_e:.3g} | "
+                  f"{rate_e / py_rate:.0f}× | {rate_e / nb_rate:.2f}× | – |")
+        ours = run("generated")[0]
+        print(f"| {method} | (generated − hand-written numba, largest state difference) | "
+              f"{np.abs(ours[:, :3] - states[:, :3]).max():.1e} | | | | |")
+    # With its log, against the loop it ran in before (NumPy per step, the same model).
+    steps = 6000
+    heading_step(ship, pid, 20.0, duration=1.0, dt=0.1)
+    fast = best_of(lambda: heading_step(ship, pid, 20.0, steps * 0.1, dt=0.1))
+    slow = best_of(lambda: heading_loop(ship, pid, 20.0, steps * 0.1, dt=0.1), 1)
+    print(f"\nheading_step() with its log, {steps} RK4 steps: {1e3 * fast:.1f} ms; the "
+          f"NumPy-per-step loop it ran in before: {1e3 * slow:.0f} ms ({slow / fast:.0f}×)")
 
 
 def kvlcc2_against_solve_ivp() -> None:
