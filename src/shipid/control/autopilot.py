@@ -28,7 +28,7 @@ from shipid.dynamics.simulate import DivergenceBounds, initial_states, step_stat
 from shipid.dynamics.steering import SteeringMachine
 from shipid.errors import ShipidError
 from shipid.limits import check_samples
-from shipid.trials.manoeuvres import as_vessel, manoeuvre_params, run_closed_loop
+from shipid.trials.manoeuvres import as_vessel, doubling, manoeuvre_params, run_closed_loop
 
 
 @dataclass(frozen=True)
@@ -139,17 +139,18 @@ def heading_step(ship, pid: PID, heading_deg: float, duration: float | None = No
     target = math.radians(heading_deg)
     params = manoeuvre_params(vessel, kernel.MODE_HEADING, target, 0.0, 0.0, rps=rps)
     params[kernel.P_KP], params[kernel.P_KI], params[kernel.P_KD] = pid.kp, pid.ki, pid.kd
-    length = duration or HEADING_STEP_DURATION
-    while True:
+    tol = SETTLED_SHARE * max(abs(target), math.radians(1.0))
+
+    def run(length: float):
         res = run_closed_loop(vessel, params, length, dt, method, rps=rps)
         psi = res.log["psi"].to_numpy()
         tail = psi[int(0.8 * len(psi)):]
-        tol = SETTLED_SHARE * max(abs(target), math.radians(1.0))
-        settled = bool(np.ptp(tail) <= tol and abs(psi[-1] - target) <= tol)
-        if (duration is not None or res.diverged or settled
-                or length >= HEADING_STEP_DURATION * 2**HEADING_STEP_MAX_DOUBLINGS):  # fmt: skip
-            break
-        length *= 2
+        return res, bool(np.ptp(tail) <= tol and abs(psi[-1] - target) <= tol)
+
+    (res, settled), length = doubling(
+        run, duration or HEADING_STEP_DURATION,
+        lambda out: duration is not None or out[0].diverged or out[1],
+        2**HEADING_STEP_MAX_DOUBLINGS)  # fmt: skip
     log = res.log
     log["psi_d"] = target
     log["cross_track"] = math.nan

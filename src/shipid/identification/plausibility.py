@@ -23,7 +23,7 @@ import numpy as np
 
 from shipid.dynamics.equilibrium import still_air_accelerations, surge_equilibrium
 from shipid.dynamics.model import ManoeuvringModel
-from shipid.trials.manoeuvres import turning_circle
+from shipid.trials.manoeuvres import doubling, turning_circle
 
 SETTLED_FRACTION = 0.02  # of the steady value, over the last 10 % of the run
 HELD_DURATION, HELD_MAX_DOUBLINGS = 300.0, 4
@@ -52,14 +52,11 @@ def held_rudder(model: ManoeuvringModel, speed: float, rps: float | None = None,
     the ``duration`` run (see the module's note)."""
     out = {}
     for side in ("starboard", "port"):
-        length = duration or HELD_DURATION
-        while True:
-            entry = _held(model, speed, rps, rudder_deg, side, length, dt)
-            if (duration is not None or entry["diverged"] or entry["settled"]
-                    or length >= HELD_DURATION * 2**HELD_MAX_DOUBLINGS):  # fmt: skip
-                break
-            length *= 2
-        out[side] = entry
+        out[side], _ = doubling(
+            lambda length, side=side: _held(model, speed, rps, rudder_deg, side, length, dt),
+            duration or HELD_DURATION,
+            lambda entry: duration is not None or entry["diverged"] or entry["settled"],
+            2**HELD_MAX_DOUBLINGS)  # fmt: skip
     return out
 
 

@@ -63,14 +63,21 @@ EXTEND_MAX = 64
 SETTLED_SHARE = 0.01
 
 
-def _extended(run, first: float) -> ManoeuvreResult:
-    """``run(length)`` from ``first``, doubled while its result is incomplete (not diverged)."""
+def doubling(run, first: float, done, most: float = EXTEND_MAX):
+    """``run(length)`` from ``first`` s, the length doubled until ``done(result)`` or it reaches
+    ``most`` times ``first``: (the last result, its length). The run lengths of manoeuvres,
+    plausibility checks and autopilot steps that must last until the ship has settled."""
     length = first
     while True:
         res = run(length)
-        if res.diverged or not res.incomplete or length >= EXTEND_MAX * first:
-            return res
+        if done(res) or length >= most * first:
+            return res, length
         length *= 2
+
+
+def _extended(run, first: float) -> ManoeuvreResult:
+    """``run(length)`` from ``first``, doubled while its result is incomplete (not diverged)."""
+    return doubling(run, first, lambda res: res.diverged or not res.incomplete)[0]
 
 
 def _settled(r: np.ndarray, scale: float) -> bool:
@@ -495,15 +502,13 @@ def spiral(
         value = stbd * math.radians(a)
         params = manoeuvre_params(vessel, kernel.MODE_HOLD, value, initial.get("delta", 0.0),
                                   0.0, rps=rps)  # fmt: skip
-        length = hold or SPIRAL_HOLD
-        while True:
+        def step(length, params=params, initial=initial, peak=peak):
             res = run_closed_loop(vessel, params, length, dt, method, initial=initial, rps=rps)
             # Within 1 % of the rate itself, or of a tenth of the largest (near 0 rudder).
-            settled = _settled(res.log["r"].to_numpy(), 0.1 * peak)
-            if (hold is not None or res.diverged or settled
-                    or length >= EXTEND_MAX * SPIRAL_HOLD):  # fmt: skip
-                break
-            length *= 2
+            return res, _settled(res.log["r"].to_numpy(), 0.1 * peak)
+
+        (res, settled), length = doubling(
+            step, hold or SPIRAL_HOLD, lambda out: hold is not None or out[0].diverged or out[1])
         seg = res.log
         seg["t"] = seg["t"] + t0
         logs.append(seg.iloc[:-1] if len(logs) < len(angles) - 1 else seg)
