@@ -216,3 +216,14 @@ def test_weighted_refit_is_identify_with_sample_weight_to_the_bit(noisy_zigzag, 
         np.testing.assert_array_equal(ours.theta, theirs.theta)
     with pytest.raises(ShipidError, match="sample_weight must be"):
         refit(np.ones(3))
+
+
+def test_where_an_index_was_measured_gets_no_interval():
+    """``manoeuvre`` printed intervals on the span of the steady turn ('steady_to: 480
+    [480, 1920]' once runs last until the turn settles): bookkeeping, not a ship's index."""
+    from shipid.identification.uncertainty import index_intervals
+
+    samples = [{"tactical_diameter": 20.0 + 0.01 * k, "steady_from": 100.0 + k,
+                "steady_to": 240.0 * (1 + k % 3), "first_execute_time": 0.0,
+                "switch_heading_deg": 20.0} for k in range(100)]  # fmt: skip
+    assert set(index_intervals(samples)) == {"tactical_diameter"}

@@ -291,6 +291,10 @@ def free_run_bands(runs: Sequence, n: int, level: float = LEVEL) -> tuple[Bands,
 def index_intervals(samples: Sequence[Mapping[str, float]], level: float = LEVEL
                     ) -> dict[str, tuple[float, float]]:  # fmt: skip
     """Per index name: the percentile interval over the replicates' indices (a replicate that
-    diverged or lacks the index counts as ``interval`` says: too many give (−∞, +∞))."""
-    names = sorted({k for s in samples for k, v in s.items() if isinstance(v, int | float)})
+    diverged or lacks the index counts as ``interval`` says: too many give (−∞, +∞)). The
+    bookkeeping of a measurement (``shipid.trials.indices.BOOKKEEPING``) gets none."""
+    from shipid.trials.indices import BOOKKEEPING
+
+    names = sorted({k for s in samples for k, v in s.items()
+                    if isinstance(v, int | float) and k not in BOOKKEEPING})  # fmt: skip
     return {k: interval([s.get(k, math.nan) for s in samples], level) for k in names}

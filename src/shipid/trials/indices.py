@@ -58,6 +58,10 @@ def _rts_smooth(z: np.ndarray, w: np.ndarray, R: float, q: float) -> np.ndarray:
         out[k] = pf[k] + G * (out[k + 1] - pp[k + 1])
     return out
 
+# Where and how an index was measured (the switch heading, the execute time, the span of the
+# steady turn), not a property of the ship: no interval is drawn over them.
+BOOKKEEPING = ("switch_heading_deg", "first_execute_time", "steady_from", "steady_to")
+
 
 def _white_noise_var(x: np.ndarray) -> float:
     """Variance of the white noise on a smooth signal, from its second differences
