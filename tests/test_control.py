@@ -147,10 +147,11 @@ def test_cli_linearise_export_autopilot_follow(tmp_path, capsys):
     assert code == 1 and "two 'x,y' pairs" in err
 
 
-@pytest.mark.parametrize(("K", "T"), [(0.131, -18.58), (-31.24, -2401.0)])
-def test_pid_from_nomoto_stabilises_a_straight_line_unstable_ship(K, T):
+@pytest.mark.parametrize(("K", "T"), [(0.131, -18.58), (-31.24, -2401.0), (5.039, 344.8)])
+def test_pid_from_nomoto_steers_unstable_and_nearly_neutral_ships(K, T):
     """KVLCC2 models have T < 0 (the MARIN-identified one −18.6 s, the MMG one −2401 s): tuning
-    refused them. The placement holds for T < 0, at ω = max(1/|T|, √|K/T|) by default."""
+    refused them. The placement holds for T < 0, at ω = max(1/|T|, √|K/T|) by default. The
+    Esso Osaka model is nearly neutral (T = 345 s): at ω = 1/T its heading ran away."""
     pid = pid_from_nomoto(K, T)
     w = max(1 / abs(T), math.sqrt(abs(K / T)))
     # Without the integral: T s² + (1 + K Kd) s + K Kp = T (s² + 2ζω s + ω²).

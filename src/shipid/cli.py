@@ -1727,7 +1727,7 @@ def build_parser() -> argparse.ArgumentParser:
                        help="the model's steering machine rate (default: its training logs' "
                        "rudder rate; a reference ship: its own gear)")
         p.add_argument("--omega", type=float, help="closed-loop natural frequency [rad/s] "
-                       "(default 1/T)")
+                       "(default max(1/|T|, √|K/T|): Kp at least 1)")
         p.add_argument("--dt", type=float, default=0.1, help="step [s] (default %(default)s)")
         if name == "autopilot":
             p.add_argument("--heading", type=float, default=20.0, metavar="DEG",

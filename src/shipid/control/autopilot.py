@@ -49,17 +49,16 @@ class PID:
 
 def pid_from_nomoto(K: float, T: float, omega: float | None = None, zeta: float = 0.9) -> PID:
     """Pole placement on Nomoto's first-order model; ``omega`` (closed-loop natural frequency,
-    rad/s) defaults to 1/T (as fast as the ship's own yaw response).
+    rad/s) defaults to the larger of 1/|T| (as fast as the ship's own yaw response) and √|K/T|,
+    the frequency at which Kp = 1 (a degree of rudder per degree of heading error): a nearly
+    neutral ship's 1/|T| would barely steer it (1/345 s for the Esso Osaka model, whose heading
+    then ran away to −900° on a 20° order; 1/2400 s for the MMG KVLCC2).
 
     A straight-line unstable ship (T < 0: KVLCC2) is stabilised by the same placement (the
-    closed-loop polynomial T s² + (1 + K Kd) s + K Kp divides by T either way); its default
-    ``omega`` is the larger of 1/|T| (faster than the divergence) and √|K/T|, the frequency at
-    which Kp = 1 (a degree of rudder per degree of heading error): a nearly neutral ship's 1/|T|
-    (1/2400 s for the MMG KVLCC2) would barely steer it."""
+    closed-loop polynomial T s² + (1 + K Kd) s + K Kp divides by T either way)."""
     if not (math.isfinite(K) and K != 0 and math.isfinite(T) and T != 0):
         raise ShipidError(f"PID tuning needs a finite K ≠ 0 and T ≠ 0, got K = {K}, T = {T}")
-    w = omega if omega is not None else (
-        1.0 / T if T > 0 else max(1.0 / abs(T), math.sqrt(abs(K / T))))
+    w = omega if omega is not None else max(1.0 / abs(T), math.sqrt(abs(K / T)))
     return PID(kp=w * w * T / K, ki=w**3 * T / (10.0 * K), kd=(2.0 * zeta * w * T - 1.0) / K)
 
 
