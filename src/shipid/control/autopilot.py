@@ -78,12 +78,29 @@ class FollowResult:
     diverged: bool = False
 
 
+class _StillAir:
+    """A model with wind terms in still air: the apparent wind of its own motion, from each
+    integration stage's state, as the compiled closed loop has it (``kernel.terms_rhs``)."""
+
+    def __init__(self, model) -> None:
+        self.model = model
+        self.uses_rps = model.uses_rps
+        self.uses_thrust = model.uses_thrust
+
+    def derivatives(self, nu, delta, thrust=None, rps=None) -> np.ndarray:
+        u, v = nu[:, 0], nu[:, 1]
+        return self.model.derivatives(nu, delta, thrust, rps, wind_speed=np.hypot(u, v),
+                                      wind_angle=np.arctan2(v, u))  # fmt: skip
+
+
 def _run(ship, pid: PID, desired, duration: float, dt: float, speed: float | None,
          rps: float | None, steering: SteeringMachine | None, method: str,
          psi0: float = 0.0):  # fmt: skip
     """Closed loop of the autopilot: ``desired(t, state) -> (ψd, cross-track or nan, done)``."""
     vessel = as_vessel(ship, speed, steering, rps)
     dyn = vessel.dynamics
+    if getattr(dyn, "uses_wind", False):
+        dyn = _StillAir(dyn)
     n = check_samples(duration / dt + 1, 8 * 12, f"a {duration:g} s run at a {dt:g} s step")
     s = initial_states({"u": vessel.approach_speed, "psi": psi0}, 1)
     speed_lim, yaw_lim = DivergenceBounds().resolved(vessel.approach_speed)
