@@ -132,6 +132,9 @@ def test_cli_linearise_export_autopilot_follow(tmp_path, capsys):
     scale_ship_model().save(path)
     code, out, err = run(["export", path, "-o", tmp_path / "m.py"], capsys)
     assert code == 0 and (tmp_path / "m.py").exists()
+    # Again, over the module it wrote: it was refused as "exists and is not a folder".
+    code, out, err = run(["export", path, "-o", tmp_path / "m.py"], capsys)
+    assert code == 0, err
     code, _, err = run(["export", path, "-o", tmp_path / "m.txt"], capsys)
     assert code == 1 and ".py file" in err
     code, out, err = run(["autopilot", path, "--speed", "1.93", "--truth", "scale-ship",

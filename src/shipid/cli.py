@@ -908,7 +908,7 @@ def cmd_export(args) -> int:
 
     if Path(args.output).suffix != ".py":
         raise ShipidError(f"-o {args.output}: the exported module must be a .py file")
-    check_outputs({"-o": (args.output, "dir")}, [args.model])
+    check_outputs({"-o": (args.output, "python")}, [args.model])
     model = load_model(args.model)
     export_numpy(model, args.output)
     print(f"standalone NumPy module written to {args.output} (accelerations, derivatives, "
