@@ -24,6 +24,7 @@ import pandas as pd
 
 from shipid.data.log import make_log
 from shipid.dynamics import kernel
+from shipid.dynamics.equilibrium import still_air_accelerations
 from shipid.dynamics.simulate import DivergenceBounds, initial_states, step_state, within_bounds
 from shipid.dynamics.steering import SteeringMachine
 from shipid.errors import ShipidError
@@ -88,9 +89,8 @@ class _StillAir:
         self.uses_thrust = model.uses_thrust
 
     def derivatives(self, nu, delta, thrust=None, rps=None) -> np.ndarray:
-        u, v = nu[:, 0], nu[:, 1]
-        return self.model.derivatives(nu, delta, thrust, rps, wind_speed=np.hypot(u, v),
-                                      wind_angle=np.arctan2(v, u))  # fmt: skip
+        rps = None if rps is None else float(np.asarray(rps).ravel()[0])
+        return still_air_accelerations(self.model, nu[:, 0], nu[:, 1], nu[:, 2], delta, rps)
 
 
 def _run(ship, pid: PID, desired, duration: float, dt: float, speed: float | None,
