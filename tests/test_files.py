@@ -331,3 +331,29 @@ def test_a_log_that_cannot_be_validated_is_named_once(tmp_path):
     (v,) = validate(model, [read_log(path)], names=[str(path)])
     assert v.error.startswith(f"{path}: the model needs the log column 'wind_speed'"), v.error
     assert v.error.count("zz.csv") == 1
+
+
+def test_a_log_at_another_scale_than_the_training_logs_is_named(tmp_path, capsys):
+    """A model identified from model-scale logs, validated on a full-scale file read without
+    --scale (the MARIN files' default), only said 'extrapolating'. The model file keeps its
+    training logs' scale (rescaled with it); validate names the mismatch and the remedy."""
+    log = zigzag(scale_ship(), 20, 20, duration=60, dt=0.2).log
+    lam = log.attrs["scale"]
+    assert lam > 1
+    train = write_log(log, tmp_path / "train.csv")
+    model = tmp_path / "m.json"
+    assert run(["identify", train, "--filter", "none", "-o", model], capsys)[0] == 0
+    assert json.loads(model.read_text())["identification"]["preprocessing"]["log_scale"] == lam
+    other = log.copy()
+    other.attrs = {**log.attrs, "scale": 1.0}
+    full = write_log(other, tmp_path / "full.csv")
+    code, _, err = run(["validate", model, full], capsys)
+    assert code == 0, err
+    assert f"at scale 1:1 and the model's training logs were at 1:{lam:g}" in err
+    assert f"--scale {lam:g}" in err
+    code, _, err = run(["validate", model, train], capsys)
+    assert "training logs were at" not in err
+    rescaled = tmp_path / "full.json"
+    assert run(["rescale", model, "--factor", str(lam), "-o", rescaled], capsys)[0] == 0
+    prep = json.loads(rescaled.read_text())["identification"]["preprocessing"]
+    assert prep["log_scale"] == pytest.approx(1.0)

@@ -318,6 +318,27 @@ def _rudder_rate(logs) -> float | None:
     return max(rates) if rates else None
 
 
+def _log_scale(logs) -> float | None:
+    """The scale λ of the training logs (their metadata), when they share one."""
+    scales = {float(log.attrs["scale"]) for log in logs if "scale" in log.attrs}
+    return scales.pop() if len(scales) == 1 and all("scale" in log.attrs for log in logs) \
+        else None
+
+
+def _scale_notes(cond: dict, logs, names) -> list[str]:
+    """Logs at another scale than the model's training logs: read with the wrong --scale."""
+    trained = cond.get("log_scale")
+    out = []
+    for log, name in zip(logs, names, strict=True):
+        lam = log.attrs.get("scale")
+        if trained and lam and abs(lam / trained - 1) > 0.01:
+            out.append(f"{name}: this log is at scale 1:{lam:g} and the model's training logs were"
+                       f" at 1:{trained:g}: read it with --scale {trained:g} (if its format "
+                       f"takes one), or carry the model over with shipid rescale --factor "
+                       f"{trained / lam:g}")  # fmt: skip
+    return out
+
+
 def _fmt_speed(u: float | None) -> str:
     return "none" if u is None else f"{u:.3g} m/s"
 
@@ -374,7 +395,8 @@ def cmd_identify(args) -> int:
             "columns": args.columns, "degrees": args.degrees,
             "format": args.format, "scale": args.scale,
             "approach_speed": speed, "approach_rps": rps, "rudder_rate": _rudder_rate(logs),
-            "rudder_positive": logs[0].attrs.get("rudder_positive")}  # fmt: skip
+            "rudder_positive": logs[0].attrs.get("rudder_positive"),
+            "log_scale": _log_scale(logs)}  # fmt: skip
     refinement = None
     print(ident.model.equations(std_errors=_std_errors(ident)))
     print("(± standard errors of the equation-error fit: they hold the scatter of the fitted "
@@ -596,7 +618,8 @@ def cmd_select(args) -> int:
             "columns": args.columns, "degrees": args.degrees, "format": args.format,
             "scale": args.scale, "approach_speed": speed, "approach_rps": rps,
             "rudder_rate": _rudder_rate(logs),
-            "rudder_positive": logs[0].attrs.get("rudder_positive")}  # fmt: skip
+            "rudder_positive": logs[0].attrs.get("rudder_positive"),
+            "log_scale": _log_scale(logs)}  # fmt: skip
     ensemble = None
     others = len(sel.shares) - (sel.chosen_share > 0)
     print(f"\nThe choice on {RESAMPLES} resamples of the held-out logs: this candidate "
@@ -1069,6 +1092,8 @@ def cmd_validate(args) -> int:
         logs, notes = common_rudder_convention(logs, cond["rudder_positive"])
         for note in notes:
             _warn(note)
+    for note in _scale_notes(cond, logs, names):
+        _warn(note)
     from tqdm.auto import tqdm
 
     vals = [validate(model, log, [name], method=args.method, kind=args.kind,

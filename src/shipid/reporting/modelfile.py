@@ -356,7 +356,7 @@ def rescaled_document(doc: Mapping, factor: float, to_rho: float | None = None,
         out["particulars"] = p
     prep = ident.get("preprocessing") or {}
     for key, scale in (("approach_speed", k), ("approach_rps", 1 / k), ("rudder_rate", 1 / k),
-                       ("dt", k)):  # fmt: skip
+                       ("dt", k), ("log_scale", 1 / factor)):  # fmt: skip
         if isinstance(prep.get(key), int | float):
             prep[key] = prep[key] * scale
     if isinstance(ident.get("dt"), int | float):
@@ -403,7 +403,7 @@ def training_conditions(doc: Mapping) -> dict:
     prep = ident.get("preprocessing") or {}
     out = {"speed": prep.get("approach_speed"), "rps": prep.get("approach_rps"),
            "envelope": ident.get("envelope") or {}, "particulars": None,
-           "rudder_rate": prep.get("rudder_rate"),
+           "rudder_rate": prep.get("rudder_rate"), "log_scale": prep.get("log_scale"),
            "rudder_positive": prep.get("rudder_positive")}  # fmt: skip
     if doc.get("particulars"):
         from shipid.data.particulars import Particulars
