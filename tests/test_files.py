@@ -353,6 +353,8 @@ def test_a_log_at_another_scale_than_the_training_logs_is_named(tmp_path, capsys
     assert f"--scale {lam:g}" in err
     code, _, err = run(["validate", model, train], capsys)
     assert "training logs were at" not in err
+    code, _, err = run(["simulate", model, full, "-o", tmp_path / "sim.csv"], capsys)
+    assert code == 0 and f"--scale {lam:g}" in err
     rescaled = tmp_path / "full.json"
     assert run(["rescale", model, "--factor", str(lam), "-o", rescaled], capsys)[0] == 0
     prep = json.loads(rescaled.read_text())["identification"]["preprocessing"]

@@ -1295,6 +1295,8 @@ def cmd_simulate(args) -> int:
                                      or cond.get("rudder_positive"))  # fmt: skip
     if note:
         _warn(note)
+    for note in _scale_notes(cond, [log], [str(log_path)]):
+        _warn(note)
     res = simulate_log(dynamics, log, method=args.method)
     write_log(res.log, args.output)
     if res.diverged:
