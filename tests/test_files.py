@@ -359,3 +359,22 @@ def test_a_log_at_another_scale_than_the_training_logs_is_named(tmp_path, capsys
     assert run(["rescale", model, "--factor", str(lam), "-o", rescaled], capsys)[0] == 0
     prep = json.loads(rescaled.read_text())["identification"]["preprocessing"]
     assert prep["log_scale"] == pytest.approx(1.0)
+
+
+def test_logs_at_different_scales_are_not_fitted_together(tmp_path, capsys):
+    """A model-scale and a full-scale run fitted together mix two time scales; nothing said
+    so. identify, select and compare refuse them in one line naming both files."""
+    log = zigzag(scale_ship(), 20, 20, duration=60, dt=0.2).log
+    a = write_log(log, tmp_path / "model_scale.csv")
+    other = log.copy()
+    other.attrs = {**log.attrs, "scale": 1.0}
+    b = write_log(other, tmp_path / "full_scale.csv")
+    for argv in (["identify", a, b, "-o", tmp_path / "m.json"],
+                 ["select", a, b, "--library", "blanke", "-o", tmp_path / "m.json"],
+                 ["compare", a, b]):  # fmt: skip
+        code, _, err = run(argv, capsys)
+        lines = [ln for ln in err.splitlines() if not ln.startswith("warning:")]
+        assert code == 1 and len(lines) == 1, err
+        assert "model_scale.csv" in lines[0] and "full_scale.csv" in lines[0]
+        assert "must be at one scale" in lines[0]
+    assert not (tmp_path / "m.json").exists()

@@ -177,6 +177,22 @@ def _read_logs(args, paths=None) -> list:
     return logs
 
 
+def _training_logs(args) -> list:
+    """The logs a model is fitted to: ``_read_logs``, refused when they are at different
+    scales (a model-scale and a full-scale run fitted together mix two ships' time scales)."""
+    logs = _read_logs(args)
+    scales = {}
+    for path, log in zip(args.logs, logs, strict=True):
+        if "scale" in log.attrs:
+            scales.setdefault(float(log.attrs["scale"]), str(path))
+    if len(scales) > 1:
+        (a, pa), (b, pb) = list(scales.items())[:2]
+        raise ShipidError(f"{pb} is at scale 1:{b:g} and {pa} at 1:{a:g}: the logs of one fit "
+                          "must be at one scale (read the trial files with the same "
+                          "--scale)")  # fmt: skip
+    return logs
+
+
 def _particulars(args):
     """The particulars of --particulars (None when not given)."""
     if not getattr(args, "particulars", None):
@@ -360,7 +376,7 @@ def cmd_identify(args) -> int:
     if args.error_band is not None and (args.refine or args.output_error):
         raise ShipidError("--error-band describes the LS-SVM fit; it does not go with --refine "
                           "or --output-error")  # fmt: skip
-    logs = _read_logs(args)
+    logs = _training_logs(args)
     raw_logs = logs  # the output-error fit needs the noise as measured, not prefiltered
     names = [str(p) for p in args.logs]
     physics = _physics(args, logs, _structure(args))
@@ -569,7 +585,7 @@ def cmd_select(args) -> int:
     from shipid.reporting.modelfile import model_text
 
     check_outputs({"-o": (args.output, "json"), "--table": (args.table, "log")}, args.logs)
-    logs = _read_logs(args)
+    logs = _training_logs(args)
     names = [str(p) for p in args.logs]
     from shipid.dynamics.model import get_structure
     from shipid.identification.select import default_library
@@ -689,7 +705,7 @@ def cmd_compare(args) -> int:
 
     check_outputs({"--json": (args.json, "json")}, args.logs)
     methods = [m.strip() for m in args.methods.split(",") if m.strip()]
-    logs = _read_logs(args)
+    logs = _training_logs(args)
     names = [Path(p).name for p in args.logs]
     table = compare(logs, args.model, methods, names, gamma=args.gamma, cv=args.cv,
                     method=args.method, progress=not args.quiet)  # fmt: skip
