@@ -378,3 +378,12 @@ def test_logs_at_different_scales_are_not_fitted_together(tmp_path, capsys):
         assert "model_scale.csv" in lines[0] and "full_scale.csv" in lines[0]
         assert "must be at one scale" in lines[0]
     assert not (tmp_path / "m.json").exists()
+
+
+def test_scale_is_refused_where_it_would_be_ignored(tmp_path, capsys):
+    """``--scale`` on a canonical or Osaka log was silently ignored: the user believed the log
+    Froude-scaled. It is refused in one line."""
+    path = write_log(zigzag(scale_ship(), 20, 20, duration=30, dt=0.2).log, tmp_path / "zz.csv")
+    code, _, err = run(["identify", path, "--scale", "45.7", "-o", tmp_path / "m.json"], capsys)
+    assert code == 1 and "--scale applies to the SIMMAN files" in err
+    assert not (tmp_path / "m.json").exists()

@@ -163,6 +163,11 @@ def read_log(path: str | Path, options: ReadOptions | None = None, **overrides) 
         options = dataclasses.replace(options, **overrides)
     path = Path(path)
     name = str(path)
+    if options.scale is not None and options.fmt in ("canonical", "osaka-frt"):
+        # It was ignored: a user who gave it believed the log Froude-scaled.
+        raise ShipidError(f"{name}: --scale applies to the SIMMAN files (MARIN's are full scale, "
+                          f"Froude-scaled by it); a {options.fmt} log is read at its own scale "
+                          "(to carry a model to another scale: shipid rescale)")  # fmt: skip
     if options.fmt != "canonical":
         _check_file(path)
         log = read_format(path, options.fmt, options.scale)
