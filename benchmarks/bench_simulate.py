@@ -220,6 +220,33 @@ def numba_zigzag(a, b, c, n, dt, u0, rk4, rudder, switch, rate, stbd, states, ru
         u, v, r, psi, x, y = _blanke_step(a, b, c, u, v, r, psi, x, y, delta, dt, rk4)
 
 
+def _engine_rows(method, model, gen, params, s0, dt, n, py_rate, nb_rate, target: str):
+    """The closed loop of ``params`` on the interpreted and generated kernels (kernel entries,
+    no log), printed as rows against the baselines' rates; returns the run (engine → states)."""
+    rk4 = method == "rk4"
+    # Written into the same arrays every run, as the hand-written loop is: allocating and
+    # first touching 112 MB per run would time the page faults, not the loop.
+    out, rud, nv = np.zeros((1, n, 6)), np.zeros((1, n)), np.zeros(1, dtype=np.int64)
+
+    def run(engine):
+        args = (dt, n, s0, params[None].copy(), rk4, np.array([20.0]), np.array([5.0]), out,
+                rud, nv)  # fmt: skip
+        if engine == "generated":
+            gen.integrate_closed(model.theta[None].copy(), *args)
+        else:
+            kernel.integrate_closed(model.theta[None].copy(), *model.code.arrays(),
+                                    model.code.uses_derived, *args)  # fmt: skip
+        return out
+
+    for engine in ("interpreted", "generated"):
+        run(engine)
+        rate_e = n / best_of(lambda e=engine: run(e))
+        print(f"| {method} | {engine} | {n / rate_e:.3f} | {rate_e:.3g} | "
+              f"{rate_e / py_rate:.0f}× | {rate_e / nb_rate:.2f}× | "
+              f"{target if engine == 'generated' else '–'} |")
+    return run
+
+
 def closed_loop() -> None:
     """Closed-loop 20/20 zig-zags of the Blanke model (scale ship, 9.6 °/s rudder): the term
     interpreter and the generated kernel (``kernel``-level entries, no log built) against a
@@ -258,26 +285,8 @@ def closed_loop() -> None:
         print(f"| {method} | hand-written numba | – | {nb_rate:.3g} | {nb_rate / py_rate:.0f}× | "
               f"1× | baseline |")
 
-        # Written into the same arrays every run, as the hand-written loop is: allocating and
-        # first touching 112 MB per run would time the page faults, not the loop.
-        out, rud, nv = np.zeros((1, n, 6)), np.zeros((1, n)), np.zeros(1, dtype=np.int64)
-
-        def run(engine, rk4=rk4, out=out, rud=rud, nv=nv):
-            args = (dt, n, s0, params[None].copy(), rk4, np.array([20.0]), np.array([5.0]), out,
-                    rud, nv)  # fmt: skip
-            if engine == "generated":
-                gen.integrate_closed(model.theta[None].copy(), *args)
-            else:
-                kernel.integrate_closed(model.theta[None].copy(), *model.code.arrays(),
-                                        model.code.uses_derived, *args)  # fmt: skip
-            return out
-
-        for engine in ("interpreted", "generated"):
-            run(engine)
-            rate_e = n / best_of(lambda e=engine: run(e))
-            target = "≥ 50× Python, ≥ 0.8× numba" if engine == "generated" else "–"
-            print(f"| {method} | {engine} | {n / rate_e:.3f} | {rate_e:.3g} | "
-                  f"{rate_e / py_rate:.0f}× | {rate_e / nb_rate:.2f}× | {target} |")
+        run = _engine_rows(method, model, gen, params, s0, dt, n, py_rate, nb_rate,
+                           "≥ 50× Python, ≥ 0.8× numba")  # fmt: skip
         check = np.zeros((n, 6))
         numba_zigzag(a, b, c, n, dt, u0, rk4, rudder, switch, rate, stbd, check, rudders)
         ours = run("generated")[0]
@@ -408,23 +417,7 @@ def heading_autopilot() -> None:
               f"{py_rate / nb_rate:.3f}× | baseline |")
         print(f"| {method} | hand-written numba | – | {nb_rate:.3g} | {nb_rate / py_rate:.0f}× | "
               f"1× | baseline |")
-        out, rud, nv = np.zeros((1, n, 6)), np.zeros((1, n)), np.zeros(1, dtype=np.int64)
-
-        def run(engine, rk4=rk4, out=out, rud=rud, nv=nv):
-            args = (dt, n, s0, params[None].copy(), rk4, np.array([20.0]), np.array([5.0]), out,
-                    rud, nv)  # fmt: skip
-            if engine == "generated":
-                gen.integrate_closed(model.theta[None].copy(), *args)
-            else:
-                kernel.integrate_closed(model.theta[None].copy(), *model.code.arrays(),
-                                        model.code.uses_derived, *args)  # fmt: skip
-            return out
-
-        for engine in ("interpreted", "generated"):
-            run(engine)
-            rate_e = n / best_of(lambda e=engine: run(e))
-            print(f"| {method} | {engine} | {n / rate_e:.3f} | {rate_e:.3g} | "
-                  f"{rate_e / py_rate:.0f}× | {rate_e / nb_rate:.2f}× | – |")
+        run = _engine_rows(method, model, gen, params, s0, dt, n, py_rate, nb_rate, "–")
         ours = run("generated")[0]
         print(f"| {method} | (generated − hand-written numba, largest state difference) | "
               f"{np.abs(ours[:, :3] - states[:, :3]).max():.1e} | | | | |")
