@@ -220,6 +220,15 @@ def numba_zigzag(a, b, c, n, dt, u0, rk4, rudder, switch, rate, stbd, states, ru
         u, v, r, psi, x, y = _blanke_step(a, b, c, u, v, r, psi, x, y, delta, dt, rk4)
 
 
+def _closed_loop_table(title: str, model, n: int, dt: float):
+    """Print a closed-loop table's title and header; returns the model's generated kernel."""
+    print(f"\n{title}, {n:.0e} steps at {dt} s (load average {os.getloadavg()[0]:.2f})\n")
+    print("| method | engine | time (s) | steps/s | vs plain Python loop | vs hand-written numba "
+          "| target |")
+    print("|---|---|---|---|---|---|---|")
+    return codegen.load(model.code, codegen.nonzero_pairs(model.code, model.theta))
+
+
 def _engine_rows(method, model, gen, params, s0, dt, n, py_rate, nb_rate, target: str):
     """The closed loop of ``params`` on the interpreted and generated kernels (kernel entries,
     no log), printed as rows against the baselines' rates; returns the run (engine → states)."""
@@ -265,12 +274,7 @@ def closed_loop() -> None:
     dt, n = 0.05, 2_000_000
     u0 = vessel.approach_speed
     s0 = np.array([[u0, 0, 0, 0, 0, 0]])
-    print(f"\nClosed-loop 20/20 zig-zag, {n:.0e} steps at {dt} s (load average "
-          f"{os.getloadavg()[0]:.2f})\n")
-    print("| method | engine | time (s) | steps/s | vs plain Python loop | vs hand-written numba "
-          "| target |")
-    print("|---|---|---|---|---|---|---|")
-    gen = codegen.load(model.code, codegen.nonzero_pairs(model.code, model.theta))
+    gen = _closed_loop_table("Closed-loop 20/20 zig-zag", model, n, dt)
     for method in ("euler", "rk4"):
         rk4 = method == "rk4"
         n_py = 200_000
@@ -396,12 +400,7 @@ def heading_autopilot() -> None:
     max_angle, rate = ship.steering.max_angle, ship.steering.max_rate
     u0 = vessel.approach_speed
     s0 = np.array([[u0, 0, 0, 0, 0, 0]])
-    print(f"\nHeading autopilot, a 20° step, {n:.0e} steps at {dt} s (load average "
-          f"{os.getloadavg()[0]:.2f})\n")
-    print("| method | engine | time (s) | steps/s | vs plain Python loop | vs hand-written numba "
-          "| target |")
-    print("|---|---|---|---|---|---|---|")
-    gen = codegen.load(model.code, codegen.nonzero_pairs(model.code, model.theta))
+    gen = _closed_loop_table("Heading autopilot, a 20° step", model, n, dt)
     for method in ("euler", "rk4"):
         rk4 = method == "rk4"
         n_py = 200_000
