@@ -242,3 +242,13 @@ def test_path_following_runs_a_model_with_wind_terms():
     res = follow_path(model, pid_from_nomoto(nm["K"], nm["T"]), [(0, 0), (60, 0), (60, 60)],
                       lookahead=15.0, speed=1.93)  # fmt: skip
     assert res.completed and not res.diverged and res.rms_cross_track < 5.0
+
+
+def test_the_lookahead_follows_the_model_files_length(tmp_path, capsys):
+    """A model file with particulars steered along with a 20 m lookahead whatever its size (a
+    3 m model around a 20 m square: 13 m rms cross-track); the default is 2 L from them."""
+    path = scale_ship_model().save(tmp_path / "m.json", particulars={"length": 5.0})
+    code, out, err = run(["follow", path, "--speed", "1.93", "--waypoints", "0,0;40,0;40,40"],
+                         capsys)  # fmt: skip
+    assert code == 0, err
+    assert "(lookahead 10 m)" in out

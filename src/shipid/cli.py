@@ -887,7 +887,7 @@ def _controlled(args):
         raise ShipidError(f"--truth must be a reference ship ({', '.join(VESSEL_NAMES)})")
     steering, note = _steering(target, cond, args.rudder_rate)
     print(f"{args.model}: {note}")
-    return target, truth, speed, rps, steering
+    return target, truth, speed, rps, steering, cond
 
 
 def _for_truth(pid, target, truth, speed, rps):
@@ -961,7 +961,7 @@ def cmd_autopilot(args) -> int:
     from shipid.outputs import check_outputs
 
     check_outputs({"-o": (args.output, "figure")}, [])
-    target, truth, speed, rps, steering = _controlled(args)
+    target, truth, speed, rps, steering, cond = _controlled(args)
     nm, pid = _tuned(target, speed, rps, args.omega)
     print(f"PID tuned on {args.model} (Nomoto K = {nm['K']:.4g} 1/s, T = {nm['T']:.4g} s): "
           f"Kp = {pid.kp:.4g}, Ki = {pid.ki:.4g} 1/s, Kd = {pid.kd:.4g} s")
@@ -1011,9 +1011,12 @@ def cmd_follow(args) -> int:
     from shipid.outputs import OutputSet, check_outputs
 
     check_outputs({"-o": (args.output, "figure"), "--json": (args.json, "json")}, [])
-    target, truth, speed, rps, steering = _controlled(args)
+    target, truth, speed, rps, steering, cond = _controlled(args)
     waypoints = _parse_waypoints(args.waypoints)
+    # A reference ship's length, else the model file's particulars', else 10 m.
     length = getattr(target, "length", None)
+    if not (length and length == length) and cond.get("particulars") is not None:
+        length = cond["particulars"].length
     lookahead = args.lookahead or 2.0 * (length if length and length == length else 10.0)
     nm, pid = _tuned(target, speed, rps, args.omega)
     runs, rows = {}, []
@@ -1783,7 +1786,8 @@ def build_parser() -> argparse.ArgumentParser:
             p.add_argument("--waypoints", required=True, metavar="X,Y;X,Y;...",
                            help="waypoints [m], x north, y east")
             p.add_argument("--lookahead", type=float, metavar="M",
-                           help="line-of-sight lookahead [m] (default 2 L, else 20 m)")
+                           help="line-of-sight lookahead [m] (default 2 L, from the ship or the model "
+                           "file's particulars, else 20 m)")
             p.add_argument("-o", "--output", metavar="FIG.png", help="figure of the tracks")
             p.add_argument("--json", metavar="OUT.json")
             p.set_defaults(func=cmd_follow)
