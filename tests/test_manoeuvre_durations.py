@@ -99,3 +99,23 @@ def test_plausibility_holds_the_rudder_until_a_full_scale_turn_settles():
         assert b["steady_yaw_rate"] == pytest.approx(a["steady_yaw_rate"] / K, rel=2e-2)
     _, notes = check_plausibility(LARGE_MODEL, LARGE["speed"], duration=300.0)
     assert any("no steady turn after 300 s" in n for n in notes)
+
+
+def test_the_full_scale_stopping_test_runs_until_the_ship_stops():
+    """The stopping test ran 600 s: enough for a model, not for a slow full-scale ship, whose
+    track reach then came back NaN without a word."""
+    from shipid.trials.manoeuvres import stopping
+
+    truth = ManoeuvringModel(
+        f"u: |u|*u, pos(n)^2, neg(n)^2; v: {', '.join(LATERAL)}; r: {', '.join(LATERAL)}",
+        {"u": {"|u|*u": -0.005, "pos(n)^2": 5e-5, "neg(n)^2": -5e-5},
+         "v": MODEL.coefficients["v"], "r": MODEL.coefficients["r"]})  # fmt: skip
+    big = froude_scaled(truth, FACTOR)
+    small = stopping(truth, 10.0, speed=1.0, dt=0.05)
+    large = stopping(big, 10.0 / K, speed=K, dt=0.05 * K)
+    assert not small.incomplete and not large.incomplete
+    assert large.indices["time_to_stop"] > 600.0
+    assert large.indices["track_reach"] == pytest.approx(small.indices["track_reach"] * FACTOR,
+                                                         rel=1e-9)  # fmt: skip
+    short = stopping(big, 10.0 / K, speed=K, dt=0.05 * K, duration=600.0)
+    assert "has not stopped within 600 s" in short.incomplete

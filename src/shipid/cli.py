@@ -1705,6 +1705,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--duration", type=float,
                    help="length of the run [s] (default: from 90 s for a zig-zag, 240 s for a "
                         "turning circle, 60 + 60 s for a pull-out, 120 s per spiral step, "
+                        "600 s for stopping, "
                         "doubled until the run is complete and its yaw rate settled; a full-"
                         "scale ship takes ten times a 1:100 model)")
     p.add_argument("--dt", "--step", dest="step", type=float, default=0.05,

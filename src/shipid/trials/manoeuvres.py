@@ -57,6 +57,7 @@ class ManoeuvreResult:
 # indices are complete or its yaw rate settled, up to EXTEND_MAX times the first length; a run
 # still incomplete then says so (``incomplete``) instead of returning indices of a transient.
 ZIGZAG_DURATION, TURNING_DURATION, PULL_OUT_PHASE, SPIRAL_HOLD = 90.0, 240.0, 60.0, 120.0
+STOPPING_DURATION = 600.0
 EXTEND_MAX = 64
 # A yaw rate is settled when it moves less than this share of its scale over the last fifth of
 # a phase (the spiral's steady rate is that fifth's mean).
@@ -414,7 +415,7 @@ def stopping(
     rps: float,
     astern_rps: float | None = None,
     reversal_time: float = 0.0,
-    duration: float = 600.0,
+    duration: float | None = None,
     dt: float = 0.05,
     speed: float | None = None,
     method: str = "rk4",
@@ -423,7 +424,8 @@ def stopping(
     """Full-astern stopping test (IMO): from a straight approach at ``rps``, the propeller is
     ordered to ``astern_rps`` (default −``rps``) at t = 0, reaching it in ``reversal_time`` s; the
     rudder stays amidships. Indices: track reach (path length until the ship stops in the water,
-    u = 0), head reach (along the original course), lateral deviation, time to stop."""
+    u = 0), head reach (along the original course), lateral deviation, time to stop.
+    ``duration`` [s]: by default 600 s, doubled until the ship has stopped."""
     if not getattr(getattr(ship, "dynamics", ship), "uses_rps", False):
         raise ShipidError("a stopping test needs a model with propeller-speed terms (n): the "
                           "ship's thrust must respond to the astern order")  # fmt: skip
@@ -439,31 +441,41 @@ def stopping(
                               wind=_check_wind(wind))  # fmt: skip
     params[kernel.P_RPS_TO], params[kernel.P_RPS_AT] = astern, 0.0
     params[kernel.P_RPS_RAMP] = reversal_time
-    res = run_closed_loop(vessel, params, duration, dt, method, rps=rps)
-    res.log.attrs["manoeuvre"] = f"stopping, {rps:g} → {astern:g} rps in {reversal_time:g} s"
-    log = res.log
-    u, t = log["u"].to_numpy(), log["t"].to_numpy()
-    stopped = np.flatnonzero(u <= 0.0)
+
+    def run(length: float) -> ManoeuvreResult:
+        res = run_closed_loop(vessel, params, length, dt, method, rps=rps)
+        res.indices = _stopping_indices(res.log, vessel)
+        if not res.diverged and not math.isfinite(res.indices["time_to_stop"]):
+            res.incomplete = f"the ship has not stopped within {length:g} s"
+        res.log.attrs["manoeuvre"] = f"stopping, {rps:g} → {astern:g} rps in {reversal_time:g} s"
+        return res
+
+    return run(duration) if duration is not None else _extended(run, STOPPING_DURATION)
+
+
+def _stopping_indices(log: pd.DataFrame, vessel: Vessel) -> dict:
+    """Track reach, head reach, lateral deviation and time to stop (u = 0) of a stopping run
+    (NaN where the ship has not stopped)."""
     from shipid.trials.indices import travelled
 
+    u, t = log["u"].to_numpy(), log["t"].to_numpy()
+    stopped = np.flatnonzero(u <= 0.0)
     nan = math.nan
-    res.indices = {"track_reach": nan, "head_reach": nan, "lateral_deviation": nan,
-                   "time_to_stop": nan}  # fmt: skip
+    out = {"track_reach": nan, "head_reach": nan, "lateral_deviation": nan, "time_to_stop": nan}
     if stopped.size:
         k = int(stopped[0])
         frac = u[k - 1] / (u[k - 1] - u[k]) if k > 0 and u[k - 1] != u[k] else 0.0
         t_stop = float(t[k - 1] + frac * (t[k] - t[k - 1])) if k > 0 else float(t[0])
-        dist = travelled(log)
         psi0 = float(log["psi"].iloc[0])
         x = np.interp(t_stop, t, log["x"]) - log["x"].iloc[0]
         y = np.interp(t_stop, t, log["y"]) - log["y"].iloc[0]
-        res.indices = {"track_reach": float(np.interp(t_stop, t, dist)),
-                       "head_reach": float(x * math.cos(psi0) + y * math.sin(psi0)),
-                       "lateral_deviation": float(-x * math.sin(psi0) + y * math.cos(psi0)),
-                       "time_to_stop": t_stop}  # fmt: skip
+        out = {"track_reach": float(np.interp(t_stop, t, travelled(log))),
+               "head_reach": float(x * math.cos(psi0) + y * math.sin(psi0)),
+               "lateral_deviation": float(-x * math.sin(psi0) + y * math.cos(psi0)),
+               "time_to_stop": t_stop}  # fmt: skip
     if vessel.length and math.isfinite(vessel.length):
-        res.indices["track_reach_L"] = res.indices["track_reach"] / vessel.length
-    return res
+        out["track_reach_L"] = out["track_reach"] / vessel.length
+    return out
 
 
 def spiral(
