@@ -252,3 +252,29 @@ def test_the_lookahead_follows_the_model_files_length(tmp_path, capsys):
                          capsys)  # fmt: skip
     assert code == 0, err
     assert "(lookahead 10 m)" in out
+
+
+@pytest.mark.parametrize("ship", ["model", "windy model", "kvlcc2", "mariner"])
+def test_the_compiled_path_following_is_the_python_loop(ship):
+    """Line-of-sight path following runs in the compiled closed loop (``kernel.MODE_FOLLOW``),
+    cut where the path ends; the step-by-step loop is its reference: the same samples, states,
+    ordered headings and cross-track errors to rounding, legs switched at the same steps."""
+    from shipid.control.autopilot import follow_loop
+    from shipid.vessels import get_vessel
+
+    target = {"model": scale_ship_model, "windy model": _windy_model}.get(ship, lambda: None)()
+    speed = 1.93 if target is not None else None
+    target = target if target is not None else get_vessel(ship)
+    scale = 30.0 if ship == "mariner" else 1.0
+    waypoints = [(5.0 * scale, 5.0 * scale), (60.0 * scale, 0.0), (60.0 * scale, 60.0 * scale)]
+    nm = nomoto(target, speed or target.approach_speed)
+    pid = pid_from_nomoto(nm["K"], nm["T"])
+    duration = 240.0 * (5.0 if ship == "mariner" else 1.0)
+    fast = follow_path(target, pid, waypoints, 15.0 * scale, duration=duration, speed=speed)
+    slow = follow_loop(target, pid, waypoints, 15.0 * scale, duration, speed=speed)
+    assert fast.completed and slow.completed and not fast.diverged
+    assert len(fast.log) == len(slow.log)
+    for col in ("u", "v", "r", "psi", "x", "y", "delta", "psi_d", "cross_track"):
+        np.testing.assert_allclose(fast.log[col], slow.log[col], rtol=1e-9, atol=1e-9,
+                                   err_msg=col)  # fmt: skip
+    assert fast.rms_cross_track == pytest.approx(slow.rms_cross_track, rel=1e-9)

@@ -25,6 +25,7 @@ import pandas as pd
 from shipid.data.log import make_log
 from shipid.dynamics import kernel
 from shipid.dynamics.equilibrium import still_air_accelerations
+from shipid.dynamics.model import ManoeuvringModel
 from shipid.dynamics.simulate import DivergenceBounds, initial_states, step_state, within_bounds
 from shipid.dynamics.steering import SteeringMachine
 from shipid.errors import ShipidError
@@ -79,6 +80,59 @@ class FollowResult:
     diverged: bool = False
 
 
+def _follow_compiled(vessel, pid: PID, wp: np.ndarray, lookahead: float, accept: float,
+                     duration: float, dt: float, rps: float | None, method: str,
+                     course: float) -> FollowResult:  # fmt: skip
+    """``follow_path`` in the compiled closed loop (``kernel.MODE_FOLLOW``): the run goes on past
+    the end of the path and is cut there, where the step-by-step loop stops; the ordered heading
+    and the cross-track error are recomputed along the track (``kernel.follow_track``)."""
+    params = manoeuvre_params(vessel, kernel.MODE_FOLLOW, 0.0, 0.0, 0.0, rps=rps)
+    params[kernel.P_KP], params[kernel.P_KI], params[kernel.P_KD] = pid.kp, pid.ki, pid.kd
+    params[kernel.P_LOOKAHEAD], params[kernel.P_ACCEPT] = lookahead, accept
+    params[kernel.P_N_WAYPOINTS] = len(wp)
+    params = np.concatenate([params, (wp - wp[0]).ravel()])
+    res = run_closed_loop(vessel, params, duration, dt, method, initial={"psi": course}, rps=rps)
+    log = res.log
+    track = np.zeros((len(log), 2))
+    end = kernel.follow_track(params, log["x"].to_numpy(), log["y"].to_numpy(), track)
+    done = end >= 0
+    if done:
+        log = log.iloc[: end + 1].copy()
+    log["psi_d"], log["cross_track"] = track[: len(log), 0], track[: len(log), 1]
+    log["x"] += wp[0, 0]
+    log["y"] += wp[0, 1]
+    e = log["cross_track"].to_numpy()
+    return FollowResult(log, float(np.sqrt(np.mean(e * e))), float(np.max(np.abs(e))), done,
+                        res.diverged and not done)  # fmt: skip
+
+
+def follow_loop(ship, pid: PID, waypoints, lookahead: float, duration: float, dt: float = 0.1,
+                speed: float | None = None, rps: float | None = None,
+                method: str = "rk4") -> FollowResult:  # fmt: skip
+    """``follow_path`` stepped in Python: the reference the compiled run is tested against."""
+    import dataclasses
+
+    vessel = as_vessel(ship, speed, None, rps)
+    stepped = dataclasses.replace(vessel, dynamics=_Stepped(vessel.dynamics))
+    return follow_path(stepped, pid, waypoints, lookahead, duration=duration, dt=dt, rps=rps,
+                       method=method)  # fmt: skip
+
+
+class _Stepped:
+    """Dynamics through their derivatives alone (no compiled entry): the step-by-step loop."""
+
+    def __init__(self, dynamics) -> None:
+        self.dynamics = dynamics
+        self.uses_rps = getattr(dynamics, "uses_rps", False)
+        self.uses_thrust = getattr(dynamics, "uses_thrust", False)
+        self.uses_wind = getattr(dynamics, "uses_wind", False)
+
+    def derivatives(self, nu, delta, thrust=None, rps=None) -> np.ndarray:
+        if rps is None:
+            return self.dynamics.derivatives(nu, delta, thrust)
+        return self.dynamics.derivatives(nu, delta, thrust, rps)
+
+
 class _StillAir:
     """A model with wind terms in still air: the apparent wind of its own motion, from each
     integration stage's state, as the compiled closed loop has it (``kernel.terms_rhs``)."""
@@ -100,7 +154,7 @@ def _run(ship, pid: PID, desired, duration: float, dt: float, speed: float | Non
     vessel = as_vessel(ship, speed, steering, rps)
     dyn = vessel.dynamics
     if getattr(dyn, "uses_wind", False):
-        dyn = _StillAir(dyn)
+        dyn = _StillAir(dyn.dynamics if isinstance(dyn, _Stepped) else dyn)
     n = check_samples(duration / dt + 1, 8 * 12, f"a {duration:g} s run at a {dt:g} s step")
     s = initial_states({"u": vessel.approach_speed, "psi": psi0}, 1)
     speed_lim, yaw_lim = DivergenceBounds().resolved(vessel.approach_speed)
@@ -217,6 +271,10 @@ def follow_path(
     if duration is None:
         duration = 3.0 * float(lengths.sum()) / vessel.approach_speed
     courses = np.arctan2(legs[:, 1], legs[:, 0])
+    dyn = vessel.dynamics
+    if isinstance(dyn, ManoeuvringModel) or hasattr(dyn, "integrate_closed"):
+        return _follow_compiled(vessel, pid, wp, lookahead, accept, duration, dt, rps, method,
+                                float(courses[0]))  # fmt: skip
     state = {"leg": 0}
     offset = wp[0]
 

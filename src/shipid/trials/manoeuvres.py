@@ -233,11 +233,15 @@ def _generic_closed_loop(dyn, params, n, dt, s0, method, speed_lim, yaw_lim, rps
     delta = float(params[kernel.P_HELD])
     side = float(params[kernel.P_SIDE])
     integral = 0.0
+    follow = params[kernel.P_MODE] == kernel.MODE_FOLLOW
+    target, leg = float(params[kernel.P_VALUE]), 0.0
     prop = None if rps is None else np.array([float(rps)])
     st = (params[kernel.P_MAX_ANGLE], params[kernel.P_MAX_RATE], params[kernel.P_TIME_CONST])
     for k in range(n):
-        cmd, side, integral = kernel.command(params, k * dt, s[0, 3], s[0, 2], side, integral,
-                                             dt)  # fmt: skip
+        if follow:
+            target, _, leg, _ = kernel.line_of_sight(params, s[0, 4], s[0, 5], leg)
+        cmd, side, integral = kernel.command(params, k * dt, s[0, 3], s[0, 2], target, side,
+                                             integral, dt)  # fmt: skip
         delta = kernel.steer(delta, cmd, dt, *st)
         states[k], rudder[k] = s[0], delta
         if k == n - 1:
