@@ -150,8 +150,9 @@ def _key(text: str) -> str:
     (numba does not track a cached function's callees) and shipid's version."""
     import hashlib  # 3 ms: on first use, not on every command's start-up
 
-    kernel_src = (Path(__file__).parent / "kernel.py").read_bytes()
-    h = hashlib.sha256(text.encode() + kernel_src + __version__.encode())
+    from shipid.dynamics import kernel
+
+    h = hashlib.sha256(text.encode() + kernel.source_digest().encode() + __version__.encode())
     return h.hexdigest()[:20]
 
 

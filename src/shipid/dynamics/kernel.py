@@ -21,6 +21,7 @@ velocity at every evaluation.
 
 from __future__ import annotations
 
+import functools
 import math
 from pathlib import Path
 
@@ -47,18 +48,25 @@ N_PARAMS = 25
 MODE_HOLD, MODE_ZIGZAG, MODE_HEADING, MODE_FOLLOW = 0, 1, 2, 3
 
 
+@functools.lru_cache(maxsize=1)
+def source_digest() -> str:
+    """SHA-256 of this module's source: what compiled code that inlines it depends on (the
+    generated kernels' names, the reference ships' caches)."""
+    import hashlib  # 3 ms: on first use, not on every command's start-up
+
+    return hashlib.sha256(Path(__file__).read_bytes()).hexdigest()
+
+
 def drop_stale_caches(module_file: str) -> None:
     """Delete numba's cache of the module at ``module_file`` when this file has changed since it
     was written. numba stamps a cached function with its own file only, not its callees': a
     reference ship's closed loop, compiled with this module's ``closed_run`` inlined, came back
     from the cache with the old one after an edit here (a new command mode ran as a zig-zag).
     Called at the top of such modules, before their entries are compiled or loaded."""
-    import hashlib
-
     path = Path(module_file)
     folder = path.parent / "__pycache__"
     marker = folder / f"{path.stem}.kernel-sha256"
-    digest = hashlib.sha256(Path(__file__).read_bytes()).hexdigest()
+    digest = source_digest()
     try:
         if marker.read_text() == digest:
             return
