@@ -65,3 +65,16 @@ def test_cli_filter_auto_is_the_default_and_recorded(tmp_path, capsys):
     with pytest.raises(SystemExit) as exit_:
         run(["identify", path, "--filter", "soft", "-o", tmp_path / "x.json"], capsys)
     assert exit_.value.code == 2 and "'soft'" in capsys.readouterr().err
+
+
+def test_a_log_every_candidate_refuses_is_named_once(tmp_path, capsys):
+    """Bug: a log with jittery time stamps got the sampling error once per cut-off candidate,
+    nine times on one line, behind 'no prefilter candidate could be fitted'."""
+    log = synthesise_trials(1)[TRAINING].copy()
+    log.loc[40:, "t"] += 0.05  # one gap of 1.25 Δk
+    path = tmp_path / "jitter.csv"
+    write_log(log, path)
+    code, out, err = run(["identify", path, "-o", tmp_path / "m.json"], capsys)
+    assert code == 1 and not (tmp_path / "m.json").exists()
+    assert err.count("sampling is not uniform") == 1, err
+    assert "prefilter" not in err and "--dt 0.2" in err

@@ -75,8 +75,10 @@ def choose_prefilter(
         rows.append(row)
     scored = [i for i, r in enumerate(rows) if math.isfinite(r["score"])]
     if not scored:
-        raise ShipidError("no prefilter candidate could be fitted: "
-                          + "; ".join(r["note"] for r in rows if r["note"])[:300])  # fmt: skip
+        notes = list(dict.fromkeys(r["note"] for r in rows if r["note"]))
+        if len(notes) == 1:  # not the filter's doing (a log's sampling, say): say it once
+            raise ShipidError(notes[0])
+        raise ShipidError("no prefilter candidate could be fitted: " + "; ".join(notes)[:300])
     best = min(scored, key=lambda i: rows[i]["score"])
     # One standard error: the least filtering candidate as good as the best within its spread
     # (the grid runs from no filter to the lowest cut-off).
