@@ -25,8 +25,10 @@ def rudder_execute_time(log: pd.DataFrame, name: str = "log") -> float:
     gathers speed are smaller or never steady."""
     from scipy.ndimage import maximum_filter1d, minimum_filter1d  # 0.3 s: only when trimming
 
+    from shipid.data.rudder_signal import rudder_for_events, stand_samples
+
     t = log["t"].to_numpy()
-    delta = log["delta"].to_numpy()
+    delta, noise = rudder_for_events(t, log["delta"].to_numpy())
     dt = float(np.median(np.diff(t)))
     dev = np.abs(delta)
     peak = float(dev.max())
@@ -40,31 +42,43 @@ def rudder_execute_time(log: pd.DataFrame, name: str = "log") -> float:
         raise ShipidError(f"{name}: no rudder execute found (no rudder deflection held for "
                           f"{EXECUTE_HOLD_S:g} s); give --start in seconds")  # fmt: skip
     k = int(np.argmax(plateau))
-    return float(t[swing_start(delta, k, np.sign(delta[k]))])
+    return float(t[swing_start(delta, k, np.sign(delta[k]), stand_samples(t) if noise else 0)])
 
 
-def swing_start(delta: np.ndarray, k: int, side: float) -> int:
+def swing_start(delta: np.ndarray, k: int, side: float, max_stand: int = 0) -> int:
     """Back from sample k along the rudder swing towards ``side`` (±1), to where it started: the
     last sample before the rudder moved by more than ``SWING_STEP_FRACTION`` of the swing's
-    steepest step (the order), so that a slow creep before the order does not count."""
+    steepest step (the order), so that a slow creep before the order does not count. With
+    ``max_stand`` > 0 (a denoised rudder, ``shipid.data.rudder_signal``: no creep, uneven steps
+    as its dead band releases) a stand of fewer samples inside the swing is crossed instead, and
+    the swing starts where the rudder stood longer or moved the other way."""
     steepest = 0.0
     while k > 0:
         step = side * (delta[k] - delta[k - 1])
-        if step <= 0 or step < SWING_STEP_FRACTION * steepest:
+        if step == 0 and max_stand:
+            j = k - 1
+            while j > 0 and delta[j - 1] == delta[k] and k - j < max_stand:
+                j -= 1
+            if j > 0 and k - j < max_stand and side * (delta[j] - delta[j - 1]) > 0:
+                k = j
+                continue
+        # A denoised rudder does not creep, and its steps are uneven (the dead band releases).
+        if step <= 0 or (not max_stand and step < SWING_STEP_FRACTION * steepest):
             break
         steepest = max(steepest, step)
         k -= 1
     return k
 
 
-def first_swing_index(delta: np.ndarray) -> int:
+def first_swing_index(delta: np.ndarray, max_stand: int = 0) -> int:
     """Start of the first swing that takes the rudder at least halfway from its initial angle to
-    its largest deflection from it (0 if the rudder never moves)."""
+    its largest deflection from it (0 if the rudder never moves); ``max_stand`` as
+    ``swing_start``'s."""
     dev = np.abs(delta - delta[0])
     if dev.max() <= 0:
         return 0
     k = int(np.argmax(dev >= EXECUTE_FRACTION * dev.max()))
-    return swing_start(delta, k, np.sign(delta[k] - delta[0]))
+    return swing_start(delta, k, np.sign(delta[k] - delta[0]), max_stand)
 
 
 def manoeuvre_end_time(log: pd.DataFrame, name: str = "log", execute: float | None = None) -> float:

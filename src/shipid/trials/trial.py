@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from shipid.data.rudder_signal import ramp_start, rise_rate, rudder_for_events, stand_samples
 from shipid.data.trim import EXECUTE_FRACTION, first_swing_index
 from shipid.errors import ShipidError
 
@@ -101,19 +102,34 @@ def runs_of(values: np.ndarray) -> list[tuple[int, int, float]]:
     return [(int(a), int(b), float(values[a])) for a, b in zip(starts, ends, strict=True)]
 
 
-def _plateau_orders(delta: np.ndarray, side: np.ndarray, i0: int) -> list[tuple[int, int]]:
-    """(order index, new side) of each rudder reversal after ``i0``: the last sample of the
-    previous plateau (within 0.5° of its extreme angle) before the rudder swung over."""
+def _plateau_orders(delta: np.ndarray, side: np.ndarray, i0: int, t: np.ndarray | None = None,
+                    raw: np.ndarray | None = None) -> list[tuple[int, int, float | None]]:  # fmt: skip
+    """(order index, new side, order time) of each rudder reversal after ``i0``: the last sample
+    of the previous plateau (within 0.5° of its extreme angle) before the rudder swung over
+    (time None: between it and the next). With the times ``t`` and the measured rudder ``raw``
+    (``delta`` denoised: its dead band leaves the plateau late), the time the swing's ramp,
+    extended back, leaves the plateau, and the last sample before it."""
     runs = [r for r in runs_of(side[i0:]) if r[2] != 0]
     orders = []
-    for (a0, b0, s0), (_, _, s1) in zip(runs[:-1], runs[1:], strict=True):
+    for (a0, b0, s0), (a1, b1, s1) in zip(runs[:-1], runs[1:], strict=True):
         if s1 == s0:
             continue
         seg = delta[i0 + a0 : i0 + b0 + 1]
         extreme = seg[np.argmax(s0 * seg)]
         near = np.flatnonzero(np.abs(seg - extreme) <= PLATEAU_TOLERANCE)
-        orders.append((i0 + a0 + int(near[-1]), int(s1)))
+        order, when = i0 + a0 + int(near[-1]), None
+        if t is not None:
+            end = i0 + a1 + int(np.argmax(s1 * delta[i0 + a1 : i0 + b1 + 1]))
+            level = float(np.median(raw[i0 + a0 + near]))
+            when = ramp_start(t, delta, order, end, level)
+            order = _before(t, when, order)
+        orders.append((order, int(s1), when))
     return orders
+
+
+def _before(t: np.ndarray, when: float, latest: int) -> int:
+    """The last sample at or before ``when``, no later than ``latest``."""
+    return max(0, min(latest, int(np.searchsorted(t, when, side="right")) - 1))
 
 
 def _rudder_rate(t: np.ndarray, delta: np.ndarray) -> float | None:
@@ -140,9 +156,14 @@ def describe_trial(
     if kind is not None and kind not in KINDS:
         raise ShipidError(f"manoeuvre kind must be one of {', '.join(KINDS)}, got {kind!r}")
     t = log["t"].to_numpy()
-    delta = log["delta"].to_numpy()
+    raw = log["delta"].to_numpy()
+    delta, rudder_noise = rudder_for_events(t, raw)
     if t_order is None:
-        i0 = first_swing_index(delta)
+        i0 = first_swing_index(delta, stand_samples(t) if rudder_noise else 0)
+        if rudder_noise:  # the dead band left the approach late: extend the ramp back
+            stood = np.flatnonzero(delta[: i0 + 1] != delta[i0])
+            level = float(np.median(raw[stood[-1] + 1 if stood.size else 0 : i0 + 1]))
+            i0 = _before(t, ramp_start(t, delta, i0, _swing_end(t, delta, i0), level), i0)
     else:
         i0 = min(int(np.searchsorted(t, t_order - 1e-9)), len(t) - 1)
     psi = unwrapped_heading(log)
@@ -156,47 +177,78 @@ def describe_trial(
     side = np.sign(dev)
     side[np.abs(dev) < max(EXECUTE_FRACTION * peak, math.radians(1.0))] = 0
     big = np.flatnonzero(side[i0:]) + i0
+    # A noisy rudder's event signal creeps up to the highest noise on a plateau: the level is
+    # the median of the measured rudder on it.
+    measured_dev = raw - neutral
     amplitudes = []
     for a, b, s in runs_of(side[i0:]):
         if s != 0:
-            amplitudes.append(float(np.max(s * dev[i0 + a : i0 + b + 1])))
+            run = slice(i0 + a, i0 + b + 1)
+            top = float(np.max(s * dev[run]))
+            if rudder_noise:
+                on_plateau = s * dev[run] >= top - PLATEAU_TOLERANCE
+                top = float(np.median(s * measured_dev[run][on_plateau]))
+            amplitudes.append(top)
     amplitude = float(np.median(amplitudes)) if amplitudes else 0.0
     first_rudder = float(side[big[0]] * amplitudes[0]) if amplitudes else 0.0
-    orders = _plateau_orders(delta, side, i0)
+    orders = _plateau_orders(delta, side, i0, *((t, raw) if rudder_noise else ()))
     switch = None
     if heading_deg is not None:
         switch = float(heading_deg)
     elif orders:
-        k = np.array([o for o, _ in orders])
-        # The order fell between the last plateau sample and the next one: take their midpoint.
+        k = np.array([o for o, _, _ in orders])
+        # The order fell between the last plateau sample and the next one: take their midpoint
+        # (the ramp's start on a denoised rudder, at the same half sample after it).
         at_order = 0.5 * (np.abs(dpsi[k]) + np.abs(dpsi[np.minimum(k + 1, len(dpsi) - 1)]))
+        if rudder_noise:
+            half = 0.5 * float(np.median(np.diff(t)))
+            at_order = np.abs(np.interp([w + half for _, _, w in orders], t, dpsi))
         switch = float(np.degrees(np.median(at_order)))
-    held_end = _held_end(delta, i0)
+    held_end = _held_end(t, delta, i0)
     swing = np.abs(delta - delta[0])
-    plateau_angle = float(np.median(np.abs(delta[swing > 0.8 * swing.max()]))) if swing.max() > 0 \
+    plateau_angle = float(np.median(np.abs(raw[swing > 0.8 * swing.max()]))) if swing.max() > 0 \
         else 0.0
     facts = dict(execute_index=i0, execute_time=float(t[i0]), psi0=psi0, neutral=neutral,
                  amplitude=amplitude, plateau_angle=plateau_angle, first_rudder=first_rudder,
                  switch_heading_deg=switch,
-                 rudder_rate=_rudder_rate(t, delta), held_end_index=held_end)  # fmt: skip
+                 rudder_rate=rise_rate(t, delta) if rudder_noise else _rudder_rate(t, delta),
+                 held_end_index=held_end)  # fmt: skip
     if kind is not None:
         return Trial(kind=kind, reason="given", **facts)
     found, reason = _classify(log, dpsi, dev, side, i0, held_end, amplitudes, orders)
     return Trial(kind=found, reason=reason, **facts)
 
 
-def _held_end(delta: np.ndarray, i0: int) -> int:
+def _held_end(t: np.ndarray, delta: np.ndarray, i0: int, stand_s: float = 1.0) -> int:
     """Last sample of the rudder held where the execute swing took it: the swing is followed to
-    where the rudder stops moving its way; held ends where the rudder leaves that angle by more
-    than 3° (or 15 % of the swing)."""
-    side = np.sign(delta[min(i0 + 1, len(delta) - 1)] - delta[i0]) or 1.0
-    k = i0
-    while k + 1 < len(delta) and side * (delta[k + 1] - delta[k]) > 0:
-        k += 1
+    where the rudder stops moving its way (a stand shorter than ``stand_s`` inside the swing, as
+    a noisy rudder's dead band makes, does not stop it); held ends where the rudder leaves that
+    angle by more than 3° (or 15 % of the swing)."""
+    k = _swing_end(t, delta, i0, stand_s)
     held = float(delta[k])
     tol = max(HELD_TOLERANCE, 0.15 * abs(held - delta[i0]))
     away = np.flatnonzero(np.abs(delta[k:] - held) > tol)
     return int(k + away[0] - 1) if away.size else len(delta) - 1
+
+
+def _swing_end(t: np.ndarray, delta: np.ndarray, i0: int, stand_s: float = 1.0) -> int:
+    """Where the swing from ``i0`` stops moving its way (a stand shorter than ``stand_s`` does
+    not stop it)."""
+    moves = np.flatnonzero(np.diff(delta[i0:])) + i0
+    side = np.sign(delta[moves[0] + 1] - delta[moves[0]]) if moves.size else 1.0
+    k = i0
+    while k + 1 < len(delta):
+        step = side * (delta[k + 1] - delta[k])
+        if step == 0:
+            j = int(np.searchsorted(moves, k))  # the next move after the stand
+            if j < moves.size and t[moves[j]] - t[k] < stand_s and \
+                    side * (delta[moves[j] + 1] - delta[k]) > 0:
+                k = int(moves[j])
+                continue
+        if step <= 0:
+            break
+        k += 1
+    return k
 
 
 def _classify(log, dpsi, dev, side, i0, held_end, amplitudes, orders) -> tuple[str, str]:
@@ -220,8 +272,8 @@ def _classify(log, dpsi, dev, side, i0, held_end, amplitudes, orders) -> tuple[s
                          " are not one zig-zag angle")  # fmt: skip
     if np.max(np.abs(dpsi[i0:])) > MAX_ZIGZAG_HEADING:
         return "other", "the heading leaves ±90° (not a zig-zag)"
-    k = np.array([o for o, _ in orders])
-    new_side = np.array([s for _, s in orders], dtype=float)
+    k = np.array([o for o, _, _ in orders])
+    new_side = np.array([s for _, s, _ in orders], dtype=float)
     at = dpsi[k]
     # Each reversal sends the ship back: the heading then lies on the side opposite to the new
     # rudder's turn; with either rudder convention sign(Δψ)·(new side) is the same at every order.
