@@ -25,6 +25,7 @@ from shipid.trials.trial import (
     Trial,
     cumulative_integral,
     describe_trial,
+    moving_average,
     unwrapped_heading,
 )
 
@@ -127,7 +128,7 @@ def travelled(log: pd.DataFrame) -> np.ndarray:
 
 # ---------------------------------------------------------------------------- events
 def smooth_heading(x: np.ndarray, t: np.ndarray, window_s: float) -> np.ndarray:
-    """Centred moving average over ``window_s`` seconds (cumulative sums: linear time)."""
+    """Centred moving average over ``window_s`` seconds (``moving_average``)."""
     if not (math.isfinite(window_s) and window_s >= 0):
         raise ShipidError(f"--smooth must be a finite number of seconds ≥ 0, got {window_s!r}")
     if window_s == 0:
@@ -136,11 +137,7 @@ def smooth_heading(x: np.ndarray, t: np.ndarray, window_s: float) -> np.ndarray:
     if window_s >= span:
         raise ShipidError(f"--smooth {window_s:g} s is not shorter than the log ({span:.4g} s)")
     n = max(1, int(round(window_s / np.median(np.diff(t)))))
-    if n < 2:
-        return x
-    pad = np.concatenate([np.full(n // 2, x[0]), x, np.full(n - 1 - n // 2, x[-1])])
-    c = np.concatenate([[0.0], np.cumsum(pad)])
-    return (c[n:] - c[:-n]) / n
+    return x if n < 2 else moving_average(x, n)
 
 
 def _crossings(y: np.ndarray, level: float) -> np.ndarray:

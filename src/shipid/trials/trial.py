@@ -109,10 +109,15 @@ def unwrapped_heading(log: pd.DataFrame) -> np.ndarray:
     n = max(1, int(round(HEADING_FUSION_S / float(np.median(np.diff(t))))))
     if n < 2 or n >= psi.size:
         return psi
-    offset = psi - integral
-    pad = np.concatenate([np.full(n // 2, offset[0]), offset, np.full(n - 1 - n // 2, offset[-1])])
+    return integral + moving_average(psi - integral, n)
+
+
+def moving_average(x: np.ndarray, n: int) -> np.ndarray:
+    """Centred moving average over ``n`` samples, the ends padded with the end values
+    (cumulative sums: linear time)."""
+    pad = np.concatenate([np.full(n // 2, x[0]), x, np.full(n - 1 - n // 2, x[-1])])
     c = np.concatenate([[0.0], np.cumsum(pad)])
-    return integral + (c[n:] - c[:-n]) / n
+    return (c[n:] - c[:-n]) / n
 
 
 def neutral_rudder(delta: np.ndarray) -> float:
