@@ -187,7 +187,7 @@ def test_cli_manoeuvre_says_not_bounded_when_replicates_diverge(tmp_path, capsys
     assert code == 0, err
     assert "(4 diverged" in out
     line = next(ln for ln in out.splitlines() if ln.startswith("tactical_diameter:"))
-    assert line.endswith("[not bounded]")
+    assert line.endswith("[not bounded: 4 of 20 bootstrap replicates have none: 4 diverged]")
 
 
 @pytest.mark.parametrize("kw", [

@@ -850,9 +850,11 @@ def cmd_criteria(args) -> int:
     table = crit.table.copy()
     ensemble = cond.get("ensemble")
     if ensemble is not None and not args.no_bands:
-        from shipid.trials.criteria import with_intervals
+        from shipid.trials.criteria import replicate_notes, with_intervals
 
-        table = with_intervals(crit, [run(m) for m in ensemble.members()])
+        replicates = [run(m) for m in ensemble.members()]
+        table = with_intervals(crit, replicates)
+        crit.notes += replicate_notes(table, replicates, ensemble.members_label)
     c = crit.conditions
     print(f"IMO MSC.137(76) criteria for {args.model}: L = {c['length']:g} m, V = {c['speed']:.4g} "
           f"m/s, λ = {c['scale']:g} (full-scale L/V = {c['L_over_V_full_scale']:.3g} s), " + (
@@ -862,8 +864,9 @@ def cmd_criteria(args) -> int:
     table["passed"] = table["passed"].map({True: "pass", False: "FAIL", None: "–"})
     print(table.to_markdown(index=False, floatfmt=".3g"))
     if "pass_share" in table:
-        print(f"lower, upper: 95 % interval of the value and pass_share: the share of passes "
-              f"over the model's {ensemble.replicates} {ensemble.members_label}")
+        print(f"lower, upper: 95 % interval of the value, pass_share: the share of passes, "
+              f"no_value: how many have none, over the model's {ensemble.replicates} "
+              f"{ensemble.members_label} (more than 2.5 % without a value: not bounded)")
     print("all criteria met" if crit.passed else "NOT all criteria met")
     for n in crit.notes:
         _warn(n)
@@ -1357,7 +1360,14 @@ def cmd_manoeuvre(args) -> int:
     """``shipid manoeuvre``: a standard manoeuvre on a model or vessel."""
     from shipid.evaluation.envelope import implausible_indices, outside_envelope
     from shipid.outputs import OutputSet, check_outputs
-    from shipid.trials.manoeuvres import pull_out, spiral, stopping, turning_circle, zigzag
+    from shipid.trials.manoeuvres import (
+        pull_out,
+        spiral,
+        stopping,
+        turning_circle,
+        without_value,
+        zigzag,
+    )
 
     check_outputs({"--json": (args.json, "json"), "-o": (args.output, "log")},
                   [args.model] if Path(args.model).exists() else [])  # fmt: skip
@@ -1418,6 +1428,7 @@ def cmd_manoeuvre(args) -> int:
     if args.kind == "turning" and not res.diverged:
         notes += implausible_indices(res.indices, speed or getattr(target, "approach_speed", None),
                                      getattr(target, "length", None))  # fmt: skip
+    unbounded = {}  # index: how many replicates have none, and why
     for k, v in res.indices.items():
         if k == "table":
             print(_pd().DataFrame(v).to_markdown(index=False, floatfmt=".4g"))
@@ -1425,7 +1436,9 @@ def cmd_manoeuvre(args) -> int:
         text = f"{k}: {v:.4g}" if isinstance(v, float) else f"{k}: {v}"
         lo, hi = intervals.get(k, (math.nan, math.nan))
         if math.isinf(lo) or math.isinf(hi):
-            text += "  [not bounded]"
+            missing, why = without_value(runs, [r.indices.get(k) for r in runs])
+            unbounded[k] = f"{missing} of {len(runs)} {ensemble.members_label} have none: {why}"
+            text += f"  [not bounded: {unbounded[k]}]"
         elif math.isfinite(lo):
             text += f"  [{lo:.4g}, {hi:.4g}]"
             if isinstance(v, float) and not lo <= v <= hi:
@@ -1441,6 +1454,7 @@ def cmd_manoeuvre(args) -> int:
                    "approach": {"speed": speed, "rps": rps},
                    "diverged_at": res.diverged_at, "reason": res.reason,
                    "indices": res.indices, "index_intervals": intervals or None,
+                   "index_not_bounded": unbounded or None,
                    "rudder_rate_deg_s": (math.degrees(gear.max_rate) if gear and gear.max_rate
                                          else None),
                    "warnings": notes}  # fmt: skip

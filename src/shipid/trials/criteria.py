@@ -28,7 +28,7 @@ from shipid.dynamics.equilibrium import unsteady_warning
 from shipid.dynamics.model import ManoeuvringModel
 from shipid.dynamics.steering import SteeringMachine
 from shipid.errors import ShipidError
-from shipid.trials.manoeuvres import stopping, turning_circle, zigzag
+from shipid.trials.manoeuvres import stopping, turning_circle, without_value, zigzag
 from shipid.vessels.vessel import Vessel
 
 SOLAS_RUDDER_RATE_DEG = 2.32
@@ -149,7 +149,7 @@ def imo_criteria(
     if getattr(dyn, "uses_rps", False) and rps:
         res = stopping(ship, rps, astern_rps, reversal_time=10.0 / math.sqrt(lam),
                        duration=3 * duration, dt=dt, speed=V, method=method)  # fmt: skip
-        runs["stopping"] = res
+        runs["full astern"] = res  # keyed as its row's manoeuvre
         rows.append(_row("stopping track reach", "full astern", _in_l(res.indices["track_reach"], L),
                          15.0, "L"))  # fmt: skip
     else:
@@ -176,7 +176,31 @@ def with_intervals(criteria: Criteria, replicates: Sequence[Criteria], level: fl
     table["lower"] = [b[0] for b in bounds]
     table["upper"] = [b[1] for b in bounds]
     table["pass_share"] = passed.mean(axis=0)
+    table["no_value"] = np.isnan(values).sum(axis=0)
     return table
+
+
+def replicate_notes(table: pd.DataFrame, replicates: Sequence[Criteria], label: str) -> list[str]:
+    """What the intervals of ``with_intervals``' ``table`` leave unsaid: for each criterion some
+    replicates have no value for, how many and why (diverged, or the event never reached; a share
+    above the tail leaves the interval not bounded), and the criteria whose verdict the
+    replicates split on (between 5 % and 95 % of them pass)."""
+    notes = []
+    n = len(replicates)
+    for i, row in table.iterrows():
+        if not row["no_value"]:
+            continue
+        runs = [c.runs.get(row["manoeuvre"]) for c in replicates]
+        _, text = without_value(runs, [c.table["value"].iloc[i] for c in replicates])
+        notes.append(f"{row['criterion']}, {row['manoeuvre']}: {int(row['no_value'])} of {n} "
+                     f"{label} have no value ({text})")  # fmt: skip
+    split = table[(table["pass_share"] > 0.05) & (table["pass_share"] < 0.95)]
+    if len(split):
+        rows = ", ".join(f"{r.criterion} ({r.manoeuvre}) {r.pass_share:.0%}"
+                         for r in split.itertuples())  # fmt: skip
+        notes.append(f"the {label} disagree on the verdict of {len(split)} criteria (share that "
+                     f"passes): {rows}")  # fmt: skip
+    return notes
 
 
 def _in_l(value, L: float) -> float | None:

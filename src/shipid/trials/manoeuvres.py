@@ -16,7 +16,8 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Mapping
+from collections import Counter
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -50,6 +51,22 @@ class ManoeuvreResult:
     diverged_at: float | None = None
     reason: str = ""
     incomplete: str = ""  # what the run did not reach (its indices need it), with the remedy
+
+
+def without_value(runs: Sequence[ManoeuvreResult | None], values: Sequence[float | None]
+                  ) -> tuple[int, str]:  # fmt: skip
+    """How many of ``runs`` (one manoeuvre on each replicate of a model) have no value among
+    ``values`` (an index of each), and why, most common first:
+    ``(11, "6 diverged; 5 the turn is not steady within 15360 s")``. An interval over replicates
+    is not bounded when more than its tail lack the value; this says whether they diverged or
+    never reached the event."""
+    reasons: Counter[str] = Counter()
+    for run, x in zip(runs, values, strict=True):
+        if run is not None and run.diverged:
+            reasons["diverged"] += 1
+        elif x is None or not math.isfinite(x):
+            reasons[run.incomplete if run is not None and run.incomplete else "no value"] += 1
+    return sum(reasons.values()), "; ".join(f"{n} {why}" for why, n in reasons.most_common())
 
 
 # Run lengths at model scale. A larger or slower ship takes longer (√λ at Froude scale: a full-scale
@@ -324,7 +341,12 @@ def zigzag(
         res.log.attrs["manoeuvre"] = f"zigzag {rudder_deg:g}/{heading_deg:g}, first {first}"
         res.indices = zigzag_indices(res.log, heading_deg, t_order=approach,
                                      length=_finite_or_none(vessel.length))  # fmt: skip
-        if res.indices.get("second_overshoot_deg") is None:
+        if res.indices.get("initial_turning_time") is None:
+            res.incomplete = f"the heading has not reached {heading_deg:g}° within {length:g} s"
+        elif res.indices.get("first_overshoot_deg") is None:
+            # The counter rudder never stops the turn: an unstable loop wider than the rudder.
+            res.incomplete = f"the counter rudder has not checked the yaw within {length:g} s"
+        elif res.indices.get("second_overshoot_deg") is None:
             res.incomplete = f"no second overshoot within {length:g} s"
         return res
 
