@@ -1,6 +1,9 @@
 """Cost of the physics in the fit (issue #10): identify with a prior, sign constraints, steady
-speed, the automatic prefilter and a bootstrap, against the plain fit on the same data in the same
-process, at 450, 4 500 and 45 000 samples (zig-zags of the paper's ship with its sensor noise).
+speed, straight-line stability, the automatic prefilter and a bootstrap, against the plain fit on
+the same data in the same process, at 450, 4 500 and 45 000 samples (zig-zags of the paper's ship
+with its sensor noise). The paper's ship is stable, so ``stable`` only checks its rows there; a
+second table fits a straight-line unstable ship, where the constraint holds (SLSQP and the exact
+polish).
 
 Run: .venv/bin/python benchmarks/bench_physics.py
 """
@@ -24,17 +27,17 @@ def main() -> None:
     ship = scale_ship(rudder_rate_deg=9.6)
     prior = {d: dict(c) for d, c in scale_ship_model().coefficients.items()}
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores\n")
-    print("| samples | plain identify (s) | prior | signs | signs + steady speed | "
+    print("| samples | plain identify (s) | prior | signs | signs + steady speed | stable | "
           "prefilter auto | bootstrap 100, identify per replicate | bootstrap 100, "
           "weighted_refit |")  # fmt: skip
-    print("|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|")
     for duration in (90, 900, 9000):
         log = PAPER_IMU.apply(zigzag(ship, 20, 20, duration=duration, dt=0.2, method="euler").log,
                               seed=1)  # fmt: skip
         log = lowpass(log, 0.5)
         plain = best_of(lambda lg=log: identify(lg))
         cases = [PhysicsOptions(prior=prior), PhysicsOptions(signs=True),
-                 PhysicsOptions(signs=True, steady_speed=True)]  # fmt: skip
+                 PhysicsOptions(signs=True, steady_speed=True), PhysicsOptions(stable=True)]
         times = [best_of(lambda lg=log, ph=ph: identify(lg, physics=ph)) for ph in cases]
         auto = best_of(lambda lg=log: choose_prefilter([lg], lambda ls: identify(ls).model), 1)
         boot = best_of(lambda lg=log: bootstrap([lg], lambda w: identify(lg, sample_weight=w).model,
@@ -42,6 +45,28 @@ def main() -> None:
         fast = best_of(lambda lg=log: bootstrap([lg], weighted_refit(lg), replicates=100), 1)
         cells = " | ".join(f"{t:.3f} ({t / plain:.1f}×)" for t in [*times, auto, boot, fast])
         print(f"| {len(log)} | {plain:.3f} | {cells} |")
+    unstable_ship()
+
+
+UNSTABLE = "u: |u|*u, 1; v: u*v, u*r, u^2*delta; r: u*v, u*r, |r|*r, u^2*delta"
+
+
+def unstable_ship() -> None:
+    """The constraint where it holds: a ship with an eigenvalue at +0.12 1/s (the tests' one)."""
+    from shipid.dynamics.model import ManoeuvringModel
+
+    ship = ManoeuvringModel(UNSTABLE, {
+        "u": {"|u|*u": -0.05, "1": 0.05},
+        "v": {"u*v": -0.6, "u*r": -0.3, "u^2*delta": 0.01},
+        "r": {"u*v": -1.5, "u*r": -0.5, "|r|*r": -5.0, "u^2*delta": -0.008}})  # fmt: skip
+    print("\n| samples (unstable ship) | plain identify (s) | stable, held |")
+    print("|---|---|---|")
+    for duration in (90, 900, 9000):
+        log = zigzag(ship, 20, 20, speed=1.0, duration=duration, dt=0.2, method="euler").log
+        plain = best_of(lambda lg=log: identify(lg, model=UNSTABLE, gamma=1e6))
+        held = best_of(lambda lg=log: identify(lg, model=UNSTABLE, gamma=1e6,
+                                               physics=PhysicsOptions(stable=True)))  # fmt: skip
+        print(f"| {len(log)} | {plain:.3f} | {held:.3f} ({held / plain:.1f}×) |")
 
 
 if __name__ == "__main__":

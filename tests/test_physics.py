@@ -237,7 +237,7 @@ def test_cli_prior_constraints_and_bounds(tmp_path, capsys, short_zigzag):
     for argv, message in [
         (["--bound", "r: u*r < 0"], "--bound expects"),
         (["--prior", "clarke"], "needs the ship's particulars"),
-        (["--constraints", "signs,stable"], "unknown 'stable'"),
+        (["--constraints", "signs,stiff"], "unknown 'stiff'"),
         (["--bound", "r: u*r >= 1", "--constraints", "signs"], "constraints conflict"),
     ]:
         code, _, err = run(["identify", log, "-o", tmp_path / "x.json", *argv], capsys)

@@ -235,7 +235,7 @@ def _physics(args, logs, structure):
     """PhysicsOptions of --prior, --constraints, --bound (None when none is given)."""
     from shipid.identification.physics import PhysicsOptions, parse_constraints, rudder_sign
 
-    signs, steady = parse_constraints(args.constraints)
+    signs, steady, stable = parse_constraints(args.constraints)
     bounds = _parse_bounds(args.bound)
     prior = None
     if args.prior == "clarke":
@@ -255,7 +255,8 @@ def _physics(args, logs, structure):
         from shipid.reporting.modelfile import load_model
 
         prior = prior_from_model(load_model(args.prior))
-    options = PhysicsOptions(prior=prior, signs=signs, bounds=bounds or None, steady_speed=steady)
+    options = PhysicsOptions(prior=prior, signs=signs, bounds=bounds or None, steady_speed=steady,
+                             stable=stable)
     return options if options.active else None
 
 
@@ -1526,7 +1527,9 @@ def _add_physics_options(p) -> None:
                    "and rudder terms from the particulars, Clarke et al. 1983) or a model file")
     g.add_argument("--constraints", metavar="LIST",
                    help="comma list: signs (damping, resistance, thrust and rudder terms keep "
-                   "their physical sign), steady-speed (u̇ = 0 on the approach)")
+                   "their physical sign), steady-speed (u̇ = 0 on the approach), stable "
+                   "(straight-line stability at the approach: the yaw equation given the "
+                   "sway one)")
     g.add_argument("--bound", action="append", metavar="'DOF: TERM <= X'",
                    help="a bound on one coefficient, e.g. 'r: u*r <= 0' (repeatable)")
 

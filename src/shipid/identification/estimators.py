@@ -55,7 +55,7 @@ def fit_linear(X: np.ndarray, y: np.ndarray, estimator="lssvm", gamma: float = 1
         A, B = accumulate_normal_equations([(X, y[:, None], w)], X.shape[1], 1)
         coef, bias, physics.active = solve_primal_constrained(
             A, B[:, 0], gamma if estimator == "lssvm" else math.inf, physics.prior,
-            physics.lower, physics.upper, physics.equalities)
+            physics.lower, physics.upper, physics.equalities, physics.inequalities)
         return coef, bias
     fit_kw = {} if sample_weight is None else {"sample_weight": sample_weight}
     if not isinstance(estimator, str):
@@ -106,6 +106,7 @@ def fit_linear(X: np.ndarray, y: np.ndarray, estimator="lssvm", gamma: float = 1
 
 def _changes_fit(physics) -> bool:
     return (physics.prior is not None or physics.equalities is not None
+            or physics.inequalities is not None
             or bool(np.isfinite(physics.lower).any() or np.isfinite(physics.upper).any()))
 
 

@@ -22,7 +22,12 @@ from shipid.dynamics.terms import parse_term, term_matrix
 from shipid.errors import ShipidError
 from shipid.evaluation.envelope import envelope
 from shipid.identification.estimators import check_estimator_name, fit_linear
-from shipid.identification.physics import PhysicsOptions, dof_physics
+from shipid.identification.physics import (
+    PhysicsOptions,
+    dof_physics,
+    stability_note,
+    with_stability,
+)
 from shipid.identification.regression import FORMS, RegressionProblem, regression_problem
 from shipid.lssvm.solvers import NumericalWarning
 
@@ -275,9 +280,10 @@ def weighted_refit(
         weights = _check_weights(weights, problems)
         terms, coefs = {}, {}
         for dof, p in problems.items():
+            extra = with_stability(extras[dof], physics, dof, p.names, p.fixed, coefs, logs)
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", NumericalWarning)  # the point fit reports them
-                g, b = fit_linear(p.X, p.y, estimator, gamma, weights, physics=extras[dof])
+                g, b = fit_linear(p.X, p.y, estimator, gamma, weights, physics=extra)
             terms[dof], coefs[dof], _ = _dof_coefficients(dof, p, g, b, form, fixed.get(dof),
                                                           structure)  # fmt: skip
         return ManoeuvringModel(ModelStructure(structure.name, terms), coefs,
@@ -330,11 +336,13 @@ def identify(
     dt = math.nan
     for dof, p in problems.items():
         dt = p.dt
-        extra = dof_physics(physics, dof, p.names, p.has_constant, p.fixed, logs)
+        extra = with_stability(dof_physics(physics, dof, p.names, p.has_constant, p.fixed, logs),
+                               physics, dof, p.names, p.fixed, coefs, logs)  # fmt: skip
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", NumericalWarning)
             g, b = fit_linear(p.X, p.y, estimator, gamma, sample_weight, physics=extra)
         diagnostics[dof], dof_notes = _diagnose(p, g, b, gamma)
+        notes += stability_note(extra, g, b)
         held = [] if extra.active is None else [n for n, a in zip(p.names, extra.active,
                                                                    strict=True) if a]  # fmt: skip
         diagnostics[dof]["at_bound"] = held

@@ -1,9 +1,21 @@
 """What physics adds to the regression (issue #10): a prior model the LS-SVM is drawn toward,
-sign constraints on damping and rudder terms, user bounds, and steady speed on the approaches.
+sign constraints on damping and rudder terms, user bounds, steady speed on the approaches and
+straight-line stability.
 
 All act on the continuous-time coefficients of the increment form (the default), inside the
 solver (``shipid.lssvm.solvers.solve_primal_constrained``): bounds by bounded least squares, the
-steady-speed conditions as linear equalities. Nothing is clipped after the fit.
+steady-speed conditions as linear equalities, stability as linear inequalities. Nothing is
+clipped after the fit.
+
+Straight-line stability (``stable``): the sway–yaw block A = [[a11, a12], [a21, a22]] of the
+model linearised about straight running (u0, v = r = 0, rudder amidships, still air) at each
+training log's approach has eigenvalues with real parts ≤ 0 iff tr A ≤ 0 and det A ≥ 0. The
+equations are fitted one after the other, so the yaw equation is fitted given the sway one:
+a11 = ∂v̇/∂v and a12 = ∂v̇/∂r are then numbers, a21 = ∂ṙ/∂v and a22 = ∂ṙ/∂r linear in the yaw
+coefficients, and both conditions are linear inequalities on them (with a margin μ:
+real parts ≤ −μ ⇔ tr A ≤ −2μ and det A + μ tr A + μ² ≥ 0). A ship the logs show unstable is
+then fitted barely stable, which is a choice, not a finding: full-form ships (the KVLCC2's MMG
+model) can be slightly unstable.
 
 Sign table (``SIGN_RULES``; accelerations in the body frame, forward speed u > 0, "rudder sign"
 s = +1 when a positive rudder angle turns the ship to starboard, −1 when to port):
@@ -21,6 +33,7 @@ they are left out, with a note. Terms not in the table are free.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -51,7 +64,11 @@ SIGN_RULES: tuple[tuple[str, frozenset[str], object, str], ...] = (
     ("r", _RUDDER_TERMS, RUDDER, "the rudder turns the ship its way"),
     ("v", _RUDDER_TERMS, "-" + RUDDER, "the rudder pushes the stern the other way"),
 )
-CONSTRAINTS = ("signs", "steady-speed")
+CONSTRAINTS = ("signs", "steady-speed", "stable")
+# ``stable``: the sway–yaw eigenvalues' real parts at most −μ, μ this share of the sway damping
+# rate |∂v̇/∂v| (a scale the model itself sets): held at the limit, the slowest mode still decays,
+# slowly, also about a steady approach a little off the log's start.
+STABILITY_MARGIN = 0.05
 
 
 @dataclass(frozen=True)
@@ -67,6 +84,8 @@ class PhysicsOptions:
     bounds : {dof: {term: (lower, upper)}} further bounds (use ±inf for one-sided).
     steady_speed : u̇ = 0 on the straight approach (u0, n0, rudder amidships, no wind) of every
         training log: the surge equation reproduces the speed each propeller speed holds.
+    stable : straight-line stability at every training log's approach (the yaw equation given
+        the sway one; see the module's notes).
     approach : {"u": u0, "n": n0}: the one approach for ``steady_speed`` (default: each
         training log's start).
     rudder_positive : 'port' or 'starboard' (default: the logs' metadata).
@@ -78,11 +97,12 @@ class PhysicsOptions:
     steady_speed: bool = False
     approach: Mapping[str, float] | None = None
     rudder_positive: str | None = None
+    stable: bool = False
 
     @property
     def active(self) -> bool:
         """Whether the options change the plain fit."""
-        return bool(self.prior or self.signs or self.bounds or self.steady_speed)
+        return bool(self.prior or self.signs or self.bounds or self.steady_speed or self.stable)
 
     def describe(self) -> dict:
         """A JSON-safe record for the model file."""
@@ -91,19 +111,19 @@ class PhysicsOptions:
                 "bounds": {d: {t: list(b) for t, b in v.items()}
                            for d, v in (self.bounds or {}).items()},
                 "approach": dict(self.approach or {}),
-                "rudder_positive": self.rudder_positive}  # fmt: skip
+                "rudder_positive": self.rudder_positive, "stable": self.stable}  # fmt: skip
 
 
-def parse_constraints(text: str | None) -> tuple[bool, bool]:
-    """(signs, steady_speed) from a comma list such as ``signs,steady-speed``."""
+def parse_constraints(text: str | None) -> tuple[bool, bool, bool]:
+    """(signs, steady_speed, stable) from a comma list such as ``signs,steady-speed``."""
     if not text:
-        return False, False
+        return False, False, False
     items = [t.strip() for t in text.split(",") if t.strip()]
     unknown = [t for t in items if t not in CONSTRAINTS]
     if unknown:
         raise ShipidError(f"--constraints: unknown {', '.join(map(repr, unknown))}; use a comma "
                           f"list of {', '.join(CONSTRAINTS)}")  # fmt: skip
-    return "signs" in items, "steady-speed" in items
+    return "signs" in items, "steady-speed" in items, "stable" in items
 
 
 @dataclass
@@ -114,6 +134,7 @@ class DofPhysics:
     lower: np.ndarray
     upper: np.ndarray
     equalities: tuple[np.ndarray, np.ndarray] | None = None  # (E over [ω; b], f)
+    inequalities: tuple[np.ndarray, np.ndarray] | None = None  # (G over [ω; b], h): G z ≥ h
     approaches: list[tuple[float, float]] = field(default_factory=list)  # (u0, n0) of the above
     reasons: dict[str, str] = field(default_factory=dict)  # term → why it is bounded
     notes: list[str] = field(default_factory=list)
@@ -144,6 +165,67 @@ def _sign_bounds(dof: str, term: str, s: float | None) -> tuple[float, float, st
     return None
 
 
+def _approach_states(options: PhysicsOptions, logs: Sequence[pd.DataFrame], what: str
+                     ) -> list[tuple[float, float]]:  # fmt: skip
+    """(u0, n0) of every training log's start (or ``options.approach``)."""
+    if options.approach:
+        states = [(float(options.approach["u"]), float(options.approach.get("n", 0.0)))]
+    else:
+        states = sorted({(float(log["u"].iloc[0]),
+                          float(log["n"].iloc[0]) if "n" in log.columns else 0.0) for log in logs})
+    if not all(u0 > 0 for u0, _ in states):
+        raise ShipidError(f"{what} constraint: a training log starts without headway; trim it to "
+                          "the approach (--start) or give the approach with --speed")  # fmt: skip
+    return states
+
+
+def _straight_running_slopes(texts: Sequence[str], u0: float, n0: float) -> np.ndarray:
+    """(2, len(texts)): ∂/∂v and ∂/∂r of each term at straight running (u0, v = r = 0, rudder
+    amidships, propeller n0, still air: the apparent wind of the ship's own motion).
+
+    Central differences at steps h and 2h, combined (2 D(h) − D(2h)) so that the kink of a
+    modulus term at 0 (|v|v, |r|r: slope 0, but h from a central difference) counts nothing: a
+    fit would otherwise buy stability with an |r|r coefficient of 10⁶."""
+
+    def central(h: float) -> np.ndarray:
+        out = np.zeros((2, len(texts)))
+        for i, (dv, dr) in enumerate(((h, 0.0), (0.0, h))):
+            cols = []
+            for sign in (1.0, -1.0):
+                u, v, r = np.array([u0]), np.array([sign * dv]), np.array([sign * dr])
+                given = {"delta": np.zeros(1), "n": np.array([n0]), "wind_speed": np.hypot(u, v),
+                         "wind_angle": np.arctan2(v, u)}  # fmt: skip
+                cols.append(term_matrix(list(texts), u, v, r, given)[0])
+            out[i] = (cols[0] - cols[1]) / (2 * h)
+        return out
+
+    h = 1e-6 * max(abs(u0), 1.0)
+    return 2.0 * central(h) - central(2.0 * h)
+
+
+def stability_rows(options: PhysicsOptions, sway: Mapping[str, float], names: Sequence[str],
+                   fixed: Mapping[str, float], logs: Sequence[pd.DataFrame],
+                   ) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """Straight-line stability of the yaw equation given the fitted sway equation ``sway``
+    ({term: coefficient}): rows G over [free yaw terms ``names``; bias] and h with G z ≥ h for
+    tr A ≤ 0 and det A ≥ 0 at each approach (``fixed`` yaw terms count as known)."""
+    sway_terms = [t for t in sway if t != "1"]
+    sway_coef = np.array([sway[t] for t in sway_terms])
+    rows, rhs = [], []
+    for u0, n0 in _approach_states(options, logs, "stable"):
+        a11, a12 = _straight_running_slopes(sway_terms, u0, n0) @ sway_coef
+        g21, g22 = _straight_running_slopes(names, u0, n0)
+        f21, f22 = (_straight_running_slopes(list(fixed), u0, n0) @ np.array(list(fixed.values()))
+                    if fixed else (0.0, 0.0))  # fmt: skip
+        # Both eigenvalues' real parts ≤ −μ ⇔ tr A ≤ −2μ and det A + μ tr A + μ² ≥ 0, with
+        # tr A = a11 + g22·θ + f22 and det A = a11 (g22·θ + f22) − a12 (g21·θ + f21).
+        mu = STABILITY_MARGIN * abs(a11)
+        rows += [np.append(-g22, 0.0), np.append((a11 + mu) * g22 - a12 * g21, 0.0)]
+        rhs += [a11 + f22 + 2 * mu,
+                -((a11 + mu) * f22 - a12 * f21) - mu * a11 - mu * mu]
+    return np.array(rows), np.array(rhs)
+
+
 def _approach_rows(dof_terms: Sequence[str], fixed: Mapping[str, float], has_constant: bool,
                    options: PhysicsOptions, logs: Sequence[pd.DataFrame],
                    ) -> tuple[np.ndarray, np.ndarray, list]:  # fmt: skip
@@ -155,14 +237,7 @@ def _approach_rows(dof_terms: Sequence[str], fixed: Mapping[str, float], has_con
         raise ShipidError("steady-speed constraint: the surge equation has a thrust term, whose "
                           "value on the approach is not known; identify with propeller-speed "
                           "(n) terms")  # fmt: skip
-    if options.approach:
-        states = [(float(options.approach["u"]), float(options.approach.get("n", 0.0)))]
-    else:
-        states = sorted({(float(log["u"].iloc[0]),
-                          float(log["n"].iloc[0]) if "n" in log.columns else 0.0) for log in logs})
-    if not all(u0 > 0 for u0, _ in states):
-        raise ShipidError("steady-speed constraint: a training log starts without headway; trim "
-                          "it to the approach (--start) or give the approach with --speed")  # fmt: skip
+    states = _approach_states(options, logs, "steady-speed")
     u0 = np.array([s[0] for s in states])
     n0 = np.array([s[1] for s in states])
     zero = np.zeros(len(states))
@@ -221,3 +296,36 @@ def dof_physics(options: PhysicsOptions | None, dof: str, names: Sequence[str], 
         where = ", ".join(f"{a:.4g} m/s at {b:.4g} rps" for a, b in out.approaches)
         out.notes.append(f"u: steady speed imposed on the approach ({where})")
     return out
+
+
+def with_stability(extra: DofPhysics, options: PhysicsOptions | None, dof: str,
+                   names: Sequence[str], fixed: Mapping[str, float],
+                   fitted: Mapping[str, Mapping[str, float]], logs: Sequence[pd.DataFrame],
+                   ) -> DofPhysics:  # fmt: skip
+    """``extra`` with the straight-line stability rows of the yaw equation (``options.stable``,
+    ``dof`` 'r', free terms ``names``, ``fixed`` ones), given the sway equation already in
+    ``fitted`` ({dof: {term: coefficient}}); ``extra`` itself otherwise. A copy: the
+    bootstrap's refits reuse ``extra``."""
+    if options is None or not options.stable or dof != "r":
+        return extra
+    if "v" not in fitted:
+        raise ShipidError("stable constraint: straight-line stability needs the sway equation "
+                          "(v) fitted with the yaw one")  # fmt: skip
+    G, h = stability_rows(options, fitted["v"], names, fixed, logs)
+    return dataclasses.replace(extra, inequalities=(G, h))
+
+
+def stability_note(extra: DofPhysics, coef: np.ndarray, bias: float) -> list[str]:
+    """What the stability rows of ``extra`` did to the fit (coef, bias): a note when they hold
+    (the fit without them is unstable), none when the fit meets them freely."""
+    if extra.inequalities is None:
+        return []
+    G, h = extra.inequalities
+    z = np.append(coef, bias)
+    scale = np.abs(G) @ np.abs(z) + np.abs(h) + 1e-300
+    if np.all(G @ z - h > 1e-6 * scale):
+        return []
+    return ["r: the fit without the stability constraint is straight-line unstable at the "
+            "approach; the yaw equation is held at its limit, given the sway equation (the "
+            f"slowest sway–yaw mode decays at {STABILITY_MARGIN:.0%} of the sway damping rate "
+            "|∂v̇/∂v|: barely stable)"]

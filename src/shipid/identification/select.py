@@ -51,7 +51,7 @@ from shipid.dynamics.terms import INPUT_SIGNALS, parse_term, term_code
 from shipid.errors import ShipidError
 from shipid.evaluation.error_band import ErrorBand, error_band
 from shipid.identification.estimators import LINEAR_ESTIMATORS, check_estimator_name, fit_linear
-from shipid.identification.physics import PhysicsOptions, dof_physics
+from shipid.identification.physics import PhysicsOptions, dof_physics, with_stability
 from shipid.identification.regression import common_sampling_time, log_terms
 from shipid.lssvm.solvers import solve_primal_constrained
 
@@ -303,13 +303,16 @@ def _fit_theta(data: _Data, terms: Mapping[str, Sequence[str]], gamma: float, tr
         cols = [index[t] for t in names]
         has_const = "1" in terms[dof]
         extra = dof_physics(physics, dof, names, has_const, {}, data.logs)
+        if physics is not None and physics.stable and dof == "r" and "v" in terms:
+            sway = {t: float(theta[1, T if t == "1" else index[t]]) for t in terms["v"]}
+            extra = with_stability(extra, physics, dof, names, {}, {"v": sway}, data.logs)
         if estimator in ("lssvm", "ols"):
             sel = cols + [T]
             A = sum(data.gram[j][np.ix_(sel, sel)] for j in train)
             b = sum(data.cross[j][dof][sel] for j in train)
             w, bias, _ = solve_primal_constrained(
                 A, b, gamma if estimator == "lssvm" else math.inf, extra.prior, extra.lower,
-                extra.upper, extra.equalities)
+                extra.upper, extra.equalities, extra.inequalities)
         else:
             X = np.vstack([data.phi[j][:, cols] for j in train])
             y = np.concatenate([data.targets[j][dof] for j in train])

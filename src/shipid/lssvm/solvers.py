@@ -23,6 +23,7 @@ import numpy as np
 from scipy import linalg
 from threadpoolctl import threadpool_limits
 
+from shipid.errors import ShipidError
 from shipid.limits import available_memory_bytes
 
 # SciPy's bundled OpenBLAS has crashed in a threaded Cholesky on 16 000 × 16 000 matrices on the
@@ -169,8 +170,10 @@ def solve_primal_constrained(
     lower: np.ndarray | None = None,
     upper: np.ndarray | None = None,
     equalities: tuple[np.ndarray, np.ndarray] | None = None,
+    inequalities: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> tuple[np.ndarray, float, np.ndarray]:
-    """One output of the primal LS-SVM with physics: a prior, bounds and linear equalities.
+    """One output of the primal LS-SVM with physics: a prior, bounds, linear equalities and
+    linear inequalities.
 
     Solves ``min ½‖ω − ω₀‖² + ½ Σ γ wᵢ eᵢ²`` (the LS-SVM regularisation drawn toward the prior
     ω₀ instead of 0) subject to ``lower ≤ ω ≤ upper`` and ``E [ω; b] = f`` (e.g. the fitted
@@ -182,6 +185,10 @@ def solve_primal_constrained(
         (p+1, p+1) and b (p+1,); the last row is the bias.
     gamma : γ > 0; ``math.inf`` for least squares (no regularisation, the prior unused).
     equalities : (E (k, p+1), f (k,)), the last column of E multiplying the bias.
+    inequalities : (G (m, p+1), h (m,)) for ``G [ω; b] ≥ h`` (e.g. straight-line stability of
+        the yaw equation given the sway one). Where the solution without them meets them it is
+        returned as is; else the quadratic program with them is solved by SciPy's SLSQP from that
+        solution and solved exactly again with the inequalities and bounds it holds as equalities.
 
     Returns
     -------
@@ -194,8 +201,28 @@ def solve_primal_constrained(
     ``EQUALITY_PENALTY``), then solved exactly again with the bounds it found active held as
     equalities (kept if it stays within the other bounds).
     """
-    from scipy.optimize import lsq_linear
+    x, bias, active = _solve_boxed(A, b, gamma, prior, lower, upper, equalities)
+    if inequalities is None:
+        return x, bias, active
+    G = np.atleast_2d(np.asarray(inequalities[0], dtype=float))
+    h = np.atleast_1d(np.asarray(inequalities[1], dtype=float))
+    if np.all(G @ np.append(x, bias) >= h - INEQUALITY_TOLERANCE * _row_scale(G, x, bias, h)):
+        return x, bias, active
+    return _solve_with_inequalities(A, b, gamma, prior, lower, upper, equalities, G, h,
+                                    np.append(x, bias))
 
+
+def _row_scale(G: np.ndarray, x: np.ndarray, bias: float, h: np.ndarray) -> np.ndarray:
+    """The size each inequality row is judged against: |G||[x; b]| + |h| (relative tolerance)."""
+    return np.abs(G) @ np.abs(np.append(x, bias)) + np.abs(h) + 1e-300
+
+
+# An inequality met to this share of its terms' size counts as met (and as active when solved).
+INEQUALITY_TOLERANCE = 1e-9
+
+
+def _objective_terms(A, b, gamma, prior):
+    """M, c of the quadratic ½ zᵀ M z − cᵀ z over [ω; b] that the LS-SVM with a prior minimises."""
     p = A.shape[0] - 1
     M = A.astype(float).copy()
     c = np.asarray(b, dtype=float).reshape(-1).copy()
@@ -203,6 +230,68 @@ def solve_primal_constrained(
         M[np.arange(p), np.arange(p)] += 1.0 / gamma
         if prior is not None:
             c[:p] += np.asarray(prior, dtype=float) / gamma
+    return M, c
+
+
+def _solve_with_inequalities(A, b, gamma, prior, lower, upper, equalities, G, h, start):
+    """The quadratic program of ``solve_primal_constrained`` with ``G z ≥ h`` (SLSQP on the
+    equilibrated problem, from ``start``), then solved exactly with what it holds active."""
+    from scipy.optimize import minimize
+
+    p = A.shape[0] - 1
+    M, c = _objective_terms(A, b, gamma, prior)
+    d = 1.0 / np.sqrt(np.maximum(np.diag(M), 1e-300))
+    Ms, cs = M * d[:, None] * d[None, :], c * d
+    lo = np.append(np.full(p, -np.inf) if lower is None else np.asarray(lower, dtype=float), -np.inf)
+    hi = np.append(np.full(p, np.inf) if upper is None else np.asarray(upper, dtype=float), np.inf)
+    Gs = G * d[None, :]
+    norms = np.linalg.norm(Gs, axis=1)
+    norms[norms == 0] = 1.0
+    Gs, hs = Gs / norms[:, None], h / norms
+    cons = [{"type": "ineq", "fun": lambda z: Gs @ z - hs, "jac": lambda z: Gs}]
+    if equalities is not None:
+        E = np.atleast_2d(np.asarray(equalities[0], dtype=float)) * d[None, :]
+        f = np.atleast_1d(np.asarray(equalities[1], dtype=float))
+        cons.append({"type": "eq", "fun": lambda z: E @ z - f, "jac": lambda z: E})
+    res = minimize(lambda z: 0.5 * z @ Ms @ z - cs @ z, start / d, jac=lambda z: Ms @ z - cs,
+                   bounds=list(zip(lo / d, hi / d, strict=True)), constraints=cons,
+                   method="SLSQP", options={"ftol": 1e-15, "maxiter": 500})  # fmt: skip
+    z = res.x
+    slack = Gs @ z - hs
+    # SLSQP can report success on an infeasible set: judge the point itself (unit rows).
+    if np.any(slack < -1e-6):
+        raise ShipidError("constraints conflict: the inequalities (straight-line stability) "
+                          "cannot be met within the bounds and equalities (signs, --bound, "
+                          f"steady-speed): {res.message}")  # fmt: skip
+    # Polish: the rows and bounds SLSQP holds, as equalities of the exact problem.
+    held = np.abs(slack) <= 1e-7
+    lo_s, hi_s = lo / d, hi / d
+    at_lo, at_hi = np.isfinite(lo_s), np.isfinite(hi_s)
+    at_lo[at_lo] = z[at_lo] <= lo_s[at_lo] + 1e-9 * (1 + np.abs(lo_s[at_lo]))
+    at_hi[at_hi] = z[at_hi] >= hi_s[at_hi] - 1e-9 * (1 + np.abs(hi_s[at_hi]))
+    extra_E = [Gs[held]] + [np.eye(p + 1)[at_lo | at_hi]]
+    extra_f = [hs[held], np.where(at_lo, lo_s, hi_s)[at_lo | at_hi]]
+    if equalities is not None:
+        extra_E.insert(0, E)
+        extra_f.insert(0, f)
+    C, g = np.vstack(extra_E), np.concatenate(extra_f)
+    if len(g):
+        K = np.block([[Ms, C.T], [C, np.zeros((len(g), len(g)))]])
+        exact = linalg.lstsq(K, np.concatenate([cs, g]), check_finite=False)[0][: p + 1]
+        feasible = (np.all(Gs @ exact - hs >= -1e-9) and np.all(exact >= lo_s - 1e-9)
+                    and np.all(exact <= hi_s + 1e-9))  # fmt: skip
+        if feasible:
+            z = exact
+    x = z * d
+    return x[:p], float(x[p]), (at_lo | at_hi)[:p]
+
+
+def _solve_boxed(A, b, gamma, prior, lower, upper, equalities):
+    """``solve_primal_constrained`` without inequalities."""
+    from scipy.optimize import lsq_linear
+
+    p = A.shape[0] - 1
+    M, c = _objective_terms(A, b, gamma, prior)
     lo = np.append(np.full(p, -np.inf) if lower is None else np.asarray(lower, dtype=float), -np.inf)
     hi = np.append(np.full(p, np.inf) if upper is None else np.asarray(upper, dtype=float), np.inf)
     d = 1.0 / np.sqrt(np.maximum(np.diag(M), 1e-300))
