@@ -469,3 +469,14 @@ def test_every_manoeuvre_runs_on_a_model_file(files, tmp_path, capsys, kind):
         want = [row["steady_yaw_rate"] for row in api.indices["table"]]
         assert got == pytest.approx(want, abs=1e-12)
         assert doc["rudder_rate_deg_s"] == pytest.approx(math.degrees(prep["rudder_rate"]))
+
+
+def test_a_log_sampled_coarser_than_the_models_step_is_named(files, capsys):
+    # The free runs step at the log's sampling: at 2.5 Δk the paper ship's closed-loop 10/10
+    # second overshoot moved from 10.8° to 13.4° without a word.
+    log, model = files
+    code, _, err = run(["validate", model, log, "--dt", "0.5"], capsys)
+    assert code == 0, err
+    assert "2.5 times the model's Δk (0.2 s)" in err and "give --dt 0.2" in err
+    code, _, err = run(["validate", model, log, "--dt", "0.25"], capsys)
+    assert code == 0 and "the model's Δk" not in err, err

@@ -404,7 +404,8 @@ def training_conditions(doc: Mapping) -> dict:
     out = {"speed": prep.get("approach_speed"), "rps": prep.get("approach_rps"),
            "envelope": ident.get("envelope") or {}, "particulars": None,
            "rudder_rate": prep.get("rudder_rate"), "log_scale": prep.get("log_scale"),
-           "rudder_positive": prep.get("rudder_positive")}  # fmt: skip
+           "rudder_positive": prep.get("rudder_positive"),
+           "dt": ident.get("dt") if isinstance(ident.get("dt"), int | float) else None}  # fmt: skip
     if doc.get("particulars"):
         from shipid.data.particulars import Particulars
 
