@@ -71,3 +71,27 @@ def test_the_cli_names_the_swap_and_columns_mends_it(runs, tmp_path, capsys):
     code, truth, err = run(["indices", good], capsys)
     assert code == 0, err
     assert mended.splitlines()[1:] == truth.splitlines()[1:]  # the same indices
+
+
+@pytest.mark.parametrize("seed", [None, 0])
+@pytest.mark.parametrize("column, factor, named", [
+    ("uv", 1 / 0.514444, "u, v look like knots"),
+    ("uv", 3.6, "u, v look like km/h"),
+    ("xy", 1 / 0.3048, "x, y look like feet"),
+])  # fmt: skip
+def test_a_track_in_other_units_is_named(runs, seed, column, factor, named):
+    log = runs["turn"] if seed is None else PAPER_IMU.apply(runs["turn"], seed=seed)
+    bad = log.copy()
+    for c in ("u", "v") if column == "uv" else ("x", "y"):
+        bad[c] = log[c] * factor
+    with pytest.raises(ShipidError, match=named):
+        check_units(bad, "trial.csv")
+
+
+def test_a_track_of_unknown_scale_is_a_warning(runs):
+    from shipid.errors import ShipidWarning
+
+    bad = runs["zigzag"].copy()
+    bad["u"], bad["v"] = 1.5 * bad["u"], 1.5 * bad["v"]
+    with pytest.warns(ShipidWarning, match=r"moves 0\.6\d+ times as far as u, v say"):
+        check_units(bad, "trial.csv")

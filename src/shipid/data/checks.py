@@ -157,36 +157,77 @@ def check_units(df: pd.DataFrame, name: str, degrees=()) -> None:
             _check_track_against_velocities(df, name)
 
 
+def _displacements(t, x, y, psi, u, v, window_s: float, sway_sign: float = 1.0,
+                   east_first: bool = False) -> tuple[np.ndarray, np.ndarray] | None:
+    """The track's displacements over ``window_s`` (north and east stacked) and those of u, v
+    turned by ψ and integrated, each less its mean (a current), under a convention; None when
+    the log is shorter than a few windows."""
+    h = np.diff(t)
+    k = int(round(window_s / float(np.median(h)))) if h.size else 0
+    if k < 1 or len(t) < k + 10:
+        return None
+    north, east = (y, x) if east_first else (x, y)
+    c, s = np.cos(psi), np.sin(psi)
+    sway = sway_sign * v
+    measured_out, predicted_out = [], []
+    for measured, rate in ((north, u * c - sway * s), (east, u * s + sway * c)):
+        integral = np.concatenate([[0.0], np.cumsum(0.5 * (rate[1:] + rate[:-1]) * h)])
+        dm, dp = measured[k:] - measured[:-k], integral[k:] - integral[:-k]
+        measured_out.append(dm - dm.mean())
+        predicted_out.append(dp - dp.mean())
+    return np.concatenate(measured_out), np.concatenate(predicted_out)
+
+
 def track_errors(t: np.ndarray, x: np.ndarray, y: np.ndarray, psi: np.ndarray, u: np.ndarray,
                  v: np.ndarray, window_s: float = TRACK_WINDOW_S) -> dict[str, float] | None:
     """RMS error [m] of the track's displacements over ``window_s`` against u, v turned by ψ and
     integrated (their mean difference, a current, removed), as given and under the two usual
     mistakes: ``"given"``, ``"v to port"`` (v negated), ``"x east, y north"`` (x and y swapped)
     and both. None when the log is shorter than a few windows."""
-    h = np.diff(t)
-    k = int(round(window_s / float(np.median(h)))) if h.size else 0
-    if k < 1 or len(t) < k + 10:
-        return None
     out = {}
-    for label, sway, (east_first) in (("given", v, False), ("v to port", -v, False),
-                                      ("x east, y north", v, True), ("both", -v, True)):
-        north, east = (y, x) if east_first else (x, y)
-        c, s = np.cos(psi), np.sin(psi)
-        track = []
-        for measured, rate in ((north, u * c - sway * s), (east, u * s + sway * c)):
-            integral = np.concatenate([[0.0], np.cumsum(0.5 * (rate[1:] + rate[:-1]) * h)])
-            e = (measured[k:] - measured[:-k]) - (integral[k:] - integral[:-k])
-            track.append(e - e.mean())
-        out[label] = float(np.sqrt(np.mean(track[0] ** 2 + track[1] ** 2)))
+    for label, sway, east_first in (("given", 1.0, False), ("v to port", -1.0, False),
+                                    ("x east, y north", 1.0, True), ("both", -1.0, True)):
+        parts = _displacements(t, x, y, psi, u, v, window_s, sway, east_first)
+        if parts is None:
+            return None
+        out[label] = float(np.sqrt(2.0 * np.mean((parts[0] - parts[1]) ** 2)))
     return out
 
 
+def track_scale(t, x, y, psi, u, v, window_s: float = TRACK_WINDOW_S
+                ) -> tuple[float, float] | None:  # fmt: skip
+    """(k, ρ): the least-squares factor k by which the track's displacements exceed those u, v
+    say (1 when both are in metres and m/s), and their correlation ρ (how far k can be trusted).
+    On the real logs here k is 0.995-1.014."""
+    parts = _displacements(t, x, y, psi, u, v, window_s)
+    if parts is None:
+        return None
+    measured, predicted = parts
+    pp, mm = float(predicted @ predicted), float(measured @ measured)
+    if pp <= 0 or mm <= 0:
+        return None
+    mp = float(measured @ predicted)
+    return mp / pp, mp / math.sqrt(pp * mm)
+
+
+# Unit mistakes the track's scale tells: (how many times as far the track moves as u, v say,
+# what it means and the remedy).
+TRACK_SCALES = ((1.852 / 3.6, "u, v look like knots: convert them to m/s (× 0.5144)"),
+                (1 / 3.6, "u, v look like km/h: convert them to m/s (÷ 3.6)"),
+                (0.44704, "u, v look like mph: convert them to m/s (× 0.44704)"),
+                (1 / 0.3048, "x, y look like feet: convert them to metres (× 0.3048)"),
+                (1e-3, "x, y look like kilometres: convert them to metres"))
+TRACK_SCALE_TOLERANCE = 0.2  # |k − 1| within it: metres and m/s
+
+
 def _check_track_against_velocities(df: pd.DataFrame, name: str) -> None:
-    errors = track_errors(*(df[c].to_numpy(dtype=float) for c in ("t", "x", "y", "psi", "u", "v")))
+    columns = [df[c].to_numpy(dtype=float) for c in ("t", "x", "y", "psi", "u", "v")]
+    errors = track_errors(*columns)
     if errors is None or not errors["given"] > 0:
         return
     label = min(errors, key=errors.get)
     if label == "given" or errors[label] >= TRACK_CONVENTION_SHARE * errors["given"]:
+        _check_track_scale(columns, name)
         return
     what = {"v to port": "the sway 'v' looks positive to port: negate v",
             "x east, y north": "x and y look swapped (x east, y north): swap them "
@@ -197,6 +238,21 @@ def _check_track_against_velocities(df: pd.DataFrame, name: str) -> None:
                       f"({errors['given']:.3g} m rms over {TRACK_WINDOW_S:g} s; "
                       f"{errors[label]:.3g} m with {label}): {what} (canonical: x north, y east, "
                       "v positive to starboard)")  # fmt: skip
+
+
+def _check_track_scale(columns, name: str) -> None:
+    scale = track_scale(*columns)
+    if scale is None:
+        return
+    k, rho = scale
+    if rho < 0.9 or abs(k - 1.0) <= TRACK_SCALE_TOLERANCE:
+        return
+    for factor, what in TRACK_SCALES:
+        if abs(k / factor - 1.0) <= 0.05:
+            raise ShipidError(f"{name}: the track (x, y) moves {k:.3g} times as far as u, v say: "
+                              f"{what}")  # fmt: skip
+    warnings.warn(f"{name}: the track (x, y) moves {k:.3g} times as far as u, v say (expected 1): "
+                  "check the units of u, v and x, y", ShipidWarning, stacklevel=4)
 
 
 def heading_rate_ratio(t: np.ndarray, psi: np.ndarray, r: np.ndarray) -> float | None:
