@@ -96,3 +96,16 @@ def test_cli_manoeuvre_says_why_an_index_is_not_bounded(tmp_path, capsys):
     doc = json.loads((tmp_path / "z.json").read_text(encoding="utf-8"))
     assert doc["index_intervals"]["first_overshoot_deg"] == [None, None]  # JSON has no ±inf
     assert doc["index_not_bounded"]["first_overshoot_deg"].startswith("3 of 20 bootstrap")
+
+
+def test_validate_says_why_an_interval_is_not_bounded():
+    from shipid.evaluation.validate import validate_log
+
+    log = zigzag(STABLE, 10.0, 10.0, speed=1.0, dt=0.1, duration=60.0, method="euler",
+                 approach=2.0).log  # fmt: skip
+    log.attrs["rudder_positive"] = "starboard"
+    out = validate_log(STABLE, log, "zz.csv", ensemble=_ensemble(unstable=3))
+    lo, hi = out.intervals["closed_loop"]["first_overshoot_deg"]
+    assert math.isinf(lo) and math.isinf(hi)
+    assert ("first_overshoot_deg (closed loop) is not bounded: 3 of 20 bootstrap replicates have "
+            "none (3 never reach it within the log)") in out.warnings  # fmt: skip

@@ -119,12 +119,38 @@ def validate_log(model, log: pd.DataFrame, name: str, method: str = "euler",
         runs = ensemble_runs(ensemble, log, method)
         out.bands, out.ensemble_diverged = free_run_bands(runs, len(log))
         if trial.kind != "other":
-            out.intervals["simulated"] = index_intervals([_replay_indices(r, trial)
-                                                          for r in runs])  # fmt: skip
+            replays = [_replay_indices(r, trial) for r in runs]
+            out.intervals["simulated"] = index_intervals(replays)
+            out.warnings += _unbounded_notes("replay", out.intervals["simulated"], replays,
+                                             [r.diverged for r in runs], ensemble.members_label)
             if "closed_loop" in indices:
-                out.intervals["closed_loop"] = index_intervals(
-                    [_replica_indices(m, log, method, trial) for m in ensemble.members()])
+                replicas = [trial_zigzag(m, log, method, trial) for m in ensemble.members()]
+                samples = [r.indices if r and not r.diverged else {} for r in replicas]
+                out.intervals["closed_loop"] = index_intervals(samples)
+                out.warnings += _unbounded_notes("closed loop", out.intervals["closed_loop"],
+                                                 samples, [bool(r and r.diverged)
+                                                           for r in replicas],
+                                                 ensemble.members_label)  # fmt: skip
     return out
+
+
+def _unbounded_notes(label: str, intervals: dict, samples: Sequence[dict],
+                     diverged: Sequence[bool], members: str) -> list[str]:
+    """Why an index's interval is not bounded: how many replicates have no value, diverged or
+    never reaching the event within the log (more than the interval's tail: not bounded)."""
+    notes = []
+    for k, (lo, hi) in intervals.items():
+        if not (math.isinf(lo) or math.isinf(hi)):
+            continue
+        missing = [s.get(k) is None or not math.isfinite(s[k]) for s in samples]
+        n_div = sum(m and d for m, d in zip(missing, diverged, strict=True))
+        n_other = sum(missing) - n_div
+        why = "; ".join(w for w in (f"{n_div} diverged" if n_div else "",
+                                    f"{n_other} never reach it within the log" if n_other else "")
+                        if w)  # fmt: skip
+        notes.append(f"{k} ({label}) is not bounded: {sum(missing)} of {len(samples)} {members} "
+                     f"have none ({why})")  # fmt: skip
+    return notes
 
 
 def _replay_indices(sim: SimulationResult, trial: Trial) -> dict:
