@@ -310,6 +310,16 @@ def _approach(log, column: str) -> float | None:
     return approach(log, column)
 
 
+def _warn_approach(logs, names) -> None:
+    """Say so when the first log (whose approach the checks and manoeuvres use) starts without
+    headway."""
+    from shipid.data.log import approach_note
+
+    note = approach_note(logs[0], names[0]) if logs else None
+    if note:
+        _warn(note)
+
+
 def _free_run_table(refinement) -> str:
     lines = ["| training log | LS-SVM u / v / r std | refined u / v / r std |", "|---|---|---|"]
     for row in refinement.free_run:
@@ -430,6 +440,7 @@ def cmd_identify(args) -> int:
                      drop=_parse_drop(args.drop), names=names, force=args.force,
                      estimator=args.estimator, physics=physics)  # fmt: skip
     speed, rps = _approach(logs[0], "u"), _approach(logs[0], "n")
+    _warn_approach(logs, names)
     prep = {"dt": args.dt, "start": args.start, "end": args.end, "lead": args.lead,
             "filter_hz": cutoff, "filter_by": filter_by if cutoff is not None else None,
             "columns": args.columns, "degrees": args.degrees,
@@ -652,6 +663,7 @@ def cmd_select(args) -> int:
         print(f"Their {sel.error_band.describe()}; stored in the model file, validate reports "
               "each log's share of samples inside it.")  # fmt: skip
     speed, rps = _approach(logs[0], "u"), _approach(logs[0], "n")
+    _warn_approach(logs, names)
     plausibility, notes = sel.plausibility, sel.plausibility_notes
     ident.warnings.extend(f"plausibility: {n}" for n in notes)
     prep = {"dt": args.dt, "start": args.start, "end": args.end, "lead": args.lead,

@@ -46,11 +46,46 @@ def log_name(log: pd.DataFrame, default: str = "log") -> str:
     return str(log.attrs.get("name", default))
 
 
+# A log whose first 2 % run slower than this share of its typical speed (the 90th percentile of
+# u) starts without headway (a random run from rest): its running condition is then the median
+# over the samples ahead at RUNNING_SHARE of the typical speed or more.
+STANDSTILL_SHARE = 0.3
+RUNNING_SHARE = 0.5
+
+
+def _running_samples(log: pd.DataFrame) -> np.ndarray | None:
+    """Where a log that starts without headway runs ahead (None: it starts running)."""
+    u = log["u"].to_numpy(dtype=float)
+    typical = float(np.percentile(u, 90)) if u.size else 0.0
+    start = float(u[: max(1, len(u) // 50)].mean()) if u.size else 0.0
+    if not typical > 0 or start >= STANDSTILL_SHARE * typical:
+        return None
+    return u >= RUNNING_SHARE * typical
+
+
 def approach(log: pd.DataFrame, column: str) -> float | None:
-    """Mean of a column over the first 2 % of a log (the approach), None if absent."""
+    """The log's approach condition of a column (None if absent): its mean over the first 2 % of
+    the log; for a log that starts without headway, its median where the ship runs ahead
+    (``approach_note`` says so). The plausibility checks and the manoeuvres run on a model start
+    from it: from 0.02 m/s they said nothing of the ship (a random run begun at rest)."""
     if column not in log.columns:
         return None
+    running = _running_samples(log)
+    if running is not None:
+        return float(np.median(log[column].to_numpy(dtype=float)[running]))
     return float(log[column].iloc[: max(1, len(log) // 50)].mean())
+
+
+def approach_note(log: pd.DataFrame, name: str) -> str | None:
+    """What ``approach`` did for a log that starts without headway (None: nothing to say)."""
+    if _running_samples(log) is None:
+        return None
+    start = float(log["u"].iloc[: max(1, len(log) // 50)].mean())
+    rps = approach(log, "n")
+    at = f"{approach(log, 'u'):.3g} m/s" + (f" at {rps:.3g} rps" if rps is not None else "")
+    return (f"{name} starts without headway ({start:.2g} m/s): the checks, and the manoeuvres "
+            f"run on the model, start from its running condition, {at} (the median where it "
+            f"runs ahead at half its typical speed or more; --speed and --rps to choose)")
 
 
 def rudder_positive(log: pd.DataFrame, default: str = "port") -> str:

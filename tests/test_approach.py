@@ -1,0 +1,54 @@
+"""The approach a model's checks and manoeuvres start from. It was the mean of the first 2 % of
+the first training log: for a random run begun at rest (the Esso Osaka's), 0.02 m/s, from which
+the plausibility checks said nothing of the ship, and ``select`` refused a block of it ("starts
+without headway"). A log that starts without headway now gives its running condition: the median
+where it runs ahead at half its typical speed or more, and a warning says so."""
+
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+from cli_helpers import run
+
+from shipid.data.io import write_log
+from shipid.data.log import approach, approach_note
+from shipid.trials.manoeuvres import zigzag
+from shipid.vessels import scale_ship
+
+
+def _log(u: np.ndarray, n: np.ndarray) -> pd.DataFrame:
+    t = np.arange(len(u)) * 0.1
+    return pd.DataFrame({"t": t, "delta": 0.0, "u": u, "v": 0.0, "r": 0.0, "n": n})
+
+
+def test_a_log_running_from_its_start_keeps_its_first_two_percent():
+    u = np.linspace(1.0, 2.0, 1000)
+    log = _log(u, np.full(1000, 10.0))
+    assert approach(log, "u") == pytest.approx(u[:20].mean())
+    assert approach(log, "n") == 10.0 and approach_note(log, "a.csv") is None
+    assert approach(log, "wind_speed") is None
+
+
+def test_a_log_from_rest_gives_its_running_condition():
+    # 20 s from rest at 4 rps, then 80 s running at 2 m/s, 10 rps.
+    u = np.concatenate([np.linspace(0.0, 1.5, 200), np.full(800, 2.0)])
+    n = np.concatenate([np.full(200, 4.0), np.full(800, 10.0)])
+    log = _log(u, n)
+    assert approach(log, "u") == 2.0 and approach(log, "n") == 10.0
+    note = approach_note(log, "a.csv")
+    assert note.startswith("a.csv starts without headway (0.0") and "2 m/s at 10 rps" in note
+
+
+def test_identify_on_a_log_from_rest_checks_the_running_ship(tmp_path, capsys):
+    log = zigzag(scale_ship(rudder_rate_deg=9.6), 20, 20, duration=90, dt=0.2, method="euler",
+                 approach=20.0).log  # fmt: skip
+    # The first 10 s at rest, then as simulated (no track: it would no longer follow u).
+    ramp = np.clip(log["t"].to_numpy() / 10.0, 0.0, 1.0)
+    log = log.drop(columns=["x", "y"]).assign(u=log["u"] * ramp)
+    path = write_log(log, tmp_path / "from_rest.csv")
+    code, out, err = run(["identify", path, "--force", "-o", tmp_path / "m.json"], capsys)
+    assert code == 0, err
+    assert "starts without headway" in err
+    prep = json.loads((tmp_path / "m.json").read_text())["identification"]["preprocessing"]
+    assert prep["approach_speed"] == pytest.approx(float(np.median(log["u"][ramp >= 1])), rel=0.05)
