@@ -263,25 +263,39 @@ def _solve_with_inequalities(A, b, gamma, prior, lower, upper, equalities, G, h,
         raise ShipidError("constraints conflict: the inequalities (straight-line stability) "
                           "cannot be met within the bounds and equalities (signs, --bound, "
                           f"steady-speed): {res.message}")  # fmt: skip
-    # Polish: the rows and bounds SLSQP holds, as equalities of the exact problem.
+    # Polish: the rows and bounds SLSQP holds, as equalities of the exact problem; its KKT
+    # multipliers certify the optimum (≤ 0 on held inequalities and lower bounds, ≥ 0 on upper
+    # bounds, with ∇f + Cᵀμ = 0), which SLSQP's own status does not (it stops with "positive
+    # directional derivative" at an optimum it cannot improve to 1e-15).
     held = np.abs(slack) <= 1e-7
     lo_s, hi_s = lo / d, hi / d
     at_lo, at_hi = np.isfinite(lo_s), np.isfinite(hi_s)
     at_lo[at_lo] = z[at_lo] <= lo_s[at_lo] + 1e-9 * (1 + np.abs(lo_s[at_lo]))
     at_hi[at_hi] = z[at_hi] >= hi_s[at_hi] - 1e-9 * (1 + np.abs(hi_s[at_hi]))
-    extra_E = [Gs[held]] + [np.eye(p + 1)[at_lo | at_hi]]
-    extra_f = [hs[held], np.where(at_lo, lo_s, hi_s)[at_lo | at_hi]]
+    bound = at_lo | at_hi
+    rows = [Gs[held], np.eye(p + 1)[bound]]
+    rhs = [hs[held], np.where(at_lo, lo_s, hi_s)[bound]]
+    signs = [np.full(int(held.sum()), -1.0), np.where(at_lo, -1.0, 1.0)[bound]]
     if equalities is not None:
-        extra_E.insert(0, E)
-        extra_f.insert(0, f)
-    C, g = np.vstack(extra_E), np.concatenate(extra_f)
+        rows.insert(0, E)
+        rhs.insert(0, f)
+        signs.insert(0, np.zeros(len(f)))
+    C, g, sign = np.vstack(rows), np.concatenate(rhs), np.concatenate(signs)
+    certified = False
     if len(g):
         K = np.block([[Ms, C.T], [C, np.zeros((len(g), len(g)))]])
-        exact = linalg.lstsq(K, np.concatenate([cs, g]), check_finite=False)[0][: p + 1]
+        solution = linalg.lstsq(K, np.concatenate([cs, g]), check_finite=False)[0]
+        exact, mu = solution[: p + 1], solution[p + 1:]
         feasible = (np.all(Gs @ exact - hs >= -1e-9) and np.all(exact >= lo_s - 1e-9)
                     and np.all(exact <= hi_s + 1e-9))  # fmt: skip
         if feasible:
             z = exact
+            scale = 1e-8 * max(1.0, float(np.max(np.abs(mu))) if mu.size else 1.0)
+            certified = bool(np.all(sign * mu >= -scale))
+    if not certified:
+        warnings.warn(f"the fit with inequality constraints may not be the best one (SLSQP: "
+                      f"{res.message}); its solution meets them", NumericalWarning,
+                      stacklevel=3)  # fmt: skip
     x = z * d
     return x[:p], float(x[p]), (at_lo | at_hi)[:p]
 
