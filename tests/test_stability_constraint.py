@@ -9,6 +9,7 @@ import math
 import warnings
 
 import numpy as np
+import pandas as pd
 import pytest
 from cli_helpers import run
 
@@ -131,10 +132,15 @@ def test_cli_identify_and_select_take_the_stability_constraint(unstable_logs, tm
                           "--constraints", "stable", "-o", tmp_path / "m.json"], capsys)  # fmt: skip
     assert code == 0, err
     assert "held at its limit" in err and "straight-line stable" in out
-    code, out, err = run(["select", *paths, "--library", STRUCTURE, "--search", "none",
-                          "--constraints", "stable", "--quiet", "-o", tmp_path / "s.json"],
+    # The stepwise search tries yaw equations without v and r terms, which cannot be stable:
+    # such a candidate is dropped (it stopped the whole search).
+    code, out, err = run(["select", *paths, "--library", STRUCTURE, "--constraints", "stable",
+                          "--quiet", "--table", tmp_path / "t.csv", "-o", tmp_path / "s.json"],
                          capsys)  # fmt: skip
     assert code == 0, err
+    table = pd.read_csv(tmp_path / "t.csv")
+    assert (table["note"] == "the constraints cannot be met with these terms").any()
+    assert table.loc[table["chosen"], "score"].iloc[0] < math.inf
 
 
 def test_stability_that_bounds_forbid_is_one_line(unstable_logs, tmp_path, capsys):

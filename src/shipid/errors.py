@@ -11,5 +11,10 @@ class ShipidError(ValueError):
     """Bad input or an impossible request, with a message that names the file, column or option."""
 
 
+class InfeasibleConstraintsError(ShipidError):
+    """Constraints of a fit that no coefficients meet together (a structure that cannot be
+    straight-line stable, say); ``select`` drops such a candidate instead of stopping."""
+
+
 class ShipidWarning(UserWarning):
     """A result that stands but should be looked at; the message names what and why."""

@@ -48,7 +48,7 @@ from shipid.data.log import approach, common_rudder_convention, input_columns
 from shipid.dynamics.model import DOFS, ManoeuvringModel, ModelStructure, get_structure
 from shipid.dynamics.simulate import DivergenceBounds, input_array, run_kernel
 from shipid.dynamics.terms import INPUT_SIGNALS, parse_term, term_code
-from shipid.errors import ShipidError
+from shipid.errors import InfeasibleConstraintsError, ShipidError
 from shipid.evaluation.error_band import ErrorBand, error_band
 from shipid.identification.estimators import LINEAR_ESTIMATORS, check_estimator_name, fit_linear
 from shipid.identification.physics import PhysicsOptions, dof_physics, with_stability
@@ -387,7 +387,13 @@ class _Scorer:
         self.evaluations += 1
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            out, n_valid = self.free_runs(cand.terms, cand.gamma)
+            try:
+                out, n_valid = self.free_runs(cand.terms, cand.gamma)
+            except InfeasibleConstraintsError:
+                # (a yaw equation without v and r terms cannot be straight-line stable)
+                cand.score, cand.note = math.inf, "the constraints cannot be met with these terms"
+                self.cache[cand.key] = cand
+                return cand
         P = self.options.divergence_penalty
         per_fold = np.zeros((len(self.held), 3))
         diverged = 0

@@ -23,7 +23,7 @@ import numpy as np
 from scipy import linalg
 from threadpoolctl import threadpool_limits
 
-from shipid.errors import ShipidError
+from shipid.errors import InfeasibleConstraintsError
 from shipid.limits import available_memory_bytes
 
 # SciPy's bundled OpenBLAS has crashed in a threaded Cholesky on 16 000 × 16 000 matrices on the
@@ -260,9 +260,9 @@ def _solve_with_inequalities(A, b, gamma, prior, lower, upper, equalities, G, h,
     slack = Gs @ z - hs
     # SLSQP can report success on an infeasible set: judge the point itself (unit rows).
     if np.any(slack < -1e-6):
-        raise ShipidError("constraints conflict: the inequalities (straight-line stability) "
-                          "cannot be met within the bounds and equalities (signs, --bound, "
-                          f"steady-speed): {res.message}")  # fmt: skip
+        raise InfeasibleConstraintsError(
+            "constraints conflict: the inequalities (straight-line stability) cannot be met "
+            f"within the bounds and equalities (signs, --bound, steady-speed): {res.message}")
     # Polish: the rows and bounds SLSQP holds, as equalities of the exact problem; its KKT
     # multipliers certify the optimum (≤ 0 on held inequalities and lower bounds, ≥ 0 on upper
     # bounds, with ∇f + Cᵀμ = 0), which SLSQP's own status does not (it stops with "positive
