@@ -609,12 +609,16 @@ def select(
         if not options.plausibility or cand.score == math.inf:
             return cand.score < math.inf
         if cand.key not in plausibility_cache:
-            theta = _fit_theta(data, cand.terms, cand.gamma, range(len(logs)), options.estimator,
-                               options.physics)
-            model = _model_from_theta(data, cand.terms, theta, "candidate")
-            report, _ = plausibility_at_approach(model, speed, rps, options.speed, options.rps)
-            reasons = disqualifying(report, model)
-            plausibility_cache[cand.key] = (not reasons, "; ".join(reasons))
+            try:
+                theta = _fit_theta(data, cand.terms, cand.gamma, range(len(logs)),
+                                   options.estimator, options.physics)  # fmt: skip
+            except InfeasibleConstraintsError:
+                plausibility_cache[cand.key] = (False, "the constraints cannot be met on all logs")
+            else:
+                model = _model_from_theta(data, cand.terms, theta, "candidate")
+                report, _ = plausibility_at_approach(model, speed, rps, options.speed, options.rps)
+                reasons = disqualifying(report, model)
+                plausibility_cache[cand.key] = (not reasons, "; ".join(reasons))
         ok, why = plausibility_cache[cand.key]
         cand.plausible = ok
         if not ok:
