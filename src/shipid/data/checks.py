@@ -5,7 +5,9 @@ number, but they can be read off how signals relate: the heading's rate of chang
 yaw rate (ψ̇ = r), which tells degrees from radians and milliseconds from seconds; a rudder beyond
 60° or a yaw rate beyond 3 rad/s is not in radians. Sign conventions can be read off the track:
 the positions must move as u, v turned by ψ say (ẋ = u cos ψ − v sin ψ, ẏ = u sin ψ + v cos ψ),
-which tells a sway positive to port, or x and y swapped (east, north), from the canonical axes.
+which tells a sway positive to port, or x and y swapped (east, north), from the canonical axes,
+and by how far it moves, knots or feet from m/s and metres. The heading also tells a gyro's
+offset: ψ − ∫r dt drifts at it.
 """
 
 from __future__ import annotations

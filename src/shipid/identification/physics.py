@@ -208,7 +208,8 @@ def stability_rows(options: PhysicsOptions, sway: Mapping[str, float], names: Se
                    ) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
     """Straight-line stability of the yaw equation given the fitted sway equation ``sway``
     ({term: coefficient}): rows G over [free yaw terms ``names``; bias] and h with G z ≥ h for
-    tr A ≤ 0 and det A ≥ 0 at each approach (``fixed`` yaw terms count as known)."""
+    tr A ≤ −2μ and det A + μ tr A + μ² ≥ 0 (real parts ≤ −μ, μ = ``STABILITY_MARGIN`` |a11|) at
+    each approach (``fixed`` yaw terms count as known)."""
     sway_terms = [t for t in sway if t != "1"]
     sway_coef = np.array([sway[t] for t in sway_terms])
     rows, rhs = [], []
