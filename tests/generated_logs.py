@@ -15,3 +15,18 @@ def noisy_zigzags(seed: int) -> list:
                      first=first).log  # fmt: skip
         out.append(lowpass(PAPER_IMU.apply(log, seed=seed + i), 0.5))
     return out
+
+
+# A ship whose yaw is damped by u·r (< 0 stable; det A = 0.6·0.8 − 0.45 > 0 at u·r = −0.8) and
+# held by |r|·r where it is not: the truth of the stability and replicate tests.
+YAW_DAMPED_STRUCTURE = "u: |u|*u, 1; v: u*v, u*r, u^2*delta; r: u*v, u*r, |r|*r, u^2*delta"
+
+
+def yaw_damped_ship(yaw_damping: float):
+    """The ship of ``YAW_DAMPED_STRUCTURE`` with ``u*r`` = ``yaw_damping`` in its yaw equation."""
+    from shipid.dynamics.model import ManoeuvringModel
+
+    return ManoeuvringModel(YAW_DAMPED_STRUCTURE, {
+        "u": {"|u|*u": -0.05, "1": 0.05},
+        "v": {"u*v": -0.6, "u*r": -0.3, "u^2*delta": 0.01},
+        "r": {"u*v": -1.5, "u*r": yaw_damping, "|r|*r": -5.0, "u^2*delta": -0.008}})  # fmt: skip

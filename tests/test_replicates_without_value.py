@@ -12,25 +12,14 @@ import math
 import numpy as np
 import pytest
 from cli_helpers import run
+from generated_logs import yaw_damped_ship
 
-from shipid.dynamics.model import ManoeuvringModel
 from shipid.dynamics.steering import SteeringMachine
 from shipid.identification.uncertainty import Ensemble
 from shipid.trials.criteria import imo_criteria, replicate_notes, with_intervals
 from shipid.trials.manoeuvres import without_value, zigzag
 
-STRUCTURE = "u: |u|*u, 1; v: u*v, u*r, u^2*delta; r: u*v, u*r, |r|*r, u^2*delta"
-
-
-def _model(yaw_damping: float) -> ManoeuvringModel:
-    """A ship whose yaw is damped by ``u*r`` (< 0: stable) and held by ``|r|*r`` when not."""
-    return ManoeuvringModel(STRUCTURE, {
-        "u": {"|u|*u": -0.05, "1": 0.05},
-        "v": {"u*v": -0.6, "u*r": -0.3, "u^2*delta": 0.01},
-        "r": {"u*v": -1.5, "u*r": yaw_damping, "|r|*r": -5.0, "u^2*delta": -0.008}})  # fmt: skip
-
-
-STABLE, UNSTABLE = _model(-0.8), _model(0.3)
+STABLE, UNSTABLE = yaw_damped_ship(-0.8), yaw_damped_ship(0.3)
 
 
 def test_a_zigzag_says_when_the_counter_rudder_never_checks_the_yaw():

@@ -12,24 +12,16 @@ import numpy as np
 import pandas as pd
 import pytest
 from cli_helpers import run
+from generated_logs import YAW_DAMPED_STRUCTURE as STRUCTURE
+from generated_logs import yaw_damped_ship
 
 from shipid.control.linear import linearise
 from shipid.data.io import write_log
-from shipid.dynamics.model import ManoeuvringModel
 from shipid.identification.identify import identify, weighted_refit
 from shipid.identification.physics import STABILITY_MARGIN, PhysicsOptions
 from shipid.identification.uncertainty import block_weights
 from shipid.lssvm.solvers import NumericalWarning, solve_primal_constrained
 from shipid.trials.manoeuvres import zigzag
-
-STRUCTURE = "u: |u|*u, 1; v: u*v, u*r, u^2*delta; r: u*v, u*r, |r|*r, u^2*delta"
-
-
-def _ship(yaw_damping: float) -> ManoeuvringModel:
-    return ManoeuvringModel(STRUCTURE, {
-        "u": {"|u|*u": -0.05, "1": 0.05},
-        "v": {"u*v": -0.6, "u*r": -0.3, "u^2*delta": 0.01},
-        "r": {"u*v": -1.5, "u*r": yaw_damping, "|r|*r": -5.0, "u^2*delta": -0.008}})  # fmt: skip
 
 
 def _logs(ship):
@@ -87,7 +79,7 @@ def test_inequalities_are_solved_as_the_enumerated_kkt_solution(seed):
 
 @pytest.fixture(scope="module")
 def unstable_logs():
-    truth = _ship(-0.5)  # det A = 0.3 − 0.45 < 0 at u = 1: an eigenvalue at +0.12 1/s
+    truth = yaw_damped_ship(-0.5)  # det A = 0.3 − 0.45 < 0 at u = 1: an eigenvalue at +0.12 1/s
     assert max(_sway_yaw_eigenvalues(truth, 1.0).real) == pytest.approx(0.1227, abs=1e-3)
     return _logs(truth)
 
@@ -107,7 +99,7 @@ def test_an_unstable_ship_is_fitted_barely_stable_at_the_approach(unstable_logs)
 
 
 def test_a_stable_ship_is_fitted_as_without_the_constraint():
-    logs = _logs(_ship(-1.2))
+    logs = _logs(yaw_damped_ship(-1.2))
     free = identify(logs, model=STRUCTURE, gamma=1e6)
     fit = identify(logs, model=STRUCTURE, gamma=1e6, physics=PhysicsOptions(stable=True))
     for dof in "uvr":
