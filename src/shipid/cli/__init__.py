@@ -1,0 +1,230 @@
+"""The ``shipid`` command line.
+
+Exit 0 on success, 1 on a user error (one-line message, no traceback, no output file), 2 on a usage
+error, 130 when interrupted (Ctrl-C or SIGTERM: temporaries removed, one line). Option values are
+checked before any work, and so are output paths: an output that is also an input, an unknown
+extension or an unwritable folder is refused before anything is computed. A command's output files
+are written together at its end (``shipid.outputs.OutputSet``). Warnings print as ``warning:``
+lines on stderr and go into the JSON outputs.
+
+One module per concern: ``parser`` (every command's options), ``common`` (reading logs, physics
+options, the model or ship a command runs on), and the commands by what they do:
+``identification``, ``evaluation``, ``trials``, ``control``, ``data``.
+"""
+
+from __future__ import annotations
+
+import math
+import signal
+import sys
+import warnings
+
+from shipid.cli.common import FORMATS
+from shipid.cli.parser import build_parser
+from shipid.errors import ShipidError, ShipidWarning
+from shipid.outputs import Interrupted, check_stop, clear_stop, request_stop, stop_requested
+
+__all__ = ["FORMATS", "build_parser", "main", "run"]
+
+
+# Range checks of numeric options: dest → (rule, option as typed). Rules: '>0', '>=0', 'finite',
+# 'int>=N'. Checked before any work; a bad value is a user error (exit 1), not a usage error.
+OPTION_RULES = {
+    "gamma": (">0", "--gamma"), "dt": (">0", "--dt"), "lead": (">=0", "--lead"),
+    "filter": (">0", "--filter"), "segment": (">0", "--segment"),
+    "refine_evals": ("int>=1", "--refine-evals"), "rudder_deg": (">0", "--rudder"),
+    "heading": (">0", "--heading"), "duration": (">0", "--duration"), "step": (">0", "--dt"),
+    "speed": (">0", "--speed"), "rps": ("finite", "--rps"), "smooth": (">=0", "--smooth"),
+    "length": (">0", "--length"), "rudder_rate": (">0", "--rudder-rate"),
+    "astern_rps": ("finite", "--astern-rps"),
+    "scale": (">0", "--scale"), "start": ("finite", "--start"), "end": ("finite", "--end"),
+    "wind_speed": (">=0", "--wind-speed"), "wind_from": ("finite", "--wind-from"),
+    "max_evaluations": ("int>=1", "--max-evaluations"), "show": ("int>=1", "--show"),
+    "max_lag": ("int>=1", "--max-lag"), "omega": (">0", "--omega"),
+    "lookahead": (">0", "--lookahead"), "bootstrap": ("int>=10", "--bootstrap"),
+    "block": (">0", "--block"), "workers": ("int>=1", "--workers"), "factor": (">0", "--factor"),
+    "rho": (">0", "--rho"),
+}  # fmt: skip
+
+
+def _on_sigterm(signum, frame) -> None:
+    request_stop()
+    raise Interrupted()
+
+
+def _on_sigint(signum, frame) -> None:
+    request_stop()
+    raise KeyboardInterrupt()
+
+
+def _ignore_unraisable(unraisable) -> None:
+    """``sys.unraisablehook`` while an interrupt unwinds: finaliser errors are not the user's."""
+
+
+def _quiet_lost_interrupts(hook):
+    """``sys.unraisablehook`` while a command runs: an interrupt raised inside a finaliser is
+    dropped by Python; it is recorded (``request_stop``) and acted on, so it is not printed."""
+
+    def unraisable(info) -> None:
+        if not isinstance(info.exc_value, KeyboardInterrupt):
+            hook(info)
+
+    return unraisable
+
+
+def check_options(args) -> None:
+    """Range checks of the numeric options (``OPTION_RULES``) before any work."""
+    for dest, (rule, option) in OPTION_RULES.items():
+        value = getattr(args, dest, None)
+        if value is None or isinstance(value, str):
+            continue
+        if rule.startswith("int>="):
+            least = int(rule[5:])
+            if not value >= least:
+                raise ShipidError(f"{option} must be a whole number ≥ {least}, got {value}")
+            continue
+        if not math.isfinite(value):
+            raise ShipidError(f"{option} must be a finite number, got {value}")
+        if rule == ">0" and not value > 0:
+            raise ShipidError(f"{option} must be > 0, got {value:g}")
+        if rule == ">=0" and not value >= 0:
+            raise ShipidError(f"{option} must be ≥ 0, got {value:g}")
+
+
+class _ClosableStdout:
+    """stdout that goes quiet once its reader has gone (``shipid identify ... | head``): the
+    command still finishes and writes its files instead of failing on a broken pipe."""
+
+    def __init__(self, stream):
+        self._stream = stream
+        self._closed = False
+
+    def write(self, text: str) -> int:
+        if not self._closed:
+            try:
+                return self._stream.write(text)
+            except BrokenPipeError:
+                self._close()
+        return len(text)
+
+    def flush(self) -> None:
+        if not self._closed:
+            try:
+                self._stream.flush()
+            except BrokenPipeError:
+                self._close()
+
+    def _close(self) -> None:
+        import os
+
+        self._closed = True
+        try:  # what is still buffered goes nowhere, not into an error at exit
+            null = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(null, self._stream.fileno())
+            os.close(null)
+        except (OSError, ValueError, AttributeError):
+            pass
+
+    def __getattr__(self, name):
+        return getattr(self._stream, name)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the command line; returns the exit code (0, 1, 2 usage, 130 interrupted)."""
+    args = build_parser().parse_args(argv)
+    import threading
+
+    # Only the main thread may handle signals; a Dask worker runs jobs in its own threads.
+    in_main = threading.current_thread() is threading.main_thread()
+    if in_main:
+        clear_stop()
+        previous = signal.signal(signal.SIGTERM, _on_sigterm)
+        previous_int = signal.signal(signal.SIGINT, _on_sigint)
+    unraisablehook = sys.unraisablehook
+    if in_main:
+        sys.unraisablehook = _quiet_lost_interrupts(unraisablehook)
+    caught: list[warnings.WarningMessage] = []
+    stdout = sys.stdout
+    sys.stdout = _ClosableStdout(stdout)
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", ShipidWarning)
+            check_options(args)
+            try:
+                code = args.func(args)
+            except Exception:
+                # An error after an interrupt is the interrupt's doing (it broke a JIT compile,
+                # which then fails with its own RuntimeError), not a bug: exit 130 all the same.
+                if in_main and stop_requested():
+                    raise Interrupted() from None
+                raise
+            if in_main:
+                check_stop()  # an interrupt whose exception a finaliser dropped
+    except ShipidError as exc:
+        print(f"shipid: error: {_one_line(exc)}", file=sys.stderr)
+        code = 1
+    except KeyboardInterrupt:
+        print("shipid: interrupted", file=sys.stderr)
+        code = 130
+        # What the interrupted work leaves half-built (a JIT compile's LLVM objects) may fail in
+        # its finaliser when the traceback is dropped at the end of this clause: stay one line.
+        sys.unraisablehook = _ignore_unraisable
+    except MemoryError:
+        print("shipid: error: out of memory (ask for fewer samples: a shorter run, a larger "
+              "step or --dt)", file=sys.stderr)  # fmt: skip
+        code = 1
+    except (ValueError, OSError) as exc:
+        print(f"shipid: error: {_one_line(exc)}", file=sys.stderr)
+        code = 1
+    except Exception as exc:  # a bug: still one line, no traceback (SHIPID_DEBUG=1 shows it)
+        import os
+
+        if os.environ.get("SHIPID_DEBUG"):
+            raise
+        print(f"shipid: error: internal error ({type(exc).__name__}: {_one_line(exc)}); please "
+              "report it with the command line (SHIPID_DEBUG=1 shows the traceback)",
+              file=sys.stderr)  # fmt: skip
+        code = 1
+    finally:
+        if in_main:
+            signal.signal(signal.SIGTERM, previous)
+            signal.signal(signal.SIGINT, previous_int)
+        sys.stdout = stdout
+        if sys.unraisablehook is _ignore_unraisable:
+            import gc
+
+            gc.collect()  # the finalisers of cycles, while they are still ignored
+        sys.unraisablehook = unraisablehook
+    seen = set()
+    for w in caught:
+        if issubclass(w.category, ShipidWarning) and str(w.message) not in seen:
+            seen.add(str(w.message))
+            print(f"warning: {_one_line(w.message)}", file=sys.stderr)
+    return code
+
+
+def _one_line(exc) -> str:
+    text = str(exc)
+    if isinstance(exc, OSError) and exc.strerror:
+        text = f"{exc.filename}: {exc.strerror}" if exc.filename else exc.strerror
+    return text.splitlines()[0] if text else type(exc).__name__
+
+
+def run() -> None:
+    """Console entry point: :func:`main`, then exit with its code.
+
+    After an interrupt the process ends at once (``os._exit``) once the streams are flushed:
+    the temporaries are already removed while unwinding, and an interrupted JIT compile
+    leaves objects whose finalisers would print tracebacks during interpreter teardown.
+    """
+    code = main()
+    if code == 130:
+        import os
+
+        for stream in (sys.stdout, sys.stderr):
+            try:
+                stream.flush()
+            except (OSError, ValueError):
+                pass
+        os._exit(code)
+    sys.exit(code)

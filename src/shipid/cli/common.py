@@ -1,0 +1,337 @@
+"""What the ``shipid`` commands share: reading logs with the log options, physics and bound options,
+the model or reference ship a command runs on, its approach and steering machine, and notes."""
+
+from __future__ import annotations
+
+import json
+import math
+import warnings
+from pathlib import Path
+
+from shipid.errors import ShipidError, ShipidWarning
+
+VESSEL_NAMES = ("scale-ship", "mariner", "kvlcc2")
+LINEAR_ESTIMATORS = ("lssvm", "ols", "ridge", "lasso", "svr")
+KINDS = ("zigzag", "turning", "other")
+
+
+# ---------------------------------------------------------------------------- shared options
+# The readers of shipid.data.formats (kept here so that --help and --version import no pandas;
+# a test checks the two agree).
+FORMATS = ("canonical", "simman-marin", "simman-hsva", "osaka-frt")
+
+
+def _read_options(args):
+    from shipid.data.io import ReadOptions, parse_column_map
+
+    return ReadOptions(fmt=args.format, columns=parse_column_map(args.columns),
+                       degrees=tuple(c.strip() for c in args.degrees.split(",") if c.strip()),
+                       dt=args.dt, start=args.start, end=args.end, lead=args.lead,
+                       rudder_positive=args.rudder_positive, scale=args.scale,
+                       fill_gaps=args.fill_gaps)  # fmt: skip
+
+
+def _read_logs(args, paths=None) -> list:
+    from shipid.data.io import read_log
+
+    options = _read_options(args)
+    logs = [read_log(p, options) for p in (paths or args.logs)]
+    particulars = _particulars(args)
+    if particulars is not None:
+        for log in logs:
+            log.attrs["particulars"] = particulars.to_dict()
+    return logs
+
+
+def _training_logs(args) -> list:
+    """The logs a model is fitted to: ``_read_logs``, refused when they are at different
+    scales (a model-scale and a full-scale run fitted together mix two ships' time scales)."""
+    logs = _read_logs(args)
+    scales = {}
+    for path, log in zip(args.logs, logs, strict=True):
+        if "scale" in log.attrs:
+            scales.setdefault(float(log.attrs["scale"]), str(path))
+    if len(scales) > 1:
+        (a, pa), (b, pb) = list(scales.items())[:2]
+        raise ShipidError(f"{pb} is at scale 1:{b:g} and {pa} at 1:{a:g}: the logs of one fit "
+                          "must be at one scale (read the trial files with the same "
+                          "--scale)")  # fmt: skip
+    return logs
+
+
+def _particulars(args):
+    """The particulars of --particulars (None when not given)."""
+    if not getattr(args, "particulars", None):
+        return None
+    from shipid.data.particulars import read_particulars
+
+    return read_particulars(args.particulars)
+
+
+def _log_particulars(logs) -> dict | None:
+    return next((log.attrs["particulars"] for log in logs if log.attrs.get("particulars")), None)
+
+
+BOUND_PATTERN = r"^\s*([uvr])\s*:\s*(.+?)\s*(<=|>=)\s*(\S+)\s*$"
+
+
+def _parse_bounds(specs) -> dict[str, dict[str, tuple[float, float]]]:
+    """--bound 'r: u*r <= 0' (repeatable) as {dof: {term: (lower, upper)}}."""
+    import re
+
+    out: dict[str, dict[str, tuple[float, float]]] = {}
+    for spec in specs or []:
+        m = re.match(BOUND_PATTERN, spec)
+        if not m:
+            raise ShipidError(f"--bound expects 'DOF: TERM <= X' or 'DOF: TERM >= X' (DOF u, v "
+                              f"or r), got {spec!r}")  # fmt: skip
+        dof, term, op, value = m.groups()
+        try:
+            x = float(value)
+        except ValueError:
+            raise ShipidError(f"--bound {spec!r}: {value!r} is not a number") from None
+        if not math.isfinite(x):
+            raise ShipidError(f"--bound {spec!r}: the bound must be finite")
+        lo, hi = out.setdefault(dof, {}).get(term, (-math.inf, math.inf))
+        out[dof][term] = (lo, min(hi, x)) if op == "<=" else (max(lo, x), hi)
+    return out
+
+
+def _physics(args, logs, structure):
+    """PhysicsOptions of --prior, --constraints, --bound (None when none is given)."""
+    from shipid.identification.physics import PhysicsOptions, parse_constraints, rudder_sign
+
+    signs, steady, stable = parse_constraints(args.constraints)
+    bounds = _parse_bounds(args.bound)
+    prior = None
+    if args.prior == "clarke":
+        from shipid.data.particulars import Particulars
+        from shipid.identification.priors import clarke_prior
+
+        found = _particulars(args) or _log_particulars(logs)
+        if found is None:
+            raise ShipidError("--prior clarke needs the ship's particulars (--particulars FILE)")
+        part = found if isinstance(found, Particulars) else Particulars.from_mapping(found)
+        sign = rudder_sign(logs)
+        side = None if sign is None else ("starboard" if sign > 0 else "port")
+        speed = _approach(logs[0], "u")
+        prior = clarke_prior(part, structure, speed or 0.0, side)
+    elif args.prior:
+        from shipid.identification.priors import prior_from_model
+        from shipid.reporting.modelfile import load_model
+
+        prior = prior_from_model(load_model(args.prior))
+    options = PhysicsOptions(prior=prior, signs=signs, bounds=bounds or None, steady_speed=steady,
+                             stable=stable)
+    return options if options.active else None
+
+
+def _term_display(text: str) -> str:
+    """A term as printed in a Markdown table cell (its bars escaped: ``\\|u\\|u``)."""
+    from shipid.dynamics.terms import parse_term
+
+    return (parse_term(text).display() or "1").replace("|", "\\|")
+
+
+def _json_text(data) -> str:
+    from shipid.reporting.modelfile import json_safe
+
+    return json.dumps(json_safe(data), indent=2, ensure_ascii=False) + "\n"
+
+
+def _parse_drop(spec: str | None) -> dict[str, list[str]]:
+    out: dict[str, list[str]] = {}
+    for item in (spec or "").split(","):
+        if not item.strip():
+            continue
+        if ":" not in item:
+            raise ShipidError(f"--drop expects dof:term pairs like u:r^2, got {item!r}")
+        dof, term = (s.strip() for s in item.split(":", 1))
+        out.setdefault(dof, []).append(term)
+    return out
+
+
+def _warn(message: str) -> None:
+    warnings.warn(message, ShipidWarning, stacklevel=2)
+
+
+def _approach(log, column: str) -> float | None:
+    from shipid.data.log import approach
+
+    return approach(log, column)
+
+
+def _warn_approach(logs, names) -> None:
+    """Say so when the first log (whose approach the checks and manoeuvres use) starts without
+    headway."""
+    from shipid.data.log import approach_note
+
+    note = approach_note(logs[0], names[0]) if logs else None
+    if note:
+        _warn(note)
+
+
+def _std_errors(ident) -> dict:
+    return {d: ident.diagnostics[d].get("std_errors", {}) for d in ident.diagnostics}
+
+
+def _rudder_rate(logs) -> float | None:
+    """The training logs' rudder rate [rad/s] (90th percentile while the rudder moves)."""
+    from shipid.trials.trial import describe_trial
+
+    rates = [describe_trial(log).rudder_rate for log in logs]
+    rates = [r for r in rates if r]
+    return max(rates) if rates else None
+
+
+def _log_scale(logs) -> float | None:
+    """The scale λ of the training logs (their metadata), when they share one."""
+    scales = {float(log.attrs["scale"]) for log in logs if "scale" in log.attrs}
+    return scales.pop() if len(scales) == 1 and all("scale" in log.attrs for log in logs) \
+        else None
+
+
+def _scale_notes(cond: dict, logs, names) -> list[str]:
+    """Logs at another scale than the model's training logs: read with the wrong --scale."""
+    trained = cond.get("log_scale")
+    out = []
+    for log, name in zip(logs, names, strict=True):
+        lam = log.attrs.get("scale")
+        if trained and lam and abs(lam / trained - 1) > 0.01:
+            out.append(f"{name}: this log is at scale 1:{lam:g} and the model's training logs were"
+                       f" at 1:{trained:g}: read it with --scale {trained:g} (if its format "
+                       f"takes one), or carry the model over with shipid rescale --factor "
+                       f"{trained / lam:g}")  # fmt: skip
+    return out
+
+
+def _sampling_notes(cond: dict, logs, names) -> list[str]:
+    """Logs sampled coarser than the model's Δk: the free runs step at the log's sampling, so
+    the model is integrated more coarsely than it was identified (the paper ship's 10/10 second
+    overshoot in closed loop: 10.8° at its Δk 0.2 s, 13.4° at 0.5 s)."""
+    import numpy as np
+
+    trained = cond.get("dt")
+    out = []
+    for log, name in zip(logs, names, strict=True):
+        t = log["t"].to_numpy()
+        step = float(np.median(np.diff(t))) if len(t) > 1 else 0.0
+        if trained and step > SAMPLING_SLACK * trained:
+            out.append(f"{name}: its samples are {step:.3g} s apart, {step / trained:.3g} times the "
+                       f"model's Δk ({trained:.3g} s): the free runs are integrated at the "
+                       f"log's step, coarser than the model was identified at, and lose accuracy; "
+                       f"give --dt {trained:.3g}")  # fmt: skip
+    return out
+
+
+# A log sampled up to this many times the model's Δk is run as it is without a note.
+SAMPLING_SLACK = 1.5
+
+
+def _fmt_speed(u: float | None) -> str:
+    return "none" if u is None else f"{u:.3g} m/s"
+
+
+def _structure(args):
+    """The structure of --model without the --drop terms."""
+    from shipid.dynamics.model import get_structure
+
+    try:
+        structure = get_structure(args.model)
+        drop = _parse_drop(args.drop)
+        return structure.without(drop) if drop else structure
+    except ValueError as exc:
+        raise ShipidError(str(exc)) from None
+
+
+def _parse_gammas(text: str | None) -> tuple[float, ...] | None:
+    if not text:
+        return None
+    try:
+        return tuple(float(x) for x in text.split(",") if x.strip())
+    except ValueError:
+        raise ShipidError(f"--gammas expects numbers separated by commas, got {text!r}") from None
+
+
+def _pd():
+    import pandas as pd
+
+    return pd
+
+
+def _cores() -> int:
+    import os
+
+    return os.cpu_count() or 1
+
+
+def _np():
+    import numpy as np
+
+    return np
+
+
+def _ship_or_model(name: str):
+    """A reference ship (its trimmed speed applies) or a model file with its training
+    conditions (approach speed, propeller speed, envelope)."""
+    from shipid.reporting.modelfile import load_document, model_from_document, training_conditions
+    from shipid.vessels import get_vessel
+
+    if name in VESSEL_NAMES:
+        return get_vessel(name), {"speed": None, "rps": None, "envelope": {}, "particulars": None,
+                                  "rudder_rate": None, "rudder_positive": None}  # fmt: skip
+    if not Path(name).exists():
+        raise ShipidError(f"{name}: neither a model file nor a known vessel "
+                          f"({', '.join(VESSEL_NAMES)})")  # fmt: skip
+    from shipid.reporting.modelfile import ensemble_from_document
+
+    doc = load_document(name)
+    model = model_from_document(doc, name)
+    cond = training_conditions(doc)
+    cond["ensemble"] = ensemble_from_document(doc, name, model)
+    return model, cond
+
+
+def _run_approach(target, cond: dict, speed: float | None, rps: float | None):
+    """Approach speed and rps of a run on ``target``: a reference ship's own trim, or a model's
+    steady straight approach (``shipid.dynamics.equilibrium.steady_approach``), printed, with a
+    warning when it is not steady. Returns (speed, rps, warning or None)."""
+    from shipid.dynamics.equilibrium import steady_approach
+    from shipid.dynamics.model import ManoeuvringModel
+
+    if not isinstance(target, ManoeuvringModel):
+        return speed, rps, None
+    if speed is None and not cond["speed"]:
+        return None, rps if rps is not None else cond["rps"], None  # the run names what is missing
+    app = steady_approach(target, cond["speed"], cond["rps"], speed, rps)
+    print(app.describe())
+    return app.speed, app.rps, app.warning
+
+
+def _steering(target, cond: dict, rate_deg_s: float | None, fallback: str = "instantaneous"):
+    """The steering machine of a run and a line saying which: ``--rudder-rate`` (a reference
+    ship keeps its gear's other limits), else a reference ship's own gear (None: the ship's),
+    else the rate of the model's training logs (overshoots depend on it as much as on the
+    model), else ``fallback``: an instantaneous rudder, said so, or 'caller' (None: the caller
+    chooses, as the IMO criteria take the SOLAS rate)."""
+    import dataclasses
+
+    from shipid.dynamics.steering import SteeringMachine
+
+    own = getattr(target, "steering", None)
+    if rate_deg_s is not None:
+        rate, source = math.radians(rate_deg_s), "--rudder-rate"
+    elif own is not None:
+        rate = own.max_rate
+        return None, ("rudder: the ship's own steering gear" + (
+            f", {math.degrees(rate):.3g} °/s" if rate else ", instantaneous"))
+    elif cond.get("rudder_rate"):
+        rate, source = float(cond["rudder_rate"]), "the training logs' rudder rate"
+    elif fallback == "caller":
+        return None, None
+    else:
+        return SteeringMachine(), ("rudder: instantaneous (the model file has no training rudder "
+                                   "rate; give one with --rudder-rate DEG/S)")  # fmt: skip
+    steering = (SteeringMachine(math.radians(35.0), rate) if own is None
+                else dataclasses.replace(own, max_rate=rate))  # fmt: skip
+    return steering, f"rudder rate {math.degrees(rate):.3g} °/s ({source})"

@@ -1,0 +1,198 @@
+"""``shipid linearise``, ``export``, ``autopilot`` and ``follow``: putting a model to work."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from shipid.cli.common import (
+    VESSEL_NAMES,
+    _json_text,
+    _np,
+    _pd,
+    _run_approach,
+    _ship_or_model,
+    _steering,
+    _warn,
+)
+from shipid.errors import ShipidError
+
+
+def _controlled(args):
+    """The model (or vessel) to control, the truth to test on, speed and rps."""
+    from shipid.vessels import get_vessel
+
+    target, cond = _ship_or_model(args.model)
+    speed, rps, unsteady = _run_approach(target, cond, args.speed, args.rps)
+    if unsteady:
+        _warn(unsteady)
+    speed = speed or getattr(target, "approach_speed", None)
+    truth = get_vessel(args.truth) if args.truth else None
+    if truth is not None and args.truth not in VESSEL_NAMES:
+        raise ShipidError(f"--truth must be a reference ship ({', '.join(VESSEL_NAMES)})")
+    steering, note = _steering(target, cond, args.rudder_rate)
+    print(f"{args.model}: {note}")
+    return target, truth, speed, rps, steering, cond
+
+
+def _for_truth(pid, target, truth, speed, rps):
+    """The model-tuned PID as it acts on the truth, and a note when it differs: its gains carry
+    the model's rudder sign, so they are mirrored where the truth's positive rudder turns the
+    other way (the MARIN KVLCC2 logs turn to port with positive rudder, the reference KVLCC2 to
+    starboard; unmirrored, the truth was steered away from the ordered heading)."""
+    from shipid.control.autopilot import PID
+    from shipid.trials.manoeuvres import as_vessel
+
+    side = as_vessel(target, speed, None, rps).rudder_positive
+    if side == truth.rudder_positive:
+        return pid, None
+    return PID(-pid.kp, -pid.ki, -pid.kd), (
+        f"the truth's positive rudder turns it to {truth.rudder_positive}, the model's to "
+        f"{side}: the model-tuned controller's rudder is mirrored for the truth")
+
+
+def _tuned(ship, speed, rps, omega):
+    from shipid.control.autopilot import pid_from_nomoto
+    from shipid.control.linear import nomoto
+
+    nm = nomoto(ship, speed, rps)
+    return nm, pid_from_nomoto(nm["K"], nm["T"], omega)
+
+
+def cmd_linearise(args) -> int:
+    """``shipid linearise``: state-space A, B and Nomoto K, T about the straight run."""
+    from shipid.control.linear import nomoto
+
+    target, cond = _ship_or_model(args.model)
+    speed, rps, unsteady = _run_approach(target, cond, args.speed, args.rps)
+    speed = speed or getattr(target, "approach_speed", None)
+    if not speed:
+        raise ShipidError("give the speed to linearise at (--speed)")
+    if unsteady:
+        _warn(unsteady)
+    nm = nomoto(target, speed, rps)
+    pd = _pd()
+    print(f"Linearised about straight running at u = {speed:.4g} m/s (states u, v, r; input δ):")
+    print("A =")
+    print(pd.DataFrame(nm["A"], index=["u", "v", "r"], columns=["u", "v", "r"]).to_markdown(
+        floatfmt=".5g"))
+    print("B =")
+    print(pd.DataFrame({"δ": nm["B"]}, index=["u", "v", "r"]).to_markdown(floatfmt=".5g"))
+    print(f"Nomoto: K = {nm['K']:.5g} 1/s, T1 = {nm['T1']:.5g} s, T2 = {nm['T2']:.5g} s, "
+          f"T3 = {nm['T3']:.5g} s; first order T = T1 + T2 − T3 = {nm['T']:.5g} s; "
+          f"{'stable' if nm['stable'] else 'UNSTABLE'}")  # fmt: skip
+    return 0
+
+
+def cmd_export(args) -> int:
+    """``shipid export``: write the model as a standalone NumPy function file."""
+    from shipid.control.export import export_numpy
+    from shipid.outputs import check_outputs
+    from shipid.reporting.modelfile import load_model
+
+    if Path(args.output).suffix != ".py":
+        raise ShipidError(f"-o {args.output}: the exported module must be a .py file")
+    check_outputs({"-o": (args.output, "python")}, [args.model])
+    model = load_model(args.model)
+    export_numpy(model, args.output)
+    print(f"standalone NumPy module written to {args.output} (accelerations, derivatives, "
+          "simulate)")  # fmt: skip
+    return 0
+
+
+def cmd_autopilot(args) -> int:
+    """``shipid autopilot``: heading step of a PID tuned on the model, run on model and truth."""
+    from shipid.control.autopilot import heading_step
+    from shipid.outputs import check_outputs
+
+    check_outputs({"-o": (args.output, "figure")}, [])
+    target, truth, speed, rps, steering, cond = _controlled(args)
+    nm, pid = _tuned(target, speed, rps, args.omega)
+    print(f"PID tuned on {args.model} (Nomoto K = {nm['K']:.4g} 1/s, T = {nm['T']:.4g} s): "
+          f"Kp = {pid.kp:.4g}, Ki = {pid.ki:.4g} 1/s, Kd = {pid.kd:.4g} s")
+    runs = {args.model: heading_step(target, pid, args.heading, args.duration, args.dt,
+                                     speed, rps, steering=steering)}  # fmt: skip
+    if truth is not None:
+        pid_truth, note = _for_truth(pid, target, truth, speed, rps)
+        if note:
+            print(note)
+        runs[f"{args.truth} (truth)"] = heading_step(truth, pid_truth, args.heading,
+                                                     args.duration, args.dt)  # fmt: skip
+        longest = max(float(log["t"].iloc[-1]) for log in runs.values())
+        if args.duration is None and any(log["t"].iloc[-1] < longest for log in runs.values()):
+            # One length for both, so that the figure compares them over the same time.
+            runs = {args.model: heading_step(target, pid, args.heading, longest, args.dt, speed,
+                                             rps, steering=steering),
+                    f"{args.truth} (truth)": heading_step(truth, pid_truth, args.heading,
+                                                          longest, args.dt)}  # fmt: skip
+    for name, log in runs.items():
+        if log.attrs.get("incomplete") and log.attrs["incomplete"] != "diverged":
+            _warn(f"{name}: {log.attrs['incomplete']}; give a longer --duration")
+        psi = _np().degrees(log["psi"].to_numpy())
+        over = float(psi.max() - args.heading) if args.heading > 0 else float(args.heading - psi.min())
+        print(f"{name}: overshoot {over:.3g}°, final heading {psi[-1]:.4g}°, max rudder "
+              f"{_np().degrees(log['delta'].abs().max()):.3g}°")
+    if args.output:
+        from shipid.reporting.plots import autopilot_figure
+
+        autopilot_figure(runs, args.output, f"heading autopilot, step to {args.heading:g}°")
+        print(f"figure written to {args.output}")
+    return 0
+
+
+def _parse_waypoints(text: str) -> list[tuple[float, float]]:
+    try:
+        pts = [tuple(float(x) for x in p.split(",")) for p in text.split(";") if p.strip()]
+    except ValueError:
+        raise ShipidError(f"--waypoints expects 'x,y;x,y;...' in metres, got {text!r}") from None
+    if len(pts) < 2 or any(len(p) != 2 for p in pts):
+        raise ShipidError(f"--waypoints expects at least two 'x,y' pairs, got {text!r}")
+    return pts
+
+
+def cmd_follow(args) -> int:
+    """``shipid follow``: line-of-sight path following of waypoints on model and truth."""
+    from shipid.control.autopilot import follow_path
+    from shipid.outputs import OutputSet, check_outputs
+
+    check_outputs({"-o": (args.output, "figure"), "--json": (args.json, "json")}, [])
+    target, truth, speed, rps, steering, cond = _controlled(args)
+    waypoints = _parse_waypoints(args.waypoints)
+    # A reference ship's length, else the model file's particulars', else 10 m.
+    length = getattr(target, "length", None)
+    if not (length and length == length) and cond.get("particulars") is not None:
+        length = cond["particulars"].length
+    lookahead = args.lookahead or 2.0 * (length if length and length == length else 10.0)
+    nm, pid = _tuned(target, speed, rps, args.omega)
+    runs, rows = {}, []
+    cases = [("model", target, pid, speed, rps, steering)]
+    if truth is not None:
+        _, pid_truth = _tuned(truth, truth.approach_speed, None, args.omega)
+        pid_mirrored, note = _for_truth(pid, target, truth, speed, rps)
+        if note:
+            print(note)
+        cases += [("truth, model-tuned PID", truth, pid_mirrored, None, None, None),
+                  ("truth, truth-tuned PID", truth, pid_truth, None, None, None)]
+    for label, ship, gains, sp, n, gear in cases:
+        res = follow_path(ship, gains, waypoints, lookahead, dt=args.dt, speed=sp, rps=n,
+                          steering=gear)  # fmt: skip
+        runs[label] = res.log
+        rows.append({"run": label, "rms cross-track [m]": res.rms_cross_track,
+                     "max cross-track [m]": res.max_cross_track, "completed": res.completed,
+                     "Kp": gains.kp, "Ki": gains.ki, "Kd": gains.kd})  # fmt: skip
+    table = _pd().DataFrame(rows)
+    print(f"Line-of-sight path following (lookahead {lookahead:.3g} m), PID tuned on "
+          f"{args.model}:")
+    print(table.to_markdown(index=False, floatfmt=".4g"))
+    if truth is not None:
+        ratio = rows[1]["rms cross-track [m]"] / rows[2]["rms cross-track [m]"]
+        print(f"on the truth, the model-tuned controller's rms cross-track error is {ratio:.3g} × "
+              "the truth-tuned one's")
+    with OutputSet() as out:
+        if args.output:
+            from shipid.reporting.plots import tracks_with_waypoints
+
+            tracks_with_waypoints(runs, waypoints, args.output, "path following", out=out)
+        if args.json:
+            doc = {"waypoints": waypoints, "lookahead": lookahead, "runs": rows}
+            out.write(args.json, lambda p: p.write_text(_json_text(doc), "utf-8"))
+    return 0

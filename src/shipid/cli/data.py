@@ -1,0 +1,73 @@
+"""``shipid import``, ``indices`` and ``plot``: logs in, their IMO indices and figures."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from shipid.cli.common import _json_text, _read_logs
+from shipid.errors import ShipidError
+
+
+def cmd_plot(args) -> int:
+    """``shipid plot``: a figure of any logs."""
+    from shipid.outputs import check_outputs
+    from shipid.reporting.plots import logs_figure
+
+    check_outputs({"-o": (args.output, "figure")}, args.logs)
+    logs = _read_logs(args)
+    logs_figure({Path(p).name: log for p, log in zip(args.logs, logs, strict=True)}, args.output,
+                args.title or ", ".join(Path(p).name for p in args.logs))  # fmt: skip
+    print(f"figure written to {args.output}")
+    return 0
+
+
+def cmd_indices(args) -> int:
+    """``shipid indices``: IMO indices of measured logs."""
+    from shipid.outputs import atomic_write_text, check_outputs
+    from shipid.trials.indices import manoeuvre_indices
+
+    check_outputs({"--json": (args.json, "json")}, args.logs)
+    logs = _read_logs(args)
+    out = []
+    for path, log in zip(args.logs, logs, strict=True):
+        ind = manoeuvre_indices(log, args.kind, heading_deg=args.heading, smooth_s=args.smooth)
+        out.append({"name": str(path), "indices": ind})
+        kind = ind.get("kind")
+        print(f"{path}: {kind}" + (f" ({ind['reason']})" if kind == "other" else ""))
+        for k, v in ind.items():
+            if k not in ("kind", "reason"):
+                print(f"  {k}: {v:.4g}" if isinstance(v, float) else f"  {k}: {v}")
+    if args.json:
+        atomic_write_text(args.json, _json_text({"logs": out}))
+    return 0
+
+
+def cmd_import(args) -> int:
+    """``shipid import``: trial files to canonical logs."""
+    from shipid.data.io import write_log
+    from shipid.outputs import OutputSet, check_outputs
+
+    # Several files, or one into an existing folder (as cp does): -o is a folder; each file
+    # keeps its name with the extension of --ext.
+    several = len(args.logs) > 1 or Path(args.output).is_dir()
+    if several:
+        check_outputs({"-o": (args.output, "dir")}, args.logs)
+        targets = [Path(args.output) / (Path(p).stem + args.ext) for p in args.logs]
+        check_outputs({f"-o {t.name}": (t, "log") for t in targets}, args.logs)
+        stems = [t.name for t in targets]
+        dup = next((n for n in stems if stems.count(n) > 1), None)
+        if dup:
+            raise ShipidError(f"-o {args.output}: two inputs would both be written as {dup}")
+    else:
+        check_outputs({"-o": (args.output, "log")}, args.logs)
+        targets = [Path(args.output)]
+    logs = _read_logs(args)
+    with OutputSet() as out:
+        for log, target in zip(logs, targets, strict=True):
+            write_log(log, target, out=out)
+    for log, target in zip(logs, targets, strict=True):
+        meta = ", ".join(f"{k}={log.attrs[k]}" for k in ("ship", "rudder_positive", "scale")
+                         if k in log.attrs)  # fmt: skip
+        print(f"{len(log)} samples, {log['t'].iloc[-1] - log['t'].iloc[0]:.1f} s ({meta}) "
+              f"written to {target}")
+    return 0

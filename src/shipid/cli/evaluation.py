@@ -1,0 +1,234 @@
+"""``shipid validate`` and ``simulate``: a model run free against logs."""
+
+from __future__ import annotations
+
+import io
+import math
+import sys
+from functools import partial
+from pathlib import Path
+
+from shipid.cli.common import (
+    _json_text,
+    _particulars,
+    _pd,
+    _read_options,
+    _sampling_notes,
+    _scale_notes,
+    _ship_or_model,
+    _warn,
+)
+from shipid.errors import ShipidError
+
+
+def _unique_figure_names(names: list[str]) -> list[str]:
+    """File stems for figures of logs that may share a file name: a, a-2, a-3, ..."""
+    out, used = [], {}
+    for n in names:
+        stem = Path(n).stem or "log"
+        used[stem] = used.get(stem, 0) + 1
+        out.append(stem if used[stem] == 1 else f"{stem}-{used[stem]}")
+    return out
+
+
+def cmd_validate(args) -> int:
+    """``shipid validate``: free runs on logs, metrics, indices, figures, report."""
+    from shipid.evaluation.envelope import outside_envelope
+    from shipid.evaluation.validate import validate
+    from shipid.outputs import OutputSet, check_outputs
+    from shipid.reporting.modelfile import (
+        ensemble_from_document,
+        error_band_from_document,
+        has_refinement,
+        load_document,
+        model_from_document,
+        training_conditions,
+    )
+    from shipid.reporting.report import indices_frame, metrics_frame
+
+    check_outputs({"--json": (args.json, "json"), "--plots": (args.plots, "dir"),
+                   "--report": (args.report, "dir")}, [args.model, *args.logs])  # fmt: skip
+    doc = load_document(args.model)
+    if args.lssvm and not has_refinement(doc):
+        _warn(f"{args.model} has no refinement: its model is the LS-SVM one, which --lssvm "
+              "validates")  # fmt: skip
+    model = model_from_document(doc, args.model, "lssvm" if args.lssvm else "model")
+    ensemble = None if args.no_bands else ensemble_from_document(doc, args.model, model)
+    band = None if args.no_bands or args.lssvm else error_band_from_document(doc, args.model)
+    cond = training_conditions(doc)
+    env = cond["envelope"]
+    from shipid.data.io import read_log
+    from shipid.data.log import common_rudder_convention
+
+    options = _read_options(args)
+    logs, names, failed = [], [], []
+    for p in args.logs:
+        try:
+            logs.append(read_log(p, options))
+            names.append(str(p))
+        except ShipidError as exc:
+            failed.append(str(exc))
+    if cond["rudder_positive"]:  # a file that does not say its convention: no guess
+        logs, notes = common_rudder_convention(logs, cond["rudder_positive"])
+        for note in notes:
+            _warn(note)
+    for note in _scale_notes(cond, logs, names) + _sampling_notes(cond, logs, names):
+        _warn(note)
+    from tqdm.auto import tqdm
+
+    vals = [validate(model, log, [name], method=args.method, kind=args.kind,
+                     smooth_s=args.smooth, ensemble=ensemble, error_band=band)[0]
+            for log, name in tqdm(list(zip(logs, names, strict=True)), desc="logs", unit="log",
+                                  disable=args.quiet or len(logs) < 3)]  # fmt: skip
+    for v, log in zip(vals, logs, strict=True):
+        if v.error is None:
+            v.warnings.extend(outside_envelope(env, log))
+    good = [v for v in vals if v.error is None]
+    if good:
+        if band is not None:
+            print(f"The model's {band.describe()}: a log like those is inside it for about "
+                  f"{100 * band.level:g} % of its samples (columns 'in CV band').")  # fmt: skip
+        print(metrics_frame(good).to_markdown(index=False, floatfmt=".4g"))
+        table = indices_frame(good)
+        if len(table):
+            # Mixed columns (numbers and blanks) are objects, which floatfmt leaves alone.
+            table = table.map(lambda x: f"{x:.4g}" if isinstance(x, float) and x == x else x)
+            table = table.astype(object).where(table.notna(), "–")
+            print()
+            print(table.to_markdown(index=False, floatfmt=".4g"))
+    residuals = {}
+    if args.resid or args.report:
+        from shipid.evaluation.metrics import residual_correlations
+
+        for v, log in zip(vals, logs, strict=True):
+            if v.error is None:
+                n = len(v.simulation.log)
+                residuals[v.name] = {s: residual_correlations(
+                    log[s].to_numpy()[:n], v.simulation.log[s].to_numpy(),
+                    log["delta"].to_numpy()[:n], args.max_lag) for s in ("u", "v", "r")}
+    if args.resid and residuals:
+        rows = [{"log": Path(name).name, **{f"{s} autocorr. outside band": a[s]["auto_outside"]
+                                            for s in ("u", "v", "r")},
+                 **{f"{s} corr. with δ outside band": a[s]["cross_outside"]
+                    for s in ("u", "v", "r")}} for name, a in residuals.items()]  # fmt: skip
+        print("\nResidual analysis of the free-run errors (share of lags outside the 95 % band "
+              "of white noise; ≈ 0.05 when the error is white and independent of the rudder):")
+        print(_pd().DataFrame(rows).to_markdown(index=False, floatfmt=".2f"))
+    particulars = _particulars(args) or training_conditions(doc)["particulars"]
+    crit = None
+    if particulars is not None:
+        crit = _criteria_of_logs(good, logs, vals, particulars)
+        if crit is not None:
+            print("\nIMO criteria of the logs that are standard manoeuvres (measured, predicted):")
+            print(crit.to_markdown(index=False, floatfmt=".3g"))
+    for v in good:
+        if v.simulation.diverged:
+            print(f"{v.name}: {v.simulation.reason}", file=sys.stderr)
+        for w in v.warnings:
+            _warn(f"{v.name}: {w}")
+    errors = failed + [v.error for v in vals if v.error is not None]
+    for e in errors:
+        print(f"shipid: error: {e}", file=sys.stderr)
+    if not good:
+        return 1  # nothing validated: nothing to write
+    # Some logs validated: the outputs record every log, failed ones with their error.
+    with OutputSet() as out:
+        if args.json:
+            records = [v.to_dict() for v in vals] + [{"name": None, "error": e} for e in failed]
+            out.write(args.json, lambda p: p.write_text(_json_text({"logs": records}), "utf-8"))
+        figures: dict[str, dict[str, bytes]] = {}
+        if args.plots:
+            from shipid.reporting import plots
+
+            stems = _unique_figure_names([v.name for v in good])
+            pairs = [(v, log) for v, log in zip(vals, logs, strict=True) if v.error is None]
+            ext = "." + args.plot_format
+            # PNGs drawn once serve the folder and the report alike.
+            share = args.report is not None and args.plot_format == "png"
+            for (v, log), stem in zip(pairs, stems, strict=True):
+                title = Path(v.name).name
+                jobs = [("fit", stem + ext, partial(plots.measured_vs_simulated, log,
+                                                   v.simulation.log, title=title,
+                                                   bands=v.bands,
+                                                   error_band=v.error_band))]  # fmt: skip
+                if args.resid:
+                    jobs.append(("resid", stem + "-resid" + ext, partial(
+                        plots.residuals, residuals[v.name], title=f"{title}: residual analysis")))
+                for key, file_name, plot in jobs:
+                    if not share:
+                        plot(Path(args.plots) / file_name, out=out)
+                        continue
+                    buf = io.BytesIO()
+                    plot(buf)
+                    figures.setdefault(v.name, {})[key] = png = buf.getvalue()
+                    out.write(Path(args.plots) / file_name, partial(Path.write_bytes, data=png))
+        if args.report:
+            from shipid.reporting.html import validation_report
+
+            ident = doc.get("identification") or {}
+            se = {d: (ident.get("diagnostics") or {}).get(d, {}).get("std_errors")
+                  for d in model.structure.dofs} if not args.lssvm else None  # fmt: skip
+            text = validation_report(model, vals, logs, f"Validation of {Path(args.model).name}",
+                                     std_errors=se, criteria=crit,
+                                     warnings=[w for v in good for w in v.warnings],
+                                     residuals=residuals, figures=figures)  # fmt: skip
+            out.write(Path(args.report) / "report.html",
+                      lambda p: p.write_text(text, encoding="utf-8"))
+    return 1 if errors else 0
+
+
+def _criteria_of_logs(good, logs, vals, particulars):
+    """Measured and predicted criteria rows of 35° turns and 10/10, 20/20 zig-zags."""
+    from shipid.trials.criteria import measured_criteria
+    from shipid.trials.trial import describe_trial
+
+    rows = []
+    by_name = {v.name: log for v, log in zip(vals, logs, strict=True)}
+    for v in good:
+        log = by_name[v.name]
+        trial = describe_trial(log, v.kind)
+        rudder = math.degrees(trial.plateau_angle)
+        speed = float(log["u"].iloc[: max(1, len(log) // 50)].mean())
+        if not speed > 0:
+            continue
+        meas = v.indices.get("measured", {})
+        pred = v.indices.get("closed_loop") if v.kind == "zigzag" else v.indices.get("simulated")
+        args = (rudder, meas.get("switch_heading_deg"), particulars.length, speed, particulars.scale)
+        m_rows = measured_criteria(meas, *args)
+        p_rows = {r["criterion"]: r for r in measured_criteria({**(pred or {}), "kind": v.kind},
+                                                               *args)}  # fmt: skip
+        for r in m_rows:
+            p = p_rows.get(r["criterion"], {})
+            rows.append({"log": Path(v.name).name, "criterion": r["criterion"], "unit": r["unit"],
+                         "limit": r["limit"], "measured": r["value"],
+                         "measured passes": r["passed"], "predicted": p.get("value"),
+                         "predicted passes": p.get("passed")})  # fmt: skip
+    return _pd().DataFrame(rows) if rows else None
+
+
+def cmd_simulate(args) -> int:
+    """``shipid simulate``: drive a model or vessel with a log's inputs."""
+    from shipid.data.io import read_log, write_log
+    from shipid.dynamics.simulate import simulate_log
+    from shipid.outputs import check_outputs
+
+    log_path = args.log
+    check_outputs({"-o": (args.output, "log")}, [args.model, log_path])
+    from shipid.data.log import in_rudder_convention
+
+    target, cond = _ship_or_model(args.model)
+    dynamics = getattr(target, "dynamics", target)
+    log, note = in_rudder_convention(read_log(log_path, _read_options(args)),
+                                     getattr(target, "rudder_positive", None)
+                                     or cond.get("rudder_positive"))  # fmt: skip
+    if note:
+        _warn(note)
+    for note in (_scale_notes(cond, [log], [str(log_path)])
+                 + _sampling_notes(cond, [log], [str(log_path)])):
+        _warn(note)
+    res = simulate_log(dynamics, log, method=args.method)
+    write_log(res.log, args.output)
+    if res.diverged:
+        print(res.reason, file=sys.stderr)
+    print(f"{len(res.log)} samples written to {args.output}")
+    return 0

@@ -1,0 +1,495 @@
+"""``shipid identify``, ``select``, ``compare``, ``rescale``, ``study``, ``demo``: models from logs."""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+from pathlib import Path
+
+from shipid.cli.common import (
+    _approach,
+    _cores,
+    _fmt_speed,
+    _json_text,
+    _log_particulars,
+    _log_scale,
+    _parse_drop,
+    _parse_gammas,
+    _pd,
+    _physics,
+    _rudder_rate,
+    _std_errors,
+    _structure,
+    _term_display,
+    _training_logs,
+    _warn,
+    _warn_approach,
+)
+from shipid.errors import ShipidError
+
+
+# ---------------------------------------------------------------------------- commands
+def cmd_demo(args) -> int:
+    """``shipid demo``: the paper's experiment on the embedded scale ship."""
+    from shipid.demo import run_demo, summary
+    from shipid.outputs import check_outputs
+
+    check_outputs({"--out": (args.out, "dir")})
+    t0 = time.perf_counter()
+    result = run_demo(args.out, args.seed, progress=lambda m: print(m, file=sys.stderr))
+    print(summary(result))
+    print(f"figures and report written to {Path(args.out) / 'report.md'} "
+          f"({time.perf_counter() - t0:.1f} s)")
+    return 0
+
+
+def _free_run_table(refinement) -> str:
+    lines = ["| training log | LS-SVM u / v / r std | refined u / v / r std |", "|---|---|---|"]
+    for row in refinement.free_run:
+        cells = []
+        for key in ("initial", "refined"):
+            e = row[key]
+            div = " (diverged)" if row[f"{key}_diverged"] else ""
+            cells.append(f"{e['u']:.4f} / {e['v']:.4f} / {e['r']:.4f}{div}")
+        lines.append(f"| {row['name']} | {cells[0]} | {cells[1]} |")
+    return "\n".join(lines)
+
+
+def cmd_identify(args) -> int:
+    """``shipid identify``: a model from logs (LS-SVM, optional refinement, checks)."""
+    from shipid.data.preprocess import lowpass
+    from shipid.identification.identify import identify
+    from shipid.identification.plausibility import new_failures, plausibility_at_approach
+    from shipid.outputs import atomic_write_text, check_outputs
+    from shipid.reporting.modelfile import model_text
+
+    check_outputs({"-o": (args.output, "json")}, args.logs)
+    if args.bootstrap is not None and args.refine:
+        raise ShipidError("--bootstrap describes the LS-SVM fit; it does not go with --refine")
+    if args.output_error and (args.refine or args.bootstrap is not None):
+        raise ShipidError("--output-error is its own fit with its own intervals; it does not go "
+                          "with --refine or --bootstrap")  # fmt: skip
+    if args.error_band is not None and (args.refine or args.output_error):
+        raise ShipidError("--error-band describes the LS-SVM fit; it does not go with --refine "
+                          "or --output-error")  # fmt: skip
+    logs = _training_logs(args)
+    raw_logs = logs  # the output-error fit needs the noise as measured, not prefiltered
+    names = [str(p) for p in args.logs]
+    physics = _physics(args, logs, _structure(args))
+    cutoff, filter_by = args.filter, "given"
+    if cutoff == "auto":
+        from shipid.identification.prefilter import choose_prefilter
+
+        def fit(candidate_logs):
+            return identify(candidate_logs, model=args.model, form=args.form,
+                            gamma=1e4 if args.gamma == "auto" else args.gamma,
+                            drop=_parse_drop(args.drop), names=names, force=True,
+                            estimator=args.estimator, physics=physics).model  # fmt: skip
+
+        cutoff, table = choose_prefilter(logs, fit)
+        filter_by = "free-run error, one-standard-error rule"
+        shown = "none" if cutoff is None else f"{cutoff:.4g} Hz"
+        print(f"prefilter of u, v, r: {shown} (chosen by the free-run error on the logs; "
+              "--filter HZ|none to set it)")  # fmt: skip
+    elif cutoff == "none":
+        cutoff = None
+    if cutoff is not None:
+        logs = [lowpass(log, cutoff) for log in logs]
+    gamma, gamma_report = args.gamma, None
+    if gamma == "auto":
+        gamma, gamma_report = _auto_gamma(args, logs, names, physics)
+    ident = identify(logs, model=args.model, form=args.form, gamma=gamma,
+                     drop=_parse_drop(args.drop), names=names, force=args.force,
+                     estimator=args.estimator, physics=physics)  # fmt: skip
+    speed, rps = _approach(logs[0], "u"), _approach(logs[0], "n")
+    _warn_approach(logs, names)
+    prep = {"dt": args.dt, "start": args.start, "end": args.end, "lead": args.lead,
+            "filter_hz": cutoff, "filter_by": filter_by if cutoff is not None else None,
+            "columns": args.columns, "degrees": args.degrees,
+            "format": args.format, "scale": args.scale,
+            "approach_speed": speed, "approach_rps": rps, "rudder_rate": _rudder_rate(logs),
+            "rudder_positive": logs[0].attrs.get("rudder_positive"),
+            "log_scale": _log_scale(logs)}  # fmt: skip
+    refinement = None
+    print(ident.model.equations(std_errors=_std_errors(ident)))
+    print("(± standard errors of the equation-error fit: they hold the scatter of the fitted "
+          "accelerations, not the bias that noise in u, v, r leaves in the coefficients; "
+          "--output-error gives intervals that hold the true values, --bootstrap N intervals "
+          "of the predictions)")  # fmt: skip
+    for dof, d in ident.diagnostics.items():
+        print(f"{dof}: condition number {d['condition_number']:.3g}, one-step R² "
+              f"{d['one_step_r2']:.4f}, bias b = {ident.discrete[dof]['bias']:.4g}")
+    band = None
+    if args.error_band is not None:
+        from shipid.evaluation.error_band import cross_validated_band
+
+        def refit_without(train):  # the same prefilter, structure, γ and physics
+            return identify([lowpass(x, cutoff) for x in train] if cutoff is not None else train,
+                            model=args.model, form=args.form, gamma=gamma,
+                            drop=_parse_drop(args.drop), force=True, estimator=args.estimator,
+                            physics=physics).model  # fmt: skip
+
+        band = cross_validated_band(refit_without, raw_logs, names, args.error_band)
+        print(f"{band.describe()} (γ and the prefilter as chosen on all logs); stored for "
+              "validate")  # fmt: skip
+    ensemble = None
+    if args.bootstrap is not None:
+        from shipid.identification.identify import weighted_refit
+        from shipid.identification.uncertainty import bootstrap
+
+        refit = weighted_refit(logs, model=args.model, form=args.form, gamma=gamma,
+                               drop=_parse_drop(args.drop), names=names,
+                               estimator=args.estimator, physics=physics)  # fmt: skip
+        ensemble = bootstrap(logs, refit, args.bootstrap, args.block, args.seed, progress=True)
+        table = ensemble.coefficient_table()
+        table["term"] = [_term_display(t) for t in table["term"]]
+        print(f"\n95 % intervals of the coefficients ({ensemble.method}, "
+              f"{ensemble.replicates} replicates, {ensemble.block_s:g} s blocks):")
+        print(table.to_markdown(index=False, floatfmt=".4g"))
+    if args.refine:
+        from shipid.identification.refine import refine  # scipy.optimize: only when asked
+
+        how = "whole logs" if args.segment is None else f"{args.segment:g} s segments"
+        print(f"refining by output error ({how})…", file=sys.stderr)
+        refinement = refine(ident.model, logs, segment_s=args.segment, gamma=gamma,
+                            max_nfev=args.refine_evals, names=names, progress=True)  # fmt: skip
+        print()
+        print("refined by output error:")
+        print(refinement.model.equations())
+        print(f"cost {refinement.cost_initial:.4g} → {refinement.cost_final:.4g} in "
+              f"{refinement.nfev} evaluations ({refinement.message})")
+        print(_free_run_table(refinement))
+    if args.output_error:
+        refinement, ensemble = _output_error(ident, raw_logs, names, args)
+    final = ident.model
+    if speed is None or not speed > 0:
+        raise ShipidError(f"{names[0]}: the first training log starts without headway (u = "
+                          f"{speed}); trim it to the manoeuvre (--start)")  # fmt: skip
+    plausibility, notes = plausibility_at_approach(ident.model, speed, rps)
+    if refinement:
+        refined_report, refined_notes = plausibility_at_approach(refinement.model, speed, rps)
+        worse = new_failures(plausibility, refined_report, ident.model)
+        if worse:
+            # Never hand out a model that fails checks the LS-SVM model passes, or fails worse.
+            ident.warnings.append(
+                "refinement: the refined model fails plausibility checks the LS-SVM model passes ("
+                + "; ".join(worse[:2]) + "); the model file's model is the LS-SVM one, the "
+                "refined one is kept under identification.refinement.refined_model")
+            if args.output_error:
+                ensemble = None  # its draws describe the output-error model, not this one
+        else:
+            final, plausibility, notes = refinement.model, refined_report, refined_notes
+    sl = plausibility["straight_line"]
+    if sl:
+        print(f"straight-line {'stable' if sl['stable'] else 'UNSTABLE'} (largest sway–yaw "
+              f"eigenvalue real part {sl['max_real_part']:.3g} 1/s); surge equilibrium "
+              f"{_fmt_speed(plausibility['surge_equilibrium'])}; checked from the "
+              f"{plausibility['approach']}")  # fmt: skip
+    ident.warnings.extend(f"plausibility: {n}" for n in notes)
+    if refinement:
+        ident.warnings.extend(f"refinement: {n}" for n in refinement.warnings)
+    text = model_text(ident, args.logs, preprocessing=prep, refinement=refinement,
+                      plausibility=plausibility, model=final, selection=gamma_report,
+                      particulars=_log_particulars(logs),
+                      uncertainty=ensemble.to_dict() if ensemble else None,
+                      error_band=band.to_dict() if band else None)  # fmt: skip
+    from shipid.reporting.modelfile import prime_record
+
+    _print_prime(prime_record(final, _log_particulars(logs), speed))
+    atomic_write_text(args.output, text)
+    for w in ident.warnings:
+        _warn(w)
+    print(f"model written to {args.output}")
+    return 0
+
+
+def _output_error(ident, logs, names, args):
+    """``identify --output-error``: the maximum-likelihood output-error fit from the LS-SVM model,
+    printed with its standard errors and intervals; returns the fit and its ensemble."""
+    from shipid.identification.output_error import coefficient_intervals, output_error
+
+    print("fitting by maximum-likelihood output error (unfiltered logs)…", file=sys.stderr)
+    fit, ensemble = output_error(ident.model, logs, max_nfev=args.refine_evals, names=names,
+                                 seed=args.seed)  # fmt: skip
+    st = fit.statistics
+    print("\nmaximum-likelihood output error (± standard error):")
+    print(fit.model.equations(std_errors=st["standard_errors"]))
+    noise = ", ".join(f"{s} {v:.3g}" for s, v in st["noise"].items())
+    print(f"measurement noise from the residuals: {noise}; cost {fit.cost_initial:.4g} → "
+          f"{fit.cost_final:.4g} in {fit.nfev} evaluations; covariance inflation for residual "
+          f"correlation ×{st['covariance_inflation']:.3g}")  # fmt: skip
+    table = coefficient_intervals(fit)
+    table["term"] = [_term_display(t) for t in table["term"]]
+    print(f"\n{st['level'] * 100:g} % intervals of the coefficients (estimate ± 1.96 standard "
+          "errors; the LS-SVM start beside them):")  # fmt: skip
+    print(table.to_markdown(index=False, floatfmt=".4g"))
+    print(_free_run_table(fit))
+    return fit, ensemble
+
+
+def _print_prime(record: dict | None) -> None:
+    """The prime (non-dimensional) coefficients next to the dimensional ones."""
+    if not record:
+        return
+    print(f"\nPrime form (L = {record['length']:g} m, U = {record['speed']:.4g} m/s, the "
+          f"{record['speed_basis']}; ρ = {record['rho']:g} kg/m³; u̇′ = u̇ L/U², ṙ′ = ṙ L²/U²):")
+    rows = [{"equation": f"{dof}̇′", "term": _term_display(t), "prime": c}
+            for dof, terms in record["coefficients"].items() for t, c in terms.items()]
+    print(_pd().DataFrame(rows).to_markdown(index=False, floatfmt=".5g"))
+
+
+def _auto_gamma(args, logs, names, physics=None) -> tuple[float, dict]:
+    """γ for the given structure: exact LOO of the LS-SVM pre-screens the grid, free-run
+    cross-validation over the logs decides (``shipid.identification.select``)."""
+    from shipid.identification.select import select
+
+    structure = _structure(args)
+    cv = args.cv or ("logo" if len(logs) >= 2 else "blocks:4")
+    sel = select(logs, library=structure, search="none", names=names, cv=cv,
+                 estimator=args.estimator, plausibility=False, physics=physics)  # fmt: skip
+    table = sel.candidates[["gamma", "score", "score_se", "folds_diverged"]]
+    print(f"γ chosen by free-run cross-validation ({cv}): {sel.gamma:g}")
+    print(table.to_markdown(index=False, floatfmt=".4g"))
+    print()
+    return sel.gamma, {"gamma_by": "free-run CV", **sel.to_dict()}
+
+
+def cmd_select(args) -> int:
+    """``shipid select``: structure and γ by cross-validated free-run error."""
+    from shipid.identification.select import RESAMPLES, SelectOptions, select
+    from shipid.outputs import OutputSet, check_outputs
+    from shipid.reporting.modelfile import model_text
+
+    check_outputs({"-o": (args.output, "json"), "--table": (args.table, "log")}, args.logs)
+    logs = _training_logs(args)
+    names = [str(p) for p in args.logs]
+    from shipid.dynamics.model import get_structure
+    from shipid.identification.select import default_library
+
+    try:
+        library = (get_structure(args.library) if args.library is not None
+                   else default_library(logs)[0])  # fmt: skip
+    except ValueError as exc:
+        raise ShipidError(str(exc)) from None
+    # The default library is passed as None: select trims it to the logs and says so.
+    options = SelectOptions(library=library if args.library is not None else None,
+                            search=args.search, cv=args.cv,
+                            estimator=args.estimator, method=args.method,
+                            max_evaluations=args.max_evaluations,
+                            plausibility=not args.no_plausibility, speed=args.speed,
+                            rps=args.rps, one_standard_error=not args.best,
+                            progress=not args.quiet, physics=_physics(args, logs, library),
+                            average=args.average,
+                            **({"gammas": _parse_gammas(args.gammas)} if args.gammas else {}))
+    sel = select(logs, options, names=names)
+    ident = sel.identification
+    if sel.model is not sel.chosen_model:
+        print(f"The chosen candidate:\n{sel.chosen_model.equations()}\n\nThe model written, "
+              f"the average of {len(sel.shares)} candidates weighted by how often the choice "
+              "rule picks them on resampled held-out logs (--average):")  # fmt: skip
+    print(sel.model.equations())
+    whose = " of the chosen candidate" if sel.model is not sel.chosen_model else ""
+    print(f"\nγ = {sel.gamma:g}; free-run CV score{whose} {sel.score:.4f} ({options.cv}; 1 ≈ "
+          f"predicting the mean); {len(sel.candidates)} candidates")
+    cols = ["chosen", "score", "score_se", "score_u", "score_v", "score_r", "gamma", "n_terms",
+            "folds_diverged", "plausible", "share", "stage", "note"]
+    shown = sel.candidates.head(args.show)
+    if not shown["chosen"].any():
+        shown = _pd().concat([shown, sel.candidates[sel.candidates["chosen"]]])
+    print(shown[cols].to_markdown(index=False, floatfmt=".4g"))
+    fitted = "the average" if sel.model is not sel.chosen_model else "the chosen structure"
+    print(f"\nHeld-out logs ({fitted} fitted without each):")
+    print(_fold_table(sel.folds))
+    if sel.error_band is not None:
+        print(f"Their {sel.error_band.describe()}; stored in the model file, validate reports "
+              "each log's share of samples inside it.")  # fmt: skip
+    speed, rps = _approach(logs[0], "u"), _approach(logs[0], "n")
+    _warn_approach(logs, names)
+    plausibility, notes = sel.plausibility, sel.plausibility_notes
+    ident.warnings.extend(f"plausibility: {n}" for n in notes)
+    prep = {"dt": args.dt, "start": args.start, "end": args.end, "lead": args.lead,
+            "columns": args.columns, "degrees": args.degrees, "format": args.format,
+            "scale": args.scale, "approach_speed": speed, "approach_rps": rps,
+            "rudder_rate": _rudder_rate(logs),
+            "rudder_positive": logs[0].attrs.get("rudder_positive"),
+            "log_scale": _log_scale(logs)}  # fmt: skip
+    ensemble = None
+    others = len(sel.shares) - (sel.chosen_share > 0)
+    print(f"\nThe choice on {RESAMPLES} resamples of the held-out logs: this candidate "
+          f"{100 * sel.chosen_share:.0f} %, {others} other(s) the rest (column share)")
+    if args.bootstrap is not None:
+        from shipid.identification.selection_ensemble import selection_ensemble
+
+        # Each replicate: a candidate drawn by its share, refitted on a block resample.
+        ensemble = selection_ensemble(logs, sel, args.bootstrap, args.block, args.seed,
+                                      names=names, progress=not args.quiet)  # fmt: skip
+        table = ensemble.coefficient_table()
+        table["term"] = [_term_display(t) for t in table["term"]]
+        print(f"\n95 % intervals of the coefficients ({ensemble.replicates} replicates: "
+              f"{ensemble.method}, {ensemble.block_s:g} s blocks; a term outside the model "
+              "has value 0, inclusion the share of replicates that hold it):")  # fmt: skip
+        print(table.to_markdown(index=False, floatfmt=".4g"))
+    text = model_text(ident, args.logs, preprocessing=prep, plausibility=plausibility,
+                      model=sel.model, selection=sel.to_dict(), particulars=_log_particulars(logs),
+                      uncertainty=ensemble.to_dict() if ensemble else None)  # fmt: skip
+    with OutputSet() as out:
+        out.write(args.output, lambda p: p.write_text(text, encoding="utf-8"))
+        if args.table:
+            from shipid.data.io import write_table
+
+            write_table(sel.candidates, args.table, out)
+    for w in sel.warnings:
+        _warn(w)
+    print(f"model written to {args.output}")
+    return 0
+
+
+def _fold_table(folds) -> str:
+    pd = _pd()
+
+    rows = []
+    for f in folds:
+        if "error" in f:
+            rows.append({"held-out log": f["held_out"], "error": f["error"]})
+            continue
+        m, sp = f["metrics"], f["spread"]
+        ind = (f.get("indices") or {})
+        meas = ind.get("measured", {})
+        # Zig-zags: the closed-loop run of the trial on the model, not the open-loop replay.
+        sim = ind.get("closed_loop") or {} if f.get("kind") == "zigzag" else ind.get("simulated", {})
+        key = "tactical_diameter" if f.get("kind") == "turning" else "first_overshoot_deg"
+        rows.append({"held-out log": Path(f["held_out"]).name, "kind": f.get("kind"),
+                     "u err / spread": f"{m['u']:.4f} / {sp['u']:.4f}",
+                     "v err / spread": f"{m['v']:.4f} / {sp['v']:.4f}",
+                     "r err / spread": f"{m['r']:.4f} / {sp['r']:.4f}",
+                     "diverged": f["diverged"],
+                     key.replace("_", " ") + " meas / pred": (
+                         f"{meas.get(key):.3g} / {sim.get(key):.3g}"
+                         if meas.get(key) is not None and sim.get(key) is not None else "–")})
+    return pd.DataFrame(rows).to_markdown(index=False)
+
+
+def cmd_compare(args) -> int:
+    """``shipid compare``: methods × held-out logs in one table."""
+    from shipid.evaluation.compare import compare, summary
+    from shipid.outputs import OutputSet, check_outputs
+
+    check_outputs({"--json": (args.json, "json")}, args.logs)
+    methods = [m.strip() for m in args.methods.split(",") if m.strip()]
+    logs = _training_logs(args)
+    names = [Path(p).name for p in args.logs]
+    table = compare(logs, args.model, methods, names, gamma=args.gamma, cv=args.cv,
+                    method=args.method, progress=not args.quiet)  # fmt: skip
+    print(f"Free-run score per held-out log ({args.cv}; error RMS over the log's spread, mean of "
+          "u, v, r; 1 ≈ predicting the mean), model structure " + str(args.model) + ":")
+    print(summary(table).to_markdown(floatfmt=".3f"))
+    with OutputSet() as out:
+        if args.json:
+            doc = {"structure": args.model, "cv": args.cv, "gamma": args.gamma,
+                   "rows": table.to_dict(orient="records")}  # fmt: skip
+            out.write(args.json, lambda p: p.write_text(_json_text(doc), "utf-8"))
+    return 0
+
+
+def cmd_rescale(args) -> int:
+    """``shipid rescale``: a model file carried to a similar ship of another length (Froude)."""
+    from shipid.data.particulars import Particulars
+    from shipid.outputs import atomic_write_text, check_outputs
+    from shipid.reporting.modelfile import load_document, model_from_document, rescaled_document
+
+    check_outputs({"-o": (args.output, "json")}, [args.model])
+    doc = load_document(args.model)
+    length = Particulars.from_mapping(doc["particulars"]).length if doc.get("particulars") else None
+    if (args.factor is None) == (args.length is None):
+        raise ShipidError("give the scale factor --factor F (new length / old) or the new --length")
+    factor = args.factor
+    if args.length is not None:
+        if length is None:
+            raise ShipidError(f"{args.model}: --length needs the model's particulars (its length); "
+                              "give --factor instead")  # fmt: skip
+        factor = args.length / length
+    out = rescaled_document(doc, factor, args.rho, args.model)
+    model = model_from_document(out, args.output)
+    k = math.sqrt(factor)
+    what = f"{length:g} m → {length * factor:g} m" if length else f"× {factor:g} in length"
+    print(f"Froude scaling {what}: speeds × {k:.4g}, times × {k:.4g}, rates ÷ {k:.4g}")
+    speed = ((out.get("identification") or {}).get("preprocessing") or {}).get("approach_speed")
+    if speed:
+        print(f"approach speed {speed:.4g} m/s")
+    print(model.equations())
+    _print_prime(out.get("prime"))
+    atomic_write_text(args.output, _json_text(out))
+    print(f"model written to {args.output}")
+    return 0
+
+
+def cmd_study(args) -> int:
+    """``shipid study``: a Monte Carlo study, or the identification of many log sets, on Dask."""
+    from shipid.data.io import write_table
+    from shipid.evaluation.study import GRID_KEYS, read_spec, run_study, summary
+    from shipid.outputs import OutputSet, check_outputs
+
+    check_outputs({"-o": (args.output, "log")}, [args.spec])
+    spec = read_spec(args.spec)
+    where = ("this process" if args.scheduler == "serial" else args.scheduler
+             or f"a local Dask cluster of {args.workers or _cores()} workers")  # fmt: skip
+    if hasattr(spec, "jobs"):
+        return _study_logs(args, spec, where)
+    if args.models:
+        raise ShipidError("--models is for a study of kind logs (model files of its jobs)")
+    n = len(spec.trials())
+    print(f"{n} trials ({len(spec.seeds)} seeds × {n // len(spec.seeds)} grid points) on {where}")
+    start = time.perf_counter()
+    results = run_study(spec, scheduler=args.scheduler, workers=args.workers,
+                        progress=not args.quiet)  # fmt: skip
+    wall = time.perf_counter() - start
+    print("Held-out error std of the identified model over the true model's on the same noisy "
+          "log (1 = as good as the truth):")  # fmt: skip
+    table = summary(results)
+    varying = [k for k in GRID_KEYS if table[k].nunique() > 1]
+    fixed = ", ".join(f"{k} {table[k].iloc[0]:g}" if isinstance(table[k].iloc[0], float)
+                      else f"{k} {table[k].iloc[0]}" for k in GRID_KEYS if k not in varying)
+    print(f"({fixed}; per held-out manoeuvre: the median over the seeds and the largest)")
+    table.index = [", ".join(f"{k} {row[k]}" for k in varying) or "all"
+                   for _, row in table.iterrows()]  # fmt: skip
+    print(table.drop(columns=list(GRID_KEYS)).T.to_markdown(floatfmt=".3g"))
+    print(f"\n{n} trials in {wall:.1f} s wall ({results['seconds'].sum():.1f} s of trial time)")
+    with OutputSet() as out:
+        write_table(results, args.output, out)
+    failed = results[results["error"] != ""]
+    if len(failed):
+        _warn(f"{len(failed)} of {n} trials failed (first: seed {failed['seed'].iloc[0]}: "
+              f"{failed['error'].iloc[0]}); their rows have the error")  # fmt: skip
+    print(f"results written to {args.output}")
+    return 0
+
+
+def _study_logs(args, spec, where: str) -> int:
+    """A study of kind logs: every job's model file into --models, the table to -o."""
+    from shipid.data.io import write_table
+    from shipid.identification.batch import run_batch
+    from shipid.outputs import OutputSet, check_outputs
+
+    if not args.models:
+        raise ShipidError(f"{args.spec}: a study of kind logs writes model files: give --models DIR")
+    inputs = [args.spec, *(p for job in spec.jobs for p in job.logs)]
+    check_outputs({"-o": (args.output, "log"), "--models": (args.models, "dir")}, inputs)
+    print(f"{len(spec.jobs)} jobs ({sum(len(j.logs) for j in spec.jobs)} logs) on {where}")
+    start = time.perf_counter()
+    table, texts = run_batch(spec, scheduler=args.scheduler, workers=args.workers,
+                             progress=not args.quiet)  # fmt: skip
+    cols = ["name", "command", "logs", "terms", "gamma", "prefilter_hz", "cv_score", "seconds",
+            "error"]
+    print(table[[c for c in cols if c in table]].to_markdown(index=False, floatfmt=".4g"))
+    print(f"\n{len(spec.jobs)} jobs in {time.perf_counter() - start:.1f} s wall")
+    models = Path(args.models)
+    with OutputSet() as out:
+        for name, text in texts.items():
+            out.write(models / f"{name}.json", lambda p, t=text: p.write_text(t, encoding="utf-8"))
+        write_table(table, args.output, out)
+    failed = table[table["error"] != ""]
+    print(f"{len(texts)} model files written to {models}, the table to {args.output}")
+    for _, row in failed.iterrows():  # as validate's batch: the others are written, exit 1
+        print(f"shipid: error: job {row['name']}: {row['error']}", file=sys.stderr)
+    return 1 if len(failed) else 0

@@ -1,0 +1,417 @@
+"""The ``shipid`` argument parser: every command's options, and the checks argparse runs on them."""
+
+from __future__ import annotations
+
+import argparse
+
+from shipid import __version__
+from shipid.cli.common import FORMATS, KINDS, LINEAR_ESTIMATORS
+from shipid.cli.control import cmd_autopilot, cmd_export, cmd_follow, cmd_linearise
+from shipid.cli.data import cmd_import, cmd_indices, cmd_plot
+from shipid.cli.evaluation import cmd_simulate, cmd_validate
+from shipid.cli.identification import (
+    cmd_compare,
+    cmd_demo,
+    cmd_identify,
+    cmd_rescale,
+    cmd_select,
+    cmd_study,
+)
+from shipid.cli.trials import cmd_criteria, cmd_manoeuvre
+
+
+def _add_log_options(p: argparse.ArgumentParser) -> None:
+    g = p.add_argument_group("log files")
+    g.add_argument("--format", default="canonical", choices=FORMATS,
+                   help="file format (default: %(default)s CSV/Parquet)")
+    g.add_argument("--scale", type=float, metavar="LAMBDA",
+                   help="simman-marin: Froude-scale the full-scale data to model scale 1/λ")
+    g.add_argument("--columns", metavar="MAP", help="map file columns to canonical names, "
+                   "e.g. t=time,delta=rudder_angle")
+    g.add_argument("--degrees", metavar="COLS", default="",
+                   help="angle columns given in degrees, e.g. delta,psi,r")
+    g.add_argument("--dt", type=float, help="resample to this uniform sampling time [s]")
+    g.add_argument("--start", type=_time_or_auto, metavar="S|auto",
+                   help="trim: first time [s], or 'auto': --lead s before the detected rudder execute")
+    g.add_argument("--lead", type=float, default=5.0, metavar="S",
+                   help="with --start auto: seconds kept before the execute (default %(default)s)")
+    g.add_argument("--end", type=_end_time, metavar="S|auto|dropout",
+                   help="trim: last time [s], or 'auto': the end of the manoeuvre (last large rudder, "
+                   "propeller still running), or 'dropout': before the first span where the "
+                   "ship gains headway with the propeller stopped (its logging dropped out)")
+    g.add_argument("--fill-gaps", action="store_true",
+                   help="interpolate missing values inside signals (default: refuse the log)")
+    g.add_argument("--rudder-positive", choices=("port", "starboard"),
+                   help="where a positive rudder angle turns the ship (default: the file's "
+                   "metadata, else port as in the paper)")
+    g.add_argument("--particulars", metavar="FILE",
+                   help="ship particulars (YAML or JSON: length, beam, draught, ...; the MARIN "
+                   "ship_data.yml reads as is), kept with the logs and the model")
+
+
+def _number_or_auto(text: str) -> float | str:
+    return _time_or_auto(text)
+
+
+def _number_or_auto_or_none(text: str) -> float | str:
+    if text in ("auto", "none"):
+        return text
+    try:
+        return float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, 'auto' or 'none', got {text!r}") \
+            from None
+
+
+def _time_or_auto(text: str) -> float | str:
+    if text == "auto":
+        return text
+    try:
+        return float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected seconds or 'auto', got {text!r}") from None
+
+
+def _end_time(text: str) -> float | str:
+    return text if text == "dropout" else _time_or_auto(text)
+
+
+# ---------------------------------------------------------------------------- parser
+def _add_physics_options(p) -> None:
+    g = p.add_argument_group("physics (increment form; lssvm or ols)")
+    g.add_argument("--prior", metavar="clarke|MODEL.json",
+                   help="draw the fit toward a prior instead of zero: 'clarke' (linear sway–yaw "
+                   "and rudder terms from the particulars, Clarke et al. 1983) or a model file")
+    g.add_argument("--constraints", metavar="LIST",
+                   help="comma list: signs (damping, resistance, thrust and rudder terms keep "
+                   "their physical sign), steady-speed (u̇ = 0 on the approach), stable "
+                   "(straight-line stability at the approach: the yaw equation given the "
+                   "sway one)")
+    g.add_argument("--bound", action="append", metavar="'DOF: TERM <= X'",
+                   help="a bound on one coefficient, e.g. 'r: u*r <= 0' (repeatable)")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of every command."""
+    ap = argparse.ArgumentParser(prog="shipid", description="Semiphysical identification of ship "
+                                 "manoeuvring models with LS-SVM (Moreno-Salinas et al. 2013).")
+    ap.add_argument("--version", action="version", version=f"shipid {__version__}")
+    sub = ap.add_subparsers(dest="command", required=True)
+
+    p = sub.add_parser("demo", help="the paper's experiment on the embedded scale ship")
+    p.add_argument("--out", default="shipid-demo", help="output folder (default ./%(default)s)")
+    p.add_argument("--seed", type=int, default=0, help="noise seed (default %(default)s)")
+    p.set_defaults(func=cmd_demo)
+
+    p = sub.add_parser("identify", help="identify a model from trial logs")
+    p.add_argument("logs", nargs="+", metavar="LOG")
+    p.add_argument("--model", default="blanke",
+                   help="structure: blanke (default), blanke-thrust, blanke-speed, blanke-race, "
+                   "blanke-rps, abkowitz3, low-speed, wind, race-damping, propeller-asymmetry, "
+                   "astern, linear-sway-yaw, nomoto1; combine "
+                   "with + (blanke-rps+wind, blanke-race+race-damping) or write terms: "
+                   "'u: |u|u, v*r, 1; v: ...; r: ...'")
+    p.add_argument("--form", default="increment", choices=("increment", "paper"),
+                   help="regression form (default %(default)s)")
+    p.add_argument("--gamma", type=_number_or_auto, default=1e4, metavar="G|auto",
+                   help="LS-SVM regularisation γ, or 'auto': chosen by free-run cross-validation "
+                   "over the logs (default %(default)g)")
+    p.add_argument("--estimator", default="lssvm", choices=LINEAR_ESTIMATORS,
+                   help="equation-error estimator (default %(default)s, the paper's)")
+    p.add_argument("--cv", help="with --gamma auto: logo, kfold:K or blocks:K (default: logo, "
+                   "blocks:4 for one log)")
+    p.add_argument("--drop", help="terms to drop, e.g. u:r^2 (the paper drops r²)")
+    p.add_argument("--filter", type=_number_or_auto_or_none, default="auto", metavar="HZ|auto|none",
+                   help="zero-phase low-pass of u, v, r against the errors-in-variables bias: a "
+                   "cut-off, 'none', or 'auto' (default): the cut-off whose model has the "
+                   "smallest free-run error on the logs (one-standard-error rule, so clean data "
+                   "keep none)")
+    p.add_argument("--force", action="store_true",
+                   help="keep a fit whose regressors are nearly dependent (still reported)")
+    p.add_argument("--refine", action="store_true",
+                   help="refine the LS-SVM model by output error (free-run fit to the logs); the "
+                   "model file holds the refined model and keeps the LS-SVM one")
+    p.add_argument("--output-error", action="store_true",
+                   help="fit the coefficients by maximum-likelihood output error (free runs from "
+                   "estimated initial states against the unfiltered logs; consistent under "
+                   "measurement noise, unlike any equation-error fit), with standard errors, "
+                   "95 %% intervals and 200 covariance draws stored for prediction bands and "
+                   "index intervals; the LS-SVM model is its start and stays in the file")
+    p.add_argument("--segment", type=float, metavar="S",
+                   help="with --refine: simulate segments of S seconds (default: whole logs)")
+    p.add_argument("--refine-evals", type=int, default=200, metavar="N",
+                   help="with --refine or --output-error: cap on cost evaluations (default "
+                   "%(default)s)")
+    p.add_argument("--bootstrap", type=int, metavar="N",
+                   help="uncertainty: N moving-block bootstrap refits (≥ 10; e.g. 200), stored in "
+                   "the model file: coefficient intervals here, prediction bands and index "
+                   "intervals in validate, manoeuvre and criteria")
+    p.add_argument("--block", type=float, default=10.0, metavar="S",
+                   help="with --bootstrap: block length [s] (default %(default)g)")
+    p.add_argument("--seed", type=int, default=0, help="with --bootstrap or --output-error: "
+                   "random seed "
+                   "(default %(default)s)")
+    p.add_argument("--error-band", nargs="?", const="auto", metavar="CV",
+                   help="the cross-validated 95 %% error band of the free runs, stored for "
+                   "validate: the same fit without each log (logo) or block (blocks:K), run free "
+                   "over it (default auto: logo from two logs, blocks:4 of one)")
+    # --out spelled out: since --output-error, argparse no longer takes it for --output.
+    p.add_argument("-o", "--output", "--out", required=True, metavar="MODEL.json")
+    _add_physics_options(p)
+    _add_log_options(p)
+    p.set_defaults(func=cmd_identify)
+
+    p = sub.add_parser("select", help="choose the structure and γ by cross-validated free-run "
+                       "error over several logs")
+    p.add_argument("logs", nargs="+", metavar="LOG")
+    p.add_argument("--library",
+                   help="candidate terms: a structure name, a sum (abkowitz3+blanke) or written "
+                   "terms 'u: ...; v: ...; r: ...' (default low-speed+wind+propeller-asymmetry, "
+                   "less the terms whose log columns the logs lack, said so)")
+    p.add_argument("--search", default="stepwise", choices=("stepwise", "frols", "stlsq", "none"),
+                   help="how candidates are generated (default %(default)s)")
+    p.add_argument("--gammas", metavar="G,G,...", help="γ grid (default 1e2,1e3,1e4,1e5,1e6)")
+    p.add_argument("--cv", default="logo", help="logo (leave one log out, default), kfold:K or "
+                   "blocks:K (every log cut into K blocks)")
+    p.add_argument("--estimator", default="lssvm", choices=LINEAR_ESTIMATORS,
+                   help="equation-error estimator (default %(default)s)")
+    p.add_argument("--method", default="euler", choices=("euler", "rk4"),
+                   help="integration scheme of the free runs (default %(default)s)")
+    p.add_argument("--max-evaluations", type=int, default=400, metavar="N",
+                   help="cap on candidates evaluated (default %(default)s)")
+    p.add_argument("--best", action="store_true",
+                   help="take the best CV score instead of the sparsest within one standard error")
+    p.add_argument("--average", action="store_true",
+                   help="write the average of the candidates the choice picks on resampled "
+                   "held-out logs, weighted by how often (bagging), instead of the chosen one")
+    p.add_argument("--no-plausibility", action="store_true",
+                   help="do not restrict the choice to plausible models")
+    p.add_argument("--speed", type=float, help="plausibility checks at this speed [m/s] "
+                   "(default: each candidate's steady straight speed at the first log's rps, "
+                   "or the first log's approach without propeller terms)")
+    p.add_argument("--rps", type=float, help="... and this propeller speed [rps]")
+    p.add_argument("--show", type=int, default=10, metavar="N", help="candidates printed (default 10)")
+    p.add_argument("--bootstrap", type=int, metavar="N",
+                   help="uncertainty of the selected model: N replicates (≥ 10), each a "
+                   "candidate drawn by how often it is chosen on resampled held-out logs, "
+                   "refitted on a moving-block resample; stored in the model file for bands "
+                   "and intervals")
+    p.add_argument("--block", type=float, default=10.0, metavar="S",
+                   help="with --bootstrap: block length [s] (default %(default)g)")
+    p.add_argument("--seed", type=int, default=0, help="with --bootstrap: random seed "
+                   "(default %(default)s)")
+    p.add_argument("--table", metavar="OUT.csv", help="write every candidate with its scores")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("-o", "--output", required=True, metavar="MODEL.json")
+    _add_physics_options(p)
+    _add_log_options(p)
+    p.set_defaults(func=cmd_select)
+
+    p = sub.add_parser("compare", help="methods × held-out logs: free-run cross-validation")
+    p.add_argument("logs", nargs="+", metavar="LOG")
+    p.add_argument("--model", default="blanke", help="structure for the semiphysical methods "
+                   "(default %(default)s)")
+    p.add_argument("--methods", default="lssvm,ols,ridge,lasso,svr,elm",
+                   help="comma-separated: lssvm, ols, ridge, lasso, svr, elm, lssvm-rbf, "
+                   "select:LIBRARY (default %(default)s)")
+    p.add_argument("--gamma", type=float, default=1e4, help="γ (α = 1/γ) (default %(default)g)")
+    p.add_argument("--cv", default="logo", help="logo (default) or kfold:K")
+    p.add_argument("--method", default="euler", choices=("euler", "rk4"),
+                   help="integration scheme (default %(default)s)")
+    p.add_argument("--json", metavar="OUT.json", help="write every (method, log) row")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    _add_log_options(p)
+    p.set_defaults(func=cmd_compare)
+
+    p = sub.add_parser("validate", help="free-run a model against logs: error table and indices")
+    p.add_argument("model", metavar="MODEL.json")
+    p.add_argument("logs", nargs="+", metavar="LOG")
+    p.add_argument("--json", metavar="OUT.json", help="write the results as JSON")
+    p.add_argument("--plots", metavar="DIR", help="write measured-vs-simulated figures")
+    p.add_argument("--method", default="euler", choices=("euler", "rk4"),
+                   help="integration scheme (default %(default)s, the paper's)")
+    p.add_argument("--kind", choices=KINDS, help="manoeuvre of the logs (default: detected)")
+    p.add_argument("--smooth", type=float, default=0.0,
+                   help="heading smoothing window for measured indices [s] (default 0)")
+    p.add_argument("--lssvm", action="store_true",
+                   help="validate the LS-SVM model a refined model file keeps")
+    p.add_argument("--no-bands", action="store_true",
+                   help="skip the bootstrap ensemble of the model file (its prediction bands and "
+                   "index intervals cost one free run per replicate) and its cross-validated "
+                   "error band")
+    p.add_argument("--plot-format", default="png", choices=("png", "svg", "pdf"),
+                   help="format of the --plots figures (default %(default)s)")
+    p.add_argument("--resid", action="store_true",
+                   help="residual analysis: autocorrelation of the errors and correlation with "
+                   "the rudder (a table, and figures with --plots)")
+    p.add_argument("--max-lag", type=int, default=50, metavar="N",
+                   help="with --resid: largest lag [samples] (default %(default)s)")
+    p.add_argument("--report", metavar="DIR", help="write a self-contained HTML report")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    _add_log_options(p)
+    p.set_defaults(func=cmd_validate)
+
+    p = sub.add_parser("plot", help="figure of any logs: u, v, r, rudder, heading, track")
+    p.add_argument("logs", nargs="+", metavar="LOG")
+    p.add_argument("-o", "--output", required=True, metavar="FIG.png|.svg|.pdf")
+    p.add_argument("--title", help="figure title (default: the file names)")
+    _add_log_options(p)
+    p.set_defaults(func=cmd_plot)
+
+    p = sub.add_parser("simulate", help="drive a model or vessel with a logged rudder")
+    p.add_argument("model", metavar="MODEL.json|VESSEL")
+    p.add_argument("log", metavar="LOG", help="log whose rudder and inputs drive it")
+    p.add_argument("--method", default="rk4", choices=("euler", "rk4"),
+                   help="integration scheme (default %(default)s)")
+    p.add_argument("-o", "--output", required=True, metavar="OUT.csv")
+    _add_log_options(p)
+    p.set_defaults(func=cmd_simulate)
+
+    p = sub.add_parser("manoeuvre", help="run a standard manoeuvre on a model or vessel")
+    p.add_argument("model", metavar="MODEL.json|VESSEL")
+    p.add_argument("kind", choices=("zigzag", "turning", "pull-out", "spiral", "stopping"))
+    p.add_argument("--rudder", dest="rudder_deg", type=float, metavar="DEG",
+                   help="rudder angle [deg] (default 35 for the turning circle, 20 otherwise)")
+    p.add_argument("--heading", type=float, metavar="DEG",
+                   help="zig-zag switch heading [deg] (default = rudder)")
+    p.add_argument("--first", default="starboard", choices=("starboard", "port"),
+                   help="first rudder (zig-zag) or turn side (default %(default)s)")
+    p.add_argument("--duration", type=float,
+                   help="length of the run [s] (default: from 90 s for a zig-zag, 240 s for a "
+                        "turning circle, 60 + 60 s for a pull-out, 120 s per spiral step, "
+                        "600 s for stopping, "
+                        "doubled until the run is complete and its yaw rate settled; a full-"
+                        "scale ship takes ten times a 1:100 model)")
+    p.add_argument("--dt", "--step", dest="step", type=float, default=0.05,
+                   help="integration step [s] (default %(default)s)")
+    p.add_argument("--speed", type=float, help="approach speed [m/s] (models: default from training)")
+    p.add_argument("--rps", type=float,
+                   help="propeller speed [rps] for models with n terms (default from training)")
+    p.add_argument("--astern-rps", type=float, help="stopping: the full-astern order (default −rps)")
+    p.add_argument("--rudder-rate", type=float, metavar="DEG/S",
+                   help="steering machine rate (default: a reference ship's own, else the model "
+                   "file's training rudder rate, else instantaneous)")
+    p.add_argument("--wind-speed", type=float, metavar="M/S",
+                   help="constant true wind for models with wind terms (default: still air)")
+    p.add_argument("--wind-from", type=float, metavar="DEG",
+                   help="direction the wind blows from, clockwise from north [deg] (default 0)")
+    p.add_argument("--json", metavar="OUT.json")
+    p.add_argument("-o", "--output", metavar="LOG.csv", help="write the simulated log")
+    p.add_argument("--no-bands", action="store_true",
+                   help="skip the intervals from the model file's bootstrap ensemble")
+    p.set_defaults(func=cmd_manoeuvre)
+
+    p = sub.add_parser("criteria", help="IMO MSC.137(76) criteria: run the standard manoeuvres "
+                       "on a model or vessel and judge them")
+    p.add_argument("model", metavar="MODEL.json|VESSEL")
+    p.add_argument("--particulars", metavar="FILE", help="ship particulars (default: the model "
+                   "file's)")
+    p.add_argument("--length", type=float, help="Lpp [m] (default: the particulars')")
+    p.add_argument("--speed", type=float, help="test speed [m/s] (default: the training approach)")
+    p.add_argument("--scale", type=float, metavar="LAMBDA",
+                   help="model scale λ, for the full-scale L/V and rudder rate (default: the "
+                   "particulars', else 1)")
+    p.add_argument("--rps", type=float, help="propeller speed for models with n terms (default: "
+                   "the training approach)")
+    p.add_argument("--astern-rps", type=float, help="stopping test order (default −rps)")
+    p.add_argument("--rudder-rate", type=float, metavar="DEG/S",
+                   help="steering machine rate (default: the training logs' rudder rate, else "
+                   "SOLAS 2.32 °/s at full scale, × √λ)")
+    p.add_argument("--dt", type=float, default=0.05, help="integration step [s] (default %(default)s)")
+    p.add_argument("--json", metavar="OUT.json")
+    p.add_argument("--no-bands", action="store_true",
+                   help="skip the intervals from the model file's bootstrap ensemble")
+    p.set_defaults(func=cmd_criteria)
+
+    p = sub.add_parser("linearise", help="state-space A, B and Nomoto K, T of a model or vessel")
+    p.add_argument("model", metavar="MODEL.json|VESSEL")
+    p.add_argument("--speed", type=float, help="straight-running speed [m/s] (default: training)")
+    p.add_argument("--rps", type=float, help="propeller speed for models with n terms")
+    p.set_defaults(func=cmd_linearise)
+
+    p = sub.add_parser("export", help="a model as a standalone NumPy module (no shipid needed)")
+    p.add_argument("model", metavar="MODEL.json")
+    p.add_argument("-o", "--output", required=True, metavar="MODEL.py")
+    p.set_defaults(func=cmd_export)
+
+    for name, helptext in (("autopilot", "PID heading autopilot tuned on a model: a heading step "
+                            "on the model and on a true ship"),
+                           ("follow", "line-of-sight path following along waypoints with a PID "
+                            "tuned on a model, on the model and on a true ship")):  # fmt: skip
+        p = sub.add_parser(name, help=helptext)
+        p.add_argument("model", metavar="MODEL.json|VESSEL")
+        p.add_argument("--truth", metavar="VESSEL", help="reference ship to test the controller "
+                       "on (scale-ship, mariner, kvlcc2)")
+        p.add_argument("--speed", type=float, help="approach speed [m/s] (default: training)")
+        p.add_argument("--rps", type=float, help="propeller speed for models with n terms")
+        p.add_argument("--rudder-rate", type=float, metavar="DEG/S",
+                       help="the model's steering machine rate (default: its training logs' "
+                       "rudder rate; a reference ship: its own gear)")
+        p.add_argument("--omega", type=float, help="closed-loop natural frequency [rad/s] "
+                       "(default max(1/|T|, √|K/T|): Kp at least 1)")
+        p.add_argument("--dt", type=float, default=0.1, help="step [s] (default %(default)s)")
+        if name == "autopilot":
+            p.add_argument("--heading", type=float, default=20.0, metavar="DEG",
+                           help="heading step (default %(default)s; positive to starboard)")
+            p.add_argument("--duration", type=float,
+                           help="[s] (default: from 120 s, doubled until the heading settles)")
+            p.add_argument("-o", "--output", metavar="FIG.png", help="figure of the responses")
+            p.set_defaults(func=cmd_autopilot)
+        else:
+            p.add_argument("--waypoints", required=True, metavar="X,Y;X,Y;...",
+                           help="waypoints [m], x north, y east")
+            p.add_argument("--lookahead", type=float, metavar="M",
+                           help="line-of-sight lookahead [m] (default 2 L, from the ship or the model "
+                           "file's particulars, else 20 m)")
+            p.add_argument("-o", "--output", metavar="FIG.png", help="figure of the tracks")
+            p.add_argument("--json", metavar="OUT.json")
+            p.set_defaults(func=cmd_follow)
+
+    p = sub.add_parser("rescale", help="a model carried to a geometrically similar ship of "
+                       "another length (Froude scaling, equal prime coefficients)")
+    p.add_argument("model", metavar="MODEL.json")
+    p.add_argument("--factor", type=float, help="new length / old length (e.g. 45.7: model "
+                   "basin to full scale)")
+    p.add_argument("--length", type=float, help="the new Lpp [m] (the model file's particulars "
+                   "give the old one)")
+    p.add_argument("--rho", type=float, help="the new water density [kg/m³] (default: the "
+                   "particulars', else 1025; matters for thrust terms only)")
+    p.add_argument("-o", "--output", required=True, metavar="OUT.json")
+    p.set_defaults(func=cmd_rescale)
+
+    p = sub.add_parser("study", help="Monte Carlo identifiability study of the paper's "
+                       "experiment (seeds × noise × γ × structure), or identify many log sets "
+                       "(kind: logs), on Dask")
+    p.add_argument("spec", metavar="SPEC.yml", help="the grid and seeds (see docs/study.yml)")
+    p.add_argument("-o", "--output", required=True, metavar="RESULTS.parquet|RESULTS.csv",
+                   help="one row per trial")
+    p.add_argument("--scheduler", metavar="ADDRESS", help="a running Dask scheduler "
+                   "(tcp://host:8786), or 'serial' for this process alone (default: a local "
+                   "cluster)")
+    p.add_argument("--workers", type=int, help="worker processes of the local cluster "
+                   "(default: the machine's cores)")
+    p.add_argument("--models", metavar="DIR", help="kind logs: the folder of the jobs' model "
+                   "files")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=cmd_study)
+
+    p = sub.add_parser("import", help="convert trial files to canonical logs")
+    p.add_argument("logs", nargs="+", metavar="FILE")
+    p.add_argument("-o", "--output", required=True, metavar="LOG.csv|LOG.parquet|DIR",
+                   help="the canonical log; with several files, or into an existing folder, a "
+                   "folder (each file keeps its name)")
+    p.add_argument("--ext", default=".csv", choices=(".csv", ".parquet"),
+                   help="into a folder: the output format (default %(default)s)")
+    _add_log_options(p)
+    p.set_defaults(func=cmd_import)
+
+    p = sub.add_parser("indices", help="IMO indices of measured logs")
+    p.add_argument("logs", nargs="+", metavar="LOG")
+    p.add_argument("--kind", choices=KINDS, help="default: detected")
+    p.add_argument("--heading", type=float, help="zig-zag switch heading [deg] (default: inferred)")
+    p.add_argument("--smooth", type=float, default=0.0,
+                   help="heading smoothing window [s] (default 0)")
+    p.add_argument("--json", metavar="OUT.json")
+    _add_log_options(p)
+    p.set_defaults(func=cmd_indices)
+    return ap

@@ -1,0 +1,168 @@
+"""``shipid manoeuvre`` and ``criteria``: standard manoeuvres and the IMO criteria on a model or ship."""
+
+from __future__ import annotations
+
+import math
+import sys
+from functools import partial
+from pathlib import Path
+
+from shipid.cli.common import _json_text, _pd, _run_approach, _ship_or_model, _steering, _warn
+from shipid.errors import ShipidError
+
+
+def cmd_criteria(args) -> int:
+    """``shipid criteria``: the IMO MSC.137(76) criteria of a model or vessel."""
+
+    from shipid.data.particulars import read_particulars
+    from shipid.outputs import OutputSet, check_outputs
+    from shipid.trials.criteria import imo_criteria
+
+    check_outputs({"--json": (args.json, "json")},
+                  [args.model] if Path(args.model).exists() else [])  # fmt: skip
+    target, cond = _ship_or_model(args.model)
+    particulars = read_particulars(args.particulars) if args.particulars else cond["particulars"]
+    speed, rps, _ = _run_approach(target, cond, args.speed, args.rps)  # imo_criteria notes it
+    # Given, else the ship's gear or the training logs' rate, else imo_criteria's SOLAS rate.
+    steering, _ = _steering(target, cond, args.rudder_rate, fallback="caller")
+    run = partial(imo_criteria, particulars=particulars, length=args.length, speed=speed,
+                  scale=args.scale, rps=rps, steering=steering, astern_rps=args.astern_rps,
+                  dt=args.dt)  # fmt: skip
+    crit = run(target)
+    table = crit.table.copy()
+    ensemble = cond.get("ensemble")
+    if ensemble is not None and not args.no_bands:
+        from shipid.trials.criteria import replicate_notes, with_intervals
+
+        replicates = [run(m) for m in ensemble.members()]
+        table = with_intervals(crit, replicates)
+        crit.notes += replicate_notes(table, replicates, ensemble.members_label)
+    c = crit.conditions
+    print(f"IMO MSC.137(76) criteria for {args.model}: L = {c['length']:g} m, V = {c['speed']:.4g} "
+          f"m/s, λ = {c['scale']:g} (full-scale L/V = {c['L_over_V_full_scale']:.3g} s), " + (
+              f"rudder rate {c['rudder_rate_deg_s']:.3g} °/s" if c["rudder_rate_deg_s"]
+              else "instantaneous rudder"))
+    record = {**crit.to_dict(), "criteria": table.to_dict(orient="records")}
+    table["passed"] = table["passed"].map({True: "pass", False: "FAIL", None: "–"})
+    print(table.to_markdown(index=False, floatfmt=".3g"))
+    if "pass_share" in table:
+        print(f"lower, upper: 95 % interval of the value, pass_share: the share of passes, "
+              f"no_value: how many have none, over the model's {ensemble.replicates} "
+              f"{ensemble.members_label} (more than 2.5 % without a value: not bounded)")
+    print("all criteria met" if crit.passed else "NOT all criteria met")
+    for n in crit.notes:
+        _warn(n)
+    with OutputSet() as out:
+        if args.json:
+            out.write(args.json, lambda p: p.write_text(_json_text(record), "utf-8"))
+    return 0
+
+
+def cmd_manoeuvre(args) -> int:
+    """``shipid manoeuvre``: a standard manoeuvre on a model or vessel."""
+    from shipid.evaluation.envelope import implausible_indices, outside_envelope
+    from shipid.outputs import OutputSet, check_outputs
+    from shipid.trials.manoeuvres import (
+        pull_out,
+        spiral,
+        stopping,
+        turning_circle,
+        without_value,
+        zigzag,
+    )
+
+    check_outputs({"--json": (args.json, "json"), "-o": (args.output, "log")},
+                  [args.model] if Path(args.model).exists() else [])  # fmt: skip
+    target, cond = _ship_or_model(args.model)
+    speed, rps, unsteady = _run_approach(target, cond, args.speed, args.rps)
+    steering, rudder_note = _steering(target, cond, args.rudder_rate)
+    kw = {"dt": args.step, "speed": speed, "rps": rps, "steering": steering}
+    if args.wind_speed is not None:
+        kw["wind"] = (args.wind_speed, math.radians(args.wind_from or 0.0))
+    if args.duration is not None:
+        kw["duration"] = args.duration
+    if args.rudder_deg is None:
+        args.rudder_deg = 35.0 if args.kind == "turning" else 20.0
+    if args.kind == "zigzag":
+        heading = args.heading if args.heading is not None else args.rudder_deg
+        run = partial(zigzag, rudder_deg=args.rudder_deg, heading_deg=heading, first=args.first,
+                      **kw)  # fmt: skip
+    elif args.kind == "turning":
+        run = partial(turning_circle, rudder_deg=args.rudder_deg, side=args.first, **kw)
+    elif args.kind == "pull-out":
+        if args.duration is not None:
+            kw.pop("duration")
+            kw["hold"] = kw["release"] = args.duration / 2
+        run = partial(pull_out, rudder_deg=args.rudder_deg, side=args.first, **kw)
+    elif args.kind == "spiral":
+        kw.pop("wind", None)
+        if args.duration is not None:
+            kw["hold"] = kw.pop("duration")
+        run = partial(spiral, **kw)
+    else:
+        if not rps:
+            raise ShipidError("stopping needs the approach propeller speed (--rps, or a model "
+                              "trained with the n column)")  # fmt: skip
+        kw.pop("rps")
+        kw.pop("steering")  # the rudder stays amidships
+        run = partial(stopping, rps=rps, astern_rps=args.astern_rps, **kw)
+    res = run(target)
+    print(rudder_note)
+    gear = steering or getattr(target, "steering", None)  # the one the run used
+    intervals = {}
+    ensemble = cond.get("ensemble")
+    if ensemble is not None and not args.no_bands and args.kind != "spiral":
+        from shipid.identification.uncertainty import index_intervals
+
+        runs = [run(member) for member in ensemble.members()]
+        # A diverged replicate has no indices; it widens the intervals rather than vanishing.
+        intervals = index_intervals([{} if r.diverged else r.indices for r in runs])
+        diverged = sum(r.diverged for r in runs)
+        print(f"95 % intervals over the model's {ensemble.replicates} {ensemble.members_label}"
+              + (f" ({diverged} diverged: an index is not bounded where more than 2.5 % of "
+                 "them diverged or lack it)" if diverged else "") + ":")
+    if res.diverged:
+        print(res.reason, file=sys.stderr)
+    notes = ([unsteady] if unsteady else []) + outside_envelope(cond["envelope"], res.log)
+    if res.incomplete and not res.diverged:
+        notes.append(f"{res.incomplete}: indices that need it are missing or those of a "
+                     "transient; give a longer --duration")  # fmt: skip
+    if args.kind == "turning" and not res.diverged:
+        notes += implausible_indices(res.indices, speed or getattr(target, "approach_speed", None),
+                                     getattr(target, "length", None))  # fmt: skip
+    unbounded = {}  # index: how many replicates have none, and why
+    for k, v in res.indices.items():
+        if k == "table":
+            print(_pd().DataFrame(v).to_markdown(index=False, floatfmt=".4g"))
+            continue
+        text = f"{k}: {v:.4g}" if isinstance(v, float) else f"{k}: {v}"
+        lo, hi = intervals.get(k, (math.nan, math.nan))
+        if math.isinf(lo) or math.isinf(hi):
+            missing, why = without_value(runs, [r.indices.get(k) for r in runs])
+            unbounded[k] = f"{missing} of {len(runs)} {ensemble.members_label} have none: {why}"
+            text += f"  [not bounded: {unbounded[k]}]"
+        elif math.isfinite(lo):
+            text += f"  [{lo:.4g}, {hi:.4g}]"
+            if isinstance(v, float) and not lo <= v <= hi:
+                notes.append(f"{k} {v:.4g} lies outside the interval of the model's "
+                             f"{ensemble.members_label}: they disagree with the fit, and the "
+                             "interval does not describe it")  # fmt: skip
+        print(text)
+    for n in notes:
+        _warn(n)
+    with OutputSet() as out:
+        if args.json:
+            doc = {"manoeuvre": res.log.attrs.get("manoeuvre"), "diverged": res.diverged,
+                   "approach": {"speed": speed, "rps": rps},
+                   "diverged_at": res.diverged_at, "reason": res.reason,
+                   "indices": res.indices, "index_intervals": intervals or None,
+                   "index_not_bounded": unbounded or None,
+                   "rudder_rate_deg_s": (math.degrees(gear.max_rate) if gear and gear.max_rate
+                                         else None),
+                   "warnings": notes}  # fmt: skip
+            out.write(args.json, lambda p: p.write_text(_json_text(doc), "utf-8"))
+        if args.output:
+            from shipid.data.io import write_log
+
+            write_log(res.log, args.output, out=out)
+    return 0
