@@ -1,8 +1,9 @@
 """``select --average`` on the KVLCC2's three real zig-zags (issue #10): trained on two, judged
-on the third, for two libraries, the chosen candidate against the average of the candidates the
-choice rule picks on resampled held-out logs (weighted by how often). Columns: free-run error
-std of u, v, r on the held-out log and its overshoots, measured and from the zig-zag run closed
-loop on the model.
+on the third, for three libraries (the default one among them), the chosen candidate against
+the average of the candidates the choice rule picks on resampled held-out logs (weighted by how
+often), and the chosen candidate with the sign constraints (``--constraints signs``). Columns:
+free-run error std of u, v, r on the held-out log and its overshoots, measured and from the
+zig-zag run closed loop on the model.
 
 Run: .venv/bin/python benchmarks/study_kvlcc2_average.py
 """
@@ -16,10 +17,11 @@ from pathlib import Path
 
 from shipid.data.io import read_log
 from shipid.evaluation.validate import validate
+from shipid.identification.physics import PhysicsOptions
 from shipid.identification.select import select
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
-LIBRARIES = ("blanke-race+race-damping", "blanke-speed+abkowitz3")
+LIBRARIES = ("blanke-race+race-damping", "blanke-speed+abkowitz3", None)  # None: the default
 
 
 def main() -> None:
@@ -35,21 +37,24 @@ def main() -> None:
                                       fmt="simman-hsva", dt=0.2)}  # fmt: skip
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores\n")
     print("| library | held out | overshoots measured | chosen: u / v / r error std, overshoots | "
-          "--average: u / v / r error std, overshoots |")
-    print("|---|---|---|---|---|")
+          "--average: u / v / r error std, overshoots | --constraints signs: u / v / r error "
+          "std, overshoots |")  # fmt: skip
+    print("|---|---|---|---|---|---|")
     t0 = time.perf_counter()
     for library in LIBRARIES:
         for held, log in logs.items():
             train = [x for k, x in logs.items() if k != held]
             cells, measured = [], None
-            for average in (False, True):
-                v = validate(select(train, library=library, average=average).model, [log])[0]
+            for average, physics in ((False, None), (True, None),
+                                     (False, PhysicsOptions(signs=True))):  # fmt: skip
+                model = select(train, library=library, average=average, physics=physics).model
+                v = validate(model, [log])[0]
                 m, closed = v.metrics, v.indices["closed_loop"]
                 measured = v.indices["measured"]
                 cells.append(f"{m['u']['std']:.4f} / {m['v']['std']:.4f} / {m['r']['std']:.4f}, "
                              f"{closed['first_overshoot_deg']:.1f}°, "
                              f"{closed['second_overshoot_deg']:.1f}°")  # fmt: skip
-            print(f"| {library} | {held} | {measured['first_overshoot_deg']:.1f}°, "
+            print(f"| {library or 'default'} | {held} | {measured['first_overshoot_deg']:.1f}°, "
                   f"{measured['second_overshoot_deg']:.1f}° | " + " | ".join(cells) + " |")
     print(f"\n{time.perf_counter() - t0:.0f} s")
 
