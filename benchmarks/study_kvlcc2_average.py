@@ -1,7 +1,8 @@
 """``select --average`` on the KVLCC2's three real zig-zags (issue #10): trained on two, judged
 on the third, for three libraries (the default one among them), the chosen candidate against
 the average of the candidates the choice rule picks on resampled held-out logs (weighted by how
-often), and the chosen candidate with the sign constraints (``--constraints signs``). Columns:
+often), and the chosen candidate with the sign constraints on each term (``--constraints signs``)
+and on the linearised derivatives (``--constraints derivatives``). Columns:
 free-run error std of u, v, r on the held-out log and its overshoots, measured and from the
 zig-zag run closed loop on the model.
 
@@ -38,15 +39,16 @@ def main() -> None:
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores\n")
     print("| library | held out | overshoots measured | chosen: u / v / r error std, overshoots | "
           "--average: u / v / r error std, overshoots | --constraints signs: u / v / r error "
-          "std, overshoots |")  # fmt: skip
-    print("|---|---|---|---|---|---|")
+          "std, overshoots | --constraints derivatives: u / v / r error std, overshoots |")
+    print("|---|---|---|---|---|---|---|")
     t0 = time.perf_counter()
     for library in LIBRARIES:
         for held, log in logs.items():
             train = [x for k, x in logs.items() if k != held]
             cells, measured = [], None
             for average, physics in ((False, None), (True, None),
-                                     (False, PhysicsOptions(signs=True))):  # fmt: skip
+                                     (False, PhysicsOptions(signs=True)),
+                                     (False, PhysicsOptions(derivatives=True))):  # fmt: skip
                 model = select(train, library=library, average=average, physics=physics).model
                 v = validate(model, [log])[0]
                 m, closed = v.metrics, v.indices["closed_loop"]

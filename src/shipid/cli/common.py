@@ -101,7 +101,7 @@ def _physics(args, logs, structure):
     """PhysicsOptions of --prior, --constraints, --bound (None when none is given)."""
     from shipid.identification.physics import PhysicsOptions, parse_constraints, rudder_sign
 
-    signs, steady, stable = parse_constraints(args.constraints)
+    flags = parse_constraints(args.constraints)
     bounds = _parse_bounds(args.bound)
     prior = None
     if args.prior == "clarke":
@@ -121,8 +121,7 @@ def _physics(args, logs, structure):
         from shipid.reporting.modelfile import load_model
 
         prior = prior_from_model(load_model(args.prior))
-    options = PhysicsOptions(prior=prior, signs=signs, bounds=bounds or None, steady_speed=steady,
-                             stable=stable)
+    options = PhysicsOptions(prior=prior, bounds=bounds or None, **flags)
     return options if options.active else None
 
 

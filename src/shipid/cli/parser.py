@@ -84,9 +84,10 @@ def _add_physics_options(p) -> None:
                    "and rudder terms from the particulars, Clarke et al. 1983) or a model file")
     g.add_argument("--constraints", metavar="LIST",
                    help="comma list: signs (damping, resistance, thrust and rudder terms keep "
-                   "their physical sign), steady-speed (u̇ = 0 on the approach), stable "
-                   "(straight-line stability at the approach: the yaw equation given the "
-                   "sway one)")
+                   "their physical sign), derivatives (the linearised damping and rudder "
+                   "derivatives keep theirs, whatever terms carry them), steady-speed (u̇ = 0 on "
+                   "the approach), stable (straight-line stability at the approach: the yaw "
+                   "equation given the sway one)")
     g.add_argument("--bound", action="append", metavar="'DOF: TERM <= X'",
                    help="a bound on one coefficient, e.g. 'r: u*r <= 0' (repeatable)")
 

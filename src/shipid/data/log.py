@@ -76,9 +76,14 @@ def approach(log: pd.DataFrame, column: str) -> float | None:
     return float(log[column].iloc[: max(1, len(log) // 50)].mean())
 
 
+def starts_without_headway(log: pd.DataFrame) -> bool:
+    """Whether ``approach`` takes the log's running condition instead of its start."""
+    return _running_samples(log) is not None
+
+
 def approach_note(log: pd.DataFrame, name: str) -> str | None:
     """What ``approach`` did for a log that starts without headway (None: nothing to say)."""
-    if _running_samples(log) is None:
+    if not starts_without_headway(log):
         return None
     start = float(log["u"].iloc[: max(1, len(log) // 50)].mean())
     rps = approach(log, "n")

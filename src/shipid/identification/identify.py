@@ -25,7 +25,7 @@ from shipid.identification.estimators import check_estimator_name, fit_linear
 from shipid.identification.physics import (
     PhysicsOptions,
     dof_physics,
-    stability_note,
+    inequality_notes,
     with_stability,
 )
 from shipid.identification.regression import FORMS, RegressionProblem, regression_problem
@@ -342,7 +342,7 @@ def identify(
             warnings.simplefilter("always", NumericalWarning)
             g, b = fit_linear(p.X, p.y, estimator, gamma, sample_weight, physics=extra)
         diagnostics[dof], dof_notes = _diagnose(p, g, b, gamma)
-        notes += stability_note(extra, g, b)
+        notes += inequality_notes(dof, extra, g, b)
         held = [] if extra.active is None else [n for n, a in zip(p.names, extra.active,
                                                                    strict=True) if a]  # fmt: skip
         diagnostics[dof]["at_bound"] = held

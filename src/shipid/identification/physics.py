@@ -64,7 +64,7 @@ SIGN_RULES: tuple[tuple[str, frozenset[str], object, str], ...] = (
     ("r", _RUDDER_TERMS, RUDDER, "the rudder turns the ship its way"),
     ("v", _RUDDER_TERMS, "-" + RUDDER, "the rudder pushes the stern the other way"),
 )
-CONSTRAINTS = ("signs", "steady-speed", "stable")
+CONSTRAINTS = ("signs", "steady-speed", "stable", "derivatives")
 # ``stable``: the sway–yaw eigenvalues' real parts at most −μ, μ this share of the sway damping
 # rate |∂v̇/∂v| (a scale the model itself sets): held at the limit, the slowest mode still decays,
 # slowly, also about a steady approach a little off the log's start.
@@ -86,6 +86,8 @@ class PhysicsOptions:
         training log: the surge equation reproduces the speed each propeller speed holds.
     stable : straight-line stability at every training log's approach (the yaw equation given
         the sway one; see the module's notes).
+    derivatives : the linearised damping and rudder derivatives keep their physical sign at
+        every training log's approach, whatever terms carry them (``DERIVATIVE_RULES``).
     approach : {"u": u0, "n": n0}: the one approach for ``steady_speed`` (default: each
         training log's start).
     rudder_positive : 'port' or 'starboard' (default: the logs' metadata).
@@ -98,11 +100,13 @@ class PhysicsOptions:
     approach: Mapping[str, float] | None = None
     rudder_positive: str | None = None
     stable: bool = False
+    derivatives: bool = False
 
     @property
     def active(self) -> bool:
         """Whether the options change the plain fit."""
-        return bool(self.prior or self.signs or self.bounds or self.steady_speed or self.stable)
+        return bool(self.prior or self.signs or self.bounds or self.steady_speed or self.stable
+                    or self.derivatives)
 
     def describe(self) -> dict:
         """A JSON-safe record for the model file."""
@@ -111,19 +115,21 @@ class PhysicsOptions:
                 "bounds": {d: {t: list(b) for t, b in v.items()}
                            for d, v in (self.bounds or {}).items()},
                 "approach": dict(self.approach or {}),
-                "rudder_positive": self.rudder_positive, "stable": self.stable}  # fmt: skip
+                "rudder_positive": self.rudder_positive, "stable": self.stable,
+                "derivatives": self.derivatives}  # fmt: skip
 
 
-def parse_constraints(text: str | None) -> tuple[bool, bool, bool]:
-    """(signs, steady_speed, stable) from a comma list such as ``signs,steady-speed``."""
+def parse_constraints(text: str | None) -> dict[str, bool]:
+    """The ``PhysicsOptions`` flags (signs, steady_speed, stable, derivatives) of a comma list
+    such as ``signs,steady-speed``."""
     if not text:
-        return False, False, False
+        return {c.replace("-", "_"): False for c in CONSTRAINTS}
     items = [t.strip() for t in text.split(",") if t.strip()]
     unknown = [t for t in items if t not in CONSTRAINTS]
     if unknown:
         raise ShipidError(f"--constraints: unknown {', '.join(map(repr, unknown))}; use a comma "
                           f"list of {', '.join(CONSTRAINTS)}")  # fmt: skip
-    return "signs" in items, "steady-speed" in items, "stable" in items
+    return {c.replace("-", "_"): c in items for c in CONSTRAINTS}
 
 
 @dataclass
@@ -135,6 +141,7 @@ class DofPhysics:
     upper: np.ndarray
     equalities: tuple[np.ndarray, np.ndarray] | None = None  # (E over [ω; b], f)
     inequalities: tuple[np.ndarray, np.ndarray] | None = None  # (G over [ω; b], h): G z ≥ h
+    inequality_labels: list[str] = field(default_factory=list)  # what each row holds
     approaches: list[tuple[float, float]] = field(default_factory=list)  # (u0, n0) of the above
     reasons: dict[str, str] = field(default_factory=dict)  # term → why it is bounded
     notes: list[str] = field(default_factory=list)
@@ -167,40 +174,93 @@ def _sign_bounds(dof: str, term: str, s: float | None) -> tuple[float, float, st
 
 def _approach_states(options: PhysicsOptions, logs: Sequence[pd.DataFrame], what: str
                      ) -> list[tuple[float, float]]:  # fmt: skip
-    """(u0, n0) of every training log's start (or ``options.approach``)."""
+    """(u0, n0) of every training log's start (or ``options.approach``); of a log that starts
+    without headway (a random run begun at rest), its running condition
+    (``shipid.data.log.approach``)."""
+    from shipid.data.log import approach, starts_without_headway
+
+    def state(log: pd.DataFrame) -> tuple[float, float]:
+        if starts_without_headway(log):
+            return float(approach(log, "u")), float(approach(log, "n") or 0.0)
+        return (float(log["u"].iloc[0]),
+                float(log["n"].iloc[0]) if "n" in log.columns else 0.0)  # fmt: skip
+
     if options.approach:
         states = [(float(options.approach["u"]), float(options.approach.get("n", 0.0)))]
     else:
-        states = sorted({(float(log["u"].iloc[0]),
-                          float(log["n"].iloc[0]) if "n" in log.columns else 0.0) for log in logs})
+        states = sorted({state(log) for log in logs})
     if not all(u0 > 0 for u0, _ in states):
         raise ShipidError(f"{what} constraint: a training log starts without headway; trim it to "
                           "the approach (--start) or give the approach with --speed")  # fmt: skip
     return states
 
 
-def _straight_running_slopes(texts: Sequence[str], u0: float, n0: float) -> np.ndarray:
-    """(2, len(texts)): ∂/∂v and ∂/∂r of each term at straight running (u0, v = r = 0, rudder
-    amidships, propeller n0, still air: the apparent wind of the ship's own motion).
+def _straight_running_slopes(texts: Sequence[str], u0: float, n0: float,
+                             wrt: Sequence[str] = ("v", "r")) -> np.ndarray:
+    """(len(wrt), len(texts)): ∂/∂x of each term for x in ``wrt`` (of u, v, r, delta) at
+    straight running (u0, v = r = 0, rudder amidships, propeller n0, still air: the apparent wind
+    of the ship's own motion).
 
     Central differences at steps h and 2h, combined (2 D(h) − D(2h)) so that the kink of a
     modulus term at 0 (|v|v, |r|r: slope 0, but h from a central difference) counts nothing: a
     fit would otherwise buy stability with an |r|r coefficient of 10⁶."""
 
+    def value(du: float, dv: float, dr: float, dd: float) -> np.ndarray:
+        u, v, r = np.array([u0 + du]), np.array([dv]), np.array([dr])
+        given = {"delta": np.array([dd]), "n": np.array([n0]), "wind_speed": np.hypot(u, v),
+                 "wind_angle": np.arctan2(v, u)}  # fmt: skip
+        return term_matrix(list(texts), u, v, r, given)[0]
+
     def central(h: float) -> np.ndarray:
-        out = np.zeros((2, len(texts)))
-        for i, (dv, dr) in enumerate(((h, 0.0), (0.0, h))):
-            cols = []
-            for sign in (1.0, -1.0):
-                u, v, r = np.array([u0]), np.array([sign * dv]), np.array([sign * dr])
-                given = {"delta": np.zeros(1), "n": np.array([n0]), "wind_speed": np.hypot(u, v),
-                         "wind_angle": np.arctan2(v, u)}  # fmt: skip
-                cols.append(term_matrix(list(texts), u, v, r, given)[0])
-            out[i] = (cols[0] - cols[1]) / (2 * h)
+        out = np.zeros((len(wrt), len(texts)))
+        for i, x in enumerate(wrt):
+            step = np.array([h if x == name else 0.0 for name in ("u", "v", "r", "delta")])
+            out[i] = (value(*step) - value(*(-step))) / (2 * h)
         return out
 
     h = 1e-6 * max(abs(u0), 1.0)
     return 2.0 * central(h) - central(2.0 * h)
+
+
+# ``derivatives``: (equation, state, sign, why): the linearised derivative at straight running
+# keeps its sign whatever terms carry it (−1: ≤ 0; RUDDER / "-" + RUDDER: s, −s).
+DERIVATIVE_RULES = (
+    ("u", "u", -1, "surge damping ∂u̇/∂u ≤ 0"),
+    ("v", "v", -1, "sway damping ∂v̇/∂v ≤ 0"),
+    ("v", "delta", "-" + RUDDER, "the rudder pushes the stern the other way (∂v̇/∂δ)"),
+    ("r", "r", -1, "yaw damping ∂ṙ/∂r ≤ 0"),
+    ("r", "delta", RUDDER, "the rudder turns the ship its way (∂ṙ/∂δ)"),
+)
+
+
+def derivative_rows(options: PhysicsOptions, dof: str, names: Sequence[str],
+                    fixed: Mapping[str, float], logs: Sequence[pd.DataFrame],
+                    ) -> tuple[np.ndarray, np.ndarray, list[str]] | None:  # fmt: skip
+    """The ``derivatives`` constraint of one equation: rows G over [free terms ``names``; bias],
+    h and a label per row, G z ≥ h for each rule of ``DERIVATIVE_RULES`` at each training log's
+    approach (None when no free term carries a rule's derivative). The rudder's rows need the
+    logs' rudder convention."""
+    s = rudder_sign(logs, options.rudder_positive)
+    rules = [(x, sign, why) for eq, x, sign, why in DERIVATIVE_RULES if eq == dof
+             and (s is not None or sign not in (RUDDER, "-" + RUDDER))]  # fmt: skip
+    if not rules or not names:
+        return None
+    wrt = [x for x, _, _ in rules]
+    rows, rhs, labels = [], [], []
+    for u0, n0 in _approach_states(options, logs, "derivatives"):
+        g = _straight_running_slopes(names, u0, n0, wrt)
+        f = (_straight_running_slopes(list(fixed), u0, n0, wrt) @ np.array(list(fixed.values()))
+             if fixed else np.zeros(len(wrt)))  # fmt: skip
+        for i, (_, sign, why) in enumerate(rules):
+            if not np.any(g[i]):
+                continue  # no free term carries it
+            sigma = float(sign) if sign in (1, -1) else (s if sign == RUDDER else -s)
+            rows.append(np.append(sigma * g[i], 0.0))
+            rhs.append(-sigma * f[i])
+            labels.append(f"{why} at {u0:.3g} m/s")
+    if not rows:
+        return None
+    return np.array(rows), np.array(rhs), labels
 
 
 def stability_rows(options: PhysicsOptions, sway: Mapping[str, float], names: Sequence[str],
@@ -291,6 +351,10 @@ def dof_physics(options: PhysicsOptions | None, dof: str, names: Sequence[str], 
     if out.prior is not None:
         # A prior outside the bounds would pull against them: start from the feasible point.
         out.prior = np.clip(out.prior, out.lower, out.upper)
+    if options.derivatives:
+        found = derivative_rows(options, dof, names, fixed, logs)
+        if found is not None:
+            out.inequalities, out.inequality_labels = found[:2], found[2]
     if options.steady_speed and dof == "u":
         E, f, out.approaches = _approach_rows(names, fixed, has_constant, options, logs)
         out.equalities = (E, f)
@@ -313,20 +377,34 @@ def with_stability(extra: DofPhysics, options: PhysicsOptions | None, dof: str,
         raise ShipidError("stable constraint: straight-line stability needs the sway equation "
                           "(v) fitted with the yaw one")  # fmt: skip
     G, h = stability_rows(options, fitted["v"], names, fixed, logs)
-    return dataclasses.replace(extra, inequalities=(G, h))
+    labels = [STABILITY_LABEL] * len(h)
+    if extra.inequalities is not None:
+        G, h = np.vstack([extra.inequalities[0], G]), np.concatenate([extra.inequalities[1], h])
+        labels = extra.inequality_labels + labels
+    return dataclasses.replace(extra, inequalities=(G, h), inequality_labels=labels)
 
 
-def stability_note(extra: DofPhysics, coef: np.ndarray, bias: float) -> list[str]:
-    """What the stability rows of ``extra`` did to the fit (coef, bias): a note when they hold
-    (the fit without them is unstable), none when the fit meets them freely."""
+STABILITY_LABEL = "straight-line stability"
+
+
+def inequality_notes(dof: str, extra: DofPhysics, coef: np.ndarray, bias: float) -> list[str]:
+    """What the inequalities of ``extra`` did to the fit (coef, bias): a note per constraint that
+    holds (the fit without it goes past it), none for those the fit meets freely."""
     if extra.inequalities is None:
         return []
     G, h = extra.inequalities
     z = np.append(coef, bias)
-    scale = np.abs(G) @ np.abs(z) + np.abs(h) + 1e-300
-    if np.all(G @ z - h > 1e-6 * scale):
-        return []
-    return ["r: the fit without the stability constraint is straight-line unstable at the "
-            "approach; the yaw equation is held at its limit, given the sway equation (the "
-            f"slowest sway–yaw mode decays at {STABILITY_MARGIN:.0%} of the sway damping rate "
-            "|∂v̇/∂v|: barely stable)"]
+    # A row held at its limit has a slack of rounding size against the whole fit's (a held
+    # coefficient is itself near 0, so its own size says nothing).
+    tol = 1e-7 * (np.linalg.norm(G, axis=1) * np.linalg.norm(z) + np.abs(h)) + 1e-300
+    held = [label for label, slack, t in zip(extra.inequality_labels, G @ z - h, tol,
+                                             strict=True) if slack <= t]  # fmt: skip
+    notes = []
+    if STABILITY_LABEL in held:
+        notes.append(f"{dof}: the fit without the stability constraint is straight-line unstable "
+                     "at the approach; the yaw equation is held at its limit, given the sway "
+                     f"equation (the slowest sway–yaw mode decays at {STABILITY_MARGIN:.0%} of "
+                     "the sway damping rate |∂v̇/∂v|: barely stable)")  # fmt: skip
+    notes += [f"{dof}: {label} held at 0: the unconstrained fit goes past it"
+              for label in dict.fromkeys(held) if label != STABILITY_LABEL]  # fmt: skip
+    return notes
