@@ -34,6 +34,7 @@ they are left out, with a note. Terms not in the table are free.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -88,8 +89,9 @@ class PhysicsOptions:
         the sway one; see the module's notes).
     derivatives : the linearised damping and rudder derivatives keep their physical sign at
         every training log's approach, whatever terms carry them (``DERIVATIVE_RULES``).
-    approach : {"u": u0, "n": n0}: the one approach for ``steady_speed`` (default: each
-        training log's start).
+    approach : {"u": u0, "n": n0}, or a sequence of them: the approaches ``steady_speed``,
+        ``derivatives`` and ``stable`` hold at (default: each training log's start;
+        ``with_approaches`` resolves them once for fits that repeat, as ``select``'s).
     rudder_positive : 'port' or 'starboard' (default: the logs' metadata).
     """
 
@@ -114,7 +116,8 @@ class PhysicsOptions:
                 "signs": self.signs, "steady_speed": self.steady_speed,
                 "bounds": {d: {t: list(b) for t, b in v.items()}
                            for d, v in (self.bounds or {}).items()},
-                "approach": dict(self.approach or {}),
+                "approach": (dict(self.approach) if isinstance(self.approach, Mapping)
+                             else [dict(a) for a in self.approach] if self.approach else {}),
                 "rudder_positive": self.rudder_positive, "stable": self.stable,
                 "derivatives": self.derivatives}  # fmt: skip
 
@@ -172,8 +175,8 @@ def _sign_bounds(dof: str, term: str, s: float | None) -> tuple[float, float, st
     return None
 
 
-def _approach_states(options: PhysicsOptions, logs: Sequence[pd.DataFrame], what: str
-                     ) -> list[tuple[float, float]]:  # fmt: skip
+def approach_states(options: PhysicsOptions, logs: Sequence[pd.DataFrame], what: str
+                    ) -> list[tuple[float, float]]:  # fmt: skip
     """(u0, n0) of every training log's start (or ``options.approach``); of a log that starts
     without headway (a random run begun at rest), its running condition
     (``shipid.data.log.approach``)."""
@@ -185,8 +188,10 @@ def _approach_states(options: PhysicsOptions, logs: Sequence[pd.DataFrame], what
         return (float(log["u"].iloc[0]),
                 float(log["n"].iloc[0]) if "n" in log.columns else 0.0)  # fmt: skip
 
-    if options.approach:
+    if isinstance(options.approach, Mapping):
         states = [(float(options.approach["u"]), float(options.approach.get("n", 0.0)))]
+    elif options.approach:
+        states = [(float(a["u"]), float(a.get("n", 0.0))) for a in options.approach]
     else:
         states = sorted({state(log) for log in logs})
     if not all(u0 > 0 for u0, _ in states):
@@ -199,27 +204,51 @@ def _straight_running_slopes(texts: Sequence[str], u0: float, n0: float,
                              wrt: Sequence[str] = ("v", "r")) -> np.ndarray:
     """(len(wrt), len(texts)): ∂/∂x of each term for x in ``wrt`` (of u, v, r, delta) at
     straight running (u0, v = r = 0, rudder amidships, propeller n0, still air: the apparent wind
-    of the ship's own motion).
+    of the ship's own motion); see ``_term_slopes``."""
+    if not len(texts):
+        return np.zeros((len(wrt), 0))
+    return np.array([_term_slopes(parse_term(t).text, float(u0), float(n0), tuple(wrt))
+                     for t in texts]).T.reshape(len(wrt), len(texts))  # fmt: skip
+
+
+@functools.lru_cache(maxsize=4096)
+def _term_slopes(text: str, u0: float, n0: float, wrt: tuple[str, ...]) -> tuple[float, ...]:
+    """One term's slopes of ``_straight_running_slopes`` (cached: ``select`` asks for the same
+    terms at the same approaches in every fold of every candidate).
 
     Central differences at steps h and 2h, combined (2 D(h) − D(2h)) so that the kink of a
     modulus term at 0 (|v|v, |r|r: slope 0, but h from a central difference) counts nothing: a
     fit would otherwise buy stability with an |r|r coefficient of 10⁶."""
 
-    def value(du: float, dv: float, dr: float, dd: float) -> np.ndarray:
+    def value(du: float, dv: float, dr: float, dd: float) -> float:
         u, v, r = np.array([u0 + du]), np.array([dv]), np.array([dr])
         given = {"delta": np.array([dd]), "n": np.array([n0]), "wind_speed": np.hypot(u, v),
                  "wind_angle": np.arctan2(v, u)}  # fmt: skip
-        return term_matrix(list(texts), u, v, r, given)[0]
+        return float(term_matrix([text], u, v, r, given)[0, 0])
 
     def central(h: float) -> np.ndarray:
-        out = np.zeros((len(wrt), len(texts)))
+        out = np.zeros(len(wrt))
         for i, x in enumerate(wrt):
             step = np.array([h if x == name else 0.0 for name in ("u", "v", "r", "delta")])
             out[i] = (value(*step) - value(*(-step))) / (2 * h)
         return out
 
     h = 1e-6 * max(abs(u0), 1.0)
-    return 2.0 * central(h) - central(2.0 * h)
+    return tuple((2.0 * central(h) - central(2.0 * h)).tolist())
+
+
+def with_approaches(options: PhysicsOptions | None, logs: Sequence[pd.DataFrame]
+                    ) -> PhysicsOptions | None:  # fmt: skip
+    """``options`` with the training logs' approaches resolved (``approach_states``), for fits
+    that repeat on the same logs; ``options`` itself when it needs none or has them."""
+    if options is None or options.approach or not (
+            options.steady_speed or options.derivatives or options.stable):
+        return options
+    what = "/".join(n for n, on in (("steady-speed", options.steady_speed),
+                                    ("derivatives", options.derivatives),
+                                    ("stable", options.stable)) if on)  # fmt: skip
+    states = approach_states(options, logs, what)
+    return dataclasses.replace(options, approach=tuple({"u": u, "n": n} for u, n in states))
 
 
 # ``derivatives``: (equation, state, sign, why): the linearised derivative at straight running
@@ -247,7 +276,7 @@ def derivative_rows(options: PhysicsOptions, dof: str, names: Sequence[str],
         return None
     wrt = [x for x, _, _ in rules]
     rows, rhs, labels = [], [], []
-    for u0, n0 in _approach_states(options, logs, "derivatives"):
+    for u0, n0 in approach_states(options, logs, "derivatives"):
         g = _straight_running_slopes(names, u0, n0, wrt)
         f = (_straight_running_slopes(list(fixed), u0, n0, wrt) @ np.array(list(fixed.values()))
              if fixed else np.zeros(len(wrt)))  # fmt: skip
@@ -273,7 +302,7 @@ def stability_rows(options: PhysicsOptions, sway: Mapping[str, float], names: Se
     sway_terms = [t for t in sway if t != "1"]
     sway_coef = np.array([sway[t] for t in sway_terms])
     rows, rhs = [], []
-    for u0, n0 in _approach_states(options, logs, "stable"):
+    for u0, n0 in approach_states(options, logs, "stable"):
         a11, a12 = _straight_running_slopes(sway_terms, u0, n0) @ sway_coef
         g21, g22 = _straight_running_slopes(names, u0, n0)
         f21, f22 = (_straight_running_slopes(list(fixed), u0, n0) @ np.array(list(fixed.values()))
@@ -298,7 +327,7 @@ def _approach_rows(dof_terms: Sequence[str], fixed: Mapping[str, float], has_con
         raise ShipidError("steady-speed constraint: the surge equation has a thrust term, whose "
                           "value on the approach is not known; identify with propeller-speed "
                           "(n) terms")  # fmt: skip
-    states = _approach_states(options, logs, "steady-speed")
+    states = approach_states(options, logs, "steady-speed")
     u0 = np.array([s[0] for s in states])
     n0 = np.array([s[1] for s in states])
     zero = np.zeros(len(states))

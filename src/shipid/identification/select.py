@@ -51,7 +51,12 @@ from shipid.dynamics.terms import INPUT_SIGNALS, parse_term, term_code
 from shipid.errors import InfeasibleConstraintsError, ShipidError
 from shipid.evaluation.error_band import ErrorBand, error_band
 from shipid.identification.estimators import LINEAR_ESTIMATORS, check_estimator_name, fit_linear
-from shipid.identification.physics import PhysicsOptions, dof_physics, with_stability
+from shipid.identification.physics import (
+    PhysicsOptions,
+    dof_physics,
+    with_approaches,
+    with_stability,
+)
 from shipid.identification.regression import common_sampling_time, log_terms
 from shipid.lssvm.solvers import solve_primal_constrained
 
@@ -580,6 +585,9 @@ def select(
     from shipid.identification.plausibility import disqualifying, plausibility_at_approach
 
     options = dataclasses.replace(options or SelectOptions(), **overrides)
+    # The constraints' approaches, resolved once for the thousand fits of the search.
+    options = dataclasses.replace(options, physics=with_approaches(
+        options.physics, [logs] if isinstance(logs, pd.DataFrame) else list(logs)))
     # Converted once here, for the notes; _setup's own pass then finds one convention.
     logs, notes = common_rudder_convention([logs] if isinstance(logs, pd.DataFrame) else list(logs))
     logs, names, data, folds, scorer = _setup(logs, names, options)
