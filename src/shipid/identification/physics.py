@@ -99,7 +99,7 @@ class PhysicsOptions:
     signs: bool = False
     bounds: Mapping[str, Mapping[str, tuple[float, float]]] | None = None
     steady_speed: bool = False
-    approach: Mapping[str, float] | None = None
+    approach: Mapping[str, float] | Sequence[Mapping[str, float]] | None = None
     rudder_positive: str | None = None
     stable: bool = False
     derivatives: bool = False
