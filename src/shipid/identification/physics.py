@@ -207,8 +207,8 @@ def _straight_running_slopes(texts: Sequence[str], u0: float, n0: float,
     of the ship's own motion); see ``_term_slopes``."""
     if not len(texts):
         return np.zeros((len(wrt), 0))
-    return np.array([_term_slopes(parse_term(t).text, float(u0), float(n0), tuple(wrt))
-                     for t in texts]).T.reshape(len(wrt), len(texts))  # fmt: skip
+    key = (float(u0), float(n0), tuple(wrt))  # a term's spelling is its own cache entry
+    return np.array([_term_slopes(t, *key) for t in texts]).T.reshape(len(wrt), len(texts))
 
 
 @functools.lru_cache(maxsize=4096)
