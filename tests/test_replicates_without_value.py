@@ -97,4 +97,6 @@ def test_validate_says_why_an_interval_is_not_bounded():
     lo, hi = out.intervals["closed_loop"]["first_overshoot_deg"]
     assert math.isinf(lo) and math.isinf(hi)
     assert ("first_overshoot_deg (closed loop) is not bounded: 3 of 20 bootstrap replicates have "
-            "none (3 never reach it within the log)") in out.warnings  # fmt: skip
+            "none (3 the counter rudder has not checked the yaw within 60 s)") in out.warnings
+    assert ("first_overshoot_deg (replay) is not bounded: 3 of 20 bootstrap replicates have none "
+            "(3 never reach it within the log)") in out.warnings  # fmt: skip

@@ -20,6 +20,7 @@ import numpy as np
 import pandas as pd
 
 from shipid.data.log import COLUMNS, REQUIRED
+from shipid.data.preprocess import cumulative_integral
 from shipid.errors import ShipidError, ShipidWarning
 
 ANGLE_COLUMNS = ("delta", "psi", "r", "wind_angle")
@@ -174,11 +175,28 @@ def _displacements(t, x, y, psi, u, v, window_s: float, sway_sign: float = 1.0,
     sway = sway_sign * v
     measured_out, predicted_out = [], []
     for measured, rate in ((north, u * c - sway * s), (east, u * s + sway * c)):
-        integral = np.concatenate([[0.0], np.cumsum(0.5 * (rate[1:] + rate[:-1]) * h)])
+        integral = cumulative_integral(rate, t)
         dm, dp = measured[k:] - measured[:-k], integral[k:] - integral[:-k]
         measured_out.append(dm - dm.mean())
         predicted_out.append(dp - dp.mean())
     return np.concatenate(measured_out), np.concatenate(predicted_out)
+
+
+CONVENTIONS = (("given", 1.0, False), ("v to port", -1.0, False), ("x east, y north", 1.0, True),
+               ("both", -1.0, True))  # (label, sway sign, x and y swapped)
+
+
+def _rms(parts: tuple[np.ndarray, np.ndarray]) -> float:
+    return float(np.sqrt(2.0 * np.mean((parts[0] - parts[1]) ** 2)))
+
+
+def _scale(parts: tuple[np.ndarray, np.ndarray]) -> tuple[float, float] | None:
+    measured, predicted = parts
+    pp, mm = float(predicted @ predicted), float(measured @ measured)
+    if pp <= 0 or mm <= 0:
+        return None
+    mp = float(measured @ predicted)
+    return mp / pp, mp / math.sqrt(pp * mm)
 
 
 def track_errors(t: np.ndarray, x: np.ndarray, y: np.ndarray, psi: np.ndarray, u: np.ndarray,
@@ -187,13 +205,17 @@ def track_errors(t: np.ndarray, x: np.ndarray, y: np.ndarray, psi: np.ndarray, u
     integrated (their mean difference, a current, removed), as given and under the two usual
     mistakes: ``"given"``, ``"v to port"`` (v negated), ``"x east, y north"`` (x and y swapped)
     and both. None when the log is shorter than a few windows."""
+    parts = _all_displacements(t, x, y, psi, u, v, window_s)
+    return None if parts is None else {label: _rms(p) for label, p in parts.items()}
+
+
+def _all_displacements(t, x, y, psi, u, v, window_s: float = TRACK_WINDOW_S):
     out = {}
-    for label, sway, east_first in (("given", 1.0, False), ("v to port", -1.0, False),
-                                    ("x east, y north", 1.0, True), ("both", -1.0, True)):
+    for label, sway, east_first in CONVENTIONS:
         parts = _displacements(t, x, y, psi, u, v, window_s, sway, east_first)
         if parts is None:
             return None
-        out[label] = float(np.sqrt(2.0 * np.mean((parts[0] - parts[1]) ** 2)))
+        out[label] = parts
     return out
 
 
@@ -203,14 +225,7 @@ def track_scale(t, x, y, psi, u, v, window_s: float = TRACK_WINDOW_S
     say (1 when both are in metres and m/s), and their correlation ρ (how far k can be trusted).
     On the real logs here k is 0.995-1.014."""
     parts = _displacements(t, x, y, psi, u, v, window_s)
-    if parts is None:
-        return None
-    measured, predicted = parts
-    pp, mm = float(predicted @ predicted), float(measured @ measured)
-    if pp <= 0 or mm <= 0:
-        return None
-    mp = float(measured @ predicted)
-    return mp / pp, mp / math.sqrt(pp * mm)
+    return None if parts is None else _scale(parts)
 
 
 # Unit mistakes the track's scale tells: (how many times as far the track moves as u, v say,
@@ -224,13 +239,16 @@ TRACK_SCALE_TOLERANCE = 0.2  # |k − 1| within it: metres and m/s
 
 
 def _check_track_against_velocities(df: pd.DataFrame, name: str) -> None:
-    columns = [df[c].to_numpy(dtype=float) for c in ("t", "x", "y", "psi", "u", "v")]
-    errors = track_errors(*columns)
-    if errors is None or not errors["given"] > 0:
+    parts = _all_displacements(*(df[c].to_numpy(dtype=float)
+                                 for c in ("t", "x", "y", "psi", "u", "v")))  # fmt: skip
+    if parts is None:
+        return
+    errors = {label: _rms(p) for label, p in parts.items()}
+    if not errors["given"] > 0:
         return
     label = min(errors, key=errors.get)
     if label == "given" or errors[label] >= TRACK_CONVENTION_SHARE * errors["given"]:
-        _check_track_scale(columns, name)
+        _check_track_scale(_scale(parts["given"]), name)
         return
     what = {"v to port": "the sway 'v' looks positive to port: negate v",
             "x east, y north": "x and y look swapped (x east, y north): swap them "
@@ -243,8 +261,7 @@ def _check_track_against_velocities(df: pd.DataFrame, name: str) -> None:
                       "v positive to starboard)")  # fmt: skip
 
 
-def _check_track_scale(columns, name: str) -> None:
-    scale = track_scale(*columns)
+def _check_track_scale(scale: tuple[float, float] | None, name: str) -> None:
     if scale is None:
         return
     k, rho = scale
@@ -263,7 +280,7 @@ def yaw_rate_offset(t: np.ndarray, psi: np.ndarray, r: np.ndarray) -> float | No
     least-squares slope of ψ − ∫r dt over the log (ψ unwrapped). None for logs too short."""
     if len(t) < 10 or not t[-1] > t[0]:
         return None
-    drift = np.unwrap(psi) - np.concatenate([[0.0], np.cumsum(0.5 * (r[1:] + r[:-1]) * np.diff(t))])
+    drift = np.unwrap(psi) - cumulative_integral(r, t)
     tc = t - t.mean()
     return -float(tc @ (drift - drift.mean())) / float(tc @ tc)
 

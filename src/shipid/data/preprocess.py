@@ -14,6 +14,15 @@ SIGNALS = ("u", "v", "r")
 MAX_UPSAMPLING = 100.0
 
 
+
+def cumulative_integral(y: np.ndarray, t: np.ndarray, initial: float = 0.0) -> np.ndarray:
+    """∫ y dt from t[0] by the trapezoidal rule, sample by sample."""
+    out = np.empty(len(y))
+    out[0] = initial
+    np.cumsum(0.5 * (y[1:] + y[:-1]) * np.diff(t), out=out[1:])
+    out[1:] += initial
+    return out
+
 def resample(log: pd.DataFrame, dt: float, name: str = "log") -> pd.DataFrame:
     """Linear interpolation of every column onto t0, t0 + dt, ... (heading unwrapped first)."""
     if not (isinstance(dt, int | float) and math.isfinite(dt) and dt > 0):

@@ -122,34 +122,29 @@ def validate_log(model, log: pd.DataFrame, name: str, method: str = "euler",
             replays = [_replay_indices(r, trial) for r in runs]
             out.intervals["simulated"] = index_intervals(replays)
             out.warnings += _unbounded_notes("replay", out.intervals["simulated"], replays,
-                                             [r.diverged for r in runs], ensemble.members_label)
+                                             runs, ensemble.members_label)
             if "closed_loop" in indices:
                 replicas = [trial_zigzag(m, log, method, trial) for m in ensemble.members()]
                 samples = [r.indices if r and not r.diverged else {} for r in replicas]
                 out.intervals["closed_loop"] = index_intervals(samples)
                 out.warnings += _unbounded_notes("closed loop", out.intervals["closed_loop"],
-                                                 samples, [bool(r and r.diverged)
-                                                           for r in replicas],
-                                                 ensemble.members_label)  # fmt: skip
+                                                 samples, replicas, ensemble.members_label)
     return out
 
 
-def _unbounded_notes(label: str, intervals: dict, samples: Sequence[dict],
-                     diverged: Sequence[bool], members: str) -> list[str]:
-    """Why an index's interval is not bounded: how many replicates have no value, diverged or
-    never reaching the event within the log (more than the interval's tail: not bounded)."""
+def _unbounded_notes(label: str, intervals: dict, samples: Sequence[dict], runs: Sequence,
+                     members: str) -> list[str]:  # fmt: skip
+    """Why an index's interval is not bounded: how many replicates have no value, and why
+    (``shipid.trials.manoeuvres.without_value``)."""
+    from shipid.trials.manoeuvres import without_value
+
     notes = []
     for k, (lo, hi) in intervals.items():
-        if not (math.isinf(lo) or math.isinf(hi)):
-            continue
-        missing = [s.get(k) is None or not math.isfinite(s[k]) for s in samples]
-        n_div = sum(m and d for m, d in zip(missing, diverged, strict=True))
-        n_other = sum(missing) - n_div
-        why = "; ".join(w for w in (f"{n_div} diverged" if n_div else "",
-                                    f"{n_other} never reach it within the log" if n_other else "")
-                        if w)  # fmt: skip
-        notes.append(f"{k} ({label}) is not bounded: {sum(missing)} of {len(samples)} {members} "
-                     f"have none ({why})")  # fmt: skip
+        if math.isinf(lo) or math.isinf(hi):
+            missing, why = without_value(runs, [s.get(k) for s in samples],
+                                         "never reach it within the log")  # fmt: skip
+            notes.append(f"{k} ({label}) is not bounded: {missing} of {len(samples)} {members} "
+                         f"have none ({why})")  # fmt: skip
     return notes
 
 

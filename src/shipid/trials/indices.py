@@ -19,11 +19,11 @@ import numba
 import numpy as np
 import pandas as pd
 
+from shipid.data.preprocess import cumulative_integral
 from shipid.errors import ShipidError
 from shipid.trials.trial import (
     KINDS,
     Trial,
-    cumulative_integral,
     describe_trial,
     moving_average,
     unwrapped_heading,

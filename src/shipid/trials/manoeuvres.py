@@ -53,19 +53,19 @@ class ManoeuvreResult:
     incomplete: str = ""  # what the run did not reach (its indices need it), with the remedy
 
 
-def without_value(runs: Sequence[ManoeuvreResult | None], values: Sequence[float | None]
+def without_value(runs: Sequence, values: Sequence[float | None], otherwise: str = "no value"
                   ) -> tuple[int, str]:  # fmt: skip
-    """How many of ``runs`` (one manoeuvre on each replicate of a model) have no value among
-    ``values`` (an index of each), and why, most common first:
+    """How many of ``runs`` (one run on each replicate of a model: manoeuvres, or free runs
+    along a log) have no value among ``values`` (an index of each), and why, most common first:
     ``(11, "6 diverged; 5 the turn is not steady within 15360 s")``. An interval over replicates
     is not bounded when more than its tail lack the value; this says whether they diverged or
-    never reached the event."""
+    never reached the event (a manoeuvre's ``incomplete``, else ``otherwise``)."""
     reasons: Counter[str] = Counter()
     for run, x in zip(runs, values, strict=True):
         if run is not None and run.diverged:
             reasons["diverged"] += 1
         elif x is None or not math.isfinite(x):
-            reasons[run.incomplete if run is not None and run.incomplete else "no value"] += 1
+            reasons[getattr(run, "incomplete", "") or otherwise] += 1
     return sum(reasons.values()), "; ".join(f"{n} {why}" for why, n in reasons.most_common())
 
 

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from shipid.data.preprocess import cumulative_integral
 from shipid.data.rudder_signal import ramp_start, rise_rate, rudder_for_events, stand_samples
 from shipid.data.trim import EXECUTE_FRACTION, first_swing_index
 from shipid.errors import ShipidError
@@ -72,15 +73,6 @@ class Trial:
     switch_heading_deg: float | None
     rudder_rate: float | None
     held_end_index: int
-
-
-def cumulative_integral(y: np.ndarray, t: np.ndarray, initial: float = 0.0) -> np.ndarray:
-    """∫ y dt from t[0] by the trapezoidal rule, sample by sample."""
-    out = np.empty(len(y))
-    out[0] = initial
-    np.cumsum(0.5 * (y[1:] + y[:-1]) * np.diff(t), out=out[1:])
-    out[1:] += initial
-    return out
 
 
 def heading_noise(psi: np.ndarray, integral: np.ndarray) -> float:
