@@ -215,3 +215,29 @@ def test_demo_writes_report_and_figures(tmp_path, capsys):
     assert len(list((tmp_path / "demo").glob("*.png"))) == 6
     report = (tmp_path / "demo" / "report.md").read_text()
     assert "| turning δ = +20° |" in report and "0.0400 / 0.0236 / 0.0129" in report
+
+
+def _rps_ship() -> ManoeuvringModel:
+    """The paper's scale ship with its thrust as |n|n (10 rps gives the paper's constant)."""
+    c = scale_ship().dynamics.coefficients
+    surge = {k: x for k, x in c["u"].items() if k != "1"} | {"|n|*n": c["u"]["1"] / 100.0}
+    lateral = {d: {("u^2*delta" if k == "delta" else k): x for k, x in c[d].items()}
+               for d in ("v", "r")}  # fmt: skip
+    return ManoeuvringModel("blanke-rps", {"u": surge, **lateral})
+
+
+@pytest.mark.parametrize(("speeds", "model", "noted"), [
+    ((8.0, 12.0), "blanke", True),  # n varies, no term holds it
+    ((8.0, 12.0), "blanke-rps", False),  # |n|n holds it
+    ((10.0, 10.0), "blanke", False),  # constant n: lumped into the constant, rightly
+])  # fmt: skip
+def test_a_varying_propeller_speed_without_a_term_for_it_is_named(speeds, model, noted):
+    ship = _rps_ship()
+    steady = (0.0012 / 0.0321) ** 0.5  # u/n where |n|n balances |u|u (no surge constant)
+    logs = [zigzag(ship, 20, 20, duration=60, dt=0.2, method="euler", rps=n, approach=2.0,
+                   speed=steady * n).log.assign(n=n) for n in speeds]  # fmt: skip
+    fit = identify(logs, model=model)
+    notes = [w for w in fit.warnings if "the propeller speed n varies" in w]
+    assert len(notes) == int(noted)
+    if noted:
+        assert "(8 to 12 rps)" in notes[0] and "--model blanke-rps" in notes[0]
