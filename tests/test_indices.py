@@ -232,3 +232,22 @@ def test_straight_run_is_other():
     log = make_log({"t": t, "delta": np.zeros(t.size), "u": np.full(t.size, 2.0),
                     "v": np.zeros(t.size), "r": np.zeros(t.size)})  # fmt: skip
     assert manoeuvre_indices(log) == {"kind": "other", "reason": "the rudder never swings"}
+
+
+def test_validate_says_which_switch_heading_the_overshoots_are_measured_from(tmp_path, capsys):
+    """A 20° rudder reversed at 12° of heading: the output names the switch heading the
+    overshoots are measured from (a reader comparing with a published table measured from the
+    nominal heading needs to know), the one the indices use: 12° and the heading the ship
+    turns in the sample the rudder takes to leave its plateau (0.7° here)."""
+    log = zigzag(SHIP, 20, 12, duration=90, dt=0.05, method="rk4", approach=2.0).log
+    path = write_log(log, tmp_path / "zz.csv")
+    model = tmp_path / "m.json"
+    assert main(["identify", str(path), "--dt", "0.05", "-o", str(model)]) == 0
+    capsys.readouterr()
+    assert main(["validate", str(model), str(path), "--dt", "0.05"]) == 0
+    out = capsys.readouterr().out
+    line = next(x for x in out.splitlines() if x.startswith("Zig-zag overshoots"))
+    shown = float(line.split("zz.csv ")[1].rstrip("°."))
+    assert shown == pytest.approx(describe_trial(read_log(path), "zigzag").switch_heading_deg,
+                                  abs=0.01)  # fmt: skip
+    assert 12.0 <= shown <= 12.0 + 1.0

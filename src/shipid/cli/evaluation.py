@@ -44,7 +44,7 @@ def cmd_validate(args) -> int:
         model_from_document,
         training_conditions,
     )
-    from shipid.reporting.report import indices_frame, metrics_frame
+    from shipid.reporting.report import indices_frame, metrics_frame, switch_heading_note
 
     check_outputs({"--json": (args.json, "json"), "--plots": (args.plots, "dir"),
                    "--report": (args.report, "dir")}, [args.model, *args.logs])  # fmt: skip
@@ -96,6 +96,9 @@ def cmd_validate(args) -> int:
             table = table.astype(object).where(table.notna(), "–")
             print()
             print(table.to_markdown(index=False, floatfmt=".4g"))
+            note = switch_heading_note(good)
+            if note:
+                print(note)
     residuals = {}
     if args.resid or args.report:
         from shipid.evaluation.metrics import residual_correlations

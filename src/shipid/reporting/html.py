@@ -54,7 +54,7 @@ def validation_report(
     """The HTML text of the report. ``figures``: PNGs already drawn, {log name: {"fit": ...,
     "resid": ...}} (``shipid validate --plots`` shares its own); the others are drawn here."""
     from shipid.reporting import plots
-    from shipid.reporting.report import indices_frame, metrics_frame
+    from shipid.reporting.report import indices_frame, metrics_frame, switch_heading_note
 
     good = [(v, log) for v, log in zip(validations, logs, strict=True) if v.error is None]
     parts = [f"<!doctype html><html><head><meta charset='utf-8'><title>{html.escape(title)}"
@@ -77,6 +77,9 @@ def validation_report(
     ind = indices_frame([v for v, _ in good])
     if len(ind):
         parts += ["<h2>Manoeuvring indices</h2>", _table(ind)]
+        note = switch_heading_note([v for v, _ in good])
+        if note:
+            parts.append(f"<p>{html.escape(note)}</p>")
     if criteria is not None and len(criteria):
         parts += ["<h2>IMO MSC.137(76) criteria</h2>", _table(criteria)]
     for v, log in good:
