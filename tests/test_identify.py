@@ -241,3 +241,17 @@ def test_a_varying_propeller_speed_without_a_term_for_it_is_named(speeds, model,
     assert len(notes) == int(noted)
     if noted:
         assert "(8 to 12 rps)" in notes[0] and "--model blanke-rps" in notes[0]
+
+
+def test_a_thrust_that_follows_the_speed_at_a_logged_rps_is_not_named():
+    """At constant rps the thrust rises as a zig-zag slows the ship (HSVA's KVLCC2 run: 40-53 N);
+    it is the ship's response, not an input the structure misses."""
+    ship = _rps_ship()
+    log = zigzag(ship, 20, 20, duration=60, dt=0.2, method="euler", rps=10.0, approach=2.0,
+                 speed=1.93).log  # fmt: skip
+    log = log.assign(n=10.0, thrust=40.0 * (2.0 - log["u"] / log["u"].iloc[0]))
+    assert np.ptp(log["thrust"]) > 0.1 * log["thrust"].max()
+    fit = identify(log, model="blanke")
+    assert not [w for w in fit.warnings if "varies in the training logs" in w]
+    fit = identify(log.drop(columns="n"), model="blanke")  # no rps: the thrust is the input
+    assert [w for w in fit.warnings if "the thrust T varies" in w]

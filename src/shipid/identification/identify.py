@@ -178,17 +178,18 @@ _PROPULSION_INPUTS = (("n", "the propeller speed n", "rps", "--model blanke-rps 
 
 
 def unmodelled_inputs(logs, structure: ModelStructure) -> list[str]:
-    """Notes for a propulsion input (n, thrust) that varies in the training logs while no term
-    of the structure holds it: its effect is then spread over the other terms, and the model
-    cannot follow a change of it (the paper's ``blanke`` fitted to the Esso Osaka's zig-zags at
-    10–16.7 rps and three random runs finds no steady speed, and turning circles 2.5–3.4 times
-    too wide)."""
+    """Notes for a propulsion input (n; the thrust where no rps is logged) that varies in the
+    training logs while no term of the structure holds it: its effect is then spread over the
+    other terms, and the model cannot follow a change of it (the paper's ``blanke`` fitted to
+    the Esso Osaka's zig-zags at 10–16.7 rps and three random runs finds no steady speed, and
+    turning circles 2.5–3.4 times too wide)."""
     used = {s for names in structure.terms.values() for n in names for s in parse_term(n).signals}
+    has_rps = any("n" in log.columns for log in logs)
     notes = []
     for signal, what, unit, remedy in _PROPULSION_INPUTS:
         columns = [log[signal].to_numpy(dtype=float) for log in logs if signal in log.columns]
-        if signal in used or not columns:
-            continue
+        if signal in used or not columns or (signal == "thrust" and has_rps):
+            continue  # at a logged rps the thrust follows the ship's speed (HSVA's KVLCC2 run)
         values = np.concatenate(columns)
         values = values[np.isfinite(values)]
         if values.size == 0:
