@@ -118,9 +118,9 @@ def _physics(args, logs, structure):
         prior = clarke_prior(part, structure, speed or 0.0, side)
     elif args.prior:
         from shipid.identification.priors import prior_from_model
-        from shipid.reporting.modelfile import load_model
+        from shipid.reporting.modelfile import load_document, model_from_document
 
-        prior = prior_from_model(load_model(args.prior))
+        prior = prior_from_model(model_from_document(load_document(args.prior), args.prior))
     options = PhysicsOptions(prior=prior, bounds=bounds or None, **flags)
     return options if options.active else None
 
@@ -270,9 +270,10 @@ def _np():
     return np
 
 
-def _ship_or_model(name: str):
+def _ship_or_model(name: str, hybrid: bool = False):
     """A reference ship (its trimmed speed applies) or a model file with its training
-    conditions (approach speed, propeller speed, envelope)."""
+    conditions (approach speed, propeller speed, envelope); a model with a kernel residual
+    where the command runs one (``hybrid``), else refused."""
     from shipid.reporting.modelfile import load_document, model_from_document, training_conditions
     from shipid.vessels import get_vessel
 
@@ -285,7 +286,7 @@ def _ship_or_model(name: str):
     from shipid.reporting.modelfile import ensemble_from_document
 
     doc = load_document(name)
-    model = model_from_document(doc, name)
+    model = model_from_document(doc, name, hybrid=hybrid)
     cond = training_conditions(doc)
     cond["ensemble"] = ensemble_from_document(doc, name, model)
     return model, cond
@@ -296,14 +297,17 @@ def _run_approach(target, cond: dict, speed: float | None, rps: float | None):
     steady straight approach (``shipid.dynamics.equilibrium.steady_approach``), printed, with a
     warning when it is not steady. Returns (speed, rps, warning or None)."""
     from shipid.dynamics.equilibrium import steady_approach
+    from shipid.dynamics.hybrid import HybridModel
     from shipid.dynamics.model import ManoeuvringModel
 
-    if not isinstance(target, ManoeuvringModel):
+    physical = target.physical if isinstance(target, HybridModel) else target
+    if not isinstance(physical, ManoeuvringModel):
         return speed, rps, None
     if speed is None and not cond["speed"]:
         return None, rps if rps is not None else cond["rps"], None  # the run names what is missing
-    app = steady_approach(target, cond["speed"], cond["rps"], speed, rps)
-    print(app.describe())
+    app = steady_approach(physical, cond["speed"], cond["rps"], speed, rps)
+    print(app.describe() + (" (of its physical part; the kernel residual may shift it)"
+                            if physical is not target else ""))  # fmt: skip
     return app.speed, app.rps, app.warning
 
 

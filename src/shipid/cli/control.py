@@ -87,12 +87,12 @@ def cmd_export(args) -> int:
     """``shipid export``: write the model as a standalone NumPy function file."""
     from shipid.control.export import export_numpy
     from shipid.outputs import check_outputs
-    from shipid.reporting.modelfile import load_model
+    from shipid.reporting.modelfile import load_document, model_from_document
 
     if Path(args.output).suffix != ".py":
         raise ShipidError(f"-o {args.output}: the exported module must be a .py file")
     check_outputs({"-o": (args.output, "python")}, [args.model])
-    model = load_model(args.model)
+    model = model_from_document(load_document(args.model), args.model)  # term models only
     export_numpy(model, args.output)
     print(f"standalone NumPy module written to {args.output} (accelerations, derivatives, "
           "simulate)")  # fmt: skip

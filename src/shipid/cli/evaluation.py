@@ -52,7 +52,7 @@ def cmd_validate(args) -> int:
     if args.lssvm and not has_refinement(doc):
         _warn(f"{args.model} has no refinement: its model is the LS-SVM one, which --lssvm "
               "validates")  # fmt: skip
-    model = model_from_document(doc, args.model, "lssvm" if args.lssvm else "model")
+    model = model_from_document(doc, args.model, "lssvm" if args.lssvm else "model", hybrid=True)
     ensemble = None if args.no_bands else ensemble_from_document(doc, args.model, model)
     band = None if args.no_bands or args.lssvm else error_band_from_document(doc, args.model)
     cond = training_conditions(doc)
@@ -170,7 +170,8 @@ def cmd_validate(args) -> int:
 
             ident = doc.get("identification") or {}
             se = {d: (ident.get("diagnostics") or {}).get(d, {}).get("std_errors")
-                  for d in model.structure.dofs} if not args.lssvm else None  # fmt: skip
+                  for d in getattr(model, "physical", model).structure.dofs
+                  } if not args.lssvm else None  # fmt: skip
             text = validation_report(model, vals, logs, f"Validation of {Path(args.model).name}",
                                      std_errors=se, criteria=crit,
                                      warnings=[w for v in good for w in v.warnings],
@@ -219,7 +220,7 @@ def cmd_simulate(args) -> int:
     check_outputs({"-o": (args.output, "log")}, [args.model, log_path])
     from shipid.data.log import in_rudder_convention
 
-    target, cond = _ship_or_model(args.model)
+    target, cond = _ship_or_model(args.model, hybrid=True)
     dynamics = getattr(target, "dynamics", target)
     log, note = in_rudder_convention(read_log(log_path, _read_options(args)),
                                      getattr(target, "rudder_positive", None)

@@ -73,6 +73,10 @@ def cmd_identify(args) -> int:
     if args.error_band is not None and (args.refine or args.output_error):
         raise ShipidError("--error-band describes the LS-SVM fit; it does not go with --refine "
                           "or --output-error")  # fmt: skip
+    if args.residual and (args.refine or args.output_error or args.bootstrap is not None
+                          or args.error_band is not None):
+        raise ShipidError("--residual adds a kernel residual to the LS-SVM fit; it does not go "
+                          "with --refine, --output-error, --bootstrap or --error-band")  # fmt: skip
     logs = _training_logs(args)
     raw_logs = logs  # the output-error fit needs the noise as measured, not prefiltered
     names = [str(p) for p in args.logs]
@@ -180,6 +184,10 @@ def cmd_identify(args) -> int:
                 ensemble = None  # its draws describe the output-error model, not this one
         else:
             final, plausibility, notes = refinement.model, refined_report, refined_notes
+    residual = None
+    if args.residual:
+        residual, final = _kernel_residual(args, final, logs, raw_logs, names, cutoff, gamma,
+                                           physics, ident.warnings)  # fmt: skip
     sl = plausibility["straight_line"]
     if sl:
         print(f"straight-line {'stable' if sl['stable'] else 'UNSTABLE'} (largest sway–yaw "
@@ -193,7 +201,7 @@ def cmd_identify(args) -> int:
                       plausibility=plausibility, model=final, selection=gamma_report,
                       particulars=_log_particulars(logs),
                       uncertainty=ensemble.to_dict() if ensemble else None,
-                      error_band=band.to_dict() if band else None)  # fmt: skip
+                      error_band=band.to_dict() if band else None, residual=residual)  # fmt: skip
     from shipid.reporting.modelfile import prime_record
 
     _print_prime(prime_record(final, _log_particulars(logs), speed))
@@ -237,6 +245,46 @@ def _print_prime(record: dict | None) -> None:
     rows = [{"equation": f"{dof}̇′", "term": _term_display(t), "prime": c}
             for dof, terms in record["coefficients"].items() for t, c in terms.items()]
     print(_pd().DataFrame(rows).to_markdown(index=False, floatfmt=".5g"))
+
+
+def _kernel_residual(args, physical, logs, raw_logs, names, cutoff, gamma, physics, warnings):
+    """``identify --residual``: the residual's γ and σ (or none) by free-run cross-validation of
+    the hybrid, each fold's physical model fitted as this one (structure, γ, prefilter,
+    physics); then the residual on all logs. Returns (its model-file record or None, the model
+    the file holds: the physical one alone when no residual won, whose physical part keeps its
+    own checks); the hybrid's held-rudder runs are checked too."""
+    from shipid.data.preprocess import lowpass
+    from shipid.dynamics.hybrid import HybridModel
+    from shipid.identification.identify import identify
+    from shipid.identification.plausibility import held_rudder
+    from shipid.identification.residual import choose_residual, fit_residual
+
+    def fit(train):
+        fitted_on = [lowpass(x, cutoff) for x in train] if cutoff is not None else list(train)
+        return identify(fitted_on, model=args.model, form=args.form, gamma=gamma,
+                        drop=_parse_drop(args.drop), force=True, estimator=args.estimator,
+                        physics=physics).model, fitted_on  # fmt: skip
+
+    print("choosing the kernel residual by free-run cross-validation…", file=sys.stderr)
+    choice = choose_residual(fit, raw_logs, names, cv=args.cv or "auto")
+    print(choice.describe())
+    warnings.extend(choice.notes)
+    record = {"residual": None, "selection": choice.to_dict()}
+    if choice.gamma is None:
+        return record, physical
+    residual = fit_residual(physical, logs, choice.gamma, choice.sigma, choice.features)
+    hybrid = HybridModel(physical, residual)
+    print(hybrid.equations().splitlines()[-1])
+    speed, rps = _approach(logs[0], "u"), _approach(logs[0], "n")
+    if physical.uses_wind:
+        warnings.append("kernel residual: the hybrid's held-rudder runs are not checked (its "
+                        "closed loop meets no wind, and the physical model has wind terms)")
+    elif speed and speed > 0:
+        for side, entry in held_rudder(hybrid, speed, rps if hybrid.uses_rps else None).items():
+            if entry["diverged"]:
+                warnings.append(f"kernel residual: 35° rudder held to {side}: {entry['reason']}")
+    record["residual"] = residual.to_dict()
+    return record, physical
 
 
 def _auto_gamma(args, logs, names, physics=None) -> tuple[float, dict]:

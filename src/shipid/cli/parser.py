@@ -119,8 +119,8 @@ def build_parser() -> argparse.ArgumentParser:
                    "over the logs (default %(default)g)")
     p.add_argument("--estimator", default="lssvm", choices=LINEAR_ESTIMATORS,
                    help="equation-error estimator (default %(default)s, the paper's)")
-    p.add_argument("--cv", help="with --gamma auto: logo, kfold:K or blocks:K (default: logo, "
-                   "blocks:4 for one log)")
+    p.add_argument("--cv", help="with --gamma auto or --residual: logo, kfold:K (--gamma) or "
+                   "blocks:K (default: logo, blocks:4 for one log)")
     p.add_argument("--drop", help="terms to drop, e.g. u:r^2 (the paper drops r²)")
     p.add_argument("--filter", type=_number_or_auto_or_none, default="auto", metavar="HZ|auto|none",
                    help="zero-phase low-pass of u, v, r against the errors-in-variables bias: a "
@@ -156,6 +156,11 @@ def build_parser() -> argparse.ArgumentParser:
                    help="the cross-validated 95 %% error band of the free runs, stored for "
                    "validate: the same fit without each log (logo) or block (blocks:K), run free "
                    "over it (default auto: logo from two logs, blocks:4 of one)")
+    p.add_argument("--residual", choices=("rbf",),
+                   help="add a kernel residual to the physical model: an RBF LS-SVM on its "
+                   "one-step acceleration residual, γ and σ (or none) chosen by the free-run "
+                   "error of the hybrid on each log left out (--cv); it fades out beyond the "
+                   "training logs' envelope. Validate, simulate and manoeuvre run it")
     # --out spelled out: since --output-error, argparse no longer takes it for --output.
     p.add_argument("-o", "--output", "--out", required=True, metavar="MODEL.json")
     _add_physics_options(p)

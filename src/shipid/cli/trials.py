@@ -20,7 +20,7 @@ def cmd_criteria(args) -> int:
 
     check_outputs({"--json": (args.json, "json")},
                   [args.model] if Path(args.model).exists() else [])  # fmt: skip
-    target, cond = _ship_or_model(args.model)
+    target, cond = _ship_or_model(args.model, hybrid=True)
     particulars = read_particulars(args.particulars) if args.particulars else cond["particulars"]
     speed, rps, _ = _run_approach(target, cond, args.speed, args.rps)  # imo_criteria notes it
     # Given, else the ship's gear or the training logs' rate, else imo_criteria's SOLAS rate.
@@ -73,7 +73,7 @@ def cmd_manoeuvre(args) -> int:
 
     check_outputs({"--json": (args.json, "json"), "-o": (args.output, "log")},
                   [args.model] if Path(args.model).exists() else [])  # fmt: skip
-    target, cond = _ship_or_model(args.model)
+    target, cond = _ship_or_model(args.model, hybrid=True)
     speed, rps, unsteady = _run_approach(target, cond, args.speed, args.rps)
     steering, rudder_note = _steering(target, cond, args.rudder_rate)
     kw = {"dt": args.step, "speed": speed, "rps": rps, "steering": steering}

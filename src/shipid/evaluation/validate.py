@@ -26,6 +26,7 @@ import numpy as np
 import pandas as pd
 
 from shipid.data.log import rudder_positive, starboard_sign
+from shipid.dynamics.hybrid import HybridModel
 from shipid.dynamics.model import ManoeuvringModel
 from shipid.dynamics.simulate import SimulationResult, simulate_log
 from shipid.dynamics.steering import SteeringMachine
@@ -95,6 +96,9 @@ def free_run(model, log: pd.DataFrame, method: str = "euler") -> tuple[Simulatio
     return sim, {s: error_metrics(log[s].to_numpy()[:n], sim.log[s].to_numpy()) for s in STATES}
 
 
+FADED_SHARE = 0.1  # a hybrid's run beyond its residual's envelope for more than this is named
+
+
 def validate_log(model, log: pd.DataFrame, name: str, method: str = "euler",
                  kind: str | None = None, smooth_s: float = 0.0,
                  ensemble: Ensemble | None = None,
@@ -108,9 +112,19 @@ def validate_log(model, log: pd.DataFrame, name: str, method: str = "euler",
     if trial.kind != "other":
         measured = manoeuvre_indices(log, smooth_s=smooth_s, trial=trial)
         indices = {"measured": measured, "simulated": _replay_indices(sim, trial)}
-        if trial.kind == "zigzag" and isinstance(model, ManoeuvringModel | Vessel):
+        # A hybrid's closed loop steps its NumPy path, which meets no wind (the compiled one
+        # gives a model's wind terms the still air of its own motion).
+        closes = isinstance(model, ManoeuvringModel | Vessel) or (
+            isinstance(model, HybridModel) and not model.physical.uses_wind)
+        if trial.kind == "zigzag" and closes:
             indices["closed_loop"] = _replica_indices(model, log, method, trial)
     out = Validation(name, sim, metrics, indices, trial.kind)
+    if isinstance(model, HybridModel):
+        faded = model.faded_share(sim.log)
+        if faded > FADED_SHARE:
+            out.warnings.append(f"the kernel residual is faded out over {100 * faded:.0f} % of "
+                                "the run (beyond its training envelope): there the physical "
+                                "model alone predicts")  # fmt: skip
     if error_band is not None:
         out.error_band = error_band
         out.band_shares = error_band.shares_within(log[list(STATES)].to_numpy(dtype=float),

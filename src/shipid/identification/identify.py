@@ -177,6 +177,18 @@ _PROPULSION_INPUTS = (("n", "the propeller speed n", "rps", "--model blanke-rps 
                       ("thrust", "the thrust T", "N", "--model blanke-thrust"))  # fmt: skip
 
 
+def varies(values: np.ndarray) -> bool:
+    """Whether an input's 5–95 % range exceeds ``VARYING_INPUT`` of its typical magnitude
+    (non-finite samples ignored)."""
+    values = np.asarray(values, dtype=float)
+    values = values[np.isfinite(values)]
+    if values.size == 0:
+        return False
+    lo, hi = np.percentile(values, [5, 95])
+    typical = float(np.percentile(np.abs(values), 95))
+    return typical > 0 and hi - lo > VARYING_INPUT * typical
+
+
 def unmodelled_inputs(logs, structure: ModelStructure) -> list[str]:
     """Notes for a propulsion input (n; the thrust where no rps is logged) that varies in the
     training logs while no term of the structure holds it: its effect is then spread over the
@@ -191,12 +203,8 @@ def unmodelled_inputs(logs, structure: ModelStructure) -> list[str]:
         if signal in used or not columns or (signal == "thrust" and has_rps):
             continue  # at a logged rps the thrust follows the ship's speed (HSVA's KVLCC2 run)
         values = np.concatenate(columns)
-        values = values[np.isfinite(values)]
-        if values.size == 0:
-            continue
-        lo, hi = np.percentile(values, [5, 95])
-        typical = float(np.percentile(np.abs(values), 95))
-        if typical > 0 and hi - lo > VARYING_INPUT * typical:
+        if varies(values):
+            values = values[np.isfinite(values)]
             notes.append(f"{what} varies in the training logs ({np.min(values):.4g} to "
                          f"{np.max(values):.4g} {unit}) but no term of the structure holds it: "
                          "its effect is lumped into the others and the model cannot follow a "

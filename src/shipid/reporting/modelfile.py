@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from shipid import __version__
+from shipid.dynamics.hybrid import HybridModel, KernelResidual
 from shipid.dynamics.model import ManoeuvringModel
 from shipid.errors import ShipidError
 from shipid.outputs import atomic_write_text
@@ -56,11 +57,12 @@ def model_document(ident: Identification, training_files: Sequence[str | Path] =
                    preprocessing: dict | None = None, refinement: Refinement | None = None,
                    plausibility: dict | None = None, model: ManoeuvringModel | None = None,
                    selection: dict | None = None, particulars: dict | None = None,
-                   uncertainty: dict | None = None, error_band: dict | None = None
-                   ) -> dict:  # fmt: skip
+                   uncertainty: dict | None = None, error_band: dict | None = None,
+                   residual: dict | None = None) -> dict:  # fmt: skip
     """The model file. ``model`` is the one users get (default: the refined model when there is a
     refinement, else the LS-SVM one); the LS-SVM model stays in ``refinement.initial_model`` and
-    the refined one in ``refinement.refined_model``."""
+    the refined one in ``refinement.refined_model``. ``residual``: the model's kernel residual
+    and its selection (``{"residual": KernelResidual.to_dict(), "selection": ...}``)."""
     if model is None:
         model = refinement.model if refinement is not None else ident.model
     return json_safe({
@@ -69,6 +71,7 @@ def model_document(ident: Identification, training_files: Sequence[str | Path] =
         "particulars": particulars,
         "prime": prime_record(model, particulars, (preprocessing or {}).get("approach_speed")),
         "uncertainty": uncertainty,
+        "kernel_residual": residual,
         "identification": {"form": ident.form, "gamma": ident.gamma, "dt": ident.dt,
                            "estimator": ident.estimator, "selection": selection,
                            "physics": ident.physics,
@@ -112,10 +115,13 @@ def model_text(ident: Identification, training_files: Sequence[str | Path] = (),
 def save_model(path: str | Path, ident: Identification, training_files: Sequence[str | Path] = (),
                preprocessing: dict | None = None, refinement: Refinement | None = None,
                plausibility: dict | None = None,
-               model: ManoeuvringModel | None = None) -> Path:  # fmt: skip
-    """Write the model file of an identification atomically."""
+               model: ManoeuvringModel | None = None,
+               residual: KernelResidual | None = None) -> Path:  # fmt: skip
+    """Write the model file of an identification atomically (with a kernel residual of its
+    model: ``load_model`` then gives the ``HybridModel``)."""
+    record = None if residual is None else {"residual": residual.to_dict(), "selection": None}
     text = model_text(ident, training_files, preprocessing=preprocessing, refinement=refinement,
-                      plausibility=plausibility, model=model)  # fmt: skip
+                      plausibility=plausibility, model=model, residual=record)  # fmt: skip
     return atomic_write_text(path, text)
 
 
@@ -224,9 +230,10 @@ def load_document(path: str | Path) -> dict:
     return doc
 
 
-def load_model(path: str | Path, which: str = "model") -> ManoeuvringModel:
-    """The file's model, or with ``which="lssvm"`` the LS-SVM model a refinement started from."""
-    return model_from_document(load_document(path), path, which)
+def load_model(path: str | Path, which: str = "model") -> ManoeuvringModel | HybridModel:
+    """The file's model, or with ``which="lssvm"`` the LS-SVM model a refinement started from.
+    A model identified with a kernel residual (``identify --residual``) is a ``HybridModel``."""
+    return model_from_document(load_document(path), path, which, hybrid=True)
 
 
 def has_refinement(doc: Mapping) -> bool:
@@ -234,19 +241,38 @@ def has_refinement(doc: Mapping) -> bool:
     return bool((doc.get("identification") or {}).get("refinement"))
 
 
-def model_from_document(doc: dict, path: str | Path, which: str = "model") -> ManoeuvringModel:
-    """The model (or, with ``which='lssvm'``, the LS-SVM one) of a parsed model file."""
+def model_from_document(doc: dict, path: str | Path, which: str = "model",
+                        hybrid: bool = False) -> ManoeuvringModel | HybridModel:  # fmt: skip
+    """The model (or, with ``which='lssvm'``, the LS-SVM one) of a parsed model file. A file with
+    a kernel residual gives a ``HybridModel`` where the caller runs one (``hybrid``); elsewhere
+    it is refused, since its term model alone is not the model identified."""
     if which not in ("model", "lssvm"):
         raise ShipidError(f"which must be 'model' or 'lssvm', got {which!r}")
     data = doc.get("model")
     if which == "lssvm" and has_refinement(doc):
         data = doc["identification"]["refinement"]["initial_model"]
     try:
-        return ManoeuvringModel.from_dict(data)
+        model = ManoeuvringModel.from_dict(data)
     except ShipidError as exc:
         raise ShipidError(f"{path}: {exc}") from None
     except (KeyError, TypeError, ValueError) as exc:
         raise ShipidError(f"{path}: malformed model ({exc})") from None
+    record = doc.get("kernel_residual")
+    if record is None:
+        return model
+    if not isinstance(record, Mapping):
+        raise ShipidError(f"{path}: kernel_residual must be a mapping")
+    if record.get("residual") is None:
+        return model  # the search chose no residual; its record is kept
+    if not hybrid:
+        raise ShipidError(f"{path}: the model has a kernel residual (identify --residual); this "
+                          "command needs a term model: validate, simulate, manoeuvre and "
+                          "criteria run it, the others take a model identified without "
+                          "--residual")  # fmt: skip
+    if not isinstance(record["residual"], Mapping):
+        raise ShipidError(f"{path}: kernel_residual.residual must be a mapping")
+    residual = KernelResidual.from_dict(record["residual"], f"{path}: kernel_residual")
+    return HybridModel(model, residual)
 
 
 def ensemble_from_document(doc: Mapping, path: str | Path, model: ManoeuvringModel):

@@ -25,6 +25,7 @@ import pandas as pd
 
 from shipid.data.log import make_log, starboard_sign
 from shipid.dynamics import codegen, kernel
+from shipid.dynamics.hybrid import HybridModel
 from shipid.dynamics.model import ManoeuvringModel
 from shipid.dynamics.simulate import (
     METHODS,
@@ -114,12 +115,12 @@ def _positive(value, what: str) -> float:
     return float(value)
 
 
-def as_vessel(ship: Vessel | ManoeuvringModel, speed: float | None = None,
+def as_vessel(ship: Vessel | ManoeuvringModel | HybridModel, speed: float | None = None,
               steering: SteeringMachine | None = None, rps: float | None = None) -> Vessel:  # fmt: skip
     """A Vessel for a reference ship or an identified model (which needs an approach speed)."""
     if isinstance(ship, Vessel):
         vessel = ship
-    elif isinstance(ship, ManoeuvringModel):
+    elif isinstance(ship, ManoeuvringModel | HybridModel):
         if speed is None:
             raise ShipidError("a manoeuvre on a model needs the approach speed (speed=..., --speed)")
         speed = _positive(speed, "approach speed")
@@ -220,6 +221,10 @@ def run_closed_loop(
         m = int(n_valid[0])
         states, rudder = states[0], rudder[0]
     else:
+        if {"wind_speed", "wind_angle"} & set(getattr(dyn, "inputs", ())):
+            raise ShipidError("a manoeuvre of a model with wind terms and a kernel residual is "
+                              "not supported (its NumPy closed loop meets no wind); identify "
+                              "it without --residual or without wind terms")  # fmt: skip
         states, rudder, m = _generic_closed_loop(dyn, params, n, dt, s0, method, speed_lim,
                                                  yaw_lim, rps if uses_rps else None)  # fmt: skip
     t = np.arange(n) * dt
