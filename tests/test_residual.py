@@ -167,3 +167,44 @@ def test_identify_residual_through_the_command_line(tmp_path, capsys, trials):
     code, _, err = run(["identify", *map(str, paths), "--residual", "rbf", "--bootstrap", "10",
                         "-o", str(tmp_path / "b.json")], capsys)  # fmt: skip
     assert code == 1 and "--residual" in err and not (tmp_path / "b.json").exists()
+
+
+@pytest.mark.parametrize("method", ["euler", "rk4"])
+def test_the_compiled_runs_are_the_numpy_derivatives_integrated(trials, hybrid, method):
+    """Independent check of the compiled hybrid (``hybrid_kernel``): the NumPy path integrates
+    ``HybridModel.derivatives`` (its physical part by the term matrix, not the kernel) open loop
+    and closed loop, to rounding."""
+    from shipid.dynamics.simulate import _integrate_generic, initial_states
+    from shipid.trials.manoeuvres import _generic_closed_loop, as_vessel, manoeuvre_params
+
+    _, held = trials
+    _, _, model = hybrid
+
+    class NumPyPath:  # the derivatives alone, so the simulator takes its generic path
+        uses_thrust, uses_rps, inputs = False, False, ("delta",)
+
+        def derivatives(self, nu, delta, thrust=None, rps=None):
+            base = model.physical.accelerations(nu[:, 0], nu[:, 1], nu[:, 2], delta)
+            return base + model.residual.accelerations(model.features(nu, delta))
+
+    log = held[1]
+    compiled = simulate_log(model, log, method).log[["u", "v", "r", "psi", "x", "y"]].to_numpy()
+    t, delta = log["t"].to_numpy(), log["delta"].to_numpy()[None]
+    s0 = initial_states({k: float(log[k].iloc[0]) for k in ("u", "v", "r", "psi", "x", "y")}, 1)
+    out, n_valid = np.zeros((1, len(t), 6)), np.zeros(1, dtype=np.int64)
+    _integrate_generic(NumPyPath(), t, delta, None, None, s0, method, 1e3, 5.0, out, n_valid)
+    np.testing.assert_allclose(compiled, out[0], rtol=1e-9, atol=1e-11)
+
+    vessel = as_vessel(model, speed=1.94)
+    result = zigzag(model, 20, 20, duration=40, dt=0.2, method=method, speed=1.94)
+    from shipid.dynamics import kernel
+
+    params = manoeuvre_params(vessel, kernel.MODE_ZIGZAG, np.radians(20), 0.0, 0.0,
+                              switch=np.radians(20), side=1.0)  # fmt: skip
+    states, rudder, m = _generic_closed_loop(NumPyPath(), params, len(result.log), 0.2,
+                                             initial_states({"u": 1.94}, 1), method, 1e3, 5.0,
+                                             None)  # fmt: skip
+    assert m == len(result.log)
+    np.testing.assert_allclose(result.log[["u", "v", "r", "psi"]].to_numpy(), states[:, :4],
+                               rtol=1e-9, atol=1e-11)  # fmt: skip
+    np.testing.assert_allclose(result.log["delta"].to_numpy(), rudder, atol=1e-12)

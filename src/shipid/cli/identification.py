@@ -276,10 +276,7 @@ def _kernel_residual(args, physical, logs, raw_logs, names, cutoff, gamma, physi
     hybrid = HybridModel(physical, residual)
     print(hybrid.equations().splitlines()[-1])
     speed, rps = _approach(logs[0], "u"), _approach(logs[0], "n")
-    if physical.uses_wind:
-        warnings.append("kernel residual: the hybrid's held-rudder runs are not checked (its "
-                        "closed loop meets no wind, and the physical model has wind terms)")
-    elif speed and speed > 0:
+    if speed and speed > 0:
         for side, entry in held_rudder(hybrid, speed, rps if hybrid.uses_rps else None).items():
             if entry["diverged"]:
                 warnings.append(f"kernel residual: 35° rudder held to {side}: {entry['reason']}")

@@ -13,8 +13,9 @@ k(z) = maxᵢ exp(−‖z − cᵢ‖² / σ²) is the kernel's reach at z and k
 the training samples, so the physical model alone is left where the residual has seen no data.
 ``fade`` says how far a run went there.
 
-A hybrid runs on the generic (vectorised NumPy) path of ``shipid.dynamics.simulate`` and of the
-manoeuvres' closed loop: the compiled kernel holds term models only.
+A hybrid runs compiled (``shipid.dynamics.hybrid_kernel``: the term model's state derivative plus
+the residual, through the kernel's integrators) in ``shipid.dynamics.simulate`` and in the
+manoeuvres' closed loop; ``HybridModel.derivatives`` is the same function in NumPy.
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from shipid.dynamics.kernel import c_array
 from shipid.dynamics.model import ManoeuvringModel
 from shipid.dynamics.terms import INPUT_SIGNALS
 from shipid.errors import ShipidError
@@ -136,6 +138,12 @@ class HybridModel:
         self.uses_rps = physical.uses_rps or uses_n
         self.uses_thrust = physical.uses_thrust
         self.inputs = tuple(dict.fromkeys((*physical.inputs, *(("n",) if uses_n else ()))))
+        r = residual
+        # The compiled runs' arguments (``shipid.dynamics.hybrid_kernel``), built once.
+        self.kernel_arguments = (
+            c_array(r.mean), c_array(r.scale), c_array(r.centres), c_array(r.weights),
+            c_array(r.intercept), 1.0 / (r.sigma * r.sigma), 1.0 / r.reach,
+            np.array([FEATURES.index(f) for f in r.features], dtype=np.int64))  # fmt: skip
 
     def features(self, nu: np.ndarray, delta, rps=None) -> np.ndarray:
         """(B, d) raw residual features at states ``nu`` (B, 3)."""

@@ -22,6 +22,7 @@ import pandas as pd
 
 from shipid.data.log import input_columns, make_log
 from shipid.dynamics import codegen, kernel
+from shipid.dynamics.hybrid import HybridModel
 from shipid.dynamics.model import ManoeuvringModel
 from shipid.dynamics.terms import INPUT_SIGNALS, TermCode
 from shipid.errors import ShipidError
@@ -237,6 +238,24 @@ def run_kernel(code: TermCode, theta: np.ndarray, t: np.ndarray, inputs: np.ndar
     return out, n_valid
 
 
+def run_hybrid_kernel(model: HybridModel, t: np.ndarray, inputs: np.ndarray, s0: np.ndarray,
+                      method: str, speed_lim, yaw_lim) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """A hybrid's compiled open-loop runs (``shipid.dynamics.hybrid_kernel``), as ``run_kernel``."""
+    from shipid.dynamics import hybrid_kernel
+
+    B, N = inputs.shape[0], t.size
+    phys = model.physical
+    out = np.zeros((B, N, 6))
+    n_valid = np.zeros(B, dtype=np.int64)
+    hybrid_kernel.integrate_open(
+        kernel.c_array(np.broadcast_to(phys.theta, (B, *phys.theta.shape))), *phys.code.arrays(),
+        phys.code.uses_derived, *model.kernel_arguments, kernel.c_array(t),
+        kernel.c_array(inputs), np.full(B, N, dtype=np.int64), kernel.c_array(s0),
+        method == "rk4", kernel.c_array(np.broadcast_to(np.asarray(speed_lim, float), B)),
+        kernel.c_array(np.broadcast_to(np.asarray(yaw_lim, float), B)), out, n_valid)  # fmt: skip
+    return out, n_valid
+
+
 def input_array(series: Mapping[str, np.ndarray], n_traj: int, n_steps: int) -> np.ndarray:
     """(B, N, 5) kernel inputs from {name: (N,) or (B, N)} (absent inputs are zero)."""
     out = np.zeros((n_traj, n_steps, len(INPUT_SIGNALS)))
@@ -290,6 +309,13 @@ def simulate_batch(
         out, n_valid = run_kernel(dynamics.code, dynamics.theta, t,
                                   input_array(series, n_traj, n_steps), s0, method, speed_lim,
                                   yaw_lim)  # fmt: skip
+    elif isinstance(dynamics, HybridModel):
+        missing = [c for c in dynamics.inputs if c not in ("n", "thrust") and extra.get(c) is None]
+        if missing:
+            raise ShipidError(f"this model has terms in {', '.join(missing)}: give those series")
+        series = {"delta": delta, "thrust": thrust, "n": rps, **extra}
+        out, n_valid = run_hybrid_kernel(dynamics, t, input_array(series, n_traj, n_steps), s0,
+                                         method, speed_lim, yaw_lim)  # fmt: skip
     elif hasattr(dynamics, "integrate_open"):  # a compiled reference ship: rudder input only
         out = np.zeros((n_traj, n_steps, 6))
         n_valid = np.zeros(n_traj, dtype=np.int64)

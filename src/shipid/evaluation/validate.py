@@ -112,11 +112,7 @@ def validate_log(model, log: pd.DataFrame, name: str, method: str = "euler",
     if trial.kind != "other":
         measured = manoeuvre_indices(log, smooth_s=smooth_s, trial=trial)
         indices = {"measured": measured, "simulated": _replay_indices(sim, trial)}
-        # A hybrid's closed loop steps its NumPy path, which meets no wind (the compiled one
-        # gives a model's wind terms the still air of its own motion).
-        closes = isinstance(model, ManoeuvringModel | Vessel) or (
-            isinstance(model, HybridModel) and not model.physical.uses_wind)
-        if trial.kind == "zigzag" and closes:
+        if trial.kind == "zigzag" and isinstance(model, ManoeuvringModel | HybridModel | Vessel):
             indices["closed_loop"] = _replica_indices(model, log, method, trial)
     out = Validation(name, sim, metrics, indices, trial.kind)
     if isinstance(model, HybridModel):

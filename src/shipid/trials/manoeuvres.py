@@ -212,6 +212,21 @@ def run_closed_loop(
                                     dyn.code.uses_derived, *args)  # fmt: skip
         m = int(n_valid[0])
         states, rudder = states[0], rudder[0]
+    elif isinstance(dyn, HybridModel):
+        from shipid.dynamics import hybrid_kernel
+
+        phys = dyn.physical
+        if phys.uses_thrust:
+            raise ShipidError("manoeuvres on a model with a thrust term need a thrust model; "
+                              "identify with propeller speed (n) terms instead")  # fmt: skip
+        states, rudder = np.zeros((1, n, 6)), np.zeros((1, n))
+        n_valid = np.zeros(1, dtype=np.int64)
+        hybrid_kernel.integrate_closed(
+            phys.theta[None].copy(), *phys.code.arrays(), phys.code.uses_derived,
+            *dyn.kernel_arguments, dt, n, s0, params[None].copy(), method == "rk4",
+            np.array([speed_lim]), np.array([yaw_lim]), states, rudder, n_valid)  # fmt: skip
+        m = int(n_valid[0])
+        states, rudder = states[0], rudder[0]
     elif hasattr(dyn, "integrate_closed"):  # a compiled reference ship
         states, rudder = np.zeros((1, n, 6)), np.zeros((1, n))
         n_valid = np.zeros(1, dtype=np.int64)
@@ -221,10 +236,6 @@ def run_closed_loop(
         m = int(n_valid[0])
         states, rudder = states[0], rudder[0]
     else:
-        if {"wind_speed", "wind_angle"} & set(getattr(dyn, "inputs", ())):
-            raise ShipidError("a manoeuvre of a model with wind terms and a kernel residual is "
-                              "not supported (its NumPy closed loop meets no wind); identify "
-                              "it without --residual or without wind terms")  # fmt: skip
         states, rudder, m = _generic_closed_loop(dyn, params, n, dt, s0, method, speed_lim,
                                                  yaw_lim, rps if uses_rps else None)  # fmt: skip
     t = np.arange(n) * dt
