@@ -75,6 +75,8 @@ def test_the_residual_predicts_unseen_runs_better_where_the_terms_miss_one(trial
     the 25° turn's by 12, 9, 9 %)."""
     choice, physical, model = hybrid
     assert choice.gamma is not None and choice.scores[(choice.gamma, choice.sigma)] < choice.without
+    assert choice.gain == pytest.approx(choice.without - choice.scores[(choice.gamma, choice.sigma)])
+    assert choice.gain_se > 0  # two folds: the paired standard error of the gain
     _, held = trials
     for log, most in zip(held, (0.8, 0.95), strict=True):
         phys, hyb = _rms(log, simulate_log(physical, log).log), _rms(log, simulate_log(model, log).log)
