@@ -163,6 +163,10 @@ def test_identify_residual_through_the_command_line(tmp_path, capsys, trials):
     code, out, err = run(["validate", str(model), str(held_path)], capsys)
     assert code == 0, err
     assert "held.csv" in out and "closed loop" in out
+    code, out, err = run(["manoeuvre", str(model), "turning", "--rudder", "35", "--duration",
+                          "60"], capsys)  # fmt: skip
+    assert code == 0, err
+    assert "the kernel residual is faded out over" in err  # 35°: beyond the 20° zig-zags
     code, out, err = run(["export", str(model), "-o", str(tmp_path / "m.py")], capsys)
     assert code == 1 and "has a kernel residual" in err and "Traceback" not in err
     assert not (tmp_path / "m.py").exists()

@@ -61,6 +61,7 @@ def cmd_criteria(args) -> int:
 def cmd_manoeuvre(args) -> int:
     """``shipid manoeuvre``: a standard manoeuvre on a model or vessel."""
     from shipid.evaluation.envelope import implausible_indices, outside_envelope
+    from shipid.evaluation.validate import faded_residual_notes
     from shipid.outputs import OutputSet, check_outputs
     from shipid.trials.manoeuvres import (
         pull_out,
@@ -124,6 +125,7 @@ def cmd_manoeuvre(args) -> int:
     if res.diverged:
         print(res.reason, file=sys.stderr)
     notes = ([unsteady] if unsteady else []) + outside_envelope(cond["envelope"], res.log)
+    notes += faded_residual_notes(target, res.log)
     if res.incomplete and not res.diverged:
         notes.append(f"{res.incomplete}: indices that need it are missing or those of a "
                      "transient; give a longer --duration")  # fmt: skip

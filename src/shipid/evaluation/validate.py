@@ -99,6 +99,18 @@ def free_run(model, log: pd.DataFrame, method: str = "euler") -> tuple[Simulatio
 FADED_SHARE = 0.1  # a hybrid's run beyond its residual's envelope for more than this is named
 
 
+def faded_residual_notes(model, log: pd.DataFrame) -> list[str]:
+    """A note when a hybrid's run (``log``) left its kernel residual's envelope for more than
+    ``FADED_SHARE`` of its samples; nothing for other models."""
+    if not isinstance(model, HybridModel):
+        return []
+    faded = model.faded_share(log)
+    if faded <= FADED_SHARE:
+        return []
+    return [f"the kernel residual is faded out over {100 * faded:.0f} % of the run (beyond its "
+            "training envelope): there the physical model alone predicts"]
+
+
 def validate_log(model, log: pd.DataFrame, name: str, method: str = "euler",
                  kind: str | None = None, smooth_s: float = 0.0,
                  ensemble: Ensemble | None = None,
@@ -115,12 +127,7 @@ def validate_log(model, log: pd.DataFrame, name: str, method: str = "euler",
         if trial.kind == "zigzag" and isinstance(model, ManoeuvringModel | HybridModel | Vessel):
             indices["closed_loop"] = _replica_indices(model, log, method, trial)
     out = Validation(name, sim, metrics, indices, trial.kind)
-    if isinstance(model, HybridModel):
-        faded = model.faded_share(sim.log)
-        if faded > FADED_SHARE:
-            out.warnings.append(f"the kernel residual is faded out over {100 * faded:.0f} % of "
-                                "the run (beyond its training envelope): there the physical "
-                                "model alone predicts")  # fmt: skip
+    out.warnings += faded_residual_notes(model, sim.log)
     if error_band is not None:
         out.error_band = error_band
         out.band_shares = error_band.shares_within(log[list(STATES)].to_numpy(dtype=float),
