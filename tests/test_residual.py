@@ -214,3 +214,11 @@ def test_the_compiled_runs_are_the_numpy_derivatives_integrated(trials, hybrid, 
     np.testing.assert_allclose(result.log[["u", "v", "r", "psi"]].to_numpy(), states[:, :4],
                                rtol=1e-9, atol=1e-11)  # fmt: skip
     np.testing.assert_allclose(result.log["delta"].to_numpy(), rudder, atol=1e-12)
+
+
+def test_one_log_is_cut_into_blocks_and_too_few_to_hold_out_is_named(trials):
+    train, _ = trials
+    choice = choose_residual(_fit, train[:1], gammas=(0.1,), sigmas=(2.0,))
+    assert choice.cv == "blocks:4" and choice.folds == 4
+    with pytest.raises(ShipidError, match="--cv needs two logs to hold one out"):
+        choose_residual(_fit, train[:1], cv="logo")

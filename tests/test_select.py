@@ -12,13 +12,13 @@ from shipid.demo import TRAINING, synthesise_trials
 from shipid.errors import ShipidError
 from shipid.evaluation.validate import validate
 from shipid.identification import select as select_module
+from shipid.identification.cross_validation import normalised_error
 from shipid.identification.estimators import fit_linear
 from shipid.identification.identify import identify
 from shipid.identification.select import (
     SelectOptions,
     cross_validate,
     frols_ranking,
-    normalised_error,
     select,
 )
 from shipid.trials.manoeuvres import zigzag

@@ -2,7 +2,7 @@
 
 Every method is cross-validated the same way (leave one log out, or k-fold by log): fitted on the
 other logs, run free over the held-out one from its measured initial state with its measured
-inputs, scored by the normalised error of ``shipid.identification.select.normalised_error``
+inputs, scored by the normalised error of ``shipid.identification.cross_validation.normalised_error``
 (per state, error RMS over the state's spread in the held-out log; samples after a divergence
 count ``divergence_penalty``).
 
@@ -23,13 +23,14 @@ from shipid.data.log import common_rudder_convention
 from shipid.dynamics.model import DOFS, ModelStructure, get_structure
 from shipid.dynamics.simulate import simulate_log
 from shipid.errors import ShipidError
+from shipid.identification.cross_validation import normalised_error
 from shipid.identification.estimators import (
     BLACK_BOX_ESTIMATORS,
     ESTIMATORS,
     RegressorDynamics,
     make_black_box,
 )
-from shipid.identification.select import STATES, cross_validate, normalised_error
+from shipid.identification.select import STATES, cross_validate
 
 DEFAULT_METHODS = ("lssvm", "ols", "ridge", "lasso", "svr", "elm")
 

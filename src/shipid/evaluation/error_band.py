@@ -130,19 +130,9 @@ def cross_validated_band(fit, logs, names, cv: str = "auto", method: str = "eule
     with ``'blocks:K'``, every log cut into K blocks and each block left out. ``'auto'``: logo
     from two logs, four blocks of one."""
     from shipid.dynamics.simulate import simulate_log
-    from shipid.identification.select import parse_cv, split_blocks
+    from shipid.identification.cross_validation import held_out_logs
 
-    logs, names = list(logs), list(names)
-    if cv == "auto":
-        cv = "logo" if len(logs) >= 2 else "blocks:4"
-    kind, k = parse_cv(cv, "--error-band", kinds=("blocks",))
-    held_out = "logs"
-    if kind == "blocks":
-        logs, names = split_blocks(logs, names, k)
-        held_out = "blocks"
-    if len(logs) < 2:
-        raise ShipidError("an error band needs two logs to hold one out; give --error-band "
-                          "blocks:K to cut one")  # fmt: skip
+    logs, names, _, held_out = held_out_logs(logs, names, cv, "--error-band")
     runs = []
     for k, held in enumerate(logs):
         model = fit([x for j, x in enumerate(logs) if j != k])

@@ -45,7 +45,7 @@ def choose_prefilter(
     mean normalised free-run error on the raw ``logs``, and the table of every candidate."""
     from shipid.data.preprocess import lowpass
     from shipid.dynamics.simulate import simulate_log
-    from shipid.identification.select import normalised_error
+    from shipid.identification.cross_validation import normalised_error
 
     dt = float(np.median(np.diff(logs[0]["t"].to_numpy())))
     grid = [None, *(cutoffs if cutoffs is not None else candidate_cutoffs(dt))]

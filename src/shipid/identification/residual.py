@@ -149,7 +149,7 @@ def choose_residual(fit: Callable[[list[pd.DataFrame]], tuple[ManoeuvringModel, 
                     cv: str = "auto", method: str = "euler", gammas: Sequence[float] = GAMMAS,
                     sigmas: Sequence[float] = SIGMAS) -> ResidualChoice:  # fmt: skip
     """γ and σ of the residual, or none, by the free-run error of each fold's hybrid on the
-    log it left out (``select.normalised_error``, averaged over u, v, r and the folds).
+    log it left out (``cross_validation.normalised_error``, averaged over u, v, r and the folds).
 
     ``fit(training logs) -> (physical model, the logs it was fitted on)``: the physical fit as
     ``identify`` makes it (its structure, γ and prefilter), so that the residual is fitted on
@@ -158,18 +158,10 @@ def choose_residual(fit: Callable[[list[pd.DataFrame]], tuple[ManoeuvringModel, 
     """
     from shipid.dynamics.hybrid import HybridModel
     from shipid.dynamics.simulate import simulate_log
-    from shipid.identification.select import normalised_error, parse_cv, split_blocks
+    from shipid.identification.cross_validation import held_out_logs, normalised_error
 
-    logs = list(logs)
     names = list(names or [f"log {i}" for i in range(len(logs))])
-    if cv == "auto":
-        cv = "logo" if len(logs) >= 2 else "blocks:4"
-    kind, k = parse_cv(cv, "--cv", kinds=("blocks",))
-    if kind == "blocks":
-        logs, names = split_blocks(logs, names, k)
-    if len(logs) < 2:
-        raise ShipidError("choosing a kernel residual needs two logs to hold one out; give more "
-                          "logs, or --cv blocks:K to cut one")  # fmt: skip
+    logs, names, cv, _ = held_out_logs(logs, names, cv, "--cv")
     features = residual_features(logs)
     settings = [(None, None)] + [(float(g), float(s)) for g in gammas for s in sigmas]
     per_fold: dict[tuple, list[float]] = {key: [] for key in settings}

@@ -50,6 +50,14 @@ from shipid.dynamics.simulate import DivergenceBounds, input_array, run_kernel
 from shipid.dynamics.terms import INPUT_SIGNALS, parse_term, term_code
 from shipid.errors import InfeasibleConstraintsError, ShipidError
 from shipid.evaluation.error_band import ErrorBand, error_band
+from shipid.identification.cross_validation import (
+    folds as _folds,
+)
+from shipid.identification.cross_validation import (
+    normalised_error,
+    parse_cv,
+    split_blocks,
+)
 from shipid.identification.estimators import LINEAR_ESTIMATORS, check_estimator_name, fit_linear
 from shipid.identification.physics import (
     PhysicsOptions,
@@ -127,24 +135,6 @@ class SelectOptions:
             raise ShipidError(f"--max-evaluations must be ≥ 1, got {self.max_evaluations!r}")
         if not (math.isfinite(self.divergence_penalty) and self.divergence_penalty > 0):
             raise ShipidError("divergence_penalty must be > 0")
-
-
-def parse_cv(cv: str, option: str = "--cv", kinds: tuple[str, ...] = ("kfold", "blocks")
-             ) -> tuple[str, int]:  # fmt: skip
-    """('logo', 0) or (kind, K) of 'kind:K' with K ≥ 2 for a kind of ``kinds``; else a one-line
-    error naming ``option``."""
-    if cv == "logo":
-        return "logo", 0
-    for kind in kinds:
-        if isinstance(cv, str) and cv.startswith(kind + ":"):
-            try:
-                k = int(cv.split(":", 1)[1])
-            except ValueError:
-                k = 0
-            if k >= 2:
-                return kind, k
-    forms = " or ".join(["'logo'", *(f"'{kind}:K'" for kind in kinds)])
-    raise ShipidError(f"{option} must be {forms} with K ≥ 2, got {cv!r}")
 
 
 @dataclass
@@ -268,32 +258,6 @@ def _prepare(logs: Sequence[pd.DataFrame], names: Sequence[str], library: ModelS
     return data
 
 
-# ---------------------------------------------------------------------------- folds
-def split_blocks(logs, names, k: int) -> tuple[list[pd.DataFrame], list[str]]:
-    """Every log cut into ``k`` contiguous blocks (each a log of its own, named after it)."""
-    out, out_names = [], []
-    for log, name in zip(logs, names, strict=True):
-        edges = np.linspace(0, len(log), k + 1).round().astype(int)
-        for j, (a, b) in enumerate(zip(edges[:-1], edges[1:], strict=True)):
-            if b - a < 10:
-                raise ShipidError(f"{name}: too short for --cv blocks:{k} ({len(log)} samples)")
-            block = log.iloc[a:b].reset_index(drop=True)
-            block.attrs = dict(log.attrs)
-            out.append(block)
-            out_names.append(f"{name} [block {j + 1}/{k}]")
-    return out, out_names
-
-
-def _folds(n_logs: int, cv: str) -> list[list[int]]:
-    """Held-out log indices of each fold."""
-    kind, k = parse_cv(cv)
-    if kind == "kfold":
-        if k > n_logs:
-            raise ShipidError(f"--cv kfold:{k} needs at least {k} logs, got {n_logs}")
-        return [list(f) for f in np.array_split(np.arange(n_logs), k)]
-    return [[i] for i in range(n_logs)]
-
-
 # ---------------------------------------------------------------------------- fits
 def _fit_theta(data: _Data, terms: Mapping[str, Sequence[str]], gamma: float, train: Sequence[int],
                estimator: str, physics: PhysicsOptions | None = None) -> np.ndarray:  # fmt: skip
@@ -337,17 +301,6 @@ def _model_from_theta(data: _Data, terms, theta: np.ndarray, name: str) -> Manoe
 
 
 # ---------------------------------------------------------------------------- scoring
-def normalised_error(measured: np.ndarray, simulated: np.ndarray, penalty: float,
-                     scale: np.ndarray | None = None) -> np.ndarray:  # fmt: skip
-    """Per state: RMS of (simulated − measured)/σ(measured) over the whole log, the samples after
-    a divergence (simulated is shorter) counting ``penalty`` each. 1 ≈ predicting the mean.
-    ``scale``: σ per state to use instead (e.g. the whole log's, for a part of it)."""
-    n, m = len(measured), len(simulated)
-    sigma = np.maximum(measured.std(axis=0) if scale is None else scale, 1e-9)
-    err = (simulated - measured[:m]) / sigma
-    return np.sqrt((np.sum(err * err, axis=0) + (n - m) * penalty * penalty) / n)
-
-
 class _Scorer:
     def __init__(self, data: _Data, options: SelectOptions, folds: list[list[int]]):
         self.data, self.options, self.folds = data, options, folds
