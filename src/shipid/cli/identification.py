@@ -193,7 +193,9 @@ def cmd_identify(args) -> int:
         print(f"straight-line {'stable' if sl['stable'] else 'UNSTABLE'} (largest sway–yaw "
               f"eigenvalue real part {sl['max_real_part']:.3g} 1/s); surge equilibrium "
               f"{_fmt_speed(plausibility['surge_equilibrium'])}; checked from the "
-              f"{plausibility['approach']}")  # fmt: skip
+              f"{plausibility['approach']}"
+              + ("; of the physical part (the hybrid's held-rudder runs are checked too)"
+                 if residual and residual["residual"] else ""))  # fmt: skip
     ident.warnings.extend(f"plausibility: {n}" for n in notes)
     if refinement:
         ident.warnings.extend(f"refinement: {n}" for n in refinement.warnings)
