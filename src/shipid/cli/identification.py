@@ -186,8 +186,8 @@ def cmd_identify(args) -> int:
             final, plausibility, notes = refinement.model, refined_report, refined_notes
     residual = None
     if args.residual:
-        residual, final = _kernel_residual(args, final, logs, raw_logs, names, cutoff, gamma,
-                                           physics, ident.warnings)  # fmt: skip
+        residual = _kernel_residual(args, final, logs, raw_logs, names, cutoff, gamma, physics,
+                                    ident.warnings)  # fmt: skip
     sl = plausibility["straight_line"]
     if sl:
         print(f"straight-line {'stable' if sl['stable'] else 'UNSTABLE'} (largest sway–yaw "
@@ -252,9 +252,8 @@ def _print_prime(record: dict | None) -> None:
 def _kernel_residual(args, physical, logs, raw_logs, names, cutoff, gamma, physics, warnings):
     """``identify --residual``: the residual's γ and σ (or none) by free-run cross-validation of
     the hybrid, each fold's physical model fitted as this one (structure, γ, prefilter,
-    physics); then the residual on all logs. Returns (its model-file record or None, the model
-    the file holds: the physical one alone when no residual won, whose physical part keeps its
-    own checks); the hybrid's held-rudder runs are checked too."""
+    physics); then the residual of ``physical`` on all logs, whose held-rudder runs are checked
+    too. Returns the model file's record: the residual (None when none won) and the search."""
     from shipid.data.preprocess import lowpass
     from shipid.dynamics.hybrid import HybridModel
     from shipid.identification.identify import identify
@@ -273,7 +272,7 @@ def _kernel_residual(args, physical, logs, raw_logs, names, cutoff, gamma, physi
     warnings.extend(choice.notes)
     record = {"residual": None, "selection": choice.to_dict()}
     if choice.gamma is None:
-        return record, physical
+        return record
     residual = fit_residual(physical, logs, choice.gamma, choice.sigma, choice.features)
     hybrid = HybridModel(physical, residual)
     print(hybrid.equations().splitlines()[-1])
@@ -283,7 +282,7 @@ def _kernel_residual(args, physical, logs, raw_logs, names, cutoff, gamma, physi
             if entry["diverged"]:
                 warnings.append(f"kernel residual: 35° rudder held to {side}: {entry['reason']}")
     record["residual"] = residual.to_dict()
-    return record, physical
+    return record
 
 
 def _auto_gamma(args, logs, names, physics=None) -> tuple[float, dict]:

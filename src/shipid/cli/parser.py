@@ -160,7 +160,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="add a kernel residual to the physical model: an RBF LS-SVM on its "
                    "one-step acceleration residual, γ and σ (or none) chosen by the free-run "
                    "error of the hybrid on each log left out (--cv); it fades out beyond the "
-                   "training logs' envelope. Validate, simulate and manoeuvre run it")
+                   "training logs' envelope. Validate, simulate, manoeuvre and criteria run it")
     # --out spelled out: since --output-error, argparse no longer takes it for --output.
     p.add_argument("-o", "--output", "--out", required=True, metavar="MODEL.json")
     _add_physics_options(p)

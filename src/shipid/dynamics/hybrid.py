@@ -7,10 +7,11 @@ miss, fitted by ``shipid.identification.residual``::
 
 with x the residual's features (u, v, r, δ and, where it varies in the training logs, n),
 standardised by the training logs' mean μ and spread s; cᵢ are the LS-SVM's support vectors or,
-over ``DENSE_LIMIT`` samples, its fixed-size landmarks, so a step costs M ≤ a few hundred kernel
-evaluations. Outside the training envelope the residual fades out: w(z) = min(1, k(z)/k₀), where
-k(z) = maxᵢ exp(−‖z − cᵢ‖² / σ²) is the kernel's reach at z and k₀ the 5th percentile of it over
-the training samples, so the physical model alone is left where the residual has seen no data.
+over ``shipid.identification.residual.DENSE_LIMIT`` samples, its fixed-size landmarks, so a step
+costs M ≤ a few hundred kernel evaluations. Outside the training envelope the residual fades
+out: w(z) = min(1, k(z)/k₀), where k(z) = maxᵢ exp(−‖z − cᵢ‖² / σ²) is the kernel's reach at z
+and k₀ the 5th percentile of it over the training samples, so the physical model alone is left
+where the residual has seen no data.
 ``fade`` says how far a run went there.
 
 A hybrid runs compiled (``shipid.dynamics.hybrid_kernel``: the term model's state derivative plus
@@ -31,7 +32,6 @@ from shipid.dynamics.terms import INPUT_SIGNALS
 from shipid.errors import ShipidError
 
 FEATURES = ("u", "v", "r", "delta", "n")
-REACH_QUANTILE = 5.0  # k₀: the 5th percentile of the training samples' kernel reach
 
 
 @dataclass(frozen=True, eq=False)

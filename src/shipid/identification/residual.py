@@ -35,6 +35,7 @@ GAMMAS = (1e-3, 1e-2, 1e-1, 1.0, 10.0)
 SIGMAS = (1.0, 2.0, 4.0)
 DENSE_LIMIT = 1000
 LANDMARKS = 300
+REACH_QUANTILE = 5.0  # k₀: this percentile of the training samples' kernel reach
 REACH_SAMPLES = 5000
 DIVERGENCE_PENALTY = 2.0  # normalised error of each sample after a held-out run diverged (select's)
 
@@ -93,11 +94,12 @@ def fit_residual(physical: ManoeuvringModel, logs: Sequence[pd.DataFrame], gamma
                 random_state=seed).fit(Z, Y)  # fmt: skip
     centres = est.X_fit_ if dense else est.landmarks_
     weights = est.alpha_ if dense else est.landmark_coef_
-    # The kernel's reach at the training samples: its 5th percentile marks the envelope (from
+    # The kernel's reach at the training samples: a low percentile marks the envelope (from
     # every k-th sample past REACH_SAMPLES: the quantile, not 1e5 × 300 kernel values, is wanted).
     probe = KernelResidual(tuple(features), mean, scale, sigma, gamma, centres, weights,
                            np.asarray(est.intercept_, dtype=float), 1.0)  # fmt: skip
-    reach = float(np.percentile(probe.fade(X[:: max(1, len(X) // REACH_SAMPLES)]), 5.0))
+    reach = float(np.percentile(probe.fade(X[:: max(1, len(X) // REACH_SAMPLES)]),
+                                REACH_QUANTILE))
     return KernelResidual(tuple(features), mean, scale, sigma, gamma, centres, weights,
                           np.asarray(est.intercept_, dtype=float), max(reach, 1e-12))  # fmt: skip
 

@@ -129,7 +129,8 @@ def as_vessel(ship: Vessel | ManoeuvringModel | HybridModel, speed: float | None
                         rudder_positive=ship.rudder_positive_turns_at(speed, rps),
                         source=ship.name)  # fmt: skip
     else:
-        raise TypeError(f"expected a Vessel or ManoeuvringModel, got {type(ship).__name__}")
+        raise TypeError(f"expected a Vessel, ManoeuvringModel or HybridModel, got "
+                        f"{type(ship).__name__}")
     changes = {}
     if speed is not None:
         changes["approach_speed"] = _positive(speed, "approach speed")
