@@ -255,3 +255,19 @@ def test_a_thrust_that_follows_the_speed_at_a_logged_rps_is_not_named():
     assert not [w for w in fit.warnings if "varies in the training logs" in w]
     fit = identify(log.drop(columns="n"), model="blanke")  # no rps: the thrust is the input
     assert [w for w in fit.warnings if "the thrust T varies" in w]
+
+
+@pytest.mark.parametrize(("true_wind", "model", "noted"), [
+    (0.0, "blanke", False),  # still air: the relative wind is the ship's own motion
+    (2.0, "blanke", True),  # a true wind no term holds
+    (2.0, "blanke+wind", False),
+])  # fmt: skip
+def test_a_true_wind_without_terms_for_it_is_named(clean_zigzag, true_wind, model, noted):
+    u, v = clean_zigzag["u"].to_numpy(), clean_zigzag["v"].to_numpy()
+    ax, ay = u + true_wind, v  # air relative to the ship, a true wind from ahead (body frame)
+    log = clean_zigzag.assign(wind_speed=np.hypot(ax, ay), wind_angle=np.arctan2(ay, ax))
+    fit = identify(log, model=model, force=True)
+    notes = [w for w in fit.warnings if "the logs carry a wind" in w]
+    assert len(notes) == int(noted)
+    if noted:
+        assert "true wind 2 m/s" in notes[0] and "+wind" in notes[0]
