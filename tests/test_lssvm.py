@@ -309,3 +309,27 @@ def test_normal_equations_are_the_weighted_products(weights):
     np.testing.assert_allclose(A, Fb.T @ (w[:, None] * Fb), rtol=1e-12, atol=1e-12)
     np.testing.assert_allclose(B, Fb.T @ (w[:, None] * Y), rtol=1e-12, atol=1e-12)
     assert np.array_equal(A, A.T)
+
+
+@pytest.mark.parametrize("params", [
+    {"kernel": "rbf", "sigma": 1.5},
+    {"kernel": "linear"},  # the primal solver
+    {"kernel": "rbf", "sigma": 1.5, "solver": "fixed-size", "n_landmarks": 20, "random_state": 3},
+])  # fmt: skip
+def test_a_gamma_path_is_the_fits_at_each_gamma(params):
+    rng = np.random.default_rng(7)
+    X = rng.normal(size=(80, 3))
+    y = np.column_stack([np.sin(X[:, 0]) + 0.1 * rng.normal(size=80), X[:, 1] * X[:, 2]])
+    w = rng.uniform(0.5, 2.0, size=80)
+    gammas = (0.1, 3.0, 100.0)
+    path = LSSVR(**params).fit_path(X, y, gammas, sample_weight=w)
+    X_new = rng.normal(size=(10, 3))
+    for gamma, est in zip(gammas, path, strict=True):
+        one = LSSVR(gamma=gamma, **params).fit(X, y, sample_weight=w)
+        assert est.gamma == gamma
+        np.testing.assert_allclose(est.predict(X_new), one.predict(X_new), rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(est.intercept_, one.intercept_, rtol=1e-12, atol=1e-12)
+    with pytest.raises(ValueError, match="weighting=None"):
+        LSSVR(weighting="huber").fit_path(X, y[:, 0], gammas)
+    with pytest.raises(ValueError, match="gamma"):
+        LSSVR().fit_path(X, y, (1.0, -1.0))

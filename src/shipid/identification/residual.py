@@ -81,27 +81,38 @@ def fit_residual(physical: ManoeuvringModel, logs: Sequence[pd.DataFrame], gamma
                  seed: int = 0) -> KernelResidual:  # fmt: skip
     """The residual of ``physical`` on ``logs`` at the given γ and σ (``data``: the
     ``residual_data`` already computed for these logs and features)."""
+    return fit_residuals(physical, logs, (gamma,), sigma, features, data, seed)[0]
+
+
+def fit_residuals(physical: ManoeuvringModel, logs: Sequence[pd.DataFrame],
+                  gammas: Sequence[float], sigma: float, features: Sequence[str] | None = None,
+                  data: tuple[np.ndarray, np.ndarray] | None = None,
+                  seed: int = 0) -> list[KernelResidual]:  # fmt: skip
+    """``fit_residual`` at each γ of ``gammas`` and one σ, the kernel matrix or the fixed-size
+    features computed once (``LSSVR.fit_path``)."""
     from shipid.lssvm import LSSVR
 
     features = tuple(features or residual_features(logs))
     X, Y = data if data is not None else residual_data(physical, logs, features)
     mean, scale = X.mean(axis=0), X.std(axis=0)
     scale = np.where(scale > 0, scale, 1.0)
-    Z = (X - mean) / scale
-    dense = len(Z) <= DENSE_LIMIT
-    est = LSSVR(kernel="rbf", gamma=gamma, sigma=sigma,
-                solver="dense" if dense else "fixed-size", n_landmarks=LANDMARKS,
-                random_state=seed).fit(Z, Y)  # fmt: skip
-    centres = est.X_fit_ if dense else est.landmarks_
-    weights = est.alpha_ if dense else est.landmark_coef_
+    dense = len(X) <= DENSE_LIMIT
+    path = LSSVR(kernel="rbf", sigma=sigma, solver="dense" if dense else "fixed-size",
+                 n_landmarks=LANDMARKS, random_state=seed).fit_path((X - mean) / scale, Y, gammas)
     # The kernel's reach at the training samples: a low percentile marks the envelope (from
     # every k-th sample past REACH_SAMPLES: the quantile, not 1e5 × 300 kernel values, is wanted).
-    probe = KernelResidual(tuple(features), mean, scale, sigma, gamma, centres, weights,
-                           np.asarray(est.intercept_, dtype=float), 1.0)  # fmt: skip
-    reach = float(np.percentile(probe.fade(X[:: max(1, len(X) // REACH_SAMPLES)]),
-                                REACH_QUANTILE))
-    return KernelResidual(tuple(features), mean, scale, sigma, gamma, centres, weights,
-                          np.asarray(est.intercept_, dtype=float), max(reach, 1e-12))  # fmt: skip
+    probe_rows = X[:: max(1, len(X) // REACH_SAMPLES)]
+    out = []
+    for gamma, est in zip(gammas, path, strict=True):
+        centres = est.X_fit_ if dense else est.landmarks_
+        weights = est.alpha_ if dense else est.landmark_coef_
+        intercept = np.asarray(est.intercept_, dtype=float)
+        probe = KernelResidual(features, mean, scale, sigma, gamma, centres, weights, intercept,
+                               1.0)  # fmt: skip
+        reach = float(np.percentile(probe.fade(probe_rows), REACH_QUANTILE))
+        out.append(KernelResidual(features, mean, scale, sigma, float(gamma), centres, weights,
+                                  intercept, max(reach, 1e-12)))  # fmt: skip
+    return out
 
 
 @dataclass
@@ -171,12 +182,15 @@ def choose_residual(fit: Callable[[list[pd.DataFrame]], tuple[ManoeuvringModel, 
         physical, fitted_on = fit([x for j, x in enumerate(logs) if j != i])
         data = residual_data(physical, fitted_on, features)
         measured = held[["u", "v", "r"]].to_numpy(dtype=float)
-        for g, s in settings:
-            model = physical if g is None else HybridModel(
-                physical, fit_residual(physical, fitted_on, g, s, features, data))  # fmt: skip
-            sim = simulate_log(model, held, method).log
+        models = {(None, None): physical}
+        for s in sigmas:
+            fitted = fit_residuals(physical, fitted_on, gammas, s, features, data)
+            models.update({(float(g), float(s)): HybridModel(physical, r)
+                           for g, r in zip(gammas, fitted, strict=True)})  # fmt: skip
+        for key in settings:
+            sim = simulate_log(models[key], held, method).log
             err = normalised_error(measured, sim[["u", "v", "r"]].to_numpy(), DIVERGENCE_PENALTY)
-            per_fold[(g, s)].append(float(np.mean(err)))
+            per_fold[key].append(float(np.mean(err)))
     scores = {key: float(np.mean(v)) for key, v in per_fold.items()}
     best = min(scores, key=lambda key: (scores[key], key[0] is not None))
     notes = []

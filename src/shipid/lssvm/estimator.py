@@ -155,6 +155,44 @@ class LSSVR(RegressorMixin, BaseEstimator):
         ``sample_weight`` wᵢ ≥ 0 gives the weighted LS-SVM (γᵢ = γ·wᵢ); samples with wᵢ = 0 are
         left out.
         """
+        X, Y, w, seed = self._prepare(X, y, sample_weight)
+        if self.weighting is None:
+            self._fit_weighted(X, Y, w, seed)
+            self.n_iter_ = 1
+        elif Y.shape[1] == 1:
+            self._fit_robust(X, Y, w, seed)
+        else:
+            self._fit_robust_per_output(X, Y, w, seed)
+        self._publish()
+        return self
+
+    def fit_path(self, X, y, gammas, sample_weight=None) -> list[LSSVR]:
+        """One fitted estimator per γ of ``gammas`` (the other parameters as set), each the model
+        ``clone(self).set_params(gamma=g).fit(X, y)`` gives, with what does not depend on γ
+        computed once: the kernel matrix (dense), the normal equations (primal), the Nyström
+        features on the same landmarks and their normal equations (fixed-size). Not with
+        ``weighting``, whose refits depend on γ."""
+        if self.weighting is not None:
+            raise ValueError("fit_path needs weighting=None: robust refits depend on γ")
+        gammas = [float(g) for g in gammas]
+        for g in gammas:
+            check_positive(g, "gamma")
+        X, Y, w, seed = self._prepare(X, y, sample_weight)
+        solve = self._system(X, Y, w, seed, reuse=True)
+        fitted = [k for k in ("n_features_in_", "feature_names_in_") if hasattr(self, k)]
+        out = []
+        for g in gammas:
+            est = clone(self).set_params(gamma=g)
+            for k in (*fitted, "_ravel_output", "n_outputs_", "support_", "solver_"):
+                setattr(est, k, getattr(self, k))
+            solve(est, g)
+            est.n_iter_ = 1
+            est._publish()
+            out.append(est)
+        return out
+
+    def _prepare(self, X, y, sample_weight) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+        """Checked inputs of a fit: the used rows of X, Y (2-D) and w, and the landmark seed."""
         self._check_params()
         X, y, w = validated_training_data(self, X, y, sample_weight)
         if np.any(w < 0):
@@ -168,45 +206,55 @@ class LSSVR(RegressorMixin, BaseEstimator):
         self.support_ = used
         X, Y, w = X[used], Y[used], w[used]
         self.solver_ = self._resolve_solver(*X.shape)
-        seed = int(check_random_state(self.random_state).randint(2**31))
-
-        if self.weighting is None:
-            self._fit_weighted(X, Y, w, seed)
-            self.n_iter_ = 1
-        elif Y.shape[1] == 1:
-            self._fit_robust(X, Y, w, seed)
-        else:
-            self._fit_robust_per_output(X, Y, w, seed)
-        self._publish()
-        return self
+        return X, Y, w, int(check_random_state(self.random_state).randint(2**31))
 
     def _fit_weighted(self, X: np.ndarray, Y: np.ndarray, w: np.ndarray, seed: int) -> None:
         """One weighted LS-SVM fit; sets the private 2-D solution arrays."""
-        gamma = float(self.gamma)
-        self._coef = self._landmark_coef = self._alpha = None
+        self._system(X, Y, w, seed)(self, float(self.gamma))
+
+    def _system(self, X: np.ndarray, Y: np.ndarray, w: np.ndarray, seed: int,
+                reuse: bool = False):  # fmt: skip
+        """What a fit computes whatever γ is, and ``solve(estimator, γ)``, which sets that
+        estimator's private 2-D solution arrays from it; ``reuse``: for more than one solve (the
+        dense solve factors the kernel matrix in place, so each then takes a copy)."""
         if self.solver_ == "primal":
             A, B = accumulate_normal_equations([(X, Y, w)], X.shape[1], Y.shape[1])
-            self._coef, self._intercept, self.condition_number_ = solve_primal(A, B, gamma)
-            residual = Y - X @ self._coef.T - self._intercept
-            self._alpha = gamma * w[:, None] * residual
-        elif self.solver_ == "dense":
+
+            def solve(est: LSSVR, gamma: float) -> None:
+                est._landmark_coef = None
+                est._coef, est._intercept, est.condition_number_ = solve_primal(A, B, gamma)
+                residual = Y - X @ est._coef.T - est._intercept
+                est._alpha = gamma * w[:, None] * residual
+
+            return solve
+        if self.solver_ == "dense":
             check_dense_size(X.shape[0], self.max_dense_samples)
             K = kernel_matrix(X, X, self.kernel, **self._kernel_params())
-            self._alpha, self._intercept = solve_dual(K, Y, 1.0 / (gamma * w), self._is_mercer())
-            del K
-            if self.kernel == "linear":
-                self._coef = self._alpha.T @ X
-            else:
-                self.X_fit_ = X
-        else:  # fixed-size
-            landmarks = choose_landmarks(X, self.n_landmarks, np.random.default_rng(seed))
-            fmap = NystromMap(landmarks, self.kernel, **self._kernel_params())
-            blocks = ((phi, Y[rows], w[rows]) for rows, phi in fmap.feature_blocks(X))
-            A, B = accumulate_normal_equations(blocks, fmap.n_components, Y.shape[1])
-            coef, self._intercept, self.condition_number_ = solve_primal(A, B, gamma)
-            self.landmarks_ = landmarks
-            self._landmark_coef = fmap.transform @ coef.T
-            self.n_components_ = fmap.n_components
+            mercer = self._is_mercer()
+
+            def solve(est: LSSVR, gamma: float) -> None:
+                est._coef = est._landmark_coef = None
+                H = K.copy() if reuse else K
+                est._alpha, est._intercept = solve_dual(H, Y, 1.0 / (gamma * w), mercer)
+                if est.kernel == "linear":
+                    est._coef = est._alpha.T @ X
+                else:
+                    est.X_fit_ = X
+
+            return solve
+        landmarks = choose_landmarks(X, self.n_landmarks, np.random.default_rng(seed))
+        fmap = NystromMap(landmarks, self.kernel, **self._kernel_params())
+        blocks = ((phi, Y[rows], w[rows]) for rows, phi in fmap.feature_blocks(X))
+        A, B = accumulate_normal_equations(blocks, fmap.n_components, Y.shape[1])
+
+        def solve(est: LSSVR, gamma: float) -> None:
+            est._coef = est._alpha = None
+            coef, est._intercept, est.condition_number_ = solve_primal(A, B, gamma)
+            est.landmarks_ = landmarks
+            est._landmark_coef = fmap.transform @ coef.T
+            est.n_components_ = fmap.n_components
+
+        return solve
 
     def _training_residuals(self, X: np.ndarray, Y: np.ndarray, w: np.ndarray) -> np.ndarray:
         if self._alpha is not None:  # α = γ w e (KKT condition, eq. 5)
