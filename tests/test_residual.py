@@ -155,14 +155,15 @@ def test_identify_residual_through_the_command_line(tmp_path, capsys, trials):
     held_path = write_log(held[0], tmp_path / "held.csv")
     model = tmp_path / "m.json"
     code, out, err = run(["identify", *map(str, paths), "--model", "blanke", "--residual", "rbf",
-                          "--filter", "none", "-o", str(model)], capsys)  # fmt: skip
+                          "--filter", "none", "--error-band", "-o", str(model)], capsys)  # fmt: skip
     assert code == 0, err
     assert "kernel residual on (u, v, r, delta)" in out
+    assert "cross-validated 95 % error band" in out and "kernel residual's γ and σ" in out
     record = json.loads(model.read_text())["kernel_residual"]
     assert record["residual"]["kind"] == "rbf" and len(record["selection"]["scores"]) == 16
     code, out, err = run(["validate", str(model), str(held_path)], capsys)
     assert code == 0, err
-    assert "held.csv" in out and "closed loop" in out
+    assert "held.csv" in out and "closed loop" in out and "in CV band" in out
     code, out, err = run(["manoeuvre", str(model), "turning", "--rudder", "35", "--duration",
                           "60"], capsys)  # fmt: skip
     assert code == 0, err

@@ -73,10 +73,9 @@ def cmd_identify(args) -> int:
     if args.error_band is not None and (args.refine or args.output_error):
         raise ShipidError("--error-band describes the LS-SVM fit; it does not go with --refine "
                           "or --output-error")  # fmt: skip
-    if args.residual and (args.refine or args.output_error or args.bootstrap is not None
-                          or args.error_band is not None):
+    if args.residual and (args.refine or args.output_error or args.bootstrap is not None):
         raise ShipidError("--residual adds a kernel residual to the LS-SVM fit; it does not go "
-                          "with --refine, --output-error, --bootstrap or --error-band")  # fmt: skip
+                          "with --refine, --output-error or --bootstrap")  # fmt: skip
     logs = _training_logs(args)
     raw_logs = logs  # the output-error fit needs the noise as measured, not prefiltered
     names = [str(p) for p in args.logs]
@@ -124,19 +123,25 @@ def cmd_identify(args) -> int:
     for dof, d in ident.diagnostics.items():
         print(f"{dof}: condition number {d['condition_number']:.3g}, one-step R² "
               f"{d['one_step_r2']:.4f}, bias b = {ident.discrete[dof]['bias']:.4g}")
+    residual = None
+    if args.residual:  # no refinement goes with it: the model is the LS-SVM one
+        residual = _kernel_residual(args, ident.model, logs, raw_logs, names, cutoff, gamma,
+                                    physics, ident.warnings)  # fmt: skip
     band = None
     if args.error_band is not None:
         from shipid.evaluation.error_band import cross_validated_band
 
-        def refit_without(train):  # the same prefilter, structure, γ and physics
-            return identify([lowpass(x, cutoff) for x in train] if cutoff is not None else train,
-                            model=args.model, form=args.form, gamma=gamma,
-                            drop=_parse_drop(args.drop), force=True, estimator=args.estimator,
-                            physics=physics).model  # fmt: skip
+        def refit_without(train):  # the same prefilter, structure, γ, physics and residual
+            fitted_on = [lowpass(x, cutoff) for x in train] if cutoff is not None else train
+            model = identify(fitted_on, model=args.model, form=args.form, gamma=gamma,
+                             drop=_parse_drop(args.drop), force=True, estimator=args.estimator,
+                             physics=physics).model  # fmt: skip
+            return _with_residual(model, fitted_on, residual)
 
         band = cross_validated_band(refit_without, raw_logs, names, args.error_band)
-        print(f"{band.describe()} (γ and the prefilter as chosen on all logs); stored for "
-              "validate")  # fmt: skip
+        chosen = "γ, the prefilter and the kernel residual's γ and σ" if residual and \
+            residual["residual"] else "γ and the prefilter"
+        print(f"{band.describe()} ({chosen} as chosen on all logs); stored for validate")
     ensemble = None
     if args.bootstrap is not None:
         from shipid.identification.identify import weighted_refit
@@ -184,10 +189,6 @@ def cmd_identify(args) -> int:
                 ensemble = None  # its draws describe the output-error model, not this one
         else:
             final, plausibility, notes = refinement.model, refined_report, refined_notes
-    residual = None
-    if args.residual:
-        residual = _kernel_residual(args, final, logs, raw_logs, names, cutoff, gamma, physics,
-                                    ident.warnings)  # fmt: skip
     sl = plausibility["straight_line"]
     if sl:
         print(f"straight-line {'stable' if sl['stable'] else 'UNSTABLE'} (largest sway–yaw "
@@ -283,6 +284,19 @@ def _kernel_residual(args, physical, logs, raw_logs, names, cutoff, gamma, physi
                 warnings.append(f"kernel residual: 35° rudder held to {side}: {entry['reason']}")
     record["residual"] = residual.to_dict()
     return record
+
+
+def _with_residual(model, logs, record):
+    """``model`` with a residual of the chosen γ and σ fitted on ``logs`` (a fold's refit for
+    the error band), or ``model`` where no residual was chosen."""
+    if not record or not record["residual"]:
+        return model
+    from shipid.dynamics.hybrid import HybridModel
+    from shipid.identification.residual import fit_residual
+
+    chosen = record["residual"]
+    return HybridModel(model, fit_residual(model, logs, chosen["gamma"], chosen["sigma"],
+                                           chosen["features"]))  # fmt: skip
 
 
 def _auto_gamma(args, logs, names, physics=None) -> tuple[float, dict]:
