@@ -168,9 +168,8 @@ def test_identify_residual_through_the_command_line(tmp_path, capsys, trials):
                           "60"], capsys)  # fmt: skip
     assert code == 0, err
     assert "the kernel residual is faded out over" in err  # 35°: beyond the 20° zig-zags
-    code, out, err = run(["export", str(model), "-o", str(tmp_path / "m.py")], capsys)
+    code, out, err = run(["linearise", str(model)], capsys)
     assert code == 1 and "has a kernel residual" in err and "Traceback" not in err
-    assert not (tmp_path / "m.py").exists()
     code, _, err = run(["identify", *map(str, paths), "--residual", "rbf", "--bootstrap", "10",
                         "-o", str(tmp_path / "b.json")], capsys)  # fmt: skip
     assert code == 1 and "--residual" in err and not (tmp_path / "b.json").exists()
@@ -223,3 +222,23 @@ def test_one_log_is_cut_into_blocks_and_too_few_to_hold_out_is_named(trials):
     assert choice.cv == "blocks:4" and choice.folds == 4
     with pytest.raises(ShipidError, match="--cv needs two logs to hold one out"):
         choose_residual(_fit, train[:1], cv="logo")
+
+
+@pytest.mark.parametrize("method", ["euler", "rk4"])
+def test_the_numpy_export_carries_the_residual(tmp_path, trials, hybrid, method):
+    """The standalone module (no shipid) simulates the hybrid as shipid does."""
+    import importlib.util
+
+    from shipid.control.export import export_numpy
+
+    _, held = trials
+    _, _, model = hybrid
+    path = export_numpy(model, tmp_path / "hybrid_export.py")
+    assert "import shipid" not in path.read_text() and "from shipid" not in path.read_text()
+    spec = importlib.util.spec_from_file_location("hybrid_export", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    log = held[1]
+    ref = simulate_log(model, log, method).log[["u", "v", "r", "psi", "x", "y"]].to_numpy()
+    got = mod.simulate(log["t"].to_numpy(), log[["delta"]].to_numpy(), ref[0], method)
+    np.testing.assert_allclose(got, ref, atol=1e-9, rtol=0)

@@ -92,7 +92,7 @@ def cmd_export(args) -> int:
     if Path(args.output).suffix != ".py":
         raise ShipidError(f"-o {args.output}: the exported module must be a .py file")
     check_outputs({"-o": (args.output, "python")}, [args.model])
-    model = model_from_document(load_document(args.model), args.model)  # term models only
+    model = model_from_document(load_document(args.model), args.model, hybrid=True)
     export_numpy(model, args.output)
     print(f"standalone NumPy module written to {args.output} (accelerations, derivatives, "
           "simulate)")  # fmt: skip

@@ -7,7 +7,8 @@ thrust, wind_speed, wind_angle], outputs the states. With ``dt=None`` a continuo
 update is one step of shipid's own Euler or RK4 scheme, so its response equals ``simulate``'s.
 
 NumPy module: ``accelerations``, ``derivatives`` and ``simulate`` (Euler or RK4, inputs held over
-each step as in shipid), the coefficients written out exactly (``repr`` of each float).
+each step as in shipid), the coefficients written out exactly (``repr`` of each float); a hybrid
+model's kernel residual as a function ``residual`` and its arrays.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from shipid.dynamics.hybrid import HybridModel
 from shipid.dynamics.model import DOFS, ManoeuvringModel
 from shipid.dynamics.terms import OPS, parse_term
 from shipid.errors import ShipidError
@@ -103,19 +105,57 @@ def _factor_expr(f) -> str:
     return base if f.power == 1 else f"{base} ** {f.power}"
 
 
-def numpy_source(model: ManoeuvringModel) -> str:
-    """Python source of a standalone module (NumPy only) that evaluates and simulates the model."""
+def _array_literal(a: np.ndarray) -> str:
+    """``np.array([...])`` with every float written exactly (``repr``)."""
+    return "np.array(" + repr(np.asarray(a, dtype=float).tolist()) + ")"
+
+
+def _residual_source(model: HybridModel) -> list[str]:
+    """The kernel residual of a hybrid as module-level arrays and a function ``residual``."""
+    r = model.residual
+    args = ", ".join(r.features)
+    return [
+        "",
+        "",
+        f"RESIDUAL_FEATURES = {r.features!r}",
+        f"RESIDUAL_MEAN = {_array_literal(r.mean)}",
+        f"RESIDUAL_SCALE = {_array_literal(r.scale)}",
+        f"RESIDUAL_SIGMA = {r.sigma!r}",
+        f"RESIDUAL_REACH = {r.reach!r}",
+        f"RESIDUAL_INTERCEPT = {_array_literal(r.intercept)}",
+        f"RESIDUAL_CENTRES = {_array_literal(r.centres)}",
+        f"RESIDUAL_WEIGHTS = {_array_literal(r.weights)}",
+        "",
+        "",
+        f"def residual({args}):",
+        '    """The kernel residual\'s (u̇, v̇, ṙ) at arrays of its features, faded out where the',
+        '    kernel reaches less far than RESIDUAL_REACH (beyond the training envelope)."""',
+        f"    x = np.column_stack([np.atleast_1d(np.asarray(a, dtype=float)) for a in ({args},)])",
+        "    z = (x - RESIDUAL_MEAN) / RESIDUAL_SCALE",
+        "    d2 = ((z[:, None, :] - RESIDUAL_CENTRES[None, :, :]) ** 2).sum(axis=2)",
+        "    k = np.exp(-d2 / (RESIDUAL_SIGMA * RESIDUAL_SIGMA))",
+        "    fade = np.minimum(1.0, k.max(axis=1) / RESIDUAL_REACH)",
+        "    out = (k @ RESIDUAL_WEIGHTS + RESIDUAL_INTERCEPT) * fade[:, None]",
+        "    return out[:, 0], out[:, 1], out[:, 2]",
+    ]
+
+
+def numpy_source(model: ManoeuvringModel | HybridModel) -> str:
+    """Python source of a standalone module (NumPy only) that evaluates and simulates the model
+    (a hybrid's kernel residual with it: its centres and weights written out)."""
     from shipid import __version__
 
-    model = _check(model)
-    inputs = [s for s in model.inputs]
+    hybrid = model if isinstance(model, HybridModel) else None
+    model = _check(hybrid.physical if hybrid else model)
+    inputs = list(hybrid.inputs if hybrid else model.inputs)
+    equations = (hybrid or model).equations(precision=6)
     lines = [
         f'"""{model.name}: a manoeuvring model exported by shipid {__version__}.',
         "",
         "Standalone (NumPy only). States u, v [m/s], r [rad/s], psi [rad], x, y [m]; inputs delta",
         f"[rad]{', ' if inputs else ''}{', '.join(inputs)}. Equations:",
         "",
-        *("    " + ln for ln in model.equations(precision=6).splitlines()),
+        *("    " + ln for ln in equations.splitlines()),
         '"""',
         "",
         "import numpy as np",
@@ -138,6 +178,12 @@ def numpy_source(model: ManoeuvringModel) -> str:
             factors = " * ".join(_factor_expr(f) for f in term.factors)
             parts.append(f"{c!r}" + (f" * {factors}" if factors else " * np.ones_like(u)"))
         lines.append(f"    {dof}dot = (" + "\n             + ".join(parts) + ")")
+    if hybrid:
+        names = ", ".join(hybrid.residual.features)
+        lines += [f"    ru, rv, rr = residual({names})",
+                  "    shape = np.shape(udot)",
+                  "    udot, vdot, rdot = (udot + ru.reshape(shape), vdot + rv.reshape(shape),",
+                  "                        rdot + rr.reshape(shape))"]  # fmt: skip
     lines += [
         "    return udot, vdot, rdot",
         "",
@@ -170,12 +216,13 @@ def numpy_source(model: ManoeuvringModel) -> str:
         "            x = x + (h / 6.0) * (k1 + 2 * k2 + 2 * k3 + k4)",
         "        out[k + 1] = x",
         "    return out",
+        *(_residual_source(hybrid) if hybrid else ()),
         "",
     ]
     return "\n".join(lines)
 
 
-def export_numpy(model: ManoeuvringModel, path: str | Path) -> Path:
+def export_numpy(model: ManoeuvringModel | HybridModel, path: str | Path) -> Path:
     """Write ``numpy_source(model)`` atomically to ``path`` (a .py file)."""
     from shipid.outputs import atomic_write_text
 

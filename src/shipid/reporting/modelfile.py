@@ -266,9 +266,9 @@ def model_from_document(doc: dict, path: str | Path, which: str = "model",
         return model  # the search chose no residual; its record is kept
     if not hybrid:
         raise ShipidError(f"{path}: the model has a kernel residual (identify --residual); this "
-                          "command needs a term model: validate, simulate, manoeuvre and "
-                          "criteria run it, the others take a model identified without "
-                          "--residual")  # fmt: skip
+                          "command needs a term model: validate, simulate, manoeuvre, "
+                          "criteria and export run it, the others take a model identified "
+                          "without --residual")  # fmt: skip
     if not isinstance(record["residual"], Mapping):
         raise ShipidError(f"{path}: kernel_residual.residual must be a mapping")
     residual = KernelResidual.from_dict(record["residual"], f"{path}: kernel_residual")
