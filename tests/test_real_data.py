@@ -160,3 +160,35 @@ def test_race_damping_predicts_every_held_out_kvlcc2_log_better_in_sway_and_yaw(
     race = held_out_errors("blanke-race")
     damped = held_out_errors("blanke-race+race-damping")
     assert np.all(damped < 0.9 * race), (race, damped)
+
+
+@needs_data
+def test_the_kernel_residual_on_the_kvlcc2_is_the_readmes():
+    """README, *A kernel residual*: blanke-speed from MARIN zz 20° (1.25 Hz prefilter), γ and σ
+    by free-run CV over four blocks (0.1, 4), and the unseen zz −20° run's free-run errors
+    0.0152 / 0.0123 / 0.0038 → 0.0091 / 0.0101 / 0.0031; the folds' gain within its noise."""
+    from shipid.data.preprocess import lowpass
+    from shipid.dynamics.hybrid import HybridModel
+    from shipid.dynamics.simulate import simulate_log
+    from shipid.identification.residual import choose_residual, fit_residual
+
+    def fit(logs):
+        filtered = [lowpass(x, 1.25) for x in logs]
+        return identify(filtered, "blanke-speed", force=True).model, filtered
+
+    zz20 = read_log(MARIN / "MARIN_FREE_KVLCC2_zz_20_m.dat", fmt="simman-marin", scale=LAMBDA,
+                    dt=0.2)  # fmt: skip
+    held = read_log(MARIN / "MARIN_FREE_KVLCC2_zz_-20_m.dat", fmt="simman-marin", scale=LAMBDA,
+                    dt=0.2)  # fmt: skip
+    choice = choose_residual(fit, [zz20], cv="blocks:4")
+    assert (choice.gamma, choice.sigma) == (0.1, 4.0)
+    assert 0 < choice.gain < choice.gain_se and any("within its noise" in n for n in choice.notes)
+    physical, train = fit([zz20])
+    hybrid = HybridModel(physical, fit_residual(physical, train, choice.gamma, choice.sigma))
+    errors = {}
+    for name, model in (("physical", physical), ("hybrid", hybrid)):
+        sim = simulate_log(model, held).log
+        errors[name] = [float(np.std(held[s].to_numpy()[: len(sim)] - sim[s].to_numpy()))
+                        for s in "uvr"]  # fmt: skip
+    np.testing.assert_allclose(errors["physical"], [0.0152, 0.0123, 0.0038], atol=6e-5)
+    np.testing.assert_allclose(errors["hybrid"], [0.0091, 0.0101, 0.0031], atol=6e-5)
