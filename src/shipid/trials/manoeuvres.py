@@ -321,7 +321,7 @@ def _check_wind(wind) -> tuple[float, float] | None:
 
 
 def zigzag(
-    ship: Vessel | ManoeuvringModel,
+    ship: Vessel | ManoeuvringModel | HybridModel,
     rudder_deg: float = 20.0,
     heading_deg: float = 20.0,
     first: str = "starboard",
@@ -371,7 +371,7 @@ def zigzag(
 
 
 def turning_circle(
-    ship: Vessel | ManoeuvringModel,
+    ship: Vessel | ManoeuvringModel | HybridModel,
     rudder_deg: float = 35.0,
     side: str = "starboard",
     duration: float | None = None,
@@ -408,7 +408,7 @@ def turning_circle(
 
 
 def pull_out(
-    ship: Vessel | ManoeuvringModel,
+    ship: Vessel | ManoeuvringModel | HybridModel,
     rudder_deg: float = 20.0,
     side: str = "starboard",
     hold: float | None = None,
@@ -454,7 +454,7 @@ def pull_out(
 
 
 def stopping(
-    ship: Vessel | ManoeuvringModel,
+    ship: Vessel | ManoeuvringModel | HybridModel,
     rps: float,
     astern_rps: float | None = None,
     reversal_time: float = 0.0,
@@ -522,7 +522,7 @@ def _stopping_indices(log: pd.DataFrame, vessel: Vessel) -> dict:
 
 
 def spiral(
-    ship: Vessel | ManoeuvringModel,
+    ship: Vessel | ManoeuvringModel | HybridModel,
     rudders_deg=(25, 15, 10, 5, 2, 0, -2, -5, -10, -15, -25, -15, -10, -5, -2, 0, 2, 5, 10, 15, 25),
     hold: float | None = None,
     dt: float = 0.05,
