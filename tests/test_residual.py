@@ -242,3 +242,22 @@ def test_the_numpy_export_carries_the_residual(tmp_path, trials, hybrid, method)
     ref = simulate_log(model, log, method).log[["u", "v", "r", "psi", "x", "y"]].to_numpy()
     got = mod.simulate(log["t"].to_numpy(), log[["delta"]].to_numpy(), ref[0], method)
     np.testing.assert_allclose(got, ref, atol=1e-9, rtol=0)
+
+
+def test_a_held_dof_stays_held_and_the_approach_is_the_hybrids_own(trials, hybrid):
+    """A Nomoto model holds u and v: its residual moves only r. A manoeuvre starts a hybrid from
+    its own steady straight speed (the residual shifts the physical model's)."""
+    from shipid.dynamics.equilibrium import steady_approach, surge_equilibrium
+
+    train, held = trials
+    nomoto = identify(train, "nomoto1", force=True).model
+    residual = fit_residual(nomoto, train, 0.1, 2.0)
+    assert np.all(residual_data(nomoto, train, residual.features)[1][:, :2] == 0.0)
+    run = simulate_log(HybridModel(nomoto, residual), held[0]).log
+    assert np.ptp(run["u"]) == 0.0 and np.ptp(run["v"]) == 0.0 and np.ptp(run["r"]) > 0.1
+
+    _, physical, model = hybrid
+    own = surge_equilibrium(model, 1.94)
+    assert own is not None and own != pytest.approx(surge_equilibrium(physical, 1.94), abs=1e-6)
+    assert abs(model.accelerations(own, 0.0, 0.0, 0.0)[0, 0]) < 1e-6
+    assert steady_approach(model, 1.94, None).speed == pytest.approx(1.94)  # no rps: as trained

@@ -300,14 +300,12 @@ def _run_approach(target, cond: dict, speed: float | None, rps: float | None):
     from shipid.dynamics.hybrid import HybridModel
     from shipid.dynamics.model import ManoeuvringModel
 
-    physical = target.physical if isinstance(target, HybridModel) else target
-    if not isinstance(physical, ManoeuvringModel):
+    if not isinstance(target, ManoeuvringModel | HybridModel):
         return speed, rps, None
     if speed is None and not cond["speed"]:
         return None, rps if rps is not None else cond["rps"], None  # the run names what is missing
-    app = steady_approach(physical, cond["speed"], cond["rps"], speed, rps)
-    print(app.describe() + (" (of its physical part; the kernel residual may shift it)"
-                            if physical is not target else ""))  # fmt: skip
+    app = steady_approach(target, cond["speed"], cond["rps"], speed, rps)
+    print(app.describe())
     return app.speed, app.rps, app.warning
 
 

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from shipid.dynamics.kernel import c_array
-from shipid.dynamics.model import ManoeuvringModel
+from shipid.dynamics.model import DOFS, ManoeuvringModel, ModelStructure
 from shipid.dynamics.terms import INPUT_SIGNALS
 from shipid.errors import ShipidError
 
@@ -139,11 +139,24 @@ class HybridModel:
         self.uses_thrust = physical.uses_thrust
         self.inputs = tuple(dict.fromkeys((*physical.inputs, *(("n",) if uses_n else ()))))
         r = residual
+        # A DOF the physical model holds (a Nomoto model's u and v) stays held.
+        self._moves = np.array([d in physical.structure.dofs for d in DOFS], dtype=float)
         # The compiled runs' arguments (``shipid.dynamics.hybrid_kernel``), built once.
         self.kernel_arguments = (
-            c_array(r.mean), c_array(r.scale), c_array(r.centres), c_array(r.weights),
-            c_array(r.intercept), 1.0 / (r.sigma * r.sigma), 1.0 / r.reach,
+            c_array(r.mean), c_array(r.scale), c_array(r.centres),
+            c_array(r.weights * self._moves), c_array(r.intercept * self._moves),
+            1.0 / (r.sigma * r.sigma), 1.0 / r.reach,
             np.array([FEATURES.index(f) for f in r.features], dtype=np.int64))  # fmt: skip
+
+    @property
+    def structure(self) -> ModelStructure:
+        """The physical model's structure (which DOFs move; the residual moves no other)."""
+        return self.physical.structure
+
+    @property
+    def uses_wind(self) -> bool:
+        """Whether the physical model has wind terms."""
+        return self.physical.uses_wind
 
     def features(self, nu: np.ndarray, delta, rps=None) -> np.ndarray:
         """(B, d) raw residual features at states ``nu`` (B, 3)."""
@@ -168,7 +181,7 @@ class HybridModel:
             if given.get(name) is not None:
                 columns[:, j] = given[name]
         base = self.physical.compiled_accelerations(nu, columns)
-        return base + self.residual.accelerations(self.features(nu, delta, rps))
+        return base + self.residual.accelerations(self.features(nu, delta, rps)) * self._moves
 
     def accelerations(self, u, v, r, delta, thrust=None, rps=None, **inputs) -> np.ndarray:
         """(n, 3) accelerations for arrays of states and inputs (``ManoeuvringModel``'s form)."""

@@ -72,7 +72,9 @@ def residual_data(physical: ManoeuvringModel, logs: Sequence[pd.DataFrame],
         Y.append(observed - acc[:-1])
     if not X:
         raise ShipidError("a kernel residual needs logs of at least two samples")
-    return np.vstack(X), np.vstack(Y)
+    # A DOF the physical model holds has no residual: the hybrid holds it too.
+    moves = np.array([d in physical.structure.dofs for d in ("u", "v", "r")], dtype=float)
+    return np.vstack(X), np.vstack(Y) * moves
 
 
 def fit_residual(physical: ManoeuvringModel, logs: Sequence[pd.DataFrame], gamma: float,

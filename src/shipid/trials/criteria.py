@@ -25,6 +25,7 @@ import pandas as pd
 
 from shipid.data.particulars import Particulars
 from shipid.dynamics.equilibrium import unsteady_warning
+from shipid.dynamics.hybrid import HybridModel
 from shipid.dynamics.model import ManoeuvringModel
 from shipid.dynamics.steering import SteeringMachine
 from shipid.errors import ShipidError
@@ -117,7 +118,7 @@ def imo_criteria(
     duration = max(60.0, 40.0 * L / V)
     kw = {"dt": dt, "speed": V, "steering": steering, "method": method, "rps": rps}
     rows, runs, notes = [], {}, []
-    if isinstance(ship, ManoeuvringModel):  # a reference ship's approach is trimmed
+    if isinstance(ship, ManoeuvringModel | HybridModel):  # a reference ship's is trimmed
         unsteady = unsteady_warning(ship, V, rps if ship.uses_rps else None)
         notes += [unsteady] if unsteady else []
 
