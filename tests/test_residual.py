@@ -168,6 +168,10 @@ def test_identify_residual_through_the_command_line(tmp_path, capsys, trials):
                           "60"], capsys)  # fmt: skip
     assert code == 0, err
     assert "the kernel residual is faded out over" in err  # 35°: beyond the 20° zig-zags
+    code, out, err = run(["criteria", str(model), "--length", "4.5", "--scale", "16.95",
+                          "--no-bands"], capsys)  # fmt: skip
+    assert code == 0, err
+    assert "turning 35° starboard: the kernel residual is faded out" in err
     code, out, err = run(["linearise", str(model)], capsys)
     assert code == 1 and "has a kernel residual" in err and "Traceback" not in err
     code, _, err = run(["identify", *map(str, paths), "--residual", "rbf", "--bootstrap", "10",

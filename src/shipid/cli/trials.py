@@ -29,6 +29,10 @@ def cmd_criteria(args) -> int:
                   scale=args.scale, rps=rps, steering=steering, astern_rps=args.astern_rps,
                   dt=args.dt)  # fmt: skip
     crit = run(target)
+    from shipid.evaluation.validate import faded_residual_notes
+
+    crit.notes += [f"{name}: {note}" for name, res in crit.runs.items()
+                   for note in faded_residual_notes(target, res.log)]  # fmt: skip
     table = crit.table.copy()
     ensemble = cond.get("ensemble")
     if ensemble is not None and not args.no_bands:

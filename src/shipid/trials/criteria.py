@@ -78,7 +78,7 @@ def _row(name, manoeuvre, value, limit, unit) -> dict:
 
 
 def imo_criteria(
-    ship: Vessel | ManoeuvringModel,
+    ship: Vessel | ManoeuvringModel | HybridModel,
     particulars: Particulars | None = None,
     length: float | None = None,
     speed: float | None = None,
