@@ -28,6 +28,8 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_select.py
 	$(BIN)/python benchmarks/bench_long_logs.py
 	$(BIN)/python benchmarks/bench_physics.py
+	$(BIN)/python benchmarks/bench_residual.py
+	$(BIN)/python benchmarks/study_hybrid.py
 	$(BIN)/python benchmarks/study_uncertainty.py
 	$(BIN)/python benchmarks/study_structure.py
 	$(BIN)/python benchmarks/bench_study.py
