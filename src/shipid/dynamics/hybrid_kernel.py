@@ -27,18 +27,20 @@ kernel.drop_stale_caches(__file__)
 def hybrid_rhs(ctx, u, v, r, psi):
     """State derivative of a hybrid; ctx = (the term model's context, the residual's mean,
     scale, standardised centres (M, d), weights (M, 3), intercept (3,), 1/σ², 1/reach, feature
-    indices into (u, v, r, δ, n), a buffer of 5)."""
-    tctx, mean, scale, centres, weights, intercept, inv_s2, inv_reach, fidx, x = ctx
+    indices into (u, v, r, δ, n), buffers of 5 for the raw and the standardised features)."""
+    tctx, mean, scale, centres, weights, intercept, inv_s2, inv_reach, fidx, x, z = ctx
     a0, a1, a2, rd, xd, yd = kernel.terms_rhs(tctx, u, v, r, psi)
     inp = tctx[8]
     x[0], x[1], x[2], x[3], x[4] = u, v, r, inp[0], inp[1]
     d = fidx.size
+    for j in range(d):  # standardised once per evaluation, not per centre
+        z[j] = (x[fidx[j]] - mean[j]) / scale[j]
     k_max, s0, s1, s2 = 0.0, 0.0, 0.0, 0.0
     for i in range(centres.shape[0]):
         d2 = 0.0
         for j in range(d):
-            z = (x[fidx[j]] - mean[j]) / scale[j] - centres[i, j]
-            d2 += z * z
+            e = z[j] - centres[i, j]
+            d2 += e * e
         k = math.exp(-d2 * inv_s2)
         k_max = max(k_max, k)
         s0 += k * weights[i, 0]
@@ -53,7 +55,8 @@ def hybrid_rhs(ctx, u, v, r, psi):
 def _ctx(th, start, sig, op, kk, pw, derived, wind_true, vw, dw, mean, scale, centres, weights,
          intercept, inv_s2, inv_reach, fidx):  # fmt: skip
     return (kernel._terms_ctx(th, start, sig, op, kk, pw, derived, wind_true, vw, dw), mean,
-            scale, centres, weights, intercept, inv_s2, inv_reach, fidx, np.zeros(5))  # fmt: skip
+            scale, centres, weights, intercept, inv_s2, inv_reach, fidx, np.zeros(5),
+            np.zeros(5))  # fmt: skip
 
 
 @numba.njit(cache=True)
