@@ -159,8 +159,15 @@ def test_identify_residual_through_the_command_line(tmp_path, capsys, trials):
     assert code == 0, err
     assert "kernel residual on (u, v, r, delta)" in out
     assert "cross-validated 95 % error band" in out and "kernel residual's γ and σ" in out
-    record = json.loads(model.read_text())["kernel_residual"]
+    doc = json.loads(model.read_text())
+    record = doc["kernel_residual"]
     assert record["residual"]["kind"] == "rbf" and len(record["selection"]["scores"]) == 16
+    from shipid.dynamics.equilibrium import surge_equilibrium
+
+    checked = doc["identification"]["plausibility"]["surge_equilibrium"]  # the hybrid's, whole
+    hybrid_eq = surge_equilibrium(load_model(model), 1.94)  # (a finer grid: to 1e-6)
+    physical_eq = surge_equilibrium(load_model(model).physical, 1.94)
+    assert abs(checked - hybrid_eq) < 1e-6 and abs(checked - physical_eq) > 1e-4  # 4.6e-4 apart
     code, out, err = run(["validate", str(model), str(held_path)], capsys)
     assert code == 0, err
     assert "held.csv" in out and "closed loop" in out and "in CV band" in out

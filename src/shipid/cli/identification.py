@@ -123,10 +123,10 @@ def cmd_identify(args) -> int:
     for dof, d in ident.diagnostics.items():
         print(f"{dof}: condition number {d['condition_number']:.3g}, one-step R² "
               f"{d['one_step_r2']:.4f}, bias b = {ident.discrete[dof]['bias']:.4g}")
-    residual = None
+    residual, hybrid = None, None
     if args.residual:  # no refinement goes with it: the model is the LS-SVM one
-        residual = _kernel_residual(args, ident.model, logs, raw_logs, names, cutoff, gamma,
-                                    physics, ident.warnings)  # fmt: skip
+        residual, hybrid = _kernel_residual(args, ident.model, logs, raw_logs, names, cutoff,
+                                            gamma, physics, ident.warnings)  # fmt: skip
     band = None
     if args.error_band is not None:
         from shipid.evaluation.error_band import cross_validated_band
@@ -175,7 +175,8 @@ def cmd_identify(args) -> int:
     if speed is None or not speed > 0:
         raise ShipidError(f"{names[0]}: the first training log starts without headway (u = "
                           f"{speed}); trim it to the manoeuvre (--start)")  # fmt: skip
-    plausibility, notes = plausibility_at_approach(ident.model, speed, rps)
+    # A hybrid is checked whole: its stability, steady speed and held-rudder turns.
+    plausibility, notes = plausibility_at_approach(hybrid or ident.model, speed, rps)
     if refinement:
         refined_report, refined_notes = plausibility_at_approach(refinement.model, speed, rps)
         worse = new_failures(plausibility, refined_report, ident.model)
@@ -195,8 +196,7 @@ def cmd_identify(args) -> int:
               f"eigenvalue real part {sl['max_real_part']:.3g} 1/s); surge equilibrium "
               f"{_fmt_speed(plausibility['surge_equilibrium'])}; checked from the "
               f"{plausibility['approach']}"
-              + ("; of the physical part (the hybrid's held-rudder runs are checked too)"
-                 if residual and residual["residual"] else ""))  # fmt: skip
+              + (", with its kernel residual" if hybrid else ""))  # fmt: skip
     ident.warnings.extend(f"plausibility: {n}" for n in notes)
     if refinement:
         ident.warnings.extend(f"refinement: {n}" for n in refinement.warnings)
@@ -253,12 +253,11 @@ def _print_prime(record: dict | None) -> None:
 def _kernel_residual(args, physical, logs, raw_logs, names, cutoff, gamma, physics, warnings):
     """``identify --residual``: the residual's γ and σ (or none) by free-run cross-validation of
     the hybrid, each fold's physical model fitted as this one (structure, γ, prefilter,
-    physics); then the residual of ``physical`` on all logs, whose held-rudder runs are checked
-    too. Returns the model file's record: the residual (None when none won) and the search."""
+    physics); then the residual of ``physical`` on all logs. Returns the model file's record
+    (the residual, None when none won, and the search) and the hybrid (None likewise)."""
     from shipid.data.preprocess import lowpass
     from shipid.dynamics.hybrid import HybridModel
     from shipid.identification.identify import identify
-    from shipid.identification.plausibility import held_rudder
     from shipid.identification.residual import choose_residual, fit_residual
 
     def fit(train):
@@ -273,17 +272,12 @@ def _kernel_residual(args, physical, logs, raw_logs, names, cutoff, gamma, physi
     warnings.extend(choice.notes)
     record = {"residual": None, "selection": choice.to_dict()}
     if choice.gamma is None:
-        return record
+        return record, None
     residual = fit_residual(physical, logs, choice.gamma, choice.sigma, choice.features)
     hybrid = HybridModel(physical, residual)
     print(hybrid.equations().splitlines()[-1])
-    speed, rps = _approach(logs[0], "u"), _approach(logs[0], "n")
-    if speed and speed > 0:
-        for side, entry in held_rudder(hybrid, speed, rps if hybrid.uses_rps else None).items():
-            if entry["diverged"]:
-                warnings.append(f"kernel residual: 35° rudder held to {side}: {entry['reason']}")
     record["residual"] = residual.to_dict()
-    return record
+    return record, hybrid
 
 
 def _with_residual(model, logs, record):

@@ -30,6 +30,7 @@ from shipid.dynamics.kernel import c_array
 from shipid.dynamics.model import DOFS, ManoeuvringModel, ModelStructure
 from shipid.dynamics.terms import INPUT_SIGNALS
 from shipid.errors import ShipidError
+from shipid.lssvm.kernels import kernel_matrix
 
 FEATURES = ("u", "v", "r", "delta", "n")
 
@@ -75,7 +76,6 @@ class KernelResidual:
             raise ShipidError("kernel residual: non-finite values or a scale ≤ 0")
         if not (self.sigma > 0 and self.gamma > 0 and 0 < self.reach <= 1):
             raise ShipidError("kernel residual: sigma and gamma must be > 0, reach in (0, 1]")
-        object.__setattr__(self, "_norms", np.sum(self.centres**2, axis=1))
 
     @property
     def n_centres(self) -> int:
@@ -83,9 +83,8 @@ class KernelResidual:
         return int(self.centres.shape[0])
 
     def _kernel(self, x: np.ndarray) -> np.ndarray:
-        z = (x - self.mean) / self.scale
-        d2 = np.sum(z * z, axis=1)[:, None] + self._norms[None, :] - 2.0 * z @ self.centres.T
-        return np.exp(-np.maximum(d2, 0.0) / (self.sigma * self.sigma))
+        """K(z, cᵢ) (B, M) at raw features ``x`` (B, d): the LS-SVM's own RBF kernel."""
+        return kernel_matrix((x - self.mean) / self.scale, self.centres, "rbf", sigma=self.sigma)
 
     def fade(self, x: np.ndarray) -> np.ndarray:
         """(B,) weight w(z) in [0, 1] at raw features ``x`` (B, d): 1 inside the envelope."""

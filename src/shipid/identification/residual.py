@@ -93,6 +93,7 @@ def fit_residuals(physical: ManoeuvringModel, logs: Sequence[pd.DataFrame],
     """``fit_residual`` at each γ of ``gammas`` and one σ, the kernel matrix or the fixed-size
     features computed once (``LSSVR.fit_path``)."""
     from shipid.lssvm import LSSVR
+    from shipid.lssvm.kernels import kernel_matrix
 
     features = tuple(features or residual_features(logs))
     X, Y = data if data is not None else residual_data(physical, logs, features)
@@ -101,20 +102,17 @@ def fit_residuals(physical: ManoeuvringModel, logs: Sequence[pd.DataFrame],
     dense = len(X) <= DENSE_LIMIT
     path = LSSVR(kernel="rbf", sigma=sigma, solver="dense" if dense else "fixed-size",
                  n_landmarks=LANDMARKS, random_state=seed).fit_path((X - mean) / scale, Y, gammas)
-    # The kernel's reach at the training samples: a low percentile marks the envelope (from
-    # every k-th sample past REACH_SAMPLES: the quantile, not 1e5 × 300 kernel values, is wanted).
-    probe_rows = X[:: max(1, len(X) // REACH_SAMPLES)]
-    out = []
-    for gamma, est in zip(gammas, path, strict=True):
-        centres = est.X_fit_ if dense else est.landmarks_
-        weights = est.alpha_ if dense else est.landmark_coef_
-        intercept = np.asarray(est.intercept_, dtype=float)
-        probe = KernelResidual(features, mean, scale, sigma, gamma, centres, weights, intercept,
-                               1.0)  # fmt: skip
-        reach = float(np.percentile(probe.fade(probe_rows), REACH_QUANTILE))
-        out.append(KernelResidual(features, mean, scale, sigma, float(gamma), centres, weights,
-                                  intercept, max(reach, 1e-12)))  # fmt: skip
-    return out
+    # The kernel's reach at the training samples, maxᵢ K(z, cᵢ): a low percentile marks the
+    # envelope (from every k-th sample past REACH_SAMPLES: the quantile, not 1e5 × 300 kernel
+    # values, is wanted). The centres, and so the reach, are the same at every γ.
+    centres = path[0].X_fit_ if dense else path[0].landmarks_
+    probe = (X[:: max(1, len(X) // REACH_SAMPLES)] - mean) / scale
+    reach = float(np.percentile(kernel_matrix(probe, centres, "rbf", sigma=sigma).max(axis=1),
+                                REACH_QUANTILE))  # fmt: skip
+    return [KernelResidual(features, mean, scale, sigma, float(gamma), centres,
+                           est.alpha_ if dense else est.landmark_coef_,
+                           np.asarray(est.intercept_, dtype=float), max(reach, 1e-12))
+            for gamma, est in zip(gammas, path, strict=True)]  # fmt: skip
 
 
 @dataclass
