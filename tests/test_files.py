@@ -44,7 +44,7 @@ def trial_csv(tmp_path, trial):
 def test_log_round_trip_keeps_times_exactly_and_metadata(tmp_path, ext):
     t = np.arange(4481) * (606.0 / 4480) / math.sqrt(45.7)  # the MARIN rebuilt time grid
     log = pd.DataFrame({"t": t, "delta": 0.1 * np.sin(t), "u": 1.0 + 0 * t, "v": 0 * t,
-                        "r": 0.01 * np.cos(t)})  # fmt: skip
+                        "r": -0.01 * np.cos(t)})  # fmt: skip
     log.attrs.update({"ship": "KVLCC2", "rudder_positive": "starboard", "scale": 45.7,
                       "source": "test"})  # fmt: skip
     path = write_log(log, tmp_path / f"log{ext}")

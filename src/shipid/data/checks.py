@@ -7,7 +7,8 @@ yaw rate (ψ̇ = r), which tells degrees from radians and milliseconds from seco
 the positions must move as u, v turned by ψ say (ẋ = u cos ψ − v sin ψ, ẏ = u sin ψ + v cos ψ),
 which tells a sway positive to port, or x and y swapped (east, north), from the canonical axes,
 and by how far it moves, knots or feet from m/s and metres. The heading also tells a gyro's
-offset: ψ − ∫r dt drifts at it.
+offset: ψ − ∫r dt drifts at it. And the rudder convention can be read off the response: where
+the ship runs ahead, ṙ follows δ with the sign of the side a positive angle turns it to.
 """
 
 from __future__ import annotations
@@ -47,6 +48,18 @@ TRACK_WINDOW_S = 10.0
 # 0.25-0.27 of the wrong one's in a 20° turn and 0.37-0.39 in a 20/20 zig-zag; in a 10/10
 # zig-zag, 0.73-0.75: too little sway to tell, and nothing is said.
 TRACK_CONVENTION_SHARE = 0.6
+# The rudder's yaw response is fitted on means over bins of this length: ṙ from a differenced
+# yaw rate is noise at a fine sampling, and the bins' residuals are nearly independent (per
+# sample at 50 Hz the KVLCC2's have lag-1 correlation 0.99).
+RUDDER_BIN_S = 1.0
+# Bins with u above this share of the log's 90th percentile of u (and the propeller ahead):
+# astern, or creeping, the rudder turns the ship the other way or hardly at all.
+RUDDER_AHEAD_SHARE = 0.5
+# A convention is read off the log only at |t| of ṙ's gain on δ at least this (its residuals'
+# lag-1 correlation allowed for). The real logs here: 4.2-45 in the zig-zags and three of the
+# four Esso random runs, all with the stated sign; a turning circle, one step of the rudder,
+# 0.6-2.0, which says nothing.
+RUDDER_CONVENTION_T = 4.0
 
 
 def true_runs(mask: np.ndarray) -> list[tuple[int, int]]:
@@ -342,6 +355,84 @@ def _check_heading_against_yaw_rate(df: pd.DataFrame, name: str) -> None:
                           "positive turning to starboard); negate one of them")  # fmt: skip
     warnings.warn(f"{name}: the heading 'psi' changes {ratio:.3g} times as fast as the yaw rate "
                   "'r' says (expected 1): check their units", ShipidWarning, stacklevel=3)
+
+
+@dataclass(frozen=True)
+class RudderResponse:
+    """How the yaw rate answers the rudder in a log: ṙ ≈ gain·δ + a·r + c where it runs ahead."""
+
+    side: str  # 'port' or 'starboard': where a positive rudder angle turns the ship in the log
+    gain: float  # ∂ṙ/∂δ [1/s²]
+    t_score: float  # gain over its standard error, widened for the residuals' correlation
+
+    @property
+    def decisive(self) -> bool:
+        """Whether the response is firm enough to name a convention (``RUDDER_CONVENTION_T``)."""
+        return abs(self.t_score) >= RUDDER_CONVENTION_T
+
+
+def rudder_response(log: pd.DataFrame) -> RudderResponse | None:
+    """Least-squares ṙ ≈ gain·δ + a·r + c on ``RUDDER_BIN_S`` means of the samples running ahead
+    (u above ``RUDDER_AHEAD_SHARE`` of its 90th percentile, n > 0 where logged). The r term takes
+    the yaw damping, which would otherwise hide the rudder in a zig-zag, where r lags δ. None
+    when fewer than 20 bins run ahead or the rudder does not move."""
+    t = log["t"].to_numpy(dtype=float)
+    if len(t) < 3:
+        return None
+    dt = float(np.median(np.diff(t)))
+    per_bin = max(1, int(round(RUDDER_BIN_S / dt)))
+    cols = [c for c in ("t", "delta", "u", "r", "n") if c in log.columns]
+    bins = log[cols].groupby(np.arange(len(log)) // per_bin).mean()
+    if len(bins) < 20:
+        return None
+    tb, r = bins["t"].to_numpy(), bins["r"].to_numpy()
+    r_dot = np.gradient(r, tb)
+    u = bins["u"].to_numpy()
+    top = float(np.quantile(u, 0.9))
+    ahead = u > RUDDER_AHEAD_SHARE * top if top > 0 else np.zeros(len(u), bool)
+    if "n" in bins.columns:
+        ahead &= bins["n"].to_numpy() > 0
+    delta = bins["delta"].to_numpy()[ahead]
+    if ahead.sum() < 20 or not np.ptp(delta) > 0:
+        return None
+    x = np.column_stack([delta, r[ahead], np.ones(delta.size)])
+    y = r_dot[ahead]
+    coef, *_ = np.linalg.lstsq(x, y, rcond=None)
+    e = y - x @ coef
+    xtx = x.T @ x
+    if np.linalg.cond(xtx) > 1e12:
+        return None
+    var = float(e @ e) / (y.size - 3) * float(np.linalg.inv(xtx)[0, 0])
+    rho = float(np.corrcoef(e[1:], e[:-1])[0, 1]) if np.std(e) > 0 else 0.0
+    rho = min(max(rho, 0.0), 0.95) if math.isfinite(rho) else 0.0
+    se = math.sqrt(var * (1 + rho) / (1 - rho)) if var > 0 else 0.0
+    gain = float(coef[0])
+    t_score = gain / se if se > 0 else math.copysign(math.inf, gain)
+    return RudderResponse("starboard" if gain > 0 else "port", gain, t_score)
+
+
+def check_rudder_convention(log: pd.DataFrame, name: str, stated: bool) -> None:
+    """Warn where the log's rudder response contradicts its stated convention (metadata,
+    the format, or --rudder-positive): the sign constraints, the prior and the closed-loop
+    replica of a zig-zag use the convention, so they would be mirrored. A log that states none
+    (a canonical file without the metadata, taken as port-positive) whose response says
+    starboard is taken so, and a warning says it."""
+    found = rudder_response(log)
+    side = log.attrs.get("rudder_positive", "port")
+    if found is None or not found.decisive or found.side == side:
+        return
+    evidence = (f"where it runs ahead the yaw rate answers the rudder as if a positive angle "
+                f"turned it to {found.side} (ṙ/δ {found.gain:+.3g} 1/s², t = {found.t_score:+.1f})")
+    if stated:
+        warnings.warn(f"{name}: {evidence}, but the log says rudder_positive={side}: the sign "
+                      f"constraints, the prior and the zig-zag replica would be mirrored; give "
+                      f"--rudder-positive {found.side} if the data are right, else check the "
+                      "signs of delta and r", ShipidWarning, stacklevel=3)  # fmt: skip
+        return
+    log.attrs["rudder_positive"] = found.side
+    warnings.warn(f"{name}: states no rudder convention; {evidence}: taken as "
+                  f"rudder_positive={found.side} (--rudder-positive to state it)",
+                  ShipidWarning, stacklevel=3)  # fmt: skip
 
 
 @dataclass(frozen=True)

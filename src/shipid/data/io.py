@@ -18,7 +18,13 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from shipid.data.checks import ANGLE_COLUMNS, check_log, check_propulsion, check_units
+from shipid.data.checks import (
+    ANGLE_COLUMNS,
+    check_log,
+    check_propulsion,
+    check_rudder_convention,
+    check_units,
+)
 from shipid.data.formats import FORMATS, detect_format, read_format
 from shipid.data.log import COLUMNS, REQUIRED, csv_metadata_line, metadata, parse_csv_metadata
 from shipid.data.preprocess import resample
@@ -173,6 +179,7 @@ def read_log(path: str | Path, options: ReadOptions | None = None, **overrides) 
         log = read_format(path, options.fmt, options.scale)
         check_log(log, name, fill_gaps=options.fill_gaps)
         meta = {}
+        stated = True
     else:
         try:
             df, meta = _read_table(path)
@@ -197,14 +204,17 @@ def read_log(path: str | Path, options: ReadOptions | None = None, **overrides) 
         log = df[[c for c in COLUMNS if c in df.columns]].copy()
         log.attrs.update({"source": str(path), "rudder_positive": "port"})
         log.attrs.update(meta)
+        stated = "rudder_positive" in meta
         log.attrs.update({k: df.attrs[k] for k in ("time_origin",) if k in df.attrs})
     check_units(log, name, options.degrees)
     log.attrs["name"] = path.name
     if options.rudder_positive:
         log.attrs["rudder_positive"] = options.rudder_positive
+        stated = True
     if options.start is not None or options.end is not None:
         log = trim(log, options.start, options.end, name, options.lead)
     check_propulsion(log, name)
+    check_rudder_convention(log, name, stated)
     if options.dt is not None:
         log = resample(log, options.dt, name)
     return log
