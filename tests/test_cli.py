@@ -138,7 +138,7 @@ def test_version_and_defaults_in_help(capsys):
     with pytest.raises(SystemExit):
         main(["identify", "--help"])
     out = capsys.readouterr().out
-    assert "default 10000" in out
+    assert "default 1e4" in out and "auto (default" in out
     from shipid.dynamics.model import STRUCTURES
 
     # The help names every structure (it is written out, not imported, for a fast start);

@@ -231,6 +231,7 @@ def test_the_default_library_leaves_out_what_the_logs_cannot_give(tmp_path, caps
     logs = noisy_zigzags(5)
     for log in logs:
         log["n"] = 12.0
+        log.loc[log.index[-5:], "n"] = -4.0  # a moment astern: the astern terms are excited
     library, note = default_library(logs)
     full = get_structure(DEFAULT_LIBRARY)
     dropped = {t for d in full.terms for t in full.terms[d]} - set(library.all_terms)
@@ -239,6 +240,12 @@ def test_the_default_library_leaves_out_what_the_logs_cannot_give(tmp_path, caps
     windy = [log.assign(wind_speed=1.0, wind_angle=0.3) for log in logs]
     kept, note = default_library(windy)
     assert note == "" and kept.all_terms == full.all_terms
+    # Never astern: the astern propeller's terms are zero along every log, and left out.
+    ahead = [log.assign(n=12.0) for log in windy]
+    trimmed, note = default_library(ahead)
+    zero = set(full.all_terms) - set(trimmed.all_terms)
+    assert zero and all(t.startswith("neg(n)") for t in zero)
+    assert "zero along every log" in note
     paths = [write_log(log, tmp_path / f"zz{i}.csv") for i, log in enumerate(logs)]
     code = main(["select", *map(str, paths), "--quiet", "--search", "none", "--dt", "0.4",
                  "-o", str(tmp_path / "m.json")])  # fmt: skip

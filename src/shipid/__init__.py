@@ -36,6 +36,7 @@ _EXPORTS = {
     "weighted_refit": "shipid.identification.identify",
     "common_rudder_convention": "shipid.data.log",
     "select": "shipid.identification.select",
+    "auto_structure": "shipid.identification.auto_structure",
     "selection_ensemble": "shipid.identification.selection_ensemble",
     "imo_criteria": "shipid.trials.criteria",
     "Particulars": "shipid.data.particulars",

@@ -79,6 +79,7 @@ def cmd_identify(args) -> int:
     logs = _training_logs(args)
     raw_logs = logs  # the output-error fit needs the noise as measured, not prefiltered
     names = [str(p) for p in args.logs]
+    choice = _choose_structure(args, logs, names)
     physics = _physics(args, logs, _structure(args))
     cutoff, filter_by = args.filter, "given"
     if cutoff == "auto":
@@ -204,7 +205,8 @@ def cmd_identify(args) -> int:
                       plausibility=plausibility, model=final, selection=gamma_report,
                       particulars=_log_particulars(logs),
                       uncertainty=ensemble.to_dict() if ensemble else None,
-                      error_band=band.to_dict() if band else None, residual=residual)  # fmt: skip
+                      error_band=band.to_dict() if band else None, residual=residual,
+                      structure_choice=choice.to_dict() if choice else None)  # fmt: skip
     from shipid.reporting.modelfile import prime_record
 
     _print_prime(prime_record(final, _log_particulars(logs), speed))
@@ -213,6 +215,25 @@ def cmd_identify(args) -> int:
         _warn(w)
     print(f"model written to {args.output}")
     return 0
+
+
+def _choose_structure(args, logs, names):
+    """``--model auto``: the structure for the logs (``shipid.identification.auto_structure``),
+    put into ``args.model``, and γ into ``args.gamma`` where none was given (select's, else
+    1e4). Returns the choice (None for a given structure)."""
+    choice = None
+    if args.model == "auto":
+        from shipid.identification.auto_structure import auto_structure
+        from shipid.identification.select import default_library
+
+        # The search fits with the same physics, as select does: a prior over its library.
+        physics = _physics(args, logs, default_library(logs)[0])
+        choice = auto_structure(logs, names, physics, args.cv, args.estimator)
+        print(choice.describe())
+        args.model = choice.structure
+    if args.gamma is None:
+        args.gamma = choice.gamma if choice is not None and choice.gamma else 1e4
+    return choice
 
 
 def _output_error(ident, logs, names, args):

@@ -106,17 +106,20 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("identify", help="identify a model from trial logs")
     p.add_argument("logs", nargs="+", metavar="LOG")
-    p.add_argument("--model", default="blanke",
-                   help="structure: blanke (default), blanke-thrust, blanke-speed, blanke-race, "
+    p.add_argument("--model", default="auto",
+                   help="structure: auto (default: the paper's blanke, unless the logs hold a "
+                   "varying propeller speed or thrust or a material wind, which it cannot: then "
+                   "blanke-thrust(+wind) for a thrust, else the terms select chooses from its "
+                   "default library), blanke, blanke-thrust, blanke-speed, blanke-race, "
                    "blanke-rps, abkowitz3, low-speed, wind, race-damping, propeller-asymmetry, "
                    "astern, linear-sway-yaw, nomoto1; combine "
                    "with + (blanke-rps+wind, blanke-race+race-damping) or write terms: "
                    "'u: |u|u, v*r, 1; v: ...; r: ...'")
     p.add_argument("--form", default="increment", choices=("increment", "paper"),
                    help="regression form (default %(default)s)")
-    p.add_argument("--gamma", type=_number_or_auto, default=1e4, metavar="G|auto",
+    p.add_argument("--gamma", type=_number_or_auto, default=None, metavar="G|auto",
                    help="LS-SVM regularisation γ, or 'auto': chosen by free-run cross-validation "
-                   "over the logs (default %(default)g)")
+                   "over the logs (default 1e4, or the γ select chose with --model auto)")
     p.add_argument("--estimator", default="lssvm", choices=LINEAR_ESTIMATORS,
                    help="equation-error estimator (default %(default)s, the paper's)")
     p.add_argument("--cv", help="with --gamma auto or --residual: logo, kfold:K (--gamma) or "

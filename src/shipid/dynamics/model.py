@@ -237,9 +237,11 @@ def parse_structure_spec(spec: str, name: str = "custom") -> ModelStructure:
     return ModelStructure(name, terms)
 
 
-def get_structure(name: str) -> ModelStructure:
+def get_structure(name: str | ModelStructure) -> ModelStructure:
     """A structure by name ('blanke', 'abkowitz3', ...), a sum of names ('blanke-rps+wind'), or
-    a written-out spec ('u: ...; v: ...; r: ...')."""
+    a written-out spec ('u: ...; v: ...; r: ...'); a structure is returned as it is."""
+    if isinstance(name, ModelStructure):
+        return name
     if not isinstance(name, str) or not name.strip():
         raise ShipidError(f"model must be a structure name or term spec, got {name!r}")
     if ":" in name:

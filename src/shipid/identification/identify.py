@@ -189,6 +189,39 @@ def varies(values: np.ndarray) -> bool:
     return typical > 0 and hi - lo > VARYING_INPUT * typical
 
 
+@dataclass(frozen=True)
+class VaryingInput:
+    """A propulsion input that varies in the training logs (``varies``)."""
+
+    signal: str  # 'n' or 'thrust'
+    what: str  # 'the propeller speed n'
+    low: float
+    high: float
+    unit: str
+    remedy: str  # the structures that hold it
+
+    def describe(self) -> str:
+        """'the propeller speed n varies (10 to 16.67 rps)'."""
+        return f"{self.what} varies ({self.low:.4g} to {self.high:.4g} {self.unit})"
+
+
+def varying_propulsion(logs) -> list[VaryingInput]:
+    """The propulsion inputs that vary in ``logs``: n, and the thrust where no rps is logged (at
+    a logged rps the thrust follows the ship's speed, as in HSVA's KVLCC2 run)."""
+    has_rps = any("n" in log.columns for log in logs)
+    out = []
+    for signal, what, unit, remedy in _PROPULSION_INPUTS:
+        columns = [log[signal].to_numpy(dtype=float) for log in logs if signal in log.columns]
+        if not columns or (signal == "thrust" and has_rps):
+            continue
+        values = np.concatenate(columns)
+        if varies(values):
+            values = values[np.isfinite(values)]
+            out.append(VaryingInput(signal, what, float(np.min(values)), float(np.max(values)),
+                                    unit, remedy))  # fmt: skip
+    return out
+
+
 def unmodelled_inputs(logs, structure: ModelStructure) -> list[str]:
     """Notes for a propulsion input (n; the thrust where no rps is logged) that varies in the
     training logs while no term of the structure holds it: its effect is then spread over the
@@ -196,22 +229,17 @@ def unmodelled_inputs(logs, structure: ModelStructure) -> list[str]:
     the Esso Osaka's zig-zags at 10–16.7 rps and three random runs finds no steady speed, and
     turning circles 2.5–3.4 times too wide)."""
     used = {s for names in structure.terms.values() for n in names for s in parse_term(n).signals}
-    has_rps = any("n" in log.columns for log in logs)
-    notes = []
-    for signal, what, unit, remedy in _PROPULSION_INPUTS:
-        columns = [log[signal].to_numpy(dtype=float) for log in logs if signal in log.columns]
-        if signal in used or not columns or (signal == "thrust" and has_rps):
-            continue  # at a logged rps the thrust follows the ship's speed (HSVA's KVLCC2 run)
-        values = np.concatenate(columns)
-        if varies(values):
-            values = values[np.isfinite(values)]
-            notes.append(f"{what} varies in the training logs ({np.min(values):.4g} to "
-                         f"{np.max(values):.4g} {unit}) but no term of the structure holds it: "
-                         "its effect is lumped into the others and the model cannot follow a "
-                         f"change of it; use a structure with it ({remedy}), or choose terms "
-                         "with shipid select")  # fmt: skip
+    notes = [f"{found.describe()} in the training logs but no term of the structure holds it: "
+             "its effect is lumped into the others and the model cannot follow a change of it; "
+             f"use a structure with it ({found.remedy}), or choose terms with shipid select"
+             for found in varying_propulsion(logs) if found.signal not in used]  # fmt: skip
     if not used & {"wind_speed", "wind_angle"}:
-        notes += _unmodelled_wind(logs)
+        wind = material_wind(logs)
+        if wind is not None:
+            notes.append(f"the logs carry a wind (true wind {wind[0]:.3g} m/s against the ship's "
+                         f"{wind[1]:.3g} m/s, medians) but no term of the structure holds it: "
+                         "its gusts are lumped into the others; add wind terms (+wind), or "
+                         "choose terms with shipid select")  # fmt: skip
     return notes
 
 
@@ -219,15 +247,16 @@ def unmodelled_inputs(logs, structure: ModelStructure) -> list[str]:
 MATERIAL_WIND = 0.5
 
 
-def _unmodelled_wind(logs) -> list[str]:
-    """A note when the logs carry a relative wind that is more than the ship's own motion: the
-    true wind, −U_A (cos γ_A, sin γ_A) + (u, v) in the body frame, has a median of at least
-    ``MATERIAL_WIND`` times the ship's speed (the Esso Osaka's pond: 1.0–2.2 m/s against
-    0.07–0.47 m/s; still air: 0). Fitted on them with ``low-speed``, the held-out random runs'
-    r error is 0.86 of their spread (four folds' mean), with ``low-speed+wind`` 0.53."""
+def material_wind(logs) -> tuple[float, float] | None:
+    """(true wind, ship speed) [m/s], medians over the logs, when the logs carry a relative wind
+    that is more than the ship's own motion: the true wind, −U_A (cos γ_A, sin γ_A) + (u, v) in
+    the body frame, has a median of at least ``MATERIAL_WIND`` times the ship's speed (the Esso
+    Osaka's pond: 1.0–2.2 m/s against 0.07–0.47 m/s; still air: 0); else None. Fitted on them
+    with ``low-speed``, the held-out random runs' r error is 0.86 of their spread (four folds'
+    mean), with ``low-speed+wind`` 0.53."""
     with_wind = [log for log in logs if {"wind_speed", "wind_angle"} <= set(log.columns)]
     if not with_wind:
-        return []
+        return None
     true, ship = [], []
     for log in with_wind:
         U, g = log["wind_speed"].to_numpy(dtype=float), log["wind_angle"].to_numpy(dtype=float)
@@ -236,10 +265,8 @@ def _unmodelled_wind(logs) -> list[str]:
         ship.append(np.hypot(u, v))
     wind, speed = float(np.nanmedian(np.concatenate(true))), float(np.nanmedian(np.concatenate(ship)))
     if not wind >= MATERIAL_WIND * speed or not wind > 0:
-        return []
-    return [f"the logs carry a wind (true wind {wind:.3g} m/s against the ship's {speed:.3g} "
-            "m/s, medians) but no term of the structure holds it: its gusts are lumped into the "
-            "others; add wind terms (+wind), or choose terms with shipid select"]
+        return None
+    return wind, speed
 
 
 def _check_rudder_excitation(logs, structure: ModelStructure, fixed: Mapping) -> None:

@@ -478,19 +478,31 @@ DEFAULT_LIBRARY = "low-speed+wind+propeller-asymmetry"
 
 def default_library(logs: Sequence[pd.DataFrame]) -> tuple[ModelStructure, str]:
     """``DEFAULT_LIBRARY`` less the terms that need a log column some log lacks (the wind of a
-    basin's logs, the propeller speed of a log without it), and a note saying which were left
-    out ('' when none): the library asked for by name refuses such logs instead."""
+    basin's logs, the propeller speed of a log without it) and the terms that are zero along
+    every log (astern propeller terms where the propeller never reverses), and a note saying
+    which were left out ('' when none): the library asked for by name refuses such logs instead.
+    A term the logs never excite has no coefficient to find; kept, it made every fit of the
+    library singular (condition number 5.7e14 on zig-zags at 8 and 12 rps)."""
     library = get_structure(DEFAULT_LIBRARY)
     missing = sorted({c for log in logs for c in library.inputs if c not in log.columns})
-    if not missing:
-        return library, ""
     drop = {d: [t for t in ts if set(parse_term(t).inputs) & set(missing)]
             for d, ts in library.terms.items()}  # fmt: skip
+    notes = []
+    if missing:
+        n = sum(len(ts) for ts in drop.values())
+        notes.append(f"the default library's {n} term(s) that need the log column(s) "
+                     f"{', '.join(missing)}, which these logs lack, are left out")
+    zero = sorted({t for d, ts in library.terms.items() for t in ts if t not in drop[d]
+                   and all(not np.any(log_terms(log, [t])) for log in logs)})  # fmt: skip
+    if zero:
+        for d, ts in library.terms.items():
+            drop[d] += [t for t in ts if t in zero]
+        notes.append(f"{', '.join(zero)} are zero along every log, which never excite them, "
+                     "and are left out")  # fmt: skip
+    if not notes:
+        return library, ""
     trimmed = library.without({d: ts for d, ts in drop.items() if ts})
-    n = sum(len(ts) for ts in drop.values())
-    return trimmed, (f"the default library's {n} term(s) that need the log column(s) "
-                     f"{', '.join(missing)}, which these logs lack, are left out (--library "
-                     "chooses the candidates)")  # fmt: skip
+    return trimmed, "; ".join(notes) + " (--library chooses the candidates)"
 
 
 def _setup(logs, names, options: SelectOptions):

@@ -58,7 +58,8 @@ def model_document(ident: Identification, training_files: Sequence[str | Path] =
                    plausibility: dict | None = None, model: ManoeuvringModel | None = None,
                    selection: dict | None = None, particulars: dict | None = None,
                    uncertainty: dict | None = None, error_band: dict | None = None,
-                   residual: dict | None = None) -> dict:  # fmt: skip
+                   residual: dict | None = None, structure_choice: dict | None = None
+                   ) -> dict:  # fmt: skip
     """The model file. ``model`` is the one users get (default: the refined model when there is a
     refinement, else the LS-SVM one); the LS-SVM model stays in ``refinement.initial_model`` and
     the refined one in ``refinement.refined_model``. ``residual``: the model's kernel residual
@@ -79,7 +80,8 @@ def model_document(ident: Identification, training_files: Sequence[str | Path] =
                            "warnings": ident.warnings, "preprocessing": preprocessing or {},
                            "envelope": ident.envelope,
                            "refinement": refinement.to_dict() if refinement else None,
-                           "plausibility": plausibility, "error_band": error_band},
+                           "plausibility": plausibility, "error_band": error_band,
+                           "structure_choice": structure_choice},
         "provenance": {"training_files": [{"path": str(p), "sha256": sha256(p)}
                                           for p in training_files]},
     })  # fmt: skip

@@ -1,0 +1,130 @@
+"""The structure ``identify`` fits when none is given (``--model auto``, the command line's default).
+
+The paper's ``blanke`` where it can represent the logs. Where they hold what it cannot (a
+propeller speed that varies, a thrust that varies where no rps is logged, a material wind), its
+constant surge term and its rudder force in δ alone lump those effects into the other terms: on
+the Esso Osaka's zig-zags and random runs (10 to 16.7 rps, astern, an outdoor pond) it diverges
+in both held-out 35° turns. There the structure is chosen from the logs:
+
+- a varying propeller speed: the terms ``select`` chooses from its default library (the
+  four-quadrant ``low-speed`` terms, ``wind`` and ``propeller-asymmetry``, less what the logs
+  lack) by free-run cross-validation on the logs (leave one log out; four blocks of a single
+  log), with its γ;
+- a varying thrust without rps: ``blanke-thrust``;
+- a material wind: ``+wind`` on the above.
+
+A fixed richer structure is not the remedy: fitted whole on the Esso logs, ``low-speed`` and
+``low-speed+wind`` diverge in the held-out turns when trained on the zig-zags alone, and
+``blanke-rps`` puts the turns' tactical diameters 17–51 % long; selection keeps what the logs
+determine (``benchmarks/README.md``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import pandas as pd
+
+from shipid.dynamics.model import ModelStructure, get_structure
+from shipid.errors import ShipidError
+from shipid.identification.identify import material_wind, varying_propulsion
+from shipid.identification.physics import PhysicsOptions
+
+AUTO = "auto"
+PAPER = "blanke"
+
+
+@dataclass
+class StructureChoice:
+    """What ``auto_structure`` chose, and why."""
+
+    structure: ModelStructure
+    how: str  # 'paper', 'named' (blanke-thrust, +wind) or 'select'
+    reasons: list[str] = field(default_factory=list)  # what the paper's structure cannot hold
+    gamma: float | None = None  # select's γ (None: the caller's)
+    library: str | None = None  # select's library
+    cv: str | None = None
+    score: float | None = None  # the chosen candidate's free-run CV score
+    candidates: int | None = None
+    notes: list[str] = field(default_factory=list)
+
+    def describe(self) -> str:
+        """One paragraph for the command line."""
+        n = sum(len(t) for t in self.structure.terms.values())
+        if self.how == "paper":
+            return (f"structure: {PAPER}, the paper's ({n} terms; --model auto finds nothing in "
+                    "the logs it cannot hold; --model to choose another)")
+        why = "; ".join(self.reasons)
+        if self.how == "named":
+            return (f"structure: {self.structure.name} ({n} terms), since {why}, which the "
+                    f"paper's {PAPER} does not hold (--model to choose another)"
+                    + "".join(f"; {note}" for note in self.notes))
+        return (f"structure: {n} terms chosen by shipid select from {self.library} (free-run "
+                f"cross-validation, {self.cv}; γ {self.gamma:g}, score {self.score:.4f} over "
+                f"{self.candidates} candidates), since {why}: the paper's {PAPER} cannot hold "
+                "that (--model to choose one; shipid select for the search's table, --average "
+                "and intervals over the choice)")
+
+    def to_dict(self) -> dict:
+        """The model file's record (``identification.structure_choice``)."""
+        return {"how": self.how, "reasons": list(self.reasons), "gamma": self.gamma,
+                "library": self.library, "cv": self.cv, "score": self.score,
+                "candidates": self.candidates, "notes": list(self.notes)}  # fmt: skip
+
+
+def auto_structure(logs: Sequence[pd.DataFrame], names: Sequence[str] | None = None,
+                   physics: PhysicsOptions | None = None, cv: str | None = None,
+                   estimator: str = "lssvm") -> StructureChoice:  # fmt: skip
+    """The structure for ``logs`` (see the module): ``blanke`` unless they hold a varying
+    propulsion input or a material wind. ``cv`` for the selection (default: leave one log out,
+    four blocks of a single log); ``physics`` goes into every fit of the search."""
+    logs = [logs] if isinstance(logs, pd.DataFrame) else list(logs)
+    varying = {found.signal: found for found in varying_propulsion(logs)}
+    wind = material_wind(logs)
+    reasons = [found.describe() for found in varying.values()]
+    if wind is not None:
+        reasons.append(f"the logs carry a wind ({wind[0]:.3g} m/s true against the ship's "
+                       f"{wind[1]:.3g} m/s, medians)")  # fmt: skip
+    if not reasons:
+        return StructureChoice(get_structure(PAPER), "paper")
+    if "n" not in varying:
+        name = ("blanke-thrust" if "thrust" in varying else PAPER) + ("+wind" if wind else "")
+        return StructureChoice(get_structure(name), "named", reasons)
+    from shipid.identification.select import (
+        DEFAULT_LIBRARY,
+        SelectOptions,
+        default_library,
+        select,
+    )
+
+    library, note = default_library(logs)
+    library_name = DEFAULT_LIBRARY + (" (less what the logs lack)" if note else "")
+    cv = cv or ("logo" if len(logs) >= 2 else "blocks:4")
+    fallback = "blanke-rps" + ("+wind" if wind else "")
+    try:
+        sel = select(logs, SelectOptions(library=None, cv=cv, physics=physics,
+                                         estimator=estimator), names=names)  # fmt: skip
+    except ShipidError as exc:  # too little data to hold logs out, say
+        return StructureChoice(get_structure(fallback), "named", reasons,
+                               notes=[f"select found no structure ({exc}); {fallback} instead"])
+    chosen_row = sel.candidates[sel.candidates["chosen"]]
+    why = None
+    if not bool(chosen_row["plausible"].all()):
+        why = (f"none of select's {len(sel.candidates)} candidates from its default library is "
+               "plausible")  # fmt: skip
+    elif not sel.score < 1.0:
+        why = (f"the best of select's {len(sel.candidates)} candidates predicts the held-out "
+               f"logs no better than their mean (score {sel.score:.3g})")  # fmt: skip
+    if why:
+        # The simplest structure that holds the inputs, checked as any fit is.
+        return StructureChoice(get_structure(fallback), "named", reasons,
+                               notes=[f"{why}; {fallback} instead"])  # fmt: skip
+    chosen = sel.chosen_model.structure
+    structure = ModelStructure(f"selected from {library_name}", chosen.terms)
+    return StructureChoice(structure, "select", reasons, gamma=float(sel.gamma),
+                           library=library_name, cv=cv, score=float(sel.score),
+                           candidates=len(sel.candidates), notes=[note] if note else [])
+
+
+__all__ = ["AUTO", "StructureChoice", "auto_structure"]
