@@ -1,8 +1,8 @@
 """`identify` without --model (`auto`): the paper's blanke where it can hold the logs, else a
 structure chosen for them. Before, plain `shipid identify` fitted blanke to whatever it was given:
-on the Esso Osaka's zig-zags and random runs (10 to 16.7 rps, astern, an outdoor pond) its
-model diverged in both held-out 35° turns, and trained on the three random runs alone it put
-their tactical diameters 635 % and 788 % long and turned the −35° turn the wrong way. The
+trained on the Esso Osaka's nine zig-zags and three random runs (10 to 16.7 rps, astern, an
+outdoor pond) it put the held-out 35° turns' tactical diameters 236 % and 154 % long, on the
+three random runs alone 635 % and 788 %, turning the −35° one the wrong way. The
 truths here: a simulated ship whose thrust is |n|n (a known structure), and the real turns."""
 
 import json
