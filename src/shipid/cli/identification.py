@@ -221,8 +221,10 @@ def _choose_structure(args, logs, names):
     """``--model auto``: the structure for the logs (``shipid.identification.auto_structure``),
     put into ``args.model``, and γ into ``args.gamma`` where none was given (select's, else
     1e4). Returns the choice (None for a given structure)."""
+    from shipid.identification.auto_structure import AUTO
+
     choice = None
-    if args.model == "auto":
+    if args.model == AUTO:
         from shipid.identification.auto_structure import auto_structure
         from shipid.identification.select import default_library
 
