@@ -28,11 +28,12 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
+import numpy as np
 import pandas as pd
 
 from shipid.dynamics.model import ModelStructure, get_structure
 from shipid.errors import ShipidError
-from shipid.identification.identify import material_wind, varying_propulsion
+from shipid.identification.identify import material_wind, varies, varying_propulsion
 from shipid.identification.physics import PhysicsOptions
 
 AUTO = "auto"
@@ -147,10 +148,6 @@ RACE_CANDIDATES = (PAPER, "blanke-speed", "blanke-race+race-damping")
 def _speed_varies_at_constant_rps(logs) -> tuple[float, float] | None:
     """(rps, speed range share) when every log has a constant positive propeller speed n and the
     speed varies by more than ``SPEED_VARIES``; else None."""
-    import numpy as np
-
-    from shipid.identification.identify import varies
-
     if not all("n" in log.columns for log in logs):
         return None
     n = np.concatenate([log["n"].to_numpy(dtype=float) for log in logs])
