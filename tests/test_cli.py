@@ -93,6 +93,23 @@ def test_a_manoeuvre_outside_the_training_envelope_is_reported(tmp_path, files, 
     assert code == 0 and "warning" not in err
 
 
+def test_a_propeller_speed_or_wind_the_model_cannot_take_is_named(tmp_path, files, capsys):
+    """The paper's blanke has no term in n or the wind: a manoeuvre "at 5 rps in a 3 m/s wind"
+    ran its training condition without a word."""
+    _, model = files
+    argv = ["manoeuvre", model, "zigzag", "--rudder", "20", "--duration", "60"]
+    code, _, plain = run(argv + ["--json", tmp_path / "a.json"], capsys)
+    code, _, err = run(argv + ["--rps", "5", "--wind-speed", "3", "--json", tmp_path / "b.json"],
+                       capsys)  # fmt: skip
+    assert code == 0 and "changes nothing" not in plain
+    assert "--rps 5 changes nothing: the model (blanke) has no term in the propeller speed" in err
+    assert "--wind-speed 3 changes nothing" in err
+    a, b = (json.loads((tmp_path / f).read_text()) for f in ("a.json", "b.json"))
+    assert a["indices"] == b["indices"]  # as said: the same run
+    code, _, err = run(["criteria", model, "--length", "4.5", "--rps", "5", "--no-bands"], capsys)
+    assert "--rps 5 changes nothing" in err
+
+
 def test_implausible_turning_indices_are_named():
     notes = implausible_indices({"steady_speed": 0.047, "tactical_diameter": 1.1}, 0.35, 3.0)
     assert len(notes) == 2 and "implausible" in notes[0] and "one ship length" in notes[1]

@@ -309,6 +309,30 @@ def _run_approach(target, cond: dict, speed: float | None, rps: float | None):
     return app.speed, app.rps, app.warning
 
 
+def _unused_inputs(target, args) -> list[str]:
+    """Warnings for --rps, --astern-rps and --wind-speed given to a model without a term in the
+    propeller speed or the wind: the run takes them and nothing changes (a manoeuvre "at 5 rps"
+    of the paper's blanke model was its training condition, without a word)."""
+    from shipid.dynamics.hybrid import HybridModel
+    from shipid.dynamics.model import ManoeuvringModel
+
+    if not isinstance(target, ManoeuvringModel | HybridModel):
+        return []
+    inputs = set(target.structure.inputs)
+    name = target.structure.name
+    notes = []
+    for option, value in (("--rps", getattr(args, "rps", None)),
+                          ("--astern-rps", getattr(args, "astern_rps", None))):  # fmt: skip
+        if value is not None and "n" not in inputs:
+            notes.append(f"{option} {value:g} changes nothing: the model ({name}) has no term in "
+                         "the propeller speed n; its condition is set by --speed")  # fmt: skip
+    wind = getattr(args, "wind_speed", None)
+    if wind and not target.uses_wind:
+        notes.append(f"--wind-speed {wind:g} changes nothing: the model ({name}) has no wind "
+                     "terms")  # fmt: skip
+    return notes
+
+
 def _steering(target, cond: dict, rate_deg_s: float | None, fallback: str = "instantaneous"):
     """The steering machine of a run and a line saying which: ``--rudder-rate`` (a reference
     ship keeps its gear's other limits), else a reference ship's own gear (None: the ship's),

@@ -7,7 +7,15 @@ import sys
 from functools import partial
 from pathlib import Path
 
-from shipid.cli.common import _json_text, _pd, _run_approach, _ship_or_model, _steering, _warn
+from shipid.cli.common import (
+    _json_text,
+    _pd,
+    _run_approach,
+    _ship_or_model,
+    _steering,
+    _unused_inputs,
+    _warn,
+)
 from shipid.errors import ShipidError
 
 
@@ -29,6 +37,7 @@ def cmd_criteria(args) -> int:
                   scale=args.scale, rps=rps, steering=steering, astern_rps=args.astern_rps,
                   dt=args.dt)  # fmt: skip
     crit = run(target)
+    crit.notes += _unused_inputs(target, args)
     from shipid.evaluation.validate import faded_residual_notes
 
     crit.notes += [f"{name}: {note}" for name, res in crit.runs.items()
@@ -128,7 +137,8 @@ def cmd_manoeuvre(args) -> int:
                  "them diverged or lack it)" if diverged else "") + ":")
     if res.diverged:
         print(res.reason, file=sys.stderr)
-    notes = ([unsteady] if unsteady else []) + outside_envelope(cond["envelope"], res.log)
+    notes = ([unsteady] if unsteady else []) + _unused_inputs(target, args)
+    notes += outside_envelope(cond["envelope"], res.log)
     notes += faded_residual_notes(target, res.log)
     if res.incomplete and not res.diverged:
         notes.append(f"{res.incomplete}: indices that need it are missing or those of a "
