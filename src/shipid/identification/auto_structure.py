@@ -25,13 +25,14 @@ do in one (README, *The default structure*).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
 
 from shipid.dynamics.model import ModelStructure, get_structure
+from shipid.dynamics.terms import parse_term
 from shipid.errors import ShipidError
 from shipid.identification.identify import material_wind, varies, varying_propulsion
 from shipid.identification.physics import PhysicsOptions
@@ -84,12 +85,35 @@ class StructureChoice:
                 "candidates": self.candidates, "notes": list(self.notes)}  # fmt: skip
 
 
+def _without(structure: ModelStructure, drop: Mapping[str, Sequence[str]] | None
+             ) -> ModelStructure:  # fmt: skip
+    """``structure`` less those of the ``drop`` terms it has (a term it lacks is not an error
+    here: the user's drop says which terms never to use, whichever structure is chosen)."""
+    if not drop:
+        return structure
+    present = {}
+    for dof, names in drop.items():
+        have = structure.terms.get(dof, ())
+        kept = [n for n in names if parse_term(n).text in have]
+        if kept:
+            present[dof] = kept
+    return structure.without(present) if present else structure
+
+
 def auto_structure(logs: Sequence[pd.DataFrame], names: Sequence[str] | None = None,
                    physics: PhysicsOptions | None = None, cv: str | None = None,
-                   estimator: str = "lssvm") -> StructureChoice:  # fmt: skip
+                   estimator: str = "lssvm", drop: Mapping[str, Sequence[str]] | None = None
+                   ) -> StructureChoice:  # fmt: skip
     """The structure for ``logs`` (see the module): ``blanke`` unless they hold a varying
     propulsion input or a material wind. ``cv`` for the selection (default: leave one log out,
-    four blocks of a single log); ``physics`` goes into every fit of the search."""
+    four blocks of a single log); ``physics`` goes into every fit of the search; the ``drop``
+    terms (e.g. ``{"u": ["r^2"]}``) are left out of every candidate, and of the choice."""
+    choice = _auto_structure(logs, names, physics, cv, estimator, drop)
+    choice.structure = _without(choice.structure, drop)
+    return choice
+
+
+def _auto_structure(logs, names, physics, cv, estimator, drop) -> StructureChoice:
     logs = [logs] if isinstance(logs, pd.DataFrame) else list(logs)
     varying = {found.signal: found for found in varying_propulsion(logs)}
     wind = material_wind(logs)
@@ -98,7 +122,7 @@ def auto_structure(logs: Sequence[pd.DataFrame], names: Sequence[str] | None = N
         reasons.append(f"the logs carry a wind ({wind[0]:.3g} m/s true against the ship's "
                        f"{wind[1]:.3g} m/s, medians)")  # fmt: skip
     if not reasons:
-        return _paper_or_race(logs, names, physics, cv, estimator)
+        return _paper_or_race(logs, names, physics, cv, estimator, drop)
     if "n" not in varying:
         name = ("blanke-thrust" if "thrust" in varying else PAPER) + ("+wind" if wind else "")
         return StructureChoice(get_structure(name), "named", reasons)
@@ -114,7 +138,10 @@ def auto_structure(logs: Sequence[pd.DataFrame], names: Sequence[str] | None = N
     cv = cv or ("logo" if len(logs) >= 2 else "blocks:4")
     fallback = "blanke-rps" + ("+wind" if wind else "")
     try:
-        sel = select(logs, SelectOptions(library=None, cv=cv, physics=physics,
+        # The default library is passed as None (select trims it and says so) unless terms
+        # are dropped from it.
+        given = _without(library, drop) if drop else None
+        sel = select(logs, SelectOptions(library=given, cv=cv, physics=physics,
                                          estimator=estimator), names=names)  # fmt: skip
     except ShipidError as exc:  # too little data to hold logs out, say
         return StructureChoice(get_structure(fallback), "named", reasons,
@@ -159,7 +186,7 @@ def _speed_varies_at_constant_rps(logs) -> tuple[float, float] | None:
     return (float(np.nanmedian(n)), share) if share > SPEED_VARIES else None
 
 
-def _paper_or_race(logs, names, physics, cv, estimator) -> StructureChoice:
+def _paper_or_race(logs, names, physics, cv, estimator, drop=None) -> StructureChoice:
     """``blanke``, unless the logs are run at a constant propeller speed while their speed
     varies: the paper's rudder force in δ holds at one speed, ``blanke-speed``'s u²δ where the
     rudder sees the ship's speed, ``blanke-race+race-damping`` where it sees the propeller's race
@@ -178,8 +205,9 @@ def _paper_or_race(logs, names, physics, cv, estimator) -> StructureChoice:
     scores = {}
     for name in RACE_CANDIDATES:
         try:
-            sel = select(logs, library=name, search="none", cv=cv, gammas=(1e4,),
-                         physics=physics, estimator=estimator, names=names)  # fmt: skip
+            sel = select(logs, library=_without(get_structure(name), drop), search="none",
+                         cv=cv, gammas=(1e4,), physics=physics, estimator=estimator,
+                         names=names)  # fmt: skip
         except ShipidError:
             continue
         row = sel.candidates.iloc[0]
