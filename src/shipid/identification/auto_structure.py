@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from shipid.dynamics.model import ModelStructure, get_structure
+from shipid.dynamics.model import DOFS, ModelStructure, get_structure
 from shipid.dynamics.terms import parse_term
 from shipid.errors import ShipidError
 from shipid.identification.identify import material_wind, varies, varying_propulsion
@@ -93,8 +93,14 @@ def _without(structure: ModelStructure, drop: Mapping[str, Sequence[str]] | None
         return structure
     present = {}
     for dof, names in drop.items():
+        if dof not in DOFS:
+            raise ShipidError(f"cannot drop terms of {dof!r}: the equations are u, v and r")
+        try:
+            canon = [parse_term(n).text for n in names]
+        except ShipidError as exc:
+            raise ShipidError(f"cannot drop {list(names)} from the {dof} equation: {exc}") from None
         have = structure.terms.get(dof, ())
-        kept = [n for n in names if parse_term(n).text in have]
+        kept = [n for n, c in zip(names, canon, strict=True) if c in have]
         if kept:
             present[dof] = kept
     return structure.without(present) if present else structure
