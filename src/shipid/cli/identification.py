@@ -231,8 +231,11 @@ def _choose_structure(args, logs, names):
         # The search fits with the same physics, as select does: a prior over its library.
         physics = _physics(args, logs, default_library(logs)[0])
         choice = auto_structure(logs, names, physics, args.cv, args.estimator,
-                                _parse_drop(args.drop))  # fmt: skip
+                                _parse_drop(args.drop),
+                                announce=lambda m: print(m, file=sys.stderr))  # fmt: skip
         print(choice.describe())
+        for w in choice.warnings:
+            _warn(f"structure: {w}")
         args.model, args.drop = choice.structure, None  # the drop is in the structure
     if args.gamma is None:
         args.gamma = choice.gamma if choice is not None and choice.gamma else 1e4

@@ -25,7 +25,7 @@ do in one (README, *The default structure*).
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -54,6 +54,7 @@ class StructureChoice:
     score: float | None = None  # the chosen candidate's free-run CV score
     candidates: int | None = None
     notes: list[str] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)  # the search's (few folds, say)
 
     def describe(self) -> str:
         """One paragraph for the command line."""
@@ -82,7 +83,8 @@ class StructureChoice:
         """The model file's record (``identification.structure_choice``)."""
         return {"how": self.how, "reasons": list(self.reasons), "gamma": self.gamma,
                 "library": self.library, "cv": self.cv, "score": self.score,
-                "candidates": self.candidates, "notes": list(self.notes)}  # fmt: skip
+                "candidates": self.candidates, "notes": list(self.notes),
+                "warnings": list(self.warnings)}  # fmt: skip
 
 
 def _without(structure: ModelStructure, drop: Mapping[str, Sequence[str]] | None
@@ -108,18 +110,23 @@ def _without(structure: ModelStructure, drop: Mapping[str, Sequence[str]] | None
 
 def auto_structure(logs: Sequence[pd.DataFrame], names: Sequence[str] | None = None,
                    physics: PhysicsOptions | None = None, cv: str | None = None,
-                   estimator: str = "lssvm", drop: Mapping[str, Sequence[str]] | None = None
-                   ) -> StructureChoice:  # fmt: skip
+                   estimator: str = "lssvm", drop: Mapping[str, Sequence[str]] | None = None,
+                   announce: Callable[[str], None] | None = None) -> StructureChoice:  # fmt: skip
     """The structure for ``logs`` (see the module): ``blanke`` unless they hold a varying
     propulsion input or a material wind. ``cv`` for the selection (default: leave one log out,
     four blocks of a single log); ``physics`` goes into every fit of the search; the ``drop``
-    terms (e.g. ``{"u": ["r^2"]}``) are left out of every candidate, and of the choice."""
-    choice = _auto_structure(logs, names, physics, cv, estimator, drop)
+    terms (e.g. ``{"u": ["r^2"]}``) are left out of every candidate, and of the choice;
+    ``announce`` is told before a search starts (it takes seconds where a fit takes less)."""
+    choice = _auto_structure(logs, names, physics, cv, estimator, drop, announce or _quiet)
     choice.structure = _without(choice.structure, drop)
     return choice
 
 
-def _auto_structure(logs, names, physics, cv, estimator, drop) -> StructureChoice:
+def _quiet(message: str) -> None:
+    """The default ``announce``: say nothing."""
+
+
+def _auto_structure(logs, names, physics, cv, estimator, drop, announce) -> StructureChoice:
     logs = [logs] if isinstance(logs, pd.DataFrame) else list(logs)
     varying = {found.signal: found for found in varying_propulsion(logs)}
     wind = material_wind(logs)
@@ -128,7 +135,7 @@ def _auto_structure(logs, names, physics, cv, estimator, drop) -> StructureChoic
         reasons.append(f"the logs carry a wind ({wind[0]:.3g} m/s true against the ship's "
                        f"{wind[1]:.3g} m/s, medians)")  # fmt: skip
     if not reasons:
-        return _paper_or_race(logs, names, physics, cv, estimator, drop)
+        return _paper_or_race(logs, names, physics, cv, estimator, drop, announce)
     if "n" not in varying:
         name = ("blanke-thrust" if "thrust" in varying else PAPER) + ("+wind" if wind else "")
         return StructureChoice(get_structure(name), "named", reasons)
@@ -147,6 +154,7 @@ def _auto_structure(logs, names, physics, cv, estimator, drop) -> StructureChoic
         # The default library is passed as None (select trims it and says so) unless terms
         # are dropped from it.
         given = _without(library, drop) if drop else None
+        announce(f"choosing the terms from {library_name} by free-run cross-validation ({cv})…")
         sel = select(logs, SelectOptions(library=given, cv=cv, physics=physics,
                                          estimator=estimator), names=names)  # fmt: skip
     except ShipidError as exc:  # too little data to hold logs out, say
@@ -168,7 +176,8 @@ def _auto_structure(logs, names, physics, cv, estimator, drop) -> StructureChoic
     structure = ModelStructure(f"selected from {library_name}", chosen.terms)
     return StructureChoice(structure, "select", reasons, gamma=float(sel.gamma),
                            library=library_name, cv=cv, score=float(sel.score),
-                           candidates=len(sel.candidates), notes=[note] if note else [])
+                           candidates=len(sel.candidates), notes=[note] if note else [],
+                           warnings=list(sel.warnings))  # fmt: skip
 
 
 # A rudder behind a propeller at constant rps in logs whose speed varies by more than this share
@@ -192,7 +201,8 @@ def _speed_varies_at_constant_rps(logs) -> tuple[float, float] | None:
     return (float(np.nanmedian(n)), share) if share > SPEED_VARIES else None
 
 
-def _paper_or_race(logs, names, physics, cv, estimator, drop=None) -> StructureChoice:
+def _paper_or_race(logs, names, physics, cv, estimator, drop=None, announce=_quiet
+                   ) -> StructureChoice:  # fmt: skip
     """``blanke``, unless the logs are run at a constant propeller speed while their speed
     varies: the paper's rudder force in δ holds at one speed, ``blanke-speed``'s u²δ where the
     rudder sees the ship's speed, ``blanke-race+race-damping`` where it sees the propeller's race
@@ -208,6 +218,7 @@ def _paper_or_race(logs, names, physics, cv, estimator, drop=None) -> StructureC
     from shipid.identification.select import select
 
     cv = cv or ("logo" if len(logs) >= 2 else "blocks:4")
+    announce(f"comparing {', '.join(RACE_CANDIDATES)} by free-run cross-validation ({cv})…")
     scores = {}
     for name in RACE_CANDIDATES:
         try:
