@@ -124,6 +124,8 @@ def test_plain_identify_predicts_the_esso_turns_it_never_saw(tmp_path, capsys):
     code, out, err = run(["identify", *train, *args, "-o", tmp_path / "esso.json"], capsys)
     assert code == 0, err
     assert "chosen by shipid select" in out
+    assert "choosing the terms from" in err  # the search is announced: it takes seconds
+    assert "warning: structure: only 3 folds" in err  # and its weakness said
     ident = json.loads((tmp_path / "esso.json").read_text())["identification"]
     assert ident["structure_choice"]["how"] == "select"
     assert ident["gamma"] == ident["structure_choice"]["gamma"]  # select's γ
