@@ -186,22 +186,31 @@ class ModelStructure:
         """Whether a term needs the relative wind columns."""
         return any(s in self.inputs for s in ("wind_speed", "wind_angle"))
 
-    def without(self, drop: Mapping[str, tuple[str, ...] | list[str]]) -> ModelStructure:
-        """The structure with some terms dropped, e.g. ``{"u": ["r^2"]}`` as in the paper."""
+    def without(self, drop: Mapping[str, tuple[str, ...] | list[str]],
+                missing_ok: bool = False) -> ModelStructure:  # fmt: skip
+        """The structure with some terms dropped, e.g. ``{"u": ["r^2"]}`` as in the paper.
+        ``missing_ok``: a term (or equation) the structure lacks is passed over instead of
+        refused, as when the same drop applies to whichever structure is chosen; a term that
+        does not parse, or of no equation, is refused either way."""
         terms = dict(self.terms)
+        dropped = {}
         for dof, names in drop.items():
-            if dof not in terms:
+            if dof not in terms and (not missing_ok or dof not in DOFS):
                 raise ShipidError(f"cannot drop terms of {dof!r}: {self.name} has no {dof} equation")
             try:
                 canon = [parse_term(n).text for n in names]
             except ShipidError as exc:
                 raise ShipidError(f"cannot drop {list(names)} from the {dof} equation: {exc}") from None
-            missing = [n for n, c in zip(names, canon, strict=True) if c not in terms[dof]]
-            if missing:
+            have = terms.get(dof, ())
+            missing = [n for n, c in zip(names, canon, strict=True) if c not in have]
+            if missing and not missing_ok:
                 raise ShipidError(f"cannot drop {missing} from the {dof} equation of "
                                   f"{self.name}: it has {list(terms[dof])}")
-            terms[dof] = tuple(n for n in terms[dof] if n not in canon)
-        suffix = ",".join(f"{d}-{'-'.join(n)}" for d, n in drop.items() if n)
+            gone = [n for n, c in zip(names, canon, strict=True) if c in have]
+            if gone:
+                terms[dof] = tuple(n for n in have if n not in canon)
+                dropped[dof] = gone
+        suffix = ",".join(f"{d}-{'-'.join(n)}" for d, n in dropped.items() if n)
         return ModelStructure(f"{self.name}[drop {suffix}]" if suffix else self.name, terms)
 
     def __add__(self, other: ModelStructure) -> ModelStructure:

@@ -31,8 +31,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from shipid.dynamics.model import DOFS, ModelStructure, get_structure
-from shipid.dynamics.terms import parse_term
+from shipid.dynamics.model import ModelStructure, get_structure
 from shipid.errors import ShipidError
 from shipid.identification.identify import material_wind, varies, varying_propulsion
 from shipid.identification.physics import PhysicsOptions
@@ -89,23 +88,9 @@ class StructureChoice:
 
 def _without(structure: ModelStructure, drop: Mapping[str, Sequence[str]] | None
              ) -> ModelStructure:  # fmt: skip
-    """``structure`` less those of the ``drop`` terms it has (a term it lacks is not an error
-    here: the user's drop says which terms never to use, whichever structure is chosen)."""
-    if not drop:
-        return structure
-    present = {}
-    for dof, names in drop.items():
-        if dof not in DOFS:
-            raise ShipidError(f"cannot drop terms of {dof!r}: the equations are u, v and r")
-        try:
-            canon = [parse_term(n).text for n in names]
-        except ShipidError as exc:
-            raise ShipidError(f"cannot drop {list(names)} from the {dof} equation: {exc}") from None
-        have = structure.terms.get(dof, ())
-        kept = [n for n, c in zip(names, canon, strict=True) if c in have]
-        if kept:
-            present[dof] = kept
-    return structure.without(present) if present else structure
+    """``structure`` less those of the ``drop`` terms it has: the user's drop says which terms
+    never to use, whichever structure is chosen."""
+    return structure.without(drop, missing_ok=True) if drop else structure
 
 
 def auto_structure(logs: Sequence[pd.DataFrame], names: Sequence[str] | None = None,
