@@ -33,7 +33,7 @@ import pandas as pd
 
 from shipid.dynamics.model import ModelStructure, get_structure
 from shipid.errors import ShipidError
-from shipid.identification.identify import material_wind, varies, varying_propulsion
+from shipid.identification.identify import material_wind, spread, varies, varying_propulsion
 from shipid.identification.physics import PhysicsOptions
 
 AUTO = "auto"
@@ -178,11 +178,9 @@ def _speed_varies_at_constant_rps(logs) -> tuple[float, float] | None:
     if not all("n" in log.columns for log in logs):
         return None
     n = np.concatenate([log["n"].to_numpy(dtype=float) for log in logs])
-    u = np.concatenate([log["u"].to_numpy(dtype=float) for log in logs])
     if varies(n) or not np.nanmedian(n) > 0:
         return None
-    lo, hi = np.nanpercentile(u, [5, 95])
-    share = float((hi - lo) / np.nanpercentile(np.abs(u), 95))
+    share = spread(np.concatenate([log["u"].to_numpy(dtype=float) for log in logs]))
     return (float(np.nanmedian(n)), share) if share > SPEED_VARIES else None
 
 

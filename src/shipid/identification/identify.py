@@ -177,16 +177,21 @@ _PROPULSION_INPUTS = (("n", "the propeller speed n", "rps", "--model blanke-rps 
                       ("thrust", "the thrust T", "N", "--model blanke-thrust"))  # fmt: skip
 
 
-def varies(values: np.ndarray) -> bool:
-    """Whether an input's 5–95 % range exceeds ``VARYING_INPUT`` of its typical magnitude
-    (non-finite samples ignored)."""
+def spread(values: np.ndarray) -> float:
+    """A signal's 5–95 % range over its typical magnitude (the 95th percentile of |x|); 0 for
+    a signal that is zero or has no finite sample."""
     values = np.asarray(values, dtype=float)
     values = values[np.isfinite(values)]
     if values.size == 0:
-        return False
+        return 0.0
     lo, hi = np.percentile(values, [5, 95])
     typical = float(np.percentile(np.abs(values), 95))
-    return typical > 0 and hi - lo > VARYING_INPUT * typical
+    return float(hi - lo) / typical if typical > 0 else 0.0
+
+
+def varies(values: np.ndarray) -> bool:
+    """Whether an input's ``spread`` exceeds ``VARYING_INPUT`` (non-finite samples ignored)."""
+    return spread(values) > VARYING_INPUT
 
 
 @dataclass(frozen=True)
