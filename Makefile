@@ -39,6 +39,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/study_selection_uncertainty.py
 	$(BIN)/python benchmarks/study_kvlcc2_average.py
 	$(BIN)/python benchmarks/study_auto_structure.py
+	$(BIN)/python benchmarks/study_sampling.py
 
 clean:
 	rm -rf $(VENV) shipid-demo build *.egg-info src/*.egg-info

@@ -16,22 +16,23 @@ ZIGZAGS = {"13_04_24": (20, 16.7), "13_14_21": (30, 16.7), "13_22_52": (15, 10),
 README_HELD = "31-Jul-2020_12_29_58"
 
 
-def read(path: Path, trim: bool):
+def read(path: Path, trim: bool, dt: float | None = 0.5):
     """One log, as ``shipid import --format osaka-frt`` with ``--start auto --end auto`` (the
-    zig-zags and turns) or ``--end dropout`` (the random runs), and ``--dt 0.5`` give it."""
+    zig-zags and turns) or ``--end dropout`` (the random runs), and ``--dt 0.5`` give it (``dt``
+    None: the logs' own 0.1 s)."""
     kw = {"start": "auto", "end": "auto"} if trim else {"end": "dropout"}
-    return read_log(path, fmt="osaka-frt", dt=0.5, **kw)
+    return read_log(path, fmt="osaka-frt", dt=dt, **kw)
 
 
-def esso_logs():
+def esso_logs(dt: float | None = 0.5):
     """(zig-zags by time of day, random runs by date and time, the two turns), or None (and a
     line saying so) when ``../shared/data`` is absent."""
     if not DATA.is_dir():
         print("../shared/data is absent")
         return None
-    zz = {p.stem[-8:]: read(p, True) for p in sorted((DATA / "zigzag").glob("*.csv"))}
-    rnd = {p.stem[7:]: read(p, False) for p in sorted((DATA / "random").glob("*.csv"))}
-    turns = [read(p, True) for p in sorted((DATA / "turning").glob("*.csv"))]
+    zz = {p.stem[-8:]: read(p, True, dt) for p in sorted((DATA / "zigzag").glob("*.csv"))}
+    rnd = {p.stem[7:]: read(p, False, dt) for p in sorted((DATA / "random").glob("*.csv"))}
+    turns = [read(p, True, dt) for p in sorted((DATA / "turning").glob("*.csv"))]
     return zz, rnd, turns
 
 

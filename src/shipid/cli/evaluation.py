@@ -196,7 +196,7 @@ def _criteria_of_logs(good, logs, vals, particulars):
         if not speed > 0:
             continue
         meas = v.indices.get("measured", {})
-        pred = v.indices.get("closed_loop") if v.kind == "zigzag" else v.indices.get("simulated")
+        pred = v.indices.get("closed_loop") or v.indices.get("simulated")
         args = (rudder, meas.get("switch_heading_deg"), particulars.length, speed, particulars.scale)
         m_rows = measured_criteria(meas, *args)
         p_rows = {r["criterion"]: r for r in measured_criteria({**(pred or {}), "kind": v.kind},

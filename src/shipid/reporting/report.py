@@ -10,7 +10,7 @@ import pandas as pd
 
 from shipid.evaluation.validate import Validation
 
-INDEX_KEYS = ("first_overshoot_deg", "second_overshoot_deg", "initial_turning_time",
+INDEX_KEYS = ("approach_speed", "first_overshoot_deg", "second_overshoot_deg", "initial_turning_time",
               "advance", "transfer", "tactical_diameter", "steady_turning_diameter",
               "steady_yaw_rate")  # fmt: skip
 
@@ -39,8 +39,8 @@ def _fmt(x) -> str:
 
 
 def indices_table(validations: Sequence[Validation]) -> str:
-    """Indices measured, from the open-loop replay ("simulated") and, for zig-zags, from the
-    manoeuvre run closed loop on the model ("closed loop", see ``validate.trial_zigzag``)."""
+    """Indices measured, from the open-loop replay ("simulated") and from the manoeuvre run
+    closed loop on the model ("closed loop", see ``validate.trial_replica``)."""
     lines = ["| log | index | measured | simulated (replay) | closed loop |", "|---|---|---|---|---|"]
     for v in validations:
         meas, sim = v.indices.get("measured", {}), v.indices.get("simulated", {})

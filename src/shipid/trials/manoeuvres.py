@@ -382,17 +382,20 @@ def turning_circle(
     method: str = "rk4",
     rps: float | None = None,
     wind: tuple[float, float] | None = None,
+    initial: Mapping[str, float] | None = None,
 ) -> ManoeuvreResult:
     """Turning circle: rudder to ``side`` at t = ``approach`` (the rudder execute), held.
     ``duration`` [s]: by default 240 s, doubled until the heading has turned 180° and the turn is
-    steady."""
+    steady. ``initial`` (u, v, r, psi, delta) starts the run from a given state, the rudder held
+    at its ``delta`` until ``approach`` (as ``zigzag``'s)."""
     vessel = as_vessel(ship, speed, steering, rps)
     value = _rudder_to(side, vessel, rudder_deg)
-    params = manoeuvre_params(vessel, kernel.MODE_HOLD, value, 0.0, approach, rps=rps,
+    held = float((initial or {}).get("delta", 0.0))
+    params = manoeuvre_params(vessel, kernel.MODE_HOLD, value, held, approach, rps=rps,
                               wind=_check_wind(wind))  # fmt: skip
 
     def run(length: float) -> ManoeuvreResult:
-        res = run_closed_loop(vessel, params, length, dt, method, rps=rps)
+        res = run_closed_loop(vessel, params, length, dt, method, initial=initial, rps=rps)
         res.log.attrs["manoeuvre"] = f"turning circle {rudder_deg:g}° to {side}"
         if not res.diverged:
             res.indices = turning_indices(res.log, t_order=approach,

@@ -1,0 +1,78 @@
+"""`validate` runs a turning log's turn on the model as `shipid manoeuvre turning` runs it (issue
+#10): from the model's own steady straight speed at the log's propeller speed. Its replay starts
+from the measured state, so a model whose surge balances at the wrong speed was never caught:
+trained on the Esso Osaka's zig-zags and random runs at their Δk of 0.1 s, the README's terms
+reach 0.52 m/s at 10 rps, where the ship's 35° turns approach at 0.35 m/s."""
+
+import math
+
+import numpy as np
+import pytest
+from test_equilibrium import A_UU, B_NN, PROPELLED, steady
+
+from shipid.dynamics.model import ManoeuvringModel
+from shipid.evaluation.validate import steady_log_approach, validate
+from shipid.trials.manoeuvres import turning_circle
+from shipid.trials.trial import describe_trial
+
+RPS = 10.0
+
+
+def turning_log(side: str, held: float = 0.0, speed: float | None = None):
+    """A 35° turn of ``PROPELLED`` at 10 rps, 10 s of approach with the rudder held at
+    ``held`` [rad], from ``speed`` (default: its steady speed)."""
+    res = turning_circle(PROPELLED, 35.0, side, duration=150.0, dt=0.1, approach=10.0,
+                         speed=speed or steady(RPS), rps=RPS, method="euler",
+                         initial={"delta": held})  # fmt: skip
+    log = res.log.copy()
+    log["n"] = RPS
+    return log
+
+
+def with_thrust(factor: float) -> ManoeuvringModel:
+    coefficients = {d: dict(c) for d, c in PROPELLED.coefficients.items()}
+    coefficients["u"]["pos(n)^2"] = factor * B_NN
+    return ManoeuvringModel(PROPELLED.structure, coefficients)
+
+
+@pytest.mark.parametrize("side", ["starboard", "port"])
+@pytest.mark.parametrize("held", [0.04, -0.04])
+def test_the_true_model_predicts_its_own_turn_closed_loop(side, held):
+    log = turning_log(side, held)
+    (v,) = validate(PROPELLED, log)
+    measured, closed = v.indices["measured"], v.indices["closed_loop"]
+    assert v.kind == "turning"
+    assert measured["approach_speed"] == pytest.approx(steady(RPS), rel=1e-6)
+    assert closed["approach_speed"] == pytest.approx(steady(RPS), rel=1e-6)
+    # The turn's side: a held approach rudder on either side (the Esso's rests at 2°, then goes
+    # to 35°) once put the closed loop on the other side.
+    assert np.sign(closed["steady_yaw_rate"]) == np.sign(measured["steady_yaw_rate"])
+    for k in ("advance", "transfer", "tactical_diameter", "steady_yaw_rate"):
+        assert closed[k] == pytest.approx(measured[k], rel=0.01), k
+    assert not any("steady straight speed" in w for w in v.warnings)
+
+
+def test_a_model_that_runs_too_fast_at_the_rps_is_named_and_turns_from_its_own_speed():
+    log = turning_log("starboard")
+    fast = with_thrust(2.25)  # u = n √(−b/a): 1.5 times the speed
+    (v,) = validate(fast, log)
+    own = RPS * math.sqrt(-2.25 * B_NN / A_UU)
+    assert v.indices["closed_loop"]["approach_speed"] == pytest.approx(own, rel=1e-3)
+    assert v.indices["measured"]["approach_speed"] == pytest.approx(own / 1.5, rel=1e-6)
+    (warning,) = [w for w in v.warnings if "steady straight speed" in w]
+    assert "+50 %" in warning and f"{own:.4g} m/s" in warning
+    # The replay starts from the measured state; the closed loop from the model's approach, so
+    # it goes further before the turn settles.
+    replay, closed = v.indices["simulated"], v.indices["closed_loop"]
+    assert closed["advance"] > replay["advance"] * 1.05
+
+
+def test_a_log_that_approaches_accelerating_is_replayed_from_its_own_state():
+    log = turning_log("starboard", speed=0.6 * steady(RPS))
+    trial = describe_trial(log, "turning")
+    assert steady_log_approach(log, trial) is None
+    (v,) = validate(with_thrust(2.25), log)
+    # No steady approach to compare with: the closed loop starts where the log does.
+    assert v.indices["closed_loop"]["approach_speed"] == pytest.approx(log["u"].iloc[0])
+    assert v.indices["measured"]["approach_speed"] == pytest.approx(log["u"].iloc[0])
+    assert not any("steady straight speed" in w for w in v.warnings)
