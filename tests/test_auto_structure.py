@@ -137,8 +137,15 @@ def test_plain_identify_predicts_the_esso_turns_it_never_saw(tmp_path, capsys):
         measured, simulated = v.indices["measured"], v.indices["simulated"]
         td = simulated["tactical_diameter"] / measured["tactical_diameter"] - 1
         r = simulated["steady_yaw_rate"] / measured["steady_yaw_rate"] - 1
-        # Measured 2026-11-24: tactical diameters −1 % and +4 %, steady yaw rates +7 % and +1 %.
+        # Measured 2026-11-24: tactical diameters +12 % and +6 %, steady yaw rates −3 % and +2 %
+        # (without the library's astern terms: −1 %, +4 %; +7 %, +1 %).
         assert abs(td) < 0.15 and abs(r) < 0.15, (td, r)
+    # The random run left out, a third of it astern: r error 0.33 of its spread (0.39 without
+    # the astern terms).
+    held = read_log(DATA / "random" / "random_31-Jul-2020_12_29_58.csv", fmt="osaka-frt",
+                    end="dropout", dt=0.5)  # fmt: skip
+    (v,) = validate(model, [held])
+    assert v.metrics["r"]["std"] / held["r"].std(ddof=0) < 0.36
 
 
 KVLCC2 = DATA.parent / "kvlcc2-marin" / "MARIN_FREE_KVLCC2_zz_20_m.dat"

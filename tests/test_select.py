@@ -231,7 +231,8 @@ def test_the_default_library_leaves_out_what_the_logs_cannot_give(tmp_path, caps
     logs = noisy_zigzags(5)
     for log in logs:
         log["n"] = 12.0
-        log.loc[log.index[-5:], "n"] = -4.0  # a moment astern: the astern terms are excited
+        # A moment astern, propeller and ship: the astern terms are excited.
+        log.loc[log.index[-5:], ["n", "u"]] = [-4.0, -0.05]
     library, note = default_library(logs)
     full = get_structure(DEFAULT_LIBRARY)
     dropped = {t for d in full.terms for t in full.terms[d]} - set(library.all_terms)
@@ -246,6 +247,12 @@ def test_the_default_library_leaves_out_what_the_logs_cannot_give(tmp_path, caps
     zero = set(full.all_terms) - set(trimmed.all_terms)
     assert zero and all(t.startswith("neg(n)") for t in zero)
     assert "zero along every log" in note
+    # Nor the ship: the hull's astern terms go too.
+    forward = [log.assign(u=log["u"].abs()) for log in ahead]
+    trimmed, note = default_library(forward)
+    zero = set(full.all_terms) - set(trimmed.all_terms)
+    assert {"neg(u)^2", "neg(u)*v", "neg(u)*r"} <= zero
+    assert all(t.startswith(("neg(n)", "neg(u)")) for t in zero)
     paths = [write_log(log, tmp_path / f"zz{i}.csv") for i, log in enumerate(logs)]
     code = main(["select", *map(str, paths), "--quiet", "--search", "none", "--dt", "0.4",
                  "-o", str(tmp_path / "m.json")])  # fmt: skip

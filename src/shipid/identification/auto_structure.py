@@ -8,8 +8,8 @@ held-out 35° turns' tactical diameters 635 % and 788 % long. There the structur
 from the logs:
 
 - a varying propeller speed: the terms ``select`` chooses from its default library (the
-  four-quadrant ``low-speed`` terms, ``wind`` and ``propeller-asymmetry``, less what the logs
-  lack or never excite) by free-run cross-validation on the logs (leave one log out; four
+  four-quadrant ``low-speed`` terms, ``wind``, ``propeller-asymmetry`` and ``astern``, less what
+  the logs lack or never excite) by free-run cross-validation on the logs (leave one log out; four
   blocks of a single log), with its γ; ``blanke-rps`` where none of its candidates is plausible
   or predicts the held-out logs better than their mean;
 - a varying thrust without rps: ``blanke-thrust``;
