@@ -15,7 +15,8 @@ approaches steady and the model's surge answers the propeller, from the model's 
 speed at the log's propeller speed, which a replay from the measured state never tests. Trained on
 the Esso Osaka's zig-zags and random runs at the logs' Δk of 0.1 s, the README's terms reach 0.52
 m/s at 10 rps, where the ship's 35° turns approach at 0.35 m/s; the replay's tactical diameter is
-12 % and 5 % long, the closed loop's 28 % and 16 % (``approach_speed`` and a warning say why).
+11 % and 5 % long, the closed loop's 30 % and 17 % (``approach_speed`` and a warning say
+why; ``benchmarks/study_sampling.py``).
 
 A log that cannot be validated (a missing input column, a run that starts astern for a closed-loop
 replica) does not stop the others: its ``Validation`` carries the error.
