@@ -18,14 +18,14 @@ from shipid.trials.trial import describe_trial
 RPS = 10.0
 
 
-def turning_log(side: str, held: float = 0.0, speed: float | None = None):
-    """A 35° turn of ``PROPELLED`` at 10 rps, 10 s of approach with the rudder held at
+def turning_log(side: str, held: float = 0.0, speed: float | None = None, rps: float = RPS):
+    """A 35° turn of ``PROPELLED`` at ``rps``, 10 s of approach with the rudder held at
     ``held`` [rad], from ``speed`` (default: its steady speed)."""
     res = turning_circle(PROPELLED, 35.0, side, duration=150.0, dt=0.1, approach=10.0,
-                         speed=speed or steady(RPS), rps=RPS, method="euler",
+                         speed=speed or steady(rps), rps=rps, method="euler",
                          initial={"delta": held})  # fmt: skip
     log = res.log.copy()
-    log["n"] = RPS
+    log["n"] = rps
     return log
 
 
@@ -76,3 +76,34 @@ def test_a_log_that_approaches_accelerating_is_replayed_from_its_own_state():
     assert v.indices["closed_loop"]["approach_speed"] == pytest.approx(log["u"].iloc[0])
     assert v.indices["measured"]["approach_speed"] == pytest.approx(log["u"].iloc[0])
     assert not any("steady straight speed" in w for w in v.warnings)
+
+
+def test_the_command_line_names_the_approach_and_keeps_going(tmp_path, capsys):
+    """`shipid validate` prints the closed loop's approach against the log's and warns, exit 0."""
+    import json
+
+    from cli_helpers import run
+
+    from shipid.data.io import write_log
+    from shipid.identification.identify import identify
+    from shipid.reporting.modelfile import save_model
+
+    log = turning_log("starboard")
+    path = write_log(log, tmp_path / "turn.csv")
+    # Runs that speed up at two propeller speeds: the fit finds the surge (the steady turns
+    # never excite it).
+    runs = [turning_log(side, speed=0.6 * steady(n), rps=n)
+            for side, n in (("port", 8.0), ("starboard", 14.0))]  # fmt: skip
+    fit = identify(runs, PROPELLED.structure, force=True)
+    assert fit.model.coefficients["u"]["pos(n)^2"] == pytest.approx(B_NN, rel=0.05)
+    model_path = save_model(tmp_path / "m.json", fit)
+    doc = json.loads(model_path.read_text())
+    doc["model"]["coefficients"]["u"]["pos(n)^2"] *= 2.25  # 1.5 times the speed at any rps
+    model_path.write_text(json.dumps(doc))
+    code, out, err = run(["validate", model_path, path], capsys)
+    assert code == 0, err
+    (row,) = [line for line in out.splitlines() if "approach_speed" in line]
+    cells = [c.strip() for c in row.split("|")]
+    measured, closed = float(cells[3]), float(cells[5])
+    assert closed / measured == pytest.approx(1.5, rel=0.02)
+    assert "steady straight speed" in err and "+50 %" in err
