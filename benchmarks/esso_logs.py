@@ -4,6 +4,11 @@ folds by condition the Esso studies train and judge on."""
 
 from __future__ import annotations
 
+import os
+import sys
+import tempfile
+import time
+from collections.abc import Callable
 from pathlib import Path
 
 from shipid.data.io import read_log
@@ -53,3 +58,17 @@ def condition_folds(rnd) -> dict[str, tuple[list[str], list[str], list[str], lis
 def random_run_folds(rnd) -> dict[str, tuple[list[str], list[str], list[str], list[str]]]:
     """Each random run held out in turn (with the turns), the rest and every zig-zag trained on."""
     return {f"random {k}": (list(ZIGZAGS), [j for j in rnd if j != k], [], [k]) for k in rnd}
+
+
+def run_with_files(*studies: Callable[[Path], None]) -> None:
+    """Run each study on a scratch folder for its log files, between the machine's load and the
+    seconds taken; a line and exit 0 when ``../shared/data`` is absent."""
+    if not DATA.is_dir():
+        print("../shared/data is absent")
+        sys.exit(0)
+    print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores\n")
+    t0 = time.perf_counter()
+    with tempfile.TemporaryDirectory() as tmp:
+        for study in studies:
+            study(Path(tmp))
+    print(f"\n{time.perf_counter() - t0:.0f} s")

@@ -17,16 +17,13 @@ from __future__ import annotations
 
 import contextlib
 import io
-import os
-import sys
-import tempfile
 import time
 import warnings
 from pathlib import Path
 
 import numpy as np
 from esso_logs import DATA as ESSO
-from esso_logs import README_HELD, esso_logs
+from esso_logs import README_HELD, esso_logs, run_with_files
 
 from shipid.cli import main
 from shipid.data.io import read_log, write_log
@@ -144,12 +141,4 @@ def kvlcc2(folder: Path) -> None:
 
 
 if __name__ == "__main__":
-    if not ESSO.is_dir():
-        print("../shared/data is absent")
-        sys.exit(0)
-    print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores\n")
-    t0 = time.perf_counter()
-    with tempfile.TemporaryDirectory() as tmp:
-        esso(Path(tmp))
-        kvlcc2(Path(tmp))
-    print(f"\n{time.perf_counter() - t0:.0f} s")
+    run_with_files(esso, kvlcc2)

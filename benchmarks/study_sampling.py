@@ -19,15 +19,11 @@ Run: .venv/bin/python benchmarks/study_sampling.py
 
 from __future__ import annotations
 
-import os
-import sys
-import tempfile
-import time
 import warnings
 from pathlib import Path
 
 import numpy as np
-from esso_logs import DATA, esso_logs
+from esso_logs import esso_logs, run_with_files
 from study_auto_structure import _identify
 
 from shipid.data.io import write_log
@@ -104,11 +100,4 @@ def study(folder: Path) -> None:
 
 
 if __name__ == "__main__":
-    if not DATA.is_dir():
-        print("../shared/data is absent")
-        sys.exit(0)
-    print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores\n")
-    t0 = time.perf_counter()
-    with tempfile.TemporaryDirectory() as tmp:
-        study(Path(tmp))
-    print(f"\n{time.perf_counter() - t0:.0f} s")
+    run_with_files(study)
