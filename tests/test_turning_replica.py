@@ -107,3 +107,24 @@ def test_the_command_line_names_the_approach_and_keeps_going(tmp_path, capsys):
     measured, closed = float(cells[3]), float(cells[5])
     assert closed / measured == pytest.approx(1.5, rel=0.02)
     assert "steady straight speed" in err and "+50 %" in err
+
+
+def test_the_replicates_approach_each_at_its_own_steady_speed():
+    """With a bootstrap ensemble, each replicate's closed-loop turn starts from its own steady
+    speed at the log's rps: the interval of ``approach_speed`` is that of n √(−b/a) over the
+    replicates' thrust coefficients b."""
+    from shipid.identification.uncertainty import Ensemble, interval
+
+    factors = np.linspace(0.8, 1.25, 19)
+    terms = PROPELLED.structure.all_terms
+    thetas = np.zeros((len(factors), 3, len(terms)))
+    for i, f in enumerate(factors):
+        for j, dof in enumerate(("u", "v", "r")):
+            for k, t in enumerate(terms):
+                thetas[i, j, k] = PROPELLED.coefficients[dof].get(t, 0.0)
+        thetas[i, 0, terms.index("pos(n)^2")] *= f
+    ensemble = Ensemble(PROPELLED, thetas, block_s=10.0, seed=0)
+    (v,) = validate(PROPELLED, turning_log("port"), ensemble=ensemble)
+    lo, hi = v.intervals["closed_loop"]["approach_speed"]
+    expected = interval([RPS * math.sqrt(-f * B_NN / A_UU) for f in factors])
+    assert (lo, hi) == pytest.approx(expected, rel=1e-3)

@@ -154,7 +154,7 @@ def validate_log(model, log: pd.DataFrame, name: str, method: str = "euler",
                                              runs, ensemble.members_label)
             if "closed_loop" in indices:
                 replicas = [trial_replica(m, log, method, trial) for m in ensemble.members()]
-                samples = [r.indices if r and not r.diverged else {} for r in replicas]
+                samples = [_indices_of(r, trial) for r in replicas]
                 out.intervals["closed_loop"] = index_intervals(samples)
                 out.warnings += _unbounded_notes("closed loop", out.intervals["closed_loop"],
                                                  samples, replicas, ensemble.members_label)
@@ -185,7 +185,12 @@ def _replay_indices(sim: SimulationResult, trial: Trial) -> dict:
 
 
 def _replica_indices(model, log: pd.DataFrame, method: str, trial: Trial) -> dict:
-    replica = trial_replica(model, log, method, trial)
+    return _indices_of(trial_replica(model, log, method, trial), trial)
+
+
+def _indices_of(replica: ManoeuvreResult | None, trial: Trial) -> dict:
+    """A closed-loop replica's indices ({} when there is none or it diverged), a turning
+    circle's with the speed it approached at."""
     if replica is None or replica.diverged:
         return {}
     out = dict(replica.indices)
