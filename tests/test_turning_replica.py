@@ -128,3 +128,27 @@ def test_the_replicates_approach_each_at_its_own_steady_speed():
     lo, hi = v.intervals["closed_loop"]["approach_speed"]
     expected = interval([RPS * math.sqrt(-f * B_NN / A_UU) for f in factors])
     assert (lo, hi) == pytest.approx(expected, rel=1e-3)
+
+
+def test_a_zigzag_from_a_steady_approach_runs_from_the_models_own_speed_too():
+    """The zig-zag replica starts as `shipid manoeuvre zigzag` does where the log approaches
+    steady: the true model reproduces the log's overshoots, a model 50 % fast at the rps starts
+    50 % faster."""
+    from shipid.dynamics.steering import SteeringMachine
+    from shipid.trials.manoeuvres import zigzag
+
+    steering = SteeringMachine(max_rate=math.radians(5.0))  # a rate the 0.1 s log resolves
+    res = zigzag(PROPELLED, 20.0, 20.0, duration=120.0, dt=0.1, approach=10.0,
+                 speed=steady(RPS), rps=RPS, method="euler", steering=steering)  # fmt: skip
+    log = res.log.copy()
+    log["n"] = RPS
+    (true,) = validate(PROPELLED, log)
+    measured, closed = true.indices["measured"], true.indices["closed_loop"]
+    assert true.kind == "zigzag"
+    assert closed["approach_speed"] == pytest.approx(steady(RPS), rel=1e-6)
+    for k in ("first_overshoot_deg", "second_overshoot_deg"):
+        assert closed[k] == pytest.approx(measured[k], abs=0.2), k
+    (fast,) = validate(with_thrust(2.25), log)
+    assert fast.indices["closed_loop"]["approach_speed"] == pytest.approx(1.5 * steady(RPS),
+                                                                         rel=1e-3)
+    assert any("+50 %" in w for w in fast.warnings)

@@ -8,15 +8,15 @@ the closed-loop replica, so all three speak of the same manoeuvre.
 Zig-zag and turning-circle indices are predicted twice. "simulated" reads them off the open-loop
 replay (the measured rudder, switched when the *ship* reached the switch heading), so a small
 heading drift of the model shifts its second overshoot by the whole drift. "closed_loop" runs the
-zig-zag itself on the model, from the trial's initial state with its rudder angle, rate and switch
-heading: the model's own prediction of the manoeuvre, the one to compare overshoot angles with. A
-turning circle's closed loop is the turn as ``shipid manoeuvre turning`` runs it: where the log
-approaches steady and the model's surge answers the propeller, from the model's own steady straight
-speed at the log's propeller speed, which a replay from the measured state never tests. Trained on
-the Esso Osaka's zig-zags and random runs at the logs' Δk of 0.1 s, the README's terms reach 0.52
-m/s at 10 rps, where the ship's 35° turns approach at 0.35 m/s; the replay's tactical diameter is
-11 % and 5 % long, the closed loop's 30 % and 17 % (``approach_speed`` and a warning say
-why; ``benchmarks/study_sampling.py``).
+manoeuvre itself on the model with the trial's rudder angle, rate, execute and (zig-zag) switch
+heading: the model's own prediction of the manoeuvre, the one to compare overshoot angles with. It
+starts from the trial's initial state, or, where the log approaches steady and the model's surge
+answers the propeller, as ``shipid manoeuvre`` starts: straight, at the model's own steady speed at
+the log's propeller speed, which a replay from the measured state never tests (``approach_speed``,
+measured and closed loop, and a warning beyond 10 %). Trained on the Esso Osaka's zig-zags and
+random runs at the logs' Δk of 0.1 s, the README's terms reach 0.52 m/s at 10 rps, where the ship's
+35° turns approach at 0.35 m/s; the replay's tactical diameter is 11 % and 5 % long, the closed
+loop's 30 % and 17 % (``benchmarks/study_sampling.py``).
 
 A log that cannot be validated (a missing input column, a run that starts astern for a closed-loop
 replica) does not stop the others: its ``Validation`` carries the error.
@@ -131,9 +131,8 @@ def validate_log(model, log: pd.DataFrame, name: str, method: str = "euler",
     indices: dict[str, dict] = {}
     if trial.kind != "other":
         measured = manoeuvre_indices(log, smooth_s=smooth_s, trial=trial)
-        if trial.kind == "turning":
-            steady = steady_log_approach(log, trial)
-            measured["approach_speed"] = steady if steady else float(log["u"].iloc[0])
+        steady = steady_log_approach(log, trial)
+        measured["approach_speed"] = steady if steady else float(log["u"].iloc[0])
         indices = {"measured": measured, "simulated": _replay_indices(sim, trial)}
         if isinstance(model, ManoeuvringModel | HybridModel | Vessel):
             indices["closed_loop"] = _replica_indices(model, log, method, trial)
@@ -189,14 +188,11 @@ def _replica_indices(model, log: pd.DataFrame, method: str, trial: Trial) -> dic
 
 
 def _indices_of(replica: ManoeuvreResult | None, trial: Trial) -> dict:
-    """A closed-loop replica's indices ({} when there is none or it diverged), a turning
-    circle's with the speed it approached at."""
+    """A closed-loop replica's indices ({} when there is none or it diverged), with the speed
+    it approached at."""
     if replica is None or replica.diverged:
         return {}
-    out = dict(replica.indices)
-    if trial.kind == "turning":
-        out["approach_speed"] = float(replica.log["u"].iloc[0])
-    return out
+    return {**replica.indices, "approach_speed": float(replica.log["u"].iloc[0])}
 
 
 def steady_log_approach(log: pd.DataFrame, trial: Trial) -> float | None:
@@ -226,6 +222,23 @@ def _own_approach(model, log: pd.DataFrame, trial: Trial) -> tuple[float, float 
     rps = float(log["n"].iloc[: trial.execute_index + 1].mean())
     steady = surge_equilibrium(model, measured, rps, SEARCH_SPAN)
     return (steady, rps) if steady is not None and steady > 0 else None
+
+
+def _replica_start(model, log: pd.DataFrame, trial: Trial) -> tuple[dict, float | None]:
+    """(initial state, propeller speed) of a closed-loop replica: the log's first state and held
+    rudder at its mean rps; where the log approaches steady and ``model``'s surge answers the
+    propeller, straight at the model's own steady speed at the log's approach rps instead (the
+    approach ``shipid manoeuvre`` starts from)."""
+    row = log.iloc[0]
+    initial = {k: float(row[k]) for k in ("u", "v", "r", "psi") if k in log.columns}
+    initial["delta"] = float(row["delta"])
+    rps = float(log["n"].mean()) if "n" in log.columns else None
+    own = _own_approach(model, log, trial) if isinstance(model, ManoeuvringModel | HybridModel) \
+        else None  # fmt: skip
+    if own is not None:
+        initial.update(u=own[0], v=0.0, r=0.0)
+        rps = own[1]
+    return initial, rps
 
 
 def _approach_notes(indices: dict) -> list[str]:
@@ -276,15 +289,7 @@ def trial_turning(model, log: pd.DataFrame, method: str = "euler",
     swing = np.abs(delta - delta[0])
     held = float(np.median(delta[swing >= 0.8 * swing.max()]))
     turns = np.sign(held) * starboard_sign(rudder_positive(log))
-    row = log.iloc[0]
-    initial = {k: float(row[k]) for k in ("u", "v", "r", "psi") if k in log.columns}
-    initial["delta"] = float(delta[0])
-    rps = float(log["n"].mean()) if "n" in log.columns else None
-    own = _own_approach(model, log, trial) if isinstance(model, ManoeuvringModel | HybridModel) \
-        else None  # fmt: skip
-    if own is not None:
-        initial.update(u=own[0], v=0.0, r=0.0)
-        rps = own[1]
+    initial, rps = _replica_start(model, log, trial)
     steering = SteeringMachine(max_angle=max(math.radians(35.0), amplitude),
                                max_rate=trial.rudder_rate)  # fmt: skip
     return turning_circle(model, math.degrees(amplitude), "starboard" if turns > 0 else "port",
@@ -331,10 +336,11 @@ def validate(
 def trial_zigzag(model, log: pd.DataFrame, method: str = "euler",
                  trial: Trial | None = None) -> ManoeuvreResult | None:  # fmt: skip
     """The zig-zag of a measured log run closed loop on ``model``: same initial state (u, v, r, ψ)
-    and held rudder, first execute time and side, rudder angle (the median plateau), rudder rate
-    (the 90th percentile while it moves), switch heading (inferred from the log), mean propeller
-    speed, duration and step. None when the log has no detectable switch heading or starts
-    without headway (a zig-zag needs an approach speed)."""
+    and held rudder (or the model's own steady approach, ``_replica_start``), first execute time
+    and side, rudder angle (the median plateau), rudder rate (the 90th percentile while it
+    moves), switch heading (inferred from the log), mean propeller speed, duration and step.
+    None when the log has no detectable switch heading or starts without headway (a zig-zag
+    needs an approach speed)."""
     trial = trial or describe_trial(log, "zigzag")
     switch = trial.switch_heading_deg
     if not switch or not float(log["u"].iloc[0]) > 0:
@@ -342,16 +348,12 @@ def trial_zigzag(model, log: pd.DataFrame, method: str = "euler",
     t = log["t"].to_numpy()
     dt = float(np.median(np.diff(t)))
     i0 = trial.execute_index
-    held = float(log["delta"].iloc[0])
     amplitude = trial.plateau_angle
     turns = trial.first_rudder * starboard_sign(rudder_positive(log))
     first = "starboard" if turns > 0 else "port"
-    row = log.iloc[0]
-    initial = {k: float(row[k]) for k in ("u", "v", "r", "psi") if k in log.columns}
-    initial["delta"] = held
+    initial, rps = _replica_start(model, log, trial)
     steering = SteeringMachine(max_angle=max(math.radians(35.0), amplitude),
                                max_rate=trial.rudder_rate)  # fmt: skip
-    rps = float(log["n"].mean()) if "n" in log.columns else None
     return zigzag(model, math.degrees(amplitude), switch, first=first, duration=float(t[-1] - t[0]),
                   dt=dt, approach=float(t[min(i0 + 1, len(t) - 1)] - t[0]), speed=initial["u"],
                   steering=steering, method=method, initial=initial, rps=rps)  # fmt: skip
