@@ -142,3 +142,27 @@ def test_cli_criteria_of_a_reference_ship_and_of_a_model_file(tmp_path, capsys):
                          capsys)  # fmt: skip
     assert code == 0, err
     assert "λ = 16.95" in out and "rudder rate 9.6" in out  # the training logs' rudder rate
+
+
+def test_criteria_say_where_their_manoeuvres_leave_the_training_logs(tmp_path, capsys):
+    """`manoeuvre` named a run beyond the training range; `criteria` judged 35° turns and a
+    full-astern stop of a model trained on one 20/20 zig-zag without a word."""
+    from shipid.data.io import write_log
+    from shipid.trials.manoeuvres import zigzag
+    from shipid.vessels import scale_ship
+
+    log = zigzag(scale_ship(rudder_rate_deg=9.6), 20, 20, duration=60, dt=0.2, approach=2).log
+    path = write_log(log, tmp_path / "zz.csv")
+    assert run(["identify", path, "-o", tmp_path / "m.json"], capsys)[0] == 0
+    (tmp_path / "p.yml").write_text("length: 4.389\nscale: 16.95\n")
+    code, _, err = run(["criteria", tmp_path / "m.json", "--particulars", tmp_path / "p.yml",
+                        "--json", tmp_path / "c.json"], capsys)  # fmt: skip
+    assert code == 0, err
+    notes = [line for line in err.splitlines() if "outside the training range" in line]
+    # The 35° rudder is beyond the zig-zag's 20°: the turns, and only runs that use it, named.
+    (rudder,) = [n for n in notes if "delta spans" in n]
+    assert "turning 35° starboard" in rudder and "zigzag 10/10" not in rudder
+    trained = float(log["delta"].abs().max())
+    assert f"{trained:.3g} rad" in rudder
+    doc = json.loads((tmp_path / "c.json").read_text())
+    assert any("delta spans" in n for n in doc["notes"])

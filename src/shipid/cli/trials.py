@@ -42,6 +42,7 @@ def cmd_criteria(args) -> int:
 
     crit.notes += [f"{name}: {note}" for name, res in crit.runs.items()
                    for note in faded_residual_notes(target, res.log)]  # fmt: skip
+    crit.notes += _criteria_envelope_notes(cond["envelope"], crit.runs)
     table = crit.table.copy()
     ensemble = cond.get("ensemble")
     if ensemble is not None and not args.no_bands:
@@ -69,6 +70,24 @@ def cmd_criteria(args) -> int:
         if args.json:
             out.write(args.json, lambda p: p.write_text(_json_text(record), "utf-8"))
     return 0
+
+
+def _criteria_envelope_notes(env, runs) -> list[str]:
+    """Where the criteria's manoeuvres, together, leave the model's training envelope (one note
+    per signal, naming the runs that do): a criterion judged beyond the trials is a guess."""
+    import pandas as pd
+
+    from shipid.evaluation.envelope import outside_envelope
+
+    logs = {name: res.log for name, res in runs.items() if getattr(res, "log", None) is not None}
+    if not env or not logs:
+        return []
+    notes = []
+    for note in outside_envelope(env, pd.concat(list(logs.values()), ignore_index=True)):
+        signal = note.split(" ", 1)[0]
+        names = [n for n, log in logs.items() if outside_envelope({signal: env[signal]}, log)]
+        notes.append(f"criteria ({', '.join(names)}): {note}")
+    return notes
 
 
 def cmd_manoeuvre(args) -> int:
