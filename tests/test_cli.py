@@ -497,3 +497,22 @@ def test_a_log_sampled_coarser_than_the_models_step_is_named(files, capsys):
     assert "2.5 times the model's Δk (0.2 s)" in err and "give --dt 0.2" in err
     code, _, err = run(["validate", model, log, "--dt", "0.25"], capsys)
     assert code == 0 and "the model's Δk" not in err, err
+
+
+def test_simulate_says_when_the_log_drives_the_model_beyond_its_training(tmp_path, capsys):
+    """`validate` and `manoeuvre` named a run beyond the training logs' range; `simulate` did
+    not."""
+    from shipid.trials.manoeuvres import turning_circle, zigzag
+    from shipid.vessels import scale_ship
+
+    ship = scale_ship(rudder_rate_deg=9.6)
+    train = write_log(zigzag(ship, 20, 20, duration=60, dt=0.2, approach=2).log,
+                      tmp_path / "zz.csv")  # fmt: skip
+    turn = write_log(turning_circle(ship, 35, duration=60, dt=0.2, approach=2).log,
+                     tmp_path / "turn.csv")  # fmt: skip
+    assert run(["identify", train, "-o", tmp_path / "m.json"], capsys)[0] == 0
+    code, _, err = run(["simulate", tmp_path / "m.json", train, "-o", tmp_path / "a.csv"], capsys)
+    assert code == 0 and "outside the training range" not in err
+    code, _, err = run(["simulate", tmp_path / "m.json", turn, "-o", tmp_path / "b.csv"], capsys)
+    assert code == 0 and (tmp_path / "b.csv").exists()
+    assert f"{turn}: delta spans" in err and "outside the training range" in err

@@ -234,5 +234,9 @@ def cmd_simulate(args) -> int:
     write_log(res.log, args.output)
     if res.diverged:
         print(res.reason, file=sys.stderr)
+    from shipid.evaluation.envelope import outside_envelope
+
+    for note in outside_envelope(cond["envelope"], res.log):  # inputs and the run alike
+        _warn(f"{log_path}: {note}")
     print(f"{len(res.log)} samples written to {args.output}")
     return 0
