@@ -278,3 +278,24 @@ def test_the_compiled_path_following_is_the_python_loop(ship):
         np.testing.assert_allclose(fast.log[col], slow.log[col], rtol=1e-9, atol=1e-9,
                                    err_msg=col)  # fmt: skip
     assert fast.rms_cross_track == pytest.approx(slow.rms_cross_track, rel=1e-9)
+
+
+def test_autopilot_and_follow_say_when_the_model_runs_beyond_its_training(tmp_path, capsys):
+    """A controller tried on a model outside its trials is tried on a guess: a model from a
+    10/10 zig-zag, steered through a 60° heading step with 32° of rudder, is named."""
+    from shipid.data.io import write_log
+    from shipid.vessels import scale_ship
+
+    log = zigzag(scale_ship(rudder_rate_deg=9.6), 10, 10, duration=60, dt=0.2, approach=2).log
+    train = write_log(log, tmp_path / "zz.csv")
+    assert run(["identify", train, "-o", tmp_path / "m.json"], capsys)[0] == 0
+    code, out, err = run(["autopilot", tmp_path / "m.json", "--heading", "60"], capsys)
+    assert code == 0, err
+    rudder = float(out.split("max rudder ")[1].split("°")[0])
+    assert rudder > 1.2 * math.degrees(log["delta"].abs().max())
+    assert "delta spans" in err and "outside the training range" in err
+    code, out, err = run(["autopilot", tmp_path / "m.json", "--heading", "2"], capsys)
+    assert code == 0 and "delta spans" not in err
+    code, out, err = run(["follow", tmp_path / "m.json", "--waypoints", "0,0;60,0;60,60"],
+                         capsys)  # fmt: skip
+    assert code == 0 and "outside the training range" in err

@@ -124,6 +124,7 @@ def cmd_autopilot(args) -> int:
                                              rps, steering=steering),
                     f"{args.truth} (truth)": heading_step(truth, pid_truth, args.heading,
                                                           longest, args.dt)}  # fmt: skip
+    _warn_beyond_training(cond, args.model, runs[args.model])
     for name, log in runs.items():
         if log.attrs.get("incomplete") and log.attrs["incomplete"] != "diverged":
             _warn(f"{name}: {log.attrs['incomplete']}; give a longer --duration")
@@ -137,6 +138,15 @@ def cmd_autopilot(args) -> int:
         autopilot_figure(runs, args.output, f"heading autopilot, step to {args.heading:g}°")
         print(f"figure written to {args.output}")
     return 0
+
+
+def _warn_beyond_training(cond: dict, name: str, log) -> None:
+    """A warning per signal where the controlled model's run leaves its training logs' range
+    (a controller tuned and tried on a model beyond its trials is tried on a guess)."""
+    from shipid.evaluation.envelope import outside_envelope
+
+    for note in outside_envelope(cond.get("envelope") or {}, log):
+        _warn(f"{name}: {note}")
 
 
 def _parse_waypoints(text: str) -> list[tuple[float, float]]:
@@ -179,6 +189,7 @@ def cmd_follow(args) -> int:
         rows.append({"run": label, "rms cross-track [m]": res.rms_cross_track,
                      "max cross-track [m]": res.max_cross_track, "completed": res.completed,
                      "Kp": gains.kp, "Ki": gains.ki, "Kd": gains.kd})  # fmt: skip
+    _warn_beyond_training(cond, args.model, runs["model"])
     table = _pd().DataFrame(rows)
     print(f"Line-of-sight path following (lookahead {lookahead:.3g} m), PID tuned on "
           f"{args.model}:")
