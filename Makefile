@@ -40,6 +40,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/study_kvlcc2_average.py
 	$(BIN)/python benchmarks/study_auto_structure.py
 	$(BIN)/python benchmarks/study_sampling.py
+	$(BIN)/python benchmarks/study_auto_inflow.py
 
 clean:
 	rm -rf $(VENV) shipid-demo build *.egg-info src/*.egg-info
