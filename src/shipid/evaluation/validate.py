@@ -33,7 +33,7 @@ import numpy as np
 import pandas as pd
 
 from shipid.data.log import rudder_positive, starboard_sign
-from shipid.dynamics.equilibrium import SEARCH_SPAN, STEADY_SHARE, STEADY_WINDOW, surge_equilibrium
+from shipid.dynamics.equilibrium import STEADY_SHARE, STEADY_WINDOW, surge_equilibrium
 from shipid.dynamics.hybrid import HybridModel
 from shipid.dynamics.model import ManoeuvringModel
 from shipid.dynamics.simulate import SimulationResult, simulate_log
@@ -220,7 +220,9 @@ def _own_approach(model, log: pd.DataFrame, trial: Trial) -> tuple[float, float 
     if measured is None:
         return None
     rps = float(log["n"].iloc[: trial.execute_index + 1].mean())
-    steady = surge_equilibrium(model, measured, rps, SEARCH_SPAN)
+    # At the log's own rps, near its measured speed: three times it is far enough (a model that
+    # balances further off has no steady approach there worth the name).
+    steady = surge_equilibrium(model, measured, rps)
     return (steady, rps) if steady is not None and steady > 0 else None
 
 
