@@ -44,10 +44,11 @@ FOLDS = {
 }
 
 
-def _identify(paths: list[Path], structure: str, out: Path) -> tuple[str, float]:
-    """The model file ``shipid identify PATHS [--model STRUCTURE]`` writes, and its first line
-    (the auto structure's choice), and the seconds it took."""
-    argv = ["identify", *map(str, paths), "-o", str(out)]
+def _identify(paths: list[Path], structure: str, out: Path, extra: tuple[str, ...] = ()
+              ) -> tuple[str, float]:  # fmt: skip
+    """The model file ``shipid identify PATHS [--model STRUCTURE] [EXTRA...]`` writes, and its
+    first line (the auto structure's choice), and the seconds it took."""
+    argv = ["identify", *map(str, paths), "-o", str(out), *extra]
     if structure != "auto":
         argv += ["--model", structure]
     text = io.StringIO()

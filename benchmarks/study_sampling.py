@@ -30,7 +30,11 @@ from shipid.data.io import write_log
 from shipid.evaluation.validate import validate
 from shipid.reporting.modelfile import load_model
 
-SAMPLING = (None, 0.2, 0.5, 1.0)  # None: the logs' own 0.1 s
+# (Δk, the steady speed given to identify): None is the logs' own 0.1 s. The steady speed is the
+# turns' own approach at 10 rps, as a user knows it from a straight run: with it the turns are
+# not wholly unseen (their approach is the constraint); the random runs are.
+STEADY = "0.35@10"
+CASES = ((None, None), (0.2, None), (0.5, None), (1.0, None), (None, STEADY), (0.5, STEADY))
 
 
 def _pct(pred, meas) -> float:
@@ -43,7 +47,9 @@ def study(folder: Path) -> None:
           "error over spread |")  # fmt: skip
     print("|---|---|---|---|---|---|---|")
     means = {}
-    for dt in SAMPLING:
+    for dt, steady in CASES:
+        extra = ("--steady-speed", steady) if steady else ()
+        label = f"{dt or 0.1:g}" + (f", --steady-speed {steady}" if steady else "")
         data = esso_logs(dt)
         if data is None:
             return
@@ -57,9 +63,9 @@ def study(folder: Path) -> None:
         rows = []
         for fold, keys in folds.items():
             path = folder / "model.json"
-            _, seconds = _identify([files[k] for k in keys], "auto", path)
+            _, seconds = _identify([files[k] for k in keys], "auto", path, extra)
             if seconds < 0:
-                print(f"| {dt or 0.1:g} | {fold} | identify refused | | | | |")
+                print(f"| {label} | {fold} | identify refused | | | | |")
                 continue
             model = load_model(path)
             held_logs = [rnd[k] for k in rnd if f"rnd {k}" not in keys]
@@ -83,19 +89,19 @@ def study(folder: Path) -> None:
                              for v, x in zip(vals[2:], held_logs, strict=True)])  # fmt: skip
             rows.append((abs(_pct(own, measured)), np.mean(np.abs(td_r)), np.mean(np.abs(td_c)),
                          np.mean(np.abs(r_c)), err_r, err_u))  # fmt: skip
-            print(f"| {dt or 0.1:g} | {fold} | {own:.3f} ({measured:.3f}, "
+            print(f"| {label} | {fold} | {own:.3f} ({measured:.3f}, "
                   f"{_pct(own, measured):+.0f} %) | {td_r[0]:+.0f} %, {td_r[1]:+.0f} % | "
                   f"{td_c[0]:+.0f} %, {td_c[1]:+.0f} % | {r_c[0]:+.0f} %, {r_c[1]:+.0f} % | "
                   f"{err_r:.2f} / {err_u:.2f} |")  # fmt: skip
-        means[dt] = np.mean(rows, axis=0)
+        means[label] = np.mean(rows, axis=0)
     print("\nMeans over the folds: |error| of the model's speed at 10 rps, of the tactical "
           "diameters (replay, closed loop) and of the closed loop's steady yaw rates; random "
           "runs' r and u error over spread\n")  # fmt: skip
     print("| Δk [s] | speed at 10 rps | TD replay | TD closed loop | steady r closed loop | "
           "random runs r / u |")  # fmt: skip
     print("|---|---|---|---|---|---|")
-    for dt, m in means.items():
-        print(f"| {dt or 0.1:g} | {m[0]:.0f} % | {m[1]:.1f} % | {m[2]:.1f} % | {m[3]:.1f} % | "
+    for label, m in means.items():
+        print(f"| {label} | {m[0]:.0f} % | {m[1]:.1f} % | {m[2]:.1f} % | {m[3]:.1f} % | "
               f"{m[4]:.2f} / {m[5]:.2f} |")
 
 

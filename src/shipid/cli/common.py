@@ -99,9 +99,17 @@ def _parse_bounds(specs) -> dict[str, dict[str, tuple[float, float]]]:
 
 def _physics(args, logs, structure):
     """PhysicsOptions of --prior, --constraints, --bound (None when none is given)."""
-    from shipid.identification.physics import PhysicsOptions, parse_constraints, rudder_sign
+    from shipid.identification.physics import (
+        PhysicsOptions,
+        parse_constraints,
+        parse_steady_speeds,
+        rudder_sign,
+    )
 
     flags = parse_constraints(args.constraints)
+    steady = parse_steady_speeds(getattr(args, "steady_speed", None))
+    if steady:
+        flags["steady_speed"] = True
     bounds = _parse_bounds(args.bound)
     prior = None
     if args.prior == "clarke":
@@ -121,7 +129,8 @@ def _physics(args, logs, structure):
         from shipid.reporting.modelfile import load_document, model_from_document
 
         prior = prior_from_model(model_from_document(load_document(args.prior), args.prior))
-    options = PhysicsOptions(prior=prior, bounds=bounds or None, **flags)
+    options = PhysicsOptions(prior=prior, bounds=bounds or None, approach=tuple(steady) or None,
+                             **flags)  # fmt: skip
     return options if options.active else None
 
 

@@ -90,6 +90,11 @@ def _add_physics_options(p) -> None:
                    "equation given the sway one)")
     g.add_argument("--bound", action="append", metavar="'DOF: TERM <= X'",
                    help="a bound on one coefficient, e.g. 'r: u*r <= 0' (repeatable)")
+    g.add_argument("--steady-speed", action="append", metavar="U@N",
+                   help="the ship holds U m/s straight ahead at N rps (repeatable; a straight "
+                   "run's or sea trials' speed): u̇ = 0 there with the rudder amidships, instead "
+                   "of at the logs' starts; the speed the surge balances at is what the logs "
+                   "determine least")
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -16,6 +16,7 @@ from __future__ import annotations
 import json
 import math
 from collections.abc import Mapping
+from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
@@ -91,6 +92,65 @@ def approach_note(log: pd.DataFrame, name: str) -> str | None:
     return (f"{name} starts without headway ({start:.2g} m/s): the checks, and the manoeuvres "
             f"run on the model, start from its running condition, {at} (the median where it "
             f"runs ahead at half its typical speed or more; --speed and --rps to choose)")
+
+
+# A run is steady when its speed changes by less than this share of it in STEADY_WINDOW s (the
+# rule a model's approach is held to too, ``shipid.dynamics.equilibrium``).
+STEADY_SHARE = 0.05
+STEADY_WINDOW = 10.0
+# A log's approach: up to its first rudder order (the rudder this far from its first angle) or
+# until its heading has turned by STRAIGHT_RAD, at most STEADY_WINDOW long.
+ORDER_RAD = math.radians(5.0)
+STRAIGHT_RAD = 0.05
+
+
+@dataclass(frozen=True)
+class SteadyStart:
+    """How a log starts: its mean speed over the approach, the speed's change per
+    ``STEADY_WINDOW`` s relative to it (a least-squares slope), and whether that is steady:
+    True, False (it clearly speeds up or slows down, or turns), or None (too short or too noisy
+    to tell)."""
+
+    speed: float
+    change: float
+    steady: bool | None
+
+
+def steady_start(log: pd.DataFrame, end_index: int | None = None) -> SteadyStart:
+    """Whether ``log`` starts on a steady straight approach, up to ``end_index`` (default: its
+    first rudder order or heading change, or ``STEADY_WINDOW`` s). Unsteady only where the slope
+    is clear: beyond ``STEADY_SHARE`` per ``STEADY_WINDOW`` s and three standard errors from
+    zero; a short or noisy approach cannot be told (None)."""
+    t = log["t"].to_numpy(dtype=float)
+    u = log["u"].to_numpy(dtype=float)
+    delta = log["delta"].to_numpy(dtype=float)
+    largest = float(np.max(np.abs(delta)))
+    if end_index is None and largest > ORDER_RAD and abs(delta[0]) >= 0.5 * largest:
+        # The rudder is hard over from the first sample: the log has no approach to judge.
+        return SteadyStart(float(u[0]), math.nan, None)
+    if end_index is None:
+        r = log["r"].to_numpy(dtype=float)
+        heading = np.concatenate([[0.0], np.cumsum(0.5 * (r[1:] + r[:-1]) * np.diff(t))])
+        moved = np.flatnonzero((np.abs(delta - delta[0]) > ORDER_RAD)
+                               | (np.abs(heading) > STRAIGHT_RAD)
+                               | (t - t[0] > STEADY_WINDOW))  # fmt: skip
+        end_index = int(moved[0]) if moved.size else len(t) - 1
+    end = max(int(end_index), 1)
+    tt, uu = t[: end + 1] - t[0], u[: end + 1]
+    speed = float(np.mean(uu))
+    if len(tt) < 3 or not speed > 0:
+        return SteadyStart(speed, math.nan, None)
+    A = np.column_stack([np.ones_like(tt), tt - tt.mean()])
+    coef, *_ = np.linalg.lstsq(A, uu, rcond=None)
+    resid = uu - A @ coef
+    se = float(np.sqrt(resid @ resid / max(len(tt) - 2, 1) / np.sum((tt - tt.mean()) ** 2)))
+    change = float(coef[1]) * STEADY_WINDOW / speed
+    if "r" in log.columns and abs(float(np.mean(log["r"].to_numpy()[: end + 1]))) * tt[-1] \
+            > STRAIGHT_RAD:  # fmt: skip
+        return SteadyStart(speed, change, False)
+    if abs(change) <= STEADY_SHARE:
+        return SteadyStart(speed, change, True)
+    return SteadyStart(speed, change, False if abs(coef[1]) > 3 * se else None)
 
 
 def rudder_positive(log: pd.DataFrame, default: str = "port") -> str:

@@ -16,11 +16,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+# An approach is steady when the model's speed changes by less than STEADY_SHARE in
+# STEADY_WINDOW s (the rule a log's approach is held to, ``shipid.data.log.steady_start``).
+from shipid.data.log import STEADY_SHARE, STEADY_WINDOW
 from shipid.dynamics.model import ManoeuvringModel
 
-# An approach is steady when the model's speed changes by less than this share in STEADY_WINDOW s.
-STEADY_SHARE = 0.05
-STEADY_WINDOW = 10.0
 # Another rps than the training logs' can put the steady speed far from their approach.
 SEARCH_SPAN = 10.0
 

@@ -32,8 +32,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from shipid.data.log import rudder_positive, starboard_sign
-from shipid.dynamics.equilibrium import STEADY_SHARE, STEADY_WINDOW, surge_equilibrium
+from shipid.data.log import rudder_positive, starboard_sign, steady_start
+from shipid.dynamics.equilibrium import surge_equilibrium
 from shipid.dynamics.hybrid import HybridModel
 from shipid.dynamics.model import ManoeuvringModel
 from shipid.dynamics.simulate import SimulationResult, simulate_log
@@ -197,17 +197,9 @@ def _indices_of(replica: ManoeuvreResult | None, trial: Trial) -> dict:
 
 def steady_log_approach(log: pd.DataFrame, trial: Trial) -> float | None:
     """The mean speed over the approach of ``log`` (up to the rudder execute) when the ship runs
-    steady there (its speed changes by less than ``STEADY_SHARE`` per ``STEADY_WINDOW`` s, the
-    rule ``shipid.dynamics.equilibrium`` holds a model's approach to) and straight; else None."""
-    t, u = log["t"].to_numpy(dtype=float), log["u"].to_numpy(dtype=float)
-    i0 = max(int(trial.execute_index), 1)
-    span = float(t[i0] - t[0])
-    speed = float(np.mean(u[: i0 + 1]))
-    if not (span > 0 and speed > 0):
-        return None
-    change = abs(float(u[i0] - u[0])) / speed * STEADY_WINDOW / max(span, STEADY_WINDOW / 10)
-    turned = "r" in log.columns and abs(float(log["r"].iloc[: i0 + 1].mean())) * span > 0.05
-    return speed if change <= STEADY_SHARE and not turned else None
+    steady and straight there (``shipid.data.log.steady_start``); else None."""
+    start = steady_start(log, trial.execute_index)
+    return start.speed if start.steady else None
 
 
 def _own_approach(model, log: pd.DataFrame, trial: Trial) -> tuple[float, float | None] | None:
@@ -252,8 +244,8 @@ def _approach_notes(indices: dict) -> list[str]:
     return [f"the model's steady straight speed at the log's propeller speed is {own:.4g} m/s, "
             f"the log's steady approach {measured:.4g} m/s ({100 * (own / measured - 1):+.0f} %): "
             "manoeuvres run on the model from its own approach (shipid manoeuvre, criteria, the "
-            "closed-loop column) start at the wrong speed; give --speed, or train on logs that "
-            "hold a steady straight run"]
+            "closed-loop column) start at the wrong speed; give them --speed, or identify with "
+            "--steady-speed U@N (a straight run's speed) and validate again"]
 
 
 APPROACH_TOLERANCE = 0.10

@@ -158,11 +158,14 @@ def _auto_structure(logs, names, physics, cv, estimator, drop, announce) -> Stru
         return StructureChoice(get_structure(fallback), "named", reasons,
                                notes=[f"{why}; {fallback} instead"])  # fmt: skip
     chosen = sel.chosen_model.structure
+    # The chosen fit's own notes per equation (a constraint held, a prior) the fit of the chosen
+    # structure repeats; the search's (few folds, the library trimmed) are passed on.
     structure = ModelStructure(f"selected from {library_name}", chosen.terms)
     return StructureChoice(structure, "select", reasons, gamma=float(sel.gamma),
                            library=library_name, cv=cv, score=float(sel.score),
                            candidates=len(sel.candidates), notes=[note] if note else [],
-                           warnings=list(sel.warnings))  # fmt: skip
+                           warnings=[w for w in sel.warnings
+                                     if not w.startswith(("u: ", "v: ", "r: "))])  # fmt: skip
 
 
 # A rudder behind a propeller at constant rps in logs whose speed varies by more than this share

@@ -135,6 +135,23 @@ def parse_constraints(text: str | None) -> dict[str, bool]:
     return {c.replace("-", "_"): c in items for c in CONSTRAINTS}
 
 
+def parse_steady_speeds(items: Sequence[str] | None) -> list[dict[str, float]]:
+    """``--steady-speed U@N`` values (repeatable; ``U`` alone for a model without propeller
+    terms) as approaches ``{"u": U, "n": N}``: where the ship is known to hold U m/s straight."""
+    out = []
+    for text in items or ():
+        speed, _, rps = str(text).partition("@")
+        try:
+            u, n = float(speed), float(rps) if rps else 0.0
+        except ValueError:
+            raise ShipidError(f"--steady-speed expects U@N (m/s at rps, e.g. 0.35@10), got "
+                              f"{text!r}") from None  # fmt: skip
+        if not (math.isfinite(u) and u > 0 and math.isfinite(n)):
+            raise ShipidError(f"--steady-speed: the speed must be > 0 and both finite, got {text!r}")
+        out.append({"u": u, "n": n})
+    return out
+
+
 @dataclass
 class DofPhysics:
     """The solver's inputs for one equation: prior, bounds, tied bias, and what they mean."""
@@ -180,7 +197,7 @@ def approach_states(options: PhysicsOptions, logs: Sequence[pd.DataFrame], what:
     """(u0, n0) of every training log's start (or ``options.approach``); of a log that starts
     without headway (a random run begun at rest), its running condition
     (``shipid.data.log.approach``)."""
-    from shipid.data.log import approach, starts_without_headway
+    from shipid.data.log import approach, log_name, starts_without_headway, steady_start
 
     def state(log: pd.DataFrame) -> tuple[float, float]:
         if starts_without_headway(log):
@@ -193,11 +210,29 @@ def approach_states(options: PhysicsOptions, logs: Sequence[pd.DataFrame], what:
     elif options.approach:
         states = [(float(a["u"]), float(a.get("n", 0.0))) for a in options.approach]
     else:
+        if "steady-speed" in what:
+            logs = _steady_starts(logs, log_name, steady_start)
         states = sorted({state(log) for log in logs})
     if not all(u0 > 0 for u0, _ in states):
         raise ShipidError(f"{what} constraint: a training log starts without headway; trim it to "
                           "the approach (--start) or give the approach with --speed")  # fmt: skip
     return states
+
+
+def _steady_starts(logs, log_name, steady_start) -> list[pd.DataFrame]:
+    """The logs whose start can be a steady state: u̇ = 0 imposed where a log starts speeding up
+    (the Esso Osaka's zig-zags: +45 % in 10 s) put the surge's balance at its start; a log that
+    clearly speeds up, slows down or turns there is left out, and none left is an error."""
+    judged = [(log, steady_start(log)) for log in logs]
+    kept = [log for log, start in judged if start.steady is not False]
+    if not kept:
+        log, start = judged[0]
+        raise ShipidError(
+            f"steady-speed constraint: no training log starts on a steady straight approach "
+            f"({log_name(log)}: its speed changes by {100 * start.change:+.0f} % per 10 s before "
+            "its first rudder order); give the speed the ship holds straight at a propeller "
+            "speed with --steady-speed U@N")  # fmt: skip
+    return kept
 
 
 def _straight_running_slopes(texts: Sequence[str], u0: float, n0: float,
