@@ -77,7 +77,7 @@ def study(folder: Path) -> None:
             closed = [v.indices.get("closed_loop") or {} for v in vals[:2]]
             own = np.mean([c.get("approach_speed", np.nan) for c in closed])
             measured = np.mean([m["approach_speed"] for m in meas])
-            td_r = [_pct(r["tactical_diameter"], m["tactical_diameter"])
+            td_r = [_pct(r.get("tactical_diameter", np.nan), m["tactical_diameter"])
                     for r, m in zip(replay, meas, strict=True)]  # fmt: skip
             td_c = [_pct(c.get("tactical_diameter", np.nan), m["tactical_diameter"])
                     for c, m in zip(closed, meas, strict=True)]  # fmt: skip

@@ -4,6 +4,8 @@ zig-zags and random runs never run steady, and the default fit at their 0.1 s ba
 steady (a straight run's speed); the steady-speed constraint no longer takes the start of a log
 that speeds up there for a steady state."""
 
+from pathlib import Path
+
 import pytest
 from cli_helpers import run
 from test_equilibrium import PROPELLED, steady
@@ -18,6 +20,7 @@ from shipid.identification.physics import PhysicsOptions
 from shipid.reporting.modelfile import load_model
 
 SPEC = "u: |u|u, pos(n)^2; v: u*r, u*v, delta; r: u*r, u*v, delta"
+DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
 
 
 def speeding_up(rps: float, side: str = "starboard"):
@@ -76,3 +79,57 @@ def test_a_bad_steady_speed_is_one_clear_error(tmp_path, capsys, value, message)
                         "-o", tmp_path / "m.json"], capsys)  # fmt: skip
     assert code == 1 and message in err and "Traceback" not in err
     assert not (tmp_path / "m.json").exists()
+
+
+def test_a_turn_that_ends_going_astern_rules_a_model_out():
+    """A held-rudder turn entered ahead that ends going astern, the propeller unchanged: the
+    Esso zig-zags' fit under --steady-speed 0.35@10 at Δk 0.5 s came out with a negative thrust
+    term held up by u·|n|, and at 10 rps its 35° turn ended at −0.74 m/s."""
+    from shipid.identification.plausibility import disqualifying, failed_checks
+
+    model = PROPELLED
+    report = {"approach_speed": 0.35, "rps": 10.0, "straight_line": None,
+              "surge_equilibrium": 0.35, "rudder_deg": 35.0,
+              "held_rudder": {"starboard": {"diverged": False, "settled": True,
+                                            "steady_yaw_rate": 0.286, "steady_speed": -0.739},
+                              "port": {"diverged": False, "settled": True,
+                                       "steady_yaw_rate": -0.05, "steady_speed": 0.15}}}
+    assert disqualifying(report, model) == ["ends going astern with the rudder held to starboard"]
+    (note,) = failed_checks(report, model).values()
+    assert "ends the turn going astern" in note[1] and "-0.739" in note[1]
+
+
+@pytest.mark.skipif(not (DATA / "esso-osaka").is_dir(), reason="../shared/data is not present")
+def test_the_search_leaves_out_models_that_end_a_turn_going_astern(tmp_path, capsys):
+    """The same fit: a candidate whose held-rudder turn ends going astern is ruled out (from the
+    first log's approach, and at the speed given), so the chosen model's 35° turn at 10 rps keeps
+    its headway."""
+    raw = sorted((DATA / "esso-osaka" / "zigzag").glob("*.csv"))
+    code, _, err = run(["import", "--format", "osaka-frt", "--start", "auto", "--end", "auto",
+                        *raw, "-o", tmp_path / "zz"], capsys)  # fmt: skip
+    assert code == 0, err
+    zigzags = sorted((tmp_path / "zz").glob("*.csv"))
+    code, _, err = run(["identify", *zigzags, "--dt", "0.5", "--steady-speed", "0.35@10",
+                        "-o", tmp_path / "m.json"], capsys)  # fmt: skip
+    assert code == 0, err
+    model = load_model(tmp_path / "m.json")
+    assert surge_equilibrium(model, 0.35, 10.0) == pytest.approx(0.35, rel=1e-3)
+    from shipid.trials.manoeuvres import turning_circle
+
+    for side in ("starboard", "port"):
+        turn = turning_circle(model, 35.0, side, speed=0.35, rps=10.0, dt=0.1, method="euler")
+        # (the indices' steady speed is the magnitude: the surge itself says which way)
+        assert turn.log["u"].iloc[-1] > 0.05, side
+
+
+def test_a_manoeuvre_that_ends_astern_is_named_though_its_steady_speed_is_a_magnitude():
+    import pandas as pd
+
+    from shipid.evaluation.envelope import implausible_indices
+
+    u = [0.35] * 50 + [-0.74] * 50
+    log = pd.DataFrame({"t": range(100), "u": u})
+    notes = implausible_indices({"steady_speed": 0.74, "tactical_diameter": 8.1}, 0.35, 3.0, log)
+    assert any("ends the turn going astern (u = -0.74 m/s" in n for n in notes)
+    ahead = log.assign(u=[0.35] * 50 + [0.15] * 50)
+    assert implausible_indices({"steady_speed": 0.15}, 0.35, 3.0, ahead) == []

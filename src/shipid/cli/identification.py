@@ -199,6 +199,12 @@ def cmd_identify(args) -> int:
               f"{plausibility['approach']}"
               + (", with its kernel residual" if hybrid else ""))  # fmt: skip
     ident.warnings.extend(f"plausibility: {n}" for n in notes)
+    from shipid.identification.plausibility import given_steady_speeds
+
+    for u, n in given_steady_speeds(physics):  # where the user says the ship runs steady
+        at = plausibility_at_approach(hybrid or final, u, n, u, n)[1]
+        ident.warnings.extend(f"plausibility at {u:.4g} m/s, {n:.4g} rps (--steady-speed): {w}"
+                              for w in at)  # fmt: skip
     if refinement:
         ident.warnings.extend(f"refinement: {n}" for n in refinement.warnings)
     text = model_text(ident, args.logs, preprocessing=prep, refinement=refinement,

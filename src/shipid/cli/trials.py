@@ -164,7 +164,7 @@ def cmd_manoeuvre(args) -> int:
                      "transient; give a longer --duration")  # fmt: skip
     if args.kind == "turning" and not res.diverged:
         notes += implausible_indices(res.indices, speed or getattr(target, "approach_speed", None),
-                                     getattr(target, "length", None))  # fmt: skip
+                                     getattr(target, "length", None), res.log)  # fmt: skip
     unbounded = {}  # index: how many replicates have none, and why
     for k, v in res.indices.items():
         if k == "table":

@@ -53,9 +53,17 @@ def outside_envelope(env: Mapping[str, Sequence[float]], log: pd.DataFrame) -> l
 
 
 def implausible_indices(indices: Mapping, approach_speed: float | None,
-                        length: float | None = None) -> list[str]:  # fmt: skip
-    """Messages for turning indices no ship shows: the speed nearly lost, a circle under 1 L."""
+                        length: float | None = None, log: pd.DataFrame | None = None
+                        ) -> list[str]:  # fmt: skip
+    """Messages for turning indices no ship shows: the speed nearly lost, a circle under 1 L, a
+    turn entered ahead that ends going astern (``log``: the run; the indices' steady speed is a
+    magnitude, and read +0.74 m/s for an Esso fit that ended its turn at −0.74 m/s)."""
     notes = []
+    if log is not None and approach_speed and approach_speed > 0 and len(log):
+        end = float(np.mean(log["u"].to_numpy()[-max(1, len(log) // 10):]))
+        if end < 0:
+            notes.append(f"the ship ends the turn going astern (u = {end:.3g} m/s, entered at "
+                         f"{approach_speed:.3g} m/s ahead, the propeller unchanged): implausible")
     speed = indices.get("steady_speed")
     if speed is not None and approach_speed and math.isfinite(speed) \
             and speed < MIN_SPEED_FRACTION * approach_speed:

@@ -109,6 +109,17 @@ def plausibility_at_approach(model: ManoeuvringModel, trained_speed: float,
     return report, notes
 
 
+def given_steady_speeds(physics) -> list[tuple[float, float]]:
+    """(u, n) of the steady speeds a user gave (``--steady-speed``): the model is checked there
+    too, where its manoeuvres will be asked for, not only from the first log's approach."""
+    approach = getattr(physics, "approach", None) if getattr(physics, "steady_speed", False) \
+        else None  # fmt: skip
+    if not approach:
+        return []
+    items = [approach] if isinstance(approach, dict) else list(approach)
+    return [(float(a["u"]), float(a.get("n", 0.0))) for a in items]
+
+
 # How badly a check fails, to compare two models check by check: a rudder held to a side that
 # diverges is worse than one that turns the wrong way, which is worse than one still settling.
 UNSETTLED, WRONG_WAY, DIVERGED = 1, 2, 3
@@ -140,7 +151,17 @@ def failed_checks(report: dict, model: ManoeuvringModel) -> dict[str, tuple[int,
         elif math.copysign(1.0, entry["steady_yaw_rate"]) != (1.0 if side == "starboard" else -1.0):
             out[key] = (WRONG_WAY, f"{where}: the model turns the other way (steady yaw rate "
                                    f"{entry['steady_yaw_rate']:.3g} rad/s)")  # fmt: skip
+        elif _goes_astern(entry, speed):
+            out[key] = (WRONG_WAY, f"{where}: the model ends the turn going astern (steady speed "
+                                   f"{entry['steady_speed']:.3g} m/s from {speed:.3g} m/s ahead)")
     return out
+
+
+def _goes_astern(entry: dict, approach_speed: float) -> bool:
+    """A turn entered ahead that ends going astern, with the propeller unchanged: no ship does
+    (a surge fit whose thrust term came out negative, held up by u·|n|, did at 10 rps)."""
+    steady = entry.get("steady_speed")
+    return approach_speed > 0 and steady is not None and steady <= 0
 
 
 def new_failures(reference: dict, candidate: dict, model: ManoeuvringModel) -> list[str]:
@@ -153,8 +174,9 @@ def new_failures(reference: dict, candidate: dict, model: ManoeuvringModel) -> l
 
 def disqualifying(report: dict, model: ManoeuvringModel) -> list[str]:
     """The failed checks that rule a model out of a selection: the rudder held to a side
-    diverges or turns the ship the other way, or surge has no steady speed. Straight-line
-    instability (real full-form ships have it) and slow settling stay warnings."""
+    diverges, turns the ship the other way or ends the turn going astern, or surge has no steady
+    speed. Straight-line instability (real full-form ships have it) and slow settling stay
+    warnings."""
     reasons = []
     eq = report.get("surge_equilibrium")
     if "u" in model.structure.dofs and (eq is None or eq <= 0):
@@ -165,4 +187,6 @@ def disqualifying(report: dict, model: ManoeuvringModel) -> list[str]:
         elif entry.get("steady_yaw_rate") is not None and math.copysign(
                 1.0, entry["steady_yaw_rate"]) != (1.0 if side == "starboard" else -1.0):
             reasons.append(f"turns the wrong way with the rudder to {side}")
+        elif _goes_astern(entry, report.get("approach_speed") or 0.0):
+            reasons.append(f"ends going astern with the rudder held to {side}")
     return reasons

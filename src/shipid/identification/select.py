@@ -550,9 +550,14 @@ def select(
     import dataclasses
 
     from shipid.identification.identify import identify
-    from shipid.identification.plausibility import disqualifying, plausibility_at_approach
+    from shipid.identification.plausibility import (
+        disqualifying,
+        given_steady_speeds,
+        plausibility_at_approach,
+    )
 
     options = dataclasses.replace(options or SelectOptions(), **overrides)
+    given = given_steady_speeds(options.physics)  # before the logs' approaches fill them in
     # The constraints' approaches, resolved once for the thousand fits of the search.
     options = dataclasses.replace(options, physics=with_approaches(
         options.physics, [logs] if isinstance(logs, pd.DataFrame) else list(logs)))
@@ -594,6 +599,10 @@ def select(
                 model = _model_from_theta(data, cand.terms, theta, "candidate")
                 report, _ = plausibility_at_approach(model, speed, rps, options.speed, options.rps)
                 reasons = disqualifying(report, model)
+                for u, n in given:  # where the user says the ship runs steady
+                    at = plausibility_at_approach(model, u, n, u, n)[0]
+                    reasons += [f"{r} at {u:.3g} m/s, {n:.3g} rps"
+                                for r in disqualifying(at, model)]  # fmt: skip
                 plausibility_cache[cand.key] = (not reasons, "; ".join(reasons))
         ok, why = plausibility_cache[cand.key]
         cand.plausible = ok
