@@ -2,7 +2,7 @@
 #10): from the model's own steady straight speed at the log's propeller speed. Its replay starts
 from the measured state, so a model whose surge balances at the wrong speed was never caught:
 trained on the Esso Osaka's zig-zags and random runs at their Δk of 0.1 s, the README's terms
-reach 0.52 m/s at 10 rps, where the ship's 35° turns approach at 0.35 m/s."""
+reached 0.52 m/s at 10 rps, where the ship's 35° turns approach at 0.35 m/s."""
 
 import math
 

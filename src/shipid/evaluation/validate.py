@@ -14,9 +14,10 @@ starts from the trial's initial state, or, where the log approaches steady and t
 answers the propeller, as ``shipid manoeuvre`` starts: straight, at the model's own steady speed at
 the log's propeller speed, which a replay from the measured state never tests (``approach_speed``,
 measured and closed loop, and a warning beyond 10 %). Trained on the Esso Osaka's zig-zags and
-random runs at the logs' Δk of 0.1 s, the README's terms reach 0.52 m/s at 10 rps, where the ship's
-35° turns approach at 0.35 m/s; the replay's tactical diameter is 11 % and 5 % long, the closed
-loop's 30 % and 17 % (``benchmarks/study_sampling.py``).
+random runs at the logs' Δk of 0.1 s, a surge damped by u·|n| alone balanced at 0.52 m/s at 10 rps,
+where the ship's 35° turns approach at 0.35 m/s; the replay's tactical diameter was 11 % and 5 %
+long, the closed loop's 30 % and 17 % (``benchmarks/study_sampling.py``, before the hull's
+resistance led the surge's ranking in ``select``).
 
 A log that cannot be validated (a missing input column, a run that starts astern for a closed-loop
 replica) does not stop the others: its ``Validation`` carries the error.
