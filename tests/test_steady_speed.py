@@ -1,6 +1,6 @@
-"""Where a model's surge balances is what the logs determine least (issue #10): the Esso Osaka's zig-
-zags and random runs never run steady, and the default fit at their 0.1 s balanced at 0.52 m/s at
-10 rps, where the ship holds 0.35 m/s (0.387 with the hull's resistance in every candidate).
+"""Where a model's surge balances is what the logs determine least (issue #10): the Esso Osaka's
+zig-zags and random runs never run steady, and the default fit at their 0.1 s balanced at 0.52 m/s
+at 10 rps, where the ship holds 0.35 m/s (0.387 with the hull's resistance in every candidate).
 `--steady-speed U@N` says where the ship runs steady (a straight run's speed); the steady-speed
 constraint no longer takes the start of a log that speeds up there for a steady state."""
 
