@@ -53,9 +53,13 @@ def main() -> None:
                 v = validate(model, [log])[0]
                 m, closed = v.metrics, v.indices["closed_loop"]
                 measured = v.indices["measured"]
+                # A model with propeller terms runs its zig-zag from its own steady speed at the
+                # log's rps (as shipid manoeuvre does): said where it is not the log's.
+                own, log_speed = closed["approach_speed"], measured["approach_speed"]
+                start = f" from {own:.3g} m/s" if abs(own / log_speed - 1) > 0.005 else ""
                 cells.append(f"{m['u']['std']:.4f} / {m['v']['std']:.4f} / {m['r']['std']:.4f}, "
                              f"{closed['first_overshoot_deg']:.1f}°, "
-                             f"{closed['second_overshoot_deg']:.1f}°")  # fmt: skip
+                             f"{closed['second_overshoot_deg']:.1f}°{start}")  # fmt: skip
             print(f"| {library or 'default'} | {held} | {measured['first_overshoot_deg']:.1f}°, "
                   f"{measured['second_overshoot_deg']:.1f}° | " + " | ".join(cells) + " |")
     print(f"\n{time.perf_counter() - t0:.0f} s")
