@@ -197,7 +197,7 @@ def approach_states(options: PhysicsOptions, logs: Sequence[pd.DataFrame], what:
     """(u0, n0) of every training log's start (or ``options.approach``); of a log that starts
     without headway (a random run begun at rest), its running condition
     (``shipid.data.log.approach``)."""
-    from shipid.data.log import approach, log_name, starts_without_headway, steady_start
+    from shipid.data.log import approach, starts_without_headway
 
     def state(log: pd.DataFrame) -> tuple[float, float]:
         if starts_without_headway(log):
@@ -211,7 +211,7 @@ def approach_states(options: PhysicsOptions, logs: Sequence[pd.DataFrame], what:
         states = [(float(a["u"]), float(a.get("n", 0.0))) for a in options.approach]
     else:
         if "steady-speed" in what:
-            logs = _steady_starts(logs, log_name, steady_start)
+            logs = _steady_starts(logs)
         states = sorted({state(log) for log in logs})
     if not all(u0 > 0 for u0, _ in states):
         raise ShipidError(f"{what} constraint: a training log starts without headway; trim it to "
@@ -219,10 +219,13 @@ def approach_states(options: PhysicsOptions, logs: Sequence[pd.DataFrame], what:
     return states
 
 
-def _steady_starts(logs, log_name, steady_start) -> list[pd.DataFrame]:
+def _steady_starts(logs: Sequence[pd.DataFrame]) -> list[pd.DataFrame]:
     """The logs whose start can be a steady state: u̇ = 0 imposed where a log starts speeding up
-    (the Esso Osaka's zig-zags: +45 % in 10 s) put the surge's balance at its start; a log that
-    clearly speeds up, slows down or turns there is left out, and none left is an error."""
+    (the Esso Osaka's zig-zags: +15 to +52 % per 10 s) put the surge's balance at its start; a
+    log that clearly speeds up, slows down or turns there is left out, and none left is an
+    error."""
+    from shipid.data.log import log_name, steady_start
+
     judged = [(log, steady_start(log)) for log in logs]
     kept = [log for log, start in judged if start.steady is not False]
     if not kept:
