@@ -765,8 +765,8 @@ def _rankings(data: _Data, full) -> dict[str, list[tuple[str, float]]]:
     terms a candidate of k terms holds, and on equation error alone u·|n| (the propeller's
     thrust falling with advance) can stand in for it: the Esso Osaka's surge chosen at the
     logs' 0.1 s damped the ship by u·|n| alone, balanced at 0.52 m/s at 10 rps where the ship
-    holds 0.35 and, with the propeller stopped, lost speed at a constant 0.4 mm/s² whatever its
-    speed."""
+    holds 0.35 and, with the propeller stopped, lost speed at an almost constant 0.4 mm/s²
+    whatever its speed."""
     out = {}
     for dof, terms in full.items():
         names, X, y = _stacked(data, dof, terms)
