@@ -369,3 +369,12 @@ def _steering(target, cond: dict, rate_deg_s: float | None, fallback: str = "ins
     steering = (SteeringMachine(math.radians(35.0), rate) if own is None
                 else dataclasses.replace(own, max_rate=rate))  # fmt: skip
     return steering, f"rudder rate {math.degrees(rate):.3g} °/s ({source})"
+
+
+def _warn_beyond_training(cond: dict, name: str, log) -> None:
+    """A warning per signal where a model's run (``simulate``'s, a controller's) leaves its
+    training logs' range: a run beyond the trials is a guess."""
+    from shipid.evaluation.envelope import outside_envelope
+
+    for note in outside_envelope(cond.get("envelope") or {}, log):
+        _warn(f"{name}: {note}")

@@ -13,6 +13,7 @@ from shipid.cli.common import (
     _ship_or_model,
     _steering,
     _warn,
+    _warn_beyond_training,
 )
 from shipid.errors import ShipidError
 
@@ -138,15 +139,6 @@ def cmd_autopilot(args) -> int:
         autopilot_figure(runs, args.output, f"heading autopilot, step to {args.heading:g}°")
         print(f"figure written to {args.output}")
     return 0
-
-
-def _warn_beyond_training(cond: dict, name: str, log) -> None:
-    """A warning per signal where the controlled model's run leaves its training logs' range
-    (a controller tuned and tried on a model beyond its trials is tried on a guess)."""
-    from shipid.evaluation.envelope import outside_envelope
-
-    for note in outside_envelope(cond.get("envelope") or {}, log):
-        _warn(f"{name}: {note}")
 
 
 def _parse_waypoints(text: str) -> list[tuple[float, float]]:

@@ -17,6 +17,7 @@ from shipid.cli.common import (
     _scale_notes,
     _ship_or_model,
     _warn,
+    _warn_beyond_training,
 )
 from shipid.errors import ShipidError
 
@@ -234,9 +235,6 @@ def cmd_simulate(args) -> int:
     write_log(res.log, args.output)
     if res.diverged:
         print(res.reason, file=sys.stderr)
-    from shipid.evaluation.envelope import outside_envelope
-
-    for note in outside_envelope(cond["envelope"], res.log):  # inputs and the run alike
-        _warn(f"{log_path}: {note}")
+    _warn_beyond_training(cond, str(log_path), res.log)  # the log's inputs and the run alike
     print(f"{len(res.log)} samples written to {args.output}")
     return 0
