@@ -25,6 +25,8 @@ NOISE_FLOOR = math.radians(0.01)
 MEDIAN_WINDOW_S = 0.5
 # Half-width of the dead band, in standard deviations of the median-filtered noise.
 BAND_SIGMAS = 4.0
+# A swing's 10–90 % part resolved by at least this many sampling intervals gives its rate.
+RESOLVED_STEPS = 4
 
 
 def stand_samples(t: np.ndarray, stand_s: float = 1.0) -> int:
@@ -96,9 +98,13 @@ def ramp_start(t: np.ndarray, delta: np.ndarray, a: int, b: int, level: float) -
 
 
 def rise_rate(t: np.ndarray, delta: np.ndarray, hold_s: float = 1.0) -> float | None:
-    """Rudder rate [rad/s] read from the event rudder of a noisy log: the median over its swings
-    (runs of steps one way, a stand of ``hold_s`` or a reversal ending one) of 80 % of the swing
-    over the time from 10 % to 90 % of it. Steps between samples would measure the noise."""
+    """Rudder rate [rad/s] of a log's rudder (the event rudder of a noisy one): the median over
+    its swings (runs of steps one way, a stand of ``hold_s`` or a reversal ending one) of 80 % of
+    the swing over the time from 10 % to 90 % of it. Steps between samples would measure the
+    noise, or the quantisation: MARIN's rudder, to three digits at 50 Hz, steps by 0.3° or 0.4°
+    at its 15.7°/s, and the 90th percentile of its steps read 20°/s. A swing whose 10–90 % part
+    spans fewer than ``RESOLVED_STEPS`` samples counts its fastest step (a rate-limited gear
+    moves at its limit between two samples; interpolating 10 % and 90 % there reads it slow)."""
     step = np.sign(np.diff(delta))
     edges = np.flatnonzero(step[1:] != step[:-1]) + 1
     starts = np.concatenate([[0], edges])
@@ -114,6 +120,7 @@ def rise_rate(t: np.ndarray, delta: np.ndarray, hold_s: float = 1.0) -> float | 
         else:
             swings.append([a, b, s])
     rates = []
+    dt = float(np.median(np.diff(t)))
     for a, b, s in swings:
         swing = abs(delta[b] - delta[a])
         if swing < math.radians(2.0):
@@ -121,6 +128,8 @@ def rise_rate(t: np.ndarray, delta: np.ndarray, hold_s: float = 1.0) -> float | 
         seg = s * delta[a : b + 1]  # non-decreasing
         lo, hi = seg[0] + 0.1 * swing, seg[0] + 0.9 * swing
         t10, t90 = np.interp([lo, hi], seg, t[a : b + 1])
-        if t90 > t10:
+        if t90 - t10 >= RESOLVED_STEPS * dt:
             rates.append(0.8 * swing / (t90 - t10))
+        else:
+            rates.append(float(np.max(np.abs(np.diff(delta[a : b + 1])) / np.diff(t[a : b + 1]))))
     return float(np.median(rates)) if rates else None

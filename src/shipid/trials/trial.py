@@ -167,7 +167,10 @@ def _rudder_rate(t: np.ndarray, delta: np.ndarray) -> float | None:
     # and step/Δt would only measure the sampling.
     if step.max() >= 0.5 * np.ptp(delta):
         return None
-    return float(np.percentile(rate[moving], 90))
+    # By the swings, not by the steps, which measure the quantisation too; movements all under
+    # the 2° of a swing by their fastest steps.
+    swings = rise_rate(t, delta)
+    return swings if swings is not None else float(np.percentile(rate[moving], 90))
 
 
 def describe_trial(
