@@ -12,13 +12,17 @@ turns at 10 rps and the held-out random runs:
   `criteria` start from);
 - the turns' tactical diameters replayed from the measured state ("replay") and run closed loop
   from the model's own approach at 10 rps ("closed loop", as `validate` and `manoeuvre` do);
-- the random runs' free-run r and u error std over their spread.
+- the random runs' free-run r and u error std over their spread;
+- the CV score of the structure `select` chose (its leave-one-log-out free-run error over the
+  training logs), to see whether it could choose Δk too ("named": the search's candidates were
+  all implausible and `identify` fell back to a named structure, which has no score).
 
 Run: .venv/bin/python benchmarks/study_sampling.py
 """
 
 from __future__ import annotations
 
+import json
 import warnings
 from pathlib import Path
 
@@ -44,8 +48,8 @@ def _pct(pred, meas) -> float:
 def study(folder: Path) -> None:
     print("| Δk [s] | held out | model's speed at 10 rps (measured) | TD +35°, −35° replay | "
           "TD +35°, −35° closed loop | steady r +35°, −35° closed loop | random runs r / u "
-          "error over spread |")  # fmt: skip
-    print("|---|---|---|---|---|---|---|")
+          "error over spread | CV score |")  # fmt: skip
+    print("|---|---|---|---|---|---|---|---|")
     means = {}
     for dt, steady in CASES:
         extra = ("--steady-speed", steady) if steady else ()
@@ -68,6 +72,7 @@ def study(folder: Path) -> None:
                 print(f"| {label} | {fold} | identify refused | | | | |")
                 continue
             model = load_model(path)
+            cv = json.loads(path.read_text())["identification"]["structure_choice"].get("score")
             held_logs = [rnd[k] for k in rnd if f"rnd {k}" not in keys]
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
@@ -88,21 +93,21 @@ def study(folder: Path) -> None:
             err_u = np.mean([v.metrics["u"]["std"] / np.std(x["u"])
                              for v, x in zip(vals[2:], held_logs, strict=True)])  # fmt: skip
             rows.append((abs(_pct(own, measured)), np.mean(np.abs(td_r)), np.mean(np.abs(td_c)),
-                         np.mean(np.abs(r_c)), err_r, err_u))  # fmt: skip
+                         np.mean(np.abs(r_c)), err_r, err_u, np.nan if cv is None else cv))  # fmt: skip
             print(f"| {label} | {fold} | {own:.3f} ({measured:.3f}, "
                   f"{_pct(own, measured):+.0f} %) | {td_r[0]:+.0f} %, {td_r[1]:+.0f} % | "
                   f"{td_c[0]:+.0f} %, {td_c[1]:+.0f} % | {r_c[0]:+.0f} %, {r_c[1]:+.0f} % | "
-                  f"{err_r:.2f} / {err_u:.2f} |")  # fmt: skip
-        means[label] = np.mean(rows, axis=0)
+                  f"{err_r:.2f} / {err_u:.2f} | {'named' if cv is None else f'{cv:.3f}'} |")  # fmt: skip
+        means[label] = np.nanmean(rows, axis=0)
     print("\nMeans over the folds: |error| of the model's speed at 10 rps, of the tactical "
           "diameters (replay, closed loop) and of the closed loop's steady yaw rates; random "
-          "runs' r and u error over spread\n")  # fmt: skip
+          "runs' r and u error over spread; the CV score where select chose\n")  # fmt: skip
     print("| Δk [s] | speed at 10 rps | TD replay | TD closed loop | steady r closed loop | "
-          "random runs r / u |")  # fmt: skip
-    print("|---|---|---|---|---|---|")
+          "random runs r / u | CV score |")  # fmt: skip
+    print("|---|---|---|---|---|---|---|")
     for label, m in means.items():
         print(f"| {label} | {m[0]:.0f} % | {m[1]:.1f} % | {m[2]:.1f} % | {m[3]:.1f} % | "
-              f"{m[4]:.2f} / {m[5]:.2f} |")
+              f"{m[4]:.2f} / {m[5]:.2f} | {m[6]:.3f} |")
 
 
 if __name__ == "__main__":
