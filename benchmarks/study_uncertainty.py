@@ -4,7 +4,9 @@ maximum-likelihood output error from it (covariance intervals): how well each pr
 held-out manoeuvres against the true model's own error, and how often its 95 % intervals cover
 the true coefficients. Runs as a ``shipid study`` (``shipid.evaluation.study``).
 
-Then the same comparison on real data: the KVLCC2's held-out zig-zags (``real_data``).
+Then the same comparison on real data: the KVLCC2's held-out zig-zags (``real_data``), and
+the plain ``shipid identify`` command, whose default fits by output error where the LS-SVM's
+free runs leave only the sensors' noise (``default_command``).
 
 Run: .venv/bin/python benchmarks/study_uncertainty.py [SEEDS] [REPLICATES]
 """
@@ -70,6 +72,65 @@ def standard_error_coverage(seeds: int = 20) -> None:
           f"coefficient × seed pairs ({100 * hit / total:.0f} %), {seeds} seeds")
 
 
+def default_command(seeds: int = 20) -> None:
+    """Issue #10's acceptance, run as a user would: ``shipid identify TRAINING.csv`` (no flags)
+    on each seed's noisy 20/20 zig-zag, then the held-out trials. Counts how often the file's
+    95 % intervals (estimate ± 1.96 of its standard errors: output error's where the default
+    chose it, else the LS-SVM's) hold the true coefficient, the wrong signs outside them, and
+    the paper's table rows beaten."""
+    import contextlib
+    import io
+    import json
+    import tempfile
+    from pathlib import Path
+
+    import numpy as np
+
+    from shipid.cli import main as cli
+    from shipid.data.io import write_log
+    from shipid.demo import PAPER_TABLE, TRAINING, synthesise_trials
+    from shipid.evaluation.validate import validate
+    from shipid.reporting.modelfile import load_model
+    from shipid.vessels import scale_ship_model
+
+    truth = scale_ship_model().coefficients
+    hit = total = wrong_sign = oe = 0
+    beats = {k: 0 for k in PAPER_TABLE if k != TRAINING}
+    t0 = time.perf_counter()
+    with tempfile.TemporaryDirectory() as tmp:
+        for seed in range(seeds):
+            logs = synthesise_trials(seed)
+            train = write_log(logs[TRAINING], Path(tmp) / "train.csv")
+            out = Path(tmp) / "model.json"
+            with contextlib.redirect_stdout(io.StringIO()), \
+                    contextlib.redirect_stderr(io.StringIO()):
+                assert cli(["identify", str(train), "-o", str(out)]) == 0
+            doc = json.loads(out.read_text())
+            ref = doc["identification"].get("refinement")
+            oe += ref is not None
+            se = (ref["statistics"]["standard_errors"] if ref else
+                  {d: v.get("std_errors", {}) for d, v in doc["identification"]["diagnostics"].items()})
+            for dof, terms in doc["model"]["coefficients"].items():
+                for term, value in terms.items():
+                    if term == "1" or term not in truth.get(dof, {}):
+                        continue
+                    want, s = truth[dof][term], se[dof].get(term, 0.0)
+                    inside = abs(value - want) <= 1.96 * s
+                    total += 1
+                    hit += inside
+                    wrong_sign += (not inside) and want != 0 and np.sign(value) != np.sign(want)
+            model = load_model(out)
+            for v in validate(model, [logs[k] for k in beats], list(beats)):
+                beats[v.name] += all(v.metrics[s]["std"] <= p for s, p in
+                                     zip("uvr", PAPER_TABLE[v.name], strict=True))  # fmt: skip
+    print(f"\n`shipid identify TRAINING.csv` (no flags), {seeds} seeds of the demo's trials: "
+          f"output error chosen in {oe} of {seeds}; 95 % intervals hold the true coefficient in "
+          f"{hit} of {total} coefficient × seed pairs ({100 * hit / total:.0f} %); wrong sign "
+          f"outside the interval: {wrong_sign}; the paper's table beaten: "
+          + ", ".join(f"{k} {n} of {seeds}" for k, n in beats.items())
+          + f"; {(time.perf_counter() - t0) / seeds:.2f} s per seed")
+
+
 def real_data() -> None:
     """KVLCC2 (MARIN zz 20°, ``blanke-speed``, prefilter chosen from the data, as ``identify``):
     the LS-SVM against output error from it, free-run error std on the two held-out zig-zags,
@@ -100,6 +161,12 @@ def real_data() -> None:
 
     cutoff, _ = choose_prefilter([train], fit)
     lssvm = fit(train if cutoff is None else lowpass(train, cutoff))
+    from shipid.identification.output_error import NOISE_DOMINATES, noise_ratios
+
+    ratios = noise_ratios(lssvm, [train]).iloc[0]
+    print("\nKVLCC2, MARIN zz 20°: the LS-SVM's free-run error over the log's white noise "
+          + ", ".join(f"{s} {x:.3g}" for s, x in ratios.items())
+          + f" (the default fits by output error at ≤ {NOISE_DOMINATES:g} in every state)")
     oe, _ = output_error(lssvm, train)
     st = oe.statistics
     print(f"\nKVLCC2, trained on MARIN zz 20° (prefilter {cutoff:.3g} Hz); output error: residual "
@@ -122,4 +189,5 @@ def real_data() -> None:
 if __name__ == "__main__":
     main(*(int(a) for a in sys.argv[1:3]))
     standard_error_coverage()
+    default_command()
     real_data()

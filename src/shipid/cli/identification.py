@@ -67,13 +67,14 @@ def cmd_identify(args) -> int:
     check_outputs({"-o": (args.output, "json")}, args.logs)
     if args.bootstrap is not None and args.refine:
         raise ShipidError("--bootstrap describes the LS-SVM fit; it does not go with --refine")
-    if args.output_error and (args.refine or args.bootstrap is not None):
+    asked = args.output_error == "always"
+    if asked and (args.refine or args.bootstrap is not None):
         raise ShipidError("--output-error is its own fit with its own intervals; it does not go "
                           "with --refine or --bootstrap")  # fmt: skip
-    if args.error_band is not None and (args.refine or args.output_error):
+    if args.error_band is not None and (args.refine or asked):
         raise ShipidError("--error-band describes the LS-SVM fit; it does not go with --refine "
                           "or --output-error")  # fmt: skip
-    if args.residual and (args.refine or args.output_error or args.bootstrap is not None):
+    if args.residual and (args.refine or asked or args.bootstrap is not None):
         raise ShipidError("--residual adds a kernel residual to the LS-SVM fit; it does not go "
                           "with --refine, --output-error or --bootstrap")  # fmt: skip
     logs = _training_logs(args)
@@ -170,8 +171,11 @@ def cmd_identify(args) -> int:
         print(f"cost {refinement.cost_initial:.4g} → {refinement.cost_final:.4g} in "
               f"{refinement.nfev} evaluations ({refinement.message})")
         print(_free_run_table(refinement))
-    if args.output_error:
+    if asked:
         refinement, ensemble = _output_error(ident, raw_logs, names, args)
+    elif args.output_error == "auto" and not (args.refine or args.bootstrap is not None
+                                             or args.error_band is not None or args.residual):
+        refinement, ensemble = _output_error_where_noise_is_left(ident, raw_logs, names, args)
     final = ident.model
     if speed is None or not speed > 0:
         raise ShipidError(f"{names[0]}: the first training log starts without headway (u = "
@@ -187,7 +191,7 @@ def cmd_identify(args) -> int:
                 "refinement: the refined model fails plausibility checks the LS-SVM model passes ("
                 + "; ".join(worse[:2]) + "); the model file's model is the LS-SVM one, the "
                 "refined one is kept under identification.refinement.refined_model")
-            if args.output_error:
+            if not args.refine:  # an output-error fit
                 ensemble = None  # its draws describe the output-error model, not this one
         else:
             final, plausibility, notes = refinement.model, refined_report, refined_notes
@@ -246,6 +250,38 @@ def _choose_structure(args, logs, names):
     if args.gamma is None:
         args.gamma = choice.gamma if choice is not None and choice.gamma else 1e4
     return choice
+
+
+def _output_error_where_noise_is_left(ident, logs, names, args):
+    """The default: output error where the LS-SVM's free runs leave only the sensors' noise
+    (``output_error.noise_dominates``) and its own residuals come out white; else the LS-SVM
+    fit, and one line saying why. Returns (refinement, ensemble), (None, None) for the LS-SVM."""
+    from shipid.identification.output_error import (
+        INFLATION_WARNING,
+        NOISE_DOMINATES,
+        noise_dominates,
+        noise_ratios,
+    )
+
+    ratios = noise_ratios(ident.model, logs)
+    worst = ratios.max(axis=0)
+    if not noise_dominates(ratios):
+        state = str(worst.idxmax())
+        print(f"output error: not fitted; the LS-SVM's free runs miss the logs by up to "
+              f"{worst[state]:.3g} times their sensor noise in {state} (more than "
+              f"{NOISE_DOMINATES:g}): model error, not noise, is what is left "
+              "(--output-error fits it anyway)")  # fmt: skip
+        return None, None
+    print(f"output error: the LS-SVM's free runs miss the logs by at most {worst.max():.3g} "
+          "times their sensor noise, so noise is what it leaves: fitting by maximum-likelihood "
+          "output error (--no-output-error to keep the LS-SVM fit)")  # fmt: skip
+    fit, ensemble = _output_error(ident, logs, names, args)
+    inflation = fit.statistics["covariance_inflation"]
+    if not inflation < INFLATION_WARNING:
+        print(f"output error: its residuals are correlated (standard errors ×{inflation:.3g}): "
+              "model error after all; the model file keeps the LS-SVM fit")  # fmt: skip
+        return None, None
+    return fit, ensemble
 
 
 def _output_error(ident, logs, names, args):

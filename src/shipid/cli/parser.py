@@ -142,12 +142,18 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--refine", action="store_true",
                    help="refine the LS-SVM model by output error (free-run fit to the logs); the "
                    "model file holds the refined model and keeps the LS-SVM one")
-    p.add_argument("--output-error", action="store_true",
+    p.add_argument("--output-error", dest="output_error", action="store_const", const="always",
+                   default="auto",
                    help="fit the coefficients by maximum-likelihood output error (free runs from "
                    "estimated initial states against the unfiltered logs; consistent under "
                    "measurement noise, unlike any equation-error fit), with standard errors, "
                    "95 %% intervals and 200 covariance draws stored for prediction bands and "
-                   "index intervals; the LS-SVM model is its start and stays in the file")
+                   "index intervals; the LS-SVM model is its start and stays in the file. "
+                   "Default: where the LS-SVM's free runs miss the logs by no more than twice "
+                   "their sensor noise, and the output-error residuals come out white (noise, "
+                   "not model error), without --refine, --bootstrap, --error-band or --residual")
+    p.add_argument("--no-output-error", dest="output_error", action="store_const",
+                   const="never", help="keep the LS-SVM fit even where noise is all it leaves")
     p.add_argument("--segment", type=float, metavar="S",
                    help="with --refine: simulate segments of S seconds (default: whole logs)")
     p.add_argument("--refine-evals", type=int, default=200, metavar="N",

@@ -23,6 +23,17 @@ def cumulative_integral(y: np.ndarray, t: np.ndarray, initial: float = 0.0) -> n
     out[1:] += initial
     return out
 
+def white_noise_variance(x: np.ndarray) -> float:
+    """Variance of the white noise on a smooth signal, from its second differences
+    (Var Δ²e = 6σ²), robustly (1.4826·MAD). The signal's own second differences, small at a
+    sampling that resolves it, add to it."""
+    d2 = np.diff(np.asarray(x, dtype=float), 2)
+    if d2.size < 3:
+        return 0.0
+    mad = float(np.median(np.abs(d2 - np.median(d2))))
+    return (1.4826 * mad) ** 2 / 6.0
+
+
 def resample(log: pd.DataFrame, dt: float, name: str = "log") -> pd.DataFrame:
     """Linear interpolation of every column onto t0, t0 + dt, ... (heading unwrapped first)."""
     if not (isinstance(dt, int | float) and math.isfinite(dt) and dt > 0):

@@ -19,7 +19,7 @@ import numba
 import numpy as np
 import pandas as pd
 
-from shipid.data.preprocess import cumulative_integral
+from shipid.data.preprocess import cumulative_integral, white_noise_variance
 from shipid.errors import ShipidError
 from shipid.trials.trial import (
     KINDS,
@@ -64,16 +64,6 @@ def _rts_smooth(z: np.ndarray, w: np.ndarray, R: float, q: float) -> np.ndarray:
 BOOKKEEPING = ("switch_heading_deg", "first_execute_time", "steady_from", "steady_to")
 
 
-def _white_noise_var(x: np.ndarray) -> float:
-    """Variance of the white noise on a smooth signal, from its second differences
-    (Var Δ²e = 6σ²), robustly (1.4826·MAD)."""
-    d2 = np.diff(x, 2)
-    if d2.size < 3:
-        return 0.0
-    mad = float(np.median(np.abs(d2 - np.median(d2))))
-    return (1.4826 * mad) ** 2 / 6.0
-
-
 def smoothed_positions(t, x, y, u, v, psi) -> tuple[np.ndarray, np.ndarray]:
     """Positions smoothed with the velocity-integrated increments (see module docstring).
 
@@ -97,7 +87,7 @@ def smoothed_positions(t, x, y, u, v, psi) -> tuple[np.ndarray, np.ndarray]:
     if R <= 1e-9 * max(var, 1e-30):
         return x, y  # positions as precise as the increments: keep them
     h2 = float(np.median(h)) ** 2
-    q_velocity = 0.5 * h2 * 0.5 * (_white_noise_var(xd) + _white_noise_var(yd))
+    q_velocity = 0.5 * h2 * 0.5 * (white_noise_variance(xd) + white_noise_variance(yd))
     # Var d − 2R is q only where it stands out of its own sampling error (≈ var·√(2/N)).
     q_moment = var - 2.0 * R
     if q_moment < 3.0 * var * math.sqrt(2.0 / d.size):
