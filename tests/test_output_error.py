@@ -268,3 +268,21 @@ def test_the_default_keeps_the_lssvm_where_model_error_is_what_is_left(tmp_path,
     assert code == 0, err
     assert "model error after all; the model file keeps the LS-SVM fit" in text
     assert json.loads((tmp_path / "m.json").read_text())["identification"].get("refinement") is None
+
+
+def test_physics_the_output_error_fit_would_not_hold_keeps_the_lssvm(tmp_path, capsys, paper_fit):
+    """Bug: output error fits every coefficient freely, so a sign constraint or prior asked for
+    would have been fitted away by the default's output-error fit without a word."""
+    _, logs = paper_fit
+    train = write_log(logs[TRAINING], tmp_path / "train.csv")
+    code, text, err = run(["identify", train, "--constraints", "signs", "-o", tmp_path / "m.json"],
+                          capsys)  # fmt: skip
+    assert code == 0, err
+    assert "output error: not fitted, since it would not hold --constraints" in text
+    doc = json.loads((tmp_path / "m.json").read_text())
+    assert doc["identification"].get("refinement") is None
+    assert doc["model"]["coefficients"]["v"]["|v|*r"] <= 0  # the sign table's: damping
+    code, _, err = run(["identify", train, "--output-error", "--bound", "r: u*r <= 0", "-o",
+                        tmp_path / "b.json"], capsys)  # fmt: skip
+    assert code == 1 and "does not hold --bound" in err and len(err.splitlines()) == 1
+    assert not (tmp_path / "b.json").exists()

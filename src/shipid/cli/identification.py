@@ -68,6 +68,13 @@ def cmd_identify(args) -> int:
     if args.bootstrap is not None and args.refine:
         raise ShipidError("--bootstrap describes the LS-SVM fit; it does not go with --refine")
     asked = args.output_error == "always"
+    given_physics = [flag for flag, value in (("--prior", args.prior),
+                                              ("--constraints", args.constraints),
+                                              ("--bound", args.bound),
+                                              ("--steady-speed", args.steady_speed)) if value]
+    if asked and given_physics:
+        raise ShipidError(f"--output-error fits the coefficients freely; it does not hold "
+                          f"{given_physics[0]} (the LS-SVM fit does: leave out --output-error)")
     if asked and (args.refine or args.bootstrap is not None):
         raise ShipidError("--output-error is its own fit with its own intervals; it does not go "
                           "with --refine or --bootstrap")  # fmt: skip
@@ -175,7 +182,11 @@ def cmd_identify(args) -> int:
         refinement, ensemble = _output_error(ident, raw_logs, names, args)
     elif args.output_error == "auto" and not (args.refine or args.bootstrap is not None
                                              or args.error_band is not None or args.residual):
-        refinement, ensemble = _output_error_where_noise_is_left(ident, raw_logs, names, args)
+        if given_physics:  # output error would fit them away
+            print(f"output error: not fitted, since it would not hold {given_physics[0]}; the "
+                  "LS-SVM fit does")  # fmt: skip
+        else:
+            refinement, ensemble = _output_error_where_noise_is_left(ident, raw_logs, names, args)
     final = ident.model
     if speed is None or not speed > 0:
         raise ShipidError(f"{names[0]}: the first training log starts without headway (u = "
