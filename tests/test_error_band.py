@@ -176,3 +176,27 @@ def test_identify_error_band_is_its_fit_without_each_log(zigzags, tmp_path, caps
     code, out, err = run(["identify", paths[0], "--error-band", "kfold:2", "-o",
                           tmp_path / "k.json"], capsys)  # fmt: skip
     assert code == 1 and "--error-band must be" in err and not (tmp_path / "k.json").exists()
+
+
+def test_identify_gives_the_band_by_default_from_two_logs(zigzags, tmp_path, capsys):
+    """Issue #10: honest uncertainty without flags. From two logs on, a plain ``identify`` whose
+    file holds its LS-SVM fit stores the band of ``--error-band logo``; ``--error-band none``
+    and one log store none."""
+    paths = [write_log(log, tmp_path / f"zz{i}.csv") for i, log in enumerate(zigzags)]
+    base = ["identify", *paths, "--model", "blanke", "--filter", "none"]
+    code, out, err = run([*base, "-o", tmp_path / "d.json"], capsys)
+    assert code == 0, err
+    assert "(--error-band none to skip)" in out and "output error: not fitted" in out
+    code, _, err = run([*base, "--error-band", "logo", "-o", tmp_path / "e.json"], capsys)
+    assert code == 0, err
+    default, explicit = (json.loads((tmp_path / f"{n}.json").read_text())["identification"]
+                         for n in "de")  # fmt: skip
+    assert default["error_band"] == explicit["error_band"]
+    assert default["error_band"]["logs"] == 3
+    for argv, name in (([*base, "--error-band", "none"], "n"),
+                       (["identify", paths[0], "--model", "blanke", "--filter", "none"], "o")):
+        code, out, err = run([*argv, "-o", tmp_path / f"{name}.json"], capsys)
+        assert code == 0, err
+        assert "error band" not in out
+        assert json.loads((tmp_path / f"{name}.json").read_text())["identification"].get(
+            "error_band") is None

@@ -78,7 +78,8 @@ def cmd_identify(args) -> int:
     if asked and (args.refine or args.bootstrap is not None):
         raise ShipidError("--output-error is its own fit with its own intervals; it does not go "
                           "with --refine or --bootstrap")  # fmt: skip
-    if args.error_band is not None and (args.refine or asked):
+    explicit_band = args.error_band not in (None, "none")
+    if explicit_band and (args.refine or asked):
         raise ShipidError("--error-band describes the LS-SVM fit; it does not go with --refine "
                           "or --output-error")  # fmt: skip
     if args.residual and (args.refine or asked or args.bootstrap is not None):
@@ -136,21 +137,27 @@ def cmd_identify(args) -> int:
     if args.residual:  # no refinement goes with it: the model is the LS-SVM one
         residual, hybrid = _kernel_residual(args, ident.model, logs, raw_logs, names, cutoff,
                                             gamma, physics, ident.warnings)  # fmt: skip
-    band = None
-    if args.error_band is not None:
+    def cv_band(cv):
+        """The cross-validated error band of this fit: the same prefilter, structure, γ,
+        physics and residual without each log (or block)."""
         from shipid.evaluation.error_band import cross_validated_band
 
-        def refit_without(train):  # the same prefilter, structure, γ, physics and residual
+        def refit_without(train):
             fitted_on = [lowpass(x, cutoff) for x in train] if cutoff is not None else train
             model = identify(fitted_on, model=args.model, form=args.form, gamma=gamma,
                              drop=_parse_drop(args.drop), force=True, estimator=args.estimator,
                              physics=physics).model  # fmt: skip
             return _with_residual(model, fitted_on, residual)
 
-        band = cross_validated_band(refit_without, raw_logs, names, args.error_band)
+        found = cross_validated_band(refit_without, raw_logs, names, cv)
         chosen = "γ, the prefilter and the kernel residual's γ and σ" if residual and \
             residual["residual"] else "γ and the prefilter"
-        print(f"{band.describe()} ({chosen} as chosen on all logs); stored for validate")
+        return found, f"{found.describe()} ({chosen} as chosen on all logs); stored for validate"
+
+    band = None
+    if explicit_band:
+        band, said = cv_band(args.error_band)
+        print(said)
     ensemble = None
     if args.bootstrap is not None:
         from shipid.identification.identify import weighted_refit
@@ -181,7 +188,7 @@ def cmd_identify(args) -> int:
     if asked:
         refinement, ensemble = _output_error(ident, raw_logs, names, args)
     elif args.output_error == "auto" and not (args.refine or args.bootstrap is not None
-                                             or args.error_band is not None or args.residual):
+                                             or explicit_band or args.residual):
         if given_physics:  # output error would fit them away
             print(f"output error: not fitted, since it would not hold {given_physics[0]}; the "
                   "LS-SVM fit does")  # fmt: skip
@@ -206,6 +213,10 @@ def cmd_identify(args) -> int:
                 ensemble = None  # its draws describe the output-error model, not this one
         else:
             final, plausibility, notes = refinement.model, refined_report, refined_notes
+    if args.error_band is None and final is ident.model and len(raw_logs) >= 2:
+        # By default, from two logs on: how far the free runs stray from a log left out.
+        band, said = cv_band("logo")
+        print(f"{said} (--error-band none to skip)")
     sl = plausibility["straight_line"]
     if sl:
         print(f"straight-line {'stable' if sl['stable'] else 'UNSTABLE'} (largest sway–yaw "

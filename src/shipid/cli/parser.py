@@ -171,7 +171,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--error-band", nargs="?", const="auto", metavar="CV",
                    help="the cross-validated 95 %% error band of the free runs, stored for "
                    "validate: the same fit without each log (logo) or block (blocks:K), run free "
-                   "over it (default auto: logo from two logs, blocks:4 of one)")
+                   "over it ('auto': logo from two logs, blocks:4 of one). Default: logo where "
+                   "two or more logs are given and the file's model is the LS-SVM fit; 'none' "
+                   "skips it")
     p.add_argument("--residual", choices=("rbf",),
                    help="add a kernel residual to the physical model: an RBF LS-SVM on its "
                    "one-step acceleration residual, γ and σ (or none) chosen by the free-run "
