@@ -12,7 +12,7 @@ from shipid import identify, lowpass, zigzag
 from shipid.control.autopilot import follow_path, heading_step, pid_from_nomoto
 from shipid.control.export import export_numpy, linearised_control, to_control
 from shipid.control.linear import linearise, nomoto
-from shipid.dynamics.model import ManoeuvringModel, nomoto_parameters
+from shipid.dynamics.model import ManoeuvringModel, ModelStructure, nomoto_parameters
 from shipid.dynamics.simulate import simulate
 from shipid.vessels import PAPER_IMU, scale_ship, scale_ship_model
 
@@ -24,7 +24,7 @@ def test_linearisation_of_the_paper_model_against_its_coefficients():
     (reference-ships.md §7.2 gives it at 2 m/s), B = [Y_δ, N_δ]; surge: ∂u̇/∂u = 2 X_|u|u u0."""
     m, u0 = scale_ship_model(), 2.0
     cv, cr = m.coefficients["v"], m.coefficients["r"]
-    lin = linearise(m, u0)
+    lin = linearise(m, u0, trimmed=False)  # the reference's point: rudder amidships
     expected = u0 * np.array([[cv["uv"], cv["ur"]], [cr["uv"], cr["ur"]]])
     np.testing.assert_allclose(lin["A"][1:, 1:], expected, rtol=1e-6)
     np.testing.assert_allclose(lin["A"][1:, 1:], [[-1.0568, -0.9062], [-1.3392, -2.3398]],
@@ -36,9 +36,35 @@ def test_linearisation_of_the_paper_model_against_its_coefficients():
         "v": {"v": expected[0, 0], "r": expected[0, 1], "delta": cv["delta"]},
         "r": {"v": expected[1, 0], "r": expected[1, 1], "delta": cr["delta"]}})  # fmt: skip
     ref, got = nomoto_parameters(lsy), nomoto(m, u0)
-    for k in ("K", "T1", "T2", "T3"):
-        assert got[k] == pytest.approx(ref[k], rel=1e-6)
+    for k in ("K", "T1", "T2", "T3"):  # trimmed at 0.6° of rudder: the same to 1e-3
+        assert got[k] == pytest.approx(ref[k], rel=1e-3)
     assert got["K"] == pytest.approx(-0.517, abs=0.002)  # §7.2: steady r/δ = −0.517
+
+
+def test_the_linearisation_is_about_the_trimmed_straight_run():
+    """Bug: about (v = 0, δ = 0), where a model with constant sway and yaw terms (every
+    identified one; a single screw's race) does not run straight and the modulus terms have
+    their kinks. The trim against its closed form: for v̇ = a v + c|v|v + b δ + e and
+    ṙ = f v + g δ + k at r = 0, δ0 = −(k + f v0)/g with v0 the root of the quadratic."""
+    a, c, b, e, f, g, k = -0.8, -2.0, 0.05, 0.002, -0.6, -0.5, -0.004
+    m = ManoeuvringModel(ModelStructure("kinked", {"v": ("v", "|v|*v", "delta", "1"),
+                                                   "r": ("v", "r", "delta", "1")}),
+                         {"v": {"v": a, "|v|*v": c, "delta": b, "1": e},
+                          "r": {"v": f, "r": -1.0, "delta": g, "1": k}})  # fmt: skip
+    # v̇ = 0 with δ0 = −(k + f v0)/g: (a − b f/g) v0 + c|v0|v0 + e − b k/g = 0.
+    p, q = a - b * f / g, e - b * k / g
+    roots = [x for x in np.roots([c, p, q]).real if x >= 0] + \
+        [x for x in np.roots([-c, p, q]).real if x < 0]  # fmt: skip
+    v0 = min(roots, key=abs)
+    d0 = -(k + f * v0) / g
+    lin = linearise(m, 1.5)
+    assert lin["trim"]["v"] == pytest.approx(v0, rel=1e-9)
+    assert lin["trim"]["delta"] == pytest.approx(d0, rel=1e-9)
+    assert np.abs(lin["residual"][1:]).max() < 1e-12
+    assert lin["A"][1, 1] == pytest.approx(a + 2 * c * abs(v0), rel=1e-6)  # |v|v's slope there
+    amidships = linearise(m, 1.5, trimmed=False)
+    assert amidships["trim"] is None and amidships["A"][1, 1] == pytest.approx(a, rel=1e-6)
+    assert abs(amidships["residual"][2]) > 1e-3  # not a straight run: it turns
 
 
 def test_pid_from_nomoto_places_the_closed_loop_poles():
@@ -154,7 +180,8 @@ def test_cli_linearise_export_autopilot_follow(tmp_path, capsys):
 def test_pid_from_nomoto_steers_unstable_and_nearly_neutral_ships(K, T):
     """KVLCC2 models have T < 0 (the MARIN-identified one −18.6 s, the MMG one −2401 s): tuning
     refused them. The placement holds for T < 0, at ω = max(1/|T|, √|K/T|) by default. The
-    Esso Osaka model is nearly neutral (T = 345 s): at ω = 1/T its heading ran away."""
+    Esso Osaka model linearised at rudder amidships is nearly neutral (T = 345 s): at ω = 1/T its
+    heading ran away."""
     pid = pid_from_nomoto(K, T)
     w = max(1 / abs(T), math.sqrt(abs(K / T)))
     # Without the integral: T s² + (1 + K Kd) s + K Kp = T (s² + 2ζω s + ω²).

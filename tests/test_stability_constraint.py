@@ -33,7 +33,8 @@ def _logs(ship):
 
 
 def _sway_yaw_eigenvalues(model, speed):
-    return np.linalg.eigvals(linearise(model, speed)["A"][1:, 1:])
+    # The constraint's point: straight running with the rudder amidships (not the trim).
+    return np.linalg.eigvals(linearise(model, speed, trimmed=False)["A"][1:, 1:])
 
 
 def _kkt_by_enumeration(M, c, G, h):

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 from shipid.cli.common import (
@@ -72,7 +73,12 @@ def cmd_linearise(args) -> int:
         _warn(unsteady)
     nm = nomoto(target, speed, rps)
     pd = _pd()
-    print(f"Linearised about straight running at u = {speed:.4g} m/s (states u, v, r; input δ):")
+    trim = nm["trim"]
+    held = ("rudder amidships: no rudder within ±35° holds it straight" if trim is None else
+            f"trimmed: δ0 = {math.degrees(trim['delta']):.3g}° and v0 = {trim['v']:.3g} m/s hold "
+            "it straight")  # fmt: skip
+    print(f"Linearised about straight running at u = {speed:.4g} m/s, {held} (states u, v, r; "
+          "input δ; ν̇ ≈ A (ν − ν0) + B (δ − δ0)):")  # fmt: skip
     print("A =")
     print(pd.DataFrame(nm["A"], index=["u", "v", "r"], columns=["u", "v", "r"]).to_markdown(
         floatfmt=".5g"))
