@@ -74,8 +74,9 @@ def to_control(model: ManoeuvringModel, dt: float | None = None, method: str = "
 
 
 def linearised_control(model: ManoeuvringModel, speed: float, rps: float | None = None):
-    """``control.StateSpace`` of the surge–sway–yaw dynamics linearised about straight running
-    (states u, v, r; input δ), from ``shipid.control.linear.linearise``."""
+    """``control.StateSpace`` of the surge–sway–yaw dynamics linearised about the trimmed
+    straight run (states u − u0, v − v0, r; input δ − δ0, the trim in
+    ``shipid.control.linear.linearise(model, speed, rps)["trim"]``)."""
     import control
 
     from shipid.control.linear import linearise
