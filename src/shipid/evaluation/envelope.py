@@ -16,8 +16,11 @@ import pandas as pd
 
 ENVELOPE_SIGNALS = ("u", "v", "r", "delta", "n", "wind_speed")
 UNITS = {"u": "m/s", "v": "m/s", "r": "rad/s", "delta": "rad", "n": "rps", "wind_speed": "m/s"}
-# A run may exceed the training range by this fraction of its span before it is reported.
+# A run may exceed the training range by this fraction of its span, and at least this fraction
+# of the range's magnitude, before it is reported: a signal held constant in training (the
+# KVLCC2's 10.23 rps at HSVA) has no span, and MARIN's 10.33 rps was called an extrapolation.
 MARGIN = 0.1
+MAGNITUDE_MARGIN = 0.05
 # A turn that keeps less than this fraction of its approach speed has left any plausible regime.
 MIN_SPEED_FRACTION = 0.2
 
@@ -40,7 +43,7 @@ def outside_envelope(env: Mapping[str, Sequence[float]], log: pd.DataFrame) -> l
         if s not in log.columns or len(bounds) != 2:
             continue
         lo, hi = (float(b) for b in bounds)
-        margin = MARGIN * max(hi - lo, 1e-12)
+        margin = max(MARGIN * (hi - lo), MAGNITUDE_MARGIN * max(abs(lo), abs(hi)), 1e-12)
         x = log[s].to_numpy()
         if x.size == 0:
             continue
