@@ -19,6 +19,8 @@ UNITS = {"u": "m/s", "v": "m/s", "r": "rad/s", "delta": "rad", "n": "rps", "wind
 # A run may exceed the training range by this fraction of its span, and at least this fraction
 # of the range's magnitude, before it is reported: a signal held constant in training (the
 # KVLCC2's 10.23 rps at HSVA) has no span, and MARIN's 10.33 rps was called an extrapolation.
+# Every signal counts, those the model has no term in too: a model without propeller terms
+# holds its training rps in its constant.
 MARGIN = 0.1
 MAGNITUDE_MARGIN = 0.05
 # A turn that keeps less than this fraction of its approach speed has left any plausible regime.

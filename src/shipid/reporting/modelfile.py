@@ -425,28 +425,12 @@ def _scale_statistics(stats: dict, ratios: Mapping, factor: float, rho: float, t
                 x0[s] *= signal_scale(s, factor, rho, to_rho)
 
 
-def _envelope_of_its_inputs(doc: Mapping, envelope: Mapping) -> dict:
-    """The envelope's signals the model runs on: u, v, r and δ, and the propeller speed or the
-    wind only where a term (or a kernel residual's feature) takes them. A model without n
-    terms was warned of "extrapolating" in n on a log at another rps it never reads."""
-    try:
-        inputs = set(ManoeuvringModel.from_dict(doc["model"]).structure.inputs)
-    except (ShipidError, KeyError, TypeError, ValueError):
-        return dict(envelope)
-    residual = (doc.get("kernel_residual") or {}).get("residual") or {}
-    inputs |= set(residual.get("features") or ()) if isinstance(residual, Mapping) else set()
-    keep = {"u", "v", "r", "delta"} | inputs
-    return {s: b for s, b in envelope.items() if s in keep}
-
-
 def training_conditions(doc: Mapping) -> dict:
-    """Approach speed, propeller speed and envelope of a model file's training logs (the
-    envelope of the signals the model runs on)."""
+    """Approach speed, propeller speed and envelope of a model file's training logs."""
     ident = doc.get("identification") or {}
     prep = ident.get("preprocessing") or {}
     out = {"speed": prep.get("approach_speed"), "rps": prep.get("approach_rps"),
-           "envelope": _envelope_of_its_inputs(doc, ident.get("envelope") or {}),
-           "particulars": None,
+           "envelope": ident.get("envelope") or {}, "particulars": None,
            "rudder_rate": prep.get("rudder_rate"), "log_scale": prep.get("log_scale"),
            "rudder_positive": prep.get("rudder_positive"),
            "dt": ident.get("dt") if isinstance(ident.get("dt"), int | float) else None}  # fmt: skip
