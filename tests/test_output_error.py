@@ -223,6 +223,8 @@ def test_the_default_fits_by_output_error_where_noise_is_all_the_lssvm_leaves(tm
     ref = doc["identification"]["refinement"]
     assert ref["method"] == METHOD and doc["model"] == ref["refined_model"]
     assert doc["uncertainty"]["method"] == DRAWS_METHOD
+    choice = doc["identification"]["preprocessing"]["output_error"]  # why, kept in the file
+    assert choice["fit"] == "output error" and max(choice["noise_ratios"].values()) <= 2.0
     truth = scale_ship_model().coefficients
     model, se = doc["model"]["coefficients"], ref["statistics"]["standard_errors"]
     # Sway and yaw all inside; surge's four (v·r and r² nearly collinear in one zig-zag) at
@@ -258,6 +260,9 @@ def test_the_default_keeps_the_lssvm_where_model_error_is_what_is_left(tmp_path,
         code, text, err = run([*argv, "-o", tmp_path / "k.json"], capsys)
         assert code == 0, err
         assert "output error: not fitted; the LS-SVM's free runs miss the logs by up to" in text
+        choice = json.loads((tmp_path / "k.json").read_text())["identification"][
+            "preprocessing"]["output_error"]
+        assert choice["fit"] == "LS-SVM" and max(choice["noise_ratios"].values()) > 2.0
         assert run([*argv, "--no-output-error", "-o", tmp_path / "k2.json"], capsys)[0] == 0
         assert json.loads((tmp_path / "k.json").read_text())["model"] == \
             json.loads((tmp_path / "k2.json").read_text())["model"]
@@ -267,7 +272,10 @@ def test_the_default_keeps_the_lssvm_where_model_error_is_what_is_left(tmp_path,
     code, text, err = run(["identify", train, "-o", tmp_path / "m.json"], capsys)
     assert code == 0, err
     assert "model error after all; the model file keeps the LS-SVM fit" in text
-    assert json.loads((tmp_path / "m.json").read_text())["identification"].get("refinement") is None
+    ident = json.loads((tmp_path / "m.json").read_text())["identification"]
+    assert ident.get("refinement") is None
+    assert ident["preprocessing"]["output_error"]["fit"] == "LS-SVM"
+    assert "correlated" in ident["preprocessing"]["output_error"]["why"]
 
 
 def test_physics_the_output_error_fit_would_not_hold_keeps_the_lssvm(tmp_path, capsys, paper_fit):

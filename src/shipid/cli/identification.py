@@ -189,11 +189,14 @@ def cmd_identify(args) -> int:
         refinement, ensemble = _output_error(ident, raw_logs, names, args)
     elif args.output_error == "auto" and not (args.refine or args.bootstrap is not None
                                              or explicit_band or args.residual):
+        prep["output_error"] = {"fit": "LS-SVM"}
         if given_physics:  # output error would fit them away
-            print(f"output error: not fitted, since it would not hold {given_physics[0]}; the "
-                  "LS-SVM fit does")  # fmt: skip
+            prep["output_error"]["why"] = f"it would not hold {given_physics[0]}"
+            print(f"output error: not fitted, since {prep['output_error']['why']}; the LS-SVM "
+                  "fit does")  # fmt: skip
         else:
-            refinement, ensemble = _output_error_where_noise_is_left(ident, raw_logs, names, args)
+            refinement, ensemble = _output_error_where_noise_is_left(ident, raw_logs, names, args,
+                                                                     prep["output_error"])  # fmt: skip
     final = ident.model
     if speed is None or not speed > 0:
         raise ShipidError(f"{names[0]}: the first training log starts without headway (u = "
@@ -211,6 +214,9 @@ def cmd_identify(args) -> int:
                 "refined one is kept under identification.refinement.refined_model")
             if not args.refine:  # an output-error fit
                 ensemble = None  # its draws describe the output-error model, not this one
+                if "output_error" in prep:
+                    prep["output_error"].update(fit="LS-SVM", why="the output-error model fails "
+                                                "plausibility checks the LS-SVM model passes")
         else:
             final, plausibility, notes = refinement.model, refined_report, refined_notes
     if args.error_band is None and final is ident.model and len(raw_logs) >= 2:
@@ -274,10 +280,11 @@ def _choose_structure(args, logs, names):
     return choice
 
 
-def _output_error_where_noise_is_left(ident, logs, names, args):
+def _output_error_where_noise_is_left(ident, logs, names, args, record: dict):
     """The default: output error where the LS-SVM's free runs leave only the sensors' noise
     (``output_error.noise_dominates``) and its own residuals come out white; else the LS-SVM
-    fit, and one line saying why. Returns (refinement, ensemble), (None, None) for the LS-SVM."""
+    fit, and one line saying why (both into ``record``, kept in the model file). Returns
+    (refinement, ensemble), (None, None) for the LS-SVM."""
     from shipid.identification.output_error import (
         INFLATION_WARNING,
         NOISE_DOMINATES,
@@ -287,12 +294,13 @@ def _output_error_where_noise_is_left(ident, logs, names, args):
 
     ratios = noise_ratios(ident.model, logs)
     worst = ratios.max(axis=0)
+    record["noise_ratios"] = {str(s): float(x) for s, x in worst.items()}
     if not noise_dominates(ratios):
         state = str(worst.idxmax())
-        print(f"output error: not fitted; the LS-SVM's free runs miss the logs by up to "
-              f"{worst[state]:.3g} times their sensor noise in {state} (more than "
-              f"{NOISE_DOMINATES:g}): model error, not noise, is what is left "
-              "(--output-error fits it anyway)")  # fmt: skip
+        record["why"] = (f"the LS-SVM's free runs miss the logs by up to {worst[state]:.3g} times "
+                         f"their sensor noise in {state} (more than {NOISE_DOMINATES:g}): model "
+                         "error, not noise, is what is left")  # fmt: skip
+        print(f"output error: not fitted; {record['why']} (--output-error fits it anyway)")
         return None, None
     print(f"output error: the LS-SVM's free runs miss the logs by at most {worst.max():.3g} "
           "times their sensor noise, so noise is what it leaves: fitting by maximum-likelihood "
@@ -300,9 +308,11 @@ def _output_error_where_noise_is_left(ident, logs, names, args):
     fit, ensemble = _output_error(ident, logs, names, args)
     inflation = fit.statistics["covariance_inflation"]
     if not inflation < INFLATION_WARNING:
-        print(f"output error: its residuals are correlated (standard errors ×{inflation:.3g}): "
-              "model error after all; the model file keeps the LS-SVM fit")  # fmt: skip
+        record["why"] = (f"its residuals are correlated (standard errors ×{inflation:.3g}): model "
+                         "error after all")  # fmt: skip
+        print(f"output error: {record['why']}; the model file keeps the LS-SVM fit")
         return None, None
+    record.update(fit="output error", why="noise is what the LS-SVM leaves")
     return fit, ensemble
 
 
