@@ -11,7 +11,7 @@ from cli_helpers import run
 from shipid import identify, lowpass, zigzag
 from shipid.control.autopilot import follow_path, heading_step, pid_from_nomoto
 from shipid.control.export import export_numpy, linearised_control, to_control
-from shipid.control.linear import linearise, nomoto
+from shipid.control.linear import linearise, nomoto, trim
 from shipid.dynamics.model import ManoeuvringModel, ModelStructure, nomoto_parameters
 from shipid.dynamics.simulate import simulate
 from shipid.vessels import PAPER_IMU, scale_ship, scale_ship_model
@@ -65,6 +65,10 @@ def test_the_linearisation_is_about_the_trimmed_straight_run():
     amidships = linearise(m, 1.5, trimmed=False)
     assert amidships["trim"] is None and amidships["A"][1, 1] == pytest.approx(a, rel=1e-6)
     assert abs(amidships["residual"][2]) > 1e-3  # not a straight run: it turns
+    # A yaw moment no rudder within ±35° balances (δ0 = −k/g = 1.2 rad): no trim, amidships.
+    strong = ManoeuvringModel(m.structure, {**m.coefficients,
+                                            "r": {**m.coefficients["r"], "1": 0.6}})
+    assert trim(strong, 1.5) is None and linearise(strong, 1.5)["trim"] is None
 
 
 def test_pid_from_nomoto_places_the_closed_loop_poles():
