@@ -322,3 +322,30 @@ def test_the_default_keeps_the_lssvm_where_the_two_fits_turn_apart(tmp_path, cap
     assert doc["model"] == ref["initial_model"] and doc["uncertainty"] is None
     lssvm = doc["identification"]["plausibility"]["held_rudder"]["starboard"]["steady_yaw_rate"]
     assert abs(lssvm) == pytest.approx(0.0555, rel=0.15)  # the MMG model's 35° turn
+
+
+def test_the_report_of_an_output_error_model_gives_its_own_standard_errors(tmp_path, capsys,
+                                                                           paper_fit):
+    """Bug: ``validate --report`` printed an output-error model's coefficients with the LS-SVM
+    fit's standard errors, labelled as the LS-SVM's (ṙ u·r ± 0.027 where output error's is
+    0.15)."""
+    import html
+    import re
+
+    _, logs = paper_fit
+    train = write_log(logs[TRAINING], tmp_path / "train.csv")
+    held = write_log(logs["zigzag 10/10"], tmp_path / "zz10.csv")
+    assert run(["identify", train, "-o", tmp_path / "m.json"], capsys)[0] == 0
+    doc = json.loads((tmp_path / "m.json").read_text())
+    se = doc["identification"]["refinement"]["statistics"]["standard_errors"]["r"]["u*r"]
+    ls_se = doc["identification"]["diagnostics"]["r"]["std_errors"]["u*r"]
+    assert se > 3 * ls_se
+    for extra, label, want in (([], "maximum-likelihood output error", se),
+                               (["--lssvm"], "LS-SVM linear fit", ls_se)):
+        report = tmp_path / f"rep{len(extra)}"
+        assert run(["validate", tmp_path / "m.json", held, "--report", report, *extra],
+                   capsys)[0] == 0  # fmt: skip
+        text = html.unescape((report / "report.html").read_text(encoding="utf-8"))
+        assert f"one standard error of each coefficient ({label}" in text
+        shown = float(re.search(r"ṙ = −\([0-9.]+ ± ([0-9.e-]+)\) u r", text).group(1))
+        assert shown == pytest.approx(want, rel=0.05)  # shown to two digits

@@ -169,17 +169,30 @@ def cmd_validate(args) -> int:
         if args.report:
             from shipid.reporting.html import validation_report
 
-            ident = doc.get("identification") or {}
-            se = {d: (ident.get("diagnostics") or {}).get(d, {}).get("std_errors")
-                  for d in getattr(model, "physical", model).structure.dofs
-                  } if not args.lssvm else None  # fmt: skip
+            se, se_label = _coefficient_errors(doc, model, args.lssvm)
             text = validation_report(model, vals, logs, f"Validation of {Path(args.model).name}",
-                                     std_errors=se, criteria=crit,
+                                     std_errors=se, std_errors_label=se_label, criteria=crit,
                                      warnings=[w for v in good for w in v.warnings],
                                      residuals=residuals, figures=figures)  # fmt: skip
             out.write(Path(args.report) / "report.html",
                       lambda p: p.write_text(text, encoding="utf-8"))
     return 1 if errors else 0
+
+
+def _coefficient_errors(doc, model, lssvm: bool) -> tuple[dict | None, str]:
+    """The standard errors of the model validated, and whose: the LS-SVM fit's (its
+    diagnostics) where the model is the LS-SVM one, output error's where the file's model is
+    the output-error fit. Bug: a report of an output-error model printed its coefficients with
+    the LS-SVM fit's standard errors, labelled as such (5.6 times too small for ṙ u·r)."""
+    ident = doc.get("identification") or {}
+    ref = ident.get("refinement") or {}
+    dofs = getattr(model, "physical", model).structure.dofs
+    refined = bool(ref) and doc.get("model") == ref.get("refined_model")
+    if refined and not lssvm:
+        se = (ref.get("statistics") or {}).get("standard_errors")
+        return (se, "maximum-likelihood output error, Gauss–Newton") if se else (None, "")
+    return ({d: (ident.get("diagnostics") or {}).get(d, {}).get("std_errors") for d in dofs},
+            "LS-SVM linear fit")  # fmt: skip
 
 
 def _criteria_of_logs(good, logs, vals, particulars):

@@ -46,6 +46,7 @@ def validation_report(
     logs: Sequence[pd.DataFrame],
     title: str,
     std_errors: Mapping | None = None,
+    std_errors_label: str = "LS-SVM linear fit",
     criteria: pd.DataFrame | None = None,
     warnings: Sequence[str] = (),
     residuals: Mapping[str, Mapping] | None = None,
@@ -65,7 +66,8 @@ def validation_report(
              "MATLAB's compare (100 % perfect, 0 % no better than the mean).</p>",
              "<h2>Model</h2>", f"<pre>{html.escape(model.equations(std_errors=std_errors))}</pre>"]
     if std_errors:
-        parts.append("<p>± one standard error of each coefficient (LS-SVM linear fit).</p>")
+        parts.append(f"<p>± one standard error of each coefficient "
+                     f"({html.escape(std_errors_label)}).</p>")
     if warnings:
         parts.append("<h2>Warnings</h2><ul>" + "".join(
             f"<li class='warn'>{html.escape(w)}</li>" for w in warnings) + "</ul>")
