@@ -322,6 +322,12 @@ def test_the_default_keeps_the_lssvm_where_the_two_fits_turn_apart(tmp_path, cap
     assert doc["model"] == ref["initial_model"] and doc["uncertainty"] is None
     lssvm = doc["identification"]["plausibility"]["held_rudder"]["starboard"]["steady_yaw_rate"]
     assert abs(lssvm) == pytest.approx(0.0555, rel=0.15)  # the MMG model's 35° turn
+    # Asked for, output error is kept, with the warning.
+    code, _, err = run(["identify", *paths, "--model", "blanke-race+race-damping",
+                        "--output-error", "-o", tmp_path / "oe.json"], capsys)  # fmt: skip
+    assert code == 0 and "(kept, as --output-error asks" in err, err
+    asked = json.loads((tmp_path / "oe.json").read_text())
+    assert asked["model"] == asked["identification"]["refinement"]["refined_model"]
 
 
 def test_the_report_of_an_output_error_model_gives_its_own_standard_errors(tmp_path, capsys,
