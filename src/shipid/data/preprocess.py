@@ -23,6 +23,7 @@ def cumulative_integral(y: np.ndarray, t: np.ndarray, initial: float = 0.0) -> n
     out[1:] += initial
     return out
 
+
 def white_noise_variance(x: np.ndarray) -> float:
     """Variance of the white noise on a smooth signal, from its second differences
     (Var Δ²e = 6σ²), robustly (1.4826·MAD). The signal's own second differences, small at a

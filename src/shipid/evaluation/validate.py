@@ -275,9 +275,6 @@ def trial_turning(model, log: pd.DataFrame, method: str = "euler",
     trial = trial or describe_trial(log, "turning")
     if not float(log["u"].iloc[0]) > 0:
         return None
-    t = log["t"].to_numpy()
-    dt = float(np.median(np.diff(t)))
-    amplitude = trial.plateau_angle
     # The side of the held rudder (``trial.first_rudder`` is a zig-zag's: a turn's mid-range
     # "neutral" puts its approach rudder on the other side).
     delta = log["delta"].to_numpy(dtype=float)
@@ -285,13 +282,20 @@ def trial_turning(model, log: pd.DataFrame, method: str = "euler",
     held = float(np.median(delta[swing >= 0.8 * swing.max()]))
     turns = np.sign(held) * starboard_sign(rudder_positive(log))
     initial, rps = _replica_start(model, log, trial)
-    steering = SteeringMachine(max_angle=max(math.radians(35.0), amplitude),
-                               max_rate=trial.rudder_rate)  # fmt: skip
-    return turning_circle(model, math.degrees(amplitude), "starboard" if turns > 0 else "port",
-                          duration=float(t[-1] - t[0]), dt=dt,
-                          approach=float(t[min(trial.execute_index + 1, len(t) - 1)] - t[0]),
-                          speed=initial["u"], steering=steering, method=method, rps=rps,
-                          initial=initial)  # fmt: skip
+    return turning_circle(model, math.degrees(trial.plateau_angle),
+                          "starboard" if turns > 0 else "port", speed=initial["u"], method=method,
+                          rps=rps, initial=initial, **_replica_run(log, trial))  # fmt: skip
+
+
+def _replica_run(log: pd.DataFrame, trial: Trial) -> dict:
+    """What a closed-loop replica takes from the log as it is: duration, step, the execute time
+    (``approach``) and the steering machine (the log's rudder rate, and an angle limit that
+    holds its rudder)."""
+    t = log["t"].to_numpy()
+    return {"duration": float(t[-1] - t[0]), "dt": float(np.median(np.diff(t))),
+            "approach": float(t[min(trial.execute_index + 1, len(t) - 1)] - t[0]),
+            "steering": SteeringMachine(max_angle=max(math.radians(35.0), trial.plateau_angle),
+                                        max_rate=trial.rudder_rate)}  # fmt: skip
 
 
 def validate(
@@ -332,26 +336,20 @@ def trial_zigzag(model, log: pd.DataFrame, method: str = "euler",
                  trial: Trial | None = None) -> ManoeuvreResult | None:  # fmt: skip
     """The zig-zag of a measured log run closed loop on ``model``: same initial state (u, v, r, ψ)
     and held rudder (or the model's own steady approach, ``_replica_start``), first execute time
-    and side, rudder angle (the median plateau), rudder rate (the 90th percentile while it
-    moves), switch heading (inferred from the log), mean propeller speed, duration and step.
+    and side, rudder angle (the median plateau), rudder rate (over its swings,
+    ``shipid.data.rudder_signal.rise_rate``), switch heading (inferred from the log), mean
+    propeller speed, duration and step.
     None when the log has no detectable switch heading or starts without headway (a zig-zag
     needs an approach speed)."""
     trial = trial or describe_trial(log, "zigzag")
     switch = trial.switch_heading_deg
     if not switch or not float(log["u"].iloc[0]) > 0:
         return None
-    t = log["t"].to_numpy()
-    dt = float(np.median(np.diff(t)))
-    i0 = trial.execute_index
-    amplitude = trial.plateau_angle
     turns = trial.first_rudder * starboard_sign(rudder_positive(log))
-    first = "starboard" if turns > 0 else "port"
     initial, rps = _replica_start(model, log, trial)
-    steering = SteeringMachine(max_angle=max(math.radians(35.0), amplitude),
-                               max_rate=trial.rudder_rate)  # fmt: skip
-    return zigzag(model, math.degrees(amplitude), switch, first=first, duration=float(t[-1] - t[0]),
-                  dt=dt, approach=float(t[min(i0 + 1, len(t) - 1)] - t[0]), speed=initial["u"],
-                  steering=steering, method=method, initial=initial, rps=rps)  # fmt: skip
+    return zigzag(model, math.degrees(trial.plateau_angle), switch,
+                  first="starboard" if turns > 0 else "port", speed=initial["u"], method=method,
+                  initial=initial, rps=rps, **_replica_run(log, trial))  # fmt: skip
 
 
 __all__ = ["Validation", "free_run", "steady_log_approach", "trial_replica", "trial_turning",

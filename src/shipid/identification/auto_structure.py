@@ -242,6 +242,14 @@ def _paper_or_race(logs, names, physics, cv, estimator, drop=None, announce=_qui
 TURNS_APART = 1.25
 
 
+def rates_apart(rates) -> bool:
+    """Whether fits' steady yaw rates (None: no steady turn) are more than ``TURNS_APART``
+    apart, or some fit has none: what ``_turns_apart`` warns of and what ``identify`` weighs
+    between its output-error and LS-SVM fits."""
+    known = [abs(r) for r in rates if r is not None and np.isfinite(r) and r != 0]
+    return len(known) < len(rates) or max(known) > TURNS_APART * min(known)
+
+
 def _turns_apart(models: Mapping[str, object], logs) -> list[str]:
     """A warning when structures that predict the logs alike (free-run scores within one standard
     error) predict a 35° turn far apart (their fits of the comparison, from the first log's
@@ -263,8 +271,7 @@ def _turns_apart(models: Mapping[str, object], logs) -> list[str]:
                              dt=float(np.median(np.diff(logs[0]["t"].to_numpy()))))  # fmt: skip
         r = None if res.diverged else (res.indices or {}).get("steady_yaw_rate")
         rates[name] = abs(r) if r is not None and np.isfinite(r) else None
-    known = [r for r in rates.values() if r]
-    if len(known) == len(rates) and max(known) <= TURNS_APART * min(known):
+    if not rates_apart(list(rates.values())):
         return []
     shown = ", ".join(f"{k} {'no steady turn' if r is None else f'{r:.3g} rad/s'}"
                       for k, r in rates.items())  # fmt: skip
