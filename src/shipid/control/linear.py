@@ -11,7 +11,7 @@ Why the trim: a single-screw ship goes straight with rudder and drift (the Esso 
 holds 0.48° and −0.013 m/s at 16.7 rps), and an identified model has constant terms besides.
 At (v = 0, δ = 0) such a model is not running straight, and the modulus terms (|v|v, |δ| of a
 propeller's asymmetric race) have their kinks there: the Esso's K came out 5.0 1/s and T1 353 s
-at rudder amidships against 0.96 1/s and 59 s at its trim.
+at rudder amidships against 0.97 1/s and 59 s at its trim (``benchmarks/study_trim.py``).
 """
 
 from __future__ import annotations
@@ -113,12 +113,12 @@ def linearise(dynamics, speed: float, rps: float | None = None, trimmed: bool = 
             "residual": _acc(dyn, *x0, d0, rps)[0]}  # fmt: skip
 
 
-def nomoto(dynamics, speed: float, rps: float | None = None) -> dict:
+def nomoto(dynamics, speed: float, rps: float | None = None, trimmed: bool = True) -> dict:
     """Nomoto's K, T1, T2, T3 of the sway–yaw block, and the first-order T = T1 + T2 − T3.
 
     r/δ = (b2 s + a21 b1 − a11 b2) / (s² − tr s + det) for [v̇, ṙ] = [[a11, a12], [a21, a22]]
     [v, r] + [b1, b2] δ. Complex time constants (an oscillatory sway–yaw pair) are refused."""
-    lin = linearise(dynamics, speed, rps)
+    lin = linearise(dynamics, speed, rps, trimmed)
     A2, b = lin["A"][1:, 1:], lin["B"][1:]
     det, tr = float(np.linalg.det(A2)), float(np.trace(A2))
     if det == 0:
