@@ -43,6 +43,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/study_sampling.py
 	$(BIN)/python benchmarks/study_auto_inflow.py
 	$(BIN)/python benchmarks/study_trim.py
+	$(BIN)/python benchmarks/study_gyro_offset.py
 
 clean:
 	rm -rf $(VENV) shipid-demo build *.egg-info src/*.egg-info

@@ -3,14 +3,20 @@ zig-zag an offset of 0.57 °/s (6 % of its rms r) made a held-out turn's free-ru
 as large. The heading tells it: ψ − ∫r dt drifts at the offset. The truth here is an offset added
 to a simulated log."""
 
+import json
 import math
+import re
 import warnings
 
 import pytest
+from cli_helpers import run
 
-from shipid.data.checks import check_units, yaw_rate_offset
-from shipid.errors import ShipidWarning
-from shipid.trials.manoeuvres import zigzag
+from shipid.data import checks
+from shipid.data.checks import check_units
+from shipid.data.io import read_log, write_log
+from shipid.data.yaw_rate import yaw_rate_offset
+from shipid.errors import ShipidError, ShipidWarning
+from shipid.trials.manoeuvres import turning_circle, zigzag
 from shipid.vessels import PAPER_IMU, scale_ship
 
 
@@ -38,3 +44,83 @@ def test_a_large_offset_is_named_and_a_clean_log_is_not(trial):
     named = r"zz\.csv: the yaw rate 'r' runs \+0\.(599|6\d*) °/s off"
     with pytest.warns(ShipidWarning, match=named):
         check_units(biased, "zz.csv")
+
+
+# -- an offset too small for the rate rule that still moves the heading (MARIN's KVLCC2: 0.035–
+# 0.039 °/s, under 2 % of the rms r, 3.5° of heading over a 90 s zig-zag)
+
+
+@pytest.fixture(scope="module")
+def turn():
+    return turning_circle(scale_ship(rudder_rate_deg=9.6), 20, "starboard", duration=200, dt=0.2,
+                          method="euler").log  # fmt: skip
+
+
+def _warned(log) -> list[str]:
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", ShipidWarning)
+        check_units(log, "log.csv")
+    return [str(w.message) for w in caught if "yaw rate 'r' runs" in str(w.message)]
+
+
+def test_an_offset_that_moves_the_heading_is_named_though_small(trial):
+    biased = trial.assign(r=trial["r"] + math.radians(0.04))  # 3.6° over the 90 s
+    named = _warned(biased)
+    assert len(named) == 1 and "ends 3.6° from psi" in named[0] and "--yaw-rate-offset auto" \
+        in named[0]  # fmt: skip
+    # The rate rule alone (0.1 °/s and 5 % of the rms r) did not name it.
+    assert math.radians(0.04) < math.radians(checks.YAW_RATE_OFFSET_DEG_S)
+    assert not _warned(trial.assign(r=trial["r"] + math.radians(0.015)))  # 1.35°: left alone
+
+
+@pytest.mark.parametrize("which", ["trial", "turn"])
+def test_the_paper_sensors_alone_are_not_named(which, trial, turn):
+    """Gyro noise random-walks ∫r away from psi (up to 5° over these logs), but not on a line
+    standing 15 times its scatter: no false alarm in 30 seeds."""
+    base = trial if which == "trial" else turn
+    for seed in range(30):
+        assert not _warned(PAPER_IMU.apply(base, seed=seed)), seed
+
+
+@pytest.mark.parametrize("offset_deg_s", [0.04, -0.3])
+def test_auto_subtracts_the_offset_added(tmp_path, trial, offset_deg_s):
+    biased = trial.assign(r=trial["r"] + math.radians(offset_deg_s))
+    path = write_log(biased, tmp_path / "zz.csv")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ShipidWarning)  # asked for: no warning of it
+        log = read_log(path, yaw_rate_offset="auto")
+    assert math.degrees(log.attrs["yaw_rate_offset"]) == pytest.approx(offset_deg_s, abs=0.002)
+    assert log["r"].to_numpy() == pytest.approx(trial["r"].to_numpy(), abs=math.radians(0.002))
+    # Kept in the file it is written to; a second correction adds what is left (nothing).
+    again = read_log(write_log(log, tmp_path / "corrected.csv"), yaw_rate_offset="auto")
+    assert again.attrs["yaw_rate_offset"] == pytest.approx(log.attrs["yaw_rate_offset"],
+                                                           abs=math.radians(1e-4))  # fmt: skip
+    given = read_log(path, yaw_rate_offset=math.radians(offset_deg_s))
+    assert given["r"].to_numpy() == pytest.approx(trial["r"].to_numpy(), abs=1e-12)
+
+
+def test_auto_without_a_heading_and_bad_values_are_refused(tmp_path, trial):
+    path = write_log(trial.drop(columns=["psi"]), tmp_path / "nopsi.csv")
+    with pytest.raises(ShipidError, match=r"nopsi\.csv: --yaw-rate-offset auto .* no 'psi'"):
+        read_log(path, yaw_rate_offset="auto")
+    with pytest.raises(ShipidError, match="yaw_rate_offset must be"):
+        read_log(path, yaw_rate_offset=math.inf)
+
+
+def test_the_cli_corrects_records_and_names_an_uncorrected_log(tmp_path, trial, capsys):
+    biased = write_log(trial.assign(r=trial["r"] + math.radians(0.04)), tmp_path / "zz.csv")
+    model = tmp_path / "m.json"
+    code, _, err = run(["identify", biased, "--yaw-rate-offset", "auto", "--no-output-error",
+                        "-o", model], capsys)  # fmt: skip
+    assert code == 0 and re.search(r"zz\.csv \+0\.0(39\d*|4) °/s", err) and "runs +0.0" not in err
+    prep = json.loads(model.read_text())["identification"]["preprocessing"]
+    assert prep["yaw_rate_offset_deg_s"] == [pytest.approx(0.04, abs=0.002)]
+    code, _, err = run(["validate", model, biased, "--no-bands"], capsys)
+    assert code == 0 and "identified from yaw rates less their gyro offsets" in err
+    code, _, err = run(["validate", model, biased, "--no-bands", "--yaw-rate-offset", "auto"],
+                       capsys)  # fmt: skip
+    assert code == 0 and "identified from yaw rates less" not in err
+    code, _, err = run(["validate", model, write_log(trial.drop(columns=["psi"]),
+                                                      tmp_path / "nopsi.csv"),
+                        "--yaw-rate-offset", "auto"], capsys)  # fmt: skip
+    assert code == 1 and "no 'psi'" in err and "Traceback" not in err

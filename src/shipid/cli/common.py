@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import math
+import sys
 import warnings
 from pathlib import Path
 
@@ -28,7 +29,8 @@ def _read_options(args):
                        degrees=tuple(c.strip() for c in args.degrees.split(",") if c.strip()),
                        dt=args.dt, start=args.start, end=args.end, lead=args.lead,
                        rudder_positive=args.rudder_positive, scale=args.scale,
-                       fill_gaps=args.fill_gaps)  # fmt: skip
+                       fill_gaps=args.fill_gaps,
+                       yaw_rate_offset=args.yaw_rate_offset)  # fmt: skip
 
 
 def _read_logs(args, paths=None) -> list:
@@ -36,6 +38,7 @@ def _read_logs(args, paths=None) -> list:
 
     options = _read_options(args)
     logs = [read_log(p, options) for p in (paths or args.logs)]
+    _print_yaw_rate_offsets(args, paths or args.logs, logs)
     particulars = _particulars(args)
     if particulars is not None:
         for log in logs:
@@ -190,6 +193,35 @@ def _rudder_rate(logs) -> float | None:
     rates = [describe_trial(log).rudder_rate for log in logs]
     rates = [r for r in rates if r]
     return max(rates) if rates else None
+
+
+def _print_yaw_rate_offsets(args, paths, logs) -> None:
+    """One line of the offsets ``--yaw-rate-offset auto`` read off the logs' headings."""
+    if args.yaw_rate_offset == "auto" and logs:
+        offsets = ", ".join(f"{Path(p).name} {d:+.3g} °/s" for p, d in
+                            zip(paths, _yaw_rate_offsets(logs), strict=True))  # fmt: skip
+        print("yaw rate less each log's gyro offset read off its heading (--yaw-rate-offset "
+              f"auto): {offsets}", file=sys.stderr)
+
+
+def _yaw_rate_notes(cond: dict, logs, names) -> list[str]:
+    """Logs whose r is not corrected the way the model's training logs' was."""
+    trained = cond.get("yaw_rate_offset_deg_s")
+    out = []
+    for log, name in zip(logs, names, strict=True):
+        if trained and "yaw_rate_offset" not in log.attrs and "psi" in log.columns:
+            out.append(f"{name}: the model was identified from yaw rates less their gyro "
+                       "offsets (--yaw-rate-offset), this log's r is as measured: its free "
+                       "runs start from and are judged against another r; give "
+                       "--yaw-rate-offset auto")  # fmt: skip
+    return out
+
+
+def _yaw_rate_offsets(logs) -> list[float] | None:
+    """The gyro offsets [°/s] subtracted from each log's r (``--yaw-rate-offset``), or None."""
+    if not any("yaw_rate_offset" in log.attrs for log in logs):
+        return None
+    return [math.degrees(float(log.attrs.get("yaw_rate_offset", 0.0))) for log in logs]
 
 
 def _log_scale(logs) -> float | None:

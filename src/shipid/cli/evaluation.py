@@ -12,12 +12,14 @@ from shipid.cli.common import (
     _json_text,
     _particulars,
     _pd,
+    _print_yaw_rate_offsets,
     _read_options,
     _sampling_notes,
     _scale_notes,
     _ship_or_model,
     _warn,
     _warn_beyond_training,
+    _yaw_rate_notes,
 )
 from shipid.errors import ShipidError
 
@@ -69,11 +71,13 @@ def cmd_validate(args) -> int:
             names.append(str(p))
         except ShipidError as exc:
             failed.append(str(exc))
+    _print_yaw_rate_offsets(args, names, logs)
     if cond["rudder_positive"]:  # a file that does not say its convention: no guess
         logs, notes = common_rudder_convention(logs, cond["rudder_positive"])
         for note in notes:
             _warn(note)
-    for note in _scale_notes(cond, logs, names) + _sampling_notes(cond, logs, names):
+    for note in (_scale_notes(cond, logs, names) + _sampling_notes(cond, logs, names)
+                 + _yaw_rate_notes(cond, logs, names)):
         _warn(note)
     from tqdm.auto import tqdm
 

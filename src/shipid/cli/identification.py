@@ -25,6 +25,7 @@ from shipid.cli.common import (
     _training_logs,
     _warn,
     _warn_approach,
+    _yaw_rate_offsets,
 )
 from shipid.errors import ShipidError
 
@@ -123,7 +124,7 @@ def cmd_identify(args) -> int:
             "format": args.format, "scale": args.scale,
             "approach_speed": speed, "approach_rps": rps, "rudder_rate": _rudder_rate(logs),
             "rudder_positive": logs[0].attrs.get("rudder_positive"),
-            "log_scale": _log_scale(logs)}  # fmt: skip
+            "log_scale": _log_scale(logs), "yaw_rate_offset_deg_s": _yaw_rate_offsets(logs)}  # fmt: skip
     refinement = None
     print(ident.model.equations(std_errors=_std_errors(ident)))
     print("(± standard errors of the equation-error fit: they hold the scatter of the fitted "
@@ -505,7 +506,7 @@ def cmd_select(args) -> int:
             "scale": args.scale, "approach_speed": speed, "approach_rps": rps,
             "rudder_rate": _rudder_rate(logs),
             "rudder_positive": logs[0].attrs.get("rudder_positive"),
-            "log_scale": _log_scale(logs)}  # fmt: skip
+            "log_scale": _log_scale(logs), "yaw_rate_offset_deg_s": _yaw_rate_offsets(logs)}  # fmt: skip
     ensemble = None
     others = len(sel.shares) - (sel.chosen_share > 0)
     print(f"\nThe choice on {RESAMPLES} resamples of the held-out logs: this candidate "

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 
 from shipid import __version__
 from shipid.cli.common import FORMATS, KINDS, LINEAR_ESTIMATORS
@@ -41,6 +42,10 @@ def _add_log_options(p: argparse.ArgumentParser) -> None:
                    "ship gains headway with the propeller stopped (its logging dropped out)")
     g.add_argument("--fill-gaps", action="store_true",
                    help="interpolate missing values inside signals (default: refuse the log)")
+    g.add_argument("--yaw-rate-offset", type=_offset_or_auto, metavar="DEG_S|auto",
+                   help="subtract a gyro's offset from r: in °/s, or 'auto': each log's own, "
+                   "read off the drift of psi − ∫r dt (default: r as measured, and a warning "
+                   "where that drift moves the heading)")
     g.add_argument("--rudder-positive", choices=("port", "starboard"),
                    help="where a positive rudder angle turns the ship (default: the file's "
                    "metadata, else port as in the paper)")
@@ -70,6 +75,18 @@ def _time_or_auto(text: str) -> float | str:
         return float(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected seconds or 'auto', got {text!r}") from None
+
+
+def _offset_or_auto(text: str) -> float | str:
+    if text == "auto":
+        return text
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"expected °/s or 'auto', got {text!r}")
+    return math.radians(value)
 
 
 def _end_time(text: str) -> float | str:

@@ -9,6 +9,7 @@ first comment line ``# shipid-log: {...}``. A log written by shipid reads back a
 from __future__ import annotations
 
 import dataclasses
+import math
 import mmap
 import re
 from collections.abc import Mapping, Sequence
@@ -29,6 +30,7 @@ from shipid.data.formats import FORMATS, detect_format, read_format
 from shipid.data.log import COLUMNS, REQUIRED, csv_metadata_line, metadata, parse_csv_metadata
 from shipid.data.preprocess import resample
 from shipid.data.trim import trim
+from shipid.data.yaw_rate import correct_yaw_rate
 from shipid.errors import ShipidError
 from shipid.outputs import atomic_write
 
@@ -53,6 +55,8 @@ class ReadOptions:
     rudder_positive : overrides the file's rudder convention ('port' or 'starboard').
     scale : Froude scale λ (simman formats).
     fill_gaps : interpolate missing values inside signals instead of refusing the log.
+    yaw_rate_offset : a gyro's offset to subtract from r [rad/s], or 'auto' for each log's own,
+        read off its heading (``shipid.data.yaw_rate``); None leaves r as measured.
     """
 
     fmt: str = "canonical"
@@ -65,8 +69,14 @@ class ReadOptions:
     rudder_positive: str | None = None
     scale: float | None = None
     fill_gaps: bool = False
+    yaw_rate_offset: float | str | None = None
 
     def __post_init__(self) -> None:
+        if not (self.yaw_rate_offset in (None, "auto") or (
+                isinstance(self.yaw_rate_offset, int | float)
+                and math.isfinite(self.yaw_rate_offset))):
+            raise ShipidError(f"yaw_rate_offset must be None, 'auto' or a finite number "
+                              f"[rad/s], got {self.yaw_rate_offset!r}")  # fmt: skip
         if self.fmt not in FORMATS:
             raise ShipidError(f"unknown --format {self.fmt!r}; use one of {', '.join(FORMATS)}")
         object.__setattr__(self, "degrees", tuple(self.degrees))
@@ -206,13 +216,15 @@ def read_log(path: str | Path, options: ReadOptions | None = None, **overrides) 
         log.attrs.update(meta)
         stated = "rudder_positive" in meta
         log.attrs.update({k: df.attrs[k] for k in ("time_origin",) if k in df.attrs})
-    check_units(log, name, options.degrees)
+    check_units(log, name, options.degrees, offset_given=options.yaw_rate_offset is not None)
     log.attrs["name"] = path.name
     if options.rudder_positive:
         log.attrs["rudder_positive"] = options.rudder_positive
         stated = True
     if options.start is not None or options.end is not None:
         log = trim(log, options.start, options.end, name, options.lead)
+    if options.yaw_rate_offset is not None:
+        log = correct_yaw_rate(log, options.yaw_rate_offset, name)
     check_propulsion(log, name)
     check_rudder_convention(log, name, stated)
     if options.dt is not None:

@@ -6,7 +6,8 @@ Columns: ``t`` [s], ``delta`` [rad], ``u``, ``v`` [m/s], ``r`` [rad/s]; optional
 
 Metadata keys (``METADATA_KEYS``): ``ship``, ``source``, ``rudder_positive`` ('port' or
 'starboard': where a positive rudder angle turns the ship), ``scale`` (λ = ship length / model
-length, 1 at full scale), ``manoeuvre`` and ``time_origin``. They survive a round trip through
+length, 1 at full scale), ``manoeuvre``, ``time_origin`` and ``yaw_rate_offset`` (a gyro's offset
+already subtracted from r, rad/s). They survive a round trip through
 files: Parquet keeps them in its schema metadata, CSV in a first comment line
 ``# shipid-log: {...JSON...}`` (pandas reads such a file with ``comment="#"``).
 """
@@ -28,7 +29,7 @@ OPTIONAL = ("psi", "x", "y", "n", "thrust", "wind_speed", "wind_angle")
 COLUMNS = REQUIRED + OPTIONAL
 RUDDER_SIDES = ("port", "starboard")
 METADATA_KEYS = ("ship", "source", "rudder_positive", "scale", "manoeuvre", "time_origin",
-                 "particulars")
+                 "particulars", "yaw_rate_offset")
 CSV_METADATA_PREFIX = "# shipid-log: "
 
 
@@ -248,6 +249,10 @@ def check_metadata(meta: Mapping, name: str) -> dict:
         if k == "scale" and not (isinstance(v, int | float) and not isinstance(v, bool)
                                  and math.isfinite(v) and v > 0):
             raise ShipidError(f"{name}: metadata scale must be a number > 0, got {v!r}")
+        if k == "yaw_rate_offset" and not (isinstance(v, int | float) and not isinstance(v, bool)
+                                           and math.isfinite(v)):
+            raise ShipidError(f"{name}: metadata yaw_rate_offset must be a number [rad/s], "
+                              f"got {v!r}")  # fmt: skip
         if k == "particulars":
             from shipid.data.particulars import Particulars
 

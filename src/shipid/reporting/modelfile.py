@@ -433,6 +433,7 @@ def training_conditions(doc: Mapping) -> dict:
            "envelope": ident.get("envelope") or {}, "particulars": None,
            "rudder_rate": prep.get("rudder_rate"), "log_scale": prep.get("log_scale"),
            "rudder_positive": prep.get("rudder_positive"),
+           "yaw_rate_offset_deg_s": prep.get("yaw_rate_offset_deg_s"),
            "dt": ident.get("dt") if isinstance(ident.get("dt"), int | float) else None}  # fmt: skip
     if doc.get("particulars"):
         from shipid.data.particulars import Particulars
