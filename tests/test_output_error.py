@@ -279,23 +279,81 @@ def test_the_default_keeps_the_lssvm_where_model_error_is_what_is_left(tmp_path,
 
 
 def test_physics_the_output_error_fit_would_not_hold_keeps_the_lssvm(tmp_path, capsys, paper_fit):
-    """Bug: output error fits every coefficient freely, so a sign constraint or prior asked for
-    would have been fitted away by the default's output-error fit without a word."""
+    """Bug: output error fitted every coefficient freely, so a prior or stability asked for would
+    have been fitted away by the default's output-error fit without a word. It holds sign
+    constraints and bounds now (box bounds); the rest keeps the LS-SVM fit, and is refused with
+    an explicit --output-error."""
     _, logs = paper_fit
     train = write_log(logs[TRAINING], tmp_path / "train.csv")
-    code, text, err = run(["identify", train, "--constraints", "signs", "-o", tmp_path / "m.json"],
+    code, text, err = run(["identify", train, "--constraints", "stable", "-o", tmp_path / "m.json"],
                           capsys)  # fmt: skip
     assert code == 0, err
-    assert "output error: not fitted, since it would not hold --constraints" in text
+    assert "output error: not fitted, since it would not hold --constraints stable" in text
     doc = json.loads((tmp_path / "m.json").read_text())
     assert doc["identification"].get("refinement") is None
-    assert run(["identify", train, "--constraints", "signs", "--no-output-error", "-o",
+    assert run(["identify", train, "--constraints", "stable", "--no-output-error", "-o",
                 tmp_path / "ls.json"], capsys)[0] == 0  # fmt: skip
     assert doc["model"] == json.loads((tmp_path / "ls.json").read_text())["model"]
-    code, _, err = run(["identify", train, "--output-error", "--bound", "r: u*r <= 0", "-o",
+    code, _, err = run(["identify", train, "--output-error", "--constraints", "signs,stable", "-o",
                         tmp_path / "b.json"], capsys)  # fmt: skip
-    assert code == 1 and "does not hold --bound" in err and len(err.splitlines()) == 1
+    assert code == 1 and "does not hold --constraints stable" in err and len(err.splitlines()) == 1
     assert not (tmp_path / "b.json").exists()
+
+
+def test_the_default_output_error_fit_holds_the_sign_constraints(tmp_path, capsys, paper_fit):
+    """`--constraints signs` on noise-dominated logs: output error with the sign table as bounds.
+    The paper's own model has a sway |v|v of +0.54 against the table's ≤ 0, so it is held at
+    0, and named; an explicit --bound past the free estimate is held too."""
+    _, logs = paper_fit
+    train = write_log(logs[TRAINING], tmp_path / "train.csv")
+    code, text, err = run(["identify", train, "--constraints", "signs", "-o", tmp_path / "s.json"],
+                          capsys)  # fmt: skip
+    assert code == 0, err
+    doc = json.loads((tmp_path / "s.json").read_text())
+    assert doc["identification"]["preprocessing"]["output_error"]["fit"] == "output error"
+    coefs, stats = doc["model"]["coefficients"], doc["identification"]["refinement"]["statistics"]
+    assert coefs["v"]["|v|*v"] == 0.0 and ["v", "|v|*v"] in stats["at_bound"]
+    assert "v: |v|v held at its bound 0 (sway damping): the unbounded output-error fit" in err
+    for dof, terms in stats["bounds"].items():  # every sign the table sets, held
+        for term, (lo, hi) in terms.items():
+            assert (lo is None or coefs[dof][term] >= lo) and (hi is None or coefs[dof][term] <= hi)
+    code, text, err = run(["identify", train, "--output-error", "--bound", "r: u*r >= -1",
+                           "-o", tmp_path / "b.json"], capsys)  # fmt: skip
+    assert code == 0, err
+    doc = json.loads((tmp_path / "b.json").read_text())
+    assert doc["model"]["coefficients"]["r"]["u*r"] == -1.0  # the free fit: about -1.2
+    assert "r: u r held at its bound -1 (bound [-1, inf])" in err
+
+
+def test_a_bounded_constant_acceleration_is_the_line_with_its_slope_held():
+    """A bound past the free slope: the estimate is the bound, the initial state the mean of
+    u − c t (the closed form with the slope held), the other equations as without it; its
+    interval is cut at the bound and so are the draws."""
+    rng = np.random.default_rng(3)
+    t = np.arange(200) * 0.2
+    log = pd.DataFrame({"t": t, "delta": np.zeros_like(t)})
+    for s, x0, c, sd in (("u", 1.5, 0.01, 0.03), ("v", 0.1, -0.002, 0.01), ("r", -0.02, 0.001,
+                                                                          0.004)):  # fmt: skip
+        log[s] = x0 + c * t + sd * rng.standard_normal(t.size)
+    free, _ = output_error(constant_model((0.0, 0.0, 0.0)), log, draws=50)
+    fit, ensemble = output_error(constant_model((0.0, 0.0, 0.0)), log, draws=50,
+                                 bounds={"u": {"1": (-1.0, 0.005)}})  # fmt: skip
+    assert fit.model.coefficients["u"]["1"] == 0.005
+    u0 = float(np.mean(log["u"] - 0.005 * t))
+    assert fit.statistics["initial_states"][0]["u"] == pytest.approx(u0, rel=1e-6)
+    for s in "vr":
+        assert fit.model.coefficients[s]["1"] == pytest.approx(free.model.coefficients[s]["1"],
+                                                               rel=1e-6)  # fmt: skip
+    assert fit.statistics["at_bound"] == [["u", "1"]]
+    assert any("u: 1 held at its bound 0.005" in n for n in fit.warnings)
+    row = coefficient_intervals(fit).set_index(["equation", "term"]).loc[("u", "1")]
+    assert row["upper"] == 0.005
+    assert row["lower"] == pytest.approx(0.005 - 1.96 * row["std_error"], rel=1e-4)
+    assert ensemble.thetas[:, 0, 0].max() <= 0.005 < free.model.coefficients["u"]["1"]
+    with pytest.raises(ShipidError, match=r"bounds: u: \|u\|\*u is not a term"):
+        output_error(constant_model(), log, bounds={"u": {"|u|*u": (-1.0, 0.0)}})
+    with pytest.raises(ShipidError, match="lower 1 is not below upper 1"):
+        output_error(constant_model(), log, bounds={"u": {"1": (1.0, 1.0)}})
 
 
 def test_the_default_keeps_the_lssvm_where_the_two_fits_turn_apart(tmp_path, capsys):

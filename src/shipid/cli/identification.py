@@ -69,13 +69,6 @@ def cmd_identify(args) -> int:
     if args.bootstrap is not None and args.refine:
         raise ShipidError("--bootstrap describes the LS-SVM fit; it does not go with --refine")
     asked = args.output_error == "always"
-    given_physics = [flag for flag, value in (("--prior", args.prior),
-                                              ("--constraints", args.constraints),
-                                              ("--bound", args.bound),
-                                              ("--steady-speed", args.steady_speed)) if value]
-    if asked and given_physics:
-        raise ShipidError(f"--output-error fits the coefficients freely; it does not hold "
-                          f"{given_physics[0]} (the LS-SVM fit does: leave out --output-error)")
     if asked and (args.refine or args.bootstrap is not None):
         raise ShipidError("--output-error is its own fit with its own intervals; it does not go "
                           "with --refine or --bootstrap")  # fmt: skip
@@ -91,6 +84,14 @@ def cmd_identify(args) -> int:
     names = [str(p) for p in args.logs]
     choice = _choose_structure(args, logs, names)
     physics = _physics(args, logs, _structure(args))
+    from shipid.identification.physics import unboxed
+
+    # Output error holds sign constraints and bounds (box bounds on its coefficients), not the
+    # conditions on the equation-error regression.
+    given_physics = unboxed(physics)
+    if asked and given_physics:
+        raise ShipidError(f"--output-error holds --constraints signs and --bound; it does not hold "
+                          f"{given_physics[0]} (the LS-SVM fit does: leave out --output-error)")
     cutoff, filter_by = args.filter, "given"
     if cutoff == "auto":
         from shipid.identification.prefilter import choose_prefilter
@@ -187,7 +188,7 @@ def cmd_identify(args) -> int:
               f"{refinement.nfev} evaluations ({refinement.message})")
         print(_free_run_table(refinement))
     if asked:
-        refinement, ensemble = _output_error(ident, raw_logs, names, args)
+        refinement, ensemble = _output_error(ident, raw_logs, names, args, physics)
     elif args.output_error == "auto" and not (args.refine or args.bootstrap is not None
                                              or explicit_band or args.residual):
         prep["output_error"] = {"fit": "LS-SVM"}
@@ -196,8 +197,8 @@ def cmd_identify(args) -> int:
             print(f"output error: not fitted, since {prep['output_error']['why']}; the LS-SVM "
                   "fit does")  # fmt: skip
         else:
-            refinement, ensemble = _output_error_where_noise_is_left(ident, raw_logs, names, args,
-                                                                     prep["output_error"])  # fmt: skip
+            refinement, ensemble = _output_error_where_noise_is_left(
+                ident, raw_logs, names, args, prep["output_error"], physics)
     final = ident.model
     if speed is None or not speed > 0:
         raise ShipidError(f"{names[0]}: the first training log starts without headway (u = "
@@ -318,7 +319,7 @@ def _turns_apart(lssvm: dict, refined: dict) -> str | None:
     return None
 
 
-def _output_error_where_noise_is_left(ident, logs, names, args, record: dict):
+def _output_error_where_noise_is_left(ident, logs, names, args, record: dict, physics=None):
     """The default: output error where the LS-SVM's free runs leave only the sensors' noise
     (``output_error.noise_dominates``) and its own residuals come out white; else the LS-SVM
     fit, and one line saying why (both into ``record``, kept in the model file). Returns
@@ -343,7 +344,7 @@ def _output_error_where_noise_is_left(ident, logs, names, args, record: dict):
     print(f"output error: the LS-SVM's free runs miss the logs by at most {worst.max():.3g} "
           "times their sensor noise, so noise is what it leaves: fitting by maximum-likelihood "
           "output error (--no-output-error to keep the LS-SVM fit)")  # fmt: skip
-    fit, ensemble = _output_error(ident, logs, names, args)
+    fit, ensemble = _output_error(ident, logs, names, args, physics)
     inflation = fit.statistics["covariance_inflation"]
     if not inflation < INFLATION_WARNING:
         record["why"] = (f"its residuals are correlated (standard errors ×{inflation:.3g}): model "
@@ -354,14 +355,20 @@ def _output_error_where_noise_is_left(ident, logs, names, args, record: dict):
     return fit, ensemble
 
 
-def _output_error(ident, logs, names, args):
-    """``identify --output-error``: the maximum-likelihood output-error fit from the LS-SVM model,
-    printed with its standard errors and intervals; returns the fit and its ensemble."""
+def _output_error(ident, logs, names, args, physics=None):
+    """``identify --output-error``: the maximum-likelihood output-error fit from the LS-SVM model
+    (holding the sign constraints and bounds of ``physics``), printed with its standard errors
+    and intervals; returns the fit and its ensemble."""
     from shipid.identification.output_error import coefficient_intervals, output_error
+    from shipid.identification.physics import coefficient_bounds
 
-    print("fitting by maximum-likelihood output error (unfiltered logs)…", file=sys.stderr)
+    bounds, reasons, bound_notes = coefficient_bounds(physics, ident.model, logs)
+    print("fitting by maximum-likelihood output error (unfiltered logs"
+          + (f"; {sum(map(len, bounds.values()))} coefficients bounded" if bounds else "")
+          + ")…", file=sys.stderr)  # fmt: skip
     fit, ensemble = output_error(ident.model, logs, max_nfev=args.refine_evals, names=names,
-                                 seed=args.seed)  # fmt: skip
+                                 seed=args.seed, bounds=bounds, reasons=reasons)  # fmt: skip
+    fit.warnings[:0] = [n for n in bound_notes if n not in fit.warnings]
     st = fit.statistics
     print("\nmaximum-likelihood output error (± standard error):")
     print(fit.model.equations(std_errors=st["standard_errors"]))

@@ -166,9 +166,11 @@ def build_parser() -> argparse.ArgumentParser:
                    "measurement noise, unlike any equation-error fit), with standard errors, "
                    "95 %% intervals and 200 covariance draws stored for prediction bands and "
                    "index intervals; the LS-SVM model is its start and stays in the file. "
-                   "Default: where the LS-SVM's free runs miss the logs by no more than twice "
-                   "their sensor noise, and the output-error residuals come out white (noise, "
-                   "not model error), without --refine, --bootstrap, --error-band or --residual")
+                   "Holds --constraints signs and --bound (not a prior, stable, derivatives or "
+                   "steady speed). Default: where the LS-SVM's free runs miss the logs by no "
+                   "more than twice their sensor noise, and the output-error residuals come out "
+                   "white (noise, not model error), without --refine, --bootstrap, --error-band "
+                   "or --residual")
     p.add_argument("--no-output-error", dest="output_error", action="store_const",
                    const="never", help="keep the LS-SVM fit even where noise is all it leaves")
     p.add_argument("--segment", type=float, metavar="S",

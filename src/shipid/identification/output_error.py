@@ -34,13 +34,14 @@ and index intervals are Gaussian draws from the coefficient covariance.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 import pandas as pd
 
 from shipid.dynamics.model import DOFS, ManoeuvringModel
 from shipid.dynamics.simulate import METHODS, DivergenceBounds, run_kernel
+from shipid.dynamics.terms import parse_term
 from shipid.errors import ShipidError
 from shipid.identification.refine import (
     DIVERGED_RESIDUAL,
@@ -118,6 +119,8 @@ def output_error(
     names: Sequence[str] | None = None,
     draws: int = 200,
     seed: int = 0,
+    bounds: Mapping[str, Mapping[str, tuple[float, float]]] | None = None,
+    reasons: Mapping[str, Mapping[str, str]] | None = None,
 ) -> tuple[Refinement, Ensemble]:
     """Maximum-likelihood output-error estimate of ``model``'s coefficients from ``logs``.
 
@@ -129,6 +132,12 @@ def output_error(
     max_nfev : cap on cost evaluations of each of the two passes.
     draws : members of the ensemble drawn from the coefficient covariance (≥ 10).
     seed : random seed of the draws.
+    bounds : {dof: {term: (lower, upper)}} box bounds on coefficients (sign constraints, user
+        bounds: ``shipid.identification.physics.coefficient_bounds``), held by a trust-region
+        reflective fit instead of Levenberg–Marquardt. A coefficient the fit holds at its bound
+        keeps the standard error of the unbounded information matrix; its interval and the
+        ensemble's draws are cut at the bound.
+    reasons : {dof: {term: why}} of the bounds, named in the note of a coefficient held at one.
 
     Returns
     -------
@@ -160,6 +169,9 @@ def output_error(
     n_coef = len(rows)
     x0 = np.concatenate([model.theta[rows, cols], seg.shot0[:, state_col].ravel()])
     p = x0.size
+    lower, upper = _bound_vectors(model, rows, cols, bounds, p)
+    bounded = bool(np.isfinite(lower).any() or np.isfinite(upper).any())
+    x0 = np.clip(x0, lower, upper)  # an unconstrained start moved onto the feasible set
     n_obs = int(seg.mask.sum()) * n_states
     if n_obs <= p:
         raise ShipidError(f"the logs hold {n_obs} measured values for {p} parameters (the "
@@ -205,14 +217,20 @@ def output_error(
 
     sigma = _noise_from_differences(seg.measured, seg.mask)
     x, nfev = x0, 0
+    solver = {"method": "trf", "bounds": (lower, upper)} if bounded else {"method": "lm"}
     for _ in range(2):  # the second pass with the noise the first one's residuals show
-        fit = least_squares(residuals, x, jac=jacobian, method="lm", x_scale="jac",
-                            max_nfev=max_nfev, args=(sigma,))  # fmt: skip
+        fit = least_squares(residuals, x, jac=jacobian, x_scale="jac", max_nfev=max_nfev,
+                            args=(sigma,), **solver)  # fmt: skip
         x, nfev = fit.x, nfev + int(fit.nfev)
         raw = simulate(x[None])[0] - seg.measured
         raw[..., ~seg.mask, :] = np.nan
         per_state = np.sum(seg.mask) - p / n_states
         sigma = np.maximum(np.sqrt(np.nansum(raw**2, axis=(0, 1)) / per_state), 1e-12)
+    # The bounds the trust-region fit holds active, put exactly on them (it keeps iterates a
+    # hair inside, 1e-10 relative).
+    active = np.asarray(getattr(fit, "active_mask", np.zeros(p)))
+    at_bound = active[:n_coef] != 0
+    x = np.where(active < 0, lower, np.where(active > 0, upper, x))
 
     # Costs, Jacobian and covariance with the final noise estimate; the start's cost from its
     # measured initial states.
@@ -238,6 +256,12 @@ def output_error(
         std_errors[DOFS[i]][model.term_texts[j]] = float(value)
         labels.append([DOFS[i], model.term_texts[j]])
 
+    for j in np.flatnonzero(at_bound):
+        dof, term = DOFS[rows[j]], model.term_texts[cols[j]]
+        why = ((reasons or {}).get(dof) or {}).get(term)
+        notes.append(f"{dof}: {parse_term(term).display() or '1'} held at its bound {x[j]:.4g}"
+                     + (f" ({why})" if why else "") + ": the unbounded output-error fit goes "
+                     "past it")  # fmt: skip
     if fit.status == 0:
         notes.append(f"output error stopped at the evaluation cap ({max_nfev}) before converging")
     if inflation > INFLATION_WARNING:
@@ -254,11 +278,35 @@ def output_error(
         "covariance": {"terms": labels, "matrix": cov_coef.tolist()},
         "initial_states": [{"log": n, **{s: float(x0_fit[b, j]) for j, s in enumerate(states)}}
                            for b, n in enumerate(names)],
+        "bounds": {dof: {t: [float(lo), float(hi)] for t, (lo, hi) in b.items()}
+                   for dof, b in (bounds or {}).items() if b},
+        "at_bound": [[DOFS[rows[j]], model.term_texts[cols[j]]] for j in np.flatnonzero(at_bound)],
     }  # fmt: skip
     result = Refinement(fitted, model, seg_len, B, states, cost_initial, cost_final, nfev,
                         bool(fit.success), str(fit.message), runs, notes, METHOD,
                         statistics)  # fmt: skip
-    return result, gaussian_ensemble(fitted, rows, cols, cov_coef, draws, seed)
+    return result, gaussian_ensemble(fitted, rows, cols, cov_coef, draws, seed,
+                                     (lower[:n_coef], upper[:n_coef]) if bounded else None)
+
+
+def _bound_vectors(model: ManoeuvringModel, rows: np.ndarray, cols: np.ndarray,
+                   bounds: Mapping[str, Mapping[str, tuple[float, float]]] | None, p: int
+                   ) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """Lower and upper bounds of the p parameters (the coefficients at ``rows``, ``cols``, then
+    the initial states, never bounded), refusing a bound on a term the model lacks."""
+    lower, upper = np.full(p, -np.inf), np.full(p, np.inf)
+    index = {(DOFS[i], model.term_texts[j]): k for k, (i, j) in enumerate(zip(rows, cols,
+                                                                              strict=True))}
+    for dof, terms in (bounds or {}).items():
+        for term, (lo, hi) in terms.items():
+            k = index.get((dof, term))
+            if k is None:
+                raise ShipidError(f"bounds: {dof}: {term} is not a term of the model's {dof} "
+                                  "equation")  # fmt: skip
+            if not lo < hi:
+                raise ShipidError(f"bounds: {dof}: {term}: lower {lo:g} is not below upper {hi:g}")
+            lower[k], upper[k] = lo, hi
+    return lower, upper
 
 
 def _lag1_autocorrelation(raw: np.ndarray, mask: np.ndarray, states: Sequence[str]
@@ -302,32 +350,40 @@ def _covariance(jac: np.ndarray, scale: float, rows: np.ndarray, cols: np.ndarra
 
 
 def gaussian_ensemble(model: ManoeuvringModel, rows: np.ndarray, cols: np.ndarray,
-                      cov: np.ndarray, draws: int, seed: int) -> Ensemble:  # fmt: skip
+                      cov: np.ndarray, draws: int, seed: int,
+                      bounds: tuple[np.ndarray, np.ndarray] | None = None) -> Ensemble:  # fmt: skip
     """``draws`` coefficient sets θ ~ N(θ̂, cov) over the fitted coefficients (at ``rows``,
-    ``cols`` of θ; the rest as θ̂)."""
+    ``cols`` of θ; the rest as θ̂), cut at ``bounds`` (lower, upper) of those coefficients: a
+    member past a sign constraint would be a ship the fit ruled out."""
     rng = np.random.default_rng(seed)
     w, V = np.linalg.eigh(cov)
     root = V * np.sqrt(np.clip(w, 0.0, None))
     delta = rng.standard_normal((draws, len(rows))) @ root.T
     thetas = np.broadcast_to(model.theta, (draws, *model.theta.shape)).copy()
     thetas[:, rows, cols] += delta
+    if bounds is not None:
+        thetas[:, rows, cols] = np.clip(thetas[:, rows, cols], bounds[0], bounds[1])
     return Ensemble(model, thetas, 0.0, int(seed), DRAWS_METHOD)
 
 
 def coefficient_intervals(fit: Refinement, level: float = LEVEL) -> pd.DataFrame:
     """One row per coefficient of an output-error fit: estimate, standard error and the normal
-    interval estimate ± z·SE (z = 1.96 at 95 %)."""
+    interval estimate ± z·SE (z = 1.96 at 95 %), cut at the coefficient's bounds if it has any."""
     from statistics import NormalDist
 
     if not fit.statistics:
         raise ShipidError("not a maximum-likelihood output-error fit: it has no standard errors")
     z = NormalDist().inv_cdf(0.5 + level / 2.0)
     se = fit.statistics["standard_errors"]
+    bounds = fit.statistics.get("bounds") or {}
     rows = []
     for dof, terms in fit.model.coefficients.items():
         for term, value in terms.items():
             s = se[dof][term]
+            lo, hi = (bounds.get(dof) or {}).get(term, (None, None))  # a file's JSON: null
+            lo, hi = -math.inf if lo is None else lo, math.inf if hi is None else hi
             rows.append({"equation": dof, "term": term, "value": value,
                          "lssvm": fit.initial.coefficients[dof].get(term, math.nan),
-                         "std_error": s, "lower": value - z * s, "upper": value + z * s})  # fmt: skip
+                         "std_error": s, "lower": max(value - z * s, lo),
+                         "upper": min(value + z * s, hi)})  # fmt: skip
     return pd.DataFrame(rows)

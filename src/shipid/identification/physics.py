@@ -430,6 +430,44 @@ def dof_physics(options: PhysicsOptions | None, dof: str, names: Sequence[str], 
     return out
 
 
+def unboxed(options: PhysicsOptions | None) -> list[str]:
+    """The options of ``options`` that are not box bounds on the coefficients (the command-line
+    flags that give them), which an output-error fit does not hold: they are conditions on the
+    equation-error regression (a prior on its weights, rows of its solver)."""
+    if options is None:
+        return []
+    flags = (("prior", "--prior"), ("steady_speed", "--steady-speed"),
+             ("stable", "--constraints stable"), ("derivatives", "--constraints derivatives"))
+    return [flag for name, flag in flags if getattr(options, name)]
+
+
+def coefficient_bounds(options: PhysicsOptions | None, model, logs: Sequence[pd.DataFrame]
+                       ) -> tuple[dict[str, dict[str, tuple[float, float]]],
+                                  dict[str, dict[str, str]], list[str]]:  # fmt: skip
+    """The sign rules and user bounds of ``options`` on every coefficient of ``model`` (a
+    ``ManoeuvringModel``), as {dof: {term: (lower, upper)}} for the bounded ones, why each is
+    bounded ({dof: {term: reason}}) and notes; the same table and errors as the LS-SVM fit's
+    (``dof_physics``). Refused for options that are not box bounds (``unboxed``)."""
+    left = unboxed(options)
+    if left:
+        raise ShipidError(f"an output-error fit holds sign constraints and --bound (box bounds on "
+                          f"the coefficients), not {left[0]}")  # fmt: skip
+    if options is None or not options.active:
+        return {}, {}, []
+    bounds: dict[str, dict[str, tuple[float, float]]] = {}
+    reasons: dict[str, dict[str, str]] = {}
+    notes: list[str] = []
+    for dof, terms in model.coefficients.items():
+        names = [t for t in terms if t != "1"]
+        extra = dof_physics(options, dof, names, "1" in terms, {}, logs)
+        notes += extra.notes
+        for j, name in enumerate(names):
+            if math.isfinite(extra.lower[j]) or math.isfinite(extra.upper[j]):
+                bounds.setdefault(dof, {})[name] = (float(extra.lower[j]), float(extra.upper[j]))
+                reasons.setdefault(dof, {})[name] = extra.reasons.get(name, "bound")
+    return bounds, reasons, notes
+
+
 def with_stability(extra: DofPhysics, options: PhysicsOptions | None, dof: str,
                    names: Sequence[str], fixed: Mapping[str, float],
                    fitted: Mapping[str, Mapping[str, float]], logs: Sequence[pd.DataFrame],
