@@ -38,6 +38,7 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 import pandas as pd
+from threadpoolctl import threadpool_limits
 
 from shipid.dynamics.model import DOFS, ManoeuvringModel
 from shipid.dynamics.simulate import METHODS, DivergenceBounds, run_kernel
@@ -219,8 +220,12 @@ def output_error(
     x, nfev = x0, 0
     solver = {"method": "trf", "bounds": (lower, upper)} if bounded else {"method": "lm"}
     for _ in range(2):  # the second pass with the noise the first one's residuals show
-        fit = least_squares(residuals, x, jac=jacobian, x_scale="jac", max_nfev=max_nfev,
-                            args=(sigma,), **solver)  # fmt: skip
+        # The trust-region steps are BLAS SVDs: OpenBLAS's threads, left spinning between them,
+        # slowed the compiled free runs on 2 cores 4-fold (the bounded fit took 10 times the
+        # free one's 0.025 s on the paper's zig-zag; ``benchmarks/bench_physics.py``).
+        with threadpool_limits(limits=1, user_api="blas"):
+            fit = least_squares(residuals, x, jac=jacobian, x_scale="jac", max_nfev=max_nfev,
+                                args=(sigma,), **solver)  # fmt: skip
         x, nfev = fit.x, nfev + int(fit.nfev)
         raw = simulate(x[None])[0] - seg.measured
         raw[..., ~seg.mask, :] = np.nan
