@@ -1,5 +1,12 @@
 """Test-session settings shared by every test file."""
 
+import os
+
+# BLAS on one thread, as the commands run it (``shipid.blas``): two test workers on two cores,
+# each with OpenBLAS threads spinning between calls, took the cores the compiled simulations
+# needed (the suite 88 s against 74 s). Read by OpenBLAS when it loads, in each worker.
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
 # ``make test`` runs two workers with ``--dist loadfile``: whole files go to whichever worker is
 # free, in collection order. Collected alphabetically, test_readme.py (a third of the suite's
 # time: its blocks run in order on one worker) started late and ran alone at the end; the longest

@@ -19,6 +19,7 @@ import signal
 import sys
 import warnings
 
+from shipid.blas import one_thread
 from shipid.cli.common import FORMATS
 from shipid.cli.parser import build_parser
 from shipid.errors import ShipidError, ShipidWarning
@@ -151,7 +152,8 @@ def main(argv: list[str] | None = None) -> int:
             warnings.simplefilter("always", ShipidWarning)
             check_options(args)
             try:
-                code = args.func(args)
+                with one_thread():  # BLAS: see shipid.blas
+                    code = args.func(args)
             except Exception:
                 # An error after an interrupt is the interrupt's doing (it broke a JIT compile,
                 # which then fails with its own RuntimeError), not a bug: exit 130 all the same.

@@ -23,6 +23,7 @@ import numpy as np
 from scipy import linalg
 from threadpoolctl import threadpool_limits
 
+from shipid.blas import threads_for
 from shipid.errors import InfeasibleConstraintsError
 from shipid.limits import available_memory_bytes
 
@@ -77,7 +78,7 @@ def solve_dual(
     rhs = np.empty((n, q + 1))
     rhs[:, :q] = Y
     rhs[:, q] = 1.0
-    threads = 1 if n > SINGLE_THREAD_CHOLESKY_ABOVE else None
+    threads = 1 if n > SINGLE_THREAD_CHOLESKY_ABOVE else threads_for(n)
     with threadpool_limits(limits=threads):
         if positive_definite:
             try:

@@ -1,0 +1,36 @@
+"""BLAS threads in the commands (``shipid.blas``): one thread around a command, the user's
+setting left alone, every core for the dense solves that gain from it."""
+
+import os
+
+import numpy as np
+import pytest
+from threadpoolctl import threadpool_info, threadpool_limits
+
+from shipid import blas
+
+
+def _blas_threads() -> set[int]:
+    return {lib["num_threads"] for lib in threadpool_info() if lib["user_api"] == "blas"}
+
+
+def test_a_command_runs_blas_on_one_thread_and_restores_it(monkeypatch):
+    np.ones((2, 2)) @ np.ones((2, 2))  # BLAS loaded
+    monkeypatch.delenv(blas.THREADS_VARIABLE, raising=False)
+    with threadpool_limits(limits=2, user_api="blas"):
+        with blas.one_thread():
+            assert os.environ[blas.THREADS_VARIABLE] == "1"
+            assert _blas_threads() == {1}
+        assert blas.THREADS_VARIABLE not in os.environ
+        assert _blas_threads() == {2}
+
+
+def test_the_users_setting_holds(monkeypatch):
+    monkeypatch.setenv(blas.THREADS_VARIABLE, "2")
+    with threadpool_limits(limits=2, user_api="blas"), blas.one_thread():
+        assert os.environ[blas.THREADS_VARIABLE] == "2" and _blas_threads() == {2}
+
+
+@pytest.mark.parametrize("n, expected", [(999, None), (1000, os.cpu_count())])
+def test_threads_for_a_dense_solve(n, expected):
+    assert blas.threads_for(n) == expected
