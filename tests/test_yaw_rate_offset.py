@@ -124,3 +124,21 @@ def test_the_cli_corrects_records_and_names_an_uncorrected_log(tmp_path, trial, 
                                                       tmp_path / "nopsi.csv"),
                         "--yaw-rate-offset", "auto"], capsys)  # fmt: skip
     assert code == 1 and "no 'psi'" in err and "Traceback" not in err
+
+
+def test_a_corrected_file_keeps_its_offset_and_a_model_of_raw_rates_names_it(tmp_path, trial,
+                                                                             capsys):  # fmt: skip
+    biased = write_log(trial.assign(r=trial["r"] + math.radians(0.04)), tmp_path / "zz.csv")
+    folder = tmp_path / "corrected"
+    folder.mkdir()
+    assert run(["import", biased, "--yaw-rate-offset", "auto", "-o", folder], capsys)[0] == 0
+    again = tmp_path / "again"
+    again.mkdir()
+    code, _, err = run(["import", folder / "zz.csv", "--yaw-rate-offset", "auto", "-o", again],
+                       capsys)  # fmt: skip
+    # Nothing left to read off the second time; the file's own offset said beside it.
+    assert code == 0 and "(+0.0" in err and "the offset its file had taken off before" in err
+    raw_model = tmp_path / "raw.json"
+    assert run(["identify", biased, "--no-output-error", "-o", raw_model], capsys)[0] == 0
+    code, _, err = run(["validate", raw_model, again / "zz.csv", "--no-bands"], capsys)
+    assert code == 0 and "identified from yaw rates as measured" in err

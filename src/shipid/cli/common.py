@@ -198,10 +198,15 @@ def _rudder_rate(logs) -> float | None:
 def _print_yaw_rate_offsets(args, paths, logs) -> None:
     """One line of the offsets ``--yaw-rate-offset auto`` read off the logs' headings."""
     if args.yaw_rate_offset == "auto" and logs:
-        offsets = ", ".join(f"{Path(p).name} {d:+.3g} °/s" for p, d in
-                            zip(paths, _yaw_rate_offsets(logs), strict=True))  # fmt: skip
+        shown = []
+        for p, log in zip(paths, logs, strict=True):
+            read, total = (math.degrees(log.attrs.get(k, 0.0))
+                           for k in ("yaw_rate_offset_read", "yaw_rate_offset"))  # fmt: skip
+            shown.append(f"{Path(p).name} {read:+.3g} °/s" + (
+                "" if math.isclose(read, total) else f" ({total:+.3g} °/s with the offset its "
+                "file had taken off before)"))
         print("yaw rate less each log's gyro offset read off its heading (--yaw-rate-offset "
-              f"auto): {offsets}", file=sys.stderr)
+              f"auto): {', '.join(shown)}", file=sys.stderr)
 
 
 def _yaw_rate_notes(cond: dict, logs, names) -> list[str]:
@@ -214,6 +219,10 @@ def _yaw_rate_notes(cond: dict, logs, names) -> list[str]:
                        "offsets (--yaw-rate-offset), this log's r is as measured: its free "
                        "runs start from and are judged against another r; give "
                        "--yaw-rate-offset auto")  # fmt: skip
+        elif not trained and log.attrs.get("yaw_rate_offset"):
+            out.append(f"{name}: its r is less a gyro offset (--yaw-rate-offset), the model was "
+                       "identified from yaw rates as measured, which hold their offsets in its "
+                       "yaw equation: identify it from corrected logs too")  # fmt: skip
     return out
 
 

@@ -89,6 +89,8 @@ def correct_yaw_rate(log: pd.DataFrame, offset: float | str, name: str) -> pd.Da
         raise ShipidError(f"the yaw rate's offset must be 'auto' or a finite number [rad/s], "
                           f"got {offset!r}")
     out = log.assign(r=log["r"].to_numpy(dtype=float) - value)
+    # The file keeps the whole offset taken off its r; this reading's share is said apart.
     out.attrs = {**log.attrs,
-                 "yaw_rate_offset": float(log.attrs.get("yaw_rate_offset", 0.0)) + value}
+                 "yaw_rate_offset": float(log.attrs.get("yaw_rate_offset", 0.0)) + value,
+                 "yaw_rate_offset_read": value}
     return out
