@@ -202,6 +202,25 @@ def test_cli_select_compare_and_gamma_auto(paper_trials, tmp_path, capsys):
     assert len(rows) == 4 * 3
 
 
+def test_compare_names_logs_its_default_structure_cannot_hold(tmp_path, capsys, paper_trials):
+    """Bug: `compare` scored every method through the paper's blanke whatever the logs held: on
+    the Esso's zig-zags (10–16.7 rps, wind) every method came out worse than the logs' means,
+    without a word."""
+    training, _ = paper_trials
+    paths = [write_log(log.assign(n=rps), tmp_path / f"zz{rps}.csv")
+             for log, rps in zip(training[:3], (10.0, 13.0, 16.0), strict=True)]  # fmt: skip
+    argv = ["compare", *map(str, paths), "--methods", "ols", "--quiet"]
+    code = main(argv)
+    err = capsys.readouterr().err
+    assert code == 0 and "the propeller speed n varies (10 to 16 rps)" in err
+    assert "the paper's blanke cannot hold that" in err
+    assert main([*argv, "--model", "blanke"]) == 0  # asked for: no warning
+    assert "cannot hold" not in capsys.readouterr().err
+    plain = [write_log(log, tmp_path / f"plain{i}.csv") for i, log in enumerate(training[:2])]
+    assert main(["compare", *map(str, plain), "--methods", "ols", "--quiet"]) == 0
+    assert "cannot hold" not in capsys.readouterr().err
+
+
 def test_cli_select_refuses_one_log(tmp_path, capsys, paper_trials):
     training, _ = paper_trials
     path = write_log(training[0], tmp_path / "one.csv")

@@ -573,20 +573,34 @@ def _fold_table(folds) -> str:
 def cmd_compare(args) -> int:
     """``shipid compare``: methods × held-out logs in one table."""
     from shipid.evaluation.compare import compare, summary
+    from shipid.identification.auto_structure import PAPER
     from shipid.outputs import OutputSet, check_outputs
 
     check_outputs({"--json": (args.json, "json")}, args.logs)
     methods = [m.strip() for m in args.methods.split(",") if m.strip()]
     logs = _training_logs(args)
     names = [Path(p).name for p in args.logs]
-    table = compare(logs, args.model, methods, names, gamma=args.gamma, cv=args.cv,
+    structure = args.model or PAPER
+    if args.model is None and any(not m.startswith("select:") for m in methods):
+        from shipid.identification.auto_structure import beyond_the_paper
+
+        reasons = beyond_the_paper(logs)[0]
+        if reasons:
+            # Scored through a structure that cannot hold the logs, every method looks bad and
+            # the table ranks them by luck (the Esso's zig-zags: scores 0.9–5.7, worse than
+            # the logs' means).
+            _warn(f"{'; '.join(reasons)}: the paper's blanke cannot hold that, so these scores "
+                  "judge the structure, not the methods; give --model (e.g. blanke-rps+wind, "
+                  "or the structure identify chooses) or a term search (--methods "
+                  "select:low-speed+wind)")  # fmt: skip
+    table = compare(logs, structure, methods, names, gamma=args.gamma, cv=args.cv,
                     method=args.method, progress=not args.quiet)  # fmt: skip
     print(f"Free-run score per held-out log ({args.cv}; error RMS over the log's spread, mean of "
-          "u, v, r; 1 ≈ predicting the mean), model structure " + str(args.model) + ":")
+          "u, v, r; 1 ≈ predicting the mean), model structure " + structure + ":")
     print(summary(table).to_markdown(floatfmt=".3f"))
     with OutputSet() as out:
         if args.json:
-            doc = {"structure": args.model, "cv": args.cv, "gamma": args.gamma,
+            doc = {"structure": structure, "cv": args.cv, "gamma": args.gamma,
                    "rows": table.to_dict(orient="records")}  # fmt: skip
             out.write(args.json, lambda p: p.write_text(_json_text(doc), "utf-8"))
     return 0

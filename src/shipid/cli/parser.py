@@ -252,8 +252,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("compare", help="methods × held-out logs: free-run cross-validation")
     p.add_argument("logs", nargs="+", metavar="LOG")
-    p.add_argument("--model", default="blanke", help="structure for the semiphysical methods "
-                   "(default %(default)s)")
+    p.add_argument("--model", help="structure for the semiphysical methods (default blanke, "
+                   "the paper's, with a warning where the logs hold a varying propeller speed or "
+                   "a wind it cannot)")
     p.add_argument("--methods", default="lssvm,ols,ridge,lasso,svr,elm",
                    help="comma-separated: lssvm, ols, ridge, lasso, svr, elm, lssvm-rbf, "
                    "select:LIBRARY (default %(default)s)")

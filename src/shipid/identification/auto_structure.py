@@ -111,14 +111,21 @@ def _quiet(message: str) -> None:
     """The default ``announce``: say nothing."""
 
 
-def _auto_structure(logs, names, physics, cv, estimator, drop, announce) -> StructureChoice:
-    logs = [logs] if isinstance(logs, pd.DataFrame) else list(logs)
+def beyond_the_paper(logs: Sequence[pd.DataFrame]) -> tuple[list[str], dict, object]:
+    """What the logs hold that the paper's ``blanke`` cannot (a varying propeller speed or
+    thrust, a material wind), said in words; with the varying signals and the wind found."""
     varying = {found.signal: found for found in varying_propulsion(logs)}
     wind = material_wind(logs)
     reasons = [found.describe() for found in varying.values()]
     if wind is not None:
         reasons.append(f"the logs carry a wind ({wind[0]:.3g} m/s true against the ship's "
                        f"{wind[1]:.3g} m/s, medians)")  # fmt: skip
+    return reasons, varying, wind
+
+
+def _auto_structure(logs, names, physics, cv, estimator, drop, announce) -> StructureChoice:
+    logs = [logs] if isinstance(logs, pd.DataFrame) else list(logs)
+    reasons, varying, wind = beyond_the_paper(logs)
     if not reasons:
         return _paper_or_race(logs, names, physics, cv, estimator, drop, announce)
     if "n" not in varying:
