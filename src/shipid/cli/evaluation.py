@@ -104,6 +104,8 @@ def cmd_validate(args) -> int:
             note = switch_heading_note(good)
             if note:
                 print(note)
+    if args.horizon and good:
+        _print_horizons(model, good, logs, vals, args)
     residuals = {}
     if args.resid or args.report:
         from shipid.evaluation.metrics import residual_correlations
@@ -181,6 +183,31 @@ def cmd_validate(args) -> int:
             out.write(Path(args.report) / "report.html",
                       lambda p: p.write_text(text, encoding="utf-8"))
     return 1 if errors else 0
+
+
+def _print_horizons(model, good, logs, vals, args) -> None:
+    """``validate --horizon``: each log's free runs restarted every H seconds, a table of their
+    errors over the log's spread; kept with each log's validation (``--json``)."""
+    from shipid.evaluation.horizon import horizon_errors
+
+    rows = []
+    for v, log in zip(vals, logs, strict=True):
+        if v.error is not None:
+            continue
+        for h in args.horizon:
+            try:
+                found = horizon_errors(model, log, h, args.method, v.name)
+            except ShipidError as exc:
+                v.warnings.append(str(exc))
+                continue
+            v.horizons.append(found.to_dict())
+            rows.append({"log": Path(v.name).name, "horizon [s]": found.horizon_s,
+                         "windows": found.windows, "diverged": found.diverged,
+                         **{f"{s} error / spread": found.over_spread[s] for s in "uvr"}})  # fmt: skip
+    if rows:
+        print("\nPredictions over a horizon: free runs restarted from the measured state every "
+              "H s, their rms error over the log's spread (1 ≈ predicting its mean):")
+        print(_pd().DataFrame(rows).to_markdown(index=False, floatfmt=".3g"))
 
 
 def _coefficient_errors(doc, model, lssvm: bool) -> tuple[dict | None, str]:

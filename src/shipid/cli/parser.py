@@ -89,6 +89,16 @@ def _offset_or_auto(text: str) -> float | str:
     return math.radians(value)
 
 
+def _seconds_list(text: str) -> list[float]:
+    try:
+        values = [float(x) for x in text.split(",") if x.strip()]
+    except ValueError:
+        values = []
+    if not values or not all(math.isfinite(v) and v > 0 for v in values):
+        raise argparse.ArgumentTypeError(f"expected seconds > 0, comma-separated, got {text!r}")
+    return values
+
+
 def _end_time(text: str) -> float | str:
     return text if text == "dropout" else _time_or_auto(text)
 
@@ -285,6 +295,10 @@ def build_parser() -> argparse.ArgumentParser:
                    "error band")
     p.add_argument("--plot-format", default="png", choices=("png", "svg", "pdf"),
                    help="format of the --plots figures (default %(default)s)")
+    p.add_argument("--horizon", type=_seconds_list, metavar="S[,S...]",
+                   help="predictions over horizons: free runs restarted from the measured state "
+                   "every S seconds, their error per state over the log's spread (e.g. 10,30,60: "
+                   "what an autopilot or a predictive controller asks of the model)")
     p.add_argument("--resid", action="store_true",
                    help="residual analysis: autocorrelation of the errors and correlation with "
                    "the rudder (a table, and figures with --plots)")

@@ -75,6 +75,8 @@ class Validation:
     # With a cross-validated error band: the band and, per state, the share of samples in it.
     error_band: ErrorBand | None = None
     band_shares: dict[str, float] | None = None
+    # Free runs restarted every H seconds (``shipid.evaluation.horizon``), one per horizon asked.
+    horizons: list[dict] = field(default_factory=list)
 
     def to_frame(self):
         """The metrics as a DataFrame: one row per state (u, v, r), one column per metric."""
@@ -93,7 +95,7 @@ class Validation:
                 "index_intervals": {k: {i: list(b) for i, b in v.items()}
                                     for k, v in self.intervals.items()},
                 "ensemble_diverged": self.ensemble_diverged if self.bands else None,
-                "within_error_band": self.band_shares,
+                "within_error_band": self.band_shares, "horizons": self.horizons,
                 "warnings": self.warnings}  # fmt: skip
 
 

@@ -1,0 +1,81 @@
+"""Predictions over a horizon: free runs restarted from the measured state every H seconds.
+
+A free run over a whole log (the paper's validation, ``validate``) carries every early error to
+its end. Over a random run of a quarter of an hour, astern spans included, it says little of how
+well a model predicts the next half minute, which is what an autopilot or a model-predictive
+controller asks of it. Here the log is cut into consecutive windows of H seconds; each is
+simulated from the measured u, v, r at its start, driven by the measured rudder (and propeller,
+wind), and its error kept over the window. Reported per state as the root-mean-square error over
+all windows' samples, and over the state's spread in the log (1 ≈ predicting the log's mean).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from shipid.dynamics.simulate import model_inputs, simulate_batch
+from shipid.errors import ShipidError
+
+STATES = ("u", "v", "r")
+
+
+@dataclass
+class HorizonErrors:
+    """The errors of free runs over windows of ``horizon_s`` (see the module)."""
+
+    horizon_s: float
+    windows: int
+    diverged: int
+    rmse: dict[str, float] = field(default_factory=dict)
+    over_spread: dict[str, float] = field(default_factory=dict)
+
+    def to_dict(self) -> dict:
+        """The errors as JSON-ready data (``validate --json``, each log's ``horizons``)."""
+        return {"horizon_s": self.horizon_s, "windows": self.windows, "diverged": self.diverged,
+                "rmse": dict(self.rmse), "over_spread": dict(self.over_spread)}  # fmt: skip
+
+
+def horizon_errors(model, log: pd.DataFrame, horizon_s: float, method: str = "euler",
+                   name: str | None = None) -> HorizonErrors:  # fmt: skip
+    """Free runs of ``model`` over consecutive windows of ``horizon_s`` seconds of ``log``, each
+    from the log's measured state at its start (``HorizonErrors``). A window whose run diverges
+    counts in ``diverged`` and its samples from there on as missing."""
+    name = name or log.attrs.get("name", "log")
+    if not (isinstance(horizon_s, int | float) and math.isfinite(horizon_s) and horizon_s > 0):
+        raise ShipidError(f"--horizon must be seconds > 0, got {horizon_s!r}")
+    t = log["t"].to_numpy(dtype=float)
+    if len(t) < 3:
+        raise ShipidError(f"{name}: too short for predictions over a horizon")
+    dt = float(np.median(np.diff(t)))
+    steps = max(1, int(round(horizon_s / dt)))
+    if steps >= len(t) - 1:
+        raise ShipidError(f"{name}: a horizon of {horizon_s:g} s spans the whole log "
+                          f"({t[-1] - t[0]:.4g} s): its error is the free run's")  # fmt: skip
+    starts = np.arange(0, len(t) - 1, steps)
+    index = np.minimum(starts[:, None] + np.arange(steps + 1)[None, :], len(t) - 1)  # (B, L)
+    real = (starts[:, None] + np.arange(steps + 1)[None, :]) <= len(t) - 1
+    initial = np.zeros((len(starts), 6))
+    for j, s in enumerate(("u", "v", "r", "psi", "x", "y")):
+        if s in log.columns:
+            initial[:, j] = log[s].to_numpy(dtype=float)[starts]
+    series = {k: np.asarray(v, dtype=float)[index] for k, v in model_inputs(model, log, name).items()}
+    thrust, rps = series.pop("thrust", None), series.pop("n", None)
+    batch = simulate_batch(model, np.arange(steps + 1) * dt, log["delta"].to_numpy(float)[index],
+                           initial, thrust, method, rps=rps, inputs=series or None,
+                           n_trajectories=len(starts))  # fmt: skip
+    alive = np.arange(steps + 1)[None, :] < batch.n_valid[:, None]
+    keep = real & alive
+    keep[:, 0] = False  # the measured start itself
+    out = HorizonErrors(steps * dt, len(starts), int(batch.diverged.sum()))
+    for j, s in enumerate(STATES):
+        measured = log[s].to_numpy(dtype=float)
+        err = (batch.states[:, :, j] - measured[index])[keep]
+        rmse = float(np.sqrt(np.mean(err**2))) if err.size else math.nan
+        spread = float(np.std(measured))
+        out.rmse[s] = rmse
+        out.over_spread[s] = rmse / spread if spread > 0 else math.nan
+    return out
