@@ -77,9 +77,10 @@ def test_validate_prints_and_keeps_the_horizons(tmp_path, capsys, truth_and_log)
     save_model(model, identify(log))
     out = tmp_path / "v.json"
     code, text, err = run(["validate", model, path, "--horizon", "10,30", "--no-bands", "--json",
-                           out], capsys)  # fmt: skip
+                           out, "--report", tmp_path / "report"], capsys)  # fmt: skip
     assert code == 0, err
     assert "Predictions over a horizon" in text and "|            30 |" in text
+    assert "<h2>Predictions over a horizon</h2>" in (tmp_path / "report" / "report.html").read_text()
     rec = json.loads(out.read_text())["logs"][0]["horizons"]
     assert [h["horizon_s"] for h in rec] == [pytest.approx(10.0), pytest.approx(30.0)]
     with pytest.raises(SystemExit) as exited:

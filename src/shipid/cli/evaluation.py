@@ -105,7 +105,7 @@ def cmd_validate(args) -> int:
             if note:
                 print(note)
     if args.horizon and good:
-        _print_horizons(model, good, logs, vals, args)
+        _print_horizons(model, vals, logs, args)
     residuals = {}
     if args.resid or args.report:
         from shipid.evaluation.metrics import residual_correlations
@@ -185,29 +185,25 @@ def cmd_validate(args) -> int:
     return 1 if errors else 0
 
 
-def _print_horizons(model, good, logs, vals, args) -> None:
-    """``validate --horizon``: each log's free runs restarted every H seconds, a table of their
-    errors over the log's spread; kept with each log's validation (``--json``)."""
+def _print_horizons(model, vals, logs, args) -> None:
+    """``validate --horizon``: each log's free runs restarted every H seconds (kept with its
+    validation: ``--json``, the report), and a table of their errors over the log's spread."""
     from shipid.evaluation.horizon import horizon_errors
+    from shipid.reporting.report import horizons_frame
 
-    rows = []
     for v, log in zip(vals, logs, strict=True):
         if v.error is not None:
             continue
         for h in args.horizon:
             try:
-                found = horizon_errors(model, log, h, args.method, v.name)
+                v.horizons.append(horizon_errors(model, log, h, args.method, v.name).to_dict())
             except ShipidError as exc:
                 v.warnings.append(str(exc))
-                continue
-            v.horizons.append(found.to_dict())
-            rows.append({"log": Path(v.name).name, "horizon [s]": found.horizon_s,
-                         "windows": found.windows, "diverged": found.diverged,
-                         **{f"{s} error / spread": found.over_spread[s] for s in "uvr"}})  # fmt: skip
-    if rows:
+    table = horizons_frame(vals)
+    if len(table):
         print("\nPredictions over a horizon: free runs restarted from the measured state every "
               "H s, their rms error over the log's spread (1 ≈ predicting its mean):")
-        print(_pd().DataFrame(rows).to_markdown(index=False, floatfmt=".3g"))
+        print(table.to_markdown(index=False, floatfmt=".3g"))
 
 
 def _coefficient_errors(doc, model, lssvm: bool) -> tuple[dict | None, str]:

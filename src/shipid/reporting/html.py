@@ -55,7 +55,12 @@ def validation_report(
     """The HTML text of the report. ``figures``: PNGs already drawn, {log name: {"fit": ...,
     "resid": ...}} (``shipid validate --plots`` shares its own); the others are drawn here."""
     from shipid.reporting import plots
-    from shipid.reporting.report import indices_frame, metrics_frame, switch_heading_note
+    from shipid.reporting.report import (
+        horizons_frame,
+        indices_frame,
+        metrics_frame,
+        switch_heading_note,
+    )
 
     good = [(v, log) for v, log in zip(validations, logs, strict=True) if v.error is None]
     parts = [f"<!doctype html><html><head><meta charset='utf-8'><title>{html.escape(title)}"
@@ -72,6 +77,11 @@ def validation_report(
         parts.append("<h2>Warnings</h2><ul>" + "".join(
             f"<li class='warn'>{html.escape(w)}</li>" for w in warnings) + "</ul>")
     parts += ["<h2>Free-run errors</h2>", _table(metrics_frame([v for v, _ in good]))]
+    horizons = horizons_frame([v for v, _ in good])
+    if len(horizons):
+        parts += ["<h2>Predictions over a horizon</h2>",
+                  "<p>Free runs restarted from the measured state every H s; rms error over "
+                  "the log's spread (1 ≈ predicting its mean).</p>", _table(horizons)]
     failed = [v for v in validations if v.error is not None]
     if failed:
         parts.append("<ul>" + "".join(f"<li class='warn'>{html.escape(v.error)}</li>"

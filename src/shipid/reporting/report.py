@@ -57,6 +57,16 @@ STATES = ("u", "v", "r")
 UNITS = {"u": "m/s", "v": "m/s", "r": "rad/s"}
 
 
+def horizons_frame(validations: Sequence[Validation]) -> pd.DataFrame:
+    """One row per log and horizon (``validate --horizon``): windows, diverged, and the rms
+    error of u, v, r over the log's spread."""
+    rows = [{"log": Path(v.name).name, "horizon [s]": h["horizon_s"], "windows": h["windows"],
+             "diverged": h["diverged"],
+             **{f"{s} error / spread": h["over_spread"][s] for s in ("u", "v", "r")}}
+            for v in validations if v.error is None for h in v.horizons]  # fmt: skip
+    return pd.DataFrame(rows)
+
+
 def metrics_frame(validations: Sequence[Validation]) -> pd.DataFrame:
     """One row per log: rmse and fit % of u, v, r first, then bias and std, and divergence."""
     rows = []
