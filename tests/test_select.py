@@ -216,6 +216,8 @@ def test_compare_names_logs_its_default_structure_cannot_hold(tmp_path, capsys, 
     assert "the paper's blanke cannot hold that" in err
     assert main([*argv, "--model", "blanke"]) == 0  # asked for: no warning
     assert "cannot hold" not in capsys.readouterr().err
+    assert main([*argv[:-3], "--methods", "elm", "--quiet"]) == 0  # black boxes: no structure
+    assert "cannot hold" not in capsys.readouterr().err
     plain = [write_log(log, tmp_path / f"plain{i}.csv") for i, log in enumerate(training[:2])]
     assert main(["compare", *map(str, plain), "--methods", "ols", "--quiet"]) == 0
     assert "cannot hold" not in capsys.readouterr().err

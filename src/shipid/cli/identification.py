@@ -581,7 +581,11 @@ def cmd_compare(args) -> int:
     logs = _training_logs(args)
     names = [Path(p).name for p in args.logs]
     structure = args.model or PAPER
-    if args.model is None and any(not m.startswith("select:") for m in methods):
+    from shipid.identification.estimators import BLACK_BOX_ESTIMATORS
+
+    semiphysical = [m for m in methods if not m.startswith("select:")
+                    and m not in BLACK_BOX_ESTIMATORS]  # fmt: skip
+    if args.model is None and semiphysical:
         from shipid.identification.auto_structure import beyond_the_paper
 
         reasons = beyond_the_paper(logs)[0]
