@@ -318,9 +318,9 @@ def _check_yaw_rate_offset(df: pd.DataFrame, name: str) -> None:
     warnings.warn(f"{name}: the yaw rate 'r' runs {math.degrees(b):+.3g} °/s off the heading's "
                   f"rate ({100 * abs(b) / rms:.1f} % of its rms), so ∫r dt ends "
                   f"{math.degrees(drift.drift):.2g}° from psi over the log's "
-                  f"{drift.duration:.0f} s: a gyro's offset biases the fit and every heading "
-                  "a model of it runs (overshoots); --yaw-rate-offset auto subtracts it "
-                  "(or check psi)", ShipidWarning, stacklevel=4)
+                  f"{drift.duration:.0f} s: a gyro's offset (or, in a turn, its scale) biases "
+                  "the fit and every heading a model of it runs (overshoots); --yaw-rate-offset "
+                  "auto subtracts it (or check psi)", ShipidWarning, stacklevel=4)
 
 
 def heading_rate_ratio(t: np.ndarray, psi: np.ndarray, r: np.ndarray) -> float | None:
