@@ -56,9 +56,13 @@ class Trial:
         initial angle: the commanded rudder angle of a zig-zag or turn.
     first_rudder : signed deflection of the first plateau from neutral.
     switch_heading_deg : zig-zag switch heading inferred at the rudder orders (None if none).
-    rudder_rate : 90th percentile of the rudder rate while it moves [rad/s] (None if it never does,
-        or if the sampling does not resolve the movement).
+    rudder_rate : the rudder's rate over its swings [rad/s] (``shipid.data.rudder_signal``; None
+        if it never swings, or if the sampling does not resolve the movement).
     held_end_index : last sample of the held rudder after the execute (turning; else the end).
+    reversal_headings_deg : the signed heading change from ψ0 at each rudder order after the
+        execute (a zig-zag's reversals), in order; ``switch_heading_deg`` is their median size.
+    reversal_step_deg : the largest heading change over one sample at those orders: how finely
+        the log resolves them.
     """
 
     kind: str
@@ -73,6 +77,8 @@ class Trial:
     switch_heading_deg: float | None
     rudder_rate: float | None
     held_end_index: int
+    reversal_headings_deg: tuple[float, ...] = ()
+    reversal_step_deg: float = 0.0
 
 
 def heading_noise(psi: np.ndarray, integral: np.ndarray) -> float:
@@ -220,18 +226,20 @@ def describe_trial(
     amplitude = float(np.median(amplitudes)) if amplitudes else 0.0
     first_rudder = float(side[big[0]] * amplitudes[0]) if amplitudes else 0.0
     orders = _plateau_orders(delta, side, i0, *((t, raw) if rudder_noise else ()))
-    switch = None
-    if heading_deg is not None:
-        switch = float(heading_deg)
-    elif orders:
+    switch, reversals, step = None, (), 0.0
+    if orders:
         k = np.array([o for o, _, _ in orders])
         # The order fell between the last plateau sample and the next one: take their midpoint
         # (the ramp's start on a denoised rudder, at the same half sample after it).
-        at_order = 0.5 * (np.abs(dpsi[k]) + np.abs(dpsi[np.minimum(k + 1, len(dpsi) - 1)]))
+        at_order = 0.5 * (dpsi[k] + dpsi[np.minimum(k + 1, len(dpsi) - 1)])
         if rudder_noise:
             half = 0.5 * float(np.median(np.diff(t)))
-            at_order = np.abs(np.interp([w + half for _, _, w in orders], t, dpsi))
-        switch = float(np.degrees(np.median(at_order)))
+            at_order = np.interp([w + half for _, _, w in orders], t, dpsi)
+        reversals = tuple(float(x) for x in np.degrees(at_order))
+        step = float(np.degrees(np.max(np.abs(dpsi[np.minimum(k + 1, len(dpsi) - 1)] - dpsi[k]))))
+        switch = float(np.degrees(np.median(np.abs(at_order))))
+    if heading_deg is not None:
+        switch = float(heading_deg)
     held_end = _held_end(t, delta, i0)
     swing = np.abs(delta - delta[0])
     plateau_angle = float(np.median(np.abs(raw[swing > 0.8 * swing.max()]))) if swing.max() > 0 \
@@ -240,7 +248,8 @@ def describe_trial(
                  amplitude=amplitude, plateau_angle=plateau_angle, first_rudder=first_rudder,
                  switch_heading_deg=switch,
                  rudder_rate=rise_rate(t, delta) if rudder_noise else _rudder_rate(t, delta),
-                 held_end_index=held_end)  # fmt: skip
+                 held_end_index=held_end, reversal_headings_deg=reversals,
+                 reversal_step_deg=step)  # fmt: skip
     if kind is not None:
         return Trial(kind=kind, reason="given", **facts)
     found, reason = _classify(log, dpsi, dev, side, i0, held_end, amplitudes, orders)

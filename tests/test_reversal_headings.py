@@ -1,0 +1,73 @@
+"""The heading changes at which a zig-zag's rudder was reversed, and the note where they spread:
+the closed-loop replica reverses at their median every time, so a trial reversed unevenly
+(MARIN's −20° run: +19.81°, −21.24°, +19.54°) has overshoots no replica at one switch heading
+follows. The truth here is a simulated zig-zag, reversed where its own switch logic did."""
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from shipid.data.io import read_log
+from shipid.evaluation.validate import REVERSAL_SPREAD_DEG, validate_log
+from shipid.trials.manoeuvres import zigzag
+from shipid.trials.trial import describe_trial
+from shipid.vessels import scale_ship_model
+
+MARIN = (Path(__file__).resolve().parents[2] / "shared" / "data" / "kvlcc2-marin"
+         / "MARIN_FREE_KVLCC2_zz_-20_m.dat")  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def zz():
+    truth = scale_ship_model()
+    return truth, zigzag(truth, 20, 20, duration=90, dt=0.2, method="euler", speed=1.93,
+                         approach=2.0).log  # fmt: skip
+
+
+def test_the_reversals_of_a_simulated_zigzag_are_its_switch_heading(zz):
+    truth, log = zz
+    trial = describe_trial(log, "zigzag")
+    heads = np.array(trial.reversal_headings_deg)
+    # Reversed as soon as the heading change reached ±20° (within one step's turn), alternating.
+    assert len(heads) >= 3 and np.all(np.sign(heads[1:]) == -np.sign(heads[:-1]))
+    steps = np.degrees(np.abs(log["r"]).max()) * 0.2
+    assert np.all(np.abs(np.abs(heads) - 20.0) <= steps)
+    assert not [w for w in validate_log(truth, log, "zz").warnings if "reversed at" in w]
+
+
+def test_an_uneven_trial_is_named():
+    truth = scale_ship_model()
+    log = zigzag(truth, 20, 20, duration=90, dt=0.05, method="euler", speed=1.93,
+                 approach=2.0).log  # fmt: skip
+    clean = describe_trial(log, "zigzag")
+    assert clean.reversal_step_deg < REVERSAL_SPREAD_DEG
+    assert not [w for w in validate_log(truth, log, "zz").warnings if "reversed at" in w]
+    # A heading that drifts 0.06 °/s: every reversal read that much more to one side at its
+    # time, as a trial reversed unevenly.
+    drifting = log.assign(psi=log["psi"] + math.radians(0.06) * (log["t"] - 1.0))
+    trial = describe_trial(drifting, "zigzag")
+    # The orders: the last plateau sample before each swing of the rudder after the execute;
+    # a reversal's heading is read half a sample after it.
+    t, delta = log["t"].to_numpy(), log["delta"].to_numpy()
+    moving = np.abs(np.diff(delta)) > 1e-12
+    starts = [i for i in range(1, moving.size) if moving[i] and not moving[i - 1]]
+    times = [t[i] + 0.025 for i in starts if i > clean.execute_index + 1]
+    assert len(times) == len(clean.reversal_headings_deg)
+    expected = [h + 0.06 * (tk - 1.0) for h, tk in zip(clean.reversal_headings_deg, times,
+                                                       strict=True)]  # fmt: skip
+    # (within the drift of the approach heading ψ0 itself, 0.0015°)
+    assert trial.reversal_headings_deg == pytest.approx(expected, abs=0.005)
+    sizes = np.abs(trial.reversal_headings_deg)
+    assert sizes.max() - sizes.min() > REVERSAL_SPREAD_DEG
+    notes = [w for w in validate_log(truth, drifting, "zz").warnings if "reversed at" in w]
+    assert len(notes) == 1 and "the closed loop reverses at" in notes[0]
+
+
+@pytest.mark.skipif(not MARIN.is_file(), reason="../shared/data is not present")
+def test_marins_minus_20_run_reversed_unevenly():
+    log = read_log(MARIN, fmt="simman-marin", scale=45.7, dt=0.2)
+    trial = describe_trial(log, "zigzag")
+    assert trial.reversal_headings_deg == pytest.approx([19.81, -21.24, 19.54], abs=0.01)
+    assert trial.switch_heading_deg == pytest.approx(19.81, abs=0.01)
