@@ -6,7 +6,7 @@ A model fitted to that r learns the offset as a yaw moment, and its heading (∫
 drifts from the ship's: heading-based indices (zig-zag overshoots, the advance of a turn) move
 with it, in replays and closed loop alike. On MARIN's KVLCC2 zig-zags the offset is 0.035–0.039
 °/s at model scale, under 2 % of the rms r, yet over the 90 s of a run it puts the heading 3.5°
-off, and a replay's second overshoot of the training log 2.5° high (0.6° with the offset
+off, and a replay's second overshoot of the training log 2.7° high (0.65° with the offset
 subtracted; ``benchmarks/study_gyro_offset.py``).
 """
 
@@ -24,7 +24,8 @@ from shipid.errors import ShipidError
 
 def yaw_rate_offset(t: np.ndarray, psi: np.ndarray, r: np.ndarray) -> float | None:
     """The constant b [rad/s] by which r exceeds the heading's rate (a gyro's offset): minus the
-    least-squares slope of ψ − ∫r dt over the log (ψ unwrapped). None for logs too short."""
+    least-squares slope of ψ − ∫r dt over the log (ψ unwrapped; ``heading_drift``). None for
+    logs too short."""
     drift = heading_drift(t, psi, r)
     return None if drift is None else drift.offset
 
