@@ -120,6 +120,10 @@ def test_the_cli_corrects_records_and_names_an_uncorrected_log(tmp_path, trial, 
     code, _, err = run(["validate", model, biased, "--no-bands", "--yaw-rate-offset", "auto"],
                        capsys)  # fmt: skip
     assert code == 0 and "identified from yaw rates less" not in err
+    # A log without a material offset (HSVA's, say) needs no correction to be judged alike.
+    clean = write_log(trial, tmp_path / "clean.csv")
+    code, _, err = run(["validate", model, clean, "--no-bands"], capsys)
+    assert code == 0 and "identified from yaw rates less" not in err
     code, _, err = run(["validate", model, write_log(trial.drop(columns=["psi"]),
                                                       tmp_path / "nopsi.csv"),
                         "--yaw-rate-offset", "auto"], capsys)  # fmt: skip

@@ -210,11 +210,15 @@ def _print_yaw_rate_offsets(args, paths, logs) -> None:
 
 
 def _yaw_rate_notes(cond: dict, logs, names) -> list[str]:
-    """Logs whose r is not corrected the way the model's training logs' was."""
+    """Logs whose r is not corrected the way the model's training logs' was: read as measured
+    where its offset is material (the checks name it) for a model of corrected rates, or
+    corrected for a model of raw ones."""
+    from shipid.data.checks import material_yaw_rate_offset
+
     trained = cond.get("yaw_rate_offset_deg_s")
     out = []
     for log, name in zip(logs, names, strict=True):
-        if trained and "yaw_rate_offset" not in log.attrs and "psi" in log.columns:
+        if trained and "yaw_rate_offset" not in log.attrs and material_yaw_rate_offset(log):
             out.append(f"{name}: the model was identified from yaw rates less their gyro "
                        "offsets (--yaw-rate-offset), this log's r is as measured: its free "
                        "runs start from and are judged against another r; give "

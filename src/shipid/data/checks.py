@@ -304,17 +304,28 @@ HEADING_DRIFT_DEG = 2.0
 HEADING_DRIFT_LINEAR = 15.0
 
 
-def _check_yaw_rate_offset(df: pd.DataFrame, name: str) -> None:
+def material_yaw_rate_offset(df: pd.DataFrame):
+    """The ``HeadingDrift`` of a log with a heading whose yaw rate runs off the heading's rate
+    by as much as the checks name (see the constants above); None where it does not."""
+    if "psi" not in df.columns:
+        return None
     r = df["r"].to_numpy(dtype=float)
     drift = heading_drift(df["t"].to_numpy(dtype=float), df["psi"].to_numpy(dtype=float), r)
     if drift is None:
-        return
+        return None
     b = drift.offset
     rms = float(np.sqrt(np.mean(r**2)))
     large = abs(b) > math.radians(YAW_RATE_OFFSET_DEG_S) and abs(b) > YAW_RATE_OFFSET_SHARE * rms
     moves = drift.drift > math.radians(HEADING_DRIFT_DEG) and drift.linear > HEADING_DRIFT_LINEAR
-    if not (large or moves):
+    return drift if large or moves else None
+
+
+def _check_yaw_rate_offset(df: pd.DataFrame, name: str) -> None:
+    drift = material_yaw_rate_offset(df)
+    if drift is None:
         return
+    b = drift.offset
+    rms = float(np.sqrt(np.mean(df["r"].to_numpy(dtype=float) ** 2)))
     warnings.warn(f"{name}: the yaw rate 'r' runs {math.degrees(b):+.3g} °/s off the heading's "
                   f"rate ({100 * abs(b) / rms:.1f} % of its rms), so ∫r dt ends "
                   f"{math.degrees(drift.drift):.2g}° from psi over the log's "
