@@ -25,8 +25,9 @@ MULTITHREADED_FROM = 1000
 @contextlib.contextmanager
 def one_thread() -> Iterator[None]:
     """BLAS on one thread: the libraries loaded now (``threadpoolctl``) and those loaded inside
-    (the variable OpenBLAS reads when it loads); both restored after. Where the user has set
-    the variable, their setting holds."""
+    (the variable OpenBLAS reads when it loads); both restored after, but a library first loaded
+    inside keeps the one thread it started with (a process that runs ``shipid.cli.main`` before
+    importing NumPy itself). Where the user has set the variable, their setting holds."""
     if THREADS_VARIABLE in os.environ:
         yield
         return
