@@ -3,13 +3,15 @@ the closed-loop replica reverses at their median every time, so a trial reversed
 (MARIN's −20° run: +19.81°, −21.24°, +19.54°) has overshoots no replica at one switch heading
 follows. The truth here is a simulated zig-zag, reversed where its own switch logic did."""
 
+import json
 import math
 from pathlib import Path
 
 import numpy as np
 import pytest
+from cli_helpers import run
 
-from shipid.data.io import read_log
+from shipid.data.io import read_log, write_log
 from shipid.evaluation.validate import REVERSAL_SPREAD_DEG, validate_log
 from shipid.trials.manoeuvres import zigzag
 from shipid.trials.trial import describe_trial
@@ -71,3 +73,14 @@ def test_marins_minus_20_run_reversed_unevenly():
     trial = describe_trial(log, "zigzag")
     assert trial.reversal_headings_deg == pytest.approx([19.81, -21.24, 19.54], abs=0.01)
     assert trial.switch_heading_deg == pytest.approx(19.81, abs=0.01)
+
+
+def test_indices_prints_and_keeps_the_reversals(tmp_path, capsys, zz):
+    _, log = zz
+    path = write_log(log, tmp_path / "zz.csv")
+    code, text, err = run(["indices", path, "--json", tmp_path / "i.json"], capsys)
+    assert code == 0, err
+    heads = describe_trial(log, "zigzag").reversal_headings_deg
+    assert "  reversal_headings_deg: " + ", ".join(f"{h:+.2f}" for h in heads) in text
+    kept = json.loads((tmp_path / "i.json").read_text())["logs"][0]["reversal_headings_deg"]
+    assert kept == pytest.approx(list(heads))

@@ -25,18 +25,27 @@ def cmd_indices(args) -> int:
     """``shipid indices``: IMO indices of measured logs."""
     from shipid.outputs import atomic_write_text, check_outputs
     from shipid.trials.indices import manoeuvre_indices
+    from shipid.trials.trial import describe_trial
 
     check_outputs({"--json": (args.json, "json")}, args.logs)
     logs = _read_logs(args)
     out = []
     for path, log in zip(args.logs, logs, strict=True):
-        ind = manoeuvre_indices(log, args.kind, heading_deg=args.heading, smooth_s=args.smooth)
-        out.append({"name": str(path), "indices": ind})
+        trial = describe_trial(log, args.kind, args.heading)
+        ind = manoeuvre_indices(log, args.kind, heading_deg=args.heading, smooth_s=args.smooth,
+                                trial=trial)  # fmt: skip
+        record = {"name": str(path), "indices": ind}
         kind = ind.get("kind")
         print(f"{path}: {kind}" + (f" ({ind['reason']})" if kind == "other" else ""))
         for k, v in ind.items():
             if k not in ("kind", "reason"):
                 print(f"  {k}: {v:.4g}" if isinstance(v, float) else f"  {k}: {v}")
+        if kind == "zigzag" and trial.reversal_headings_deg:
+            # Where the rudder was reversed, each time: a trial switched unevenly shows here.
+            record["reversal_headings_deg"] = list(trial.reversal_headings_deg)
+            print("  reversal_headings_deg: "
+                  + ", ".join(f"{h:+.2f}" for h in trial.reversal_headings_deg))
+        out.append(record)
     if args.json:
         atomic_write_text(args.json, _json_text({"logs": out}))
     return 0
