@@ -44,6 +44,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/study_auto_inflow.py
 	$(BIN)/python benchmarks/study_trim.py
 	$(BIN)/python benchmarks/study_gyro_offset.py
+	$(BIN)/python benchmarks/bench_blas_threads.py
 
 clean:
 	rm -rf $(VENV) shipid-demo build *.egg-info src/*.egg-info

@@ -34,3 +34,20 @@ def test_the_users_setting_holds(monkeypatch):
 @pytest.mark.parametrize("n, expected", [(999, None), (1000, os.cpu_count())])
 def test_threads_for_a_dense_solve(n, expected):
     assert blas.threads_for(n) == expected
+
+
+def test_a_command_that_loads_numpy_inside_gets_one_thread():
+    """The installed command's path: NumPy is first loaded inside the command, where only the
+    variable OpenBLAS reads at load can hold it (threadpoolctl is not imported for it)."""
+    import subprocess
+    import sys
+
+    code = ("import sys\nfrom shipid.blas import one_thread\nwith one_thread():\n"
+            "    loaded = 'threadpoolctl' in sys.modules\n    import numpy\n"
+            "from threadpoolctl import threadpool_info\n"
+            "print(loaded, sorted({l['num_threads'] for l in threadpool_info()"
+            " if l['user_api'] == 'blas'}))")  # fmt: skip
+    env = {k: v for k, v in os.environ.items() if k != blas.THREADS_VARIABLE}
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,
+                         check=True).stdout.strip()  # fmt: skip
+    assert out == "False [1]"

@@ -298,6 +298,10 @@ def test_physics_the_output_error_fit_would_not_hold_keeps_the_lssvm(tmp_path, c
                         tmp_path / "b.json"], capsys)  # fmt: skip
     assert code == 1 and "does not hold --constraints stable" in err and len(err.splitlines()) == 1
     assert not (tmp_path / "b.json").exists()
+    # Said before the logs are read (and a structure searched): a missing log is not reached.
+    code, _, err = run(["identify", tmp_path / "missing.csv", "--output-error", "--prior",
+                        "clarke", "-o", tmp_path / "c.json"], capsys)  # fmt: skip
+    assert code == 1 and "does not hold --prior" in err
 
 
 def test_the_default_output_error_fit_holds_the_sign_constraints(tmp_path, capsys, paper_fit):

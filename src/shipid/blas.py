@@ -6,14 +6,15 @@ spinning for a while after each call, and on the 2-core machines this project ta
 hold the cores the simulation needs: `select` on the Esso Osaka recipe took 3.82 s (5.7 s of
 CPU) with them and 3.50 s (4.3 s) without, the test suite 88 s and 74 s. So the commands run BLAS
 on one thread, and the dense LS-SVM solves large enough to gain from more ask for every core
-(``threads_for``; a Cholesky of 1000 equations runs 1.17–1.39 times as fast on two, of 4000
-1.47 times).
+(``threads_for``; a Cholesky solve of 500 equations gains nothing from a second thread, of 1000
+1.29–1.36 times, of 4000 1.42–1.48 times: ``benchmarks/bench_blas_threads.py``).
 """
 
 from __future__ import annotations
 
 import contextlib
 import os
+import sys
 from collections.abc import Iterator
 
 # The variable OpenBLAS (NumPy's and SciPy's wheels) reads when it loads.
@@ -31,10 +32,15 @@ def one_thread() -> Iterator[None]:
     if THREADS_VARIABLE in os.environ:
         yield
         return
-    from threadpoolctl import threadpool_limits
-
     os.environ[THREADS_VARIABLE] = "1"
     try:
+        if "numpy" not in sys.modules:
+            # No BLAS is loaded yet (the installed command's case): the variable is enough, and
+            # importing threadpoolctl would cost every command 20 ms.
+            yield
+            return
+        from threadpoolctl import threadpool_limits
+
         with threadpool_limits(limits=1, user_api="blas"):
             yield
     finally:

@@ -6,6 +6,7 @@ import math
 import sys
 import time
 from pathlib import Path
+from types import SimpleNamespace
 
 from shipid.cli.common import (
     _approach,
@@ -72,6 +73,18 @@ def cmd_identify(args) -> int:
     if asked and (args.refine or args.bootstrap is not None):
         raise ShipidError("--output-error is its own fit with its own intervals; it does not go "
                           "with --refine or --bootstrap")  # fmt: skip
+    from shipid.identification.physics import parse_constraints, unboxed
+
+    # Output error holds sign constraints and bounds (box bounds on its coefficients), not the
+    # conditions on the equation-error regression: said before the logs are read and the
+    # structure chosen (select's search, seconds).
+    flags = parse_constraints(args.constraints)
+    given_physics = unboxed(SimpleNamespace(
+        prior=args.prior, steady_speed=bool(args.steady_speed) or flags["steady_speed"],
+        stable=flags["stable"], derivatives=flags["derivatives"]))
+    if asked and given_physics:
+        raise ShipidError(f"--output-error holds --constraints signs and --bound; it does not hold "
+                          f"{given_physics[0]} (the LS-SVM fit does: leave out --output-error)")
     explicit_band = args.error_band not in (None, "none")
     if explicit_band and (args.refine or asked):
         raise ShipidError("--error-band describes the LS-SVM fit; it does not go with --refine "
@@ -84,14 +97,6 @@ def cmd_identify(args) -> int:
     names = [str(p) for p in args.logs]
     choice = _choose_structure(args, logs, names)
     physics = _physics(args, logs, _structure(args))
-    from shipid.identification.physics import unboxed
-
-    # Output error holds sign constraints and bounds (box bounds on its coefficients), not the
-    # conditions on the equation-error regression.
-    given_physics = unboxed(physics)
-    if asked and given_physics:
-        raise ShipidError(f"--output-error holds --constraints signs and --bound; it does not hold "
-                          f"{given_physics[0]} (the LS-SVM fit does: leave out --output-error)")
     cutoff, filter_by = args.filter, "given"
     if cutoff == "auto":
         from shipid.identification.prefilter import choose_prefilter
@@ -573,7 +578,8 @@ def _fold_table(folds) -> str:
 def cmd_compare(args) -> int:
     """``shipid compare``: methods × held-out logs in one table."""
     from shipid.evaluation.compare import compare, summary
-    from shipid.identification.auto_structure import PAPER
+    from shipid.identification.auto_structure import PAPER, beyond_the_paper
+    from shipid.identification.estimators import BLACK_BOX_ESTIMATORS
     from shipid.outputs import OutputSet, check_outputs
 
     check_outputs({"--json": (args.json, "json")}, args.logs)
@@ -581,13 +587,9 @@ def cmd_compare(args) -> int:
     logs = _training_logs(args)
     names = [Path(p).name for p in args.logs]
     structure = args.model or PAPER
-    from shipid.identification.estimators import BLACK_BOX_ESTIMATORS
-
     semiphysical = [m for m in methods if not m.startswith("select:")
                     and m not in BLACK_BOX_ESTIMATORS]  # fmt: skip
     if args.model is None and semiphysical:
-        from shipid.identification.auto_structure import beyond_the_paper
-
         reasons = beyond_the_paper(logs)[0]
         if reasons:
             # Scored through a structure that cannot hold the logs, every method looks bad and

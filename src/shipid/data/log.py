@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from shipid.data.preprocess import cumulative_integral
 from shipid.errors import ShipidError
 
 REQUIRED = ("t", "delta", "u", "v", "r")
@@ -130,8 +131,7 @@ def steady_start(log: pd.DataFrame, end_index: int | None = None) -> SteadyStart
         # The rudder is hard over from the first sample: the log has no approach to judge.
         return SteadyStart(float(u[0]), math.nan, None)
     if end_index is None:
-        r = log["r"].to_numpy(dtype=float)
-        heading = np.concatenate([[0.0], np.cumsum(0.5 * (r[1:] + r[:-1]) * np.diff(t))])
+        heading = cumulative_integral(log["r"].to_numpy(dtype=float), t)
         moved = np.flatnonzero((np.abs(delta - delta[0]) > ORDER_RAD)
                                | (np.abs(heading) > STRAIGHT_RAD)
                                | (t - t[0] > STEADY_WINDOW))  # fmt: skip
@@ -146,8 +146,7 @@ def steady_start(log: pd.DataFrame, end_index: int | None = None) -> SteadyStart
     resid = uu - A @ coef
     se = float(np.sqrt(resid @ resid / max(len(tt) - 2, 1) / np.sum((tt - tt.mean()) ** 2)))
     change = float(coef[1]) * STEADY_WINDOW / speed
-    if "r" in log.columns and abs(float(np.mean(log["r"].to_numpy()[: end + 1]))) * tt[-1] \
-            > STRAIGHT_RAD:  # fmt: skip
+    if abs(float(np.mean(log["r"].to_numpy()[: end + 1]))) * tt[-1] > STRAIGHT_RAD:
         return SteadyStart(speed, change, False)
     if abs(change) <= STEADY_SHARE:
         return SteadyStart(speed, change, True)

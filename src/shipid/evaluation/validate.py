@@ -265,7 +265,8 @@ def _reversal_notes(trial: Trial) -> list[str]:
     """A note where the trial's rudder was reversed at heading changes further apart than
     ``REVERSAL_SPREAD_DEG`` and a sample's heading change: part of the closed loop's overshoot
     errors is then the trial's own execution, which a replica reversing at one switch heading
-    cannot follow (a degree of switch heading moves an overshoot by about a degree)."""
+    cannot follow (on MARIN's −20° run a degree of switch heading moved an overshoot by 1.0–1.5°,
+    ad hoc)."""
     sizes = [abs(h) for h in trial.reversal_headings_deg]
     if len(sizes) < 2 or max(sizes) - min(sizes) <= max(REVERSAL_SPREAD_DEG,
                                                          trial.reversal_step_deg):

@@ -430,9 +430,11 @@ def dof_physics(options: PhysicsOptions | None, dof: str, names: Sequence[str], 
     return out
 
 
-def unboxed(options: PhysicsOptions | None) -> list[str]:
-    """The options of ``options`` that are not box bounds on the coefficients (the command-line
-    flags that give them), which an output-error fit does not hold: they are conditions on the
+def unboxed(options) -> list[str]:
+    """The options of ``options`` (a ``PhysicsOptions``, or anything with its ``prior``,
+    ``steady_speed``, ``stable`` and ``derivatives``: the command line checks its flags before
+    it reads the logs) that are not box bounds on the coefficients (the command-line flags that
+    give them), which an output-error fit does not hold: they are conditions on the
     equation-error regression (a prior on its weights, rows of its solver)."""
     if options is None:
         return []
