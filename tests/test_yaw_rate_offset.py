@@ -8,13 +8,14 @@ import math
 import re
 import warnings
 
+import numpy as np
 import pytest
 from cli_helpers import run
 
 from shipid.data import checks
 from shipid.data.checks import check_units
 from shipid.data.io import read_log, write_log
-from shipid.data.yaw_rate import yaw_rate_offset
+from shipid.data.yaw_rate import heading_drift, yaw_rate_offset
 from shipid.errors import ShipidError, ShipidWarning
 from shipid.trials.manoeuvres import turning_circle, zigzag
 from shipid.vessels import PAPER_IMU, scale_ship
@@ -76,7 +77,8 @@ def test_an_offset_that_moves_the_heading_is_named_though_small(trial):
 @pytest.mark.parametrize("which", ["trial", "turn"])
 def test_the_paper_sensors_alone_are_not_named(which, trial, turn):
     """Gyro noise random-walks ∫r away from psi (up to 5° over these logs), but not on a line
-    standing 15 times its scatter: no false alarm in 30 seeds."""
+    standing 15 times its scatter and 5 times the random walk of the noise: no false alarm in
+    30 seeds."""
     base = trial if which == "trial" else turn
     for seed in range(30):
         assert not _warned(PAPER_IMU.apply(base, seed=seed)), seed
@@ -146,3 +148,36 @@ def test_a_corrected_file_keeps_its_offset_and_a_model_of_raw_rates_names_it(tmp
     assert run(["identify", biased, "--no-output-error", "-o", raw_model], capsys)[0] == 0
     code, _, err = run(["validate", raw_model, again / "zz.csv", "--no-bands"], capsys)
     assert code == 0 and "identified from yaw rates as measured" in err
+
+
+def test_the_noise_drift_is_the_random_walk_of_white_noise():
+    """A straight course (r = 0, ψ = 0) under white noise only: over 1000 seeds the drift's std is
+    the closed form HeadingDrift.noise_drift gives (1.2 σ_r² Δt T + 12 σ_ψ² / N)."""
+    from shipid.data.yaw_rate import heading_drift
+
+    rng = np.random.default_rng(3)
+    t = np.arange(0.0, 90.0, 0.2)
+    sr, sp = math.radians(0.35), math.radians(0.05)
+    drifts, closed = [], []
+    for _ in range(1000):
+        d = heading_drift(t, sp * rng.standard_normal(t.size), sr * rng.standard_normal(t.size))
+        drifts.append(-d.offset * d.duration)
+        closed.append(d.noise_drift)
+    exact = math.sqrt(1.2 * sr**2 * 0.2 * t[-1] + 12 * sp**2 / t.size)
+    assert np.median(closed) == pytest.approx(exact, rel=0.05)  # the noise read off the log
+    assert np.std(drifts) == pytest.approx(exact, rel=0.1)  # 1000 draws: ±2.2 % one-sigma
+
+
+@pytest.mark.parametrize("seed, name", [(11, "zigzag 20/20 (training)"), (17, "turning δ = +20°")])
+def test_a_random_walk_on_a_line_is_not_named(seed, name):
+    """Two of the demo's noisy trials (of 600 over 150 seeds) whose ∫r random-walked 3.9° and
+    8.8° away from ψ on a line 17 times its scatter were named as a gyro offset, which they have
+    not: the drift stands 1.6 and 3.3 times what the white noise of r gives alone."""
+    from shipid.demo import synthesise_trials
+
+    log = synthesise_trials(seed)[name]
+    drift = heading_drift(*(log[c].to_numpy() for c in ("t", "psi", "r")))
+    assert drift.drift > math.radians(checks.HEADING_DRIFT_DEG)  # the old rule named them
+    assert drift.linear > checks.HEADING_DRIFT_LINEAR
+    assert drift.beyond_noise < checks.HEADING_DRIFT_BEYOND_NOISE
+    assert not _warned(log)

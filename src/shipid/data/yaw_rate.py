@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from shipid.data.preprocess import cumulative_integral
+from shipid.data.preprocess import cumulative_integral, white_noise_variance
 from shipid.errors import ShipidError
 
 
@@ -41,17 +41,28 @@ class HeadingDrift:
     drift : |b| times the log's duration [rad]: how far an integrated r ends from the heading.
     scatter : std of ψ − ∫r dt about its straight line [rad] (noise, gain errors, unsteady bias).
     duration : the log's duration [s].
+    noise_drift : the std of the drift [rad] that white noise on r and ψ alone would give (its
+        level read off their second differences): ∫ of white noise σ_r at step Δt is a random
+        walk, whose least-squares slope over a duration T puts a drift of variance
+        1.2 σ_r² Δt T (6D/5T for a Brownian motion of diffusion D = σ_r² Δt), and the heading's
+        own noise σ_ψ adds 12 σ_ψ² / N.
     """
 
     offset: float
     drift: float
     scatter: float
     duration: float
+    noise_drift: float = 0.0
 
     @property
     def linear(self) -> float:
         """The drift over its scatter: large for a steady offset, a few for noise."""
         return self.drift / self.scatter if self.scatter > 0 else math.inf
+
+    @property
+    def beyond_noise(self) -> float:
+        """The drift over the std of the drift the sensors' white noise alone would give."""
+        return self.drift / self.noise_drift if self.noise_drift > 0 else math.inf
 
 
 def heading_drift(t: np.ndarray, psi: np.ndarray, r: np.ndarray) -> HeadingDrift | None:
@@ -70,7 +81,10 @@ def heading_drift(t: np.ndarray, psi: np.ndarray, r: np.ndarray) -> HeadingDrift
     slope = float(coef[1])
     scatter = float(np.std(drift - design @ coef))
     duration = float(t[-1] - t[0])
-    return HeadingDrift(-slope, abs(slope) * duration, scatter, duration)
+    step = float(np.median(np.diff(t)))
+    noise_drift = math.sqrt(1.2 * white_noise_variance(r) * step * duration
+                            + 12.0 * white_noise_variance(np.unwrap(psi)) / len(t))  # fmt: skip
+    return HeadingDrift(-slope, abs(slope) * duration, scatter, duration, noise_drift)
 
 
 def correct_yaw_rate(log: pd.DataFrame, offset: float | str, name: str) -> pd.DataFrame:
