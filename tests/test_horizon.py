@@ -83,6 +83,10 @@ def test_validate_prints_and_keeps_the_horizons(tmp_path, capsys, truth_and_log)
     assert "<h2>Predictions over a horizon</h2>" in (tmp_path / "report" / "report.html").read_text()
     rec = json.loads(out.read_text())["logs"][0]["horizons"]
     assert [h["horizon_s"] for h in rec] == [pytest.approx(10.0), pytest.approx(30.0)]
+    # A horizon as long as the log is a warning naming the log once (it was named twice).
+    code, _, err = run(["validate", model, path, "--horizon", "500", "--no-bands"], capsys)
+    assert code == 0 and f"{path}: a horizon of 500 s spans the whole log" in err
+    assert f"{path}: {path}" not in err
     with pytest.raises(SystemExit) as exited:
         run(["validate", model, path, "--horizon", "10,x"], capsys)
     assert exited.value.code == 2 and "expected seconds > 0" in capsys.readouterr().err

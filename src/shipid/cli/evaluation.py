@@ -197,8 +197,8 @@ def _print_horizons(model, vals, logs, args) -> None:
         for h in args.horizon:
             try:
                 v.horizons.append(horizon_errors(model, log, h, args.method, v.name).to_dict())
-            except ShipidError as exc:
-                v.warnings.append(str(exc))
+            except ShipidError as exc:  # printed after the log's name, which it starts with
+                v.warnings.append(str(exc).removeprefix(f"{v.name}: "))
     table = horizons_frame(vals)
     if len(table):
         print("\nPredictions over a horizon: free runs restarted from the measured state every "
