@@ -6,6 +6,7 @@ three random runs alone 635 % and 788 %, turning the −35° one the wrong way. 
 truths here: a simulated ship whose thrust is |n|n (a known structure), and the real turns."""
 
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -183,3 +184,31 @@ def test_structures_the_logs_cannot_tell_apart_but_that_turn_apart_are_named():
              if "rad/s" in x]  # fmt: skip
     assert len(rates) >= 2 and max(rates) > 1.25 * min(rates)
     assert warning.startswith("blanke, ") and "blanke-race+race-damping" in warning
+    # Their 10°/10° zig-zags too (blanke's second overshoot 16.1°, blanke-speed's 10.1°), and
+    # the truth's own overshoots lie between the tied fits': the spread is the uncertainty.
+    (warning,) = [w for w in choice.warnings if "10°/10° zig-zag apart" in w]
+    named = [[float(x) for x in re.findall(r"(-?\d+\.\d)°", part)]
+             for part in warning.split("fits: ")[1].split(";")[:3]]  # fmt: skip
+    first, second = zip(*named, strict=True)
+    truth = zigzag(ship, 10, 10, dt=0.2, method="euler").indices
+    assert min(first) <= truth["first_overshoot_deg"] <= max(first)
+    assert min(second) <= truth["second_overshoot_deg"] <= max(second)
+    assert max(second) - min(second) > 1.5
+
+
+HSVA = DATA.parent / "kvlcc2-hsva" / "HSVA_CPMC_KVLCC2_Z_20_10_P.dat"
+
+
+@needs_data
+def test_the_real_kvlccs_zig_zags_tie_on_structures_whose_10_10_zig_zags_differ():
+    """The KVLCC2's three real zig-zags (MARIN ±20°, HSVA 20/10): blanke-speed is chosen and
+    blanke-race+race-damping ties with it; their 35° turns agree, but their 10°/10° second
+    overshoots lie 3° apart (11.5° and 14.5°). The choice said nothing of it."""
+    logs = [read_log(KVLCC2.parent / f"MARIN_FREE_KVLCC2_zz_{a}_m.dat", fmt="simman-marin",
+                     scale=45.7, dt=0.2) for a in ("20", "-20")]  # fmt: skip
+    logs.append(read_log(HSVA, fmt="simman-hsva", dt=0.2))
+    choice = auto_structure(logs)
+    assert choice.structure.name == "blanke-speed"
+    assert not [w for w in choice.warnings if "turning circle apart" in w]
+    (warning,) = [w for w in choice.warnings if "10°/10° zig-zag apart" in w]
+    assert "blanke-speed 7.9°, 11.5°; blanke-race+race-damping 9.5°, 14.5°" in warning
