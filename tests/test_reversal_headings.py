@@ -1,7 +1,8 @@
-"""The heading changes at which a zig-zag's rudder was reversed, and the note where they spread:
-the closed-loop replica reverses at their median every time, so a trial reversed unevenly
-(MARIN's −20° run: +19.81°, −21.24°, +19.54°) has overshoots no replica at one switch heading
-follows. The truth here is a simulated zig-zag, reversed where its own switch logic did."""
+"""The heading changes at which a zig-zag's rudder was reversed, and the note where they spread.
+The closed-loop replica reversed at their median every time, so a trial reversed unevenly
+(MARIN's −20° run: +19.81°, −21.24°, +19.54°) had overshoots no replica at one switch heading
+follows; it now reverses at each of them in turn. The truth here is a simulated zig-zag,
+reversed where its own switch logic did."""
 
 import json
 import math
@@ -12,6 +13,7 @@ import pytest
 from cli_helpers import run
 
 from shipid.data.io import read_log, write_log
+from shipid.errors import ShipidError
 from shipid.evaluation.validate import REVERSAL_SPREAD_DEG, validate_log
 from shipid.trials.manoeuvres import zigzag
 from shipid.trials.trial import describe_trial
@@ -64,7 +66,25 @@ def test_an_uneven_trial_is_named():
     sizes = np.abs(trial.reversal_headings_deg)
     assert sizes.max() - sizes.min() > REVERSAL_SPREAD_DEG
     notes = [w for w in validate_log(truth, drifting, "zz").warnings if "reversed at" in w]
-    assert len(notes) == 1 and "the closed loop reverses at" in notes[0]
+    assert len(notes) == 1 and "the closed loop reverses at each of them in turn" in notes[0]
+
+
+def test_the_replica_of_an_uneven_trial_reverses_as_it_did():
+    """A zig-zag reversed at 17°, 23° and 18.5°, then 20°: the true model's closed-loop replica
+    reproduces its overshoots to 0.01° (at the median switch heading every time it put them
+    3.4° and 2.6° off)."""
+    truth = scale_ship_model()
+    log = zigzag(truth, 20, 20, duration=90, dt=0.05, method="euler", speed=1.93, approach=2.0,
+                 switches=[17.0, 23.0, 18.5]).log  # fmt: skip
+    v = validate_log(truth, log, "zz")
+    measured, replica = v.indices["measured"], v.indices["closed_loop"]
+    for key in ("first_overshoot_deg", "second_overshoot_deg"):
+        assert replica[key] == pytest.approx(measured[key], abs=0.01)
+    even = zigzag(truth, 20, 20, duration=90, dt=0.05, method="euler", speed=1.93,
+                  approach=2.0).indices  # fmt: skip
+    assert abs(even["first_overshoot_deg"] - measured["first_overshoot_deg"]) > 2.0
+    with pytest.raises(ShipidError, match="reversal heading"):
+        zigzag(truth, 20, 20, speed=1.93, switches=[0.0])
 
 
 @pytest.mark.skipif(not MARIN.is_file(), reason="../shared/data is not present")

@@ -44,6 +44,10 @@ P_KP, P_KI, P_KD = range(19, 22)
 # Line-of-sight path following: lookahead and acceptance distance [m], number of waypoints;
 # the waypoints (x, y relative to the first, where the run starts) follow the N_PARAMS entries.
 P_LOOKAHEAD, P_ACCEPT, P_N_WAYPOINTS = range(22, 25)
+# A zig-zag's own switch heading for each of its first reversals, in turn (a replica of a trial
+# reversed unevenly), follows the N_PARAMS entries as the waypoints do; the same slot counts them.
+# Past them, P_SWITCH.
+P_N_SWITCHES = P_N_WAYPOINTS
 N_PARAMS = 25
 MODE_HOLD, MODE_ZIGZAG, MODE_HEADING, MODE_FOLLOW = 0, 1, 2, 3
 
@@ -281,7 +285,9 @@ def command(p, t, psi, r, target, side, integral, dt):
 
     Hold mode: the held rudder before ``approach``, ``value`` until ``release``, then 0.
     Zig-zag: the held rudder before ``approach``, then ``side``·``stbd``·``value``, the side
-    reversed when the heading change from ψ_ref reaches ±switch on the side the ship turns to.
+    reversed when the heading change from ψ_ref reaches ±switch on the side the ship turns to
+    (the k-th reversal's own switch where ``P_N_SWITCHES`` > k; ``integral``, the autopilot's,
+    counts the reversals).
     Heading: the PID autopilot δc = −(Kp ψ̃ + Ki ∫ψ̃ dt + Kd r), ψ̃ = ψ − ``target`` (the
     ``value``) wrapped to [−π, π), the integral frozen while the command exceeds the rudder
     limit (anti-windup). Follow: the same autopilot on the line-of-sight heading, which
@@ -293,10 +299,14 @@ def command(p, t, psi, r, target, side, integral, dt):
         return (p[P_VALUE] if t < p[P_RELEASE] - 1e-9 else 0.0), side, integral
     if p[P_MODE] == MODE_ZIGZAG:
         dpsi = psi - p[P_PSI_REF]
-        if side > 0 and dpsi >= p[P_SWITCH]:
+        done = int(integral)
+        switch = p[N_PARAMS + done] if done < p[P_N_SWITCHES] else p[P_SWITCH]
+        if side > 0 and dpsi >= switch:
             side = -1.0
-        elif side < 0 and dpsi <= -p[P_SWITCH]:
+            integral += 1.0
+        elif side < 0 and dpsi <= -switch:
             side = 1.0
+            integral += 1.0
         return side * p[P_STBD] * p[P_VALUE], side, integral
     err = (psi - target + math.pi) % (2.0 * math.pi) - math.pi
     cmd = -(p[P_KP] * err + p[P_KI] * integral + p[P_KD] * r)

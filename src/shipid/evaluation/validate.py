@@ -255,27 +255,35 @@ def _approach_notes(indices: dict) -> list[str]:
 
 APPROACH_TOLERANCE = 0.10
 # Reversal headings of a zig-zag further apart than this [deg], and than the heading's change over
-# one sample there (how finely the log, and a replica stepping as it does, resolve them), are
-# named: the closed loop reverses at their median every time (MARIN's −20° run at Δk 0.2 s:
-# 19.81°, −21.24°, 19.54°, 0.7° a sample).
+# one sample there (how finely the log, and a replica stepping as it does, resolve them), are the
+# trial's own execution: the closed loop reverses at each of them in turn, as the trial did, not
+# at their median every time (MARIN's −20° run at Δk 0.2 s: 19.81°, −21.24°, 19.54°, 0.7° a
+# sample, where a degree of switch heading moved an overshoot by 1.0–1.5°, ad hoc).
 REVERSAL_SPREAD_DEG = 1.0
 
 
-def _reversal_notes(trial: Trial) -> list[str]:
-    """A note where the trial's rudder was reversed at heading changes further apart than
-    ``REVERSAL_SPREAD_DEG`` and a sample's heading change: part of the closed loop's overshoot
-    errors is then the trial's own execution, which a replica reversing at one switch heading
-    cannot follow (on MARIN's −20° run a degree of switch heading moved an overshoot by 1.0–1.5°,
-    ad hoc)."""
+def uneven_reversals(trial: Trial) -> list[float] | None:
+    """The heading changes [deg] at which a zig-zag's rudder was reversed, in turn, where they lie
+    further apart than ``REVERSAL_SPREAD_DEG`` and a sample's heading change; else None."""
     sizes = [abs(h) for h in trial.reversal_headings_deg]
     if len(sizes) < 2 or max(sizes) - min(sizes) <= max(REVERSAL_SPREAD_DEG,
                                                          trial.reversal_step_deg):
+        return None
+    return list(trial.reversal_headings_deg)
+
+
+def _reversal_notes(trial: Trial) -> list[str]:
+    """A note where the trial's rudder was reversed unevenly (``uneven_reversals``): the closed
+    loop follows its reversals, so what is left of its overshoot errors is the model's."""
+    headings = uneven_reversals(trial)
+    if headings is None:
         return []
-    shown = ", ".join(f"{h:+.2f}°" for h in trial.reversal_headings_deg)
+    sizes = [abs(h) for h in headings]
+    shown = ", ".join(f"{h:+.2f}°" for h in headings)
     return [f"its rudder was reversed at heading changes of {shown} ({max(sizes) - min(sizes):.2g}° "
-            f"apart); the closed loop reverses at {trial.switch_heading_deg:.4g}° every time, so "
-            "its overshoots can differ from the measured ones by about as much from the trial's "
-            "execution alone (the replay follows the log's rudder)"]
+            f"apart, around the median {trial.switch_heading_deg:.4g}°): the closed loop reverses "
+            "at each of them in turn, as the trial did (its overshoots are measured from the "
+            "median, as the log's are)"]
 
 
 def trial_replica(model, log: pd.DataFrame, method: str = "euler",
@@ -363,8 +371,9 @@ def trial_zigzag(model, log: pd.DataFrame, method: str = "euler",
     """The zig-zag of a measured log run closed loop on ``model``: same initial state (u, v, r, ψ)
     and held rudder (or the model's own steady approach, ``_replica_start``), first execute time
     and side, rudder angle (the median plateau), rudder rate (over its swings,
-    ``shipid.data.rudder_signal.rise_rate``), switch heading (inferred from the log), mean
-    propeller speed, duration and step.
+    ``shipid.data.rudder_signal.rise_rate``), switch heading (inferred from the log; where the
+    trial reversed unevenly, each reversal at its own: ``uneven_reversals``), mean propeller
+    speed, duration and step.
     None when the log has no detectable switch heading or starts without headway (a zig-zag
     needs an approach speed)."""
     trial = trial or describe_trial(log, "zigzag")
@@ -375,7 +384,8 @@ def trial_zigzag(model, log: pd.DataFrame, method: str = "euler",
     initial, rps = _replica_start(model, log, trial)
     return zigzag(model, math.degrees(trial.plateau_angle), switch,
                   first="starboard" if turns > 0 else "port", speed=initial["u"], method=method,
-                  initial=initial, rps=rps, **_replica_run(log, trial))  # fmt: skip
+                  initial=initial, rps=rps, switches=uneven_reversals(trial),
+                  **_replica_run(log, trial))  # fmt: skip
 
 
 __all__ = ["Validation", "free_run", "steady_log_approach", "trial_replica", "trial_turning",

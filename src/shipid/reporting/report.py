@@ -114,8 +114,8 @@ def switch_heading_note(validations: Sequence[Validation]) -> str | None:
     """Which switch heading each zig-zag's overshoots are measured from (None without a
     zig-zag). A trial's rudder is reversed a little past its nominal switch heading (the MARIN
     KVLCC2 20/20 runs at 20.1°–21.0°); its overshoots are measured from the median heading
-    change at its reversals, and the closed loop reverses there too, so that both are measured
-    alike. Measured from the nominal 20° instead, the MARIN run's second overshoot reads about
+    change at its reversals, and the closed loop reverses there too (or where the trial did,
+    reversal by reversal, if unevenly), so that both are measured alike. Measured from the nominal 20° instead, the MARIN run's second overshoot reads about
     one degree more, as published tables give it."""
     shown = [f"{Path(v.name).name} {v.indices['measured']['switch_heading_deg']:.4g}°"
              for v in validations
@@ -124,7 +124,8 @@ def switch_heading_note(validations: Sequence[Validation]) -> str | None:
         return None
     return ("Zig-zag overshoots, in every column, are measured from the switch heading at which "
             "the log's rudder was reversed (the median heading change from the approach heading "
-            "at its reversals), not from a nominal one, and the closed loop reverses there: "
+            "at its reversals), not from a nominal one, and the closed loop reverses there (at "
+            "each reversal's own heading where the trial reversed unevenly): "
             + ", ".join(shown) + ".")
 
 

@@ -334,9 +334,11 @@ def zigzag(
     initial: Mapping[str, float] | None = None,
     rps: float | None = None,
     wind: tuple[float, float] | None = None,
+    switches: Sequence[float] | None = None,
 ) -> ManoeuvreResult:
     """δ/ψ zig-zag: rudder ``first`` at t = ``approach``, reversed whenever the heading change
-    reaches ±ψ on the side the ship is turning to.
+    reaches ±ψ on the side the ship is turning to; ``switches`` [deg] gives the first reversals
+    their own ψ, in turn (a replica of a trial reversed unevenly), ``heading_deg`` the rest.
 
     ``initial`` (u, v, r, psi, delta) starts the run from a trial's measured state instead of a
     straight approach; the rudder is held at its initial ``delta`` until ``approach`` and the
@@ -352,6 +354,10 @@ def zigzag(
     params = manoeuvre_params(vessel, kernel.MODE_ZIGZAG, rudder, held, approach, switch=switch,
                               side=_side_sign(first), psi_ref=psi_ref, rps=rps,
                               wind=_check_wind(wind))  # fmt: skip
+    if switches:
+        own = [math.radians(_positive(abs(h), "reversal heading [deg]")) for h in switches]
+        params[kernel.P_N_SWITCHES] = len(own)
+        params = np.concatenate([params, own])
 
     def run(length: float) -> ManoeuvreResult:
         res = run_closed_loop(vessel, params, length, dt, method, initial=initial, rps=rps)
