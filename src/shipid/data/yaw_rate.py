@@ -6,9 +6,9 @@ A model fitted to that r learns the offset as a yaw moment, and its heading (∫
 drifts from the ship's: heading-based indices (zig-zag overshoots, the advance of a turn) move
 with it, in replays and closed loop alike. On MARIN's KVLCC2 zig-zags the offset is 0.035–0.039
 °/s at model scale, under 2 % of the rms r, yet over the 90 s of a run it puts the heading 3.5°
-off. Subtracting it brings the held-out logs' closed-loop overshoots only 0.03–0.10° closer on
-average; replayed on its own training log, a model's second overshoot comes 2.7° high with r as
-measured and 0.65° less the offset (``benchmarks/study_gyro_offset.py``).
+off. Subtracting it moves the held-out logs' closed-loop overshoots from 0.09° closer to 0.03°
+further on average; replayed on its own training log, a model's second overshoot comes 2.7°
+high with r as measured and 0.65° less the offset (``benchmarks/study_gyro_offset.py``).
 """
 
 from __future__ import annotations

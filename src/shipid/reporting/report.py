@@ -115,8 +115,9 @@ def switch_heading_note(validations: Sequence[Validation]) -> str | None:
     zig-zag). A trial's rudder is reversed a little past its nominal switch heading (the MARIN
     KVLCC2 20/20 runs at 20.1°–21.0°); its overshoots are measured from the median heading
     change at its reversals, and the closed loop reverses there too (or where the trial did,
-    reversal by reversal, if unevenly), so that both are measured alike. Measured from the nominal 20° instead, the MARIN run's second overshoot reads about
-    one degree more, as published tables give it."""
+    reversal by reversal, if unevenly), so that both are measured alike. Measured from the
+    nominal 20° instead, the MARIN run's second overshoot reads about one degree more, as
+    published tables give it."""
     shown = [f"{Path(v.name).name} {v.indices['measured']['switch_heading_deg']:.4g}°"
              for v in validations
              if v.kind == "zigzag" and (v.indices.get("measured") or {}).get("switch_heading_deg")]
