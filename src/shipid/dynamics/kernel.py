@@ -299,8 +299,9 @@ def command(p, t, psi, r, target, side, integral, dt):
         return (p[P_VALUE] if t < p[P_RELEASE] - 1e-9 else 0.0), side, integral
     if p[P_MODE] == MODE_ZIGZAG:
         dpsi = psi - p[P_PSI_REF]
-        done = int(integral)
-        switch = p[N_PARAMS + done] if done < p[P_N_SWITCHES] else p[P_SWITCH]
+        switch = p[P_SWITCH]
+        if integral < p[P_N_SWITCHES]:  # one float comparison where no list is given
+            switch = p[N_PARAMS + int(integral)]
         if side > 0 and dpsi >= switch:
             side = -1.0
             integral += 1.0
