@@ -266,9 +266,9 @@ def uneven_reversals(trial: Trial) -> list[float] | None:
     """The heading changes [deg] at which a zig-zag's rudder was reversed, in turn, where they lie
     further apart than ``REVERSAL_SPREAD_DEG`` and a sample's heading change; else None."""
     sizes = [abs(h) for h in trial.reversal_headings_deg]
-    if len(sizes) < 2 or max(sizes) - min(sizes) <= max(REVERSAL_SPREAD_DEG,
-                                                         trial.reversal_step_deg):
-        return None
+    if len(sizes) < 2 or not min(sizes) > 0 or max(sizes) - min(sizes) <= max(
+            REVERSAL_SPREAD_DEG, trial.reversal_step_deg):  # fmt: skip
+        return None  # (a reversal at no heading change is none a replica can make)
     return list(trial.reversal_headings_deg)
 
 
