@@ -79,9 +79,49 @@ def main(seeds: int) -> None:
           + "; ".join(f"{label} {k} of {n}" for label, k, n in inside))
 
 
+def paper_ship(seeds: int = 6) -> None:
+    """The same comparison where ``blanke`` is the truth: the paper's ship (its rudder force in
+    δ alone) with a constant rps logged, trained on its 20/20 zig-zag, then with the 10/10 too.
+    Which structure is fitted, and the held-out 20° turns' yaw-rate error std over the true
+    model's own on the same noisy trial (1 = the noise floor), the fitted one's against
+    ``blanke``'s."""
+    from shipid.demo import TRAINING, synthesise_trials
+    from shipid.evaluation.validate import validate
+    from shipid.vessels import scale_ship_model
+
+    truth = scale_ship_model()
+    held = ["turning δ = −20°", "turning δ = +20°"]
+    chosen, costs = {}, []
+    for seed in range(seeds):
+        trials = synthesise_trials(seed)
+        first = [trials[TRAINING].assign(n=10.0)]
+        for logs in (first, first + [trials["zigzag 10/10"].assign(n=10.0)]):
+            name = auto_structure(logs).structure.name
+            chosen[name] = chosen.get(name, 0) + 1
+            if name == PAPER_TRUTH:
+                continue
+            own = validate(truth, [trials[h] for h in held], held)
+            ratio = {}
+            for structure in (name, PAPER_TRUTH):
+                model, _ = fit_as_identify(logs, structure)
+                runs = validate(model, [trials[h].assign(n=10.0) for h in held], held)
+                ratio[structure] = [v.metrics["r"]["std"] / o.metrics["r"]["std"]
+                                    for v, o in zip(runs, own, strict=True)]  # fmt: skip
+            costs.append((seed, len(logs), ratio))
+    print(f"\nThe paper's ship (blanke the truth) with 10 rps logged, {seeds} seeds × (20/20; "
+          "20/20 and 10/10): fitted " + ", ".join(f"{k} {v}" for k, v in chosen.items()))
+    for seed, n, ratio in costs:
+        print(f"  seed {seed}, {n} log(s): held-out 20° turns' r error over the noise floor "
+              + "; ".join(f"{k} " + ", ".join(f"{x:.2f}" for x in v) for k, v in ratio.items()))
+
+
+PAPER_TRUTH = "blanke"
+
+
 if __name__ == "__main__":
     warnings.simplefilter("ignore")
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores\n")
     t0 = time.perf_counter()
     main(int(sys.argv[1]) if len(sys.argv) > 1 else 4)
+    paper_ship()
     print(f"\n{time.perf_counter() - t0:.0f} s")
