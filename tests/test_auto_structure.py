@@ -217,3 +217,60 @@ def test_the_real_kvlccs_zig_zags_tie_on_structures_whose_10_10_zig_zags_differ(
     assert not [w for w in choice.warnings if "turning circle apart" in w]
     (warning,) = [w for w in choice.warnings if "10°/10° zig-zag apart" in w]
     assert "blanke-speed 7.9°, 11.5°; blanke-race+race-damping 9.5°, 14.5°" in warning
+
+
+@pytest.fixture(scope="module")
+def mmg_tied(tmp_path_factory):
+    """The KVLCC2's MMG model through a noisy 20/20 zig-zag with its rps logged (the three
+    inflow structures tie), identified by the plain command."""
+    from shipid.vessels import kvlcc2
+    from shipid.vessels.kvlcc2 import trimmed_revolutions
+
+    log = zigzag(kvlcc2(), 20, 20, duration=300, dt=0.2, approach=5).log
+    log = PAPER_IMU.scaled(0.25).apply(log, seed=0).assign(n=trimmed_revolutions(1.179))
+    folder = tmp_path_factory.mktemp("tied")
+    model = folder / "m.json"
+    import contextlib
+    import io
+
+    from shipid.cli import main
+
+    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+        assert main(["identify", str(write_log(log, folder / "zz.csv")), "-o", str(model)]) == 0
+    return model
+
+
+def test_manoeuvre_runs_the_structures_the_logs_could_not_tell_apart(mmg_tied, tmp_path, capsys):
+    """The tied structures' fits are kept in the model file, and `manoeuvre` runs the same
+    manoeuvre on them: the same indices as the run on each alone, from the same approach. At full
+    scale (rescale) they come along, Froude-scaled: the same overshoot angles."""
+    from shipid.reporting.modelfile import alternatives_from_document, load_document
+
+    doc = load_document(mmg_tied)
+    alternatives = alternatives_from_document(doc, mmg_tied)
+    assert doc["identification"]["structure_choice"]["how"] == "compared"
+    assert set(alternatives) == {"blanke", "blanke-speed"}  # the fitted one is the third
+    out = tmp_path / "zz.json"
+    code, text, err = run(["manoeuvre", mmg_tied, "zigzag", "--rudder", "10", "--no-bands",
+                           "--json", out], capsys)  # fmt: skip
+    assert code == 0, err
+    assert "could not tell apart" in text
+    rec = json.loads(out.read_text())
+    speed = rec["approach"]["speed"]
+    from shipid.dynamics.steering import SteeringMachine
+
+    gear = SteeringMachine(max_rate=np.radians(rec["rudder_rate_deg_s"]))
+    for name, model in alternatives.items():
+        alone = zigzag(model, 10, 10, speed=speed, steering=gear, dt=0.05).indices
+        for key in ("first_overshoot_deg", "second_overshoot_deg"):
+            assert rec["tied_structures"][name][key] == pytest.approx(alone[key], abs=1e-9)
+        assert f"  {name}: switch_heading_deg 10, first_overshoot_deg " in text
+    full = tmp_path / "full.json"
+    assert run(["rescale", mmg_tied, "--factor", "45.7", "-o", full], capsys)[0] == 0
+    big = tmp_path / "big.json"
+    assert run(["manoeuvre", full, "zigzag", "--rudder", "10", "--no-bands", "--json", big],
+               capsys)[0] == 0  # fmt: skip
+    scaled = json.loads(big.read_text())["tied_structures"]
+    for name in alternatives:
+        for key in ("first_overshoot_deg", "second_overshoot_deg"):
+            assert scaled[name][key] == pytest.approx(rec["tied_structures"][name][key], abs=0.2)

@@ -90,6 +90,27 @@ def _criteria_envelope_notes(env, runs) -> list[str]:
     return notes
 
 
+def _tied_structures(run, alternatives: dict, kind: str) -> dict:
+    """The same manoeuvre on the structures that tied with the model's in ``identify``'s inflow
+    comparison (``identification.structure_choice.alternatives``), printed one line each: what
+    the training logs left open. Not an interval: on the KVLCC2's MMG model the truth's 10/10
+    overshoots lay between the tied fits' in 9–12 of 16 cases (``study_auto_inflow.py``)."""
+    if not alternatives or kind == "spiral":
+        return {}
+    out = {}
+    for name, model in alternatives.items():
+        res = run(model)
+        out[name] = None if res.diverged else {k: v for k, v in res.indices.items()
+                                                if isinstance(v, float)}  # fmt: skip
+    print("The same manoeuvre on the structures the training logs could not tell apart from this "
+          "one (identify's comparison fits; what the logs leave open, not an interval):")
+    for name, indices in out.items():
+        shown = "diverged" if indices is None else ", ".join(f"{k} {v:.4g}"
+                                                             for k, v in indices.items())
+        print(f"  {name}: {shown}")
+    return out
+
+
 def cmd_manoeuvre(args) -> int:
     """``shipid manoeuvre``: a standard manoeuvre on a model or vessel."""
     from shipid.evaluation.envelope import implausible_indices, outside_envelope
@@ -183,6 +204,7 @@ def cmd_manoeuvre(args) -> int:
                              f"{ensemble.members_label}: they disagree with the fit, and the "
                              "interval does not describe it")  # fmt: skip
         print(text)
+    tied = _tied_structures(run, cond.get("alternatives") or {}, args.kind)
     for n in notes:
         _warn(n)
     with OutputSet() as out:
@@ -191,7 +213,7 @@ def cmd_manoeuvre(args) -> int:
                    "approach": {"speed": speed, "rps": rps},
                    "diverged_at": res.diverged_at, "reason": res.reason,
                    "indices": res.indices, "index_intervals": intervals or None,
-                   "index_not_bounded": unbounded or None,
+                   "index_not_bounded": unbounded or None, "tied_structures": tied or None,
                    "rudder_rate_deg_s": (math.degrees(gear.max_rate) if gear and gear.max_rate
                                          else None),
                    "warnings": notes}  # fmt: skip

@@ -55,6 +55,9 @@ class StructureChoice:
     candidates: int | None = None
     notes: list[str] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)  # the search's (few folds, say)
+    # The structures that tied with the one fitted (free-run scores within one standard error),
+    # as the comparison fitted them (γ 1e4, no prefilter): what the logs could not rule out.
+    alternatives: dict = field(default_factory=dict)
 
     def describe(self) -> str:
         """One paragraph for the command line."""
@@ -84,7 +87,8 @@ class StructureChoice:
         return {"how": self.how, "reasons": list(self.reasons), "gamma": self.gamma,
                 "library": self.library, "cv": self.cv, "score": self.score,
                 "candidates": self.candidates, "notes": list(self.notes),
-                "warnings": list(self.warnings)}  # fmt: skip
+                "warnings": list(self.warnings),
+                "alternatives": {k: m.to_dict() for k, m in self.alternatives.items()}}  # fmt: skip
 
 
 def _without(structure: ModelStructure, drop: Mapping[str, Sequence[str]] | None
@@ -251,11 +255,14 @@ def _paper_or_race(logs, names, physics, cv, estimator, drop=None, announce=_qui
     table = ", ".join(f"{k} {v[0]:.3f}" for k, v in scores.items())
     warnings = _predictions_apart({k: models[k] for k in tied}, logs) if len(tied) > 1 \
         else []  # fmt: skip
+    alternatives = {k: models[k] for k in tied if k != name}
     if name == PAPER:
         return StructureChoice(get_structure(PAPER), "paper", [reason], cv=cv,
-                               notes=[f"free-run scores {table}"], warnings=warnings)
+                               notes=[f"free-run scores {table}"], warnings=warnings,
+                               alternatives=alternatives)  # fmt: skip
     return StructureChoice(get_structure(name), "compared", [reason], cv=cv,
                            score=scores[name][0], candidates=len(scores),
+                           alternatives=alternatives,
                            notes=[f"free-run scores ({cv}) {table}; {RACE_PREFERRED} where "
                                   "within one standard error of the best (the rudder in the "
                                   "propeller's race), else the simplest within it"],

@@ -289,6 +289,20 @@ def ensemble_from_document(doc: Mapping, path: str | Path, model: ManoeuvringMod
     return Ensemble.from_dict(data, model, f"{path}: uncertainty")
 
 
+def alternatives_from_document(doc: Mapping, path: str | Path) -> dict[str, ManoeuvringModel]:
+    """The structures that tied with the file's in ``identify``'s inflow comparison, as that
+    comparison fitted them (``identification.structure_choice.alternatives``); {} for none."""
+    choice = (doc.get("identification") or {}).get("structure_choice") or {}
+    found = choice.get("alternatives") if isinstance(choice, Mapping) else None
+    if not found:
+        return {}
+    if not isinstance(found, Mapping):
+        raise ShipidError(f"{path}: identification.structure_choice.alternatives must be a "
+                          "mapping")  # fmt: skip
+    return {str(k): model_from_document({"model": v}, f"{path}: structure_choice.alternatives."
+                                        f"{k}") for k, v in found.items()}  # fmt: skip
+
+
 def _error_band_record(doc: Mapping) -> tuple[dict | None, str, object]:
     """(the mapping that holds the band, its key path, the band's raw record): ``select``
     keeps it in its selection record, ``identify --error-band`` beside it."""
@@ -360,6 +374,9 @@ def rescaled_document(doc: Mapping, factor: float, to_rho: float | None = None,
         sparse = model_from_document({"model": chosen}, path)
         out["identification"]["selection"]["chosen_model"] = scaled(
             sparse, froude_ratios(sparse.structure, factor, rho, to_rho)).to_dict()
+    for key, alt in alternatives_from_document(doc, path).items():  # the tied structures' fits
+        out["identification"]["structure_choice"]["alternatives"][key] = scaled(
+            alt, froude_ratios(alt.structure, factor, rho, to_rho)).to_dict()
     if out.get("uncertainty"):
         unc = out["uncertainty"]
         # The members' structure: the model's, or a superset of it (select --bootstrap).
