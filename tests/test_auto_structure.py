@@ -274,3 +274,31 @@ def test_manoeuvre_runs_the_structures_the_logs_could_not_tell_apart(mmg_tied, t
     for name in alternatives:
         for key in ("first_overshoot_deg", "second_overshoot_deg"):
             assert scaled[name][key] == pytest.approx(rec["tied_structures"][name][key], abs=0.2)
+
+
+def test_validate_judges_the_tied_structures_on_the_same_logs(mmg_tied, tmp_path, capsys):
+    """On a log none of them was fitted to (the MMG model's 10/10 zig-zag), `validate` runs the
+    tied fits too: each row is what validating that fit alone gives."""
+    from shipid.evaluation.validate import validate
+    from shipid.reporting.modelfile import alternatives_from_document, load_document
+    from shipid.vessels import kvlcc2
+    from shipid.vessels.kvlcc2 import trimmed_revolutions
+
+    held = zigzag(kvlcc2(), 10, 10, duration=300, dt=0.2, approach=5).log
+    held = PAPER_IMU.scaled(0.25).apply(held, seed=7).assign(n=trimmed_revolutions(1.179))
+    path = write_log(held, tmp_path / "zz10.csv")
+    out = tmp_path / "v.json"
+    code, text, err = run(["validate", mmg_tied, path, "--no-bands", "--json", out], capsys)
+    assert code == 0, err
+    assert "could not tell apart from this one" in text and "| (the model)" in text
+    rec = json.loads(out.read_text())["tied_structures"]
+    alternatives = alternatives_from_document(load_document(mmg_tied), mmg_tied)
+    assert set(rec) == set(alternatives)
+    log = read_log(path)
+    for name, model in alternatives.items():
+        alone = validate(model, log, [str(path)])[0]
+        (row,) = rec[name]
+        for s in "uvr":
+            assert row["metrics"][s]["std"] == pytest.approx(alone.metrics[s]["std"], rel=1e-12)
+        assert row["closed_loop"]["second_overshoot_deg"] == pytest.approx(
+            alone.indices["closed_loop"]["second_overshoot_deg"], abs=1e-9)  # fmt: skip

@@ -106,6 +106,7 @@ def cmd_validate(args) -> int:
                 print(note)
     if args.horizon and good:
         _print_horizons(model, vals, logs, args)
+    tied = {} if args.lssvm or not good else _tied_structures(doc, args, vals, logs)
     residuals = {}
     if args.resid or args.report:
         from shipid.evaluation.metrics import residual_correlations
@@ -145,7 +146,8 @@ def cmd_validate(args) -> int:
     with OutputSet() as out:
         if args.json:
             records = [v.to_dict() for v in vals] + [{"name": None, "error": e} for e in failed]
-            out.write(args.json, lambda p: p.write_text(_json_text({"logs": records}), "utf-8"))
+            body = {"logs": records, **({"tied_structures": tied} if tied else {})}
+            out.write(args.json, lambda p: p.write_text(_json_text(body), "utf-8"))
         figures: dict[str, dict[str, bytes]] = {}
         if args.plots:
             from shipid.reporting import plots
@@ -183,6 +185,46 @@ def cmd_validate(args) -> int:
             out.write(Path(args.report) / "report.html",
                       lambda p: p.write_text(text, encoding="utf-8"))
     return 1 if errors else 0
+
+
+# Indices of the tied structures' closed loops shown beside their free-run errors.
+TIED_INDICES = ("first_overshoot_deg", "second_overshoot_deg", "tactical_diameter",
+                "steady_yaw_rate")  # fmt: skip
+
+
+def _tied_structures(doc, args, vals, logs) -> dict:
+    """``validate`` of a model whose structure tied with others in ``identify``'s inflow
+    comparison: the same logs run on each tied fit (``structure_choice.alternatives``), their
+    free-run error std and closed-loop indices in one table, so that logs none of them was
+    fitted to can tell them apart. {} where the file keeps none."""
+    from shipid.evaluation.validate import validate
+    from shipid.reporting.modelfile import alternatives_from_document
+
+    alternatives = alternatives_from_document(doc, args.model)
+    if not alternatives:
+        return {}
+    rows, out = [], {}
+    pairs = [(v, log) for v, log in zip(vals, logs, strict=True) if v.error is None]
+    for structure, alt in {"(the model)": None, **alternatives}.items():
+        for v, log in pairs:
+            w = v if alt is None else validate(alt, log, [v.name], method=args.method,
+                                               kind=args.kind, smooth_s=args.smooth)[0]  # fmt: skip
+            closed = (w.indices or {}).get("closed_loop") or {}
+            row = {"structure": structure, "log": Path(v.name).name,
+                   **{f"std {s}": w.metrics[s]["std"] for s in ("u", "v", "r")},
+                   **{f"{k} (closed loop)": closed.get(k) for k in TIED_INDICES
+                      if k in ((v.indices or {}).get("measured") or {})}}  # fmt: skip
+            rows.append(row)
+            if alt is not None:
+                out.setdefault(structure, []).append(
+                    {"log": v.name, "metrics": w.metrics, "closed_loop": closed,
+                     "diverged": w.simulation.diverged})  # fmt: skip
+    table = _pd().DataFrame(rows)
+    table = table.astype(object).where(table.notna(), "–")
+    print("\nThe structures identify's comparison could not tell apart from this one, on the same "
+          "logs (their comparison fits; judge them on logs none was fitted to):")
+    print(table.to_markdown(index=False, floatfmt=".4g"))
+    return out
 
 
 def _print_horizons(model, vals, logs, args) -> None:
