@@ -302,3 +302,29 @@ def test_validate_judges_the_tied_structures_on_the_same_logs(mmg_tied, tmp_path
             assert row["metrics"][s]["std"] == pytest.approx(alone.metrics[s]["std"], rel=1e-12)
         assert row["closed_loop"]["second_overshoot_deg"] == pytest.approx(
             alone.indices["closed_loop"]["second_overshoot_deg"], abs=1e-9)  # fmt: skip
+
+
+def test_criteria_give_the_tied_structures_values_beside_the_models(mmg_tied, tmp_path, capsys):
+    """`criteria` adds a column per tied structure: the IMO criteria of that fit alone, run
+    from the same approach at the same rudder rate."""
+    from shipid.dynamics.steering import SteeringMachine
+    from shipid.reporting.modelfile import alternatives_from_document, load_document
+    from shipid.trials.criteria import imo_criteria
+
+    out = tmp_path / "c.json"
+    code, text, err = run(["criteria", mmg_tied, "--length", "7", "--scale", "45.7",
+                           "--no-bands", "--json", out], capsys)  # fmt: skip
+    assert code == 0, err
+    rec = json.loads(out.read_text())
+    cond = rec["conditions"]
+    gear = SteeringMachine(max_rate=np.radians(cond["rudder_rate_deg_s"]))
+    alternatives = alternatives_from_document(load_document(mmg_tied), mmg_tied)
+    assert set(rec["tied_structures"]) == set(alternatives)
+    for name, model in alternatives.items():
+        alone = imo_criteria(model, length=7.0, scale=45.7, speed=cond["speed"], steering=gear)
+        keys = zip(alone.table["criterion"], alone.table["manoeuvre"], strict=True)
+        expected = dict(zip(keys, alone.table["value"], strict=True))
+        for row in rec["criteria"]:
+            assert row[name] == pytest.approx(expected[(row["criterion"], row["manoeuvre"])],
+                                              rel=1e-9, nan_ok=True)  # fmt: skip
+    assert "could not tell apart from this one (identify's comparison fits)" in text

@@ -51,18 +51,38 @@ def cmd_criteria(args) -> int:
         replicates = [run(m) for m in ensemble.members()]
         table = with_intervals(crit, replicates)
         crit.notes += replicate_notes(table, replicates, ensemble.members_label)
+    tied = {}
+    for name, alt in (cond.get("alternatives") or {}).items():
+        # The structures the training logs could not tell apart from this one: their values
+        # and verdicts beside the model's, from the same approach.
+        rows = run(alt).table.to_dict(orient="records")
+        tied[name] = rows
+        other = {(row["criterion"], row["manoeuvre"]): row for row in rows}
+        keys = list(zip(crit.table["criterion"], crit.table["manoeuvre"], strict=True))
+        table[name] = [other.get(k, {}).get("value", math.nan) for k in keys]
+        flips = [f"{k[0]} ({k[1]}): {'pass' if other[k]['passed'] else 'FAIL'}"
+                 for k, mine in zip(keys, crit.table["passed"], strict=True)
+                 if k in other and mine is not None and other[k]["passed"] is not None
+                 and bool(mine) != bool(other[k]["passed"])]  # fmt: skip
+        if flips:
+            crit.notes.append(f"{name}, a structure the training logs could not tell apart from "
+                              f"this one, reaches another verdict: {'; '.join(flips)}")
     c = crit.conditions
     print(f"IMO MSC.137(76) criteria for {args.model}: L = {c['length']:g} m, V = {c['speed']:.4g} "
           f"m/s, λ = {c['scale']:g} (full-scale L/V = {c['L_over_V_full_scale']:.3g} s), " + (
               f"rudder rate {c['rudder_rate_deg_s']:.3g} °/s" if c["rudder_rate_deg_s"]
               else "instantaneous rudder"))
-    record = {**crit.to_dict(), "criteria": table.to_dict(orient="records")}
+    record = {**crit.to_dict(), "criteria": table.to_dict(orient="records"),
+              "tied_structures": tied or None}  # fmt: skip
     table["passed"] = table["passed"].map({True: "pass", False: "FAIL", None: "–"})
     print(table.to_markdown(index=False, floatfmt=".3g"))
     if "pass_share" in table:
         print(f"lower, upper: 95 % interval of the value, pass_share: the share of passes, "
               f"no_value: how many have none, over the model's {ensemble.replicates} "
               f"{ensemble.members_label} (more than 2.5 % without a value: not bounded)")
+    if tied:
+        print(f"{', '.join(tied)}: the value of each structure the training logs could not tell "
+              "apart from this one (identify's comparison fits), from the same approach")
     print("all criteria met" if crit.passed else "NOT all criteria met")
     for n in crit.notes:
         _warn(n)
