@@ -106,7 +106,7 @@ def cmd_validate(args) -> int:
                 print(note)
     if args.horizon and good:
         _print_horizons(model, vals, logs, args)
-    tied = {} if args.lssvm or not good else _tied_structures(doc, args, vals, logs)
+    tied = {} if args.lssvm or not good else _tied_validations(doc, args, vals, logs)
     residuals = {}
     if args.resid or args.report:
         from shipid.evaluation.metrics import residual_correlations
@@ -192,7 +192,7 @@ TIED_INDICES = ("first_overshoot_deg", "second_overshoot_deg", "tactical_diamete
                 "steady_yaw_rate")  # fmt: skip
 
 
-def _tied_structures(doc, args, vals, logs) -> dict:
+def _tied_validations(doc, args, vals, logs) -> dict:
     """``validate`` of a model whose structure tied with others in ``identify``'s inflow
     comparison: the same logs run on each tied fit (``structure_choice.alternatives``), their
     free-run error std and closed-loop indices in one table, so that logs none of them was

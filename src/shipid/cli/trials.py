@@ -110,7 +110,7 @@ def _criteria_envelope_notes(env, runs) -> list[str]:
     return notes
 
 
-def _tied_structures(run, alternatives: dict, kind: str) -> dict:
+def _tied_manoeuvres(run, alternatives: dict, kind: str) -> dict:
     """The same manoeuvre on the structures that tied with the model's in ``identify``'s inflow
     comparison (``identification.structure_choice.alternatives``), printed one line each: what
     the training logs left open. Not an interval: on the KVLCC2's MMG model the truth's 10/10
@@ -224,7 +224,7 @@ def cmd_manoeuvre(args) -> int:
                              f"{ensemble.members_label}: they disagree with the fit, and the "
                              "interval does not describe it")  # fmt: skip
         print(text)
-    tied = _tied_structures(run, cond.get("alternatives") or {}, args.kind)
+    tied = _tied_manoeuvres(run, cond.get("alternatives") or {}, args.kind)
     for n in notes:
         _warn(n)
     with OutputSet() as out:
