@@ -288,9 +288,12 @@ def test_validate_judges_the_tied_structures_on_the_same_logs(mmg_tied, tmp_path
     held = PAPER_IMU.scaled(0.25).apply(held, seed=7).assign(n=trimmed_revolutions(1.179))
     path = write_log(held, tmp_path / "zz10.csv")
     out = tmp_path / "v.json"
-    code, text, err = run(["validate", mmg_tied, path, "--no-bands", "--json", out], capsys)
+    code, text, err = run(["validate", mmg_tied, path, "--no-bands", "--json", out, "--report",
+                           tmp_path / "report"], capsys)  # fmt: skip
     assert code == 0, err
     assert "could not tell apart from this one" in text and "| (the model)" in text
+    page = (tmp_path / "report" / "report.html").read_text()
+    assert "<h2>Structures the training logs could not tell apart</h2>" in page
     rec = json.loads(out.read_text())["tied_structures"]
     alternatives = alternatives_from_document(load_document(mmg_tied), mmg_tied)
     assert set(rec) == set(alternatives)

@@ -106,7 +106,8 @@ def cmd_validate(args) -> int:
                 print(note)
     if args.horizon and good:
         _print_horizons(model, vals, logs, args)
-    tied = {} if args.lssvm or not good else _tied_validations(doc, args, vals, logs)
+    tied, tied_table = ({}, None) if args.lssvm or not good else _tied_validations(
+        doc, args, vals, logs)  # fmt: skip
     residuals = {}
     if args.resid or args.report:
         from shipid.evaluation.metrics import residual_correlations
@@ -181,7 +182,8 @@ def cmd_validate(args) -> int:
             text = validation_report(model, vals, logs, f"Validation of {Path(args.model).name}",
                                      std_errors=se, std_errors_label=se_label, criteria=crit,
                                      warnings=[w for v in good for w in v.warnings],
-                                     residuals=residuals, figures=figures)  # fmt: skip
+                                     residuals=residuals, figures=figures,
+                                     tied=tied_table)  # fmt: skip
             out.write(Path(args.report) / "report.html",
                       lambda p: p.write_text(text, encoding="utf-8"))
     return 1 if errors else 0
@@ -192,17 +194,18 @@ TIED_INDICES = ("first_overshoot_deg", "second_overshoot_deg", "tactical_diamete
                 "steady_yaw_rate")  # fmt: skip
 
 
-def _tied_validations(doc, args, vals, logs) -> dict:
+def _tied_validations(doc, args, vals, logs) -> tuple[dict, object]:
     """``validate`` of a model whose structure tied with others in ``identify``'s inflow
     comparison: the same logs run on each tied fit (``structure_choice.alternatives``), their
     free-run error std and closed-loop indices in one table, so that logs none of them was
-    fitted to can tell them apart. {} where the file keeps none."""
+    fitted to can tell them apart. ({}, None) where the file keeps none; else the record for
+    ``--json`` and the table."""
     from shipid.evaluation.validate import validate
     from shipid.reporting.modelfile import alternatives_from_document
 
     alternatives = alternatives_from_document(doc, args.model)
     if not alternatives:
-        return {}
+        return {}, None
     rows, out = [], {}
     pairs = [(v, log) for v, log in zip(vals, logs, strict=True) if v.error is None]
     for structure, alt in {"(the model)": None, **alternatives}.items():
@@ -224,7 +227,7 @@ def _tied_validations(doc, args, vals, logs) -> dict:
     print("\nThe structures identify's comparison could not tell apart from this one, on the same "
           "logs (their comparison fits; judge them on logs none was fitted to):")
     print(table.to_markdown(index=False, floatfmt=".4g"))
-    return out
+    return out, table
 
 
 def _print_horizons(model, vals, logs, args) -> None:

@@ -51,9 +51,12 @@ def validation_report(
     warnings: Sequence[str] = (),
     residuals: Mapping[str, Mapping] | None = None,
     figures: Mapping[str, Mapping[str, bytes]] | None = None,
+    tied: pd.DataFrame | None = None,
 ) -> str:
     """The HTML text of the report. ``figures``: PNGs already drawn, {log name: {"fit": ...,
-    "resid": ...}} (``shipid validate --plots`` shares its own); the others are drawn here."""
+    "resid": ...}} (``shipid validate --plots`` shares its own); the others are drawn here.
+    ``tied``: the table of the structures ``identify`` could not tell apart from the model's,
+    run on the same logs (``shipid validate``)."""
     from shipid.reporting import plots
     from shipid.reporting.report import (
         horizons_frame,
@@ -92,6 +95,11 @@ def validation_report(
         note = switch_heading_note([v for v, _ in good])
         if note:
             parts.append(f"<p>{html.escape(note)}</p>")
+    if tied is not None and len(tied):
+        parts += ["<h2>Structures the training logs could not tell apart</h2>",
+                  "<p>The same logs run on the fits of the structures that tied with the model's "
+                  "in identify's comparison: what the training logs left open, which logs none "
+                  "was fitted to can decide.</p>", _table(tied)]  # fmt: skip
     if criteria is not None and len(criteria):
         parts += ["<h2>IMO MSC.137(76) criteria</h2>", _table(criteria)]
     for v, log in good:
