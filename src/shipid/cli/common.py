@@ -186,15 +186,6 @@ def _std_errors(ident) -> dict:
     return {d: ident.diagnostics[d].get("std_errors", {}) for d in ident.diagnostics}
 
 
-def _rudder_rate(logs) -> float | None:
-    """The training logs' rudder rate [rad/s] (90th percentile while the rudder moves)."""
-    from shipid.trials.trial import describe_trial
-
-    rates = [describe_trial(log).rudder_rate for log in logs]
-    rates = [r for r in rates if r]
-    return max(rates) if rates else None
-
-
 def _print_yaw_rate_offsets(args, paths, logs) -> None:
     """One line of the offsets ``--yaw-rate-offset auto`` read off the logs' headings."""
     if args.yaw_rate_offset == "auto" and logs:

@@ -52,13 +52,13 @@ def cmd_criteria(args) -> int:
         table = with_intervals(crit, replicates)
         crit.notes += replicate_notes(table, replicates, ensemble.members_label)
     tied = {}
+    keys = list(zip(crit.table["criterion"], crit.table["manoeuvre"], strict=True))
     for name, alt in (cond.get("alternatives") or {}).items():
         # The structures the training logs could not tell apart from this one: their values
         # and verdicts beside the model's, from the same approach.
         rows = run(alt).table.to_dict(orient="records")
         tied[name] = rows
         other = {(row["criterion"], row["manoeuvre"]): row for row in rows}
-        keys = list(zip(crit.table["criterion"], crit.table["manoeuvre"], strict=True))
         table[name] = [other.get(k, {}).get("value", math.nan) for k in keys]
         flips = [f"{k[0]} ({k[1]}): {'pass' if other[k]['passed'] else 'FAIL'}"
                  for k, mine in zip(keys, crit.table["passed"], strict=True)

@@ -52,7 +52,7 @@ class HeadingDrift:
     drift: float
     scatter: float
     duration: float
-    noise_drift: float = 0.0
+    noise_drift: float
 
     @property
     def linear(self) -> float:

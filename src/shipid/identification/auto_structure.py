@@ -305,15 +305,15 @@ def _predictions_apart(models: Mapping[str, object], logs) -> list[str]:
     from shipid.data.log import approach
     from shipid.dynamics.steering import SteeringMachine
     from shipid.trials.manoeuvres import turning_circle, zigzag
-    from shipid.trials.trial import describe_trial
+    from shipid.trials.trial import logs_rudder_rate
 
     speed, rps = approach(logs[0], "u"), approach(logs[0], "n")
     if not speed or not speed > 0:
         return []
     dt = float(np.median(np.diff(logs[0]["t"].to_numpy())))
     rates, overshoots = {}, {}
-    rudder_rates = [r for r in (describe_trial(log).rudder_rate for log in logs) if r]
-    steering = SteeringMachine(max_rate=max(rudder_rates)) if rudder_rates else None
+    rate = logs_rudder_rate(logs)  # the gear identify records in the model file
+    steering = SteeringMachine(max_rate=rate) if rate else None
     for name, model in models.items():
         res = turning_circle(model, 35.0, speed=speed, rps=rps, method="euler", dt=dt)
         r = None if res.diverged else (res.indices or {}).get("steady_yaw_rate")

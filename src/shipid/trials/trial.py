@@ -17,6 +17,7 @@ A kind can be forced (``kind=``); then the classification only supplies the fact
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -177,6 +178,13 @@ def _rudder_rate(t: np.ndarray, delta: np.ndarray) -> float | None:
     # the 2° of a swing by their fastest steps.
     swings = rise_rate(t, delta)
     return swings if swings is not None else float(np.percentile(rate[moving], 90))
+
+
+def logs_rudder_rate(logs: Sequence[pd.DataFrame]) -> float | None:
+    """The rudder rate of a set of logs [rad/s]: the fastest of their ``Trial.rudder_rate`` (the
+    steering gear's, which manoeuvres on a model of them run at); None where none swings."""
+    rates = [r for r in (describe_trial(log).rudder_rate for log in logs) if r]
+    return max(rates) if rates else None
 
 
 def describe_trial(
