@@ -225,7 +225,7 @@ def _tied_validations(doc, args, vals, logs) -> tuple[dict, object]:
     table = _pd().DataFrame(rows)
     table = table.astype(object).where(table.notna(), "–")
     print("\nThe structures identify's comparison could not tell apart from this one, on the same "
-          "logs (their comparison fits; judge them on logs none was fitted to):")
+          "logs (fitted as this model was; judge them on logs none was fitted to):")
     print(table.to_markdown(index=False, floatfmt=".4g"))
     return out, table
 

@@ -122,6 +122,8 @@ def cmd_identify(args) -> int:
     ident = identify(logs, model=args.model, form=args.form, gamma=gamma,
                      drop=_parse_drop(args.drop), names=names, force=args.force,
                      estimator=args.estimator, physics=physics)  # fmt: skip
+    if choice is not None and choice.alternatives:
+        choice.alternatives = _refit_alternatives(choice, args, logs, names, gamma)
     speed, rps = _approach(logs[0], "u"), _approach(logs[0], "n")
     _warn_approach(logs, names)
     prep = {"dt": args.dt, "start": args.start, "end": args.end, "lead": args.lead,
@@ -310,6 +312,25 @@ def _choose_structure(args, logs, names):
     if args.gamma is None:
         args.gamma = choice.gamma if choice is not None and choice.gamma else 1e4
     return choice
+
+
+def _refit_alternatives(choice, args, logs, names, gamma) -> dict:
+    """The structures that tied with the chosen one, refitted as the file's LS-SVM model is:
+    the same (prefiltered) logs, γ and physics. The comparison fitted each at γ = 1e4 on the
+    unfiltered logs; its fits set against a prefiltered, tuned model would show the fitting's
+    difference as the structure's. A structure the fit refuses keeps the comparison's fit."""
+    from shipid.identification.identify import identify
+
+    out = {}
+    for name, compared in choice.alternatives.items():
+        try:
+            out[name] = identify(logs, model=compared.structure, form=args.form, gamma=gamma,
+                                 names=names, force=True, estimator=args.estimator,
+                                 physics=_physics(args, logs, compared.structure)).model
+        except ShipidError as exc:
+            _warn(f"structure: {name}, which tied, keeps the comparison's fit ({exc})")
+            out[name] = compared
+    return out
 
 
 def _turns_apart(lssvm: dict, refined: dict) -> str | None:

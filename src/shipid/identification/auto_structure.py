@@ -55,8 +55,9 @@ class StructureChoice:
     candidates: int | None = None
     notes: list[str] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)  # the search's (few folds, say)
-    # The structures that tied with the one fitted (free-run scores within one standard error),
-    # as the comparison fitted them (γ 1e4, no prefilter): what the logs could not rule out.
+    # The structures that tied with the one fitted (free-run scores within one standard error):
+    # what the logs could not rule out. As the comparison fitted them (γ 1e4, no prefilter);
+    # ``identify`` refits them as it fits its model (prefilter, γ, physics) before the file.
     alternatives: dict = field(default_factory=dict)
 
     def describe(self) -> str:

@@ -290,8 +290,8 @@ def ensemble_from_document(doc: Mapping, path: str | Path, model: ManoeuvringMod
 
 
 def alternatives_from_document(doc: Mapping, path: str | Path) -> dict[str, ManoeuvringModel]:
-    """The structures that tied with the file's in ``identify``'s inflow comparison, as that
-    comparison fitted them (``identification.structure_choice.alternatives``); {} for none."""
+    """The structures that tied with the file's in ``identify``'s inflow comparison, fitted as
+    the file's model was (``identification.structure_choice.alternatives``); {} for none."""
     choice = (doc.get("identification") or {}).get("structure_choice") or {}
     found = choice.get("alternatives") if isinstance(choice, Mapping) else None
     if not found:
