@@ -7,6 +7,14 @@ import os
 # needed (the suite 88 s against 74 s). Read by OpenBLAS when it loads, in each worker.
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
+# numba on one thread in each test worker, as ``shipid.parallel`` runs its Dask tasks: two
+# workers each spinning two numba threads of the compiled simulations' ``prange`` on two cores
+# oversubscribed them (output error's 40 fits took 7.7 s beside another worker, 1.1 s alone; the
+# suite 84 s against 56 s). Read when numba loads, before any test imports it; a serial run
+# (no worker) keeps numba's default. The suite's subprocesses (the README's commands) inherit it.
+if os.environ.get("PYTEST_XDIST_WORKER"):
+    os.environ.setdefault("NUMBA_NUM_THREADS", "1")
+
 # ``make test`` runs two workers with ``--dist loadfile``: whole files go to whichever worker is
 # free, in collection order. Collected alphabetically, test_readme.py (a third of the suite's
 # time: its blocks run in order on one worker) started late and ran alone at the end; the longest

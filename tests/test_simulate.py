@@ -140,6 +140,33 @@ def test_batch_equals_single_runs():
         np.testing.assert_allclose(batch.log(i).to_numpy(), single.to_numpy(), rtol=1e-13)
 
 
+def test_batch_on_two_numba_threads_equals_single_runs():
+    """The test workers run numba on one thread (conftest); the compiled batch's ``prange``
+    on the threads a user's process has is checked here, in a process of its own."""
+    import os
+    import subprocess
+    import sys
+
+    code = """
+import numba, numpy as np
+from shipid.dynamics.simulate import simulate, simulate_batch
+from shipid.vessels import scale_ship_model
+assert numba.get_num_threads() == 2
+m, t = scale_ship_model(), np.arange(0, 20, 0.2)
+rng = np.random.default_rng(2)
+deltas, u0 = 0.3 * rng.uniform(-1, 1, size=(64, t.size)), rng.uniform(1.5, 2.0, size=64)
+batch = simulate_batch(m, t, deltas, np.column_stack([u0, np.zeros((64, 5))]))
+print(max(float(np.max(np.abs(batch.log(i).to_numpy()
+                              - simulate(m, t, deltas[i], {'u': u0[i]}).log.to_numpy())))
+          for i in range(64)))
+"""
+    env = {**os.environ, "NUMBA_NUM_THREADS": "2"}
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,
+                         timeout=120)  # fmt: skip
+    assert out.returncode == 0, out.stderr
+    assert float(out.stdout) <= 1e-12
+
+
 def test_simulate_log_replays_a_log():
     m = scale_ship_model()
     t = np.arange(0, 30, 0.2)
