@@ -297,10 +297,13 @@ def test_manoeuvre_runs_the_structures_the_logs_could_not_tell_apart(mmg_tied, t
             assert scaled[name][key] == pytest.approx(rec["tied_structures"][name][key], abs=0.2)
 
 
-def test_validate_judges_the_tied_structures_on_the_same_logs(mmg_tied, tmp_path, capsys):
+def test_validate_judges_the_tied_structures_on_the_same_logs(mmg_tied, tmp_path, capsys,
+                                                              monkeypatch):
     """On a log none of them was fitted to (the MMG model's 10/10 zig-zag), `validate` runs the
-    tied fits too: each row is what validating that fit alone gives."""
+    tied fits too: each row is what validating that fit alone gives, and its figure draws each
+    tied fit's free run (dashed) beside the model's."""
     from shipid.evaluation.validate import validate
+    from shipid.reporting import plots
     from shipid.reporting.modelfile import alternatives_from_document, load_document
     from shipid.vessels import kvlcc2
     from shipid.vessels.kvlcc2 import trimmed_revolutions
@@ -309,8 +312,17 @@ def test_validate_judges_the_tied_structures_on_the_same_logs(mmg_tied, tmp_path
     held = PAPER_IMU.scaled(0.25).apply(held, seed=7).assign(n=trimmed_revolutions(1.179))
     path = write_log(held, tmp_path / "zz10.csv")
     out = tmp_path / "v.json"
+    drawn = []
+    save = plots._save
+
+    def keep_lines(fig, target, out=None):
+        drawn.append({line.get_label(): line.get_ydata() for ax in fig.axes
+                      for line in ax.get_lines() if ax.get_ylabel() == plots.LABELS["r"]})
+        return save(fig, target, out)
+
+    monkeypatch.setattr(plots, "_save", keep_lines)
     code, text, err = run(["validate", mmg_tied, path, "--no-bands", "--json", out, "--report",
-                           tmp_path / "report"], capsys)  # fmt: skip
+                           tmp_path / "report", "--plots", tmp_path / "figs"], capsys)  # fmt: skip
     assert code == 0, err
     assert "could not tell apart from this one" in text and "| (the model)" in text
     page = (tmp_path / "report" / "report.html").read_text()
@@ -326,6 +338,8 @@ def test_validate_judges_the_tied_structures_on_the_same_logs(mmg_tied, tmp_path
             assert row["metrics"][s]["std"] == pytest.approx(alone.metrics[s]["std"], rel=1e-12)
         assert row["closed_loop"]["second_overshoot_deg"] == pytest.approx(
             alone.indices["closed_loop"]["second_overshoot_deg"], abs=1e-9)  # fmt: skip
+        (figure,) = [d for d in drawn if "simulated" in d]  # the validation figure's r panel
+        np.testing.assert_allclose(figure[f"{name} (tied)"], alone.simulation.log["r"], rtol=1e-12)
 
 
 def test_criteria_give_the_tied_structures_values_beside_the_models(mmg_tied, tmp_path, capsys):

@@ -106,8 +106,8 @@ def cmd_validate(args) -> int:
                 print(note)
     if args.horizon and good:
         _print_horizons(model, vals, logs, args)
-    tied, tied_table = ({}, None) if args.lssvm or not good else _tied_validations(
-        doc, args, vals, logs)  # fmt: skip
+    tied, tied_table, tied_runs = ({}, None, {}) if args.lssvm or not good else \
+        _tied_validations(doc, args, vals, logs)  # fmt: skip
     residuals = {}
     if args.resid or args.report:
         from shipid.evaluation.metrics import residual_correlations
@@ -163,7 +163,8 @@ def cmd_validate(args) -> int:
                 jobs = [("fit", stem + ext, partial(plots.measured_vs_simulated, log,
                                                    v.simulation.log, title=title,
                                                    bands=v.bands,
-                                                   error_band=v.error_band))]  # fmt: skip
+                                                   error_band=v.error_band,
+                                                   tied=tied_runs.get(v.name)))]  # fmt: skip
                 if args.resid:
                     jobs.append(("resid", stem + "-resid" + ext, partial(
                         plots.residuals, residuals[v.name], title=f"{title}: residual analysis")))
@@ -194,19 +195,20 @@ TIED_INDICES = ("first_overshoot_deg", "second_overshoot_deg", "tactical_diamete
                 "steady_yaw_rate")  # fmt: skip
 
 
-def _tied_validations(doc, args, vals, logs) -> tuple[dict, object]:
+def _tied_validations(doc, args, vals, logs) -> tuple[dict, object, dict]:
     """``validate`` of a model whose structure tied with others in ``identify``'s inflow
     comparison: the same logs run on each tied fit (``structure_choice.alternatives``), their
     free-run error std and closed-loop indices in one table, so that logs none of them was
-    fitted to can tell them apart. ({}, None) where the file keeps none; else the record for
-    ``--json`` and the table."""
+    fitted to can tell them apart. ({}, None, {}) where the file keeps none; else the record for
+    ``--json``, the table and each log's tied free runs {log: {structure: simulated log}} for
+    its figure."""
     from shipid.evaluation.validate import validate
     from shipid.reporting.modelfile import alternatives_from_document
 
     alternatives = alternatives_from_document(doc, args.model)
     if not alternatives:
-        return {}, None
-    rows, out = [], {}
+        return {}, None, {}
+    rows, out, runs = [], {}, {}
     pairs = [(v, log) for v, log in zip(vals, logs, strict=True) if v.error is None]
     for structure, alt in {"(the model)": None, **alternatives}.items():
         for v, log in pairs:
@@ -219,6 +221,7 @@ def _tied_validations(doc, args, vals, logs) -> tuple[dict, object]:
                       if k in ((v.indices or {}).get("measured") or {})}}  # fmt: skip
             rows.append(row)
             if alt is not None:
+                runs.setdefault(v.name, {})[structure] = w.simulation.log
                 out.setdefault(structure, []).append(
                     {"log": v.name, "metrics": w.metrics, "closed_loop": closed,
                      "diverged": w.simulation.diverged})  # fmt: skip
@@ -227,7 +230,7 @@ def _tied_validations(doc, args, vals, logs) -> tuple[dict, object]:
     print("\nThe structures identify's comparison could not tell apart from this one, on the same "
           "logs (fitted as this model was; judge them on logs none was fitted to):")
     print(table.to_markdown(index=False, floatfmt=".4g"))
-    return out, table
+    return out, table, runs
 
 
 def _print_horizons(model, vals, logs, args) -> None:

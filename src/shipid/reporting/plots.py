@@ -83,11 +83,16 @@ def rudder_and_heading(log: pd.DataFrame, path: str | Path, title: str = "",
 def measured_vs_simulated(measured: pd.DataFrame, simulated: pd.DataFrame, path: str | Path,
                           title: str = "", out: OutputSet | None = None,
                           bands: Mapping[str, tuple[np.ndarray, np.ndarray]] | None = None,
-                          error_band=None) -> Path:  # fmt: skip
+                          error_band=None,
+                          tied: Mapping[str, pd.DataFrame] | None = None) -> Path:  # fmt: skip
     """u, v, r measured and simulated with their errors; rudder and heading; x–y tracks.
     ``bands``: {state: (lower, upper)} prediction band drawn around the simulation;
     ``error_band`` (``shipid.evaluation.error_band.ErrorBand``): its ± half-widths drawn on the
-    errors."""
+    errors; ``tied``: {structure: simulated log} of the structures that tied with the model's
+    in ``identify``'s comparison, dashed beside its simulation (states, heading, track)."""
+    tied = dict(tied or {})
+    tied_style = {name: {"lw": 1.0, "ls": "--", "color": f"C{4 + k}", "label": f"{name} (tied)"}
+                  for k, name in enumerate(tied)}  # fmt: skip
     fig = plt.figure(figsize=(12, 11))
     grid = fig.add_gridspec(4, 2, height_ratios=[1, 1, 1, 1.3])
     n = len(simulated)
@@ -98,6 +103,8 @@ def measured_vs_simulated(measured: pd.DataFrame, simulated: pd.DataFrame, path:
         first = first or ax
         ax.plot(measured["t"], measured[s], lw=0.8, color="0.5", label="measured")
         ax.plot(t_sim, simulated[s], lw=1.4, color="C0", label="simulated")
+        for name, run in tied.items():
+            ax.plot(run["t"], run[s], **tied_style[name])
         if bands and s in bands:
             lo, hi = bands[s][0][:n], bands[s][1][:n]
             bounded = np.isfinite(lo) & np.isfinite(hi)
@@ -132,6 +139,9 @@ def measured_vs_simulated(measured: pd.DataFrame, simulated: pd.DataFrame, path:
             label="heading change, measured")  # fmt: skip
     ax.plot(t_sim, np.degrees(psi_s - psi_s[0]), lw=1.2, color="C0",
             label="heading change, simulated")  # fmt: skip
+    tied_tracks = {name: track(run) for name, run in tied.items()}
+    for name, (psi_t, _, _) in tied_tracks.items():
+        ax.plot(tied[name]["t"], np.degrees(psi_t - psi_t[0]), **tied_style[name])
     ax.set_ylabel("angle [deg]")
     ax.set_xlabel("t [s]")
     ax.grid(alpha=0.3)
@@ -139,6 +149,8 @@ def measured_vs_simulated(measured: pd.DataFrame, simulated: pd.DataFrame, path:
     tr = fig.add_subplot(grid[3, 1])
     tr.plot(ym - ym[0], xm - xm[0], color="0.5", lw=0.8, label="measured")
     tr.plot(ys - ys[0], xs - xs[0], color="C0", lw=1.2, label="simulated")
+    for name, (_, xt, yt) in tied_tracks.items():
+        tr.plot(yt - yt[0], xt - xt[0], **tied_style[name])
     _track_axes(tr, relative=True)
     fig.suptitle(title)
     # Drawn for every validated log: fixed margins (see _fixed_margins).
