@@ -365,4 +365,4 @@ def test_criteria_give_the_tied_structures_values_beside_the_models(mmg_tied, tm
         for row in rec["criteria"]:
             assert row[name] == pytest.approx(expected[(row["criterion"], row["manoeuvre"])],
                                               rel=1e-9, nan_ok=True)  # fmt: skip
-    assert "could not tell apart from this one (fitted as this model was)" in text
+    assert "could not tell apart from this one (LS-SVM fits with its prefilter and γ)" in text

@@ -228,7 +228,8 @@ def _tied_validations(doc, args, vals, logs) -> tuple[dict, object, dict]:
     table = _pd().DataFrame(rows)
     table = table.astype(object).where(table.notna(), "–")
     print("\nThe structures identify's comparison could not tell apart from this one, on the same "
-          "logs (fitted as this model was; judge them on logs none was fitted to):")
+          "logs (LS-SVM fits with this model's prefilter and γ; judge them on logs none was "
+          "fitted to):")
     print(table.to_markdown(index=False, floatfmt=".4g"))
     return out, table, runs
 

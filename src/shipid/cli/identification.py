@@ -315,10 +315,11 @@ def _choose_structure(args, logs, names):
 
 
 def _refit_alternatives(choice, args, logs, names, gamma) -> dict:
-    """The structures that tied with the chosen one, refitted as the file's LS-SVM model is:
-    the same (prefiltered) logs, γ and physics. The comparison fitted each at γ = 1e4 on the
-    unfiltered logs; its fits set against a prefiltered, tuned model would show the fitting's
-    difference as the structure's. A structure the fit refuses keeps the comparison's fit."""
+    """The structures that tied with the chosen one, refitted as the file's LS-SVM fit is (the
+    model's, unless output error replaces it): the same (prefiltered) logs, γ and physics. The
+    comparison fitted each at γ = 1e4 on the unfiltered logs; its fits set against a
+    prefiltered, tuned model would show the fitting's difference as the structure's. A structure
+    the fit refuses keeps the comparison's fit."""
     from shipid.identification.identify import identify
 
     out = {}

@@ -82,7 +82,7 @@ def cmd_criteria(args) -> int:
               f"{ensemble.members_label} (more than 2.5 % without a value: not bounded)")
     if tied:
         print(f"{', '.join(tied)}: the value of each structure the training logs could not tell "
-              "apart from this one (fitted as this model was), from the same approach")
+              "apart from this one (LS-SVM fits with its prefilter and γ), from the same approach")
     print("all criteria met" if crit.passed else "NOT all criteria met")
     for n in crit.notes:
         _warn(n)
@@ -123,7 +123,7 @@ def _tied_manoeuvres(run, alternatives: dict, kind: str) -> dict:
         out[name] = None if res.diverged else {k: v for k, v in res.indices.items()
                                                 if isinstance(v, float)}  # fmt: skip
     print("The same manoeuvre on the structures the training logs could not tell apart from this "
-          "one (fitted as this model was; what the logs leave open, not an interval):")
+          "one (LS-SVM fits with its prefilter and γ; what the logs leave open, not an interval):")
     for name, indices in out.items():
         shown = "diverged" if indices is None else ", ".join(f"{k} {v:.4g}"
                                                              for k, v in indices.items())
