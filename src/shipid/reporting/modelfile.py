@@ -290,8 +290,9 @@ def ensemble_from_document(doc: Mapping, path: str | Path, model: ManoeuvringMod
 
 
 def alternatives_from_document(doc: Mapping, path: str | Path) -> dict[str, ManoeuvringModel]:
-    """The structures that tied with the file's in ``identify``'s inflow comparison, fitted as
-    the file's model was (``identification.structure_choice.alternatives``); {} for none."""
+    """The structures that tied with the file's in ``identify``'s inflow comparison, LS-SVM fits
+    with its model's prefilter, γ and physics (``identification.structure_choice.alternatives``);
+    {} for none."""
     choice = (doc.get("identification") or {}).get("structure_choice") or {}
     found = choice.get("alternatives") if isinstance(choice, Mapping) else None
     if not found:
