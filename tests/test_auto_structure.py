@@ -247,8 +247,17 @@ def test_the_tied_structures_are_fitted_as_the_models_own_fit(mmg_tied):
     from shipid.data.io import read_log
     from shipid.data.preprocess import lowpass
     from shipid.identification.identify import identify
-    from shipid.reporting.modelfile import alternatives_from_document, load_document
+    from shipid.reporting.modelfile import (
+        alternatives_fit,
+        alternatives_from_document,
+        load_document,
+    )
 
+    doc = load_document(mmg_tied)
+    assert alternatives_fit(doc) == "LS-SVM fits with the model's prefilter and γ"
+    # A file of an earlier version holds the comparison's fits, and is said to.
+    del doc["identification"]["structure_choice"]["alternatives_fit"]
+    assert alternatives_fit(doc) == "identify's comparison fits: γ 1e4, unfiltered"
     doc = load_document(mmg_tied)
     prep = doc["identification"]["preprocessing"]
     assert prep["filter_hz"] is not None  # the noisy log is prefiltered: the case that differs
@@ -365,4 +374,4 @@ def test_criteria_give_the_tied_structures_values_beside_the_models(mmg_tied, tm
         for row in rec["criteria"]:
             assert row[name] == pytest.approx(expected[(row["criterion"], row["manoeuvre"])],
                                               rel=1e-9, nan_ok=True)  # fmt: skip
-    assert "could not tell apart from this one (LS-SVM fits with its prefilter and γ)" in text
+    assert "could not tell apart from this one (LS-SVM fits with the model's prefilter and γ)" in text

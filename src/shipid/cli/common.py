@@ -325,17 +325,22 @@ def _ship_or_model(name: str, hybrid: bool = False):
     if name in VESSEL_NAMES:
         return get_vessel(name), {"speed": None, "rps": None, "envelope": {}, "particulars": None,
                                   "rudder_rate": None, "rudder_positive": None,
-                                  "alternatives": {}}  # fmt: skip
+                                  "alternatives": {}, "alternatives_fit": ""}  # fmt: skip
     if not Path(name).exists():
         raise ShipidError(f"{name}: neither a model file nor a known vessel "
                           f"({', '.join(VESSEL_NAMES)})")  # fmt: skip
-    from shipid.reporting.modelfile import alternatives_from_document, ensemble_from_document
+    from shipid.reporting.modelfile import (
+        alternatives_fit,
+        alternatives_from_document,
+        ensemble_from_document,
+    )
 
     doc = load_document(name)
     model = model_from_document(doc, name, hybrid=hybrid)
     cond = training_conditions(doc)
     cond["ensemble"] = ensemble_from_document(doc, name, model)
     cond["alternatives"] = alternatives_from_document(doc, name)
+    cond["alternatives_fit"] = alternatives_fit(doc)
     return model, cond
 
 

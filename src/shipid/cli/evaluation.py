@@ -203,7 +203,7 @@ def _tied_validations(doc, args, vals, logs) -> tuple[dict, object, dict]:
     ``--json``, the table and each log's tied free runs {log: {structure: simulated log}} for
     its figure."""
     from shipid.evaluation.validate import validate
-    from shipid.reporting.modelfile import alternatives_from_document
+    from shipid.reporting.modelfile import alternatives_fit, alternatives_from_document
 
     alternatives = alternatives_from_document(doc, args.model)
     if not alternatives:
@@ -228,8 +228,7 @@ def _tied_validations(doc, args, vals, logs) -> tuple[dict, object, dict]:
     table = _pd().DataFrame(rows)
     table = table.astype(object).where(table.notna(), "–")
     print("\nThe structures identify's comparison could not tell apart from this one, on the same "
-          "logs (LS-SVM fits with this model's prefilter and γ; judge them on logs none was "
-          "fitted to):")
+          f"logs ({alternatives_fit(doc)}; judge them on logs none was fitted to):")
     print(table.to_markdown(index=False, floatfmt=".4g"))
     return out, table, runs
 

@@ -123,7 +123,8 @@ def cmd_identify(args) -> int:
                      drop=_parse_drop(args.drop), names=names, force=args.force,
                      estimator=args.estimator, physics=physics)  # fmt: skip
     if choice is not None and choice.alternatives:
-        choice.alternatives = _refit_alternatives(choice, args, logs, names, gamma)
+        choice.alternatives, refitted = _refit_alternatives(choice, args, logs, names, gamma)
+        choice.alternatives_fit = "model" if refitted else "comparison"
     speed, rps = _approach(logs[0], "u"), _approach(logs[0], "n")
     _warn_approach(logs, names)
     prep = {"dt": args.dt, "start": args.start, "end": args.end, "lead": args.lead,
@@ -314,15 +315,16 @@ def _choose_structure(args, logs, names):
     return choice
 
 
-def _refit_alternatives(choice, args, logs, names, gamma) -> dict:
+def _refit_alternatives(choice, args, logs, names, gamma) -> tuple[dict, bool]:
     """The structures that tied with the chosen one, refitted as the file's LS-SVM fit is (the
     model's, unless output error replaces it): the same (prefiltered) logs, γ and physics. The
     comparison fitted each at γ = 1e4 on the unfiltered logs; its fits set against a
     prefiltered, tuned model would show the fitting's difference as the structure's. A structure
-    the fit refuses keeps the comparison's fit."""
+    the fit refuses keeps the comparison's fit. Returns the fits and whether every one was
+    refitted."""
     from shipid.identification.identify import identify
 
-    out = {}
+    out, refitted = {}, True
     for name, compared in choice.alternatives.items():
         try:
             out[name] = identify(logs, model=compared.structure, form=args.form, gamma=gamma,
@@ -330,8 +332,8 @@ def _refit_alternatives(choice, args, logs, names, gamma) -> dict:
                                  physics=_physics(args, logs, compared.structure)).model
         except ShipidError as exc:
             _warn(f"structure: {name}, which tied, keeps the comparison's fit ({exc})")
-            out[name] = compared
-    return out
+            out[name], refitted = compared, False
+    return out, refitted
 
 
 def _turns_apart(lssvm: dict, refined: dict) -> str | None:

@@ -82,7 +82,7 @@ def cmd_criteria(args) -> int:
               f"{ensemble.members_label} (more than 2.5 % without a value: not bounded)")
     if tied:
         print(f"{', '.join(tied)}: the value of each structure the training logs could not tell "
-              "apart from this one (LS-SVM fits with its prefilter and γ), from the same approach")
+              f"apart from this one ({cond.get('alternatives_fit', '')}), from the same approach")
     print("all criteria met" if crit.passed else "NOT all criteria met")
     for n in crit.notes:
         _warn(n)
@@ -110,7 +110,7 @@ def _criteria_envelope_notes(env, runs) -> list[str]:
     return notes
 
 
-def _tied_manoeuvres(run, alternatives: dict, kind: str) -> dict:
+def _tied_manoeuvres(run, alternatives: dict, kind: str, fitted: str = "") -> dict:
     """The same manoeuvre on the structures that tied with the model's in ``identify``'s inflow
     comparison (``identification.structure_choice.alternatives``), printed one line each: what
     the training logs left open. Not an interval: on the KVLCC2's MMG model the truth's 10/10
@@ -123,7 +123,7 @@ def _tied_manoeuvres(run, alternatives: dict, kind: str) -> dict:
         out[name] = None if res.diverged else {k: v for k, v in res.indices.items()
                                                 if isinstance(v, float)}  # fmt: skip
     print("The same manoeuvre on the structures the training logs could not tell apart from this "
-          "one (LS-SVM fits with its prefilter and γ; what the logs leave open, not an interval):")
+          f"one ({fitted}; what the logs leave open, not an interval):")
     for name, indices in out.items():
         shown = "diverged" if indices is None else ", ".join(f"{k} {v:.4g}"
                                                              for k, v in indices.items())
@@ -224,7 +224,8 @@ def cmd_manoeuvre(args) -> int:
                              f"{ensemble.members_label}: they disagree with the fit, and the "
                              "interval does not describe it")  # fmt: skip
         print(text)
-    tied = _tied_manoeuvres(run, cond.get("alternatives") or {}, args.kind)
+    tied = _tied_manoeuvres(run, cond.get("alternatives") or {}, args.kind,
+                            cond.get("alternatives_fit", ""))  # fmt: skip
     for n in notes:
         _warn(n)
     with OutputSet() as out:

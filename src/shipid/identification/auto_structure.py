@@ -59,6 +59,8 @@ class StructureChoice:
     # what the logs could not rule out. As the comparison fitted them (γ 1e4, no prefilter);
     # ``identify`` refits them as it fits its model (prefilter, γ, physics) before the file.
     alternatives: dict = field(default_factory=dict)
+    # How they were fitted: 'comparison' (γ 1e4, unfiltered) or 'model' (refitted as the model).
+    alternatives_fit: str = "comparison"
 
     def describe(self) -> str:
         """One paragraph for the command line."""
@@ -89,7 +91,8 @@ class StructureChoice:
                 "library": self.library, "cv": self.cv, "score": self.score,
                 "candidates": self.candidates, "notes": list(self.notes),
                 "warnings": list(self.warnings),
-                "alternatives": {k: m.to_dict() for k, m in self.alternatives.items()}}  # fmt: skip
+                "alternatives": {k: m.to_dict() for k, m in self.alternatives.items()},
+                "alternatives_fit": self.alternatives_fit}  # fmt: skip
 
 
 def _without(structure: ModelStructure, drop: Mapping[str, Sequence[str]] | None

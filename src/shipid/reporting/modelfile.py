@@ -289,6 +289,16 @@ def ensemble_from_document(doc: Mapping, path: str | Path, model: ManoeuvringMod
     return Ensemble.from_dict(data, model, f"{path}: uncertainty")
 
 
+def alternatives_fit(doc: Mapping) -> str:
+    """How the file's tied structures were fitted, in words: LS-SVM fits with the model's
+    prefilter, γ and physics, or (files of earlier versions, or a structure that refused the
+    refit) the inflow comparison's own fits."""
+    choice = (doc.get("identification") or {}).get("structure_choice") or {}
+    if isinstance(choice, Mapping) and choice.get("alternatives_fit") == "model":
+        return "LS-SVM fits with the model's prefilter and γ"
+    return "identify's comparison fits: γ 1e4, unfiltered"
+
+
 def alternatives_from_document(doc: Mapping, path: str | Path) -> dict[str, ManoeuvringModel]:
     """The structures that tied with the file's in ``identify``'s inflow comparison, LS-SVM fits
     with its model's prefilter, γ and physics (``identification.structure_choice.alternatives``);
