@@ -104,6 +104,9 @@ def cmd_validate(args) -> int:
             note = switch_heading_note(good)
             if note:
                 print(note)
+            spread = _start_spread_note(good)
+            if spread:
+                print(spread)
     if args.horizon and good:
         _print_horizons(model, vals, logs, args)
     tied, tied_table, tied_runs = ({}, None, {}) if args.lssvm or not good else \
@@ -188,6 +191,25 @@ def cmd_validate(args) -> int:
             out.write(Path(args.report) / "report.html",
                       lambda p: p.write_text(text, encoding="utf-8"))
     return 1 if errors else 0
+
+
+def _start_spread_note(vals) -> str | None:
+    """How far each log's closed-loop indices move with the noise of the replica's start
+    (``shipid.evaluation.validate.start_spread``), or None."""
+    from shipid.evaluation.validate import START_DRAWS, START_SHOWN
+
+    lines = []
+    for v in vals:
+        shown = [(k, v.start_spread[k]) for k in START_SHOWN if k in v.start_spread]
+        if shown:
+            lines.append(f"  {Path(v.name).name}: "
+                         + ", ".join(f"{k} ±{x:.2g}" for k, x in shown))  # fmt: skip
+    if not lines:
+        return None
+    return ("closed loop: how far its indices move with the noise of its start (the log's first "
+            f"u, v, r; standard deviation over {START_DRAWS} starts drawn with each state's white "
+            "noise): a miss within about twice this may be the start's, not the model's\n"
+            + "\n".join(lines))
 
 
 # Indices of the tied structures' closed loops shown beside their free-run errors.
