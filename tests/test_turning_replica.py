@@ -176,7 +176,7 @@ def test_the_true_models_replica_of_its_own_trial_reads_every_index_as_measured(
 def test_the_closed_loops_spread_with_its_noisy_start_is_what_the_seeds_show(tmp_path, capsys):
     """The replica starts from the log's first measured u, v, r, one noisy sample each: over 60
     seeds of the demo's noisy 10°/10° zig-zag the true model's replica missed the measured
-    overshoots by 0.45° and 0.47° (standard deviation; 0.05° from the noise-free start). The
+    overshoots by 0.43° and 0.46° (standard deviation; 0.05° from the noise-free start). The
     spread ``validate`` draws from one log says so; from a noise-free log it is nil."""
     import json
 

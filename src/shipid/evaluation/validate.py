@@ -212,7 +212,7 @@ def start_spread(model, log: pd.DataFrame, method: str, trial: Trial, point: dic
     than ``START_MAX_SAMPLES``.
 
     On the demo's noisy trials the true model's replica misses the measured 10°/10°
-    overshoots by 0.45° and 0.47° (standard deviation over 60 seeds), and by 0.05° from the
+    overshoots by 0.43° and 0.46° (standard deviation over 60 seeds), and by 0.05° from the
     noise-free start: the noise of one sample, not the model. (The delta method, each state
     moved by its noise alone, read twice that: a reversal falls on one sample or the next.)"""
     if not point or len(log) > START_MAX_SAMPLES or (
