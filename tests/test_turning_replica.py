@@ -201,3 +201,25 @@ def test_the_closed_loops_spread_with_its_noisy_start_is_what_the_seeds_show(tmp
     assert "how far its indices move with the noise of its start" in text
     rec = json.loads((tmp_path / "v.json").read_text())["logs"][0]
     assert rec["closed_loop_start_spread"] == pytest.approx(noisy[0].start_spread, rel=1e-9)
+
+
+def test_the_closed_loops_intervals_hold_the_noise_of_its_start():
+    """An ensemble of identical members (the true model, 40 times) once gave the closed loop's
+    indices an interval of zero width: every replicate started from the log's one noisy first
+    sample. Each now starts from its own draw of that noise, so the interval is what the start
+    alone leaves open: about ±2 of ``start_spread``'s standard deviations."""
+    from shipid.demo import synthesise_trials
+    from shipid.identification.uncertainty import Ensemble
+    from shipid.vessels import scale_ship_model
+
+    truth = scale_ship_model()
+    thetas = np.repeat(truth.theta[None], 40, axis=0)
+    ensemble = Ensemble(truth, thetas, block_s=10.0, seed=0)
+    log = synthesise_trials(0)["zigzag 10/10"]
+    (v,) = validate(truth, log, ensemble=ensemble)
+    lo, hi = v.intervals["closed_loop"]["first_overshoot_deg"]
+    width = (hi - lo) / (2 * 1.96 * v.start_spread["first_overshoot_deg"])
+    assert 0.5 <= width <= 2.0, width
+    # The replay starts from the measured state as the free run does: no start noise there.
+    lo, hi = v.intervals["simulated"]["first_overshoot_deg"]
+    assert hi - lo < 1e-9

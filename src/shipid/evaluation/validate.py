@@ -162,7 +162,13 @@ def validate_log(model, log: pd.DataFrame, name: str, method: str = "euler",
             out.warnings += _unbounded_notes("replay", out.intervals["simulated"], replays,
                                              runs, ensemble.members_label)
             if "closed_loop" in indices:
-                replicas = [trial_replica(m, log, method, trial) for m in ensemble.members()]
+                # Each replicate from a start drawn with the noise of the log's first sample:
+                # the trial's own start is known only to that noise (``start_spread``).
+                members = ensemble.members()
+                starts = drawn_starts(model, log, trial, len(members), seed=1) or \
+                    [None] * len(members)  # fmt: skip
+                replicas = [trial_replica(m, log, method, trial, start)
+                            for m, start in zip(members, starts, strict=True)]  # fmt: skip
                 samples = [_indices_of(r, trial, log) for r in replicas]
                 out.intervals["closed_loop"] = index_intervals(samples)
                 out.warnings += _unbounded_notes("closed loop", out.intervals["closed_loop"],
@@ -215,21 +221,12 @@ def start_spread(model, log: pd.DataFrame, method: str, trial: Trial, point: dic
     overshoots by 0.43° and 0.46° (standard deviation over 60 seeds), and by 0.05° from the
     noise-free start: the noise of one sample, not the model. (The delta method, each state
     moved by its noise alone, read twice that: a reversal falls on one sample or the next.)"""
-    if not point or len(log) > START_MAX_SAMPLES or (
-            isinstance(model, ManoeuvringModel | HybridModel)
-            and _own_approach(model, log, trial) is not None):  # fmt: skip
+    starts = drawn_starts(model, log, trial, START_DRAWS) if point and \
+        len(log) <= START_MAX_SAMPLES else None  # fmt: skip
+    if starts is None:
         return {}
-    from shipid.data.preprocess import white_noise_variance
-
-    first = log.iloc[0]
-    sigma = {s: math.sqrt(white_noise_variance(log[s].to_numpy(dtype=float))) for s in STATES}
-    if not any(x > 0 for x in sigma.values()):
-        return {}
-    rng = np.random.default_rng(0)
-    draws = []
-    for _ in range(START_DRAWS):
-        start = {s: float(first[s]) + sigma[s] * float(rng.standard_normal()) for s in STATES}
-        draws.append(_indices_of(trial_replica(model, log, method, trial, start), trial, log))
+    draws = [_indices_of(trial_replica(model, log, method, trial, start), trial, log)
+             for start in starts]  # fmt: skip
     out = {}
     for k, x in point.items():
         if k in BOOKKEEPING or k == "approach_speed" or not isinstance(x, float):
@@ -239,6 +236,25 @@ def start_spread(model, log: pd.DataFrame, method: str, trial: Trial, point: dic
         if len(values) == START_DRAWS:  # a start that loses the index: no spread to give
             out[k] = float(np.std(values, ddof=1))
     return out
+
+
+def drawn_starts(model, log: pd.DataFrame, trial: Trial, n: int, seed: int = 0
+                 ) -> list[dict] | None:  # fmt: skip
+    """``n`` starts for closed-loop replicas of ``log``: its first measured u, v, r plus each
+    state's white noise (``white_noise_variance``), seeded. None where the replica starts from
+    ``model``'s own steady approach instead, or the log shows no noise."""
+    from shipid.data.preprocess import white_noise_variance
+
+    if isinstance(model, ManoeuvringModel | HybridModel) and \
+            _own_approach(model, log, trial) is not None:  # fmt: skip
+        return None
+    first = log.iloc[0]
+    sigma = {s: math.sqrt(white_noise_variance(log[s].to_numpy(dtype=float))) for s in STATES}
+    if not any(x > 0 for x in sigma.values()):
+        return None
+    rng = np.random.default_rng(seed)
+    return [{s: float(first[s]) + sigma[s] * float(rng.standard_normal()) for s in STATES}
+            for _ in range(n)]  # fmt: skip
 
 
 def _replica_indices(model, log: pd.DataFrame, method: str, trial: Trial) -> dict:
