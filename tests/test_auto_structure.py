@@ -349,6 +349,12 @@ def test_validate_judges_the_tied_structures_on_the_same_logs(mmg_tied, tmp_path
             alone.indices["closed_loop"]["second_overshoot_deg"], abs=1e-9)  # fmt: skip
         (figure,) = [d for d in drawn if "simulated" in d]  # the validation figure's r panel
         np.testing.assert_allclose(figure[f"{name} (tied)"], alone.simulation.log["r"], rtol=1e-12)
+    # A report without --plots draws its own figure: the tied runs are in it too.
+    drawn.clear()
+    assert run(["validate", mmg_tied, path, "--no-bands", "--report", tmp_path / "alone"],
+               capsys)[0] == 0  # fmt: skip
+    (figure,) = [d for d in drawn if "simulated" in d]
+    assert {f"{name} (tied)" for name in alternatives} <= set(figure)
 
 
 def test_criteria_give_the_tied_structures_values_beside_the_models(mmg_tied, tmp_path, capsys):

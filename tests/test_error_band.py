@@ -131,7 +131,8 @@ def test_the_report_draws_its_own_figures_with_both_bands(zigzags, monkeypatch):
     vals = validate(sel.model, zigzags[:1], ensemble=ens, error_band=sel.error_band)
     seen = []
 
-    def record(measured, simulated, path, title="", out=None, bands=None, error_band=None):
+    def record(measured, simulated, path, title="", out=None, bands=None, error_band=None,
+               tied=None):
         seen.append((bands, error_band))
         path.write(b"png")
 

@@ -196,9 +196,12 @@ def test_the_closed_loops_spread_with_its_noisy_start_is_what_the_seeds_show(tmp
     path = write_log(synthesise_trials(0)["zigzag 10/10"], tmp_path / "zz.csv")
     model = tmp_path / "truth.json"
     model.write_text(json.dumps({"format": "shipid-model", "version": 2, "model": truth.to_dict()}))
-    code, text, err = run(["validate", model, path, "--json", tmp_path / "v.json"], capsys)
+    code, text, err = run(["validate", model, path, "--json", tmp_path / "v.json", "--report",
+                           tmp_path / "report"], capsys)  # fmt: skip
     assert code == 0, err
     assert "how far its indices move with the noise of its start" in text
+    assert "how far its indices move with the noise of its start" in (
+        tmp_path / "report" / "report.html").read_text()
     rec = json.loads((tmp_path / "v.json").read_text())["logs"][0]
     assert rec["closed_loop_start_spread"] == pytest.approx(noisy[0].start_spread, rel=1e-9)
 

@@ -47,7 +47,12 @@ def cmd_validate(args) -> int:
         model_from_document,
         training_conditions,
     )
-    from shipid.reporting.report import indices_frame, metrics_frame, switch_heading_note
+    from shipid.reporting.report import (
+        indices_frame,
+        metrics_frame,
+        start_spread_note,
+        switch_heading_note,
+    )
 
     check_outputs({"--json": (args.json, "json"), "--plots": (args.plots, "dir"),
                    "--report": (args.report, "dir")}, [args.model, *args.logs])  # fmt: skip
@@ -104,7 +109,7 @@ def cmd_validate(args) -> int:
             note = switch_heading_note(good)
             if note:
                 print(note)
-            spread = _start_spread_note(good)
+            spread = start_spread_note(good)
             if spread:
                 print(spread)
     if args.horizon and good:
@@ -187,29 +192,10 @@ def cmd_validate(args) -> int:
                                      std_errors=se, std_errors_label=se_label, criteria=crit,
                                      warnings=[w for v in good for w in v.warnings],
                                      residuals=residuals, figures=figures,
-                                     tied=tied_table)  # fmt: skip
+                                     tied=tied_table, tied_runs=tied_runs)  # fmt: skip
             out.write(Path(args.report) / "report.html",
                       lambda p: p.write_text(text, encoding="utf-8"))
     return 1 if errors else 0
-
-
-def _start_spread_note(vals) -> str | None:
-    """How far each log's closed-loop indices move with the noise of the replica's start
-    (``shipid.evaluation.validate.start_spread``), or None."""
-    from shipid.evaluation.validate import START_DRAWS, START_SHOWN
-
-    lines = []
-    for v in vals:
-        shown = [(k, v.start_spread[k]) for k in START_SHOWN if k in v.start_spread]
-        if shown:
-            lines.append(f"  {Path(v.name).name}: "
-                         + ", ".join(f"{k} ±{x:.2g}" for k, x in shown))  # fmt: skip
-    if not lines:
-        return None
-    return ("closed loop: how far its indices move with the noise of its start (the log's first "
-            f"u, v, r; standard deviation over {START_DRAWS} starts drawn with each state's white "
-            "noise): a miss within about twice this may be the start's, not the model's\n"
-            + "\n".join(lines))
 
 
 # Indices of the tied structures' closed loops shown beside their free-run errors.
@@ -288,8 +274,9 @@ def _coefficient_errors(doc, model, lssvm: bool) -> tuple[dict | None, str]:
     if refined and not lssvm:
         se = (ref.get("statistics") or {}).get("standard_errors")
         return (se, "maximum-likelihood output error, Gauss–Newton") if se else (None, "")
-    return ({d: (ident.get("diagnostics") or {}).get(d, {}).get("std_errors") for d in dofs},
-            "LS-SVM linear fit")  # fmt: skip
+    se = {d: ((ident.get("diagnostics") or {}).get(d) or {}).get("std_errors") for d in dofs}
+    # A model file without the fit's diagnostics (written by hand, say) has none to show.
+    return (se, "LS-SVM linear fit") if any(se.values()) else (None, "")
 
 
 def _criteria_of_logs(good, logs, vals, particulars):

@@ -424,7 +424,7 @@ class ManoeuvringModel:
                 # Coefficients of large regressors (|n|n ~ 100 rps²) are tiny: keep their digits.
                 small = 0 < abs(c) < 10 ** (1 - precision)
                 mag = f"{abs(c):.{precision - 1}e}" if small else f"{abs(c):.{precision}f}"
-                se = (std_errors or {}).get(dof, {}).get(n)
+                se = ((std_errors or {}).get(dof) or {}).get(n)
                 if se is not None and math.isfinite(se):
                     mag = f"({mag} ± {se:.2g})"
                 term = parse_term(n).display()

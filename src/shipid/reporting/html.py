@@ -52,16 +52,19 @@ def validation_report(
     residuals: Mapping[str, Mapping] | None = None,
     figures: Mapping[str, Mapping[str, bytes]] | None = None,
     tied: pd.DataFrame | None = None,
+    tied_runs: Mapping[str, Mapping[str, pd.DataFrame]] | None = None,
 ) -> str:
     """The HTML text of the report. ``figures``: PNGs already drawn, {log name: {"fit": ...,
     "resid": ...}} (``shipid validate --plots`` shares its own); the others are drawn here.
     ``tied``: the table of the structures ``identify`` could not tell apart from the model's,
-    run on the same logs (``shipid validate``)."""
+    run on the same logs (``shipid validate``), and ``tied_runs`` their free runs per log
+    ({log: {structure: simulated log}}), drawn in the figures."""
     from shipid.reporting import plots
     from shipid.reporting.report import (
         horizons_frame,
         indices_frame,
         metrics_frame,
+        start_spread_note,
         switch_heading_note,
     )
 
@@ -92,9 +95,10 @@ def validation_report(
     ind = indices_frame([v for v, _ in good])
     if len(ind):
         parts += ["<h2>Manoeuvring indices</h2>", _table(ind)]
-        note = switch_heading_note([v for v, _ in good])
-        if note:
-            parts.append(f"<p>{html.escape(note)}</p>")
+        for note in (switch_heading_note([v for v, _ in good]),
+                     start_spread_note([v for v, _ in good])):  # fmt: skip
+            if note:
+                parts.append(f"<p>{html.escape(note)}</p>".replace("\n", "<br>"))
     if tied is not None and len(tied):
         parts += ["<h2>Structures the training logs could not tell apart</h2>",
                   "<p>The same logs run on the fits of the structures that tied with the model's "
@@ -107,7 +111,8 @@ def validation_report(
         drawn = (figures or {}).get(v.name, {})
         parts += [f"<h2>{html.escape(name)}</h2>",
                   _figure_html(lambda p, v=v, log=log, name=name: plots.measured_vs_simulated(
-                      log, v.simulation.log, p, name, bands=v.bands, error_band=v.error_band),
+                      log, v.simulation.log, p, name, bands=v.bands, error_band=v.error_band,
+                      tied=(tied_runs or {}).get(v.name)),
                       drawn.get("fit"))]
         if residuals and v.name in residuals:
             parts.append(_figure_html(lambda p, v=v, name=name: plots.residuals(

@@ -110,6 +110,25 @@ def indices_frame(validations: Sequence[Validation]) -> pd.DataFrame:
     return pd.DataFrame(rows, columns=columns)
 
 
+def start_spread_note(validations: Sequence[Validation]) -> str | None:
+    """How far each log's closed-loop indices move with the noise of the replica's start
+    (``shipid.evaluation.validate.start_spread``), or None where none was drawn."""
+    from shipid.evaluation.validate import START_DRAWS, START_SHOWN
+
+    lines = []
+    for v in validations:
+        shown = [(k, v.start_spread[k]) for k in START_SHOWN if k in v.start_spread]
+        if shown:
+            lines.append(f"  {Path(v.name).name}: "
+                         + ", ".join(f"{k} ±{x:.2g}" for k, x in shown))  # fmt: skip
+    if not lines:
+        return None
+    return ("closed loop: how far its indices move with the noise of its start (the log's first "
+            f"u, v, r; standard deviation over {START_DRAWS} starts drawn with each state's white "
+            "noise): a miss within about twice this may be the start's, not the model's\n"
+            + "\n".join(lines))
+
+
 def switch_heading_note(validations: Sequence[Validation]) -> str | None:
     """Which switch heading each zig-zag's overshoots are measured from (None without a
     zig-zag). A trial's rudder is reversed a little past its nominal switch heading (the MARIN
