@@ -220,8 +220,10 @@ def _tied_validations(doc, args, vals, logs) -> tuple[dict, object, dict]:
     pairs = [(v, log) for v, log in zip(vals, logs, strict=True) if v.error is None]
     for structure, alt in {"(the model)": None, **alternatives}.items():
         for v, log in pairs:
+            # The tied fits' spread with the start is not shown: not drawn.
             w = v if alt is None else validate(alt, log, [v.name], method=args.method,
-                                               kind=args.kind, smooth_s=args.smooth)[0]  # fmt: skip
+                                               kind=args.kind, smooth_s=args.smooth,
+                                               start_draws=False)[0]  # fmt: skip
             closed = (w.indices or {}).get("closed_loop") or {}
             row = {"structure": structure, "log": Path(v.name).name,
                    **{f"std {s}": w.metrics[s]["std"] for s in ("u", "v", "r")},

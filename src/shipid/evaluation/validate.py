@@ -128,7 +128,8 @@ def faded_residual_notes(model, log: pd.DataFrame) -> list[str]:
 def validate_log(model, log: pd.DataFrame, name: str, method: str = "euler",
                  kind: str | None = None, smooth_s: float = 0.0,
                  ensemble: Ensemble | None = None,
-                 error_band: ErrorBand | None = None) -> Validation:  # fmt: skip
+                 error_band: ErrorBand | None = None,
+                 start_draws: bool = True) -> Validation:  # fmt: skip
     """Validate ``model`` on one log (raises ``ShipidError`` when it cannot). With a bootstrap
     ``ensemble`` of the model: prediction bands and intervals on the predicted indices; with a
     cross-validated ``error_band``: the share of the log's samples within it."""
@@ -143,7 +144,7 @@ def validate_log(model, log: pd.DataFrame, name: str, method: str = "euler",
         if isinstance(model, ManoeuvringModel | HybridModel | Vessel):
             indices["closed_loop"] = _replica_indices(model, log, method, trial)
     out = Validation(name, sim, metrics, indices, trial.kind)
-    if indices.get("closed_loop"):
+    if indices.get("closed_loop") and start_draws:
         out.start_spread = start_spread(model, log, method, trial, indices["closed_loop"])
     out.warnings += _approach_notes(indices)
     if trial.kind == "zigzag" and "closed_loop" in indices:
@@ -192,11 +193,15 @@ def _unbounded_notes(label: str, intervals: dict, samples: Sequence[dict], runs:
     return notes
 
 
+def _read_as_logged(run: pd.DataFrame, trial: Trial, t_exec: float) -> dict:
+    """The indices of a simulated ``run`` read as the log's are: its kind and switch heading,
+    from the execute at ``t_exec`` (the log's, on the run's time axis)."""
+    return manoeuvre_indices(run, trial=describe_trial(run, trial.kind, trial.switch_heading_deg,
+                                                       t_exec))  # fmt: skip
+
+
 def _replay_indices(sim: SimulationResult, trial: Trial) -> dict:
-    if sim.diverged:
-        return {}
-    return manoeuvre_indices(sim.log, trial=describe_trial(
-        sim.log, trial.kind, trial.switch_heading_deg, trial.execute_time))
+    return {} if sim.diverged else _read_as_logged(sim.log, trial, trial.execute_time)
 
 
 # Indices whose spread with the replica's start ``validate`` shows (all are kept).
@@ -273,8 +278,7 @@ def _indices_of(replica: ManoeuvreResult | None, trial: Trial, log: pd.DataFrame
     if replica is None or replica.diverged:
         return {}
     t_exec = float(replica.log["t"].iloc[0]) + trial.execute_time - float(log["t"].iloc[0])
-    read = manoeuvre_indices(replica.log, trial=describe_trial(
-        replica.log, trial.kind, trial.switch_heading_deg, t_exec))
+    read = _read_as_logged(replica.log, trial, t_exec)
     read.pop("kind", None)
     return {**read, "approach_speed": float(replica.log["u"].iloc[0])}
 
@@ -422,12 +426,14 @@ def validate(
     smooth_s: float = 0.0,
     ensemble: Ensemble | None = None,
     error_band: ErrorBand | None = None,
+    start_draws: bool = True,
 ) -> list[Validation]:
     """Validate ``model`` on each log; errors are over the simulated (not diverged) part. A log
     that cannot be validated gets a ``Validation`` with ``error`` set; the others go on. With a
     bootstrap ``ensemble`` of the model (``shipid.identification.uncertainty``): bands and
     intervals; with a cross-validated ``error_band`` (``Selection.error_band``): each log's share
-    of samples within it."""
+    of samples within it; ``start_draws``: the closed loop's spread with its start
+    (``start_spread``, ``START_DRAWS`` more closed-loop runs per log)."""
     if isinstance(logs, pd.DataFrame):
         logs = [logs]
     names = names or [log.attrs.get("name", f"log {i}") for i, log in enumerate(logs)]
@@ -435,7 +441,7 @@ def validate(
     for log, name in zip(logs, names, strict=True):
         try:
             out.append(validate_log(model, log, name, method, kind, smooth_s, ensemble,
-                                    error_band))
+                                    error_band, start_draws))
         except ShipidError as exc:
             message = str(exc)
             # Messages from deeper down may name the log by its file name alone.
