@@ -33,9 +33,11 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/study_hybrid.py
 	$(BIN)/python benchmarks/study_uncertainty.py
 	$(BIN)/python benchmarks/study_structure.py
+	$(BIN)/python benchmarks/study_stability.py
 	$(BIN)/python benchmarks/bench_study.py
 	$(BIN)/python benchmarks/bench_figures.py
 	$(BIN)/python benchmarks/study_esso.py
+	$(BIN)/python benchmarks/study_esso_port_turn.py
 	$(BIN)/python benchmarks/study_esso_extrapolation.py
 	$(BIN)/python benchmarks/study_selection_uncertainty.py
 	$(BIN)/python benchmarks/study_kvlcc2_average.py
