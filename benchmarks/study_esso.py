@@ -101,17 +101,21 @@ def main() -> None:
               + f" | {np.mean([r[1] for r in rows]):.2f} | {np.mean([r[2] for r in rows]):.2f} | "
               + ", ".join(f"{min(e):.2f}…{max(e):.2f}" for e in early) + " |")  # fmt: skip
     print(f"\nThe README's fold ({README_HELD} held out): the turns' indices with the 95 % "
-          "intervals of 100 replicates: the selected terms refitted on block resamples (terms "
-          "held), and select --bootstrap 100's ensemble, whose replicates also draw their terms "
-          "from the choices on resampled held-out logs (terms resampled)\n")  # fmt: skip
+          "intervals of 100 replicates: the selected terms refitted on 10 s block resamples (terms "
+          "held), and select --bootstrap 100 --block 10's ensemble, whose replicates also draw "
+          "their terms from the choices on resampled held-out logs (terms resampled)\n")  # fmt: skip
     print("| library | replicates | turn | tactical diameter: measured, predicted [95 %] | "
           "steady yaw rate: measured, predicted [95 %] |")  # fmt: skip
     print("|---|---|---|---|---|")
     for library, (train, sel, results, average) in readme.items():
         # The average has no terms of its own to hold: its replicates are the resampled ones.
+        # 10 s blocks, as select --bootstrap resampled before it drew whole logs from 5 logs on
+        # (study_selection_uncertainty.py compares the two).
         ensembles = {} if average else {"terms held": bootstrap(
-            train, weighted_refit(train, model=sel.model.structure, gamma=sel.gamma), 100)}
-        ensembles["terms resampled"] = selection_ensemble(train, sel, replicates=100)
+            train, weighted_refit(train, model=sel.model.structure, gamma=sel.gamma), 100,
+            block_s=10.0)}
+        ensembles["terms resampled"] = selection_ensemble(train, sel, replicates=100,
+                                                          block_s=10.0)
         for label, ens in ensembles.items():
             for v, turn, side in zip(results[:2], turns, ("+35°", "−35°"), strict=True):
                 again = validate(sel.model, [turn], ensemble=ens)[0]

@@ -1,19 +1,24 @@
 """Do the intervals of a selected model cover what it was not trained on? (issue #10, item 5)
 
 On the Esso Osaka logs, in seven folds (three beyond the training conditions, each random run
-held out in turn; ``esso_logs.py``), ``select`` (the README's library) and two ensembles of 100
+held out in turn; ``esso_logs.py``), ``select`` (the README's library) and three ensembles of 100
 replicates of its model:
 
 * ``terms held``: the selected terms and γ refitted on moving-block resamples of the equations
-  (``bootstrap`` of ``weighted_refit``; what ``select --bootstrap`` gave before);
-* ``terms resampled``: ``select --bootstrap``'s ensemble now (``selection_ensemble``): each
-  replicate draws a candidate by how often the choice rule picks it on resampled held-out logs,
-  then refits it on a block resample.
+  (``bootstrap`` of ``weighted_refit``, 10 s blocks);
+* ``terms resampled``: ``select --bootstrap N --block 10``'s ensemble (``selection_ensemble``):
+  each replicate draws a candidate by how often the choice rule picks it on resampled held-out
+  logs, then refits it on a block resample.
+* ``terms and logs resampled``: the same with whole logs resampled instead of blocks
+  (``select --bootstrap N``'s default from five logs on, ``--block log``): each replicate draws
+  as many training logs as there are, with replacement, so the replicates differ as the logs
+  differ from one another.
 
 Judged on the held-out logs: whether the measured tactical diameter and steady yaw rate of each
-±35° turn lie in the 95 % intervals (28 checks in all), the intervals' mean width over the
-prediction, and the share of the held-out zig-zags' and random runs' samples whose measured r
-and u lie in the 95 % prediction bands. A calibrated 95 % interval covers 95 % of them.
+±35° turn lie in the 95 % intervals of the replay (28 checks in all), and its advance and
+transfer (28 more), the intervals' mean width over the prediction, and the share of the
+held-out zig-zags' and random runs' samples whose measured r and u lie in the 95 % prediction
+bands. A calibrated 95 % interval covers 95 % of them.
 
 Then the cross-validated 95 % error band of each fold's model, the chosen candidate and the
 average of ``select --average`` (``Selection.error_band``: the conformal quantile of the
@@ -41,6 +46,7 @@ from shipid.identification.uncertainty import bootstrap
 LIBRARY = "low-speed+wind+propeller-asymmetry"
 REPLICATES = 100
 KEYS = ("tactical_diameter", "steady_yaw_rate")
+EARLY = ("advance", "transfer")  # the first 90° of the turn
 
 
 def _band_share(v, log, state: str) -> float:
@@ -59,11 +65,13 @@ def main() -> None:
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores; library {LIBRARY}; "
           f"{REPLICATES} replicates\n")  # fmt: skip
     print("| fold | chosen share | replicates | turns' TD and steady r in the 95 % interval | "
-          "interval width / prediction (TD, steady r) | held-out samples in the r, u bands |")
-    print("|---|---|---|---|---|---|")
+          "advance and transfer | interval width / prediction (TD, steady r) | held-out samples "
+          "in the r, u bands |")  # fmt: skip
+    print("|---|---|---|---|---|---|---|")
     cv_rows = []
     t0 = time.perf_counter()
-    totals = {"terms held": [], "terms resampled": []}
+    totals = {"terms held": [], "terms resampled": [], "terms and logs resampled": []}
+    early = {k: [] for k in totals}
     widths = {k: [] for k in totals}
     bands = {k: [] for k in totals}
     for fold, (zk, rk, zig_held, rnd_held) in folds.items():
@@ -76,33 +84,44 @@ def main() -> None:
             cv_rows.append((fold, label, band, [validate(model_of.model, [lg], error_band=band)[0]
                                                 .band_shares for lg in held + turns]))  # fmt: skip
         refit = weighted_refit(train, model=sel.model.structure, gamma=sel.gamma)
-        ensembles = {"terms held": bootstrap(train, refit, replicates=REPLICATES),
-                     "terms resampled": selection_ensemble(train, sel, replicates=REPLICATES)}
+        ensembles = {"terms held": bootstrap(train, refit, replicates=REPLICATES, block_s=10.0),
+                     "terms resampled": selection_ensemble(train, sel, replicates=REPLICATES,
+                                                           block_s=10.0),
+                     "terms and logs resampled": selection_ensemble(
+                         train, sel, replicates=REPLICATES, block_s="log")}  # fmt: skip
         for label, ens in ensembles.items():
-            inside, width = [], []
+            inside, width, first = [], [], []
             for v in validate(sel.model, turns, ensemble=ens):
                 meas, pred = v.indices["measured"], v.indices["simulated"]
                 for key in KEYS:
                     lo, hi = v.intervals["simulated"][key]
                     inside.append(bool(lo <= meas[key] <= hi))
                     width.append(abs((hi - lo) / pred[key]))
+                for key in EARLY:
+                    lo, hi = v.intervals["simulated"][key]
+                    first.append(bool(lo <= meas[key] <= hi))
             runs = validate(sel.model, held, ensemble=ens) if held else []
             r_share, u_share = (float(np.mean([_band_share(v, lg, s)
                                                 for v, lg in zip(runs, held, strict=True)]))
                                 if held else float("nan") for s in ("r", "u"))  # fmt: skip
             totals[label] += inside
+            early[label] += first
             widths[label] += width
             bands[label].append((r_share, u_share))
             print(f"| {fold} | {100 * sel.chosen_share:.0f} % | {label} | {sum(inside)} of "
-                  f"{len(inside)} | {np.mean(width[0::2]):.2f}, {np.mean(width[1::2]):.2f} | "
+                  f"{len(inside)} | {sum(first)} of {len(first)} | {np.mean(width[0::2]):.2f}, "
+                  f"{np.mean(width[1::2]):.2f} | "
                   f"{r_share:.2f}, {u_share:.2f} |")  # fmt: skip
-    print("\n| replicates | turns' indices in the 95 % interval | mean width / prediction "
-          "(TD, steady r) | held-out samples in the r, u bands (mean over folds) |")
-    print("|---|---|---|---|")
+    print("\n| replicates | turns' TD and steady r in the 95 % interval | advance and transfer | "
+          "mean width / prediction (TD, steady r) | held-out samples in the r, u bands (mean "
+          "over folds) |")  # fmt: skip
+    print("|---|---|---|---|---|")
     for label, inside in totals.items():
         w = widths[label]
         b = np.array(bands[label])
+        e = early[label]
         print(f"| {label} | {sum(inside)} of {len(inside)} ({100 * np.mean(inside):.0f} %) | "
+              f"{sum(e)} of {len(e)} ({100 * np.mean(e):.0f} %) | "
               f"{np.mean(w[0::2]):.2f}, {np.mean(w[1::2]):.2f} | {np.mean(b[:, 0]):.2f}, "
               f"{np.mean(b[:, 1]):.2f} |")  # fmt: skip
     print("\nThe cross-validated 95 % error band of each fold's model (select's leave-one-log-"

@@ -17,7 +17,7 @@ from shipid.errors import ShipidError
 from shipid.identification.identify import weighted_refit
 from shipid.identification.select import Candidate, select, selection_shares
 from shipid.identification.selection_ensemble import selection_ensemble
-from shipid.identification.uncertainty import Ensemble, bootstrap
+from shipid.identification.uncertainty import SELECTION_LOG_METHOD, Ensemble, bootstrap
 from shipid.reporting.modelfile import ensemble_from_document, model_from_document
 
 
@@ -76,6 +76,40 @@ def test_one_candidate_gives_the_bootstrap_of_it_to_the_bit(zigzags):
                                               gamma=sel.gamma), replicates=12, seed=5)  # fmt: skip
     assert not ens.varies_structure and ens.term_texts == plain.model.term_texts
     np.testing.assert_array_equal(ens.thetas, plain.thetas)
+
+
+def test_whole_logs_one_candidate_is_the_log_bootstrap_of_it_and_is_filed(zigzags, tmp_path,
+                                                                          capsys):  # fmt: skip
+    logs = zigzags + noisy_zigzags(23)
+    sel = select(logs, library="blanke", search="none", gammas=(1e4,))
+    ens = selection_ensemble(logs, sel, replicates=12, seed=5, block_s="log")
+    plain = bootstrap(logs, weighted_refit(logs, model=sel.model.structure, gamma=sel.gamma),
+                      replicates=12, seed=5, block_s="log")  # fmt: skip
+    np.testing.assert_array_equal(ens.thetas, plain.thetas)
+    assert ens.method == SELECTION_LOG_METHOD and "whole logs resamples" in ens.members_label
+    paths = [write_log(log, tmp_path / f"zz{i}.csv") for i, log in enumerate(logs)]
+    code, out, err = run(["identify", *paths, "--model", "blanke", "--no-output-error",
+                          "--bootstrap", "12", "-o", tmp_path / "m.json"], capsys)  # fmt: skip
+    assert code == 0, err
+    assert "(12 replicates: bootstrap of whole logs)" in out
+    doc = json.loads((tmp_path / "m.json").read_text(encoding="utf-8"))
+    assert doc["uncertainty"]["block_s"] == "log"
+    again = ensemble_from_document(doc, "m.json", model_from_document(doc, "m.json"))
+    assert again.block_s == "log" and again.replicates == 12
+    code, _, err = run(["select", *paths[:3], "--library", "blanke", "--quiet", "--bootstrap",
+                        "12", "--block", "log", "-o", tmp_path / "s.json"], capsys)  # fmt: skip
+    assert code == 1 and "needs at least 5 of them, got 3" in err
+    assert not (tmp_path / "s.json").exists()
+    with pytest.raises(SystemExit) as exc:  # a usage error: argparse's exit code
+        run(["select", *paths[:3], "--bootstrap", "12", "--block", "0", "-o",
+             tmp_path / "s.json"], capsys)  # fmt: skip
+    assert exc.value.code == 2
+    assert "expected seconds > 0, 'log' or 'auto', got '0'" in capsys.readouterr().err
+    # By default: whole logs from five logs on, 10 s blocks below.
+    code, out, err = run(["identify", *paths[:3], "--model", "blanke", "--no-output-error",
+                          "--bootstrap", "12", "-o", tmp_path / "b.json"], capsys)  # fmt: skip
+    assert code == 0, err
+    assert "(12 replicates: moving-block bootstrap of the regression equations, 10 s blocks)" in out
 
 
 def test_varied_structure_members_file_and_rescale(zigzags, tmp_path, capsys):

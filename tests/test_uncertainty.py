@@ -12,7 +12,14 @@ from shipid.data.io import write_log
 from shipid.dynamics.model import ManoeuvringModel
 from shipid.errors import ShipidError
 from shipid.identification.identify import identify
-from shipid.identification.uncertainty import Ensemble, block_weights, bootstrap, interval
+from shipid.identification.uncertainty import (
+    LOG_METHOD,
+    Ensemble,
+    block_weights,
+    bootstrap,
+    interval,
+    log_weights,
+)
 from shipid.reporting.modelfile import ensemble_from_document, load_document, model_from_document
 from shipid.trials.manoeuvres import zigzag
 from shipid.vessels import SensorModel, scale_ship
@@ -60,6 +67,53 @@ def test_block_bootstrap_of_an_autocorrelated_mean_matches_the_closed_form():
     assert interval([1.0, 2.0, 3.0], 0.5) == (1.5, 2.5)
     # One of four without a value is more than the 25 % tail of a 50 % interval.
     assert interval([1.0, 2.0, math.nan, 3.0], 0.5) == (-math.inf, math.inf)
+
+
+def test_whole_logs_are_drawn_with_replacement():
+    rng = np.random.default_rng(4)
+    lengths = [5, 9, 3, 12, 7]
+    counts = np.zeros(5)
+    for _ in range(2000):
+        w = log_weights(lengths, rng)
+        parts = np.split(w, np.cumsum(lengths)[:-1])
+        assert all(len(set(p)) == 1 for p in parts)  # a log is drawn whole or not at all
+        k = np.array([p[0] for p in parts])
+        assert k.sum() == 5 and np.all(k == np.round(k))
+        counts += k
+    np.testing.assert_allclose(counts / 2000, 1.0, atol=0.06)  # each log once on average
+
+
+def test_log_bootstrap_of_a_mean_holds_the_logs_spread():
+    """Eight logs whose levels differ (a day's wind, a campaign's loading) by more than their
+    samples' noise says: the standard error of the pooled mean is the spread of the log means
+    over √8 (the plug-in of whole-log resampling, Σ(m_i − m̄)²/n/n). Blocks of a second count
+    each log as 40 independent pieces of it and give about a sixth of that."""
+    rng = np.random.default_rng(11)
+    n_logs, n = 8, 400
+    levels = rng.normal(0.0, 1.0, n_logs)
+    data = np.concatenate([lv + 0.2 * rng.normal(size=n) for lv in levels])
+    logs = [__import__("pandas").DataFrame({"t": np.arange(n + 1) * 0.1})] * n_logs
+
+    class Mean:
+        theta = None
+
+    def fit(weights):
+        w = np.ones(data.size) if weights is None else weights
+        m = Mean()
+        m.theta = np.array([[np.sum(w * data) / np.sum(w)]])
+        return m
+
+    means = data.reshape(n_logs, n).mean(axis=1)
+    closed = math.sqrt(np.mean((means - means.mean()) ** 2) / n_logs)
+    ens = bootstrap(logs, fit, replicates=600, block_s="log", seed=3)
+    assert ens.method == ens.resampling == LOG_METHOD and ens.block_s == "log"
+    assert np.std(ens.thetas[:, 0, 0]) == pytest.approx(closed, rel=0.1)
+    blocks = bootstrap(logs, fit, replicates=200, block_s=1.0, seed=3).thetas[:, 0, 0]
+    assert np.std(blocks) < closed / 4
+    with pytest.raises(ShipidError, match="needs at least 5 of them, got 4"):
+        bootstrap(logs[:4], fit, replicates=20, block_s="log")
+    with pytest.raises(ShipidError, match="> 0 s or 'log'"):
+        bootstrap(logs, fit, replicates=20, block_s="logs")
 
 
 @pytest.fixture(scope="module")
@@ -216,6 +270,21 @@ def test_weighted_refit_is_identify_with_sample_weight_to_the_bit(noisy_zigzag, 
         np.testing.assert_array_equal(ours.theta, theirs.theta)
     with pytest.raises(ShipidError, match="sample_weight must be"):
         refit(np.ones(3))
+
+
+def test_a_log_drawn_twice_weighs_as_the_log_given_twice(noisy_zigzag):
+    """A whole-log replicate is identify on the drawn logs, each as often as drawn: the refit
+    with the log bootstrap's weights equals identify of the logs repeated, to rounding."""
+    from shipid.identification.identify import weighted_refit
+
+    logs = [noisy_zigzag.iloc[k * 40:(k + 1) * 40 + 1].reset_index(drop=True) for k in range(5)]
+    weights = log_weights([len(lg) - 1 for lg in logs], np.random.default_rng(2))
+    counts = [int(w[0]) for w in np.split(weights, np.cumsum([40] * 4))]
+    assert sorted(counts) != [1] * 5  # a resample, not the data
+    ours = weighted_refit(logs, gamma=1e4)(weights)
+    repeated = [lg for lg, c in zip(logs, counts, strict=True) for _ in range(c)]
+    theirs = identify(repeated, gamma=1e4, force=True).model
+    np.testing.assert_allclose(ours.theta, theirs.theta, rtol=1e-8, atol=1e-9)
 
 
 def test_where_an_index_was_measured_gets_no_interval():

@@ -179,8 +179,8 @@ def cmd_identify(args) -> int:
         ensemble = bootstrap(logs, refit, args.bootstrap, args.block, args.seed, progress=True)
         table = ensemble.coefficient_table()
         table["term"] = [_term_display(t) for t in table["term"]]
-        print(f"\n95 % intervals of the coefficients ({ensemble.method}, "
-              f"{ensemble.replicates} replicates, {ensemble.block_s:g} s blocks):")
+        print(f"\n95 % intervals of the coefficients ({ensemble.replicates} replicates: "
+              f"{ensemble.resampling}):")
         print(table.to_markdown(index=False, floatfmt=".4g"))
     if args.refine:
         from shipid.identification.refine import refine  # scipy.optimize: only when asked
@@ -562,13 +562,13 @@ def cmd_select(args) -> int:
     if args.bootstrap is not None:
         from shipid.identification.selection_ensemble import selection_ensemble
 
-        # Each replicate: a candidate drawn by its share, refitted on a block resample.
+        # Each replicate: a candidate drawn by its share, refitted on a resample.
         ensemble = selection_ensemble(logs, sel, args.bootstrap, args.block, args.seed,
                                       names=names, progress=not args.quiet)  # fmt: skip
         table = ensemble.coefficient_table()
         table["term"] = [_term_display(t) for t in table["term"]]
         print(f"\n95 % intervals of the coefficients ({ensemble.replicates} replicates: "
-              f"{ensemble.method}, {ensemble.block_s:g} s blocks; a term outside the model "
+              f"{ensemble.resampling}; a term outside the model "
               "has value 0, inclusion the share of replicates that hold it):")  # fmt: skip
         print(table.to_markdown(index=False, floatfmt=".4g"))
     text = model_text(ident, args.logs, preprocessing=prep, plausibility=plausibility,

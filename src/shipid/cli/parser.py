@@ -99,6 +99,18 @@ def _seconds_list(text: str) -> list[float]:
     return values
 
 
+def _block(text: str) -> float | str:
+    if text in ("auto", "log"):
+        return text
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"expected seconds > 0, 'log' or 'auto', got {text!r}")
+    return value
+
+
 def _end_time(text: str) -> float | str:
     return text if text == "dropout" else _time_or_auto(text)
 
@@ -192,8 +204,10 @@ def build_parser() -> argparse.ArgumentParser:
                    help="uncertainty: N moving-block bootstrap refits (≥ 10; e.g. 200), stored in "
                    "the model file: coefficient intervals here, prediction bands and index "
                    "intervals in validate, manoeuvre and criteria")
-    p.add_argument("--block", type=float, default=10.0, metavar="S",
-                   help="with --bootstrap: block length [s] (default %(default)g)")
+    p.add_argument("--block", type=_block, default="auto", metavar="S|log|auto",
+                   help="with --bootstrap: resample blocks of S seconds, or whole logs ('log': "
+                   "the intervals then hold how the logs differ from one another); 'auto' "
+                   "(default): whole logs from 5 logs on, else 10 s blocks")
     p.add_argument("--seed", type=int, default=0, help="with --bootstrap or --output-error: "
                    "random seed "
                    "(default %(default)s)")
@@ -249,8 +263,10 @@ def build_parser() -> argparse.ArgumentParser:
                    "candidate drawn by how often it is chosen on resampled held-out logs, "
                    "refitted on a moving-block resample; stored in the model file for bands "
                    "and intervals")
-    p.add_argument("--block", type=float, default=10.0, metavar="S",
-                   help="with --bootstrap: block length [s] (default %(default)g)")
+    p.add_argument("--block", type=_block, default="auto", metavar="S|log|auto",
+                   help="with --bootstrap: resample blocks of S seconds, or whole logs ('log': "
+                   "the intervals then hold how the logs differ from one another); 'auto' "
+                   "(default): whole logs from 5 logs on, else 10 s blocks")
     p.add_argument("--seed", type=int, default=0, help="with --bootstrap: random seed "
                    "(default %(default)s)")
     p.add_argument("--table", metavar="OUT.csv", help="write every candidate with its scores")

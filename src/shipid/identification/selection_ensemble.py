@@ -6,8 +6,9 @@ terms and γ at the selection's: its intervals say what the equation error leave
 predict differently beyond them. Here each replicate first draws a candidate of the search (its
 terms and γ) with the probability ``select`` chose it on resampled held-out logs
 (``Candidate.share``, ``shipid.identification.select.selection_shares``), then refits it on a
-moving-block resample of the equations, as ``bootstrap`` does. A member's coefficient of a term
-its candidate lacks is 0, so every member is a model of the union of the drawn structures.
+moving-block resample of the equations (or a resample of whole logs), as ``bootstrap`` does. A
+member's coefficient of a term its candidate lacks is 0, so every member is a model of the union
+of the drawn structures.
 
 When one candidate is always chosen, the ensemble is ``bootstrap`` of it, replicate for
 replicate (the block resamples come from the same random stream).
@@ -23,11 +24,13 @@ import pandas as pd
 from shipid.dynamics.model import DOFS, ModelStructure
 from shipid.errors import ShipidError
 from shipid.identification.uncertainty import (
+    SELECTION_LOG_METHOD,
     SELECTION_METHOD,
+    WHOLE_LOGS,
     Ensemble,
     _bar,
-    block_weights,
-    resampling_blocks,
+    resampler,
+    resolve_block,
 )
 
 
@@ -35,7 +38,7 @@ def selection_ensemble(
     logs: Sequence[pd.DataFrame],
     selection,
     replicates: int = 200,
-    block_s: float = 10.0,
+    block_s: float | str = "auto",
     seed: int = 0,
     names: Sequence[str] | None = None,
     progress: bool = False,
@@ -52,7 +55,8 @@ def selection_ensemble(
     from shipid.identification.identify import weighted_refit
 
     logs = [logs] if isinstance(logs, pd.DataFrame) else list(logs)
-    block, lengths = resampling_blocks(logs, replicates, block_s)
+    block_s = resolve_block(block_s, len(logs))
+    draw = resampler(logs, replicates, block_s)
     cands = list(selection.shares)
     if not cands:
         raise ShipidError("the selection has no candidate chosen on resampled held-out logs "
@@ -74,11 +78,13 @@ def selection_ensemble(
             refits[i] = weighted_refit(logs, model=ModelStructure("candidate", cands[i].terms),
                                        gamma=cands[i].gamma, names=names,
                                        estimator=options.estimator, physics=options.physics)  # fmt: skip
-        member = refits[i](block_weights(lengths, block, rng))
+        member = refits[i](draw(rng))
         for dof, coefs in member.coefficients.items():
             for t, value in coefs.items():
                 thetas[k, DOFS.index(dof), columns[t]] = value
         bar.update()
     bar.close()
-    return Ensemble(point, thetas, float(block_s), int(seed), SELECTION_METHOD, structure)
+    whole = block_s == WHOLE_LOGS
+    return Ensemble(point, thetas, block_s if whole else float(block_s), int(seed),
+                    SELECTION_LOG_METHOD if whole else SELECTION_METHOD, structure)
 
