@@ -387,3 +387,66 @@ def test_scale_is_refused_where_it_would_be_ignored(tmp_path, capsys):
     code, _, err = run(["identify", path, "--scale", "45.7", "-o", tmp_path / "m.json"], capsys)
     assert code == 1 and "--scale applies to the SIMMAN files" in err
     assert not (tmp_path / "m.json").exists()
+
+
+# ---------------------------------------------------------------------------- header units
+def _si_and_stated(trial):
+    """The trial in SI, and written as a spreadsheet might: °, °/s, knots, rpm, ms."""
+    si = trial[["t", "delta", "u", "v", "r", "psi", "x", "y"]].assign(n=10.0)
+    stated = pd.DataFrame({
+        "t [ms]": si["t"] * 1000, "delta [deg]": np.degrees(si["delta"]),
+        "u [kn]": si["u"] * 3600 / 1852, "v [m/s]": si["v"], "r [°/s]": np.degrees(si["r"]),
+        "psi [rad]": si["psi"], "x [m]": si["x"], "y [m]": si["y"], "n [rpm]": si["n"] * 60,
+        "rudder_order [deg]": 1.0})  # fmt: skip
+    return si, stated
+
+
+def test_units_stated_in_the_header_are_converted(tmp_path, trial):
+    si, stated = _si_and_stated(trial)
+    path = tmp_path / "stated.csv"
+    stated.to_csv(path, index=False)
+    log = read_log(path)
+    for c in si.columns:
+        np.testing.assert_allclose(log[c], si[c], rtol=1e-12, atol=1e-12, err_msg=c)
+    # Named by --columns, the file's own column keeps its unit.
+    stated.rename(columns={"r [°/s]": "yaw_rate [deg/s]"}).to_csv(path, index=False)
+    np.testing.assert_allclose(read_log(path, columns={"yaw_rate": "r"})["r"], si["r"],
+                               rtol=1e-12)  # fmt: skip
+
+
+def test_a_yaw_rate_in_degrees_per_second_is_read_so_without_a_heading(tmp_path, trial):
+    """The bug: 'r [deg/s]' had its unit dropped and was read as rad/s. Without ψ to check it
+    against and under 3 °/s (a big ship's turn), nothing said so."""
+    slow = trial[["t", "delta", "u", "v", "r"]].assign(r=trial["r"] * 0.1)
+    assert np.degrees(slow["r"]).abs().max() < 3
+    path = tmp_path / "slow.csv"
+    slow.assign(r=np.degrees(slow["r"])).rename(columns={"r": "r [deg/s]"}).to_csv(path,
+                                                                                     index=False)
+    np.testing.assert_allclose(read_log(path)["r"], slow["r"], rtol=1e-12)
+
+
+def test_units_shipid_cannot_convert_or_that_contradict_degrees_are_refused(tmp_path, trial,
+                                                                            capsys):  # fmt: skip
+    _, stated = _si_and_stated(trial)
+    path = tmp_path / "feet.csv"
+    stated.rename(columns={"u [kn]": "u [ft/s]"}).to_csv(path, index=False)
+    code, _, err = run(["identify", path, "-o", tmp_path / "m.json"], capsys)
+    assert code == 1 and not (tmp_path / "m.json").exists()
+    assert err.strip() == (f"shipid: error: {path}: column 'u' is in 'ft/s' by its header, which "
+                           "shipid does not convert (it reads km/h, kn, knot, knots, kt, m/s); "
+                           "convert the column, or drop the unit from its name")  # fmt: skip
+    with pytest.raises(ShipidError, match="--degrees names 'psi', but its header says 'rad'"):
+        read_log(_write(tmp_path, stated), degrees=("psi",))
+    # Named in --degrees as the header says: converted once.
+    np.testing.assert_allclose(read_log(_write(tmp_path, stated), degrees=("delta",))["delta"],
+                               trial["delta"], rtol=1e-12)  # fmt: skip
+
+
+@pytest.mark.parametrize(("sep", "decimal"), [(";", ","), (";", "."), ("\t", ".")])
+def test_semicolon_and_tab_separated_files_read_as_comma_separated(tmp_path, trial, sep, decimal):
+    cols = ["t", "delta", "u", "v", "r", "psi", "x", "y"]
+    path = tmp_path / "spreadsheet.csv"
+    trial[cols].to_csv(path, sep=sep, decimal=decimal, index=False)
+    log = read_log(path)
+    for c in cols:
+        np.testing.assert_allclose(log[c], trial[c], rtol=1e-12, atol=1e-12, err_msg=c)

@@ -27,6 +27,7 @@ from shipid.data.checks import (
     check_units,
 )
 from shipid.data.formats import FORMATS, detect_format, read_format
+from shipid.data.header_units import si_factors, split_units
 from shipid.data.log import COLUMNS, REQUIRED, csv_metadata_line, metadata, parse_csv_metadata
 from shipid.data.preprocess import resample
 from shipid.data.trim import trim
@@ -34,7 +35,6 @@ from shipid.data.yaw_rate import correct_yaw_rate
 from shipid.errors import ShipidError
 from shipid.outputs import atomic_write
 
-UNIT_SUFFIX = re.compile(r"\s*\[[^\]]*\]\s*$")
 # No log line comes near this: a canonical row is ~200 characters. Longer lines are not logs, and
 # parsing a line of millions of fields takes minutes.
 MAX_LINE_BYTES = 65_536
@@ -124,6 +124,24 @@ def longest_line(path: Path) -> tuple[int, int]:
     return int(lengths[k]), k + 1
 
 
+DECIMAL_COMMA = re.compile(r"^-?\d+,\d+([eE][-+]?\d+)?$")
+
+
+def _separators(lines: Sequence[str]) -> tuple[str, str]:
+    """Field separator and decimal mark of a CSV from its first lines: commas, or the
+    semicolons (with decimal commas where its numbers have them) or tabs that spreadsheets in
+    many locales write."""
+    rows = [ln for ln in lines if ln.strip() and not ln.lstrip().startswith("#")]
+    if not rows or "," in rows[0]:
+        return ",", "."
+    for sep in (";", "\t"):
+        if sep in rows[0]:
+            fields = [f.strip() for f in rows[1].split(sep)] if len(rows) > 1 else []
+            comma = sep == ";" and any(DECIMAL_COMMA.match(f) for f in fields)
+            return sep, "," if comma else "."
+    return ",", "."
+
+
 def _read_table(path: Path) -> tuple[pd.DataFrame, dict]:
     """The raw table of a canonical CSV/Parquet log and the metadata the file carries."""
     _check_file(path)
@@ -146,8 +164,9 @@ def _read_table(path: Path) -> tuple[pd.DataFrame, dict]:
                           "hundred: not a CSV log (or a broken one)")  # fmt: skip
     first_lines = head.decode("utf-8", errors="replace").splitlines()[:5]
     meta = parse_csv_metadata(first_lines, str(path))
+    sep, decimal = _separators(head.decode("utf-8", errors="replace").splitlines())
     try:
-        df = pd.read_csv(path, skip_blank_lines=True, comment="#")
+        df = pd.read_csv(path, skip_blank_lines=True, comment="#", sep=sep, decimal=decimal)
     except UnicodeDecodeError:
         raise ShipidError(f"{path}: not a text CSV file") from None
     except pd.errors.EmptyDataError:
@@ -195,8 +214,10 @@ def read_log(path: str | Path, options: ReadOptions | None = None, **overrides) 
             df, meta = _read_table(path)
         except ShipidError as exc:
             raise _hint_format(path, exc) from None
-        # "u_velo [m/s]" → "u_velo": units in brackets are documentation, not part of the name.
-        df.columns = [UNIT_SUFFIX.sub("", str(c)).strip() for c in df.columns]
+        # "r [deg/s]" → "r" in °/s: a canonical column's unit is converted, others' are notes.
+        bare, units = split_units(df.columns)
+        df.columns = bare
+        factors = si_factors(units, dict(options.columns), options.degrees, name)
         df = df.rename(columns=dict(options.columns))
         dup = df.columns[df.columns.duplicated()].tolist()
         if dup:
@@ -208,6 +229,9 @@ def read_log(path: str | Path, options: ReadOptions | None = None, **overrides) 
             if any(c not in df.columns for c in REQUIRED):
                 raise _hint_format(path, exc) from None
             raise
+        for c, factor in factors.items():
+            if c in df.columns:
+                df[c] = df[c].to_numpy() * factor
         for c in options.degrees:
             if c in df.columns:
                 df[c] = np.radians(df[c].to_numpy())
