@@ -104,3 +104,40 @@ def test_indices_prints_and_keeps_the_reversals(tmp_path, capsys, zz):
     assert "  reversal_headings_deg: " + ", ".join(f"{h:+.2f}" for h in heads) in text
     kept = json.loads((tmp_path / "i.json").read_text())["logs"][0]["reversal_headings_deg"]
     assert kept == pytest.approx(list(heads))
+
+
+ESSO_1515 = (Path(__file__).resolve().parents[2] / "shared" / "data" / "esso-osaka" / "zigzag"
+             / "zigzag_31-Jul-2020_13_22_52.csv")  # fmt: skip
+
+
+@pytest.mark.parametrize("helm_deg", [7.0, -7.0, 12.0])
+def test_a_first_order_from_the_helm_over_is_the_execute(zz, helm_deg):
+    """The bug: a log that starts with the helm over (an operator holding the course at +7°
+    before a 20°/20° zig-zag) has a first order of 13° against reversals of 40°, and the first
+    reversal was taken for the execute. The same zig-zag with its approach rudder held off zero
+    must read as it does from zero: the same execute, heading reference, first rudder and
+    reversals."""
+    _, log = zz
+    helm = log.copy()
+    before = helm["t"] < 2.0 - 1e-9  # the approach, up to the order at 2 s
+    helm.loc[before, "delta"] = math.radians(helm_deg)
+    plain, held = describe_trial(log, "zigzag"), describe_trial(helm, "zigzag")
+    assert held.execute_index == plain.execute_index
+    assert held.psi0 == plain.psi0
+    # Held over by 12° against the first order's side, the helm was read as a plateau of the
+    # trial's too: an order at the execute and the first rudder to the wrong side.
+    assert held.first_rudder == pytest.approx(plain.first_rudder)
+    assert held.amplitude == pytest.approx(plain.amplitude)
+    np.testing.assert_allclose(held.reversal_headings_deg, plain.reversal_headings_deg)
+
+
+@pytest.mark.skipif(not ESSO_1515.is_file(), reason="../shared/data is not present")
+def test_the_esso_15_15_zigzag_from_rest_executes_at_its_first_order():
+    """The Esso Osaka's 15°/15° zig-zag, trimmed as the README imports it: the helm holds about
+    +7° while the ship gathers speed, the first order (+14.8° at 36 s) is a 7° swing, the first
+    reversal (at 61.5 s) a 30° one."""
+    log = read_log(ESSO_1515, fmt="osaka-frt", start="auto", end="auto")
+    trial = describe_trial(log, "zigzag")
+    assert trial.execute_time == pytest.approx(36.0, abs=0.3)
+    assert trial.first_rudder > 0
+    assert trial.reversal_headings_deg[:2] == pytest.approx([16.1, -13.8], abs=0.2)

@@ -25,7 +25,7 @@ import pandas as pd
 
 from shipid.data.preprocess import cumulative_integral
 from shipid.data.rudder_signal import ramp_start, rise_rate, rudder_for_events, stand_samples
-from shipid.data.trim import EXECUTE_FRACTION, first_swing_index
+from shipid.data.trim import EXECUTE_FRACTION, first_swing_index, swing_start
 from shipid.errors import ShipidError
 
 KINDS = ("zigzag", "turning", "other")
@@ -159,6 +159,41 @@ def _plateau_orders(delta: np.ndarray, side: np.ndarray, i0: int, t: np.ndarray 
     return orders
 
 
+# An order before the first swing from the log's first angle: a plateau at this share of the
+# trial's deflection from neutral, held this long.
+EARLIER_LEVEL = 0.7
+EARLIER_HOLD_S = 2.0
+
+
+def earlier_order(t: np.ndarray, delta: np.ndarray, i0: int, max_stand: int = 0) -> int:
+    """The first order where the log starts with the helm over: the first swing from the first
+    angle that is at least half the largest (``first_swing_index``) misses a smaller first
+    order. An Esso Osaka 15°/15° zig-zag starts at +7.7° (the helm holding the course), so its
+    first order to +14.8° is a 7° swing against the reversals' 30°, and the first reversal was
+    taken for the execute (the first overshoot read 18.5° from a heading averaged over the first
+    leg). Where the rudder swings over from side to side at least twice after the swing at ``i0``
+    (a zig-zag's reversals, by ``EARLIER_LEVEL`` of its deflection from their mid-range), the first
+    swing before ``i0`` to a plateau at that level held ``EARLIER_HOLD_S`` is the order; ``i0``
+    if there is none (or the trial is a turn: one swing, and back at the end of the run)."""
+    if i0 <= 0:
+        return i0
+    dev = delta - neutral_rudder(delta[i0:])
+    level = EARLIER_LEVEL * float(np.max(np.abs(dev[i0:])))
+    side = np.where(np.abs(dev) >= level, np.sign(dev), 0.0)
+    legs = [s for _, _, s in runs_of(side[_swing_end(t, delta, i0) :]) if s != 0]
+    if sum(1 for a, b in zip(legs[:-1], legs[1:], strict=True) if a != b) < 2:
+        return i0
+    hold = max(1, int(round(EARLIER_HOLD_S / float(np.median(np.diff(t))))))
+    smallest = max(math.radians(2.0), 0.2 * level)  # a swing, not a log that starts on the plateau
+    for k in np.flatnonzero(side[:i0]):
+        k = int(k)
+        if k + hold < len(delta) and np.ptp(delta[k : k + hold + 1]) <= PLATEAU_TOLERANCE:
+            start = swing_start(delta, k, float(side[k]), max_stand)
+            if abs(delta[k] - delta[start]) >= smallest:
+                return start
+    return i0
+
+
 def _before(t: np.ndarray, when: float, latest: int) -> int:
     """The last sample at or before ``when``, no later than ``latest``."""
     return max(0, min(latest, int(np.searchsorted(t, when, side="right")) - 1))
@@ -201,7 +236,8 @@ def describe_trial(
     raw = log["delta"].to_numpy()
     delta, rudder_noise = rudder_for_events(t, raw)
     if t_order is None:
-        i0 = first_swing_index(delta, stand_samples(t) if rudder_noise else 0)
+        stand = stand_samples(t) if rudder_noise else 0
+        i0 = earlier_order(t, delta, first_swing_index(delta, stand), stand)
         if rudder_noise:  # the dead band left the approach late: extend the ramp back
             stood = np.flatnonzero(delta[: i0 + 1] != delta[i0])
             level = float(np.median(raw[stood[-1] + 1 if stood.size else 0 : i0 + 1]))
@@ -218,6 +254,15 @@ def describe_trial(
     peak = float(np.max(np.abs(dev[i0:])))
     side = np.sign(dev)
     side[np.abs(dev) < max(EXECUTE_FRACTION * peak, math.radians(1.0))] = 0
+    # A helm held over before the execute, by half the amplitude or more to the side the first
+    # order leaves, read as a plateau of the trial's: an order at the execute and the first
+    # rudder to the wrong side. Where the rudder later comes back over to that side (a zig-zag;
+    # a turn's approach is the other side of its mid-range for good), it is no plateau.
+    away = np.sign(delta[_swing_end(t, delta, i0)] - delta[i0])
+    if away != 0 and side[i0] == -away:
+        on_side = np.flatnonzero(side[i0:] == away)
+        if on_side.size and np.any(side[i0 + int(on_side[0]) :] == -away):
+            side[i0 : i0 + int(on_side[0])] = 0
     big = np.flatnonzero(side[i0:]) + i0
     # A noisy rudder's event signal creeps up to the highest noise on a plateau: the level is
     # the median of the measured rudder on it.
