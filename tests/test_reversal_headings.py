@@ -112,11 +112,11 @@ ESSO_1515 = (Path(__file__).resolve().parents[2] / "shared" / "data" / "esso-osa
 
 @pytest.mark.parametrize("helm_deg", [7.0, -7.0, 12.0])
 def test_a_first_order_from_the_helm_over_is_the_execute(zz, helm_deg):
-    """The bug: a log that starts with the helm over (an operator holding the course at +7°
-    before a 20°/20° zig-zag) has a first order of 13° against reversals of 40°, and the first
-    reversal was taken for the execute. The same zig-zag with its approach rudder held off zero
-    must read as it does from zero: the same execute, heading reference, first rudder and
-    reversals."""
+    """The bug: a log that starts with the helm over (an operator holding the course at −7°
+    before a 20°/20° zig-zag whose first order is −20°) has a first order of 13° against
+    reversals of 40°, and the first reversal was taken for the execute. The same zig-zag with
+    its approach rudder held off zero must read as it does from zero: the same execute, heading
+    reference, first rudder and reversals (−7° and +12° failed before, +7° did not)."""
     _, log = zz
     helm = log.copy()
     before = helm["t"] < 2.0 - 1e-9  # the approach, up to the order at 2 s

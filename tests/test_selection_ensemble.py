@@ -86,7 +86,7 @@ def test_whole_logs_one_candidate_is_the_log_bootstrap_of_it_and_is_filed(zigzag
     plain = bootstrap(logs, weighted_refit(logs, model=sel.model.structure, gamma=sel.gamma),
                       replicates=12, seed=5, block_s="log")  # fmt: skip
     np.testing.assert_array_equal(ens.thetas, plain.thetas)
-    assert ens.method == SELECTION_LOG_METHOD and "whole logs resamples" in ens.members_label
+    assert ens.method == SELECTION_LOG_METHOD and "resamples of whole logs" in ens.members_label
     paths = [write_log(log, tmp_path / f"zz{i}.csv") for i, log in enumerate(logs)]
     code, out, err = run(["identify", *paths, "--model", "blanke", "--no-output-error",
                           "--bootstrap", "12", "-o", tmp_path / "m.json"], capsys)  # fmt: skip

@@ -201,7 +201,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="with --refine or --output-error: cap on cost evaluations (default "
                    "%(default)s)")
     p.add_argument("--bootstrap", type=int, metavar="N",
-                   help="uncertainty: N moving-block bootstrap refits (≥ 10; e.g. 200), stored in "
+                   help="uncertainty: N bootstrap refits (≥ 10; e.g. 200; --block), stored in "
                    "the model file: coefficient intervals here, prediction bands and index "
                    "intervals in validate, manoeuvre and criteria")
     p.add_argument("--block", type=_block, default="auto", metavar="S|log|auto",
@@ -261,7 +261,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--bootstrap", type=int, metavar="N",
                    help="uncertainty of the selected model: N replicates (≥ 10), each a "
                    "candidate drawn by how often it is chosen on resampled held-out logs, "
-                   "refitted on a moving-block resample; stored in the model file for bands "
+                   "refitted on a resample (--block); stored in the model file for bands "
                    "and intervals")
     p.add_argument("--block", type=_block, default="auto", metavar="S|log|auto",
                    help="with --bootstrap: resample blocks of S seconds, or whole logs ('log': "

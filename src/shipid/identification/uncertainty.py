@@ -6,11 +6,10 @@ Each replicate refits the same regression (structure, form, γ, estimator, prior
 with the equations resampled in blocks of ``block_s`` seconds within each log (Künsch 1989): the
 blocks keep the equation errors' autocorrelation, which resampling single equations would
 ignore. With ``block_s="log"`` (the default, ``"auto"``, from five logs on) a replicate draws
-whole logs instead, as many as there are, with
-replacement (a cluster bootstrap, Davison & Hinkley 1997, §3.8): where the logs differ from one
-another by more than their equation errors say (a day's wind, a campaign's loading, a kind of
-manoeuvre), the replicates differ by that too. The intervals are percentile intervals of the
-replicates. They cover what the equation
+whole logs instead, as many as there are, with replacement (a cluster bootstrap, Davison &
+Hinkley 1997, §3.8): where the logs differ from one another by more than their equation errors
+say (a day's wind, a campaign's loading, a kind of manoeuvre), the replicates differ by that
+too. The intervals are percentile intervals of the replicates. They cover what the equation
 error makes uncertain; a bias common to all replicates (errors in the measured states, a
 structure that lacks a term) is not in them, unless the structure is resampled too: the
 ensemble of ``shipid.identification.selection_ensemble`` draws each replicate's terms from the
@@ -38,6 +37,7 @@ WHOLE_LOGS = "log"  # block_s of a bootstrap that resamples whole logs
 # Fewer logs than this give a log bootstrap too few distinct resamples to say how they vary.
 MIN_WHOLE_LOGS = 5
 BLOCK_S = 10.0  # the moving blocks' length where there are fewer logs
+LEVEL = 0.95
 
 
 def resolve_block(block_s: float | str, n_logs: int) -> float | str:
@@ -48,7 +48,6 @@ def resolve_block(block_s: float | str, n_logs: int) -> float | str:
     if block_s == "auto":
         return WHOLE_LOGS if n_logs >= MIN_WHOLE_LOGS else BLOCK_S
     return block_s
-LEVEL = 0.95
 
 
 @dataclass
@@ -104,9 +103,9 @@ class Ensemble:
         if self.method in (METHOD, LOG_METHOD):
             return "bootstrap replicates"
         if self.method in (SELECTION_METHOD, SELECTION_LOG_METHOD):
-            what = "whole logs" if self.method == SELECTION_LOG_METHOD else "block"
-            return f"replicates (terms chosen on resampled held-out logs, refitted on {what} " \
-                   "resamples)"
+            what = "resamples of whole logs" if self.method == SELECTION_LOG_METHOD \
+                else "block resamples"
+            return f"replicates (terms chosen on resampled held-out logs, refitted on {what})"
         return "draws of its covariance"
 
     @property
