@@ -143,6 +143,34 @@ def test_validate_lssvm_on_an_unrefined_model_says_so(files, capsys):
     assert code == 0 and "has no refinement" in err
 
 
+def test_validate_names_the_logs_the_model_was_fitted_to(tmp_path, files, trial, capsys):
+    """Always judge a model on logs it was not fitted to: validate used to print a training
+    log's errors as it prints a prediction's. The model file keeps its training files' SHA-256,
+    so the same log, also copied under another name, is named; another log is not, nor is any
+    under a model file that keeps no training files."""
+    log, model = files
+    copy = tmp_path / "renamed.csv"
+    copy.write_bytes(Path(log).read_bytes())
+    other = write_log(zigzag(SHIP, 10, 10, duration=60, dt=0.2, method="euler",
+                             approach=2.0).log, tmp_path / "zz10.csv")  # fmt: skip
+    code, out, err = run(["validate", model, log, copy, other, "--json", tmp_path / "v.json"],
+                         capsys)  # fmt: skip
+    assert code == 0, err
+    records = json.loads((tmp_path / "v.json").read_text())["logs"]
+    assert [r["fitted_to"] for r in records] == [True, True, False]
+    assert f"renamed.csv: the model was fitted to this log (the same file as its training log " \
+           f"{log})" in err
+    assert "zz10.csv: the model was fitted" not in err
+    header = next(ln for ln in out.splitlines() if ln.startswith("| log"))
+    assert header.rstrip("| ").endswith("fitted to")
+    doc = json.loads(Path(model).read_text())
+    doc.pop("provenance")
+    bare = tmp_path / "bare.json"
+    bare.write_text(json.dumps(doc))
+    code, out, err = run(["validate", bare, log], capsys)
+    assert code == 0 and "fitted to" not in out and "was fitted to this log" not in err
+
+
 # ---------------------------------------------------------------------------- 22: option values
 @pytest.mark.parametrize(("argv", "match"), [
     (["manoeuvre", "{model}", "zigzag", "--heading", "0"], "--heading must be > 0"),

@@ -93,6 +93,7 @@ def cmd_validate(args) -> int:
     for v, log in zip(vals, logs, strict=True):
         if v.error is None:
             v.warnings.extend(outside_envelope(env, log))
+    _mark_training_logs(doc, vals)
     good = [v for v in vals if v.error is None]
     if good:
         if band is not None:
@@ -196,6 +197,25 @@ def cmd_validate(args) -> int:
             out.write(Path(args.report) / "report.html",
                       lambda p: p.write_text(text, encoding="utf-8"))
     return 1 if errors else 0
+
+
+def _mark_training_logs(doc, vals) -> None:
+    """Name the logs that are files the model was fitted to (by content: a copy or a renamed
+    file is one too): their errors measure the fit, not a prediction."""
+    from shipid.reporting.modelfile import sha256, training_files
+
+    fitted = training_files(doc)
+    if not fitted:
+        return
+    for v in vals:
+        if v.error is not None or not Path(v.name).is_file():
+            continue
+        was = fitted.get(sha256(v.name))
+        if was is not None:
+            v.fitted_to = True
+            v.warnings.append(f"the model was fitted to this log (the same file as its "
+                              f"training log {was}): its errors measure the fit, not a "
+                              "prediction; judge the model on logs it was not fitted to")  # fmt: skip
 
 
 # Indices of the tied structures' closed loops shown beside their free-run errors.

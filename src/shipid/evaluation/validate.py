@@ -79,6 +79,8 @@ class Validation:
     horizons: list[dict] = field(default_factory=list)
     # How far the closed-loop indices move with the noise of the replica's start (``start_spread``).
     start_spread: dict[str, float] = field(default_factory=dict)
+    # The log is one the model was fitted to (a file of its training logs): not a prediction.
+    fitted_to: bool = False
 
     def to_frame(self):
         """The metrics as a DataFrame: one row per state (u, v, r), one column per metric."""
@@ -99,7 +101,7 @@ class Validation:
                 "ensemble_diverged": self.ensemble_diverged if self.bands else None,
                 "within_error_band": self.band_shares, "horizons": self.horizons,
                 "closed_loop_start_spread": self.start_spread or None,
-                "warnings": self.warnings}  # fmt: skip
+                "fitted_to": self.fitted_to, "warnings": self.warnings}  # fmt: skip
 
 
 def free_run(model, log: pd.DataFrame, method: str = "euler") -> tuple[SimulationResult, dict]:

@@ -107,6 +107,13 @@ def prime_record(model: ManoeuvringModel, particulars: dict | None,
             "coefficients": prime_coefficients(model, p.length, speed, p.rho)}
 
 
+def training_files(doc: Mapping) -> dict[str, str]:
+    """SHA-256 → path of the files the model was fitted to (``provenance``; {} if not kept)."""
+    files = (doc.get("provenance") or {}).get("training_files") or []
+    return {str(f["sha256"]): str(f.get("path", "")) for f in files
+            if isinstance(f, Mapping) and f.get("sha256")}  # fmt: skip
+
+
 def model_text(ident: Identification, training_files: Sequence[str | Path] = (), **kw) -> str:
     """The model file's JSON text (``model_document`` serialised; floats exact)."""
     # repr of a float is exact, so the coefficients survive the round trip bit for bit.

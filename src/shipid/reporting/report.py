@@ -84,6 +84,11 @@ def metrics_frame(validations: Sequence[Validation]) -> pd.DataFrame:
         row["diverged"] = (f"at {v.simulation.diverged_at:.1f} s" if v.simulation.diverged
                            else "no")  # fmt: skip
         rows.append(row)
+    if any(v.fitted_to for v in validations if v.error is None):
+        # Beside a prediction's errors, a training log's only measure the fit.
+        fitted = [v.fitted_to for v in validations if v.error is None]
+        for row, f in zip(rows, fitted, strict=True):
+            row["fitted to"] = "yes" if f else "no"
     return pd.DataFrame(rows)
 
 
