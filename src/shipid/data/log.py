@@ -79,6 +79,25 @@ def approach(log: pd.DataFrame, column: str) -> float | None:
     return float(log[column].iloc[: max(1, len(log) // 50)].mean())
 
 
+def mean_true_wind(log: pd.DataFrame) -> tuple[float, float] | None:
+    """The log's mean true wind (speed [m/s], the direction it blows from [rad], clockwise from
+    north: the constant wind a closed-loop manoeuvre takes, ``shipid.dynamics.kernel``), from
+    its relative wind, velocity and heading: the air's velocity over the ground, averaged as a
+    vector. None without a relative wind or a heading."""
+    if not {"wind_speed", "wind_angle", "psi"} <= set(log.columns):
+        return None
+    U, g = log["wind_speed"].to_numpy(dtype=float), log["wind_angle"].to_numpy(dtype=float)
+    u, v = log["u"].to_numpy(dtype=float), log["v"].to_numpy(dtype=float)
+    psi = log["psi"].to_numpy(dtype=float)
+    # The air's velocity in the body frame (relative air plus the ship's), turned by ψ.
+    bx, by = u - U * np.cos(g), v - U * np.sin(g)
+    c, s = np.cos(psi), np.sin(psi)
+    wx, wy = float(np.nanmean(bx * c - by * s)), float(np.nanmean(bx * s + by * c))
+    if not (math.isfinite(wx) and math.isfinite(wy)):
+        return None
+    return math.hypot(wx, wy), math.atan2(-wy, -wx)
+
+
 def starts_without_headway(log: pd.DataFrame) -> bool:
     """Whether ``approach`` takes the log's running condition instead of its start."""
     return _running_samples(log) is not None
