@@ -171,6 +171,37 @@ def test_validate_names_the_logs_the_model_was_fitted_to(tmp_path, files, trial,
     assert code == 0 and "fitted to" not in out and "was fitted to this log" not in err
 
 
+def test_manoeuvre_says_why_its_rudder_is_instantaneous_and_its_air_still(tmp_path, capsys):
+    """A model of logs whose rudder swings between two samples (the Esso Osaka's 35° in under
+    0.3 s at 10 Hz) has no training rudder rate: `manoeuvre` said the file had none, as of a
+    file written by hand. Now it says why; and a model with wind terms says that it runs in still
+    air unless a wind is given."""
+    from shipid.trials.trial import rudder_unresolved
+
+    instant = zigzag(scale_ship(), 20, 20, duration=90, dt=0.2, method="euler", approach=2.0).log
+    geared = zigzag(SHIP, 20, 20, duration=90, dt=0.2, method="euler", approach=2.0).log
+    assert rudder_unresolved(instant) and not rudder_unresolved(geared)
+    log = write_log(instant, tmp_path / "instant.csv")
+    model = tmp_path / "m.json"
+    assert run(["identify", log, "--no-output-error", "-o", model], capsys)[0] == 0
+    assert json.loads(model.read_text())["identification"]["preprocessing"]["rudder_unresolved"]
+    code, out, err = run(["manoeuvre", model, "zigzag", "--duration", "40"], capsys)
+    assert code == 0, err
+    assert "rudder: instantaneous (the training logs' rudder swings between two samples" in out
+    assert "wind: still air" not in out
+    windy = tmp_path / "windy.json"
+    doc = json.loads(model.read_text())
+    doc["model"]["structure"]["terms"]["r"].append("wind_speed^2*sin(wind_angle)")
+    doc["model"]["coefficients"]["r"]["wind_speed^2*sin(wind_angle)"] = 1e-3
+    windy.write_text(json.dumps(doc))
+    code, out, err = run(["manoeuvre", windy, "zigzag", "--duration", "40"], capsys)
+    assert code == 0, err
+    assert "wind: still air (the model has wind terms" in out
+    code, out, err = run(["manoeuvre", windy, "zigzag", "--duration", "40", "--wind-speed", "2"],
+                         capsys)  # fmt: skip
+    assert code == 0 and "wind: still air" not in out, err
+
+
 # ---------------------------------------------------------------------------- 22: option values
 @pytest.mark.parametrize(("argv", "match"), [
     (["manoeuvre", "{model}", "zigzag", "--heading", "0"], "--heading must be > 0"),

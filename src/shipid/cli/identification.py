@@ -19,6 +19,7 @@ from shipid.cli.common import (
     _parse_gammas,
     _pd,
     _physics,
+    _rudder_record,
     _std_errors,
     _structure,
     _term_display,
@@ -64,7 +65,6 @@ def cmd_identify(args) -> int:
     from shipid.identification.plausibility import new_failures, plausibility_at_approach
     from shipid.outputs import atomic_write_text, check_outputs
     from shipid.reporting.modelfile import model_text
-    from shipid.trials.trial import logs_rudder_rate
 
     check_outputs({"-o": (args.output, "json")}, args.logs)
     if args.bootstrap is not None and args.refine:
@@ -131,7 +131,7 @@ def cmd_identify(args) -> int:
             "filter_hz": cutoff, "filter_by": filter_by if cutoff is not None else None,
             "columns": args.columns, "degrees": args.degrees,
             "format": args.format, "scale": args.scale,
-            "approach_speed": speed, "approach_rps": rps, "rudder_rate": logs_rudder_rate(logs),
+            "approach_speed": speed, "approach_rps": rps, **_rudder_record(logs),
             "rudder_positive": logs[0].attrs.get("rudder_positive"),
             "log_scale": _log_scale(logs), "yaw_rate_offset_deg_s": _yaw_rate_offsets(logs)}  # fmt: skip
     refinement = None
@@ -500,7 +500,6 @@ def cmd_select(args) -> int:
     from shipid.identification.select import RESAMPLES, SelectOptions, select
     from shipid.outputs import OutputSet, check_outputs
     from shipid.reporting.modelfile import model_text
-    from shipid.trials.trial import logs_rudder_rate
 
     check_outputs({"-o": (args.output, "json"), "--table": (args.table, "log")}, args.logs)
     logs = _training_logs(args)
@@ -552,8 +551,7 @@ def cmd_select(args) -> int:
     prep = {"dt": args.dt, "start": args.start, "end": args.end, "lead": args.lead,
             "columns": args.columns, "degrees": args.degrees, "format": args.format,
             "scale": args.scale, "approach_speed": speed, "approach_rps": rps,
-            "rudder_rate": logs_rudder_rate(logs),
-            "rudder_positive": logs[0].attrs.get("rudder_positive"),
+            **_rudder_record(logs), "rudder_positive": logs[0].attrs.get("rudder_positive"),
             "log_scale": _log_scale(logs), "yaw_rate_offset_deg_s": _yaw_rate_offsets(logs)}  # fmt: skip
     ensemble = None
     others = len(sel.shares) - (sel.chosen_share > 0)

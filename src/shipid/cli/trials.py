@@ -182,6 +182,10 @@ def cmd_manoeuvre(args) -> int:
         run = partial(stopping, rps=rps, astern_rps=args.astern_rps, **kw)
     res = run(target)
     print(rudder_note)
+    if getattr(target, "uses_wind", False) and "wind" not in kw:
+        # The model's wind terms meet only the ship's own motion through the air.
+        print("wind: still air (the model has wind terms; --wind-speed and --wind-from set a "
+              "true wind)")  # fmt: skip
     gear = steering or getattr(target, "steering", None)  # the one the run used
     intervals = {}
     ensemble = cond.get("ensemble")

@@ -466,7 +466,9 @@ def training_conditions(doc: Mapping) -> dict:
     prep = ident.get("preprocessing") or {}
     out = {"speed": prep.get("approach_speed"), "rps": prep.get("approach_rps"),
            "envelope": ident.get("envelope") or {}, "particulars": None,
-           "rudder_rate": prep.get("rudder_rate"), "log_scale": prep.get("log_scale"),
+           "rudder_rate": prep.get("rudder_rate"),
+           "rudder_unresolved": bool(prep.get("rudder_unresolved")),
+           "log_scale": prep.get("log_scale"),
            "rudder_positive": prep.get("rudder_positive"),
            "yaw_rate_offset_deg_s": prep.get("yaw_rate_offset_deg_s"),
            "dt": ident.get("dt") if isinstance(ident.get("dt"), int | float) else None}  # fmt: skip

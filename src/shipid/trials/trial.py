@@ -222,6 +222,14 @@ def logs_rudder_rate(logs: Sequence[pd.DataFrame]) -> float | None:
     return max(rates) if rates else None
 
 
+def rudder_unresolved(log: pd.DataFrame) -> bool:
+    """Whether the log's rudder swings faster than its sampling resolves: half its travel or more
+    between two samples (``Trial.rudder_rate`` is None then, though the rudder moves)."""
+    step = np.abs(np.diff(log["delta"].to_numpy(dtype=float)))
+    travel = float(np.ptp(log["delta"].to_numpy(dtype=float)))
+    return bool(travel > math.radians(2.0) and step.size and step.max() >= 0.5 * travel)
+
+
 def describe_trial(
     log: pd.DataFrame,
     kind: str | None = None,
