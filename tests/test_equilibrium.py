@@ -166,3 +166,36 @@ def test_manoeuvre_stopping_runs_on_a_propelled_model_file(tmp_path, capsys):
     # Noise-free logs: the identified model stops as the truth does.
     assert doc["indices"]["track_reach"] == pytest.approx(
         stopping(truth, 10.0, speed=steady(10.0)).indices["track_reach"], rel=1e-2)
+
+
+def _windy_propelled() -> ManoeuvringModel:
+    terms = {d: tuple(PROPELLED.structure.terms[d]) for d in "uvr"}
+    terms["u"] += ("wind_speed^2*cos(wind_angle)",)
+    coefs = {d: dict(PROPELLED.coefficients[d]) for d in "uvr"}
+    coefs["u"]["wind_speed^2*cos(wind_angle)"] = -2e-3
+    return ManoeuvringModel(ModelStructure("windy propelled", terms), coefs)
+
+
+def _head(a, b, c, w):
+    """Positive root of (a + c) u² + 2cW u + b + cW² = 0: u̇ = a u² + b + c (W + u)²."""
+    return (-2 * c * w - math.sqrt(4 * c * c * w * w - 4 * (a + c) * (b + c * w * w))) / (2 * (a + c))
+
+
+def _tail(a, b, c, w):
+    """Positive root of (a − c) u² + 2cW u + b − cW² = 0: u̇ = a u² + b − c (W − u)², u < W."""
+    return (-2 * c * w - math.sqrt(4 * c * c * w * w - 4 * (a - c) * (b - c * w * w))) / (2 * (a - c))
+
+
+@pytest.mark.parametrize(("source_deg", "psi_deg", "closed_form"), [
+    (0.0, 0.0, _head), (180.0, 0.0, _tail), (90.0, 90.0, _head), (0.0, 180.0, _tail)])
+def test_the_steady_speed_in_a_true_wind_is_the_closed_form(source_deg, psi_deg, closed_form):
+    """A model with a wind term in surge, c U_A² cos γ_A: in a head wind W on its heading the
+    relative wind is W + u from ahead (the closed loop's own turning of the true wind, tested on
+    its runs elsewhere), in a tail wind W − u from astern while u < W."""
+    model, w, n = _windy_propelled(), 2.0, 10.0
+    got = surge_equilibrium(model, 0.45, n, wind=(w, math.radians(source_deg)),
+                            psi=math.radians(psi_deg))  # fmt: skip
+    assert got == pytest.approx(closed_form(A_UU, B_NN * n * n, -2e-3, w), rel=1e-6)
+    # Still air: the ship's own motion through it, from ahead.
+    assert surge_equilibrium(model, 0.45, n) == pytest.approx(_head(A_UU, B_NN * n * n, -2e-3,
+                                                                    0.0), rel=1e-6)  # fmt: skip

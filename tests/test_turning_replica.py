@@ -244,7 +244,7 @@ def _relative_wind(log, speed: float, from_dir: float):
 def test_a_wind_models_replica_meets_the_logs_wind(kind):
     """Bug: the closed-loop replica of a model with wind terms ran in still air, whatever the log
     met: on the Esso Osaka's +35° turn (a true wind of 1.1 m/s, three times the ship's speed)
-    its tactical diameter came 8.47 m instead of 8.06 m. The replica now meets the log's mean
+    its tactical diameter came 8.47 m instead of 8.02 m. The replica now meets the log's mean
     true wind, read off its relative wind: the true model's replica of its own trial in a
     steady wind reads every index as measured (in still air its first overshoot and its advance
     missed: checked against the code before)."""
@@ -276,3 +276,26 @@ def test_a_wind_models_replica_meets_the_logs_wind(kind):
     assert len(shared) >= 5
     for k in shared:
         assert closed[k] == pytest.approx(measured[k], rel=1e-6, abs=1e-6), k
+
+
+def test_a_wind_models_own_approach_is_steady_in_the_logs_wind():
+    """A turn's replica starts from the model's own steady straight speed at the log's rps: for
+    a model with wind terms that speed was found in still air and the replica then met the log's
+    wind, 32 % slower here than in still air. Found in the log's mean true wind on its heading,
+    the true model's own approach is the log's, and every index of its turn reads as measured."""
+    from test_equilibrium import _windy_propelled
+
+    from shipid.dynamics.equilibrium import surge_equilibrium
+
+    truth, wind = _windy_propelled(), (2.0, math.radians(20.0))
+    speed = surge_equilibrium(truth, 0.45, RPS, wind=wind)
+    assert speed < 0.7 * surge_equilibrium(truth, 0.45, RPS)  # a wind from near ahead
+    res = turning_circle(truth, 35.0, duration=150.0, dt=0.1, approach=10.0, speed=speed,
+                         rps=RPS, method="euler", wind=wind)  # fmt: skip
+    log = _relative_wind(res.log.assign(n=RPS), *wind)
+    (v,) = validate(truth, log)
+    measured, closed = v.indices["measured"], v.indices["closed_loop"]
+    assert closed["approach_speed"] == pytest.approx(speed, rel=1e-4)
+    assert measured["approach_speed"] == pytest.approx(speed, rel=1e-4)
+    for k in ("advance", "transfer", "tactical_diameter", "steady_yaw_rate"):
+        assert closed[k] == pytest.approx(measured[k], rel=1e-3), k

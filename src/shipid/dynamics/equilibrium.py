@@ -25,28 +25,39 @@ from shipid.dynamics.model import ManoeuvringModel
 SEARCH_SPAN = 10.0
 
 
-def still_air_accelerations(model: ManoeuvringModel, u, v, r, delta, rps) -> np.ndarray:
+def still_air_accelerations(model: ManoeuvringModel, u, v, r, delta, rps,
+                            wind: tuple[float, float] | None = None,
+                            psi: float = 0.0) -> np.ndarray:  # fmt: skip
     """(u̇, v̇, ṙ) rows at the given states, the propeller at ``rps`` and, for models with wind
-    terms, still air (the apparent wind of the ship's own motion)."""
+    terms, still air (the apparent wind of the ship's own motion), or a constant true ``wind``
+    (speed [m/s], the direction it blows from [rad]) met on heading ``psi``, turned into the
+    relative wind as the compiled closed loop turns it (``shipid.dynamics.kernel``)."""
     u = np.atleast_1d(np.asarray(u, dtype=float))
     n = None if rps is None else np.full(u.shape, rps)
-    wind = {}
+    air = {}
     if model.uses_wind:
         v_ = np.broadcast_to(np.asarray(v, dtype=float), u.shape)
-        wind = {"wind_speed": np.hypot(u, v_), "wind_angle": np.arctan2(v_, u)}
-    return model.accelerations(u, v, r, delta, None, n, **wind)
+        speed, source = wind if wind is not None else (0.0, 0.0)
+        # The air over the ground in the body frame, less the ship's own velocity.
+        c, s = math.cos(psi), math.sin(psi)
+        ax, ay = -speed * math.cos(source), -speed * math.sin(source)
+        bx, by = ax * c + ay * s - u, -ax * s + ay * c - v_
+        air = {"wind_speed": np.hypot(bx, by), "wind_angle": np.arctan2(-by, -bx)}
+    return model.accelerations(u, v, r, delta, None, n, **air)
 
 
 def surge_equilibrium(model: ManoeuvringModel, speed: float, rps: float | None = None,
-                      span: float = 3.0) -> float | None:  # fmt: skip
+                      span: float = 3.0, wind: tuple[float, float] | None = None,
+                      psi: float = 0.0) -> float | None:  # fmt: skip
     """Steady straight speed with the rudder amidships: the root of u̇(u, 0, 0, 0) with u̇
     falling through it, searched up to ``span`` × ``speed``, the one nearest ``speed``; None if
-    there is none."""
+    there is none. ``wind``, ``psi``: a true wind met on that heading (``still_air_accelerations``),
+    else still air."""
     if "u" not in model.structure.dofs:
         return None
     grid = np.linspace(0.0, span * speed, int(1000 * span) + 1)
     zeros = np.zeros_like(grid)
-    udot = still_air_accelerations(model, grid, zeros, zeros, zeros, rps)[:, 0]
+    udot = still_air_accelerations(model, grid, zeros, zeros, zeros, rps, wind, psi)[:, 0]
     falling = np.flatnonzero((udot[:-1] > 0) & (udot[1:] <= 0))
     if falling.size == 0:
         return None
