@@ -299,3 +299,27 @@ def test_a_wind_models_own_approach_is_steady_in_the_logs_wind():
     assert measured["approach_speed"] == pytest.approx(speed, rel=1e-4)
     for k in ("advance", "transfer", "tactical_diameter", "steady_yaw_rate"):
         assert closed[k] == pytest.approx(measured[k], rel=1e-3), k
+
+
+def test_a_wind_models_manoeuvre_logs_the_wind_it_met():
+    """A manoeuvre on a model with wind terms logged no wind, so its log could not be replayed,
+    validated or fitted by that model. It now logs what an anemometer on the ship reads: the
+    Euler replay with that relative wind (held over each step) runs as the closed loop did, to
+    rounding, and the log's mean true wind is the one given."""
+    from test_equilibrium import _windy_propelled
+
+    from shipid.data.log import mean_true_wind
+    from shipid.dynamics.simulate import simulate_log
+    from shipid.trials.manoeuvres import zigzag
+
+    model, wind = _windy_propelled(), (2.0, 0.4)
+    log = zigzag(model, 20, 20, duration=60, dt=0.1, speed=0.45, rps=RPS, wind=wind,
+                 method="euler").log  # fmt: skip
+    assert mean_true_wind(log) == pytest.approx(wind, abs=1e-12)
+    expected = _relative_wind(log.drop(columns=["wind_speed", "wind_angle"]), *wind)
+    np.testing.assert_allclose(log["wind_angle"], expected["wind_angle"], atol=1e-12)
+    replay = simulate_log(model, log, method="euler").log
+    for c in ("u", "v", "r", "psi"):
+        np.testing.assert_allclose(replay[c], log[c], atol=1e-12, err_msg=c)
+    still = zigzag(model, 20, 20, duration=60, dt=0.1, speed=0.45, rps=RPS, method="euler").log
+    assert mean_true_wind(still)[0] == pytest.approx(0.0, abs=1e-12)  # still air: no wind

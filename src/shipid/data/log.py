@@ -79,6 +79,20 @@ def approach(log: pd.DataFrame, column: str) -> float | None:
     return float(log[column].iloc[: max(1, len(log) // 50)].mean())
 
 
+def relative_wind(u, v, psi, wind: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
+    """The relative wind (``wind_speed`` [m/s], ``wind_angle`` [rad]: where it comes from,
+    clockwise from the bow) an anemometer on the ship reads in a constant true ``wind`` (speed,
+    the direction it blows from [rad]): the air over the ground less the ship's velocity, in the
+    body frame, as the compiled closed loop turns it (``shipid.dynamics.kernel``);
+    ``mean_true_wind`` reverses it."""
+    u, v, psi = (np.asarray(x, dtype=float) for x in (u, v, psi))
+    c, s = np.cos(psi), np.sin(psi)
+    ax = -wind[0] * math.cos(wind[1]) - (u * c - v * s)
+    ay = -wind[0] * math.sin(wind[1]) - (u * s + v * c)
+    bx, by = ax * c + ay * s, -ax * s + ay * c
+    return np.hypot(bx, by), np.arctan2(-by, -bx)
+
+
 def mean_true_wind(log: pd.DataFrame) -> tuple[float, float] | None:
     """The log's mean true wind (speed [m/s], the direction it blows from [rad], clockwise from
     north: the constant wind a closed-loop manoeuvre takes, ``shipid.dynamics.kernel``), from

@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from shipid.data.log import make_log, starboard_sign
+from shipid.data.log import make_log, relative_wind, starboard_sign
 from shipid.dynamics import codegen, kernel
 from shipid.dynamics.hybrid import HybridModel
 from shipid.dynamics.model import ManoeuvringModel
@@ -243,6 +243,11 @@ def run_closed_loop(
     cols = dict(zip(("u", "v", "r", "psi", "x", "y"), states[:m].T, strict=True))
     if rps is not None and uses_rps:
         cols["n"] = propeller_series(params, t[:m])
+    if getattr(dyn, "uses_wind", False):
+        # What an anemometer on the ship reads: the log replays (and validates) as it ran.
+        wind = (float(params[kernel.P_WIND_SPEED]), float(params[kernel.P_WIND_DIR]))
+        cols["wind_speed"], cols["wind_angle"] = relative_wind(cols["u"], cols["v"],
+                                                               cols["psi"], wind)  # fmt: skip
     log = make_log({"t": t[:m], "delta": rudder[:m], **cols}, **vessel.log_metadata())
     if m == n:
         return ManoeuvreResult(log)
