@@ -43,7 +43,8 @@ print(f"selected {selection.candidates.loc[selection.candidates['chosen'], 'n_te
 print(selection.model.equations())
 print(f"chosen on {100 * selection.chosen_share:.0f} % of resampled held-out logs")
 # Its uncertainty, the choice of terms included: each replicate a candidate drawn by its
-# share, refitted on moving-block resamples of the equations (select --bootstrap 100).
+# share, refitted on the training logs resampled whole, with replacement (select --bootstrap
+# 100; from five logs on, so the intervals hold how the logs differ from one another).
 ensemble = shipid.selection_ensemble(training, selection, replicates=100)
 
 # 3. Predict what was held out: free-run errors (rmse, fit %) and the turning indices with
