@@ -288,6 +288,9 @@ def test_datetime_time_becomes_seconds(tmp_path, trial):
     (lambda d: d.assign(u=d["u"] > 1), "true/false"),
     (lambda d: d.assign(u=d["u"] * 3.6 * 20), "not a ship speed"),
     (lambda d: d.assign(r=np.degrees(d["r"])), "'r' reaches .* looks like degrees"),
+    # Was read as radians without a word (a relative wind's angle in degrees, 0–360).
+    (lambda d: d.assign(wind_speed=3.0, wind_angle=np.linspace(0.0, 359.0, len(d))),
+     "'wind_angle' reaches 359, which looks like degrees; give --degrees wind_angle"),
     (lambda d: d.assign(psi=-d["psi"]), "opposite sign conventions"),
 ])  # fmt: skip
 def test_misread_units_and_types_are_refused(tmp_path, trial, change, match):

@@ -27,7 +27,9 @@ from shipid.errors import ShipidError, ShipidWarning
 
 ANGLE_COLUMNS = ("delta", "psi", "r", "wind_angle")
 # A rudder beyond 60° or a yaw rate beyond 3 rad/s (172 °/s) is not radians.
-RADIAN_PLAUSIBLE = {"delta": math.radians(60.0), "r": 3.0}
+# A relative wind's angle is a direction: within a turn either way of 0 in radians (a file in
+# degrees, up to 180° or 360°, was read as radians without a word).
+RADIAN_PLAUSIBLE = {"delta": math.radians(60.0), "r": 3.0, "wind_angle": 2.0 * math.pi + 0.01}
 SPEED_PLAUSIBLE = 40.0  # m/s on |u| and |v|: 78 kn, beyond any displacement ship
 # No manoeuvre can be identified from samples this far apart: the time is not in seconds.
 MAX_SAMPLING_S = 30.0
