@@ -93,6 +93,14 @@ def relative_wind(u, v, psi, wind: tuple[float, float]) -> tuple[np.ndarray, np.
     return np.hypot(bx, by), np.arctan2(-by, -bx)
 
 
+def true_air_velocity(log: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
+    """The air's velocity over the ground in the body frame [m/s] from a log's relative wind:
+    the relative air, −U_A (cos γ_A, sin γ_A), plus the ship's (u, v)."""
+    U, g = log["wind_speed"].to_numpy(dtype=float), log["wind_angle"].to_numpy(dtype=float)
+    return (log["u"].to_numpy(dtype=float) - U * np.cos(g),
+            log["v"].to_numpy(dtype=float) - U * np.sin(g))
+
+
 def mean_true_wind(log: pd.DataFrame) -> tuple[float, float] | None:
     """The log's mean true wind (speed [m/s], the direction it blows from [rad], clockwise from
     north: the constant wind a closed-loop manoeuvre takes, ``shipid.dynamics.kernel``), from
@@ -100,11 +108,8 @@ def mean_true_wind(log: pd.DataFrame) -> tuple[float, float] | None:
     vector. None without a relative wind or a heading."""
     if not {"wind_speed", "wind_angle", "psi"} <= set(log.columns):
         return None
-    U, g = log["wind_speed"].to_numpy(dtype=float), log["wind_angle"].to_numpy(dtype=float)
-    u, v = log["u"].to_numpy(dtype=float), log["v"].to_numpy(dtype=float)
+    bx, by = true_air_velocity(log)
     psi = log["psi"].to_numpy(dtype=float)
-    # The air's velocity in the body frame (relative air plus the ship's), turned by ψ.
-    bx, by = u - U * np.cos(g), v - U * np.sin(g)
     c, s = np.cos(psi), np.sin(psi)
     wx, wy = float(np.nanmean(bx * c - by * s)), float(np.nanmean(bx * s + by * c))
     if not (math.isfinite(wx) and math.isfinite(wy)):

@@ -18,7 +18,7 @@ import numpy as np
 
 # An approach is steady when the model's speed changes by less than STEADY_SHARE in
 # STEADY_WINDOW s (the rule a log's approach is held to, ``shipid.data.log.steady_start``).
-from shipid.data.log import STEADY_SHARE, STEADY_WINDOW
+from shipid.data.log import STEADY_SHARE, STEADY_WINDOW, relative_wind
 from shipid.dynamics.model import ManoeuvringModel
 
 # Another rps than the training logs' can put the steady speed far from their approach.
@@ -37,12 +37,8 @@ def still_air_accelerations(model: ManoeuvringModel, u, v, r, delta, rps,
     air = {}
     if model.uses_wind:
         v_ = np.broadcast_to(np.asarray(v, dtype=float), u.shape)
-        speed, source = wind if wind is not None else (0.0, 0.0)
-        # The air over the ground in the body frame, less the ship's own velocity.
-        c, s = math.cos(psi), math.sin(psi)
-        ax, ay = -speed * math.cos(source), -speed * math.sin(source)
-        bx, by = ax * c + ay * s - u, -ax * s + ay * c - v_
-        air = {"wind_speed": np.hypot(bx, by), "wind_angle": np.arctan2(-by, -bx)}
+        speed, angle = relative_wind(u, v_, np.full(u.shape, psi), wind or (0.0, 0.0))
+        air = {"wind_speed": speed, "wind_angle": angle}
     return model.accelerations(u, v, r, delta, None, n, **air)
 
 

@@ -253,7 +253,7 @@ def drawn_starts(model, log: pd.DataFrame, trial: Trial, n: int, seed: int = 0
     from shipid.data.preprocess import white_noise_variance
 
     if isinstance(model, ManoeuvringModel | HybridModel) and \
-            _own_approach(model, log, trial) is not None:  # fmt: skip
+            _own_approach(model, log, trial, _log_wind(model, log)) is not None:  # fmt: skip
         return None
     first = log.iloc[0]
     sigma = {s: math.sqrt(white_noise_variance(log[s].to_numpy(dtype=float))) for s in STATES}
@@ -292,10 +292,20 @@ def steady_log_approach(log: pd.DataFrame, trial: Trial) -> float | None:
     return start.speed if start.steady else None
 
 
-def _own_approach(model, log: pd.DataFrame, trial: Trial) -> tuple[float, float | None] | None:
-    """(speed, rps) of ``model``'s own steady straight approach at the log's propeller speed,
-    when the log's approach is steady and the model's surge answers the propeller (the approach
-    ``shipid manoeuvre`` and ``criteria`` start from); else None."""
+def _log_wind(model, log: pd.DataFrame) -> tuple[float, float] | None:
+    """The true wind a replica of ``log`` meets: the log's mean (``mean_true_wind``) for a model
+    with wind terms (it met still air before: on the Esso Osaka's +35° turn, 1.1 m/s at three
+    times the ship's speed, its tactical diameter came 8.47 m instead of 8.02 m, measured 7.27
+    m), else None."""
+    return mean_true_wind(log) if getattr(model, "uses_wind", False) else None
+
+
+def _own_approach(model, log: pd.DataFrame, trial: Trial, wind: tuple[float, float] | None
+                  ) -> tuple[float, float | None] | None:  # fmt: skip
+    """(speed, rps) of ``model``'s own steady straight approach at the log's propeller speed in
+    the true ``wind`` on the log's approach heading, when the log's approach is steady and the
+    model's surge answers the propeller (the approach ``shipid manoeuvre`` and ``criteria``
+    start from); else None."""
     if not getattr(model, "uses_rps", False) or "n" not in log.columns:
         return None
     measured = steady_log_approach(log, trial)
@@ -303,30 +313,30 @@ def _own_approach(model, log: pd.DataFrame, trial: Trial) -> tuple[float, float 
         return None
     rps = float(log["n"].iloc[: trial.execute_index + 1].mean())
     # At the log's own rps, near its measured speed: three times it is far enough (a model that
-    # balances further off has no steady approach there worth the name). A model with wind terms
-    # in the log's mean true wind on its approach heading, as its replica then runs.
-    wind = mean_true_wind(log) if getattr(model, "uses_wind", False) else None
+    # balances further off has no steady approach there worth the name).
     steady = surge_equilibrium(model, measured, rps, wind=wind, psi=trial.psi0)
     return (steady, rps) if steady is not None and steady > 0 else None
 
 
 def _replica_start(model, log: pd.DataFrame, trial: Trial, start: dict | None = None
-                   ) -> tuple[dict, float | None]:  # fmt: skip
-    """(initial state, propeller speed) of a closed-loop replica: the log's first state (or
-    ``start``'s states in its place) and held rudder at its mean rps; where the log approaches
-    steady and ``model``'s surge answers the propeller, straight at the model's own steady speed
-    at the log's approach rps instead (the approach ``shipid manoeuvre`` starts from)."""
+                   ) -> tuple[dict, float | None, tuple[float, float] | None]:  # fmt: skip
+    """(initial state, propeller speed, true wind) of a closed-loop replica: the log's first
+    state (or ``start``'s states in its place) and held rudder at its mean rps; where the log
+    approaches steady and ``model``'s surge answers the propeller, straight at the model's own
+    steady speed at the log's approach rps instead (the approach ``shipid manoeuvre`` starts
+    from); the wind ``_log_wind`` gives."""
     row = log.iloc[0]
     initial = {k: float(row[k]) for k in ("u", "v", "r", "psi") if k in log.columns}
     initial.update(start or {})
     initial["delta"] = float(row["delta"])
     rps = float(log["n"].mean()) if "n" in log.columns else None
-    own = _own_approach(model, log, trial) if isinstance(model, ManoeuvringModel | HybridModel) \
-        else None  # fmt: skip
+    wind = _log_wind(model, log)
+    own = _own_approach(model, log, trial, wind) \
+        if isinstance(model, ManoeuvringModel | HybridModel) else None  # fmt: skip
     if own is not None:
         initial.update(u=own[0], v=0.0, r=0.0)
         rps = own[1]
-    return initial, rps
+    return initial, rps, wind
 
 
 def _approach_notes(indices: dict) -> list[str]:
@@ -404,21 +414,18 @@ def trial_turning(model, log: pd.DataFrame, method: str = "euler", trial: Trial 
     swing = np.abs(delta - delta[0])
     held = float(np.median(delta[swing >= 0.8 * swing.max()]))
     turns = np.sign(held) * starboard_sign(rudder_positive(log))
-    initial, rps = _replica_start(model, log, trial, start)
+    initial, rps, wind = _replica_start(model, log, trial, start)
     return turning_circle(model, math.degrees(trial.plateau_angle),
                           "starboard" if turns > 0 else "port", speed=initial["u"], method=method,
-                          rps=rps, initial=initial, **_replica_run(model, log, trial))  # fmt: skip
+                          rps=rps, initial=initial, **_replica_run(log, trial, wind))  # fmt: skip
 
 
-def _replica_run(model, log: pd.DataFrame, trial: Trial) -> dict:
+def _replica_run(log: pd.DataFrame, trial: Trial, wind: tuple[float, float] | None) -> dict:
     """What a closed-loop replica takes from the log as it is: duration, step, the execute time
     (``approach``), the steering machine (the log's rudder rate, and an angle limit that holds
-    its rudder) and, for a model with wind terms, the log's mean true wind (``mean_true_wind``;
-    the replica met still air before: on the Esso Osaka's +35° turn, 1.1 m/s at three times the
-    ship's speed, its tactical diameter came 8.47 m instead of 8.02 m, measured 7.27 m; the
-    turn's own approach is found in that wind too, ``_own_approach``)."""
+    its rudder) and the true ``wind`` (``_log_wind``; the turn's own approach is found in it
+    too, ``_own_approach``)."""
     t = log["t"].to_numpy()
-    wind = mean_true_wind(log) if getattr(model, "uses_wind", False) else None
     return {"duration": float(t[-1] - t[0]), "dt": float(np.median(np.diff(t))),
             "approach": float(t[min(trial.execute_index + 1, len(t) - 1)] - t[0]),
             "steering": SteeringMachine(max_angle=max(math.radians(35.0), trial.plateau_angle),
@@ -477,11 +484,11 @@ def trial_zigzag(model, log: pd.DataFrame, method: str = "euler", trial: Trial |
     if not switch or not float(log["u"].iloc[0]) > 0:
         return None
     turns = trial.first_rudder * starboard_sign(rudder_positive(log))
-    initial, rps = _replica_start(model, log, trial, start)
+    initial, rps, wind = _replica_start(model, log, trial, start)
     return zigzag(model, math.degrees(trial.plateau_angle), switch,
                   first="starboard" if turns > 0 else "port", speed=initial["u"], method=method,
                   initial=initial, rps=rps, switches=uneven_reversals(trial),
-                  **_replica_run(model, log, trial))  # fmt: skip
+                  **_replica_run(log, trial, wind))  # fmt: skip
 
 
 __all__ = ["Validation", "free_run", "steady_log_approach", "trial_replica", "trial_turning",

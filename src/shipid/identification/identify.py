@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from shipid.data.log import common_rudder_convention
+from shipid.data.log import common_rudder_convention, true_air_velocity
 from shipid.dynamics.model import (
     ManoeuvringModel,
     ModelStructure,
@@ -264,10 +264,8 @@ def material_wind(logs) -> tuple[float, float] | None:
         return None
     true, ship = [], []
     for log in with_wind:
-        U, g = log["wind_speed"].to_numpy(dtype=float), log["wind_angle"].to_numpy(dtype=float)
-        u, v = log["u"].to_numpy(dtype=float), log["v"].to_numpy(dtype=float)
-        true.append(np.hypot(u - U * np.cos(g), v - U * np.sin(g)))
-        ship.append(np.hypot(u, v))
+        true.append(np.hypot(*true_air_velocity(log)))
+        ship.append(np.hypot(log["u"].to_numpy(dtype=float), log["v"].to_numpy(dtype=float)))
     wind, speed = float(np.nanmedian(np.concatenate(true))), float(np.nanmedian(np.concatenate(ship)))
     if not wind >= MATERIAL_WIND * speed or not wind > 0:
         return None

@@ -30,7 +30,6 @@ from shipid.identification.uncertainty import (
     Ensemble,
     _bar,
     resampler,
-    resolve_block,
 )
 
 
@@ -55,8 +54,7 @@ def selection_ensemble(
     from shipid.identification.identify import weighted_refit
 
     logs = [logs] if isinstance(logs, pd.DataFrame) else list(logs)
-    block_s = resolve_block(block_s, len(logs))
-    draw = resampler(logs, replicates, block_s)
+    draw, block_s = resampler(logs, replicates, block_s)
     cands = list(selection.shares)
     if not cands:
         raise ShipidError("the selection has no candidate chosen on resampled held-out logs "
@@ -84,7 +82,6 @@ def selection_ensemble(
                 thetas[k, DOFS.index(dof), columns[t]] = value
         bar.update()
     bar.close()
-    whole = block_s == WHOLE_LOGS
-    return Ensemble(point, thetas, block_s if whole else float(block_s), int(seed),
-                    SELECTION_LOG_METHOD if whole else SELECTION_METHOD, structure)
+    return Ensemble(point, thetas, block_s, int(seed),
+                    SELECTION_LOG_METHOD if block_s == WHOLE_LOGS else SELECTION_METHOD, structure)
 

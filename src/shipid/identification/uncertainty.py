@@ -261,9 +261,10 @@ def log_weights(lengths: Sequence[int], rng: np.random.Generator) -> np.ndarray:
 
 
 def resampler(logs: Sequence[pd.DataFrame], replicates: int, block_s: float | str
-              ) -> Callable[[np.random.Generator], np.ndarray]:  # fmt: skip
+              ) -> tuple[Callable[[np.random.Generator], np.ndarray], float | str]:  # fmt: skip
     """The draw of one replicate's equation multiplicities (moving blocks of ``block_s``
-    seconds, or whole logs for ``"log"``), after checking the number of replicates (≥ 10), the
+    seconds, whole logs for ``"log"``, ``"auto"`` as ``resolve_block`` says) and the resampling
+    it stands for (seconds or ``"log"``), after checking the number of replicates (≥ 10), the
     block length (> 0 s) and, for whole logs, their number (≥ ``MIN_WHOLE_LOGS``)."""
     if not (isinstance(replicates, int) and replicates >= 10):
         raise ShipidError(f"--bootstrap needs at least 10 replicates, got {replicates!r}")
@@ -274,12 +275,12 @@ def resampler(logs: Sequence[pd.DataFrame], replicates: int, block_s: float | st
             raise ShipidError(f"--block log resamples whole logs and needs at least "
                               f"{MIN_WHOLE_LOGS} of them, got {len(logs)}: give a block length "
                               "in seconds")  # fmt: skip
-        return lambda rng: log_weights(lengths, rng)
+        return (lambda rng: log_weights(lengths, rng)), WHOLE_LOGS
     if not (isinstance(block_s, int | float) and math.isfinite(block_s) and block_s > 0):
         raise ShipidError(f"--block must be > 0 s or 'log', got {block_s!r}")
     dt = float(np.median(np.diff(logs[0]["t"].to_numpy())))
     block = max(1, int(round(block_s / dt)))
-    return lambda rng: block_weights(lengths, block, rng)
+    return (lambda rng: block_weights(lengths, block, rng)), float(block_s)
 
 
 def bootstrap(
@@ -294,8 +295,7 @@ def bootstrap(
     ``sample_weight``) over the equations of ``logs`` (one per sample but the last of each):
     moving blocks of ``block_s`` seconds, or whole logs (``block_s="log"``; ``"auto"``: as
     ``resolve_block`` says)."""
-    block_s = resolve_block(block_s, len(logs))
-    draw = resampler(logs, replicates, block_s)
+    draw, block_s = resampler(logs, replicates, block_s)
     rng = np.random.default_rng(seed)
     point = fit(None)
     thetas = np.empty((replicates, *point.theta.shape))
@@ -304,9 +304,8 @@ def bootstrap(
         thetas[k] = fit(draw(rng)).theta
         bar.update()
     bar.close()
-    whole = block_s == WHOLE_LOGS
-    return Ensemble(point, thetas, block_s if whole else float(block_s), int(seed),
-                    LOG_METHOD if whole else METHOD)
+    return Ensemble(point, thetas, block_s, int(seed),
+                    LOG_METHOD if block_s == WHOLE_LOGS else METHOD)
 
 
 def _bar(progress: bool, total: int):

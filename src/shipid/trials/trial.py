@@ -199,15 +199,17 @@ def _before(t: np.ndarray, when: float, latest: int) -> int:
     return max(0, min(latest, int(np.searchsorted(t, when, side="right")) - 1))
 
 
-def _rudder_rate(t: np.ndarray, delta: np.ndarray) -> float | None:
+def _swings_unresolved(delta: np.ndarray) -> bool:
+    """Half the rudder's travel or more between two samples: the sampling does not resolve the
+    movement, and step/Δt would only measure the sampling."""
     step = np.abs(np.diff(delta))
-    rate = step / np.diff(t)
+    return bool(step.size and step.max() >= 0.5 * np.ptp(delta))
+
+
+def _rudder_rate(t: np.ndarray, delta: np.ndarray) -> float | None:
+    rate = np.abs(np.diff(delta)) / np.diff(t)
     moving = rate > math.radians(0.5)
-    if not moving.any():
-        return None
-    # Half the rudder's travel between two samples: the sampling does not resolve the movement,
-    # and step/Δt would only measure the sampling.
-    if step.max() >= 0.5 * np.ptp(delta):
+    if not moving.any() or _swings_unresolved(delta):
         return None
     # By the swings, not by the steps, which measure the quantisation too; movements all under
     # the 2° of a swing by their fastest steps.
@@ -225,9 +227,8 @@ def logs_rudder_rate(logs: Sequence[pd.DataFrame]) -> float | None:
 def rudder_unresolved(log: pd.DataFrame) -> bool:
     """Whether the log's rudder swings faster than its sampling resolves: half its travel or more
     between two samples (``Trial.rudder_rate`` is None then, though the rudder moves)."""
-    step = np.abs(np.diff(log["delta"].to_numpy(dtype=float)))
-    travel = float(np.ptp(log["delta"].to_numpy(dtype=float)))
-    return bool(travel > math.radians(2.0) and step.size and step.max() >= 0.5 * travel)
+    delta = log["delta"].to_numpy(dtype=float)
+    return bool(np.ptp(delta) > math.radians(2.0) and _swings_unresolved(delta))
 
 
 def describe_trial(
