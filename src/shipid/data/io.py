@@ -229,12 +229,11 @@ def read_log(path: str | Path, options: ReadOptions | None = None, **overrides) 
             if any(c not in df.columns for c in REQUIRED):
                 raise _hint_format(path, exc) from None
             raise
+        # Header units and --degrees (si_factors leaves a column --degrees names to it).
+        factors.update({c: math.pi / 180.0 for c in options.degrees})
         for c, factor in factors.items():
             if c in df.columns:
                 df[c] = df[c].to_numpy() * factor
-        for c in options.degrees:
-            if c in df.columns:
-                df[c] = np.radians(df[c].to_numpy())
         log = df[[c for c in COLUMNS if c in df.columns]].copy()
         log.attrs.update({"source": str(path), "rudder_positive": "port"})
         log.attrs.update(meta)
