@@ -597,3 +597,19 @@ def test_simulate_says_when_the_log_drives_the_model_beyond_its_training(tmp_pat
     code, _, err = run(["simulate", tmp_path / "m.json", turn, "-o", tmp_path / "b.csv"], capsys)
     assert code == 0 and (tmp_path / "b.csv").exists()
     assert f"{turn}: delta spans" in err and "outside the training range" in err
+
+
+def test_a_propeller_speed_in_rpm_is_named_as_such():
+    """A log of the Esso Osaka's turn with n in rpm (600 where the model knows 10 rps) had its
+    model diverge with only 'n spans 600…600 rps, outside the training range': the 60 times
+    that says rpm is named. A log at 25 rps, beyond the training range too, is not called rpm."""
+    import pandas as pd
+
+    from shipid.evaluation.envelope import outside_envelope
+
+    env = {"n": [-10.0, 16.67]}
+    (note,) = outside_envelope(env, pd.DataFrame({"n": np.full(10, 600.0)}))
+    assert "36 times the training logs' largest: in rpm?" in note
+    (note,) = outside_envelope(env, pd.DataFrame({"n": np.full(10, 25.0)}))
+    assert "rpm" not in note
+    assert outside_envelope(env, pd.DataFrame({"n": np.full(10, 12.0)})) == []

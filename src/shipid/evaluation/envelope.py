@@ -25,6 +25,9 @@ MARGIN = 0.1
 MAGNITUDE_MARGIN = 0.05
 # A turn that keeps less than this fraction of its approach speed has left any plausible regime.
 MIN_SPEED_FRACTION = 0.2
+# A log's propeller speed this many times the training logs' largest reads as rpm where the model
+# has rps (60×; a log's rps is rarely above twice the training logs', ten times never).
+RPM_RATIO = (20.0, 200.0)
 
 
 def envelope(logs: Sequence[pd.DataFrame]) -> dict[str, list[float]]:
@@ -53,8 +56,19 @@ def outside_envelope(env: Mapping[str, Sequence[float]], log: pd.DataFrame) -> l
         if xmin < lo - margin or xmax > hi + margin:
             unit = UNITS.get(s, "")
             notes.append(f"{s} spans {xmin:.3g}…{xmax:.3g} {unit}, outside the training range "
-                         f"{lo:.3g}…{hi:.3g} {unit}: the model is extrapolating")  # fmt: skip
+                         f"{lo:.3g}…{hi:.3g} {unit}: the model is extrapolating"
+                         + (_rpm_hint(x, lo, hi) if s == "n" else ""))  # fmt: skip
     return notes
+
+
+def _rpm_hint(n: np.ndarray, lo: float, hi: float) -> str:
+    """A hint when the log's propeller speed looks like the training logs' in rpm."""
+    trained = max(abs(lo), abs(hi))
+    ratio = float(np.max(np.abs(n))) / trained if trained > 0 else 0.0
+    if not RPM_RATIO[0] <= ratio <= RPM_RATIO[1]:
+        return ""
+    return (f" (it is {ratio:.0f} times the training logs' largest: in rpm? a header 'n [rpm]' "
+            "reads it as rps)")
 
 
 def implausible_indices(indices: Mapping, approach_speed: float | None,
