@@ -330,3 +330,30 @@ def test_autopilot_and_follow_say_when_the_model_runs_beyond_its_training(tmp_pa
     code, out, err = run(["follow", tmp_path / "m.json", "--waypoints", "0,0;60,0;60,60"],
                          capsys)  # fmt: skip
     assert code == 0 and "outside the training range" in err
+
+
+@pytest.mark.parametrize("side", ["port", "starboard"])
+def test_the_exported_module_says_which_way_its_rudder_turns(tmp_path, capsys, side):
+    """The standalone module had no word of its rudder convention, units or sampling: used
+    without shipid, an Esso Osaka model (positive delta to starboard) steers a KVLCC2 user's
+    autopilot (positive to port) the wrong way. It now says so, and holds it in RUDDER_POSITIVE:
+    the module's own run with positive delta turns that way."""
+    from shipid.data.io import write_log
+
+    log = zigzag(scale_ship(), 20, 20, duration=60, dt=0.2, method="euler", approach=2.0).log
+    if side == "starboard":  # the paper's ship turns to port with positive rudder
+        log["delta"] = -log["delta"]
+    log.attrs.update({"ship": "scale-ship", "rudder_positive": side})
+    model = tmp_path / "m.json"
+    assert run(["identify", write_log(log, tmp_path / "zz.csv"), "--model", "blanke",
+                "--no-output-error", "-o", model], capsys)[0] == 0  # fmt: skip
+    assert run(["export", model, "-o", tmp_path / "m.py"], capsys)[0] == 0
+    spec = importlib.util.spec_from_file_location("exported_side", tmp_path / "m.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    assert mod.RUDDER_POSITIVE == side
+    assert f"positive delta turns the ship to {side}" in mod.__doc__
+    assert "sampled at 0.2 s" in mod.__doc__
+    t = np.arange(0, 30, 0.2)
+    run_ = mod.simulate(t, np.full((len(t), 1), math.radians(20)), [2.0, 0, 0, 0, 0, 0])
+    assert np.sign(run_[-1, 2]) == (1 if side == "starboard" else -1)

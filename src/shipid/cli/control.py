@@ -94,13 +94,15 @@ def cmd_export(args) -> int:
     """``shipid export``: write the model as a standalone NumPy function file."""
     from shipid.control.export import export_numpy
     from shipid.outputs import check_outputs
-    from shipid.reporting.modelfile import load_document, model_from_document
+    from shipid.reporting.modelfile import load_document, model_from_document, training_conditions
 
     if Path(args.output).suffix != ".py":
         raise ShipidError(f"-o {args.output}: the exported module must be a .py file")
     check_outputs({"-o": (args.output, "python")}, [args.model])
-    model = model_from_document(load_document(args.model), args.model, hybrid=True)
-    export_numpy(model, args.output)
+    doc = load_document(args.model)
+    model = model_from_document(doc, args.model, hybrid=True)
+    trained = training_conditions(doc)
+    export_numpy(model, args.output, trained["rudder_positive"], trained["dt"])
     print(f"standalone NumPy module written to {args.output} (accelerations, derivatives, "
           "simulate)")  # fmt: skip
     return 0

@@ -24,6 +24,13 @@ from shipid.dynamics.terms import OPS, parse_term
 from shipid.errors import ShipidError
 
 STATE_NAMES = ("u", "v", "r", "psi", "x", "y")
+# What each input of an exported module is, in shipid's canonical units and conventions.
+INPUT_MEANINGS = {
+    "n": "n [rps], the propeller speed (negative astern)",
+    "thrust": "thrust [N]",
+    "wind_speed": "wind_speed [m/s], the relative wind an anemometer on the ship reads",
+    "wind_angle": "wind_angle [rad], where that wind comes from, clockwise from the bow",
+}
 
 
 def _inputs(model: ManoeuvringModel) -> list[str]:
@@ -141,9 +148,32 @@ def _residual_source(model: HybridModel) -> list[str]:
     ]
 
 
-def numpy_source(model: ManoeuvringModel | HybridModel) -> str:
+def _conventions(inputs: list[str], rudder_positive: str | None, dt: float | None
+                 ) -> list[str]:  # fmt: skip
+    """The exported module's docstring lines on units and signs: a module used without shipid
+    has no log metadata to say which way its rudder turns (the Esso Osaka's models turn to
+    starboard with positive delta, the KVLCC2's to port)."""
+    rudder = ("delta [rad], the rudder angle; positive delta turns the ship to "
+              f"{rudder_positive}" if rudder_positive else
+              "delta [rad], the rudder angle (which way positive delta turns the ship: as in "
+              "the training logs)")  # fmt: skip
+    lines = ["Inputs, in INPUTS order:", "", f"- {rudder}"]
+    lines += [f"- {INPUT_MEANINGS.get(s, s)}" for s in inputs]
+    lines += ["", "States: u, v [m/s] surge and sway (body axes, v to starboard), r [rad/s] yaw",
+              "rate (positive to starboard), psi [rad] heading (clockwise from north), x, y [m]",
+              "position (x north, y east, as derivatives() integrates them)."]  # fmt: skip
+    if dt:
+        lines.append(f"Identified from logs sampled at {dt:g} s: simulate at that step, as "
+                     "shipid validated it.")  # fmt: skip
+    return lines
+
+
+def numpy_source(model: ManoeuvringModel | HybridModel, rudder_positive: str | None = None,
+                 dt: float | None = None) -> str:  # fmt: skip
     """Python source of a standalone module (NumPy only) that evaluates and simulates the model
-    (a hybrid's kernel residual with it: its centres and weights written out)."""
+    (a hybrid's kernel residual with it: its centres and weights written out). ``rudder_positive``
+    ('port' or 'starboard', the model file's) is written into it as RUDDER_POSITIVE, and said in
+    its docstring with the inputs' units; ``dt``, the training logs' sampling time, too."""
     from shipid import __version__
 
     hybrid = model if isinstance(model, HybridModel) else None
@@ -153,15 +183,17 @@ def numpy_source(model: ManoeuvringModel | HybridModel) -> str:
     lines = [
         f'"""{model.name}: a manoeuvring model exported by shipid {__version__}.',
         "",
-        "Standalone (NumPy only). States u, v [m/s], r [rad/s], psi [rad], x, y [m]; inputs delta",
-        f"[rad]{', ' if inputs else ''}{', '.join(inputs)}. Equations:",
+        "Standalone (NumPy only). Equations:",
         "",
         *("    " + ln for ln in equations.splitlines()),
+        "",
+        *_conventions(inputs, rudder_positive, dt),
         '"""',
         "",
         "import numpy as np",
         "",
         f"INPUTS = {('delta', *inputs)!r}",
+        f"RUDDER_POSITIVE = {rudder_positive!r}  # which way positive delta turns the ship",
         "",
         "",
         f"def accelerations(u, v, r, delta{''.join(f', {s}=0.0' for s in inputs)}):",
@@ -223,8 +255,9 @@ def numpy_source(model: ManoeuvringModel | HybridModel) -> str:
     return "\n".join(lines)
 
 
-def export_numpy(model: ManoeuvringModel | HybridModel, path: str | Path) -> Path:
-    """Write ``numpy_source(model)`` atomically to ``path`` (a .py file)."""
+def export_numpy(model: ManoeuvringModel | HybridModel, path: str | Path,
+                 rudder_positive: str | None = None, dt: float | None = None) -> Path:  # fmt: skip
+    """Write ``numpy_source(model, rudder_positive, dt)`` atomically to ``path`` (a .py file)."""
     from shipid.outputs import atomic_write_text
 
-    return atomic_write_text(path, numpy_source(model))
+    return atomic_write_text(path, numpy_source(model, rudder_positive, dt))
