@@ -158,6 +158,8 @@ def test_continuous_control_system_and_its_linearisation():
 def test_cli_linearise_export_autopilot_follow(tmp_path, capsys):
     code, out, err = run(["linearise", "scale-ship"], capsys)
     assert code == 0 and "Nomoto: K = -0.53" in out
+    # K's sign is the convention's (the paper's ship: positive rudder to port), said beside it.
+    assert "input δ, positive to port;" in out
     path = tmp_path / "m.json"
     scale_ship_model().save(path)
     code, out, err = run(["export", path, "-o", tmp_path / "m.py"], capsys)

@@ -77,8 +77,11 @@ def cmd_linearise(args) -> int:
     held = ("rudder amidships: no rudder within ±35° holds it straight" if trim is None else
             f"trimmed: δ0 = {math.degrees(trim['delta']):.3g}° and v0 = {trim['v']:.3g} m/s hold "
             "it straight")  # fmt: skip
+    # The signs of B and K are the rudder convention's: say which it is.
+    side = cond.get("rudder_positive") or getattr(target, "rudder_positive", None)
+    convention = f", positive to {side}" if side else ""
     print(f"Linearised about straight running at u = {speed:.4g} m/s, {held} (states u, v, r; "
-          "input δ; ν̇ ≈ A (ν − ν0) + B (δ − δ0)):")  # fmt: skip
+          f"input δ{convention}; ν̇ ≈ A (ν − ν0) + B (δ − δ0)):")  # fmt: skip
     print("A =")
     print(pd.DataFrame(nm["A"], index=["u", "v", "r"], columns=["u", "v", "r"]).to_markdown(
         floatfmt=".5g"))
