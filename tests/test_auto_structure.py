@@ -160,7 +160,11 @@ def test_a_speed_that_varies_at_constant_rps_compares_the_rudders_inflow(paper_l
     log = read_log(KVLCC2, fmt="simman-marin", scale=45.7, dt=0.2)
     choice = auto_structure([log])
     assert choice.how == "compared" and choice.structure.name == "blanke-speed"
-    assert not choice.warnings  # alone within one standard error: no tie to name
+    # Alone within one standard error: no tie to name. But four blocks of one log penalise the
+    # race structure, which predicts both unseen real runs better (study_kvlcc2_sampling.py).
+    (warning,) = choice.warnings
+    assert warning.startswith("the rudder's inflow was compared on blocks of one log")
+    assert "score 0.463 against blanke-speed's 0.294" in warning
     assert "the speed varies by 30 % at a constant 10.33 rps" in choice.describe()
     # The paper's ship with a logged rps: blanke (its truth) ties with the race structure, which
     # is fitted (the rudder in the race a constant rps implies), and the tie is named.
