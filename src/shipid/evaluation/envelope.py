@@ -26,7 +26,7 @@ MAGNITUDE_MARGIN = 0.05
 # A turn that keeps less than this fraction of its approach speed has left any plausible regime.
 MIN_SPEED_FRACTION = 0.2
 # A log's propeller speed this many times the training logs' largest reads as rpm where the model
-# has rps (60×; a log's rps is rarely above twice the training logs', ten times never).
+# has rps (60× at the same speed; 20× would be a propeller twenty times faster than any trained on).
 RPM_RATIO = (20.0, 200.0)
 
 

@@ -276,8 +276,9 @@ def _paper_or_race(logs, names, physics, cv, estimator, drop=None, announce=_qui
 
 def _blocks_penalise_race(logs, cv: str, name: str, scores: Mapping) -> list[str]:
     """A warning where the comparison held out blocks of one log and the race structure, scored
-    but outside the tie, was not fitted: on three quarters of one zig-zag its three rudder terms
-    (u²δ, uδ, δ) are near-collinear. On the real KVLCC2's MARIN run the blocks scored it 0.463
+    but outside the tie, was not fitted: fitted on three quarters of one zig-zag, its extra rudder
+    terms (u²δ, uδ, δ) predict the quarter left out worse than they predict another whole run
+    once fitted on the whole log. On the real KVLCC2's MARIN run the blocks scored it 0.463
     against ``blanke-speed``'s 0.294 ± 0.106 at Δk 0.2 s, yet fitted on the whole run it predicts
     the two unseen runs with 42–55 % and 16–35 % lower sway errors and 49–63 % and 25–30 % lower
     yaw errors at every Δk from 0.05 to 1 s (``benchmarks/study_kvlcc2_sampling.py``)."""
