@@ -239,6 +239,18 @@ def _rudder_record(logs) -> dict:
             "rudder_unresolved": rate is None and any(rudder_unresolved(lg) for lg in logs)}
 
 
+def _log_record(args, logs) -> dict:
+    """The model file's ``preprocessing`` record of how the training logs were read (the read
+    options given) and what they hold (approach, rudder, convention, scale, gyro offsets), as
+    ``identify`` and ``select`` both write it."""
+    return {"dt": args.dt, "start": args.start, "end": args.end, "lead": args.lead,
+            "columns": args.columns, "degrees": args.degrees, "format": args.format,
+            "scale": args.scale, "approach_speed": _approach(logs[0], "u"),
+            "approach_rps": _approach(logs[0], "n"), **_rudder_record(logs),
+            "rudder_positive": logs[0].attrs.get("rudder_positive"),
+            "log_scale": _log_scale(logs), "yaw_rate_offset_deg_s": _yaw_rate_offsets(logs)}  # fmt: skip
+
+
 def _log_scale(logs) -> float | None:
     """The scale λ of the training logs (their metadata), when they share one."""
     scales = {float(log.attrs["scale"]) for log in logs if "scale" in log.attrs}

@@ -14,19 +14,17 @@ from shipid.cli.common import (
     _fmt_speed,
     _json_text,
     _log_particulars,
-    _log_scale,
+    _log_record,
     _parse_drop,
     _parse_gammas,
     _pd,
     _physics,
-    _rudder_record,
     _std_errors,
     _structure,
     _term_display,
     _training_logs,
     _warn,
     _warn_approach,
-    _yaw_rate_offsets,
 )
 from shipid.errors import ShipidError
 
@@ -127,13 +125,8 @@ def cmd_identify(args) -> int:
         choice.alternatives_fit = "model" if refitted else "comparison"
     speed, rps = _approach(logs[0], "u"), _approach(logs[0], "n")
     _warn_approach(logs, names)
-    prep = {"dt": args.dt, "start": args.start, "end": args.end, "lead": args.lead,
-            "filter_hz": cutoff, "filter_by": filter_by if cutoff is not None else None,
-            "columns": args.columns, "degrees": args.degrees,
-            "format": args.format, "scale": args.scale,
-            "approach_speed": speed, "approach_rps": rps, **_rudder_record(logs),
-            "rudder_positive": logs[0].attrs.get("rudder_positive"),
-            "log_scale": _log_scale(logs), "yaw_rate_offset_deg_s": _yaw_rate_offsets(logs)}  # fmt: skip
+    prep = {**_log_record(args, logs), "filter_hz": cutoff,
+            "filter_by": filter_by if cutoff is not None else None}
     refinement = None
     print(ident.model.equations(std_errors=_std_errors(ident)))
     print("(± standard errors of the equation-error fit: they hold the scatter of the fitted "
@@ -544,15 +537,10 @@ def cmd_select(args) -> int:
     if sel.error_band is not None:
         print(f"Their {sel.error_band.describe()}; stored in the model file, validate reports "
               "each log's share of samples inside it.")  # fmt: skip
-    speed, rps = _approach(logs[0], "u"), _approach(logs[0], "n")
     _warn_approach(logs, names)
     plausibility, notes = sel.plausibility, sel.plausibility_notes
     ident.warnings.extend(f"plausibility: {n}" for n in notes)
-    prep = {"dt": args.dt, "start": args.start, "end": args.end, "lead": args.lead,
-            "columns": args.columns, "degrees": args.degrees, "format": args.format,
-            "scale": args.scale, "approach_speed": speed, "approach_rps": rps,
-            **_rudder_record(logs), "rudder_positive": logs[0].attrs.get("rudder_positive"),
-            "log_scale": _log_scale(logs), "yaw_rate_offset_deg_s": _yaw_rate_offsets(logs)}  # fmt: skip
+    prep = _log_record(args, logs)
     ensemble = None
     others = len(sel.shares) - (sel.chosen_share > 0)
     print(f"\nThe choice on {RESAMPLES} resamples of the held-out logs: this candidate "
