@@ -126,3 +126,46 @@ def test_the_real_marin_rudder_rate_does_not_depend_on_the_sampling():
     for dt in (None, 0.2, 0.5):
         log = read_log(path, fmt="simman-marin", scale=45.7, dt=dt)
         assert math.degrees(describe_trial(log).rudder_rate) == pytest.approx(want, rel=0.03), dt
+
+
+@pytest.mark.parametrize("dt", [0.2, 0.5])
+@pytest.mark.parametrize("phase", [0.13, 0.37, 0.71])
+def test_a_ramp_whose_corners_fall_between_samples_reads_at_its_rate(dt, phase):
+    """A real log samples the gear's ramps wherever their corners fall. Bug: the line through
+    the swing's 10 % and 90 % points, interpolated between samples, crossed a corner's step
+    where a sample moved more than a tenth of the swing: this 15.7 °/s gear sampled at 0.2 s
+    read 15.58–15.59 °/s (HSVA's real 20/10 zig-zag resampled to 0.5 s: 15.54 against its own
+    15.85)."""
+    from shipid.data.rudder_signal import ramp_line, rise_rate
+
+    rate = math.radians(15.7)
+    t = np.arange(0.0, 60.0, dt)
+    # Swings of 40° and 20° between plateaus, each order a fraction `phase` of a step after a
+    # sample (a ramp of 20° at 15.7 °/s spans 1.3 s: two samples of 0.5 s inside 10–90 %).
+    orders = [(5.0 + phase * dt, 0.0, 0.35), (20.0 + phase * dt, 0.35, -0.35),
+              (38.0 + phase * dt, -0.35, 0.0)]  # fmt: skip
+    delta = np.zeros_like(t)
+    for t0, a, b in orders:
+        end = t0 + abs(b - a) / rate
+        on = t >= t0
+        delta[on] = np.where(t[on] >= end, b, a + np.sign(b - a) * rate * (t[on] - t0))
+    assert rise_rate(t, delta) == pytest.approx(rate, rel=1e-9)
+    k = int(np.searchsorted(t, orders[1][0])) - 1
+    b = int(np.searchsorted(t, orders[1][0] + 0.7 / rate)) + 1
+    slope, at_zero = ramp_line(t, delta, k, b)
+    assert (0.35 - at_zero) / slope == pytest.approx(orders[1][0], abs=1e-9)
+
+
+def test_the_real_hsva_rudder_rate_does_not_depend_on_the_sampling():
+    from pathlib import Path
+
+    from shipid.data.io import read_log
+
+    path = (Path(__file__).resolve().parents[2] / "shared" / "data" / "kvlcc2-hsva"
+            / "HSVA_CPMC_KVLCC2_Z_20_10_P.dat")  # fmt: skip
+    if not path.is_file():
+        pytest.skip("../shared/data is absent")
+    own = describe_trial(read_log(path, fmt="simman-hsva")).rudder_rate
+    for dt in (0.2, 0.5, 1.0):
+        log = read_log(path, fmt="simman-hsva", dt=dt)
+        assert describe_trial(log).rudder_rate == pytest.approx(own, rel=0.005), dt

@@ -25,8 +25,6 @@ NOISE_FLOOR = math.radians(0.01)
 MEDIAN_WINDOW_S = 0.5
 # Half-width of the dead band, in standard deviations of the median-filtered noise.
 BAND_SIGMAS = 4.0
-# A swing's 10–90 % part resolved by at least this many sampling intervals gives its rate.
-RESOLVED_STEPS = 4
 
 
 def stand_samples(t: np.ndarray, stand_s: float = 1.0) -> int:
@@ -81,10 +79,35 @@ def rudder_for_events(t: np.ndarray, delta: np.ndarray) -> tuple[np.ndarray, flo
     return dead_band(smooth, BAND_SIGMAS * residual), sigma
 
 
+def ramp_line(t: np.ndarray, delta: np.ndarray, a: int, b: int) -> tuple[float, float] | None:
+    """(rate [rad/s], angle at t = 0) of the ramp of the monotone swing from sample ``a`` to
+    ``b``: the least-squares line through its samples within 10–90 % of the swing, which lie
+    on the ramp wherever its corners fall between samples. The 10 % and 90 % points
+    interpolated between samples do not where a sample moves more than a tenth of the swing:
+    HSVA's 20/10 zig-zag resampled to 0.5 s read 15.54 °/s against 15.85 °/s at its own
+    0.05 s (now 15.87 and 15.87). None with fewer than two such samples."""
+    seg = delta[a : b + 1]
+    swing = float(seg[-1] - seg[0])
+    if swing == 0.0:
+        return None
+    frac = (seg - seg[0]) / swing
+    inside = (frac >= 0.1) & (frac <= 0.9)
+    if np.count_nonzero(inside) < 2:
+        return None
+    tt, dd = t[a : b + 1][inside], seg[inside]
+    tm = float(np.mean(tt))
+    rate = float(np.sum((tt - tm) * (dd - np.mean(dd))) / np.sum((tt - tm) ** 2))
+    return rate, float(np.mean(dd)) - rate * tm
+
+
 def ramp_start(t: np.ndarray, delta: np.ndarray, a: int, b: int, level: float) -> float:
     """When the swing from sample ``a`` to ``b`` (monotone) left ``level`` (the measured rudder
-    where it stood): its line through 10 % and 90 % of the swing, extended back. Noise blurs
-    the corner itself, and the dead band's plateau creeps towards the highest noise."""
+    where it stood): its ramp (``ramp_line``) extended back, else the line through its 10 %
+    and 90 % points. Noise blurs the corner itself, and the dead band's plateau creeps towards
+    the highest noise."""
+    line = ramp_line(t, delta, a, b)
+    if line is not None and line[0] != 0.0:
+        return float((level - line[1]) / line[0])
     s = 1.0 if delta[b] >= delta[a] else -1.0
     seg = s * delta[a : b + 1]
     swing = seg[-1] - seg[0]
@@ -99,12 +122,12 @@ def ramp_start(t: np.ndarray, delta: np.ndarray, a: int, b: int, level: float) -
 
 def rise_rate(t: np.ndarray, delta: np.ndarray, hold_s: float = 1.0) -> float | None:
     """Rudder rate [rad/s] of a log's rudder (the event rudder of a noisy one): the median over
-    its swings (runs of steps one way, a stand of ``hold_s`` or a reversal ending one) of 80 % of
-    the swing over the time from 10 % to 90 % of it. Steps between samples would measure the
-    noise, or the quantisation: MARIN's rudder, to three digits at 50 Hz, steps by 0.3° or 0.4°
-    at its 15.7°/s, and the 90th percentile of its steps read 20°/s. A swing whose 10–90 % part
-    spans fewer than ``RESOLVED_STEPS`` samples counts its fastest step (a rate-limited gear
-    moves at its limit between two samples; interpolating 10 % and 90 % there reads it slow)."""
+    its swings (runs of steps one way, a stand of ``hold_s`` or a reversal ending one) of the
+    slope of its ramp (``ramp_line``). Steps between samples would measure the noise, or the
+    quantisation: MARIN's rudder, to three digits at 50 Hz, steps by 0.3° or 0.4° at its
+    15.7°/s, and the 90th percentile of its steps read 20°/s. A swing with fewer than two
+    samples within 10–90 % of it counts its fastest step (a rate-limited gear moves at its
+    limit between two samples)."""
     step = np.sign(np.diff(delta))
     edges = np.flatnonzero(step[1:] != step[:-1]) + 1
     starts = np.concatenate([[0], edges])
@@ -120,16 +143,13 @@ def rise_rate(t: np.ndarray, delta: np.ndarray, hold_s: float = 1.0) -> float | 
         else:
             swings.append([a, b, s])
     rates = []
-    dt = float(np.median(np.diff(t)))
-    for a, b, s in swings:
+    for a, b, _ in swings:
         swing = abs(delta[b] - delta[a])
         if swing < math.radians(2.0):
             continue
-        seg = s * delta[a : b + 1]  # non-decreasing
-        lo, hi = seg[0] + 0.1 * swing, seg[0] + 0.9 * swing
-        t10, t90 = np.interp([lo, hi], seg, t[a : b + 1])
-        if t90 - t10 >= RESOLVED_STEPS * dt:
-            rates.append(0.8 * swing / (t90 - t10))
+        line = ramp_line(t, delta, a, b)
+        if line is not None:
+            rates.append(abs(line[0]))
         else:
             rates.append(float(np.max(np.abs(np.diff(delta[a : b + 1])) / np.diff(t[a : b + 1]))))
     return float(np.median(rates)) if rates else None
