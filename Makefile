@@ -47,6 +47,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/study_auto_inflow.py
 	$(BIN)/python benchmarks/study_trim.py
 	$(BIN)/python benchmarks/study_gyro_offset.py
+	$(BIN)/python benchmarks/study_event_timing.py
 	$(BIN)/python benchmarks/bench_blas_threads.py
 
 clean:
