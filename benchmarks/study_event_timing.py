@@ -17,7 +17,8 @@ from __future__ import annotations
 
 import time
 import warnings
-from pathlib import Path
+
+from esso_logs import DATA as ESSO
 
 from shipid.data.io import read_log
 from shipid.trials.manoeuvres import zigzag
@@ -26,7 +27,7 @@ from shipid.vessels import get_vessel
 
 STEPS = (0.01, 0.05, 0.1, 0.2, 0.5, 1.0)
 RESAMPLED = (None, 0.05, 0.1, 0.2, 0.5)
-DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
+DATA = ESSO.parent
 
 
 def reference_ships() -> None:

@@ -5,6 +5,7 @@ held)", a 20/20 zig-zag "not one zig-zag angle", and the rudder rate (the replic
 machine) measured the noise: 24°/s from 0.5° on a 5°/s rudder."""
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -112,15 +113,21 @@ def test_the_rudder_rate_of_a_quantised_rudder_is_its_swings_not_its_steps(dt):
     assert math.degrees(describe_trial(log).rudder_rate) == pytest.approx(rate, rel=0.01)
 
 
-def test_the_real_marin_rudder_rate_does_not_depend_on_the_sampling():
-    from pathlib import Path
+DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
 
-    from shipid.data.io import read_log
 
-    path = (Path(__file__).resolve().parents[2] / "shared" / "data" / "kvlcc2-marin"
-            / "MARIN_FREE_KVLCC2_zz_20_m.dat")  # fmt: skip
+def _shared(name: str) -> Path:
+    """A file of ``../shared/data``; the test is skipped without it."""
+    path = DATA / name
     if not path.is_file():
         pytest.skip("../shared/data is absent")
+    return path
+
+
+def test_the_real_marin_rudder_rate_does_not_depend_on_the_sampling():
+    from shipid.data.io import read_log
+
+    path = _shared("kvlcc2-marin/MARIN_FREE_KVLCC2_zz_20_m.dat")
     # The data README: 2.32 °/s at full scale, 15.7 °/s Froude-scaled to the 7 m model.
     want = 2.32 * math.sqrt(45.7)
     for dt in (None, 0.2, 0.5):
@@ -157,14 +164,9 @@ def test_a_ramp_whose_corners_fall_between_samples_reads_at_its_rate(dt, phase):
 
 
 def test_the_real_hsva_rudder_rate_does_not_depend_on_the_sampling():
-    from pathlib import Path
-
     from shipid.data.io import read_log
 
-    path = (Path(__file__).resolve().parents[2] / "shared" / "data" / "kvlcc2-hsva"
-            / "HSVA_CPMC_KVLCC2_Z_20_10_P.dat")  # fmt: skip
-    if not path.is_file():
-        pytest.skip("../shared/data is absent")
+    path = _shared("kvlcc2-hsva/HSVA_CPMC_KVLCC2_Z_20_10_P.dat")
     own = describe_trial(read_log(path, fmt="simman-hsva")).rudder_rate
     for dt in (0.2, 0.5, 1.0):
         log = read_log(path, fmt="simman-hsva", dt=dt)

@@ -85,7 +85,7 @@ def ramp_line(t: np.ndarray, delta: np.ndarray, a: int, b: int) -> tuple[float, 
     on the ramp wherever its corners fall between samples. The 10 % and 90 % points
     interpolated between samples do not where a sample moves more than a tenth of the swing:
     HSVA's 20/10 zig-zag resampled to 0.5 s read 15.54 °/s against 15.85 °/s at its own
-    0.05 s (now 15.87 and 15.87). None with fewer than two such samples."""
+    0.05 s (now 15.87 at both). None with fewer than two such samples."""
     seg = delta[a : b + 1]
     swing = float(seg[-1] - seg[0])
     if swing == 0.0:
