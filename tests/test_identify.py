@@ -147,11 +147,18 @@ BAD_FILES = {
     "short.csv": "t,delta,u,v,r\n0,0,1,0,0\n0.2,0,1,0,0\n",
     "degrees.csv": "t,delta,u,v,r\n0,20,1,0,0\n0.2,20,1,0,0\n0.4,-20,1,0,0\n",
     "binary.csv": b"\x89PNG\r\n\x1a\n\x00\x00\x00",
+    # Epoch milliseconds: ':g' printed every row's stamp as 1.7e+12 (and called it seconds).
+    "epoch_dup.csv": "t [ms],delta,u,v,r\n1700000000000,0,1,0,0\n1700000000200,0,1,0,0\n"
+                     "1700000000200,0,1,0,0\n",
+    "epoch_nan.csv": "t [ms],delta,u,v,r\n1700000000000,0,1,0,0\n1700000000200,0,,0,0\n"
+                     "1700000000400,0,1,0,0\n",
 }
 MESSAGES = {"missing.csv": "no such file", "empty.csv": "empty", "header.csv": "no rows",
             "nocol.csv": r"missing column\(s\) r", "nan.csv": "column 'u'.*row 2",
             "back.csv": "not increasing", "dup.csv": "duplicate time", "short.csv": "too short",
-            "degrees.csv": "--degrees delta", "binary.csv": "binary"}  # fmt: skip
+            "degrees.csv": "--degrees delta", "binary.csv": "binary",
+            "epoch_dup.csv": r"duplicate time stamp t = 1700000000200 at data rows 2 and 3",
+            "epoch_nan.csv": r"row 2 \(t = 1700000000200\)"}  # fmt: skip
 
 
 @pytest.mark.parametrize("name", list(BAD_FILES))

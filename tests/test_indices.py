@@ -251,3 +251,51 @@ def test_validate_says_which_switch_heading_the_overshoots_are_measured_from(tmp
     assert shown == pytest.approx(describe_trial(read_log(path), "zigzag").switch_heading_deg,
                                   abs=0.01)  # fmt: skip
     assert 12.0 <= shown <= 12.0 + 1.0
+
+
+INSTANT = scale_ship()  # no rudder rate: the log's first sample already has the rudder over
+
+
+@pytest.mark.parametrize("angle", [10, 20])
+@pytest.mark.parametrize("first", ["starboard", "port"])
+def test_a_zigzag_logged_from_its_order_is_read_as_the_manoeuvre_measured_it(angle, first):
+    """The scale ship's instantaneous rudder is over from the first sample of `shipid manoeuvre
+    zigzag -o`'s log: read back, the first reversal was taken for the execute (20/20: reversals
+    at −27.9° and +12.5°, first overshoot 8.7° against 3.7°)."""
+    res = zigzag(INSTANT, angle, angle, first=first, duration=90, dt=0.05)
+    tr = describe_trial(res.log)
+    assert tr.kind == "zigzag" and tr.execute_index == 0
+    assert np.allclose(np.abs(tr.reversal_headings_deg), angle, atol=0.5)
+    read = zigzag_indices(res.log)
+    for key in ("first_overshoot_deg", "second_overshoot_deg"):
+        assert read[key] == pytest.approx(res.indices[key], abs=0.1)
+    assert read["initial_turning_time"] == pytest.approx(res.indices["initial_turning_time"],
+                                                         abs=0.06)  # fmt: skip
+
+
+def test_a_pull_out_logged_from_its_order_reads_its_turn_before_the_release():
+    """Its release was taken for the execute: a 'turn' of advance 0 after it."""
+    log = pull_out(INSTANT, 35, hold=60, release=60, dt=0.1).log
+    turn = turning_circle(INSTANT, 35, duration=60, dt=0.1).indices
+    read = manoeuvre_indices(log)
+    assert read["kind"] == "turning"
+    for key in ("advance", "transfer", "tactical_diameter"):
+        assert read[key] == pytest.approx(turn[key], rel=0.01)
+
+
+def test_a_straight_approach_with_the_helm_held_over_is_not_the_order(clean_turn):
+    """The Esso Osaka's rudder rests near −6° on a straight course: a held helm before the
+    execute, under which the ship barely turns, is the approach."""
+    log = clean_turn.copy()
+    i0 = describe_trial(log).execute_index
+    log.loc[: i0, "delta"] = math.radians(-6.0)
+    assert describe_trial(log).execute_index > 0
+
+
+def test_indices_print_an_epoch_execute_time_in_full(tmp_path, capsys, clean_zigzag_10):
+    log = clean_zigzag_10.copy()
+    log["t"] += 1_700_000_000.0
+    path = tmp_path / "epoch.csv"
+    write_log(log, path)
+    assert main(["indices", str(path)]) == 0
+    assert "first_execute_time: 1700000001.8" in capsys.readouterr().out  # was 1.7e+09

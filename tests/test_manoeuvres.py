@@ -162,11 +162,13 @@ def test_sensor_model_is_seeded_and_has_the_stated_noise():
     assert np.all(a["delta"] == 0)
 
 
-def test_zigzag_detected_when_the_log_starts_with_the_rudder_over():
+@pytest.mark.parametrize("cut", [4.0, 4.5, 5.0, 5.5])
+def test_zigzag_detected_when_the_log_starts_with_the_rudder_over(cut):
     """Bug: the neutral rudder was the first sample, so a trimmed zig-zag starting at −30° was
-    not recognised (its rudder never crossed −30°)."""
+    not recognised (its rudder never crossed −30°). Cut inside a leg, the ship is turning (5 s)
+    or drifting (4 s, at the heading's extreme): not a log that starts on its order."""
     res = zigzag(scale_ship(), 30, 30, duration=60, dt=0.1)
-    late = res.log[res.log["t"] >= 5.0].reset_index(drop=True)
+    late = res.log[res.log["t"] >= cut].reset_index(drop=True)
     late.attrs = dict(res.log.attrs)
     assert detect_manoeuvre(late) == "zigzag"
 

@@ -270,7 +270,7 @@ def test_gaps_are_reported_with_their_span_or_interpolated(tmp_path):
     path = tmp_path / "gap.csv"
     path.write_text("\n".join(rows) + "\n")
     with pytest.raises(ShipidError, match=r"column 'u' has 3 missing values at data rows 5–7 "
-                                          r"\(t = 2–3 s\).*--fill-gaps"):
+                                          r"\(t = 2–3\).*--fill-gaps"):
         read_log(path)
     filled = read_log(path, fill_gaps=True)
     np.testing.assert_allclose(filled["u"], u, rtol=1e-12)  # linear in t: exact

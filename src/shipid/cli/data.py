@@ -8,6 +8,12 @@ from shipid.cli.common import _json_text, _read_logs
 from shipid.errors import ShipidError
 
 
+def _number(value: float) -> str:
+    """Four significant digits, or tenths where more digits are needed: an execute time of a log
+    in epoch seconds (1700000003.1) printed as 1.7e+09."""
+    return f"{value:.4g}" if abs(value) < 1e4 else f"{value:.1f}"
+
+
 def cmd_plot(args) -> int:
     """``shipid plot``: a figure of any logs."""
     from shipid.outputs import check_outputs
@@ -39,7 +45,7 @@ def cmd_indices(args) -> int:
         print(f"{path}: {kind}" + (f" ({ind['reason']})" if kind == "other" else ""))
         for k, v in ind.items():
             if k not in ("kind", "reason"):
-                print(f"  {k}: {v:.4g}" if isinstance(v, float) else f"  {k}: {v}")
+                print(f"  {k}: {_number(v)}" if isinstance(v, float) else f"  {k}: {v}")
         if kind == "zigzag" and trial.reversal_headings_deg:
             # Where the rudder was reversed, each time: a trial switched unevenly shows here.
             record["reversal_headings_deg"] = list(trial.reversal_headings_deg)

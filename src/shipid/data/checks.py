@@ -93,6 +93,12 @@ def convert_types(df: pd.DataFrame, name: str) -> pd.DataFrame:
     return df
 
 
+def _stamp(value: float) -> str:
+    """A time stamp as the file gives it (before any unit in its header is applied), with every
+    digit that tells rows apart: ``:g`` printed an epoch time in ms as 1.7e+12 for every row."""
+    return f"{value:.15g}"
+
+
 def check_log(df: pd.DataFrame, name: str, min_samples: int = 3, fill_gaps: bool = False) -> None:
     """Required columns, finite numbers, strictly increasing time, enough samples.
 
@@ -132,9 +138,9 @@ def check_log(df: pd.DataFrame, name: str, min_samples: int = 3, fill_gaps: bool
             raise ShipidError(f"{name}: column {c!r} is empty")
         if not fill_gaps:
             more = f" and {len(runs) - 1} more gap(s)" if len(runs) > 1 else ""
-            span = (f"1 missing value at data row {first + 1} (t = {t[first]:g} s)" if first == last
+            span = (f"1 missing value at data row {first + 1} (t = {_stamp(t[first])})" if first == last
                     else f"{last - first + 1} missing values at data rows {first + 1}–{last + 1} "
-                    f"(t = {t[first]:g}–{t[last]:g} s)")
+                    f"(t = {_stamp(t[first])}–{_stamp(t[last])})")
             raise ShipidError(f"{name}: column {c!r} has {span}{more}; trim them off with "
                               "--start/--end or interpolate with --fill-gaps")  # fmt: skip
         good = ~gap
@@ -142,12 +148,12 @@ def check_log(df: pd.DataFrame, name: str, min_samples: int = 3, fill_gaps: bool
     dt = np.diff(t)
     if np.any(dt == 0):
         row = int(np.argmax(dt == 0)) + 1
-        raise ShipidError(f"{name}: duplicate time stamp t = {t[row]:g} "
+        raise ShipidError(f"{name}: duplicate time stamp t = {_stamp(t[row])} "
                           f"at data rows {row} and {row + 1}")
     if np.any(dt < 0):
         row = int(np.argmax(dt < 0)) + 1
         raise ShipidError(f"{name}: time is not increasing at data row {row + 1} "
-                          f"(t = {t[row]:g} after {t[row - 1]:g})")  # fmt: skip
+                          f"(t = {_stamp(t[row])} after {_stamp(t[row - 1])})")  # fmt: skip
     if len(df) < min_samples:
         raise ShipidError(f"{name}: {len(df)} samples, too short (at least {min_samples} needed)")
 
@@ -170,7 +176,8 @@ def check_units(df: pd.DataFrame, name: str, degrees=(), offset_given: bool = Fa
     dt = float(np.median(np.diff(t))) if len(t) > 1 else 0.0
     if dt > MAX_SAMPLING_S:
         raise ShipidError(f"{name}: samples are {dt:g} apart in 't'; that is not seconds "
-                          "(milliseconds?): give t in seconds")  # fmt: skip
+                          "(milliseconds?): give t in seconds, or its unit in the header: "
+                          "'time [ms]'")  # fmt: skip
     if "psi" in df.columns:
         _check_heading_against_yaw_rate(df, name)
         if not offset_given:
@@ -373,7 +380,8 @@ def _check_heading_against_yaw_rate(df: pd.DataFrame, name: str) -> None:
                           "the yaw rate 'r' says: r looks like degrees per second; give --degrees r")
     if 0.5e-3 <= ratio <= 2e-3:
         raise ShipidError(f"{name}: the heading 'psi' changes 1000 times slower than the yaw "
-                          "rate 'r' says: 't' looks like milliseconds; give t in seconds")
+                          "rate 'r' says: 't' looks like milliseconds; give t in seconds, or its "
+                          "unit in the header: 'time [ms]'")
     if -2.0 <= ratio <= -0.5:
         raise ShipidError(f"{name}: the heading 'psi' decreases while the yaw rate 'r' is "
                           "positive: psi and r have opposite sign conventions (canonical: both "

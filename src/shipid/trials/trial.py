@@ -194,6 +194,35 @@ def earlier_order(t: np.ndarray, delta: np.ndarray, i0: int, max_stand: int = 0)
     return i0
 
 
+# A log that starts on its order: the ship straight at the first sample (yaw rate and sway
+# within this share of their largest before the first swing), turning before that swing at least
+# this share as hard as after it.
+STRAIGHT_START = 0.1
+TURNS_ON_FIRST_RUDDER = 0.5
+
+
+def starts_on_order(log: pd.DataFrame, delta: np.ndarray, i0: int) -> int:
+    """0 where the log starts on its first order, else ``i0``. A simulated manoeuvre with an
+    instantaneous rudder (the scale ship's), or a log cut at the execute, has the rudder over
+    from its first sample: the first swing (``i0``) is then the first reversal of a zig-zag or
+    the release of a pull-out, and was taken for the execute (the scale ship's 20/20 zig-zag read
+    reversals at −27.9° and +12.5° from a heading averaged over its first leg, and a first
+    overshoot of 8.7° against 3.7°; its pull-out read as a turn with advance 0). The rudder held
+    from the first sample to ``i0``, the ship straight at the start (neither turning nor
+    drifting: a log cut inside a zig-zag's leg does one or the other) and turning under that
+    rudder about as hard as it turns after ``i0``: the order came at the first sample. A straight
+    approach with the helm held over (the Esso Osaka's −6°) turns far less than the trial."""
+    if i0 <= 0 or np.ptp(delta[: i0 + 1]) > PLATEAU_TOLERANCE:
+        return i0
+    r = np.abs(log["r"].to_numpy())
+    v = np.abs(log["v"].to_numpy())
+    turning = float(np.max(r[: i0 + 1]))
+    straight = r[0] <= STRAIGHT_START * turning and v[0] <= STRAIGHT_START * np.max(v[: i0 + 1])
+    if turning >= TURNS_ON_FIRST_RUDDER * float(np.max(r[i0:])) and straight:
+        return 0
+    return i0
+
+
 def _before(t: np.ndarray, when: float, latest: int) -> int:
     """The last sample at or before ``when``, no later than ``latest``."""
     return max(0, min(latest, int(np.searchsorted(t, when, side="right")) - 1))
@@ -251,6 +280,7 @@ def describe_trial(
             stood = np.flatnonzero(delta[: i0 + 1] != delta[i0])
             level = float(np.median(raw[stood[-1] + 1 if stood.size else 0 : i0 + 1]))
             i0 = _before(t, ramp_start(t, delta, i0, _swing_end(t, delta, i0), level), i0)
+        i0 = starts_on_order(log, delta, i0)
     else:
         i0 = min(int(np.searchsorted(t, t_order - 1e-9)), len(t) - 1)
     psi = unwrapped_heading(log)
