@@ -136,6 +136,15 @@ def test_exports_reproduce_the_simulator(tmp_path, method):
     assert "import shipid" not in text and "from shipid" not in text
     got = mod.simulate(t, np.column_stack([d, n, ws, wa]), [1.5, 0, 0, 0, 0, 0], method)
     np.testing.assert_allclose(got, ref, atol=1e-9, rtol=0)
+    # u, v, r alone start at psi = x = y = 0; a wrong shape or method is named, not broadcast.
+    short = mod.simulate(t, np.column_stack([d, n, ws, wa]), [1.5, 0, 0], method)
+    np.testing.assert_array_equal(short, got)
+    with pytest.raises(ValueError, match="state0: 4 values"):
+        mod.simulate(t, np.column_stack([d, n, ws, wa]), [1.5, 0, 0, 0], method)
+    with pytest.raises(ValueError, match=r"inputs: \(600,\) values for 600 times and 4"):
+        mod.simulate(t, d, [1.5, 0, 0], method)
+    with pytest.raises(ValueError, match="method must be 'euler' or 'rk4', got 'RK4'"):
+        mod.simulate(t, np.column_stack([d, n, ws, wa]), [1.5, 0, 0], "RK4")
     sys = to_control(m, dt=0.1, method=method)
     resp = control.input_output_response(sys, t, np.vstack([d, n, ws, wa]), [1.5, 0, 0, 0, 0, 0])
     np.testing.assert_allclose(resp.states.T, ref, atol=1e-9, rtol=0)
