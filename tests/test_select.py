@@ -283,3 +283,18 @@ def test_the_default_library_leaves_out_what_the_logs_cannot_give(tmp_path, caps
     code = main(["select", *map(str, paths), "--quiet", "--library", "low-speed+wind",
                  "-o", str(tmp_path / "m2.json")])  # fmt: skip
     assert code == 1 and "needs the log column" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(("option", "message"), [
+    (["--cv", "blocks:1"], "--cv must be 'logo' or 'kfold:K' or 'blocks:K' with K ≥ 2"),
+    (["--gammas", "-1"], "--gammas must be numbers > 0, got '-1'"),
+    (["--gammas", "1,x"], "--gammas expects numbers separated by commas"),
+    (["--library", "blanke-speed+"], "'blanke-speed+': an empty name between '+' signs"),
+])
+def test_cli_select_checks_its_options_before_reading_the_logs(tmp_path, capsys, option, message):
+    """The logs are not there: an option's error must come first, and alone (it came after the
+    logs were read, behind their warnings; '+' at the end was 'unknown model ''')."""
+    missing = [str(tmp_path / "a.csv"), str(tmp_path / "b.csv")]
+    assert main(["select", *missing, *option, "-o", str(tmp_path / "m.json")]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and message in err, err

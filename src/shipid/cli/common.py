@@ -315,9 +315,12 @@ def _parse_gammas(text: str | None) -> tuple[float, ...] | None:
     if not text:
         return None
     try:
-        return tuple(float(x) for x in text.split(",") if x.strip())
+        gammas = tuple(float(x) for x in text.split(",") if x.strip())
     except ValueError:
         raise ShipidError(f"--gammas expects numbers separated by commas, got {text!r}") from None
+    if not gammas or not all(math.isfinite(g) and g > 0 for g in gammas):
+        raise ShipidError(f"--gammas must be numbers > 0, got {text!r}")
+    return gammas
 
 
 def _pd():

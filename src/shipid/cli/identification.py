@@ -490,21 +490,23 @@ def _auto_gamma(args, logs, names, physics=None) -> tuple[float, dict]:
 
 def cmd_select(args) -> int:
     """``shipid select``: structure and γ by cross-validated free-run error."""
-    from shipid.identification.select import RESAMPLES, SelectOptions, select
+    from shipid.dynamics.model import get_structure
+    from shipid.identification.cross_validation import parse_cv
+    from shipid.identification.select import RESAMPLES, SelectOptions, default_library, select
     from shipid.outputs import OutputSet, check_outputs
     from shipid.reporting.modelfile import model_text
 
     check_outputs({"-o": (args.output, "json"), "--table": (args.table, "log")}, args.logs)
-    logs = _training_logs(args)
-    names = [str(p) for p in args.logs]
-    from shipid.dynamics.model import get_structure
-    from shipid.identification.select import default_library
-
+    # The options logs do not decide, checked before the logs are read.
+    parse_cv(args.cv)
+    gammas = _parse_gammas(args.gammas)
     try:
-        library = (get_structure(args.library) if args.library is not None
-                   else default_library(logs)[0])  # fmt: skip
+        given = get_structure(args.library) if args.library is not None else None
     except ValueError as exc:
         raise ShipidError(str(exc)) from None
+    logs = _training_logs(args)
+    names = [str(p) for p in args.logs]
+    library = given if given is not None else default_library(logs)[0]
     # The default library is passed as None: select trims it to the logs and says so.
     options = SelectOptions(library=library if args.library is not None else None,
                             search=args.search, cv=args.cv,
@@ -514,7 +516,7 @@ def cmd_select(args) -> int:
                             rps=args.rps, one_standard_error=not args.best,
                             progress=not args.quiet, physics=_physics(args, logs, library),
                             average=args.average,
-                            **({"gammas": _parse_gammas(args.gammas)} if args.gammas else {}))
+                            **({"gammas": gammas} if gammas else {}))
     sel = select(logs, options, names=names)
     ident = sel.identification
     if sel.model is not sel.chosen_model:

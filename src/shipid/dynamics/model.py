@@ -256,6 +256,8 @@ def get_structure(name: str | ModelStructure) -> ModelStructure:
     if ":" in name:
         return parse_structure_spec(name)
     parts = [p.strip() for p in name.split("+")]
+    if not all(parts):
+        raise ShipidError(f"model {name!r}: an empty name between '+' signs")
     unknown = [p for p in parts if p not in STRUCTURES]
     if unknown:
         raise ShipidError(f"unknown model {unknown[0]!r}; known models: {', '.join(STRUCTURES)} "
