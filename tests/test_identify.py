@@ -278,3 +278,10 @@ def test_a_true_wind_without_terms_for_it_is_named(clean_zigzag, true_wind, mode
     assert len(notes) == int(noted)
     if noted:
         assert "true wind 2 m/s" in notes[0] and "+wind" in notes[0]
+
+
+def test_identify_refuses_a_malformed_cv_before_reading(tmp_path, capsys):
+    """Without --gamma auto or --residual a malformed --cv went unnoticed."""
+    code, _, err = run(["identify", tmp_path / "absent.csv", "--cv", "foo", "-o",
+                        tmp_path / "m.json"], capsys)  # fmt: skip
+    assert code == 1 and err.count("\n") == 1 and "--cv must be 'logo'" in err

@@ -90,6 +90,10 @@ def cmd_identify(args) -> int:
     if args.residual and (args.refine or asked or args.bootstrap is not None):
         raise ShipidError("--residual adds a kernel residual to the LS-SVM fit; it does not go "
                           "with --refine, --output-error or --bootstrap")  # fmt: skip
+    if args.cv is not None:
+        from shipid.identification.cross_validation import parse_cv
+
+        parse_cv(args.cv)  # before the logs are read; 'foo' went unnoticed without --gamma auto
     logs = _training_logs(args)
     raw_logs = logs  # the output-error fit needs the noise as measured, not prefiltered
     names = [str(p) for p in args.logs]
