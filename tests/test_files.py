@@ -205,6 +205,9 @@ def model_doc(tmp_path, trial_csv, capsys):
     (lambda d: d["identification"]["preprocessing"].update({"approach_speed": "fast"}),
      "approach_speed"),
     (lambda d: d["model"]["structure"]["terms"]["u"].append("w^2"), "unknown signal 'w'"),
+    # Read as 0 before: a ship without its yaw coefficients never turned, and nothing said so.
+    (lambda d: d["model"]["coefficients"].pop("r"), r"model\.coefficients\.r has no value for 'u\*r'"),
+    (lambda d: d["model"]["coefficients"]["v"].pop("u*r"), r"coefficients\.v has no value for 'u\*r',"),
 ])  # fmt: skip
 @pytest.mark.parametrize("command", ["validate", "simulate", "manoeuvre"])
 def test_malformed_model_files_give_one_line(tmp_path, trial_csv, capsys, model_doc, edit, match,

@@ -250,6 +250,24 @@ def has_refinement(doc: Mapping) -> bool:
     return bool((doc.get("identification") or {}).get("refinement"))
 
 
+def _check_every_term(data: Mapping, model: ManoeuvringModel, path: str | Path) -> None:
+    """A model file gives a coefficient for every term of its structure (0 where it has none):
+    the constructor's zero for a term not given (a convenience of the Python API) made a file
+    with its yaw coefficients cut out a ship that never turns, without a word."""
+    from shipid.dynamics.terms import parse_term
+
+    given = data.get("coefficients") or {}
+    for dof, names in model.structure.terms.items():
+        raw = given.get(dof)
+        have = {parse_term(k).text for k in raw} if isinstance(raw, Mapping) else set()
+        missing = [n for n in names if n not in have]
+        if missing:
+            raise ShipidError(f"{path}: model.coefficients.{dof} has no value for "
+                              f"{', '.join(map(repr, missing))}, a term of its {dof} equation "
+                              "(a model file gives every term's coefficient, 0 where it has "
+                              "none): a damaged or hand-edited file?")  # fmt: skip
+
+
 def model_from_document(doc: dict, path: str | Path, which: str = "model",
                         hybrid: bool = False) -> ManoeuvringModel | HybridModel:  # fmt: skip
     """The model (or, with ``which='lssvm'``, the LS-SVM one) of a parsed model file. A file with
@@ -266,6 +284,7 @@ def model_from_document(doc: dict, path: str | Path, which: str = "model",
         raise ShipidError(f"{path}: {exc}") from None
     except (KeyError, TypeError, ValueError) as exc:
         raise ShipidError(f"{path}: malformed model ({exc})") from None
+    _check_every_term(data, model, path)
     record = doc.get("kernel_residual")
     if record is None:
         return model
