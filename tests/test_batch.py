@@ -72,6 +72,16 @@ def test_the_command_writes_every_model_and_names_a_failed_job(logs, capsys):
     ([{"name": "a", "logs": ["logs/zz15.csv"], "options": {"output": "x.json"}}], "set by the study"),
     ([{"name": "a", "logs": ["logs/zz15.csv"], "model": "blanke"}], "unknown key 'model'"),
     ([], "give a list of jobs"),
+    # Each made argparse exit inside the job: the study ended with exit 2 and no word, or kept
+    # the last of a list silently.
+    ([{"name": "a", "logs": ["logs/zz15.csv"], "options": {"bogus": 1}}],
+     r"jobs\[0\]: options: unrecognized arguments: --bogus 1 \(shipid identify --help\)"),
+    ([{"name": "a", "logs": ["logs/zz15.csv"], "options": {"dt": "abc"}}],
+     "argument --dt: invalid float value: 'abc'"),
+    ([{"name": "a", "command": "select", "logs": ["logs/zz15.csv"], "options": {"filter": 1}}],
+     "unrecognized arguments: --filter 1 \\(shipid select --help\\)"),
+    ([{"name": "a", "logs": ["logs/zz15.csv"], "options": {"filter": [1, 2]}}],
+     "filter takes one value, not a list"),
 ])  # fmt: skip
 def test_bad_jobs_are_named(logs, jobs, message):
     with pytest.raises(ShipidError, match=message.replace("*", r"\*")):

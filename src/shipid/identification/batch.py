@@ -73,9 +73,13 @@ class BatchSpec:
         jobs = spec.get("jobs")
         if not isinstance(jobs, list) or not jobs:
             raise ShipidError(f"{where}jobs: give a list of jobs (name, command, logs, options)")
+        from shipid.cli.parser import build_parser
+
+        parser = build_parser()
         out, names = [], set()
         for i, job in enumerate(jobs):
             out.append(_job(i, job, f"{where}jobs[{i}]", Path(base)))
+            _check_options(parser, out[-1], f"{where}jobs[{i}]")
             if out[-1].name in names:
                 raise ShipidError(f"{where}jobs[{i}]: the name {out[-1].name!r} is used twice")
             names.add(out[-1].name)
@@ -121,6 +125,25 @@ def _job(index: int, job, where: str, base: Path) -> Job:
     return Job(index, name, command, tuple(logs), tuple(argv))
 
 
+def _check_options(parser, job: Job, where: str) -> None:
+    """The job's command line as the command's parser reads it, before any job runs: an option
+    the command does not have made argparse exit inside the job, ending the whole study with
+    exit code 2 and no word (its message went to the job's captured stderr)."""
+    err = io.StringIO()
+    try:
+        with redirect_stderr(err):
+            parsed = parser.parse_args(job.argv(Path(f"{job.name}.json")))
+    except SystemExit:
+        said = [ln for ln in err.getvalue().splitlines() if "error: " in ln]
+        why = said[-1].split("error: ", 1)[1] if said else "not a valid command line"
+        raise ShipidError(f"{where}: options: {why} (shipid {job.command} --help)") from None
+    # A list repeats the option; one that takes a single value kept the last without a word.
+    flags = [a for a in job.options if a.startswith("--")]
+    for flag in sorted({f for f in flags if flags.count(f) > 1}):
+        if not isinstance(getattr(parsed, flag[2:].replace("-", "_"), None), list):
+            raise ShipidError(f"{where}: options: {flag[2:]} takes one value, not a list")
+
+
 def run_job(job: Job) -> dict:
     """Run one job in this process; its row, with the model file's text (or the error)."""
     from shipid.parallel import single_threaded
@@ -138,7 +161,10 @@ def _run_job(job: Job) -> dict:
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / f"{job.name}.json"
         with redirect_stdout(out), redirect_stderr(err):
-            code = main(job.argv(path))
+            try:
+                code = main(job.argv(path))
+            except SystemExit as exc:  # argparse's: the job fails, the study goes on
+                code = exc.code if isinstance(exc.code, int) and exc.code else 2
         lines = err.getvalue().splitlines()
         row["warnings"] = "; ".join(ln[len("warning: "):] for ln in lines
                                     if ln.startswith("warning: "))  # fmt: skip
