@@ -189,6 +189,11 @@ def test_cli_linearise_export_autopilot_follow(tmp_path, capsys):
     assert "truth, model-tuned PID" in out and (tmp_path / "f.png").exists()
     code, _, err = run(["follow", path, "--speed", "1.93", "--waypoints", "0,0"], capsys)
     assert code == 1 and "two 'x,y' pairs" in err
+    # Named before the model runs (the approach's warnings came after the error) and which.
+    for bad, said in [("0,0;40,0;40,0", "waypoints 2 and 3 are the same point 40,0"),
+                      ("0,0;inf,0", "must be finite")]:
+        code, _, err = run(["follow", tmp_path / "absent.json", "--waypoints", bad], capsys)
+        assert code == 1 and err.count("\n") == 1 and said in err, err
 
 
 @pytest.mark.parametrize(("K", "T"), [(0.131, -18.58), (-31.24, -2401.0), (5.039, 344.8)])

@@ -159,6 +159,12 @@ def _parse_waypoints(text: str) -> list[tuple[float, float]]:
         raise ShipidError(f"--waypoints expects 'x,y;x,y;...' in metres, got {text!r}") from None
     if len(pts) < 2 or any(len(p) != 2 for p in pts):
         raise ShipidError(f"--waypoints expects at least two 'x,y' pairs, got {text!r}")
+    if not all(math.isfinite(x) for p in pts for x in p):
+        raise ShipidError(f"--waypoints must be finite numbers, got {text!r}")
+    for k in range(1, len(pts)):
+        if pts[k] == pts[k - 1]:
+            raise ShipidError(f"--waypoints: waypoints {k} and {k + 1} are the same point "
+                              f"{pts[k][0]:g},{pts[k][1]:g}")  # fmt: skip
     return pts
 
 
@@ -168,8 +174,8 @@ def cmd_follow(args) -> int:
     from shipid.outputs import OutputSet, check_outputs
 
     check_outputs({"-o": (args.output, "figure"), "--json": (args.json, "json")}, [])
+    waypoints = _parse_waypoints(args.waypoints)  # before the model is loaded and run
     target, truth, speed, rps, steering, cond = _controlled(args)
-    waypoints = _parse_waypoints(args.waypoints)
     # A reference ship's length, else the model file's particulars', else 10 m.
     length = getattr(target, "length", None)
     if not (length and length == length) and cond.get("particulars") is not None:
