@@ -113,3 +113,19 @@ def test_every_real_log_answers_its_rudder_as_its_format_says():
         assert found.side == log.attrs["rudder_positive"], path.name
         decisive += found.decisive
     assert decisive == len(cases)
+
+
+def test_plot_draws_every_rudder_in_the_first_logs_convention(trials, tmp_path, capsys,
+                                                              monkeypatch):  # fmt: skip
+    """A port-positive and a starboard-positive log drew the same rudder with opposite signs."""
+    from shipid.reporting import plots
+
+    drawn = {}
+    monkeypatch.setattr(plots, "logs_figure", lambda logs, path, title: drawn.update(logs))
+    paths = [write_log(trials[("port", "zigzag")], tmp_path / "port.csv"),
+             write_log(trials[("starboard", "zigzag")], tmp_path / "starboard.csv")]
+    code, _, err = run(["plot", *paths, "-o", tmp_path / "p.png"], capsys)
+    assert code == 0 and "starboard.csv: a positive rudder angle turns it to starboard" in err
+    np.testing.assert_array_equal(drawn["starboard.csv"]["delta"],
+                                  -trials[("starboard", "zigzag")]["delta"].to_numpy())
+    assert drawn["starboard.csv"].attrs["rudder_positive"] == "port"

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from shipid.cli.common import _json_text, _read_logs
+from shipid.cli.common import _json_text, _read_logs, _warn
 from shipid.errors import ShipidError
 
 
@@ -16,11 +16,16 @@ def _number(value: float) -> str:
 
 def cmd_plot(args) -> int:
     """``shipid plot``: a figure of any logs."""
+    from shipid.data.log import common_rudder_convention
     from shipid.outputs import check_outputs
     from shipid.reporting.plots import logs_figure
 
     check_outputs({"-o": (args.output, "figure")}, args.logs)
-    logs = _read_logs(args)
+    # One rudder convention on one axis: a port-positive and a starboard-positive log drew the
+    # same rudder with opposite signs, side by side.
+    logs, notes = common_rudder_convention(_read_logs(args))
+    for note in notes:
+        _warn(note)
     logs_figure({Path(p).name: log for p, log in zip(args.logs, logs, strict=True)}, args.output,
                 args.title or ", ".join(Path(p).name for p in args.logs))  # fmt: skip
     print(f"figure written to {args.output}")

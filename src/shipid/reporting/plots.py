@@ -210,7 +210,10 @@ def logs_figure(logs: Mapping[str, pd.DataFrame], path: str | Path, title: str =
         if extra and "n" in log.columns:
             axes[5].plot(t, log["n"], lw=1.0, label=label)
         track_ax.plot(y - y[0], x - x[0], lw=1.0, label=label)
-    labels = [LABELS["u"], LABELS["v"], LABELS["r"], "rudder δ [deg]", "heading ψ − ψ0 [deg]",
+    sides = {log.attrs.get("rudder_positive") for log in logs.values()}
+    rudder = "rudder δ [deg]" + (f", + to {sides.pop()}" if len(sides) == 1 and None not in sides
+                                 else "")  # fmt: skip
+    labels = [LABELS["u"], LABELS["v"], LABELS["r"], rudder, "heading ψ − ψ0 [deg]",
               "propeller n [rps]"]  # fmt: skip
     for ax, lab in zip(axes, labels, strict=False):
         ax.set_ylabel(lab)
