@@ -613,3 +613,23 @@ def test_a_propeller_speed_in_rpm_is_named_as_such():
     (note,) = outside_envelope(env, pd.DataFrame({"n": np.full(10, 25.0)}))
     assert "rpm" not in note
     assert outside_envelope(env, pd.DataFrame({"n": np.full(10, 12.0)})) == []
+
+
+def test_simulated_logs_carry_the_simulated_ships_metadata(files, tmp_path, capsys):
+    """simulate copied the driving log's metadata: a KVLCC2 run on the scale ship's rudder was
+    written as the scale ship at 1:16.95, with its manoeuvre; a model's runs were at scale 1."""
+    from shipid.data.io import read_log
+
+    log, model = files
+    assert read_log(log).attrs["scale"] == pytest.approx(16.95)
+    assert run(["simulate", "kvlcc2", log, "-o", tmp_path / "k.csv"], capsys)[0] == 0
+    k = read_log(tmp_path / "k.csv").attrs
+    assert (k["ship"], k["scale"], k["rudder_positive"]) == ("kvlcc2", 45.7, "starboard")
+    assert "manoeuvre" not in k and f"driven by the inputs of {log}" in k["source"]
+    assert run(["simulate", model, log, "-o", tmp_path / "s.csv"], capsys)[0] == 0
+    assert read_log(tmp_path / "s.csv").attrs["scale"] == pytest.approx(16.95)
+    assert run(["manoeuvre", model, "turning", "--duration", "30", "-o", tmp_path / "t.csv"],
+               capsys)[0] == 0  # fmt: skip
+    t = read_log(tmp_path / "t.csv").attrs
+    assert (t["ship"], t["scale"]) == ("m.json", pytest.approx(16.95))
+    assert t["manoeuvre"].startswith("turning circle")

@@ -258,6 +258,21 @@ def _log_scale(logs) -> float | None:
         else None
 
 
+def _simulated_metadata(name: str, target, cond: dict) -> dict:
+    """Metadata of a log simulated on ``name`` (a reference ship or a model file): the ship, the
+    source and the scale are the simulated ship's. ``simulate`` copied the driving log's (a
+    KVLCC2 run on the scale ship's rudder was written as the scale ship at 1:16.95, with the
+    log's manoeuvre and gyro offset), and a model file's runs were written at scale 1 whatever
+    the scale of the logs it was identified from."""
+    if hasattr(target, "log_metadata"):
+        return target.log_metadata()
+    out = {"ship": Path(name).name, "source": f"simulated: model file {name}",
+           "scale": float(cond["log_scale"]) if cond.get("log_scale") else 1.0}
+    if cond.get("particulars") is not None:
+        out["particulars"] = cond["particulars"].to_dict()
+    return out
+
+
 def _scale_notes(cond: dict, logs, names) -> list[str]:
     """Logs at another scale than the model's training logs: read with the wrong --scale."""
     trained = cond.get("log_scale")

@@ -17,6 +17,7 @@ from shipid.cli.common import (
     _sampling_notes,
     _scale_notes,
     _ship_or_model,
+    _simulated_metadata,
     _warn,
     _warn_beyond_training,
     _yaw_rate_notes,
@@ -351,6 +352,10 @@ def cmd_simulate(args) -> int:
                  + _sampling_notes(cond, [log], [str(log_path)])):
         _warn(note)
     res = simulate_log(dynamics, log, method=args.method)
+    # The driving log's times and rudder convention; the rest is the simulated ship's.
+    kept = {k: log.attrs[k] for k in ("rudder_positive", "time_origin") if k in log.attrs}
+    res.log.attrs = {**_simulated_metadata(args.model, target, cond), **kept,
+                     "source": f"simulated: {args.model}, driven by the inputs of {log_path}"}
     write_log(res.log, args.output)
     if res.diverged:
         print(res.reason, file=sys.stderr)

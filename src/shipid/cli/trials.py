@@ -12,6 +12,7 @@ from shipid.cli.common import (
     _pd,
     _run_approach,
     _ship_or_model,
+    _simulated_metadata,
     _steering,
     _unused_inputs,
     _warn,
@@ -246,5 +247,8 @@ def cmd_manoeuvre(args) -> int:
         if args.output:
             from shipid.data.io import write_log
 
+            meta = _simulated_metadata(args.model, target, cond)
+            meta.pop("rudder_positive", None)  # the run's own, as the model turns at its speed
+            res.log.attrs.update(meta)
             write_log(res.log, args.output, out=out)
     return 0
