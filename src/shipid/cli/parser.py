@@ -111,6 +111,16 @@ def _block(text: str) -> float | str:
     return value
 
 
+def _add_block_option(p: argparse.ArgumentParser) -> None:
+    """``--block`` of identify's and select's bootstrap (the numbers are
+    ``shipid.identification.uncertainty``'s MIN_WHOLE_LOGS and BLOCK_S, not imported: the parser
+    is built before every command, and that module brings NumPy)."""
+    p.add_argument("--block", type=_block, default="auto", metavar="S|log|auto",
+                   help="with --bootstrap: resample blocks of S seconds, or whole logs ('log': "
+                   "the intervals then hold how the logs differ from one another); 'auto' "
+                   "(default): whole logs from 5 logs on, else 10 s blocks")
+
+
 def _end_time(text: str) -> float | str:
     return text if text == "dropout" else _time_or_auto(text)
 
@@ -204,10 +214,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="uncertainty: N bootstrap refits (≥ 10; e.g. 200; --block), stored in "
                    "the model file: coefficient intervals here, prediction bands and index "
                    "intervals in validate, manoeuvre and criteria")
-    p.add_argument("--block", type=_block, default="auto", metavar="S|log|auto",
-                   help="with --bootstrap: resample blocks of S seconds, or whole logs ('log': "
-                   "the intervals then hold how the logs differ from one another); 'auto' "
-                   "(default): whole logs from 5 logs on, else 10 s blocks")
+    _add_block_option(p)
     p.add_argument("--seed", type=int, default=0, help="with --bootstrap or --output-error: "
                    "random seed "
                    "(default %(default)s)")
@@ -263,10 +270,7 @@ def build_parser() -> argparse.ArgumentParser:
                    "candidate drawn by how often it is chosen on resampled held-out logs, "
                    "refitted on a resample (--block); stored in the model file for bands "
                    "and intervals")
-    p.add_argument("--block", type=_block, default="auto", metavar="S|log|auto",
-                   help="with --bootstrap: resample blocks of S seconds, or whole logs ('log': "
-                   "the intervals then hold how the logs differ from one another); 'auto' "
-                   "(default): whole logs from 5 logs on, else 10 s blocks")
+    _add_block_option(p)
     p.add_argument("--seed", type=int, default=0, help="with --bootstrap: random seed "
                    "(default %(default)s)")
     p.add_argument("--table", metavar="OUT.csv", help="write every candidate with its scores")

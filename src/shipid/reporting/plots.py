@@ -211,8 +211,8 @@ def logs_figure(logs: Mapping[str, pd.DataFrame], path: str | Path, title: str =
             axes[5].plot(t, log["n"], lw=1.0, label=label)
         track_ax.plot(y - y[0], x - x[0], lw=1.0, label=label)
     sides = {log.attrs.get("rudder_positive") for log in logs.values()}
-    rudder = "rudder δ [deg]" + (f", + to {sides.pop()}" if len(sides) == 1 and None not in sides
-                                 else "")  # fmt: skip
+    side = next(iter(sides)) if len(sides) == 1 else None  # None too where no log states one
+    rudder = "rudder δ [deg]" + (f", + to {side}" if side else "")
     labels = [LABELS["u"], LABELS["v"], LABELS["r"], rudder, "heading ψ − ψ0 [deg]",
               "propeller n [rps]"]  # fmt: skip
     for ax, lab in zip(axes, labels, strict=False):

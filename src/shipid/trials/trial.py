@@ -223,6 +223,22 @@ def starts_on_order(log: pd.DataFrame, delta: np.ndarray, i0: int) -> int:
     return i0
 
 
+def execute_index(log: pd.DataFrame, delta: np.ndarray, rudder_noise: float) -> int:
+    """The sample of the first rudder order of ``log`` (``delta`` its rudder for events,
+    ``rudder_for_events``): the first swing from the first angle to at least half the largest
+    deflection (``first_swing_index``), or an earlier, smaller one to the trial's plateau
+    (``earlier_order``); on a noisy rudder the ramp extended back to where it left the approach;
+    the first sample where the log starts on the order (``starts_on_order``)."""
+    t, raw = log["t"].to_numpy(), log["delta"].to_numpy()
+    stand = stand_samples(t) if rudder_noise else 0
+    i0 = earlier_order(t, delta, first_swing_index(delta, stand), stand)
+    if rudder_noise:  # the dead band left the approach late: extend the ramp back
+        stood = np.flatnonzero(delta[: i0 + 1] != delta[i0])
+        level = float(np.median(raw[stood[-1] + 1 if stood.size else 0 : i0 + 1]))
+        i0 = _before(t, ramp_start(t, delta, i0, _swing_end(t, delta, i0), level), i0)
+    return starts_on_order(log, delta, i0)
+
+
 def _before(t: np.ndarray, when: float, latest: int) -> int:
     """The last sample at or before ``when``, no later than ``latest``."""
     return max(0, min(latest, int(np.searchsorted(t, when, side="right")) - 1))
@@ -273,16 +289,8 @@ def describe_trial(
     t = log["t"].to_numpy()
     raw = log["delta"].to_numpy()
     delta, rudder_noise = rudder_for_events(t, raw)
-    if t_order is None:
-        stand = stand_samples(t) if rudder_noise else 0
-        i0 = earlier_order(t, delta, first_swing_index(delta, stand), stand)
-        if rudder_noise:  # the dead band left the approach late: extend the ramp back
-            stood = np.flatnonzero(delta[: i0 + 1] != delta[i0])
-            level = float(np.median(raw[stood[-1] + 1 if stood.size else 0 : i0 + 1]))
-            i0 = _before(t, ramp_start(t, delta, i0, _swing_end(t, delta, i0), level), i0)
-        i0 = starts_on_order(log, delta, i0)
-    else:
-        i0 = min(int(np.searchsorted(t, t_order - 1e-9)), len(t) - 1)
+    i0 = (execute_index(log, delta, rudder_noise) if t_order is None
+          else min(int(np.searchsorted(t, t_order - 1e-9)), len(t) - 1))  # fmt: skip
     psi = unwrapped_heading(log)
     psi0 = float(np.mean(psi[: i0 + 1]))
     dpsi = psi - psi0
