@@ -54,6 +54,13 @@ def test_instant_rudder_zigzag_warns_that_delta_squared_is_not_identifiable():
     log = zigzag(scale_ship(), 20, 20, duration=60, dt=0.2, method="euler").log
     fit = identify(log, gamma=1e4)
     assert any("δ²" in w and "not identifiable" in w for w in fit.warnings)
+    # Bug: its standard error was the regulariser's ~1e-12, printed as if δ² were known to be 0.
+    assert fit.diagnostics["u"]["std_errors"]["delta^2"] == np.inf
+    assert np.isfinite(fit.diagnostics["u"]["std_errors"]["|u|*u"])
+    text = fit.model.equations(std_errors={d: fit.diagnostics[d]["std_errors"] for d in "uvr"})
+    assert "± ∞) δ²" in text and text.count("∞") == 1
+    # A model file keeps the infinite error as null, and reads it back as ∞.
+    assert "± ∞) δ²" in fit.model.equations(std_errors={"u": {"delta^2": None}})
 
 
 def test_paper_noise_prediction_errors_against_the_paper_table():

@@ -418,17 +418,21 @@ class ManoeuvringModel:
     # ------------------------------------------------------------------ presentation
     def equations(self, precision: int = 4, std_errors: Mapping | None = None) -> str:
         """The model as equations in the paper's style (eq. 16); with ``std_errors``
-        ({dof: {term: σ}}), each coefficient is followed by ± its standard error."""
+        ({dof: {term: σ}}), each coefficient is followed by ± its standard error: ± ∞ where the
+        error is infinite or recorded as null (a model file's JSON keeps an infinite one as
+        null), the coefficient the data do not determine."""
         lines = []
         for dof in self.structure.dofs:
+            errors = (std_errors or {}).get(dof) or {}
             parts = []
             for n, c in self.coefficients[dof].items():
                 # Coefficients of large regressors (|n|n ~ 100 rps²) are tiny: keep their digits.
                 small = 0 < abs(c) < 10 ** (1 - precision)
                 mag = f"{abs(c):.{precision - 1}e}" if small else f"{abs(c):.{precision}f}"
-                se = ((std_errors or {}).get(dof) or {}).get(n)
-                if se is not None and math.isfinite(se):
-                    mag = f"({mag} ± {se:.2g})"
+                if n in errors:
+                    se = errors[n]
+                    finite = se is not None and math.isfinite(se)
+                    mag = f"({mag} ± {f'{se:.2g}' if finite else '∞'})"
                 term = parse_term(n).display()
                 sign = "−" if c < 0 else "+"
                 parts.append((sign, f"{mag} {term}".rstrip()))

@@ -99,7 +99,9 @@ def _diagnose(p: RegressionProblem, coef: np.ndarray, bias: float, gamma: float
     G = Xc.T @ Xc
     A_inv = np.linalg.pinv(G + np.eye(G.shape[0]) / gamma)
     cov = sigma2 * A_inv @ G @ A_inv
-    se = np.sqrt(np.clip(np.diag(cov), 0, None))
+    # A constant term's column is all bias: the data say nothing of its coefficient, which the
+    # regulariser alone sets (to ~0, with a covariance of ~0). Its error is infinite, not tiny.
+    se = np.where(constant, np.inf, np.sqrt(np.clip(np.diag(cov), 0, None)))
     increment = y - X[:, 0] if p.form == "paper" else y
     pred_increment = fitted - (X[:, 0] if p.form == "paper" else 0.0)
     ss_tot = float(np.sum((increment - increment.mean()) ** 2))
