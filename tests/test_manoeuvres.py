@@ -98,6 +98,14 @@ def test_manoeuvre_log_replays_exactly_with_simulate_log():
     np.testing.assert_allclose(again.log.to_numpy(), res.log.to_numpy(), rtol=1e-12, atol=1e-12)
 
 
+def test_a_model_s_manoeuvre_says_no_scale_it_does_not_know():
+    # Bug: a model (which carries no scale) wrote its runs at scale 1, read back as full scale.
+    ship = scale_ship()
+    log = zigzag(ship.dynamics, 20, 20, duration=30, speed=1.9).log
+    assert "scale" not in log.attrs and log.attrs["rudder_positive"] == ship.rudder_positive
+    assert zigzag(ship, 20, 20, duration=30).log.attrs["scale"] == ship.scale
+
+
 @pytest.mark.parametrize(
     ("kwargs", "match"),
     [({"heading_deg": 0.0}, "heading switch"), ({"rudder_deg": 40.0}, "beyond the steering"),

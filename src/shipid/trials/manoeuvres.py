@@ -127,7 +127,7 @@ def as_vessel(ship: Vessel | ManoeuvringModel | HybridModel, speed: float | None
         vessel = Vessel(ship.name, ship, length=float("nan"), approach_speed=speed,
                         steering=steering or SteeringMachine(),
                         rudder_positive=ship.rudder_positive_turns_at(speed, rps),
-                        source=ship.name)  # fmt: skip
+                        scale=float("nan"), source=ship.name)  # fmt: skip
     else:
         raise TypeError(f"expected a Vessel, ManoeuvringModel or HybridModel, got "
                         f"{type(ship).__name__}")

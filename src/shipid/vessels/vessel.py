@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from shipid.dynamics.steering import SteeringMachine
@@ -41,7 +42,8 @@ class Vessel:
     approach_speed : straight-running surge speed [m/s] at which the ship is trimmed
     steering : the rudder servo of the ship
     rudder_positive : 'port' or 'starboard', where a positive rudder angle turns the ship
-    scale : λ (1 at full scale)
+    scale : λ (1 at full scale); NaN where it is not known (a vessel built from an identified
+        model, which carries no scale), and then its logs say none
     """
 
     name: str
@@ -55,5 +57,10 @@ class Vessel:
 
     def log_metadata(self) -> dict:
         """Metadata of the logs this vessel's simulations produce."""
-        return {"ship": self.name, "source": f"simulated: {self.source}",
-                "rudder_positive": self.rudder_positive, "scale": self.scale}  # fmt: skip
+        out = {"ship": self.name, "source": f"simulated: {self.source}",
+               "rudder_positive": self.rudder_positive}  # fmt: skip
+        # An unknown scale is left out: a log that said 1 was read as full scale (validate then
+        # told the user to re-read it with the model's own --scale).
+        if math.isfinite(self.scale):
+            out["scale"] = self.scale
+        return out
