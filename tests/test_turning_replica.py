@@ -311,3 +311,24 @@ def test_a_wind_models_manoeuvre_logs_the_wind_it_met():
         np.testing.assert_allclose(replay[c], log[c], atol=1e-12, err_msg=c)
     still = zigzag(model, 20, 20, duration=60, dt=0.1, speed=0.45, rps=RPS, method="euler").log
     assert mean_true_wind(still)[0] == pytest.approx(0.0, abs=1e-12)  # still air: no wind
+
+
+@pytest.mark.parametrize("kind", ["turning", "pull-out"])
+@pytest.mark.parametrize("side", ["starboard", "port"])
+def test_the_replica_of_a_turn_logged_from_its_order(kind, side):
+    """The scale ship's rudder is instantaneous, so its runs are logged from the order, the
+    rudder over at the first sample. Bugs: the held angle was read as the largest swing from the
+    first sample, none for a turn (validate stopped: "rudder angle must be > 0, got 0.0") and
+    the release for a pull-out, whose replica then turned the other way."""
+    from shipid.trials.manoeuvres import pull_out
+    from shipid.vessels import scale_ship
+
+    ship = scale_ship()
+    run = {"dt": 0.1, "method": "euler"}  # validate's closed loop: the same run exactly
+    log = (turning_circle(ship, 35, side, duration=60, **run) if kind == "turning"
+           else pull_out(ship, 35, side, hold=60, release=30, **run)).log  # fmt: skip
+    (v,) = validate(ship.dynamics, log)
+    measured, closed = v.indices["measured"], v.indices["closed_loop"]
+    assert closed["turn_direction"] == measured["turn_direction"] == side
+    for k in ("advance", "transfer", "tactical_diameter", "steady_yaw_rate"):
+        assert closed[k] == pytest.approx(measured[k], rel=1e-6), k

@@ -394,16 +394,18 @@ def turning_circle(
     rps: float | None = None,
     wind: tuple[float, float] | None = None,
     initial: Mapping[str, float] | None = None,
+    release: float = math.inf,
 ) -> ManoeuvreResult:
     """Turning circle: rudder to ``side`` at t = ``approach`` (the rudder execute), held.
     ``duration`` [s]: by default 240 s, doubled until the heading has turned 180° and the turn is
     steady. ``initial`` (u, v, r, psi, delta) starts the run from a given state, the rudder held
-    at its ``delta`` until ``approach`` (as ``zigzag``'s)."""
+    at its ``delta`` until ``approach`` (as ``zigzag``'s). ``release``: the time the rudder goes
+    back to midships (a measured turn that ends in a pull-out; the indices are the held turn's)."""
     vessel = as_vessel(ship, speed, steering, rps)
     value = _rudder_to(side, vessel, rudder_deg)
     held = float((initial or {}).get("delta", 0.0))
-    params = manoeuvre_params(vessel, kernel.MODE_HOLD, value, held, approach, rps=rps,
-                              wind=_check_wind(wind))  # fmt: skip
+    params = manoeuvre_params(vessel, kernel.MODE_HOLD, value, held, approach, release=release,
+                              rps=rps, wind=_check_wind(wind))  # fmt: skip
 
     def run(length: float) -> ManoeuvreResult:
         res = run_closed_loop(vessel, params, length, dt, method, initial=initial, rps=rps)

@@ -341,7 +341,11 @@ def describe_trial(
     if heading_deg is not None:
         switch = float(heading_deg)
     held_end = _held_end(t, delta, i0)
-    swing = np.abs(delta - delta[0])
+    # The swing from the rudder before the order; a log that starts on its order (the rudder
+    # over from the first sample) came from midships. From its first sample, a turn held from
+    # there never swung (plateau 0) and a pull-out's largest swing was its release: validate's
+    # replica of either stopped on "rudder angle must be > 0, got 0.0".
+    swing = np.abs(delta - (delta[0] if i0 > 0 else 0.0))
     plateau_angle = float(np.median(np.abs(raw[swing > 0.8 * swing.max()]))) if swing.max() > 0 \
         else 0.0
     facts = dict(execute_index=i0, execute_time=float(t[i0]), psi0=psi0, neutral=neutral,
