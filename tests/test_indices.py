@@ -14,7 +14,7 @@ from shipid.data.log import make_log
 from shipid.data.trim import trim
 from shipid.errors import ShipidError
 from shipid.trials.indices import manoeuvre_indices, turning_indices, zigzag_indices
-from shipid.trials.manoeuvres import pull_out, turning_circle, zigzag
+from shipid.trials.manoeuvres import pull_out, spiral, turning_circle, zigzag
 from shipid.trials.trial import describe_trial
 from shipid.vessels import PAPER_IMU, scale_ship
 
@@ -299,3 +299,16 @@ def test_indices_print_an_epoch_execute_time_in_full(tmp_path, capsys, clean_zig
     write_log(log, path)
     assert main(["indices", str(path)]) == 0
     assert "first_execute_time: 1700000001.8" in capsys.readouterr().out  # was 1.7e+09
+
+
+def test_a_spiral_is_no_turning_circle():
+    """Bug: a spiral's log (here the scale ship's, 30 s a step) was read as a turning circle of
+    advance, transfer and tactical diameter 0, from an execute found 600 s in, after the ship
+    had turned 3300°."""
+    log = spiral(INSTANT, (-25, -10, -2, 0, 2, 10, 25), hold=30, dt=0.1).log
+    trial = describe_trial(log)
+    assert trial.kind == "other" and "before the first rudder order" in trial.reason
+    assert manoeuvre_indices(log) == {"kind": "other", "reason": trial.reason}
+    # A turn's straight approach, however long, is none of that.
+    turn = turning_circle(SHIP, 35, duration=80, dt=0.1, approach=60).log
+    assert describe_trial(turn).kind == "turning"

@@ -33,6 +33,8 @@ AMPLITUDE_SPREAD = 0.4  # zig-zag swings within ±40 % of the median swing
 SWITCH_SPREAD = (0.3, 3.0)  # zig-zag switch headings within this factor of the median
 MIN_SWITCH = math.radians(3.0)  # IMO zig-zags switch at 5°–20°; a 2° "switch" is helm noise
 MAX_ZIGZAG_HEADING = math.radians(90.0)
+# Heading change before the first order beyond which the log has no straight approach.
+MAX_APPROACH_TURN = math.radians(90.0)
 HELD_TOLERANCE = math.radians(3.0)  # a held rudder stays within this of its plateau (or 15 %)
 PLATEAU_TOLERANCE = math.radians(0.5)
 # Heading noise above this is fused with the yaw rate (the Esso Osaka's logs show 0.06-0.1°,
@@ -395,6 +397,13 @@ def _swing_end(t: np.ndarray, delta: np.ndarray, i0: int, stand_s: float = 1.0) 
 def _classify(log, dpsi, dev, side, i0, held_end, amplitudes, orders) -> tuple[str, str]:
     if not amplitudes:
         return "other", "the rudder never swings"
+    # A turn or zig-zag is measured from the heading of a straight approach. A spiral had turned
+    # 3300° at the step its execute was found at, and read as a turning circle of advance 0.
+    before = float(np.ptp(dpsi[: i0 + 1]))
+    if before > MAX_APPROACH_TURN:
+        return "other", (f"the heading turns {math.degrees(before):.0f}° before the first rudder "
+                         "order: no straight approach (a spiral, or a log cut inside a "
+                         "manoeuvre)")  # fmt: skip
     n = log["n"].to_numpy()[i0:] if "n" in log.columns else None
     reversed_prop = n is not None and np.min(n) < 0 < np.max(n)
     turned = np.abs(dpsi[i0 : held_end + 1])
