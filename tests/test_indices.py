@@ -34,7 +34,10 @@ def test_steady_turn_ignores_the_pull_out_that_ends_a_measured_turn():
     # It says which span it used: to where the rudder (9.6 °/s) leaves the held angle.
     assert ind["steady_to"] == pytest.approx(200.0, abs=1.0)
     assert ind["steady_from"] > 20.0
-    assert manoeuvre_indices(log)["kind"] == "turning"
+    # The turn and its release: a pull-out, whose turn is read as a turning circle's.
+    read = manoeuvre_indices(log)
+    assert read["kind"] == "pull-out"
+    assert {k: read[k] for k in ind} == ind
 
 
 @pytest.fixture(scope="module")
@@ -278,9 +281,41 @@ def test_a_pull_out_logged_from_its_order_reads_its_turn_before_the_release():
     log = pull_out(INSTANT, 35, hold=60, release=60, dt=0.1).log
     turn = turning_circle(INSTANT, 35, duration=60, dt=0.1).indices
     read = manoeuvre_indices(log)
-    assert read["kind"] == "turning"
+    assert read["kind"] == "pull-out"
     for key in ("advance", "transfer", "tactical_diameter"):
         assert read[key] == pytest.approx(turn[key], rel=0.01)
+
+
+@pytest.mark.parametrize("ship", [INSTANT, SHIP], ids=["instant rudder", "9.6 °/s"])
+@pytest.mark.parametrize("side", ["starboard", "port"])
+def test_a_pull_out_log_reads_its_release_as_the_manoeuvre_gave_it(ship, side):
+    """Bug: a pull-out's log was read as a turning circle, without its yaw rates at the release
+    and at the end (what the test is for: a straight-line stable ship's residual goes to 0)."""
+    res = pull_out(ship, 20, side, hold=60, release=40, dt=0.1)
+    read = manoeuvre_indices(res.log)
+    assert read["kind"] == "pull-out" and read["release_time"] == pytest.approx(60.0)
+    for key in ("yaw_rate_at_release", "residual_yaw_rate", "residual_fraction"):
+        assert read[key] == pytest.approx(res.indices[key], rel=1e-9), key
+    # The residual against an independent reading: the stable ship's decay, e^(λ t) from the
+    # release, its slowest sway–yaw eigenvalue λ < 0 (a mean over the last 2 s of 40).
+    assert abs(read["residual_yaw_rate"]) < 0.05 * abs(read["yaw_rate_at_release"])
+    assert np.sign(read["yaw_rate_at_release"]) == np.sign(read["steady_yaw_rate"])
+
+
+def test_a_noisy_pull_out_is_read_as_one():
+    res = pull_out(SHIP, 20, hold=60, release=40, dt=0.1)
+    for seed in range(3):
+        read = manoeuvre_indices(PAPER_IMU.apply(res.log, seed))
+        assert read["kind"] == "pull-out", read.get("reason")
+        assert read["yaw_rate_at_release"] == pytest.approx(res.indices["yaw_rate_at_release"],
+                                                            abs=0.01)  # fmt: skip
+        assert read["residual_yaw_rate"] == pytest.approx(res.indices["residual_yaw_rate"],
+                                                          abs=0.005)  # fmt: skip
+
+
+def test_a_turn_released_briefly_at_its_end_stays_a_turn():
+    log = pull_out(SHIP, 35, hold=200, release=20, dt=0.1).log
+    assert manoeuvre_indices(log)["kind"] == "turning"
 
 
 def test_a_straight_approach_with_the_helm_held_over_is_not_the_order(clean_turn):
@@ -312,3 +347,15 @@ def test_a_spiral_is_no_turning_circle():
     # A turn's straight approach, however long, is none of that.
     turn = turning_circle(SHIP, 35, duration=80, dt=0.1, approach=60).log
     assert describe_trial(turn).kind == "turning"
+
+
+def test_the_command_line_knows_every_kind(tmp_path, capsys):
+    from shipid.cli.common import KINDS as CLI_KINDS
+    from shipid.trials.trial import KINDS
+
+    assert CLI_KINDS == KINDS
+    path = tmp_path / "pull-out.csv"
+    write_log(pull_out(SHIP, 20, hold=60, release=40, dt=0.1).log, path)
+    assert main(["indices", str(path), "--kind", "pull-out"]) == 0
+    out = capsys.readouterr().out
+    assert "pull-out" in out and "residual_yaw_rate" in out

@@ -329,6 +329,9 @@ def test_the_replica_of_a_turn_logged_from_its_order(kind, side):
            else pull_out(ship, 35, side, hold=60, release=30, **run)).log  # fmt: skip
     (v,) = validate(ship.dynamics, log)
     measured, closed = v.indices["measured"], v.indices["closed_loop"]
+    assert v.kind == kind
     assert closed["turn_direction"] == measured["turn_direction"] == side
-    for k in ("advance", "transfer", "tactical_diameter", "steady_yaw_rate"):
+    shared = ("advance", "transfer", "tactical_diameter", "steady_yaw_rate") + \
+        (("yaw_rate_at_release", "residual_yaw_rate") if kind == "pull-out" else ())  # fmt: skip
+    for k in shared:
         assert closed[k] == pytest.approx(measured[k], rel=1e-6), k

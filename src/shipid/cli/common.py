@@ -13,7 +13,7 @@ from shipid.errors import ShipidError, ShipidWarning
 
 VESSEL_NAMES = ("scale-ship", "mariner", "kvlcc2")
 LINEAR_ESTIMATORS = ("lssvm", "ols", "ridge", "lasso", "svr")
-KINDS = ("zigzag", "turning", "other")
+KINDS = ("zigzag", "turning", "pull-out", "other")  # trials.trial.KINDS, without its imports
 
 
 # ---------------------------------------------------------------------------- shared options

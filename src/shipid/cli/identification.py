@@ -579,6 +579,8 @@ def cmd_select(args) -> int:
 
 
 def _fold_table(folds) -> str:
+    from shipid.trials.trial import TURN_KINDS
+
     pd = _pd()
 
     rows = []
@@ -591,7 +593,7 @@ def _fold_table(folds) -> str:
         meas = ind.get("measured", {})
         # Zig-zags: the closed-loop run of the trial on the model, not the open-loop replay.
         sim = ind.get("closed_loop") or {} if f.get("kind") == "zigzag" else ind.get("simulated", {})
-        key = "tactical_diameter" if f.get("kind") == "turning" else "first_overshoot_deg"
+        key = "tactical_diameter" if f.get("kind") in TURN_KINDS else "first_overshoot_deg"
         rows.append({"held-out log": Path(f["held_out"]).name, "kind": f.get("kind"),
                      "u err / spread": f"{m['u']:.4f} / {sp['u']:.4f}",
                      "v err / spread": f"{m['v']:.4f} / {sp['v']:.4f}",

@@ -50,7 +50,7 @@ from shipid.identification.uncertainty import (
 )
 from shipid.trials.indices import BOOKKEEPING, manoeuvre_indices, zigzag_indices
 from shipid.trials.manoeuvres import ManoeuvreResult, turning_circle, zigzag
-from shipid.trials.trial import Trial, describe_trial
+from shipid.trials.trial import TURN_KINDS, Trial, describe_trial
 from shipid.vessels.vessel import Vessel
 
 STATES = ("u", "v", "r")
@@ -392,7 +392,7 @@ def trial_replica(model, log: pd.DataFrame, method: str = "euler", trial: Trial 
     trial = trial or describe_trial(log)
     if trial.kind == "zigzag":
         return trial_zigzag(model, log, method, trial, start)
-    if trial.kind == "turning":
+    if trial.kind in TURN_KINDS:  # a pull-out's replica is released where the log was
         return trial_turning(model, log, method, trial, start)
     return None
 
@@ -418,9 +418,8 @@ def trial_turning(model, log: pd.DataFrame, method: str = "euler", trial: Trial 
     initial, rps, wind = _replica_start(model, log, trial, start)
     # A turn that ends in a pull-out is released where the log's was: held on, the replica's
     # steady turn was read over a later span than the log's (0.16 % on the scale ship's).
-    t = log["t"].to_numpy()
-    end = trial.held_end_index
-    release = float(t[end + 1] - t[0]) if end + 1 < len(t) else math.inf
+    release = math.inf if trial.release_time is None else \
+        trial.release_time - float(log["t"].iloc[0])  # fmt: skip
     return turning_circle(model, math.degrees(trial.plateau_angle),
                           "starboard" if turns > 0 else "port", speed=initial["u"], method=method,
                           rps=rps, initial=initial, release=release,

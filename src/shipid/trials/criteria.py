@@ -30,6 +30,7 @@ from shipid.dynamics.model import ManoeuvringModel
 from shipid.dynamics.steering import SteeringMachine
 from shipid.errors import ShipidError
 from shipid.trials.manoeuvres import stopping, turning_circle, without_value, zigzag
+from shipid.trials.trial import TURN_KINDS
 from shipid.vessels.vessel import Vessel
 
 SOLAS_RUDDER_RATE_DEG = 2.32
@@ -215,7 +216,7 @@ def measured_criteria(indices: dict, rudder_deg: float, switch_deg: float | None
     kind = indices.get("kind")
     rows = []
     near = lambda a, b: a is not None and abs(a - b) <= 1.5  # noqa: E731
-    if kind == "turning" and near(rudder_deg, 35.0):
+    if kind in TURN_KINDS and near(rudder_deg, 35.0):  # a pull-out's turn before its release
         rows.append(_row("advance", "turning 35°", _in_l(indices.get("advance"), L), 4.5, "L"))
         rows.append(_row("tactical diameter", "turning 35°",
                          _in_l(indices.get("tactical_diameter"), L), 5.0, "L"))  # fmt: skip

@@ -61,7 +61,8 @@ def _rts_smooth(z: np.ndarray, w: np.ndarray, R: float, q: float) -> np.ndarray:
 
 # Where and how an index was measured (the switch heading, the execute time, the span of the
 # steady turn), not a property of the ship: no interval is drawn over them.
-BOOKKEEPING = ("switch_heading_deg", "first_execute_time", "steady_from", "steady_to")
+BOOKKEEPING = ("switch_heading_deg", "first_execute_time", "steady_from", "steady_to",
+               "release_time")  # fmt: skip
 
 
 def smoothed_positions(t, x, y, u, v, psi) -> tuple[np.ndarray, np.ndarray]:
@@ -324,9 +325,46 @@ def _circle_fit_radius(x: np.ndarray, y: np.ndarray) -> float:
     return float(math.sqrt(max(c + cx * cx + cy * cy, 0.0)))
 
 
+# ---------------------------------------------------------------------------- pull-out
+# The yaw rates at the release and at the end: means over the last share of the held and the
+# released spans (a noisy log's one sample is one sample of noise).
+RELEASE_SHARE = 0.05
+
+
+def pull_out_yaw_rates(t: np.ndarray, r: np.ndarray, t_release: float, t_order: float = 0.0
+                       ) -> dict:  # fmt: skip
+    """The yaw rate at the release (the mean over the last 5 % of the rudder held from
+    ``t_order``), the residual one at the end (over the last 5 % of the released span) and their
+    ratio: a straight-line stable ship's residual goes to 0, an unstable one keeps turning
+    (IMO MSC/Circ.1053, pull-out)."""
+    held = np.flatnonzero((t >= t_order) & (t < t_release))
+    released = np.flatnonzero(t >= t_release)
+    at_release, residual = (
+        float(np.mean(r[k[int((1.0 - RELEASE_SHARE) * k.size):]])) if k.size else math.nan
+        for k in (held, released))  # fmt: skip
+    return {"yaw_rate_at_release": at_release, "residual_yaw_rate": residual,
+            "residual_fraction": residual / at_release if at_release else math.nan}
+
+
+def pull_out_indices(
+    log: pd.DataFrame,
+    length: float | None = None,
+    trial: Trial | None = None,
+) -> dict:
+    """A pull-out's held turn (``turning_indices``) and its release (``pull_out_yaw_rates``)."""
+    if trial is None:
+        trial = describe_trial(log, "pull-out")
+    out = turning_indices(log, length=length, trial=trial)
+    if trial.release_time is not None:
+        out["release_time"] = trial.release_time
+        out.update(pull_out_yaw_rates(log["t"].to_numpy(), log["r"].to_numpy(),
+                                      trial.release_time, trial.execute_time))  # fmt: skip
+    return _none_if_nan(out)
+
+
 # ---------------------------------------------------------------------------- any log
 def detect_manoeuvre(log: pd.DataFrame) -> str:
-    """'zigzag', 'turning' or 'other' (see ``shipid.trials.trial``)."""
+    """'zigzag', 'turning', 'pull-out' or 'other' (see ``shipid.trials.trial``)."""
     return describe_trial(log).kind
 
 
@@ -339,7 +377,7 @@ def manoeuvre_indices(
     trial: Trial | None = None,
 ) -> dict:
     """Indices of a log, the manoeuvre detected when ``kind`` is None ({"kind": "other"} when the
-    log is neither a zig-zag nor a turning circle)."""
+    log is neither a zig-zag, a turning circle nor a pull-out)."""
     if trial is None:
         trial = describe_trial(log, kind, heading_deg)
     if trial.kind == "zigzag":
@@ -347,6 +385,8 @@ def manoeuvre_indices(
                              trial=trial)  # fmt: skip
     elif trial.kind == "turning":
         out = turning_indices(log, length=length, trial=trial)
+    elif trial.kind == "pull-out":
+        out = pull_out_indices(log, length=length, trial=trial)
     else:
         return {"kind": "other", "reason": trial.reason}
     return {"kind": trial.kind, **out}

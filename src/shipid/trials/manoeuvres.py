@@ -38,7 +38,7 @@ from shipid.dynamics.simulate import (
 from shipid.dynamics.steering import SteeringMachine
 from shipid.errors import ShipidError
 from shipid.limits import check_samples
-from shipid.trials.indices import turning_indices, zigzag_indices
+from shipid.trials.indices import pull_out_yaw_rates, turning_indices, zigzag_indices
 from shipid.vessels.vessel import Vessel
 
 SIDES = ("starboard", "port")
@@ -455,9 +455,8 @@ def pull_out(
         if not res.diverged:
             r = res.log["r"].to_numpy()
             t = res.log["t"].to_numpy()
-            at_release = float(np.interp(held, t, r))
-            res.indices = {"yaw_rate_at_release": at_release, "residual_yaw_rate": float(r[-1]),
-                           "residual_fraction": float(r[-1] / at_release)}  # fmt: skip
+            res.indices = pull_out_yaw_rates(t, r, held)
+            at_release = res.indices["yaw_rate_at_release"]
             if not (_settled(r[t <= held], abs(at_release))
                     and _settled(r[t >= held], abs(at_release))):  # fmt: skip
                 res.incomplete = (f"the yaw rate has not settled within {held:g} s held and "

@@ -28,7 +28,9 @@ from shipid.data.rudder_signal import ramp_start, rise_rate, rudder_for_events, 
 from shipid.data.trim import EXECUTE_FRACTION, first_swing_index, swing_start
 from shipid.errors import ShipidError
 
-KINDS = ("zigzag", "turning", "other")
+KINDS = ("zigzag", "turning", "pull-out", "other")
+# Kinds whose log holds a turn from a straight approach (a pull-out's before its release).
+TURN_KINDS = ("turning", "pull-out")
 AMPLITUDE_SPREAD = 0.4  # zig-zag swings within ±40 % of the median swing
 SWITCH_SPREAD = (0.3, 3.0)  # zig-zag switch headings within this factor of the median
 MIN_SWITCH = math.radians(3.0)  # IMO zig-zags switch at 5°–20°; a 2° "switch" is helm noise
@@ -49,7 +51,7 @@ class Trial:
 
     Attributes
     ----------
-    kind : 'zigzag', 'turning' or 'other'.
+    kind : 'zigzag', 'turning', 'pull-out' or 'other'.
     reason : why the log is of this kind (for 'other': which test a zig-zag or turn failed).
     execute_index, execute_time : the rudder order (start of the first large swing).
     psi0 : mean heading over the approach (up to the order).
@@ -66,6 +68,8 @@ class Trial:
         execute (a zig-zag's reversals), in order; ``switch_heading_deg`` is their median size.
     reversal_step_deg : the largest heading change over one sample at those orders: how finely
         the log resolves them.
+    release_time : where the held rudder went back to the approach's angle (or midships) and
+        stayed there to the log's end: the release of a pull-out (None where it did not).
     """
 
     kind: str
@@ -82,6 +86,7 @@ class Trial:
     held_end_index: int
     reversal_headings_deg: tuple[float, ...] = ()
     reversal_step_deg: float = 0.0
+    release_time: float | None = None
 
 
 def heading_noise(psi: np.ndarray, integral: np.ndarray) -> float:
@@ -343,6 +348,8 @@ def describe_trial(
     if heading_deg is not None:
         switch = float(heading_deg)
     held_end = _held_end(t, delta, i0)
+    release = _release_index(delta, i0, held_end)
+    release_time = None if release is None else float(t[_release_order(delta, i0, held_end)])
     # The swing from the rudder before the order; a log that starts on its order (the rudder
     # over from the first sample) came from midships. From its first sample, a turn held from
     # there never swung (plateau 0) and a pull-out's largest swing was its release: validate's
@@ -355,10 +362,11 @@ def describe_trial(
                  switch_heading_deg=switch,
                  rudder_rate=rise_rate(t, delta) if rudder_noise else _rudder_rate(t, delta),
                  held_end_index=held_end, reversal_headings_deg=reversals,
-                 reversal_step_deg=step)  # fmt: skip
+                 reversal_step_deg=step,
+                 release_time=release_time)  # fmt: skip
     if kind is not None:
         return Trial(kind=kind, reason="given", **facts)
-    found, reason = _classify(log, dpsi, dev, side, i0, held_end, amplitudes, orders)
+    found, reason = _classify(log, dpsi, dev, side, i0, held_end, amplitudes, orders, release)
     return Trial(kind=found, reason=reason, **facts)
 
 
@@ -394,7 +402,46 @@ def _swing_end(t: np.ndarray, delta: np.ndarray, i0: int, stand_s: float = 1.0) 
     return k
 
 
-def _classify(log, dpsi, dev, side, i0, held_end, amplitudes, orders) -> tuple[str, str]:
+def _release_index(delta: np.ndarray, i0: int, held_end: int) -> int | None:
+    """The first sample from which the rudder, released after ``held_end``, stays back at the
+    approach's angle (midships for a log that starts on its order) to the log's end, within 3°
+    (or 15 % of the held deflection); None where it does not, or goes anywhere else first."""
+    if held_end + 1 >= len(delta):
+        return None
+    approach = float(delta[i0 - 1]) if i0 > 0 else 0.0
+    held = float(np.median(delta[i0 : held_end + 1]))
+    tol = max(HELD_TOLERANCE, 0.15 * abs(held - approach))
+    after = delta[held_end + 1 :]
+    back = np.abs(after - approach) <= tol
+    if not back[-1]:
+        return None
+    away = np.flatnonzero(~back)
+    j = int(away[-1]) + 1 if away.size else 0
+    # On its way back the rudder stays between the held angle and the approach's.
+    lo, hi = min(held, approach) - tol, max(held, approach) + tol
+    if np.any((after[:j] < lo) | (after[:j] > hi)):
+        return None
+    return held_end + 1 + j
+
+
+def _release_order(delta: np.ndarray, i0: int, held_end: int) -> int:
+    """The first sample of the release's swing: ``held_end`` is where the rudder has left the
+    held angle by 3°, a few samples into a rate-limited swing (0.3 s at 9.6 °/s)."""
+    j = held_end + 1
+    way = np.sign(delta[j] - delta[held_end])
+    while j - 2 > i0 and way * (delta[j - 1] - delta[j - 2]) > 0:
+        j -= 1
+    return j
+
+
+# A pull-out: its held turn ≥ 90° of heading, and the rudder back for a quarter of the time it
+# was held or more (the yaw rate's decay, or its residual, is what the test measures).
+PULL_OUT_TURN = math.radians(90.0)
+PULL_OUT_RELEASED_SHARE = 0.25
+
+
+def _classify(log, dpsi, dev, side, i0, held_end, amplitudes, orders, release=None
+              ) -> tuple[str, str]:  # fmt: skip
     if not amplitudes:
         return "other", "the rudder never swings"
     # A turn or zig-zag is measured from the heading of a straight approach. A spiral had turned
@@ -407,6 +454,12 @@ def _classify(log, dpsi, dev, side, i0, held_end, amplitudes, orders) -> tuple[s
     n = log["n"].to_numpy()[i0:] if "n" in log.columns else None
     reversed_prop = n is not None and np.min(n) < 0 < np.max(n)
     turned = np.abs(dpsi[i0 : held_end + 1])
+    t = log["t"].to_numpy()
+    if release is not None and not reversed_prop and \
+            np.max(turned) >= PULL_OUT_TURN and \
+            t[-1] - t[release] >= PULL_OUT_RELEASED_SHARE * (t[held_end] - t[i0]):  # fmt: skip
+        return "pull-out", (f"rudder held through {math.degrees(np.max(turned)):.0f}° of heading,"
+                            f" then back for {t[-1] - t[release]:.3g} s")  # fmt: skip
     if turned.size and np.max(turned) >= math.pi and not reversed_prop:
         return "turning", "rudder held to one side through 180° of heading"
     if len(orders) < 2:
