@@ -58,7 +58,8 @@ class Trial:
     neutral : the rudder's neutral (mid-range) angle.
     amplitude : median rudder deflection from neutral on the plateaus.
     plateau_angle : median |δ| where the rudder is within 80 % of its largest swing from the
-        initial angle: the commanded rudder angle of a zig-zag or turn.
+        initial angle (midships where the log starts on its order): the commanded rudder angle
+        of a zig-zag or turn.
     first_rudder : signed deflection of the first plateau from neutral.
     switch_heading_deg : zig-zag switch heading inferred at the rudder orders (None if none).
     rudder_rate : the rudder's rate over its swings [rad/s] (``shipid.data.rudder_signal``; None
