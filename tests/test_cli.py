@@ -633,3 +633,10 @@ def test_simulated_logs_carry_the_simulated_ships_metadata(files, tmp_path, caps
     t = read_log(tmp_path / "t.csv").attrs
     assert (t["ship"], t["scale"]) == ("m.json", pytest.approx(16.95))
     assert t["manoeuvre"].startswith("turning circle")
+    # Training logs that say no scale: none in the runs (1 read as full scale), as in the API.
+    bare = tmp_path / "bare.csv"
+    read_log(log)[["t", "delta", "u", "v", "r"]].to_csv(bare, index=False)
+    assert run(["identify", bare, "-o", tmp_path / "b.json"], capsys)[0] == 0
+    assert run(["manoeuvre", tmp_path / "b.json", "turning", "--duration", "30",
+                "-o", tmp_path / "bt.csv"], capsys)[0] == 0  # fmt: skip
+    assert "scale" not in read_log(tmp_path / "bt.csv").attrs

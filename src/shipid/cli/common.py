@@ -266,8 +266,11 @@ def _simulated_metadata(name: str, target, cond: dict) -> dict:
     the scale of the logs it was identified from."""
     if hasattr(target, "log_metadata"):
         return target.log_metadata()
-    out = {"ship": Path(name).name, "source": f"simulated: model file {name}",
-           "scale": float(cond["log_scale"]) if cond.get("log_scale") else 1.0}
+    out = {"ship": Path(name).name, "source": f"simulated: model file {name}"}
+    # Training logs that said no scale leave it unknown: 1 reads as full scale (as
+    # ``Vessel.log_metadata`` leaves out a model's).
+    if cond.get("log_scale"):
+        out["scale"] = float(cond["log_scale"])
     if cond.get("particulars") is not None:
         out["particulars"] = cond["particulars"].to_dict()
     return out

@@ -349,8 +349,7 @@ def describe_trial(
     if heading_deg is not None:
         switch = float(heading_deg)
     held_end = _held_end(t, delta, i0)
-    release = _release_index(delta, i0, held_end)
-    release_time = None if release is None else float(t[_release_order(delta, i0, held_end)])
+    release_time = _release_time(t, delta, i0, held_end)
     # The swing from the rudder before the order; a log that starts on its order (the rudder
     # over from the first sample) came from midships. From its first sample, a turn held from
     # there never swung (plateau 0) and a pull-out's largest swing was its release: validate's
@@ -367,7 +366,8 @@ def describe_trial(
                  release_time=release_time)  # fmt: skip
     if kind is not None:
         return Trial(kind=kind, reason="given", **facts)
-    found, reason = _classify(log, dpsi, dev, side, i0, held_end, amplitudes, orders, release)
+    found, reason = _classify(log, dpsi, dev, side, i0, held_end, amplitudes, orders,
+                              release_time)  # fmt: skip
     return Trial(kind=found, reason=reason, **facts)
 
 
@@ -403,10 +403,12 @@ def _swing_end(t: np.ndarray, delta: np.ndarray, i0: int, stand_s: float = 1.0) 
     return k
 
 
-def _release_index(delta: np.ndarray, i0: int, held_end: int) -> int | None:
-    """The first sample from which the rudder, released after ``held_end``, stays back at the
-    approach's angle (midships for a log that starts on its order) to the log's end, within 3°
-    (or 15 % of the held deflection); None where it does not, or goes anywhere else first."""
+def _release_time(t: np.ndarray, delta: np.ndarray, i0: int, held_end: int) -> float | None:
+    """When the rudder held from ``i0`` to ``held_end`` was released: the first sample of its
+    swing back (``held_end`` is where it has left the held angle by 3°, a few samples into a
+    rate-limited swing: 0.3 s at 9.6 °/s). None unless it goes back to the approach's angle
+    (midships for a log that starts on its order), within 3° (or 15 % of the held deflection),
+    without going anywhere else first, and stays there to the log's end."""
     if held_end + 1 >= len(delta):
         return None
     approach = float(delta[i0 - 1]) if i0 > 0 else 0.0
@@ -417,31 +419,23 @@ def _release_index(delta: np.ndarray, i0: int, held_end: int) -> int | None:
     if not back[-1]:
         return None
     away = np.flatnonzero(~back)
-    j = int(away[-1]) + 1 if away.size else 0
-    # On its way back the rudder stays between the held angle and the approach's.
-    lo, hi = min(held, approach) - tol, max(held, approach) + tol
-    if np.any((after[:j] < lo) | (after[:j] > hi)):
+    swing_back = after[: int(away[-1]) + 1 if away.size else 0]
+    if np.any((swing_back < min(held, approach) - tol) | (swing_back > max(held, approach) + tol)):
         return None
-    return held_end + 1 + j
-
-
-def _release_order(delta: np.ndarray, i0: int, held_end: int) -> int:
-    """The first sample of the release's swing: ``held_end`` is where the rudder has left the
-    held angle by 3°, a few samples into a rate-limited swing (0.3 s at 9.6 °/s)."""
     j = held_end + 1
     way = np.sign(delta[j] - delta[held_end])
     while j - 2 > i0 and way * (delta[j - 1] - delta[j - 2]) > 0:
         j -= 1
-    return j
+    return float(t[j])
 
 
-# A pull-out: its held turn ≥ 90° of heading, and the rudder back for a quarter of the time it
-# was held or more (the yaw rate's decay, or its residual, is what the test measures).
+# A pull-out: its held turn ≥ 90° of heading, and the rudder released for a quarter of the time
+# it was held or more (the yaw rate's decay, or its residual, is what the test measures).
 PULL_OUT_TURN = math.radians(90.0)
 PULL_OUT_RELEASED_SHARE = 0.25
 
 
-def _classify(log, dpsi, dev, side, i0, held_end, amplitudes, orders, release=None
+def _classify(log, dpsi, dev, side, i0, held_end, amplitudes, orders, release_time
               ) -> tuple[str, str]:  # fmt: skip
     if not amplitudes:
         return "other", "the rudder never swings"
@@ -456,11 +450,10 @@ def _classify(log, dpsi, dev, side, i0, held_end, amplitudes, orders, release=No
     reversed_prop = n is not None and np.min(n) < 0 < np.max(n)
     turned = np.abs(dpsi[i0 : held_end + 1])
     t = log["t"].to_numpy()
-    if release is not None and not reversed_prop and \
-            np.max(turned) >= PULL_OUT_TURN and \
-            t[-1] - t[release] >= PULL_OUT_RELEASED_SHARE * (t[held_end] - t[i0]):  # fmt: skip
+    if release_time is not None and not reversed_prop and np.max(turned) >= PULL_OUT_TURN and \
+            t[-1] - release_time >= PULL_OUT_RELEASED_SHARE * (release_time - t[i0]):  # fmt: skip
         return "pull-out", (f"rudder held through {math.degrees(np.max(turned)):.0f}° of heading,"
-                            f" then back for {t[-1] - t[release]:.3g} s")  # fmt: skip
+                            f" then released for {t[-1] - release_time:.3g} s")  # fmt: skip
     if turned.size and np.max(turned) >= math.pi and not reversed_prop:
         return "turning", "rudder held to one side through 180° of heading"
     if len(orders) < 2:
