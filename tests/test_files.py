@@ -74,6 +74,8 @@ def test_imported_osaka_log_keeps_its_rudder_convention(tmp_path, capsys):
     back = read_log(imported)
     assert back.attrs["rudder_positive"] == "starboard" == direct.attrs["rudder_positive"]
     assert back.attrs["ship"] == "Esso Osaka 3 m model"
+    # The files do not say which ship the 3 m model is of: no scale, where 1 said full scale.
+    assert "scale" not in direct.attrs and "scale" not in back.attrs
     from shipid.evaluation.validate import validate
     from shipid.identification.identify import identify
 
@@ -365,6 +367,70 @@ def test_a_log_at_another_scale_than_the_training_logs_is_named(tmp_path, capsys
     assert run(["rescale", model, "--factor", str(lam), "-o", rescaled], capsys)[0] == 0
     prep = json.loads(rescaled.read_text())["identification"]["preprocessing"]
     assert prep["log_scale"] == pytest.approx(1.0)
+
+
+def test_criteria_judge_a_model_at_its_training_logs_scale(tmp_path, capsys):
+    """`criteria` of a model identified from model-scale logs, without particulars: it judged
+    the ship at λ = 1 (the KVLCC2's 7 m model by the 10/10 limits 10° and 25° of an L/V of
+    5.8 s, where at full scale its L/V is 39 s and the limits 20° and 40°). The training logs'
+    scale is the default; with none known, λ = 1 is said."""
+    from shipid.trials.criteria import overshoot_limits
+
+    log = zigzag(scale_ship(), 20, 20, duration=60, dt=0.2).log
+    lam = log.attrs["scale"]
+    model = tmp_path / "m.json"
+    assert run(["identify", write_log(log, tmp_path / "zz.csv"), "--filter", "none",
+                "--no-output-error", "-o", model], capsys)[0] == 0  # fmt: skip
+    L = 4.0
+    code, _, err = run(["criteria", model, "--length", L, "--dt", 0.2, "--no-bands",
+                        "--json", tmp_path / "c.json"], capsys)  # fmt: skip
+    assert code == 0, err
+    doc = json.loads((tmp_path / "c.json").read_text())
+    c = doc["conditions"]
+    assert c["scale"] == pytest.approx(lam)
+    assert c["L_over_V_full_scale"] == pytest.approx(L / c["speed"] * math.sqrt(lam))
+    limits = {r["criterion"]: r["limit"] for r in doc["criteria"]}
+    first, second = overshoot_limits(L / c["speed"] * math.sqrt(lam))
+    assert limits["10/10 first overshoot"] == pytest.approx(first)
+    assert limits["10/10 second overshoot"] == pytest.approx(second)
+    assert "scale λ is not known" not in err
+    code, _, err = run(["criteria", model, "--length", L, "--dt", 0.2, "--no-bands", "--scale",
+                        "1", "--json", tmp_path / "c1.json"], capsys)  # fmt: skip
+    assert json.loads((tmp_path / "c1.json").read_text())["conditions"]["scale"] == 1.0
+    unknown = log.copy()
+    unknown.attrs = {k: v for k, v in log.attrs.items() if k != "scale"}
+    plain = tmp_path / "plain.json"
+    assert run(["identify", write_log(unknown, tmp_path / "plain.csv"), "--filter", "none",
+                "--no-output-error", "-o", plain], capsys)[0] == 0  # fmt: skip
+    code, _, err = run(["criteria", plain, "--length", L, "--dt", 0.2, "--no-bands",
+                        "--json", tmp_path / "c2.json"], capsys)  # fmt: skip
+    assert code == 0, err
+    assert json.loads((tmp_path / "c2.json").read_text())["conditions"]["scale"] == 1.0
+    assert "the scale λ is not known" in err and "judged as a full-scale ship" in err
+
+
+def test_validate_judges_a_measured_zigzag_at_the_logs_scale(tmp_path, capsys):
+    """validate's criteria of the logs took λ from the particulars alone: a model-scale 10/10
+    zig-zag with particulars that give no scale was judged by the limits of its model-scale
+    L/V. The log's own scale is the default."""
+    from shipid.trials.criteria import overshoot_limits
+
+    log = zigzag(scale_ship(), 10, 10, duration=60, dt=0.2).log
+    lam = log.attrs["scale"]
+    path = write_log(log, tmp_path / "zz.csv")
+    (tmp_path / "p.yml").write_text("length: 10.0\n")  # L/V 5 s here, 20 s at full scale
+    from shipid.vessels import scale_ship_model
+
+    model = scale_ship_model().save(tmp_path / "m.json")
+    code, out, err = run(["validate", model, path, "--particulars", tmp_path / "p.yml"], capsys)
+    assert code == 0, err
+    rows = {line.split("|")[2].strip(): line.split("|") for line in out.splitlines()
+            if line.startswith("|") and "10/10" in line}  # fmt: skip
+    speed = float(log["u"].iloc[: max(1, len(log) // 50)].mean())
+    first, second = overshoot_limits(10.0 / speed * math.sqrt(lam))
+    assert first > 10.0 and second > 25.0  # not the model-scale L/V's 10° and 25°
+    assert float(rows["10/10 first overshoot"][4]) == pytest.approx(first, abs=0.05)  # 3 digits
+    assert float(rows["10/10 second overshoot"][4]) == pytest.approx(second, abs=0.05)
 
 
 def test_logs_at_different_scales_are_not_fitted_together(tmp_path, capsys):

@@ -318,7 +318,10 @@ def _criteria_of_logs(good, logs, vals, particulars):
             continue
         meas = v.indices.get("measured", {})
         pred = v.indices.get("closed_loop") or v.indices.get("simulated")
-        args = (rudder, meas.get("switch_heading_deg"), particulars.length, speed, particulars.scale)
+        # The log's own scale where the particulars give none (a 7 m model judged at λ = 1 meets
+        # the 10/10 limits of a ship with a √λ times shorter L/V).
+        lam = particulars.scale or log.attrs.get("scale") or 1.0
+        args = (rudder, meas.get("switch_heading_deg"), particulars.length, speed, lam)
         m_rows = measured_criteria(meas, *args)
         p_rows = {r["criterion"]: r for r in measured_criteria({**(pred or {}), "kind": v.kind},
                                                                *args)}  # fmt: skip

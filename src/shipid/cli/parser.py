@@ -388,7 +388,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--speed", type=float, help="test speed [m/s] (default: the training approach)")
     p.add_argument("--scale", type=float, metavar="LAMBDA",
                    help="model scale λ, for the full-scale L/V and rudder rate (default: the "
-                   "particulars', else 1)")
+                   "particulars', else the training logs', else 1)")
     p.add_argument("--rps", type=float, help="propeller speed for models with n terms (default: "
                    "the training approach)")
     p.add_argument("--astern-rps", type=float, help="stopping test order (default −rps)")

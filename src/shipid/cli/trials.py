@@ -34,8 +34,10 @@ def cmd_criteria(args) -> int:
     speed, rps, _ = _run_approach(target, cond, args.speed, args.rps)  # imo_criteria notes it
     # Given, else the ship's gear or the training logs' rate, else imo_criteria's SOLAS rate.
     steering, _ = _steering(target, cond, args.rudder_rate, fallback="caller")
+    # The scale the training logs were read at, where neither option nor particulars give one.
+    scale = args.scale or (particulars.scale if particulars else None) or cond.get("log_scale")
     run = partial(imo_criteria, particulars=particulars, length=args.length, speed=speed,
-                  scale=args.scale, rps=rps, steering=steering, astern_rps=args.astern_rps,
+                  scale=scale, rps=rps, steering=steering, astern_rps=args.astern_rps,
                   dt=args.dt)  # fmt: skip
     crit = run(target)
     crit.notes += _unused_inputs(target, args)

@@ -155,8 +155,9 @@ def read_osaka_frt(path: str | Path) -> pd.DataFrame:
     cols["psi"] = np.unwrap(cols["psi"])
     if "wind_angle" in cols:
         cols["wind_angle"] = np.angle(np.exp(1j * cols["wind_angle"]))  # (−π, π]
+    # No scale: the files do not give the ship the model is of, and 1 would say full scale.
     return make_log(cols, name=path.name, ship="Esso Osaka 3 m model",
-                    source=f"Osaka University FRT: {path}", rudder_positive="starboard", scale=1.0)
+                    source=f"Osaka University FRT: {path}", rudder_positive="starboard")
 
 
 def read_format(path: str | Path, fmt: str, scale: float | None = None) -> pd.DataFrame:

@@ -9,7 +9,8 @@ A small file (YAML or JSON) or options. Keys (SI units; aliases of common files 
     mass          m [kg]                          (m, displacement_mass)
     rudder_area   A_R [m²]                        (A_R, AR)
     propeller_diameter  D [m]                     (D, Dp)
-    scale         λ = ship length / model length (scale_factor)
+    scale         λ = ship length / model length (scale_factor; none: not known, where the
+                  criteria read the model's training logs' scale, else full scale)
     design_speed  approach speed of the trials [m/s]   (U0, speed)
     rho           water density [kg/m³]           (default 1025; the MARIN file gives 1000)
     xg            longitudinal centre of gravity from midship [m]   (x_G)
@@ -58,7 +59,7 @@ class Particulars:
     mass: float | None = None
     rudder_area: float | None = None
     propeller_diameter: float | None = None
-    scale: float = 1.0
+    scale: float | None = None  # unknown: not full scale (λ = 1), which it would claim
     design_speed: float | None = None
     rho: float = 1025.0
     xg: float = 0.0

@@ -92,7 +92,8 @@ def imo_criteria(
 ) -> Criteria:
     """Run the IMO standard manoeuvres on ``ship`` and judge them against MSC.137(76).
 
-    ``length`` (Lpp [m]) and ``scale`` default to the particulars' (or the reference ship's);
+    ``length`` (Lpp [m]) and ``scale`` default to the particulars' (or the reference ship's;
+    the scale, if none is known, to 1 with a note);
     ``speed`` to the ship's approach speed or the particulars' design speed; ``rps`` is the
     propeller speed of models with propeller terms (also the stopping test's approach).
     """
@@ -102,7 +103,18 @@ def imo_criteria(
     if not L or not (math.isfinite(L) and L > 0):
         raise ShipidError("the IMO criteria are in ship lengths: give the length (--length, or "
                           "particulars with the length)")  # fmt: skip
-    lam = scale or (particulars.scale if particulars else None) or getattr(ship, "scale", 1.0)
+    lam = next((float(x) for x in (scale, particulars.scale if particulars else None,
+                                   getattr(ship, "scale", None))
+                if x is not None and math.isfinite(x) and x > 0), None)  # fmt: skip
+    scale_note = None
+    if lam is None:
+        # Judged as full scale: a model basin's ship at λ = 1 meets the limits of a ship whose
+        # L/V is √λ times shorter, with a rudder √λ times slower (the KVLCC2's 7 m model: the
+        # 10/10 limits 10° and 25° instead of 20° and 40°).
+        lam = 1.0
+        scale_note = ("the scale λ is not known (no --scale, none in the particulars or the "
+                      "training logs): judged as a full-scale ship, λ = 1; give the scale for a "
+                      "model-scale ship")  # fmt: skip
     V = speed or getattr(ship, "approach_speed", None) or (
         particulars.design_speed if particulars else None)  # fmt: skip
     if not V or not V > 0:
@@ -118,7 +130,7 @@ def imo_criteria(
     # overshoot within ~20 L/V (model-scale times).
     duration = max(60.0, 40.0 * L / V)
     kw = {"dt": dt, "speed": V, "steering": steering, "method": method, "rps": rps}
-    rows, runs, notes = [], {}, []
+    rows, runs, notes = [], {}, [scale_note] if scale_note else []
     if isinstance(ship, ManoeuvringModel | HybridModel):  # a reference ship's is trimmed
         unsteady = unsteady_warning(ship, V, rps if ship.uses_rps else None)
         notes += [unsteady] if unsteady else []
