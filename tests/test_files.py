@@ -433,6 +433,35 @@ def test_validate_judges_a_measured_zigzag_at_the_logs_scale(tmp_path, capsys):
     assert float(rows["10/10 second overshoot"][4]) == pytest.approx(second, abs=0.05)
 
 
+def test_a_fit_at_a_finer_dt_than_its_logs_is_warned(tmp_path, capsys, trial):
+    """identify --dt 0.05 on a log sampled at 0.1 s fitted interpolated samples without a
+    word: the noise check then read r's sensor noise as none (an Esso zig-zag's free runs
+    'missed by 2.17e+13 times the noise') and the fit was no better. validate may run finer."""
+    from shipid.data.preprocess import resample, white_noise_variance
+
+    rng = np.random.default_rng(3)
+    noisy = trial.copy()
+    noisy["r"] = noisy["r"] + rng.normal(0.0, 1e-3, len(noisy))
+    assert "measured_dt" not in resample(noisy, 0.2).attrs
+    assert "measured_dt" not in resample(noisy, 0.4).attrs
+    fine = resample(noisy, 0.1)
+    assert fine.attrs["measured_dt"] == pytest.approx(0.2)
+    # Why it matters: the noise read from interpolated samples is none.
+    assert white_noise_variance(fine["r"].to_numpy()) < 1e-3 * white_noise_variance(
+        noisy["r"].to_numpy())  # fmt: skip
+    path = write_log(noisy, tmp_path / "zz.csv")
+    code, _, err = run(["identify", path, "--dt", "0.1", "--filter", "none",
+                        "-o", tmp_path / "m.json"], capsys)  # fmt: skip
+    assert code == 0, err
+    assert "--dt 0.1 s is finer than its own sampling (0.2 s)" in err
+    assert "measured_dt" not in json.dumps(json.loads((tmp_path / "m.json").read_text()))
+    code, _, err = run(["identify", path, "--dt", "0.4", "--filter", "none",
+                        "-o", tmp_path / "m2.json"], capsys)  # fmt: skip
+    assert code == 0 and "finer than its own sampling" not in err
+    code, _, err = run(["validate", tmp_path / "m.json", path, "--dt", "0.1"], capsys)
+    assert code == 0 and "finer than its own sampling" not in err
+
+
 def test_logs_at_different_scales_are_not_fitted_together(tmp_path, capsys):
     """A model-scale and a full-scale run fitted together mix two time scales; nothing said
     so. identify, select and compare refuse them in one line naming both files."""

@@ -50,6 +50,13 @@ def _training_logs(args) -> list:
     """The logs a model is fitted to: ``_read_logs``, refused when they are at different
     scales (a model-scale and a full-scale run fitted together mix two ships' time scales)."""
     logs = _read_logs(args)
+    for path, log in zip(args.logs, logs, strict=True):
+        if "measured_dt" in log.attrs:
+            _warn(f"{path}: --dt {args.dt:g} s is finer than its own sampling "
+                  f"({log.attrs['measured_dt']:.3g} s): the fit sees straight lines between its "
+                  f"samples as measurements (their second differences 0, so its sensor noise "
+                  f"reads as none); fit at --dt {log.attrs['measured_dt']:.3g} or coarser "
+                  f"(validate may run a model finer than its logs)")  # fmt: skip
     scales = {}
     for path, log in zip(args.logs, logs, strict=True):
         if "scale" in log.attrs:

@@ -12,6 +12,8 @@ from shipid.limits import check_samples
 
 SIGNALS = ("u", "v", "r")
 MAX_UPSAMPLING = 100.0
+# A --dt below this share of the log's own sampling interpolates samples between the measured ones.
+UPSAMPLED = 0.99
 
 
 
@@ -36,7 +38,10 @@ def white_noise_variance(x: np.ndarray) -> float:
 
 
 def resample(log: pd.DataFrame, dt: float, name: str = "log") -> pd.DataFrame:
-    """Linear interpolation of every column onto t0, t0 + dt, ... (heading unwrapped first)."""
+    """Linear interpolation of every column onto t0, t0 + dt, ... (heading unwrapped first).
+
+    A ``dt`` finer than the log's own sampling keeps that sampling in ``attrs["measured_dt"]``.
+    """
     if not (isinstance(dt, int | float) and math.isfinite(dt) and dt > 0):
         raise ShipidError(f"--dt must be a finite number > 0, got {dt!r}")
     t = log["t"].to_numpy()
@@ -62,6 +67,9 @@ def resample(log: pd.DataFrame, dt: float, name: str = "log") -> pd.DataFrame:
             cols[c] = np.angle(np.exp(1j * cols[c]))
     out = pd.DataFrame(cols)
     out.attrs = dict(log.attrs)
+    if dt < UPSAMPLED * own:
+        # In memory only (not file metadata): a fit told that its samples between are lines.
+        out.attrs["measured_dt"] = own
     return out
 
 
