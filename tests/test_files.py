@@ -231,6 +231,7 @@ def test_version_1_model_files_still_load(tmp_path, model_doc):
 
     _, doc = model_doc
     doc["version"] = 1
+    doc["provenance"].pop("model_sha256")  # version 1 kept none
     doc["model"]["structure"]["terms"]["u"] = ["|u|u", "vr", "r^2", "delta^2", "1"]
     old = {"|u|u": 1.0, "vr": 2.0, "r^2": 0.0, "delta^2": 3.0, "1": 4.0}
     doc["model"]["coefficients"]["u"] = old
@@ -460,6 +461,52 @@ def test_a_fit_at_a_finer_dt_than_its_logs_is_warned(tmp_path, capsys, trial):
     assert code == 0 and "finer than its own sampling" not in err
     code, _, err = run(["validate", tmp_path / "m.json", path, "--dt", "0.1"], capsys)
     assert code == 0 and "finer than its own sampling" not in err
+
+
+def test_a_hand_edited_model_file_drops_the_fits_intervals(tmp_path, capsys, trial_csv):
+    """A model file whose coefficient was edited by hand kept the bootstrap intervals and the
+    standard errors of the fit: validate printed a tactical diameter of 27.62 m beside its
+    interval [18.53, 18.6] m, the one of the coefficients before the edit. The file carries its
+    model's fingerprint; an edited model's fit records are left out, with a warning."""
+    import warnings
+
+    from shipid.errors import ShipidWarning
+    from shipid.reporting.modelfile import load_document
+    from shipid.vessels import scale_ship_model
+
+    model = tmp_path / "m.json"
+    assert run(["identify", trial_csv, "--filter", "none", "--no-output-error", "--bootstrap",
+                "10", "-o", model], capsys)[0] == 0  # fmt: skip
+    doc = json.loads(model.read_text())
+    assert doc["provenance"]["model_sha256"]
+    same = tmp_path / "same.json"
+    same.write_text(json.dumps(doc))  # another layout, the same numbers
+    edited = tmp_path / "edited.json"
+    doc["model"]["coefficients"]["r"]["delta"] *= 0.5
+    edited.write_text(json.dumps(doc, indent=1))
+    plain = scale_ship_model().save(tmp_path / "plain.json")
+    rescaled = tmp_path / "big.json"
+    assert run(["rescale", model, "--factor", "4", "-o", rescaled], capsys)[0] == 0
+    for path in (model, same, plain, rescaled):
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", ShipidWarning)
+            loaded = load_document(path)
+        assert bool(loaded.get("uncertainty")) == (path != plain)
+    with pytest.warns(ShipidWarning, match="edited.json: the model's coefficients are not those "
+                      "it was fitted with") as caught:  # fmt: skip
+        loaded = load_document(edited)
+    assert "bootstrap intervals and the standard errors" in str(caught[0].message)
+    assert loaded["uncertainty"] is None
+    assert all(d["std_errors"] is None for d in loaded["identification"]["diagnostics"].values())
+    code, out, err = run(["validate", edited, trial_csv, "--report", tmp_path / "rep"], capsys)
+    assert code == 0, err
+    assert "not those it was fitted with" in err
+    assert "standard error of each coefficient" not in (tmp_path / "rep" / "report.html").read_text(
+        encoding="utf-8")  # fmt: skip
+    code, out, err = run(["validate", same, trial_csv, "--report", tmp_path / "rep0"], capsys)
+    assert code == 0 and "fitted with" not in err
+    assert "standard error of each coefficient" in (tmp_path / "rep0" / "report.html").read_text(
+        encoding="utf-8")  # fmt: skip
 
 
 def test_logs_at_different_scales_are_not_fitted_together(tmp_path, capsys):

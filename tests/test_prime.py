@@ -208,3 +208,53 @@ def test_rescale_refuses_bad_options(model_files, capsys, args, message):
                        capsys)  # fmt: skip
     assert code == 1 and message in err and len(err.strip().splitlines()) == 1
     assert not (model_files / "x.json").exists()
+
+
+def test_a_rescaled_models_standard_errors_are_those_of_a_fit_at_the_new_scale(tmp_path, capsys):
+    """The LS-SVM fit's standard errors, printed beside the coefficients, stayed those of the
+    original scale in a rescaled file (ṙ u·v 0.0054 ± 0.0009 at ten times the length, the
+    error of 0.54). The truth: the same fit on the Froude-scaled log."""
+    import json
+
+    from cli_helpers import run
+
+    from shipid.data.io import write_log
+    from shipid.trials.manoeuvres import zigzag
+    from shipid.vessels import PAPER_IMU, scale_ship
+
+    log = PAPER_IMU.apply(zigzag(scale_ship(rudder_rate_deg=9.6), 20, 20, duration=90, dt=0.2,
+                                 method="euler").log, seed=5)  # fmt: skip
+    f = 4.0
+    k = math.sqrt(f)
+    big = log.copy()
+    big["t"] *= k
+    for s in ("u", "v"):
+        big[s] *= k
+    big["r"] /= k
+    for s in ("x", "y"):
+        if s in big:
+            big[s] *= f
+    big.attrs = {a: b for a, b in log.attrs.items() if a != "scale"}
+    small = log.copy()
+    small.attrs = dict(big.attrs)
+    # γ large: the regulariser (not scaled with the regressors) out of the comparison.
+    fit = ["--filter", "none", "--no-output-error", "--error-band", "none", "--gamma", "1e9"]
+    for name, data in (("small", small), ("big", big)):
+        path = write_log(data, tmp_path / f"{name}.csv")
+        assert run(["identify", path, *fit, "-o", tmp_path / f"{name}.json"], capsys)[0] == 0
+    assert run(["rescale", tmp_path / "small.json", "--factor", f, "-o",
+                tmp_path / "rescaled.json"], capsys)[0] == 0  # fmt: skip
+    docs = {n: json.loads((tmp_path / f"{n}.json").read_text(encoding="utf-8"))
+            for n in ("small", "big", "rescaled")}  # fmt: skip
+    checked = 0
+    for dof in ("u", "v", "r"):
+        want = docs["big"]["identification"]["diagnostics"][dof]["std_errors"]
+        got = docs["rescaled"]["identification"]["diagnostics"][dof]["std_errors"]
+        before = docs["small"]["identification"]["diagnostics"][dof]["std_errors"]
+        for term, se in want.items():
+            if se is None:  # a term constant in the data: infinite on both
+                assert got[term] is None
+                continue
+            assert got[term] == pytest.approx(se, rel=1e-3), (dof, term)
+            checked += before[term] != pytest.approx(se, rel=0.05)
+    assert checked >= 5  # most terms' errors change with the scale

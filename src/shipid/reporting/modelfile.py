@@ -40,6 +40,13 @@ def sha256(path: str | Path) -> str:
     return h.hexdigest()
 
 
+def model_fingerprint(model_data) -> str:
+    """SHA-256 of a model file's ``model`` record (its JSON with sorted keys): what the fit's
+    records (intervals, error band, standard errors) were computed for."""
+    text = json.dumps(json_safe(model_data), sort_keys=True, ensure_ascii=False)
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()
+
+
 def json_safe(obj):
     """JSON-ready data: NumPy scalars and arrays become Python ones, inf/NaN become null."""
     if hasattr(obj, "tolist") and not isinstance(obj, str):  # NumPy scalars and arrays
@@ -66,7 +73,7 @@ def model_document(ident: Identification, training_files: Sequence[str | Path] =
     and its selection (``{"residual": KernelResidual.to_dict(), "selection": ...}``)."""
     if model is None:
         model = refinement.model if refinement is not None else ident.model
-    return json_safe({
+    return _fingerprinted({
         "format": FORMAT, "version": VERSION, "shipid": __version__,
         "model": model.to_dict(),
         "particulars": particulars,
@@ -85,6 +92,46 @@ def model_document(ident: Identification, training_files: Sequence[str | Path] =
         "provenance": {"training_files": [{"path": str(p), "sha256": sha256(p)}
                                           for p in training_files]},
     })  # fmt: skip
+
+
+def _fingerprinted(doc: dict) -> dict:
+    """``json_safe(doc)`` with its model's fingerprint in ``provenance.model_sha256``."""
+    doc = json_safe(doc)
+    doc.setdefault("provenance", {})["model_sha256"] = model_fingerprint(doc["model"])
+    return doc
+
+
+def stale_fit_records(doc: dict, path: str | Path) -> str | None:
+    """Where a model file's coefficients are not those it was fitted with (edited by hand),
+    leave out what describes the fitted ones: the bootstrap ensemble, the cross-validated error
+    band and the fit's standard errors; returns the warning, or None for an unedited file (or
+    one written without a fingerprint, by earlier versions or ``ManoeuvringModel.save``)."""
+    stated = (doc.get("provenance") or {}).get("model_sha256")
+    if not stated or stated == model_fingerprint(doc.get("model")):
+        return None
+    dropped = []
+    if doc.get("uncertainty"):
+        doc["uncertainty"] = None
+        dropped.append("the bootstrap intervals")
+    holder, _, band = _error_band_record(doc)
+    if band:
+        holder["error_band"] = None
+        dropped.append("the cross-validated error band")
+    ident = doc.get("identification") or {}
+    stats = (ident.get("refinement") or {}).get("statistics") or {}
+    diagnostics = [d for d in (ident.get("diagnostics") or {}).values()
+                   if isinstance(d, Mapping) and d.get("std_errors")]  # fmt: skip
+    if stats.get("standard_errors") or diagnostics:
+        stats.pop("standard_errors", None)
+        for d in diagnostics:
+            d["std_errors"] = None
+        dropped.append("the standard errors")
+    kept = ("; its kernel residual was fitted to the misses of the coefficients before the edit"
+            if (doc.get("kernel_residual") or {}).get("residual") else "")  # fmt: skip
+    return (f"{path}: the model's coefficients are not those it was fitted with (edited?): "
+            + (f"{' and '.join((', '.join(dropped[:-1]), dropped[-1]) if dropped[:-1] else dropped)}"
+               " of the fit are left out, as they describe those"
+               if dropped else "the file's fit records describe those") + kept)
 
 
 def prime_record(model: ManoeuvringModel, particulars: dict | None,
@@ -236,7 +283,22 @@ def load_document(path: str | Path) -> dict:
         raise ShipidError(f"{path}: model file version {doc.get('version')!r} is not supported "
                           f"(this shipid reads versions {', '.join(map(str, READABLE_VERSIONS))})")
     check_document(doc, path)
+    stale = stale_fit_records(doc, path)
+    if stale and _parses(doc):  # a model that does not parse has its own error, alone
+        import warnings
+
+        from shipid.errors import ShipidWarning
+
+        warnings.warn(stale, ShipidWarning, stacklevel=2)
     return doc
+
+
+def _parses(doc: Mapping) -> bool:
+    try:
+        _check_every_term(doc["model"], ManoeuvringModel.from_dict(doc["model"]), "")
+    except (ShipidError, KeyError, TypeError, ValueError):
+        return False
+    return True
 
 
 def load_model(path: str | Path, which: str = "model") -> ManoeuvringModel | HybridModel:
@@ -443,6 +505,16 @@ def rescaled_document(doc: Mapping, factor: float, to_rho: float | None = None,
             prep[key] = prep[key] * scale
     if isinstance(ident.get("dt"), int | float):
         ident["dt"] = ident["dt"] * k
+    # The LS-SVM fit's standard errors are printed beside the coefficients: they scale with
+    # them (a rescaled model's report printed ṙ's u·v as 0.0054 ± 0.0009, the error of 0.54).
+    from shipid.dynamics.prime import prime_factor
+
+    for dof, diag in (ident.get("diagnostics") or {}).items():
+        errors = diag.get("std_errors") if isinstance(diag, Mapping) else None
+        for t, se in (errors or {}).items():
+            if isinstance(se, int | float):
+                errors[t] = se * abs(prime_factor(dof, t, 1.0, 1.0, rho)
+                                     / prime_factor(dof, t, factor, k, to_rho))  # fmt: skip
     envelope = ident.get("envelope") or {}
     for signal, bounds in envelope.items():
         scale = signal_scale(signal, factor, rho, to_rho)
@@ -453,8 +525,9 @@ def rescaled_document(doc: Mapping, factor: float, to_rho: float | None = None,
         "method": "Froude: equal prime coefficients at equal Froude number",
         "factor": factor, "rho": [rho, to_rho],
         "note": "viscous (Reynolds) effects are not scaled; identification.discrete and "
-                "diagnostics are those of the fit at the original scale"})  # fmt: skip
-    return json_safe(out)
+                "diagnostics (but their standard errors) are those of the fit at the original "
+                "scale"})  # fmt: skip
+    return _fingerprinted(out)
 
 
 def _scale_statistics(stats: dict, ratios: Mapping, factor: float, rho: float, to_rho: float
