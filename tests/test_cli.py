@@ -93,6 +93,38 @@ def test_a_manoeuvre_outside_the_training_envelope_is_reported(tmp_path, files, 
     assert code == 0 and "warning" not in err
 
 
+def test_a_run_coarser_than_the_models_step_is_warned(tmp_path, files, capsys):
+    """manoeuvre, criteria and autopilot integrated a model at any --dt in silence: a KVLCC2
+    model of Δk 0.2 s put its 10/10 first overshoot at 13.5° with --dt 2, 9.77° with 0.05."""
+    _, model = files  # Δk 0.2 s
+
+    def overshoot(step):
+        out = tmp_path / f"zz{step}.json"
+        code, _, err = run(["manoeuvre", model, "zigzag", "--rudder", "10", "--duration", "60",
+                            "--dt", step, "--no-bands", "--json", out], capsys)  # fmt: skip
+        assert code == 0, err
+        return json.loads(out.read_text())["indices"]["first_overshoot_deg"], err
+
+    fine, err = overshoot(0.05)
+    assert "Δk" not in err
+    same, err = overshoot(0.3)  # within 1.5 Δk
+    assert "Δk" not in err
+    coarse, err = overshoot(1.0)
+    assert "--dt 1 s is 5 times the model's Δk (0.2 s)" in err and "give --dt 0.2" in err
+    assert abs(coarse - fine) > abs(same - fine)  # what the warning is about
+    code, _, err = run(["criteria", model, "--length", "4", "--dt", "1", "--no-bands"], capsys)
+    assert "--dt 1 s is 5 times the model's Δk" in err
+    code, _, err = run(["criteria", model, "--length", "4", "--no-bands"], capsys)
+    assert "Δk" not in err
+    code, _, err = run(["autopilot", model, "--dt", "1"], capsys)
+    assert "--dt 1 s is 5 times the model's Δk" in err
+    # A model of logs at 0.02 s (the MARIN files' own) is not warned at the default step.
+    from shipid.cli.common import MANOEUVRE_STEP, _step_note
+
+    assert _step_note({"dt": 0.02}, MANOEUVRE_STEP, MANOEUVRE_STEP) is None
+    assert "5 times the model's Δk (0.02 s)" in _step_note({"dt": 0.02}, 0.1, MANOEUVRE_STEP)
+
+
 def test_a_signal_constant_in_training_has_a_margin(tmp_path, trial, capsys):
     """Bug: a KVLCC2 model identified at HSVA's constant 10.23 rps was "extrapolating" on
     MARIN's log at 10.33 rps: a signal constant in training had no margin at all. At 12 rps it

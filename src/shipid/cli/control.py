@@ -6,6 +6,7 @@ import math
 from pathlib import Path
 
 from shipid.cli.common import (
+    CONTROL_STEP,
     VESSEL_NAMES,
     _json_text,
     _np,
@@ -13,6 +14,7 @@ from shipid.cli.common import (
     _run_approach,
     _ship_or_model,
     _steering,
+    _step_note,
     _warn,
     _warn_beyond_training,
 )
@@ -33,6 +35,9 @@ def _controlled(args):
         raise ShipidError(f"--truth must be a reference ship ({', '.join(VESSEL_NAMES)})")
     steering, note = _steering(target, cond, args.rudder_rate)
     print(f"{args.model}: {note}")
+    coarse = _step_note(cond, args.dt, CONTROL_STEP)
+    if coarse:
+        _warn(coarse)
     return target, truth, speed, rps, steering, cond
 
 

@@ -6,7 +6,14 @@ import argparse
 import math
 
 from shipid import __version__
-from shipid.cli.common import FORMATS, KINDS, LINEAR_ESTIMATORS
+from shipid.cli.common import (
+    CONTROL_STEP,
+    CRITERIA_STEP,
+    FORMATS,
+    KINDS,
+    LINEAR_ESTIMATORS,
+    MANOEUVRE_STEP,
+)
 from shipid.cli.control import cmd_autopilot, cmd_export, cmd_follow, cmd_linearise
 from shipid.cli.data import cmd_import, cmd_indices, cmd_plot
 from shipid.cli.evaluation import cmd_simulate, cmd_validate
@@ -360,7 +367,7 @@ def build_parser() -> argparse.ArgumentParser:
                         "600 s for stopping, "
                         "doubled until the run is complete and its yaw rate settled; a full-"
                         "scale ship takes ten times a 1:100 model)")
-    p.add_argument("--dt", "--step", dest="step", type=float, default=0.05,
+    p.add_argument("--dt", "--step", dest="step", type=float, default=MANOEUVRE_STEP,
                    help="integration step [s] (default %(default)s)")
     p.add_argument("--speed", type=float, help="approach speed [m/s] (models: default from training)")
     p.add_argument("--rps", type=float,
@@ -395,7 +402,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--rudder-rate", type=float, metavar="DEG/S",
                    help="steering machine rate (default: the training logs' rudder rate, else "
                    "SOLAS 2.32 °/s at full scale, × √λ)")
-    p.add_argument("--dt", type=float, default=0.05, help="integration step [s] (default %(default)s)")
+    p.add_argument("--dt", type=float, default=CRITERIA_STEP,
+                   help="integration step [s] (default %(default)s)")
     p.add_argument("--json", metavar="OUT.json")
     p.add_argument("--no-bands", action="store_true",
                    help="skip the intervals from the model file's bootstrap ensemble")
@@ -427,7 +435,8 @@ def build_parser() -> argparse.ArgumentParser:
                        "rudder rate; a reference ship: its own gear)")
         p.add_argument("--omega", type=float, help="closed-loop natural frequency [rad/s] "
                        "(default max(1/|T|, √|K/T|): Kp at least 1)")
-        p.add_argument("--dt", type=float, default=0.1, help="step [s] (default %(default)s)")
+        p.add_argument("--dt", type=float, default=CONTROL_STEP,
+                       help="step [s] (default %(default)s)")
         if name == "autopilot":
             p.add_argument("--heading", type=float, default=20.0, metavar="DEG",
                            help="heading step (default %(default)s; positive to starboard)")

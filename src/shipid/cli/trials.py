@@ -8,12 +8,15 @@ from functools import partial
 from pathlib import Path
 
 from shipid.cli.common import (
+    CRITERIA_STEP,
+    MANOEUVRE_STEP,
     _json_text,
     _pd,
     _run_approach,
     _ship_or_model,
     _simulated_metadata,
     _steering,
+    _step_note,
     _unused_inputs,
     _warn,
 )
@@ -41,6 +44,7 @@ def cmd_criteria(args) -> int:
                   dt=args.dt)  # fmt: skip
     crit = run(target)
     crit.notes += _unused_inputs(target, args)
+    crit.notes += [n for n in (_step_note(cond, args.dt, CRITERIA_STEP),) if n]
     from shipid.evaluation.validate import faded_residual_notes
 
     crit.notes += [f"{name}: {note}" for name, res in crit.runs.items()
@@ -154,6 +158,9 @@ def cmd_manoeuvre(args) -> int:
     speed, rps, unsteady = _run_approach(target, cond, args.speed, args.rps)
     steering, rudder_note = _steering(target, cond, args.rudder_rate)
     kw = {"dt": args.step, "speed": speed, "rps": rps, "steering": steering}
+    coarse = _step_note(cond, args.step, MANOEUVRE_STEP)
+    if coarse:
+        _warn(coarse)
     if args.wind_speed is not None:
         kw["wind"] = (args.wind_speed, math.radians(args.wind_from or 0.0))
     if args.duration is not None:
