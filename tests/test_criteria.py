@@ -116,6 +116,40 @@ def test_marin_ship_data_reads_as_is():
     assert p.volume == pytest.approx(3.27)
 
 
+def test_criteria_refuse_the_length_of_another_ship(tmp_path, capsys):
+    """A model of a 4 m ship judged with full-scale particulars (67.8 m) had tactical diameters
+    of 0.19 L, and passed: its manoeuvres run at the model's scale. Another length than the
+    model's own (its particulars', a reference ship's) is refused, naming rescale."""
+    from shipid.data.io import write_log
+    from shipid.trials.manoeuvres import zigzag
+    from shipid.vessels import scale_ship
+
+    log = zigzag(scale_ship(rudder_rate_deg=9.6), 20, 20, duration=60, dt=0.2, approach=2).log
+    path = write_log(log, tmp_path / "zz.csv")
+    (tmp_path / "small.yml").write_text("length: 4.0\n")
+    (tmp_path / "big.yml").write_text("length: 67.8\nscale: 16.95\n")
+    model = tmp_path / "m.json"
+    assert run(["identify", path, "--particulars", tmp_path / "small.yml", "--no-output-error",
+                "-o", model], capsys)[0] == 0  # fmt: skip
+    out = tmp_path / "c.json"
+    for argv in (["criteria", model, "--particulars", tmp_path / "big.yml", "--json", out],
+                 ["criteria", model, "--length", "67.8", "--json", out],
+                 ["validate", model, path, "--particulars", tmp_path / "big.yml", "--json", out]):
+        code, _, err = run(argv, capsys)
+        lines = [ln for ln in err.splitlines() if not ln.startswith("warning:")]
+        assert code == 1 and len(lines) == 1, err
+        assert "gives a length of 67.8 m, but" in lines[0] and "runs as a ship of 4 m" in lines[0]
+        assert "shipid rescale" in lines[0] and "--length 67.8" in lines[0]
+        assert not out.exists()
+    code, _, err = run(["criteria", model, "--length", "4.1", "--no-bands", "--json", out],
+                       capsys)  # fmt: skip
+    assert code == 0, err  # 2.5 %: a correction, not another ship
+    rows = {r["criterion"]: r for r in json.loads(out.read_text())["criteria"]}
+    assert rows["tactical diameter"]["value"] > 1.0  # in lengths of the ship that turned
+    code, _, err = run(["criteria", "scale-ship", "--length", "67.8"], capsys)
+    assert code == 1 and "runs as a ship of 4.389 m" in err and "reference ship" in err
+
+
 def test_cli_criteria_of_a_reference_ship_and_of_a_model_file(tmp_path, capsys):
     code, out, err = run(["criteria", "scale-ship"], capsys)
     assert code == 0 and "instantaneous rudder" in out  # the paper's ship: no rate stated

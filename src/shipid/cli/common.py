@@ -412,6 +412,26 @@ def _ship_or_model(name: str, hybrid: bool = False):
     return model, cond
 
 
+# Lengths of one ship further apart than this are two ships (another scale), not a correction.
+LENGTH_SLACK = 0.05
+
+
+def _check_length(name: str, target, cond: dict, given: float | None, source: str) -> None:
+    """Refuse a length that is not the one of the ship ``target`` runs as: its indices in ship
+    lengths were divided by another ship's (a 4 m model judged with full-scale particulars of
+    67.8 m had tactical diameters of 0.19 L, and passed). ``source`` names the option."""
+    own = getattr(target, "length", math.nan)
+    if not (isinstance(own, float) and math.isfinite(own)):
+        own = cond["particulars"].length if cond.get("particulars") is not None else None
+    if own and given and abs(given / own - 1.0) > LENGTH_SLACK:
+        remedy = (f"to judge a ship {given / own:.4g} times as long, carry the model over first "
+                  f"(shipid rescale {name} --length {given:g} -o OUT.json)"
+                  if name not in VESSEL_NAMES else "a reference ship is judged at its own")
+        raise ShipidError(f"{source} gives a length of {given:g} m, but {name} runs as a ship of "
+                          f"{own:g} m: its manoeuvres are that ship's, so their lengths would be "
+                          f"divided by another's; {remedy}")  # fmt: skip
+
+
 def _run_approach(target, cond: dict, speed: float | None, rps: float | None):
     """Approach speed and rps of a run on ``target``: a reference ship's own trim, or a model's
     steady straight approach (``shipid.dynamics.equilibrium.steady_approach``), printed, with a

@@ -9,6 +9,7 @@ from functools import partial
 from pathlib import Path
 
 from shipid.cli.common import (
+    _check_length,
     _json_text,
     _particulars,
     _pd,
@@ -65,6 +66,9 @@ def cmd_validate(args) -> int:
     ensemble = None if args.no_bands else ensemble_from_document(doc, args.model, model)
     band = None if args.no_bands or args.lssvm else error_band_from_document(doc, args.model)
     cond = training_conditions(doc)
+    if getattr(args, "particulars", None):  # before the runs: the criteria of the logs need it
+        _check_length(args.model, model, cond, _particulars(args).length,
+                      f"--particulars {args.particulars}")  # fmt: skip
     env = cond["envelope"]
     from shipid.data.io import read_log
     from shipid.data.log import common_rudder_convention

@@ -10,6 +10,7 @@ from pathlib import Path
 from shipid.cli.common import (
     CRITERIA_STEP,
     MANOEUVRE_STEP,
+    _check_length,
     _json_text,
     _pd,
     _run_approach,
@@ -34,6 +35,11 @@ def cmd_criteria(args) -> int:
                   [args.model] if Path(args.model).exists() else [])  # fmt: skip
     target, cond = _ship_or_model(args.model, hybrid=True)
     particulars = read_particulars(args.particulars) if args.particulars else cond["particulars"]
+    if args.length:
+        _check_length(args.model, target, cond, args.length, "--length")
+    elif args.particulars:
+        _check_length(args.model, target, cond, particulars.length,
+                      f"--particulars {args.particulars}")  # fmt: skip
     speed, rps, _ = _run_approach(target, cond, args.speed, args.rps)  # imo_criteria notes it
     # Given, else the ship's gear or the training logs' rate, else imo_criteria's SOLAS rate.
     steering, _ = _steering(target, cond, args.rudder_rate, fallback="caller")
