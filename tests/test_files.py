@@ -480,6 +480,7 @@ def test_a_hand_edited_model_file_drops_the_fits_intervals(tmp_path, capsys, tri
     doc = json.loads(model.read_text())
     assert doc["provenance"]["model_sha256"]
     same = tmp_path / "same.json"
+    doc["model"]["name"] = "renamed"  # a name is not a coefficient
     same.write_text(json.dumps(doc))  # another layout, the same numbers
     edited = tmp_path / "edited.json"
     doc["model"]["coefficients"]["r"]["delta"] *= 0.5

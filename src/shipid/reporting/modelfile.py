@@ -41,9 +41,11 @@ def sha256(path: str | Path) -> str:
 
 
 def model_fingerprint(model_data) -> str:
-    """SHA-256 of a model file's ``model`` record (its JSON with sorted keys): what the fit's
-    records (intervals, error band, standard errors) were computed for."""
-    text = json.dumps(json_safe(model_data), sort_keys=True, ensure_ascii=False)
+    """SHA-256 of a model file's structure and coefficients (JSON, sorted keys; not its name):
+    what the fit's records (intervals, error band, standard errors) were computed for."""
+    data = model_data if isinstance(model_data, Mapping) else {}
+    text = json.dumps(json_safe({k: data.get(k) for k in ("structure", "coefficients")}),
+                      sort_keys=True, ensure_ascii=False)  # fmt: skip
     return hashlib.sha256(text.encode("utf-8")).hexdigest()
 
 
@@ -128,10 +130,10 @@ def stale_fit_records(doc: dict, path: str | Path) -> str | None:
         dropped.append("the standard errors")
     kept = ("; its kernel residual was fitted to the misses of the coefficients before the edit"
             if (doc.get("kernel_residual") or {}).get("residual") else "")  # fmt: skip
+    listed = " and ".join([", ".join(dropped[:-1]), dropped[-1]] if len(dropped) > 1 else dropped)
     return (f"{path}: the model's coefficients are not those it was fitted with (edited?): "
-            + (f"{' and '.join((', '.join(dropped[:-1]), dropped[-1]) if dropped[:-1] else dropped)}"
-               " of the fit are left out, as they describe those"
-               if dropped else "the file's fit records describe those") + kept)
+            + (f"{listed} of the fit are left out, as they describe those" if dropped
+               else "the file's fit records describe those") + kept)
 
 
 def prime_record(model: ManoeuvringModel, particulars: dict | None,
