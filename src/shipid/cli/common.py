@@ -50,22 +50,22 @@ def _training_logs(args) -> list:
     """The logs a model is fitted to: ``_read_logs``, refused when they are at different
     scales (a model-scale and a full-scale run fitted together mix two ships' time scales)."""
     logs = _read_logs(args)
-    for path, log in zip(args.logs, logs, strict=True):
-        if "measured_dt" in log.attrs:
-            _warn(f"{path}: --dt {args.dt:g} s is finer than its own sampling "
-                  f"({log.attrs['measured_dt']:.3g} s): the fit sees straight lines between its "
-                  f"samples as measurements (their second differences 0, so its sensor noise "
-                  f"reads as none); fit at --dt {log.attrs['measured_dt']:.3g} or coarser "
-                  f"(validate may run a model finer than its logs)")  # fmt: skip
-    scales = {}
+    scales, upsampled = {}, []
     for path, log in zip(args.logs, logs, strict=True):
         if "scale" in log.attrs:
             scales.setdefault(float(log.attrs["scale"]), str(path))
+        if "measured_dt" in log.attrs:  # resampled finer than measured (preprocess.resample)
+            upsampled.append((path, log.attrs["measured_dt"]))
     if len(scales) > 1:
         (a, pa), (b, pb) = list(scales.items())[:2]
         raise ShipidError(f"{pb} is at scale 1:{b:g} and {pa} at 1:{a:g}: the logs of one fit "
                           "must be at one scale (read the trial files with the same "
                           "--scale)")  # fmt: skip
+    for path, own in upsampled:
+        _warn(f"{path}: --dt {args.dt:g} s is finer than its own sampling ({own:.3g} s): the fit "
+              f"sees straight lines between its samples as measurements (their second "
+              f"differences 0, so its sensor noise reads as none); fit at --dt {own:.3g} or "
+              f"coarser (validate may run a model finer than its logs)")  # fmt: skip
     return logs
 
 

@@ -66,9 +66,9 @@ def cmd_validate(args) -> int:
     ensemble = None if args.no_bands else ensemble_from_document(doc, args.model, model)
     band = None if args.no_bands or args.lssvm else error_band_from_document(doc, args.model)
     cond = training_conditions(doc)
-    if getattr(args, "particulars", None):  # before the runs: the criteria of the logs need it
-        _check_length(args.model, model, cond, _particulars(args).length,
-                      f"--particulars {args.particulars}")  # fmt: skip
+    given = _particulars(args)  # checked before the runs: the criteria of the logs need it
+    if given is not None:
+        _check_length(args.model, model, cond, given.length, f"--particulars {args.particulars}")
     env = cond["envelope"]
     from shipid.data.io import read_log
     from shipid.data.log import common_rudder_convention
@@ -140,7 +140,7 @@ def cmd_validate(args) -> int:
         print("\nResidual analysis of the free-run errors (share of lags outside the 95 % band "
               "of white noise; ≈ 0.05 when the error is white and independent of the rudder):")
         print(_pd().DataFrame(rows).to_markdown(index=False, floatfmt=".2f"))
-    particulars = _particulars(args) or training_conditions(doc)["particulars"]
+    particulars = given or cond["particulars"]
     crit = None
     if particulars is not None:
         crit = _criteria_of_logs(good, logs, vals, particulars)
