@@ -273,6 +273,29 @@ def test_the_default_fits_by_output_error_where_noise_is_all_the_lssvm_leaves(tm
     assert _interval_hits(ls["model"]["coefficients"], ls_se, truth) == (6, 14)
 
 
+def test_bootstrap_says_it_keeps_the_lssvm_fit_the_default_would_replace(tmp_path, capsys,
+                                                                        paper_fit):
+    """``--bootstrap`` describes the LS-SVM fit, so on the paper's zig-zag (noise is all the
+    LS-SVM leaves) it keeps the fit a plain ``identify`` replaces by output error: said in one
+    line and in the model file, where before the user asking for intervals got the other fit,
+    with intervals that hold the truth a third as often, without a word."""
+    _, logs = paper_fit
+    train = write_log(logs[TRAINING], tmp_path / "train.csv")
+    argv = ["identify", train, "--bootstrap", "10"]
+    code, text, err = run([*argv, "-o", tmp_path / "b.json"], capsys)
+    assert code == 0, err
+    assert "output error: not fitted, since --bootstrap describes the LS-SVM fit" in text
+    doc = json.loads((tmp_path / "b.json").read_text())
+    choice = doc["identification"]["preprocessing"]["output_error"]
+    assert choice["fit"] == "LS-SVM" and "--bootstrap" in choice["why"]
+    assert max(choice["noise_ratios"].values()) <= 2.0
+    assert doc["identification"].get("refinement") is None
+    # Asked for the LS-SVM fit in so many words: nothing to say.
+    code, text, err = run([*argv, "--no-output-error", "-o", tmp_path / "n.json"], capsys)
+    assert code == 0, err
+    assert "output error" not in text
+
+
 def test_the_default_keeps_the_lssvm_where_model_error_is_what_is_left(tmp_path, capsys,
                                                                        paper_fit, monkeypatch):
     """A real log: the LS-SVM's free runs miss the KVLCC2's MARIN zig-zag by tens of times its

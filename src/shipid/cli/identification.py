@@ -204,6 +204,8 @@ def cmd_identify(args) -> int:
         else:
             refinement, ensemble = _output_error_where_noise_is_left(
                 ident, raw_logs, names, args, prep["output_error"], physics)
+    elif args.output_error == "auto" and not (args.refine or given_physics):
+        prep["output_error"] = _output_error_passed_over(ident, raw_logs, args, explicit_band)
     final = ident.model
     if speed is None or not speed > 0:
         raise ShipidError(f"{names[0]}: the first training log starts without headway (u = "
@@ -390,6 +392,28 @@ def _output_error_where_noise_is_left(ident, logs, names, args, record: dict, ph
         return None, None
     record.update(fit="output error", why="noise is what the LS-SVM leaves")
     return fit, ensemble
+
+
+def _output_error_passed_over(ident, logs, args, explicit_band: bool) -> dict:
+    """Where ``--bootstrap``, ``--error-band`` or ``--residual`` keep the LS-SVM fit that the
+    default would have replaced by output error (its free runs leave only the sensors' noise),
+    one line saying so: on the paper's ship the LS-SVM bootstrap's intervals held the true
+    coefficients in 36 % of cases, output error's own in 95 %, and a user adding --bootstrap for
+    intervals got the other fit without a word. Returns the model file's record."""
+    from shipid.identification.output_error import noise_dominates, noise_ratios
+
+    flag = ("--bootstrap" if args.bootstrap is not None
+            else "--error-band" if explicit_band else "--residual")  # fmt: skip
+    worst = noise_ratios(ident.model, logs).max(axis=0)
+    record = {"fit": "LS-SVM", "why": f"{flag} describes the LS-SVM fit",
+              "noise_ratios": {str(s): float(x) for s, x in worst.items()}}
+    if noise_dominates(worst.to_frame().T):
+        print(f"output error: not fitted, since {flag} describes the LS-SVM fit; its free runs "
+              f"miss the logs by at most {worst.max():.3g} times their sensor noise, where a "
+              "plain identify fits by output error, with intervals of its own (on the paper's "
+              "ship they held the true coefficients in 95 % of cases, the LS-SVM bootstrap's "
+              f"in 36 %; leave out {flag} for that fit)")  # fmt: skip
+    return record
 
 
 def _output_error(ident, logs, names, args, physics=None):
