@@ -359,3 +359,35 @@ def test_the_command_line_knows_every_kind(tmp_path, capsys):
     assert main(["indices", str(path), "--kind", "pull-out"]) == 0
     out = capsys.readouterr().out
     assert "pull-out" in out and "residual_yaw_rate" in out
+
+
+def test_an_unstable_ships_spiral_loop_need_not_turn_both_ways():
+    """Bug: the spiral's loop asked for steady turns both ways at one rudder angle. The KVLCC2's
+    MMG model is straight-line unstable (its linearisation: a sway–yaw root in the right half
+    plane), and its loop is offset to port: held at 0°, it comes to rest at 0 rad/s from
+    starboard and at −0.0205 rad/s from port, and the spiral read ``loop: False``. The same
+    rudder reached from the two sides with different steady rates is the loop."""
+    from shipid.control.linear import linearise
+    from shipid.trials.manoeuvres import _loop_rudders
+    from shipid.vessels import kvlcc2
+
+    ship = kvlcc2()
+    a = np.asarray(linearise(ship.dynamics, ship.approach_speed)["A"], dtype=float)[1:, 1:]
+    assert np.linalg.eigvals(a).real.max() > 0  # the truth: unstable
+    res = spiral(ship, (2, 0, -2, 0, 2), hold=1000.0, dt=0.1)
+    ind = res.indices
+    assert not ind["unsettled_rudders_deg"]
+    rates = [row["steady_yaw_rate"] for row in ind["table"]]
+    assert abs(rates[1]) < 1e-3 and rates[3] == pytest.approx(-0.0205, rel=0.05)
+    assert ind["loop"] and ind["loop_rudders_deg"] == [0.0]
+    assert ind["loop_yaw_rate_gap"] == pytest.approx(rates[1] - rates[3], rel=1e-12)
+    # A stable ship (the paper's) reaches one steady rate from either side: no loop.
+    stable = spiral(SHIP, (2, 0, -2, 0, 2), hold=200.0, dt=0.1).indices
+    assert not stable["loop"] and stable["loop_yaw_rate_gap"] == 0.0
+    # Unsettled rows are no evidence of a loop; rates within 5 % of the largest are one rate.
+    rows = [{"rudder_deg": a, "steady_yaw_rate": r, "settled": s}
+            for a, r, s in ((0.0, 0.0, True), (0.0, -0.02, False), (25.0, 0.05, True),
+                            (25.0, 0.049, True))]  # fmt: skip
+    assert _loop_rudders(rows) == ([], 0.0)
+    rows[1]["settled"] = True
+    assert _loop_rudders(rows) == ([0.0], pytest.approx(0.02))
