@@ -601,6 +601,29 @@ def test_every_manoeuvre_runs_on_a_model_file(files, tmp_path, capsys, kind):
         assert doc["rudder_rate_deg_s"] == pytest.approx(math.degrees(prep["rudder_rate"]))
 
 
+def test_a_pull_out_is_run_to_both_sides(tmp_path, capsys):
+    """Bug: ``manoeuvre kvlcc2 pull-out`` ran to starboard alone, where the MMG model (unstable
+    by its linearisation, its spiral's loop offset to port) returns to 0.1 % of its release
+    rate: read as stable. The other side's run keeps 40 % (−0.0205 rad/s, the spiral's port
+    rate at 0°); it is named, and its indices are those of ``--first port``."""
+    code, _, err = run(["manoeuvre", "kvlcc2", "pull-out", "--json", tmp_path / "s.json"],
+                       capsys)  # fmt: skip
+    assert code == 0, err
+    doc = json.loads((tmp_path / "s.json").read_text())
+    assert abs(doc["indices"]["residual_fraction"]) < 0.01
+    assert "the straight run is unstable to port (--first port shows it)" in err
+    code, _, err = run(["manoeuvre", "kvlcc2", "pull-out", "--first", "port", "--json",
+                        tmp_path / "p.json"], capsys)  # fmt: skip
+    assert code == 0, err
+    port = json.loads((tmp_path / "p.json").read_text())
+    assert doc["other_side_indices"] == pytest.approx(port["indices"], rel=1e-12)
+    assert port["indices"]["residual_yaw_rate"] == pytest.approx(-0.0205, rel=0.02)
+    assert "unstable to" not in err  # this side shows it; the other side returns
+    # A stable ship (the paper's) returns from either side: nothing to say.
+    code, _, err = run(["manoeuvre", "scale-ship", "pull-out"], capsys)
+    assert code == 0 and "unstable" not in err, err
+
+
 def test_a_log_sampled_coarser_than_the_models_step_is_named(files, capsys):
     # The free runs step at the log's sampling: at 2.5 Δk the paper ship's closed-loop 10/10
     # second overshoot moved from 10.8° to 13.4° without a word.

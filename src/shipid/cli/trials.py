@@ -144,6 +144,30 @@ def _tied_manoeuvres(run, alternatives: dict, kind: str, fitted: str = "") -> di
     return out
 
 
+# A pull-out whose yaw rate keeps more than this share of its rate at the release has not
+# returned to a straight course: the straight run is unstable (to that side).
+PULL_OUT_RESIDUAL = 0.05
+
+
+def _pull_out_other_side(run, target, side: str, indices: dict):
+    """The pull-out to the other side (the IMO's is run to both): its indices, and a note where
+    it keeps a residual yaw rate this side does not. The KVLCC2's MMG model, unstable, pulled
+    out from starboard returns to 0.1 % of its release rate, from port it keeps 40 %
+    (−0.0205 rad/s); one side alone read as stable."""
+    other = "port" if side == "starboard" else "starboard"
+    res = run(target, side=other)
+    if res.diverged:
+        return None, f"the pull-out to {other} diverged: {res.reason}"
+    this, that = (abs(x.get("residual_fraction") or 0.0) for x in (indices, res.indices))
+    note = None
+    if that > PULL_OUT_RESIDUAL >= this:
+        note = (f"the pull-out to {other} keeps a residual yaw rate of "
+                f"{res.indices['residual_yaw_rate']:.4g} rad/s ({100 * that:.0f} % of its rate at "
+                f"the release) where this one keeps {100 * this:.1f} %: the straight run is "
+                f"unstable to {other} (--first {other} shows it)")  # fmt: skip
+    return res.indices, note
+
+
 def cmd_manoeuvre(args) -> int:
     """``shipid manoeuvre``: a standard manoeuvre on a model or vessel."""
     from shipid.evaluation.envelope import implausible_indices, outside_envelope
@@ -223,6 +247,10 @@ def cmd_manoeuvre(args) -> int:
     if res.incomplete and not res.diverged:
         notes.append(f"{res.incomplete}: indices that need it are missing or those of a "
                      "transient; give a longer --duration")  # fmt: skip
+    other_side = None
+    if args.kind == "pull-out" and not res.diverged:
+        other_side, note = _pull_out_other_side(run, target, args.first, res.indices)
+        notes += [note] if note else []
     if args.kind == "turning" and not res.diverged:
         notes += implausible_indices(res.indices, speed or getattr(target, "approach_speed", None),
                                      getattr(target, "length", None), res.log)  # fmt: skip
@@ -255,6 +283,7 @@ def cmd_manoeuvre(args) -> int:
                    "diverged_at": res.diverged_at, "reason": res.reason,
                    "indices": res.indices, "index_intervals": intervals or None,
                    "index_not_bounded": unbounded or None, "tied_structures": tied or None,
+                   "other_side_indices": other_side,
                    "rudder_rate_deg_s": (math.degrees(gear.max_rate) if gear and gear.max_rate
                                          else None),
                    "warnings": notes}  # fmt: skip
