@@ -404,10 +404,11 @@ def _output_error_passed_over(ident, logs, args, explicit_band: bool) -> dict:
 
     flag = ("--bootstrap" if args.bootstrap is not None
             else "--error-band" if explicit_band else "--residual")  # fmt: skip
-    worst = noise_ratios(ident.model, logs).max(axis=0)
+    ratios = noise_ratios(ident.model, logs)
+    worst = ratios.max(axis=0)
     record = {"fit": "LS-SVM", "why": f"{flag} describes the LS-SVM fit",
               "noise_ratios": {str(s): float(x) for s, x in worst.items()}}
-    if noise_dominates(worst.to_frame().T):
+    if noise_dominates(ratios):
         print(f"output error: not fitted, since {flag} describes the LS-SVM fit; its free runs "
               f"miss the logs by at most {worst.max():.3g} times their sensor noise, where a "
               "plain identify fits by output error, with intervals of its own (on the paper's "

@@ -105,7 +105,7 @@ def _settled(r: np.ndarray, scale: float) -> bool:
     last three fifths, d0 and d apart, extrapolated as a geometric decay (ratio q = d/d0) put the
     limit d/(1 − q) beyond the last fifth's mean. Earlier versions took the last fifth alone,
     which a slow mode passes while far from its end: the KVLCC2 identified at full scale, in a
-    spiral from 25° to 15° held 120 s, moved 0.7 % in the last 24 s and read 0.0045 rad/s,
+    spiral from 25° to 15° held 120 s, moved 0.8 % in the last 24 s and read 0.0045 rad/s,
     18 % short of the 0.0055 it settles at."""
     n = len(r)
     tail = r[int(0.8 * n):]
