@@ -129,3 +129,39 @@ def test_plot_draws_every_rudder_in_the_first_logs_convention(trials, tmp_path, 
     np.testing.assert_array_equal(drawn["starboard.csv"]["delta"],
                                   -trials[("starboard", "zigzag")]["delta"].to_numpy())
     assert drawn["starboard.csv"].attrs["rudder_positive"] == "port"
+
+
+def test_a_full_scale_turning_circle_is_not_read_as_the_other_convention(tmp_path):
+    """The Mariner's 35° turn at Δk 0.5 s, its rudder ordered from the log's start (paper noise
+    × 0.1): ṙ's gain on δ read t = +4.3 to starboard, since it rested on the seconds the rudder
+    moved, and a plain CSV of this port-positive log had its rudder negated, the model then
+    simulated turning the wrong way. One step of the rudder no longer names a convention."""
+    from shipid.data.checks import rudder_reversals
+    from shipid.vessels import mariner
+
+    log = PAPER_IMU.scaled(0.1).apply(
+        turning_circle(mariner(), 35.0, duration=900, dt=0.5).log, seed=13)
+    assert log.attrs["rudder_positive"] == "port"
+    assert rudder_reversals(log["delta"].to_numpy()) == 0
+    assert rudder_response(log) is None
+    plain = tmp_path / "plain.csv"
+    log[["t", "delta", "u", "v", "r", "psi"]].to_csv(plain, index=False)
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ShipidWarning)
+        read = read_log(plain)
+    assert read.attrs.get("rudder_positive", "port") == "port"
+    np.testing.assert_allclose(read["delta"].to_numpy(), log["delta"].to_numpy(), atol=1e-12)
+
+
+@pytest.mark.parametrize(("delta", "expected"), [
+    ([0, -5, -20, -35, -35, -34.5, -35], 0),  # a turn, with a wobble under the hysteresis
+    ([0, 10, 35, 35, 20, 0, 0], 1),  # a pull-out
+    ([0, 20, 20, -20, -20, 20, 20, -20], 3),  # a zig-zag: one per execute after the first
+    ([0, 0, 0], 0),
+])  # fmt: skip
+def test_rudder_reversals_count_the_rudder_turning_back(delta, expected):
+    from shipid.data.checks import rudder_reversals
+
+    assert rudder_reversals(np.radians(delta)) == expected

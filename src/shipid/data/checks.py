@@ -63,6 +63,13 @@ RUDDER_AHEAD_SHARE = 0.5
 # four Esso random runs, all with the stated sign; a turning circle, one step of the rudder,
 # 0.6-2.0, which says nothing.
 RUDDER_CONVENTION_T = 4.0
+# ... and only where the rudder reverses at least ``RUDDER_REVERSALS`` times by this share of its
+# range: with one step (a turning circle) or one step and back (a pull-out) the gain rests on the
+# few seconds the rudder moves, in which the ship's lag and its loss of speed confound it. The
+# Mariner's full-scale 35° turn at Δk 0.5 s (its rudder ordered from the log's start, paper
+# noise × 0.1) read t = +4.3 to starboard, and a plain CSV of it was negated.
+RUDDER_REVERSAL_SHARE = 0.25
+RUDDER_REVERSALS = 2
 
 
 def true_runs(mask: np.ndarray) -> list[tuple[int, int]]:
@@ -404,11 +411,40 @@ class RudderResponse:
         return abs(self.t_score) >= RUDDER_CONVENTION_T
 
 
+def rudder_reversals(delta: np.ndarray, share: float = RUDDER_REVERSAL_SHARE) -> int:
+    """How many times the rudder ``delta`` turns back by at least ``share`` of its range from the
+    furthest it had moved (a hysteresis, so noise and small corrections do not count): 0 for a
+    turning circle, 1 for a pull-out, one per execute after the first in a zig-zag."""
+    delta = np.asarray(delta, dtype=float)
+    step = share * float(np.ptp(delta)) if delta.size else 0.0
+    if not step > 0:
+        return 0
+    low = high = delta[0]
+    direction, reversals = 0, 0
+    for d in delta[1:]:
+        if direction == 0:
+            low, high = min(low, d), max(high, d)
+            if high - low >= step:
+                direction = 1 if d == high else -1
+                low = high = d
+        elif direction > 0:
+            if d > high:
+                high = d
+            elif high - d >= step:
+                direction, low, reversals = -1, d, reversals + 1
+        elif d < low:
+            low = d
+        elif d - low >= step:
+            direction, high, reversals = 1, d, reversals + 1
+    return reversals
+
+
 def rudder_response(log: pd.DataFrame) -> RudderResponse | None:
     """Least-squares ṙ ≈ gain·δ + a·r + c on ``RUDDER_BIN_S`` means of the samples running ahead
     (u above ``RUDDER_AHEAD_SHARE`` of its 90th percentile, n > 0 where logged). The r term takes
     the yaw damping, which would otherwise hide the rudder in a zig-zag, where r lags δ. None
-    when fewer than 20 bins run ahead or the rudder does not move."""
+    when fewer than 20 bins run ahead or their rudder reverses fewer than ``RUDDER_REVERSALS``
+    times (``rudder_reversals``)."""
     t = log["t"].to_numpy(dtype=float)
     if len(t) < 3:
         return None
@@ -426,7 +462,7 @@ def rudder_response(log: pd.DataFrame) -> RudderResponse | None:
     if "n" in bins.columns:
         ahead &= bins["n"].to_numpy() > 0
     delta = bins["delta"].to_numpy()[ahead]
-    if ahead.sum() < 20 or not np.ptp(delta) > 0:
+    if ahead.sum() < 20 or not np.ptp(delta) > 0 or rudder_reversals(delta) < RUDDER_REVERSALS:
         return None
     x = np.column_stack([delta, r[ahead], np.ones(delta.size)])
     y = r_dot[ahead]
