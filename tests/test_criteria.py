@@ -200,3 +200,40 @@ def test_criteria_say_where_their_manoeuvres_leave_the_training_logs(tmp_path, c
     assert f"{trained:.3g} rad" in rudder
     doc = json.loads((tmp_path / "c.json").read_text())
     assert any("delta spans" in n for n in doc["notes"])
+
+
+def test_a_verdict_beyond_the_training_logs_says_so(tmp_path, capsys):
+    """The Mariner identified from two 20°/20° zig-zags (paper noise × 0.1) met every criterion,
+    the 35° tactical diameters at 4.78 L and 4.98 L, which the true Mariner fails (6.40 L and
+    6.65 L, the test above): 'all criteria met' stood unqualified, the rudder beyond the logs
+    said only in warnings below. Each criterion now names the signals its manoeuvre takes
+    beyond the logs, and the verdict counts the verdicts that rest on them."""
+    from shipid.data.io import write_log
+    from shipid.trials.manoeuvres import zigzag
+    from shipid.vessels import PAPER_IMU
+
+    paths = []
+    for i, first in enumerate(("starboard", "port")):
+        log = zigzag(mariner(), 20, 20, first=first, duration=600, dt=0.5).log
+        paths.append(write_log(PAPER_IMU.scaled(0.1).apply(log, seed=10 + i),
+                               tmp_path / f"zz{i}.csv"))  # fmt: skip
+    assert run(["identify", *paths, "-o", tmp_path / "m.json"], capsys)[0] == 0
+    code, out, err = run(["criteria", tmp_path / "m.json", "--length", "160.93", "--json",
+                          tmp_path / "c.json"], capsys)  # fmt: skip
+    assert code == 0, err
+    rows = json.loads((tmp_path / "c.json").read_text())["criteria"]
+    truth = imo_criteria(mariner(), dt=0.5).table.set_index(["criterion", "manoeuvre"])
+    for row in rows:
+        key = (row["criterion"], row["manoeuvre"])
+        if row["manoeuvre"].startswith("turning 35°"):
+            assert "δ" in row["beyond the logs"], key  # 35° against the logs' 20°
+        else:  # the zig-zags stay within the 20° rudder of the logs
+            assert "δ" not in row["beyond the logs"], key
+    wrong = [k for k in truth.index if truth.loc[k, "passed"] is not None and any(
+        (r["criterion"], r["manoeuvre"]) == k and r["passed"] != truth.loc[k, "passed"]
+        for r in rows)]  # fmt: skip
+    # The verdicts this model gets wrong are among those it takes beyond its logs.
+    assert wrong and all(k[1].startswith("turning 35°") for k in wrong)
+    verdict = [line for line in out.splitlines() if "criteria met" in line][0]
+    beyond = sum(bool(r["beyond the logs"]) for r in rows if r["passed"] is not None)
+    assert f"{beyond} of the {len(rows)} verdicts are on manoeuvres beyond the training" in verdict

@@ -57,6 +57,9 @@ def cmd_criteria(args) -> int:
                    for note in faded_residual_notes(target, res.log)]  # fmt: skip
     crit.notes += _criteria_envelope_notes(cond["envelope"], crit.runs)
     table = crit.table.copy()
+    beyond = _beyond_the_logs(cond["envelope"], crit)
+    if beyond is not None:
+        table["beyond the logs"] = beyond
     ensemble = cond.get("ensemble")
     if ensemble is not None and not args.no_bands:
         from shipid.trials.criteria import replicate_notes, with_intervals
@@ -85,8 +88,16 @@ def cmd_criteria(args) -> int:
           f"m/s, λ = {c['scale']:g} (full-scale L/V = {c['L_over_V_full_scale']:.3g} s), " + (
               f"rudder rate {c['rudder_rate_deg_s']:.3g} °/s" if c["rudder_rate_deg_s"]
               else "instantaneous rudder"))
+    verdict = "all criteria met" if crit.passed else "NOT all criteria met"
+    extrapolated = [] if beyond is None else [
+        b for b, ok in zip(beyond, crit.table["passed"], strict=True) if b and ok is not None]
+    if extrapolated:
+        verdict += (f"; {len(extrapolated)} of the {int(crit.table['passed'].notna().sum())} "
+                    "verdicts are on manoeuvres beyond the training logs (column 'beyond the "
+                    "logs': the signals that leave them), extrapolations a trial of that kind "
+                    "decides")  # fmt: skip
     record = {**crit.to_dict(), "criteria": table.to_dict(orient="records"),
-              "tied_structures": tied or None}  # fmt: skip
+              "tied_structures": tied or None, "verdict": verdict}  # fmt: skip
     table["passed"] = table["passed"].map({True: "pass", False: "FAIL", None: "–"})
     print(table.to_markdown(index=False, floatfmt=".3g"))
     if "pass_share" in table:
@@ -96,13 +107,32 @@ def cmd_criteria(args) -> int:
     if tied:
         print(f"{', '.join(tied)}: the value of each structure the training logs could not tell "
               f"apart from this one ({cond.get('alternatives_fit', '')}), from the same approach")
-    print("all criteria met" if crit.passed else "NOT all criteria met")
+    print(verdict)
     for n in crit.notes:
         _warn(n)
     with OutputSet() as out:
         if args.json:
             out.write(args.json, lambda p: p.write_text(_json_text(record), "utf-8"))
     return 0
+
+
+def _beyond_the_logs(env, crit) -> list[str] | None:
+    """Per criterion, the signals its manoeuvre takes beyond the model's training logs ('' where
+    none; None for a ship without logs). A verdict there is the model's extrapolation: the
+    Mariner identified from two 20°/20° zig-zags met the 35° tactical diameter (4.78 L, 4.98 L)
+    that the true Mariner fails (6.40 L, 6.65 L), with the rudder at 35° against ±20° trained."""
+    from shipid.evaluation.envelope import signals_outside
+
+    if not env:
+        return None
+    names = {"delta": "δ"}
+    out = []
+    for manoeuvre in crit.table["manoeuvre"]:
+        res = crit.runs.get(manoeuvre)
+        log = getattr(res, "log", None)
+        found = [] if log is None else signals_outside(env, log)
+        out.append(", ".join(names.get(s, s) for s in found))
+    return out
 
 
 def _criteria_envelope_notes(env, runs) -> list[str]:

@@ -61,6 +61,11 @@ def outside_envelope(env: Mapping[str, Sequence[float]], log: pd.DataFrame) -> l
     return notes
 
 
+def signals_outside(env: Mapping[str, Sequence[float]], log: pd.DataFrame) -> list[str]:
+    """The signals of ``log`` that leave the envelope (``outside_envelope``'s, by name)."""
+    return [note.split(" ", 1)[0] for note in outside_envelope(env, log)]
+
+
 def _rpm_hint(n: np.ndarray, lo: float, hi: float) -> str:
     """A hint when the log's propeller speed looks like the training logs' in rpm."""
     trained = max(abs(lo), abs(hi))
