@@ -135,7 +135,8 @@ def test_a_full_scale_turning_circle_is_not_read_as_the_other_convention(tmp_pat
     """The Mariner's 35° turn at Δk 0.5 s, its rudder ordered from the log's start (paper noise
     × 0.1): ṙ's gain on δ read t = +4.3 to starboard, since it rested on the seconds the rudder
     moved, and a plain CSV of this port-positive log had its rudder negated, the model then
-    simulated turning the wrong way. One step of the rudder no longer names a convention."""
+    simulated turning the wrong way. One step of the rudder no longer names a convention by
+    that fit; the turn it holds does, the right one."""
     from shipid.data.checks import rudder_reversals
     from shipid.vessels import mariner
 
@@ -143,7 +144,8 @@ def test_a_full_scale_turning_circle_is_not_read_as_the_other_convention(tmp_pat
         turning_circle(mariner(), 35.0, duration=900, dt=0.5).log, seed=13)
     assert log.attrs["rudder_positive"] == "port"
     assert rudder_reversals(log["delta"].to_numpy()) == 0
-    assert rudder_response(log) is None
+    found = rudder_response(log)
+    assert found.side == "port" and found.held_turn and "turns to starboard" in found.held_turn
     plain = tmp_path / "plain.csv"
     log[["t", "delta", "u", "v", "r", "psi"]].to_csv(plain, index=False)
     import warnings
@@ -165,3 +167,28 @@ def test_rudder_reversals_count_the_rudder_turning_back(delta, expected):
     from shipid.data.checks import rudder_reversals
 
     assert rudder_reversals(np.radians(delta)) == expected
+
+
+@pytest.mark.parametrize("seed", [None, 0])
+def test_a_plain_csv_of_a_starboard_positive_turn_is_taken_so(tmp_path, seed):
+    """A turning circle names no convention by the fit of ṙ on δ (one step of the rudder), so a
+    plain CSV of a starboard-positive one (the KVLCC2's MMG convention) was read port-positive
+    and its rudder mirrored against the model's. The turn it holds names it: 35° held, the ship
+    turns to the side that angle turns it to, through hundreds of degrees."""
+    log = turning_circle(kvlcc2(), 35.0, duration=240, dt=0.2).log
+    assert log.attrs["rudder_positive"] == "starboard"
+    log = log if seed is None else PAPER_IMU.apply(log, seed=seed)
+    plain = tmp_path / "plain.csv"
+    log[["t", "delta", "u", "v", "r", "psi"]].to_csv(plain, index=False)
+    with pytest.warns(ShipidWarning, match=r"held at \+35° ahead \(from \+\d+°\) it turns to "
+                      "starboard through .*taken as rudder_positive=starboard"):
+        assert read_log(plain).attrs["rudder_positive"] == "starboard"
+    assert rudder_response(_mirror_rudder(log)).side == "port"
+
+
+@needs_data
+def test_the_real_turning_circles_hold_their_turn_to_the_stated_side():
+    for path in sorted((DATA / "esso-osaka" / "turning").glob("*.csv")):
+        log = read_log(path, fmt="osaka-frt", start="auto", end="auto")
+        found = rudder_response(log)
+        assert found.held_turn and found.side == log.attrs["rudder_positive"], path.name

@@ -70,6 +70,13 @@ RUDDER_CONVENTION_T = 4.0
 # noise × 0.1) read t = +4.3 to starboard, and a plain CSV of it was negated.
 RUDDER_REVERSAL_SHARE = 0.25
 RUDDER_REVERSALS = 2
+# Such a log names its convention by the turn it holds: the rudder held this far [deg] from where
+# it started, to the end of the log (within this share of the step, at least 1°), and the heading
+# turned this far [deg] meanwhile, the yaw rate on one side throughout. The Esso Osaka's 35°
+# turns, the reference ships' 20° and 35° turns: their stated sides, at the paper's noise too.
+RUDDER_HELD_DEG = 10.0
+HELD_TOLERANCE = 0.05
+HELD_TURN_DEG = 90.0
 
 
 def true_runs(mask: np.ndarray) -> list[tuple[int, int]]:
@@ -399,11 +406,21 @@ def _check_heading_against_yaw_rate(df: pd.DataFrame, name: str) -> None:
 
 @dataclass(frozen=True)
 class RudderResponse:
-    """How the yaw rate answers the rudder in a log: ṙ ≈ gain·δ + a·r + c where it runs ahead."""
+    """How the yaw rate answers the rudder in a log: ṙ ≈ gain·δ + a·r + c where it runs ahead,
+    or, where the rudder does not reverse, the turn it holds (``held_turn``)."""
 
     side: str  # 'port' or 'starboard': where a positive rudder angle turns the ship in the log
-    gain: float  # ∂ṙ/∂δ [1/s²]
+    gain: float  # ∂ṙ/∂δ [1/s²]; for a held turn Δr/Δδ [1/s]
     t_score: float  # gain over its standard error, widened for the residuals' correlation
+    held_turn: str | None = None  # the held turn in words, where it decided
+
+    @property
+    def evidence(self) -> str:
+        """What the data show, in words."""
+        if self.held_turn:
+            return f"{self.held_turn}, as if a positive angle turned it to {self.side}"
+        return (f"where it runs ahead the yaw rate answers the rudder as if a positive angle "
+                f"turned it to {self.side} (ṙ/δ {self.gain:+.3g} 1/s², t = {self.t_score:+.1f})")
 
     @property
     def decisive(self) -> bool:
@@ -443,8 +460,9 @@ def rudder_response(log: pd.DataFrame) -> RudderResponse | None:
     """Least-squares ṙ ≈ gain·δ + a·r + c on ``RUDDER_BIN_S`` means of the samples running ahead
     (u above ``RUDDER_AHEAD_SHARE`` of its 90th percentile, n > 0 where logged). The r term takes
     the yaw damping, which would otherwise hide the rudder in a zig-zag, where r lags δ. None
-    when fewer than 20 bins run ahead or their rudder reverses fewer than ``RUDDER_REVERSALS``
-    times (``rudder_reversals``)."""
+    when fewer than 20 bins run ahead; where their rudder reverses fewer than
+    ``RUDDER_REVERSALS`` times (``rudder_reversals``), the turn it holds (``_held_turn``) or
+    None."""
     t = log["t"].to_numpy(dtype=float)
     if len(t) < 3:
         return None
@@ -462,8 +480,10 @@ def rudder_response(log: pd.DataFrame) -> RudderResponse | None:
     if "n" in bins.columns:
         ahead &= bins["n"].to_numpy() > 0
     delta = bins["delta"].to_numpy()[ahead]
-    if ahead.sum() < 20 or not np.ptp(delta) > 0 or rudder_reversals(delta) < RUDDER_REVERSALS:
+    if ahead.sum() < 20 or not np.ptp(delta) > 0:
         return None
+    if rudder_reversals(delta) < RUDDER_REVERSALS:
+        return _held_turn(tb[ahead], delta, r[ahead])
     x = np.column_stack([delta, r[ahead], np.ones(delta.size)])
     y = r_dot[ahead]
     coef, *_ = np.linalg.lstsq(x, y, rcond=None)
@@ -480,6 +500,35 @@ def rudder_response(log: pd.DataFrame) -> RudderResponse | None:
     return RudderResponse("starboard" if gain > 0 else "port", gain, t_score)
 
 
+def _held_turn(t: np.ndarray, delta: np.ndarray, r: np.ndarray) -> RudderResponse | None:
+    """The convention of a log whose rudder does not reverse (a turning circle), read off the
+    turn it holds: the rudder held ``RUDDER_HELD_DEG`` or more from where it started, to the end
+    (within ``HELD_TOLERANCE``), and in that span the heading turned ``HELD_TURN_DEG`` at least,
+    the yaw rate on one side of its start throughout. A ship turns to the side its held rudder
+    turns it to, stable or not (an unstable ship's loop is a few degrees wide). None where the
+    log holds no such turn."""
+    end, start = float(np.median(delta[-3:])), float(delta[0])
+    step = end - start
+    if abs(step) < math.radians(RUDDER_HELD_DEG):
+        return None
+    off = np.abs(delta - end) > max(math.radians(1.0), HELD_TOLERANCE * abs(step))
+    first = int(np.flatnonzero(off)[-1]) + 1 if off.any() else 0
+    if len(t) - first < 3:
+        return None
+    r0 = float(r[0])
+    turned = float(np.sum(r[first:-1] * np.diff(t[first:])))
+    if abs(turned) < math.radians(HELD_TURN_DEG) or not np.all(
+            np.sign(r[first:] - r0) == np.sign(turned)):  # fmt: skip
+        return None
+    side = "starboard" if turned * step > 0 else "port"
+    turn = "starboard" if turned > 0 else "port"
+    words = (f"held at {math.degrees(end):+.0f}° ahead (from {math.degrees(start):+.0f}°) it turns "
+             f"to {turn} through {math.degrees(abs(turned)):.0f}°")  # fmt: skip
+    gain = (float(np.mean(r[first:])) - r0) / step
+    return RudderResponse(side, gain, math.copysign(math.inf, 1.0 if side == "starboard"
+                                                    else -1.0), words)  # fmt: skip
+
+
 def check_rudder_convention(log: pd.DataFrame, name: str, stated: bool) -> None:
     """Warn where the log's rudder response contradicts its stated convention (metadata,
     the format, or --rudder-positive): the sign constraints, the prior and the closed-loop
@@ -490,8 +539,7 @@ def check_rudder_convention(log: pd.DataFrame, name: str, stated: bool) -> None:
     side = log.attrs.get("rudder_positive", "port")
     if found is None or not found.decisive or found.side == side:
         return
-    evidence = (f"where it runs ahead the yaw rate answers the rudder as if a positive angle "
-                f"turned it to {found.side} (ṙ/δ {found.gain:+.3g} 1/s², t = {found.t_score:+.1f})")
+    evidence = found.evidence
     if stated:
         warnings.warn(f"{name}: {evidence}, but the log says rudder_positive={side}: the sign "
                       f"constraints, the prior and the zig-zag replica would be mirrored; give "
