@@ -217,9 +217,16 @@ def test_a_verdict_beyond_the_training_logs_says_so(tmp_path, capsys):
         log = zigzag(mariner(), 20, 20, first=first, duration=600, dt=0.5).log
         paths.append(write_log(PAPER_IMU.scaled(0.1).apply(log, seed=10 + i),
                                tmp_path / f"zz{i}.csv"))  # fmt: skip
-    assert run(["identify", *paths, "-o", tmp_path / "m.json"], capsys)[0] == 0
+    assert run(["identify", *paths, "--bootstrap", "10", "-o", tmp_path / "m.json"],
+               capsys)[0] == 0  # fmt: skip
+    # With the replicates' intervals (their table dropped the column at first) and without.
     code, out, err = run(["criteria", tmp_path / "m.json", "--length", "160.93", "--json",
                           tmp_path / "c.json"], capsys)  # fmt: skip
+    assert code == 0, err
+    header = next(line for line in out.splitlines() if line.startswith("| criterion"))
+    assert "beyond the logs" in header and "pass_share" in header
+    code, out, err = run(["criteria", tmp_path / "m.json", "--length", "160.93", "--no-bands",
+                          "--json", tmp_path / "c.json"], capsys)  # fmt: skip
     assert code == 0, err
     rows = json.loads((tmp_path / "c.json").read_text())["criteria"]
     truth = imo_criteria(mariner(), dt=0.5).table.set_index(["criterion", "manoeuvre"])

@@ -57,9 +57,6 @@ def cmd_criteria(args) -> int:
                    for note in faded_residual_notes(target, res.log)]  # fmt: skip
     crit.notes += _criteria_envelope_notes(cond["envelope"], crit.runs)
     table = crit.table.copy()
-    beyond = _beyond_the_logs(cond["envelope"], crit)
-    if beyond is not None:
-        table["beyond the logs"] = beyond
     ensemble = cond.get("ensemble")
     if ensemble is not None and not args.no_bands:
         from shipid.trials.criteria import replicate_notes, with_intervals
@@ -67,6 +64,9 @@ def cmd_criteria(args) -> int:
         replicates = [run(m) for m in ensemble.members()]
         table = with_intervals(crit, replicates)
         crit.notes += replicate_notes(table, replicates, ensemble.members_label)
+    beyond = _beyond_the_logs(cond["envelope"], crit)
+    if beyond is not None:
+        table["beyond the logs"] = beyond
     tied = {}
     keys = list(zip(crit.table["criterion"], crit.table["manoeuvre"], strict=True))
     for name, alt in (cond.get("alternatives") or {}).items():
