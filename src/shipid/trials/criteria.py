@@ -167,7 +167,12 @@ def imo_criteria(
         rows.append(_row("stopping track reach", "full astern", _in_l(res.indices["track_reach"], L),
                          15.0, "L"))  # fmt: skip
     else:
-        notes.append("stopping ability not judged: the model has no propeller-speed terms")
+        # A reference ship's own physics may run a propeller, at the one speed it was set to
+        # (the KVLCC2's MMG model): it takes no order to reverse it.
+        what = ("the model has no propeller-speed terms"
+                if isinstance(ship, (ManoeuvringModel, HybridModel))
+                else f"{getattr(ship, 'name', 'the ship')}'s dynamics take no propeller-speed order")
+        notes.append(f"stopping ability not judged: {what}, so no full astern can be run")
     conditions = {"length": L, "speed": V, "scale": lam, "L_over_V_full_scale": l_over_v,
                   "rudder_rate_deg_s": (math.degrees(steering.max_rate) if steering.max_rate
                                         else None),
