@@ -55,7 +55,8 @@ def cmd_criteria(args) -> int:
 
     crit.notes += [f"{name}: {note}" for name, res in crit.runs.items()
                    for note in faded_residual_notes(target, res.log)]  # fmt: skip
-    crit.notes += _criteria_envelope_notes(cond["envelope"], crit.runs)
+    outside = _runs_outside(cond["envelope"], crit.runs)
+    crit.notes += _criteria_envelope_notes(cond["envelope"], crit.runs, outside)
     table = crit.table.copy()
     ensemble = cond.get("ensemble")
     if ensemble is not None and not args.no_bands:
@@ -64,7 +65,7 @@ def cmd_criteria(args) -> int:
         replicates = [run(m) for m in ensemble.members()]
         table = with_intervals(crit, replicates)
         crit.notes += replicate_notes(table, replicates, ensemble.members_label)
-    beyond = _beyond_the_logs(cond["envelope"], crit)
+    beyond = _beyond_the_logs(crit, outside)
     if beyond is not None:
         table["beyond the logs"] = beyond
     tied = {}
@@ -116,39 +117,43 @@ def cmd_criteria(args) -> int:
     return 0
 
 
-def _beyond_the_logs(env, crit) -> list[str] | None:
-    """Per criterion, the signals its manoeuvre takes beyond the model's training logs ('' where
-    none; None for a ship without logs). A verdict there is the model's extrapolation: the
-    Mariner identified from two 20°/20° zig-zags met the 35° tactical diameter (4.78 L, 4.98 L)
-    that the true Mariner fails (6.40 L, 6.65 L), with the rudder at 35° against ±20° trained."""
+def _runs_outside(env, runs) -> dict[str, list[str]] | None:
+    """Per manoeuvre run, the signals it takes beyond the model's training logs (None for a ship
+    without logs): checked once, for the column and the notes."""
     from shipid.evaluation.envelope import signals_outside
 
     if not env:
         return None
+    return {name: signals_outside(env, res.log) for name, res in runs.items()
+            if getattr(res, "log", None) is not None}  # fmt: skip
+
+
+def _beyond_the_logs(crit, outside) -> list[str] | None:
+    """Per criterion, the signals its manoeuvre takes beyond the model's training logs ('' where
+    none; None for a ship without logs). A verdict there is the model's extrapolation: the
+    Mariner identified from two 20°/20° zig-zags met the 35° tactical diameter (4.78 L, 4.98 L)
+    that the true Mariner fails (6.40 L, 6.65 L), with the rudder at 35° against ±20° trained."""
+    if outside is None:
+        return None
     names = {"delta": "δ"}
-    out = []
-    for manoeuvre in crit.table["manoeuvre"]:
-        res = crit.runs.get(manoeuvre)
-        log = getattr(res, "log", None)
-        found = [] if log is None else signals_outside(env, log)
-        out.append(", ".join(names.get(s, s) for s in found))
-    return out
+    return [", ".join(names.get(s, s) for s in outside.get(manoeuvre, []))
+            for manoeuvre in crit.table["manoeuvre"]]
 
 
-def _criteria_envelope_notes(env, runs) -> list[str]:
+def _criteria_envelope_notes(env, runs, outside) -> list[str]:
     """Where the criteria's manoeuvres, together, leave the model's training envelope (one note
     per signal, naming the runs that do): a criterion judged beyond the trials is a guess."""
     import pandas as pd
 
     from shipid.evaluation.envelope import outside_envelope
 
-    logs = {name: res.log for name, res in runs.items() if getattr(res, "log", None) is not None}
-    if not env or not logs:
+    logs = [res.log for res in runs.values() if getattr(res, "log", None) is not None]
+    if not outside or not logs:
         return []
     notes = []
-    for note in outside_envelope(env, pd.concat(list(logs.values()), ignore_index=True)):
+    for note in outside_envelope(env, pd.concat(logs, ignore_index=True)):
         signal = note.split(" ", 1)[0]
-        names = [n for n, log in logs.items() if outside_envelope({signal: env[signal]}, log)]
+        names = [name for name, signals in outside.items() if signal in signals]
         notes.append(f"criteria ({', '.join(names)}): {note}")
     return notes
 
