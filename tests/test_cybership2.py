@@ -1,0 +1,101 @@
+"""CyberShip II (reference-ships.md §5), the 1:70 model ship of marine-robotics work, as a truth:
+its compiled accelerations against the section's matrix equations transcribed here as written,
+its trim against the thrust balance, its turn to the side its convention names."""
+
+import math
+
+import numpy as np
+import pytest
+
+from shipid.data.checks import rudder_response
+from shipid.trials.manoeuvres import turning_circle, zigzag
+from shipid.vessels import PAPER_IMU, get_vessel
+from shipid.vessels.cybership2 import (
+    RUDDER_RATE_DEG,
+    accelerations,
+    propeller_thrust,
+    trimmed_revolutions,
+)
+
+# §5.1 as printed.
+MASS, IZ, XG = 23.8, 1.76, 0.046
+ADDED = dict(Xudot=-2.0, Yvdot=-10.0, Yrdot=0.0, Nvdot=0.0, Nrdot=-1.0)
+DAMP = dict(Xu=-0.72253, Xuu=-1.32742, Xuuu=-5.86643, Yv=-0.88965, Yvv=-36.47287, Yrv=-0.805,
+            Yr=-7.250, Yvr=-0.845, Yrr=-3.450, Nv=0.03130, Nvv=3.95645, Nrv=0.130, Nr=-1.900,
+            Nvr=0.080, Nrr=-0.750)  # fmt: skip
+
+
+def _matrix_form(u, v, r, delta, n):
+    """M ν̇ = τ − C(ν) ν − D(ν) ν with the matrices of §5.2 and τ = B [T1, T2, T3, L1, L2]."""
+    a, d = ADDED, DAMP
+    m_rb = np.array([[MASS, 0, 0], [0, MASS, MASS * XG], [0, MASS * XG, IZ]])
+    m_a = -np.array([[a["Xudot"], 0, 0], [0, a["Yvdot"], a["Yrdot"]], [0, a["Nvdot"], a["Nrdot"]]])
+    c_rb = np.array([[0, 0, -MASS * (XG * r + v)], [0, 0, MASS * u],
+                     [MASS * (XG * r + v), -MASS * u, 0]])  # fmt: skip
+    k = a["Yvdot"] * v + 0.5 * (a["Nvdot"] + a["Yrdot"]) * r
+    c_a = np.array([[0, 0, k], [0, 0, -a["Xudot"] * u], [-k, a["Xudot"] * u, 0]])
+    dmat = np.array([
+        [-d["Xu"] - d["Xuu"] * abs(u) - d["Xuuu"] * u * u, 0, 0],
+        [0, -d["Yv"] - d["Yvv"] * abs(v) - d["Yrv"] * abs(r),
+         -d["Yr"] - d["Yvr"] * abs(v) - d["Yrr"] * abs(r)],
+        [0, -d["Nv"] - d["Nvv"] * abs(v) - d["Nrv"] * abs(r),
+         -d["Nr"] - d["Nvr"] * abs(v) - d["Nrr"] * abs(r)]])  # fmt: skip
+    # Thrust with its dead zone, the rudder in the race (§5.2's actuator lines).
+    n_up = max(0.0, 1.52468e-4 * u / 3.65034e-3)
+    n_low = min(0.0, 4.55822e-2 * u / 5.10256e-3)
+    if n >= n_up:
+        thrust = 3.65034e-3 * abs(n) * n - 1.52468e-4 * abs(n) * u
+    elif n <= n_low:
+        thrust = 5.10256e-3 * abs(n) * n - 4.55822e-2 * abs(n) * u
+    else:
+        thrust = 0.0
+    u_rud = u if u < 0 else u + 0.5 * (math.sqrt(max(0.0, 8 * thrust / (math.pi * 1014 * 0.06**2)
+                                                   + u * u)) - u)  # fmt: skip
+    lift_c = (6.43306 * delta - 5.83594 * abs(delta) * delta if u_rud >= 0
+              else 3.19573 * delta - 2.34356 * abs(delta) * delta)  # fmt: skip
+    lift = lift_c * abs(u_rud) * u_rud
+    b = np.array([[1, 1, 0, 0, 0], [0, 0, 1, 1, 1], [0.078, -0.078, 0.466, -0.549, -0.549]])
+    tau = b @ np.array([thrust, thrust, 0.0, lift, lift])
+    nu = np.array([u, v, r])
+    return np.linalg.solve(m_rb + m_a, tau - (c_rb + c_a) @ nu - dmat @ nu)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_compiled_accelerations_are_the_matrix_equations(seed):
+    rng = np.random.default_rng(seed)
+    for _ in range(50):
+        u = rng.uniform(-0.3, 0.6)
+        v, r = rng.uniform(-0.2, 0.2), rng.uniform(-0.5, 0.5)
+        delta, n = rng.uniform(-0.61, 0.61), rng.choice([rng.uniform(-15, 15), 0.0, 1e-3])
+        np.testing.assert_allclose(accelerations(u, v, r, delta, n),
+                                   _matrix_form(u, v, r, delta, n), rtol=1e-12, atol=1e-14)
+
+
+def test_the_thrust_is_continuous_at_its_dead_zone():
+    for u in (-0.3, 0.0, 0.4):
+        for edge in (max(0.0, 1.52468e-4 * u / 3.65034e-3), min(0.0, 4.55822e-2 * u / 5.10256e-3)):
+            assert abs(propeller_thrust(edge, u)) < 1e-15
+    assert propeller_thrust(0.01, 0.4) == 0.0  # inside the dead zone
+    assert propeller_thrust(10.0, 0.3) > 0 > propeller_thrust(-10.0, 0.3)
+
+
+@pytest.mark.parametrize("speed", [0.1, 0.3, 0.5])
+def test_the_trimmed_propeller_holds_the_approach_speed(speed):
+    n = trimmed_revolutions(speed)
+    assert abs(accelerations(speed, 0.0, 0.0, 0.0, n)[0]) < 1e-12
+    assert 3 < n < 15  # rps of a 6 cm propeller; the thrust balance's root
+    with pytest.raises(ValueError, match="approach speed must be > 0"):
+        trimmed_revolutions(-speed)
+
+
+def test_the_vessel_turns_to_the_side_its_convention_names():
+    ship = get_vessel("cybership2")
+    assert ship.rudder_positive == "port" and ship.scale == 70.0
+    assert RUDDER_RATE_DEG == pytest.approx(65 / 28 * 70**0.5)
+    run_ = turning_circle(ship, 35.0, side="starboard", dt=0.1)
+    assert run_.log["delta"].iloc[-1] < 0 and run_.indices["steady_yaw_rate"] > 0
+    # Positive rudder to port: the section's B sends positive lift to a negative yaw moment.
+    assert accelerations(0.3, 0.0, 0.0, 0.2, trimmed_revolutions(0.3))[2] < 0
+    # Read off its own response with no convention given (a zig-zag's reversals).
+    log = PAPER_IMU.scaled(0.15).apply(zigzag(ship, 20, 20, duration=60, dt=0.1).log, seed=0)
+    assert rudder_response(log).side == "port"
