@@ -14,6 +14,7 @@ from shipid.control.export import export_numpy, linearised_control, to_control
 from shipid.control.linear import linearise, nomoto, trim
 from shipid.dynamics.model import ManoeuvringModel, ModelStructure, nomoto_parameters
 from shipid.dynamics.simulate import simulate
+from shipid.errors import ShipidError
 from shipid.vessels import PAPER_IMU, scale_ship, scale_ship_model
 
 TRUTH = scale_ship(rudder_rate_deg=9.6)
@@ -298,7 +299,7 @@ def test_the_lookahead_follows_the_model_files_length(tmp_path, capsys):
     code, out, err = run(["follow", path, "--speed", "1.93", "--waypoints", "0,0;40,0;40,40"],
                          capsys)  # fmt: skip
     assert code == 0, err
-    assert "(lookahead 10 m)" in out
+    assert "(lookahead 10 m, 2 L)" in out
 
 
 @pytest.mark.parametrize("ship", ["model", "windy model", "kvlcc2", "mariner"])
@@ -373,3 +374,49 @@ def test_the_exported_module_says_which_way_its_rudder_turns(tmp_path, capsys, s
     t = np.arange(0, 30, 0.2)
     run_ = mod.simulate(t, np.full((len(t), 1), math.radians(20)), [2.0, 0, 0, 0, 0, 0])
     assert np.sign(run_[-1, 2]) == (1 if side == "starboard" else -1)
+
+
+def test_a_leg_no_longer_than_the_acceptance_distance_is_refused():
+    """A leg no longer than the acceptance distance (the lookahead's by default) was switched
+    past as it started, and its run reported the later legs' cross-track errors as the path's:
+    a model of CyberShip II (1.25 m) on 10 m legs at the 20 m default lookahead turned back
+    along the last leg at once, 'completed'."""
+    nm = nomoto(scale_ship_model(), 1.93)
+    pid = pid_from_nomoto(nm["K"], nm["T"])
+    with pytest.raises(ShipidError, match=r"leg 2 of the path \(10 m\) is no longer than the "
+                       r"acceptance distance \(the lookahead, 12 m\)"):  # fmt: skip
+        follow_path(scale_ship_model(), pid, [(0, 0), (40, 0), (40, 10), (0, 10)],
+                    lookahead=12.0, speed=1.93)  # fmt: skip
+    with pytest.raises(ShipidError, match=r"leg 1 .* \(acceptance, 50 m\)"):
+        follow_path(scale_ship_model(), pid, [(0, 0), (40, 0), (40, 40)], lookahead=8.0,
+                    acceptance=50.0, speed=1.93)  # fmt: skip
+    # The last leg is never switched past: a short one is followed to its end.
+    res = follow_path(scale_ship_model(), pid, [(0, 0), (40, 0), (40, 5)], lookahead=8.0,
+                      speed=1.93)  # fmt: skip
+    assert res.completed and not res.diverged
+
+
+def test_a_model_without_a_length_is_steered_by_its_true_ships(tmp_path, capsys):
+    """A model of CyberShip II whose file gives no length: the 20 m default lookahead made its
+    10 m legs unfollowable. With --truth the true ship's length sets it (2 L = 2.51 m); without,
+    the path is refused, naming --lookahead."""
+    from shipid.vessels import cybership2
+
+    ship = cybership2()
+    path = ManoeuvringModel("blanke-speed", {
+        "u": {"|u|u": -1.0, "vr": 3.4, "r^2": 2.7, "delta^2": -0.24, "1": 0.081},
+        "v": {"ur": -1.88, "uv": -0.25, "|v|v": -1.0, "|v|r": -0.1, "u^2*delta": 0.33, "1": 0.0},
+        "r": {"ur": -2.53, "uv": -2.27, "|v|v": 2.6, "|v|r": 1.0, "u^2*delta": -4.06, "1": 0.0},
+    }).save(tmp_path / "cs2.json")  # fmt: skip
+    assert ship.length == pytest.approx(1.255)
+    square = ["--speed", "0.3", "--waypoints", "0,0;10,0;10,10;0,10"]
+    code, out, err = run(["follow", path, "--truth", "cybership2", *square], capsys)
+    assert code == 0, err
+    assert "(lookahead 2.51 m, 2 L of cybership2, the --truth ship" in out
+    rows = [line.split("|") for line in out.splitlines()
+            if line.startswith(("| model ", "| truth"))]  # fmt: skip
+    # rms cross-track [m] of all three runs on the 10 m square: 1.8–2.1 (7.7–8.6 at 20 m).
+    assert len(rows) == 3 and all(float(row[2]) < 3.0 and "True" in row[4] for row in rows)
+    code, out, err = run(["follow", path, *square], capsys)
+    assert code == 1 and "leg 1 of the path (10 m) is no longer than the acceptance distance " \
+        "(the lookahead, 20 m)" in err and "--lookahead" in err  # fmt: skip

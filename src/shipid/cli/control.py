@@ -181,11 +181,17 @@ def cmd_follow(args) -> int:
     check_outputs({"-o": (args.output, "figure"), "--json": (args.json, "json")}, [])
     waypoints = _parse_waypoints(args.waypoints)  # before the model is loaded and run
     target, truth, speed, rps, steering, cond = _controlled(args)
-    # A reference ship's length, else the model file's particulars', else 10 m.
-    length = getattr(target, "length", None)
+    # A reference ship's length, else the model file's particulars', else the --truth ship's
+    # (the ship the model stands for), else 10 m.
+    length, of = getattr(target, "length", None), ""
     if not (length and length == length) and cond.get("particulars") is not None:
         length = cond["particulars"].length
-    lookahead = args.lookahead or 2.0 * (length if length and length == length else 10.0)
+    if not (length and length == length) and truth is not None:
+        length, of = truth.length, f" of {truth.name}, the --truth ship: the model file gives none"
+    known = bool(length and length == length)
+    lookahead = args.lookahead or 2.0 * (length if known else 10.0)
+    source = ("given" if args.lookahead else f"2 L{of}" if known
+              else "the model file gives no length; --lookahead to set it")
     nm, pid = _tuned(target, speed, rps, args.omega)
     runs, rows = {}, []
     cases = [("model", target, pid, speed, rps, steering)]
@@ -205,8 +211,8 @@ def cmd_follow(args) -> int:
                      "Kp": gains.kp, "Ki": gains.ki, "Kd": gains.kd})  # fmt: skip
     _warn_beyond_training(cond, args.model, runs["model"])
     table = _pd().DataFrame(rows)
-    print(f"Line-of-sight path following (lookahead {lookahead:.3g} m), PID tuned on "
-          f"{args.model}:")
+    print(f"Line-of-sight path following (lookahead {lookahead:.3g} m, {source}), PID tuned "
+          f"on {args.model}:")
     print(table.to_markdown(index=False, floatfmt=".4g"))
     if truth is not None:
         ratio = rows[1]["rms cross-track [m]"] / rows[2]["rms cross-track [m]"]

@@ -267,6 +267,19 @@ def follow_path(
     if not (math.isfinite(lookahead) and lookahead > 0):
         raise ShipidError(f"lookahead must be > 0 m, got {lookahead!r}")
     accept = lookahead if acceptance is None else acceptance
+    if not (math.isfinite(accept) and accept > 0):
+        raise ShipidError(f"acceptance must be > 0 m, got {acceptance!r}")
+    # A leg no longer than the acceptance distance is switched past as it starts: the run
+    # followed the legs after it and reported their cross-track errors as the path's (a 1.25 m
+    # ship on 10 m legs at the 20 m default lookahead turned back along the last leg at once).
+    short = np.flatnonzero(lengths[:-1] <= accept)
+    if short.size:
+        k = int(short[0])
+        said = "the lookahead" if acceptance is None else "acceptance"
+        raise ShipidError(f"leg {k + 1} of the path ({lengths[k]:.3g} m) is no longer than the "
+                          f"acceptance distance ({said}, {accept:.3g} m): the ship would be "
+                          "switched past it as it starts it; give a shorter lookahead "
+                          "(--lookahead) or longer legs")  # fmt: skip
     vessel = as_vessel(ship, speed, steering, rps)
     if duration is None:
         duration = 3.0 * float(lengths.sum()) / vessel.approach_speed
