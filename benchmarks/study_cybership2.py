@@ -20,8 +20,6 @@ Run: .venv/bin/python benchmarks/study_cybership2.py [seeds, default 3]
 
 from __future__ import annotations
 
-import contextlib
-import io
 import json
 import os
 import sys
@@ -29,10 +27,9 @@ import tempfile
 import time
 import warnings
 
-from shipid.cli import main
-from shipid.data.io import write_log
-from shipid.reporting.modelfile import load_model
-from shipid.trials.manoeuvres import turning_circle, zigzag
+from cli_models import judged, model_by_cli, noisy_files, truth_indices
+
+from shipid.trials.manoeuvres import zigzag
 from shipid.vessels import PAPER_IMU, cybership2
 
 DT = 0.1
@@ -50,28 +47,6 @@ def trials(ship) -> dict:
             for a in (20, 10) for first, sign in (("starboard", ""), ("port", "-"))}
 
 
-def judged(model, truth: dict, ship) -> list[str]:
-    """Each turn's tactical diameter and steady yaw rate errors, and the 10°/10° overshoots'."""
-    cells = []
-    for angle, side in TURNS:
-        res = turning_circle(model, angle, side=side, dt=DT, speed=ship.approach_speed,
-                             steering=ship.steering)  # fmt: skip
-        ind = {} if res.diverged else (res.indices or {})
-        td, r = ind.get("tactical_diameter"), ind.get("steady_yaw_rate")
-        if td is None or r is None:
-            cells.append("no turn")
-            continue
-        td0, r0 = truth[(angle, side)]
-        cells.append(f"{100 * (td / td0 - 1):+.0f} % (r {100 * (r / r0 - 1):+.0f} %)")
-    zz = zigzag(model, 10, 10, duration=120, dt=DT, speed=ship.approach_speed,
-                steering=ship.steering)  # fmt: skip
-    ind = {} if zz.diverged else (zz.indices or {})
-    first, second = ind.get("first_overshoot_deg"), ind.get("second_overshoot_deg")
-    cells.append("–" if first is None or second is None else
-                 f"{first - truth['zz10'][0]:+.1f}°, {second - truth['zz10'][1]:+.1f}°")
-    return cells
-
-
 def structure_of(path: str, model) -> str:
     """The structure's name, or its number of terms where select chose them."""
     choice = json.loads(open(path).read())["identification"].get("structure_choice") or {}
@@ -85,12 +60,7 @@ def main_study(seeds: int = 3) -> None:
     warnings.simplefilter("ignore")
     ship = cybership2()
     clean = trials(ship)
-    truth = {}
-    for angle, side in TURNS:
-        ind = turning_circle(ship, angle, side=side, dt=DT).indices
-        truth[(angle, side)] = (ind["tactical_diameter"], ind["steady_yaw_rate"])
-    zz = zigzag(ship, 10, 10, duration=120, dt=DT).indices
-    truth["zz10"] = (zz["first_overshoot_deg"], zz["second_overshoot_deg"])
+    truth = truth_indices(ship, TURNS, DT, 120.0)
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores")
     print(f"\nCyberShip II at {ship.approach_speed} m/s: 35° tactical diameter "
           f"{truth[TURNS[0]][0]:.2f} m ({truth[TURNS[0]][0] / ship.length:.2f} L), steady yaw "
@@ -102,21 +72,15 @@ def main_study(seeds: int = 3) -> None:
     start = time.perf_counter()
     with tempfile.TemporaryDirectory() as tmp:
         for seed in range(seeds):
-            paths = {}
-            for i, (name, log) in enumerate(clean.items()):
-                noisy = PAPER_IMU.scaled(NOISE).apply(log, seed=100 * seed + i)
-                paths[name] = str(write_log(noisy, f"{tmp}/{name}_{seed}.csv"))
+            paths = noisy_files(clean, PAPER_IMU.scaled(NOISE), seed, tmp)
             for label, names in TRAINING.items():
                 for method, argv in METHODS.items():
                     out = f"{tmp}/model.json"
-                    with contextlib.redirect_stdout(io.StringIO()), \
-                            contextlib.redirect_stderr(io.StringIO()):  # fmt: skip
-                        code = main([*argv, *(paths[n] for n in names), "-o", out])
-                    if code:
+                    model = model_by_cli(argv, [paths[n] for n in names], out)
+                    if model is None:
                         print(f"| {seed} | {label} | {method} | failed |")
                         continue
-                    model = load_model(out)
-                    cells = judged(model, truth, ship)
+                    cells = judged(model, truth, ship.approach_speed, ship.steering, DT, 120.0)
                     print(f"| {seed} | {label} | {method} | {structure_of(out, model)} | "
                           + " | ".join(cells) + " |", flush=True)
     print(f"\n{time.perf_counter() - start:.0f} s")

@@ -18,8 +18,6 @@ Run: .venv/bin/python benchmarks/study_mariner.py [noise factors, default 0.1,0.
 
 from __future__ import annotations
 
-import contextlib
-import io
 import os
 import sys
 import tempfile
@@ -27,12 +25,10 @@ import time
 import warnings
 
 import numpy as np
+from cli_models import judged, model_by_cli, noisy_files, truth_indices
 
-from shipid.cli import main
-from shipid.data.io import write_log
-from shipid.reporting.modelfile import load_model
 from shipid.trials.criteria import imo_criteria
-from shipid.trials.manoeuvres import turning_circle, zigzag
+from shipid.trials.manoeuvres import zigzag
 from shipid.vessels import PAPER_IMU, mariner
 
 DT = 0.5
@@ -53,38 +49,11 @@ def trials(ship) -> dict:
     return out
 
 
-def judged(model, truth: dict, speed: float, steering) -> list[str]:
-    """The cells of one row: each turn's tactical diameter and steady yaw rate (error against the
-    Mariner's), and the 10°/10° overshoots' errors, the model run with the Mariner's own gear
-    (without it the model's rudder moved at once, and its overshoots came 2–3° low)."""
-    cells = []
-    for angle, side in TURNS:
-        res = turning_circle(model, angle, side=side, dt=DT, speed=speed, steering=steering)
-        ind = {} if res.diverged else (res.indices or {})
-        td, r = ind.get("tactical_diameter"), ind.get("steady_yaw_rate")
-        if td is None or r is None:
-            cells.append("no turn")
-            continue
-        td0, r0 = truth[(angle, side)]
-        cells.append(f"{100 * (td / td0 - 1):+.0f} % (r {100 * (r / r0 - 1):+.0f} %)")
-    zz = zigzag(model, 10, 10, duration=900, dt=DT, speed=speed, steering=steering)
-    ind = {} if zz.diverged else (zz.indices or {})
-    first, second = ind.get("first_overshoot_deg"), ind.get("second_overshoot_deg")
-    cells.append("–" if first is None or second is None else
-                 f"{first - truth['zz10'][0]:+.1f}°, {second - truth['zz10'][1]:+.1f}°")
-    return cells
-
-
 def main_study(noises=(0.1, 0.3), seeds=3) -> None:
     warnings.simplefilter("ignore")
     ship = mariner()
     clean = trials(ship)
-    truth = {}
-    for angle, side in TURNS:
-        ind = turning_circle(ship, angle, side=side, dt=DT).indices
-        truth[(angle, side)] = (ind["tactical_diameter"], ind["steady_yaw_rate"])
-    zz = zigzag(ship, 10, 10, duration=900, dt=DT).indices
-    truth["zz10"] = (zz["first_overshoot_deg"], zz["second_overshoot_deg"])
+    truth = truth_indices(ship, TURNS, DT, 900.0)
     crit = imo_criteria(ship, dt=DT).table.set_index(["criterion", "manoeuvre"])
     speed = float(np.median(clean["zz20"]["u"].to_numpy()[:10]))
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores")
@@ -100,22 +69,16 @@ def main_study(noises=(0.1, 0.3), seeds=3) -> None:
     with tempfile.TemporaryDirectory() as tmp:
         for noise in noises:
             for seed in range(seeds):
-                paths = {}
-                for i, (name, log) in enumerate(clean.items()):
-                    noisy = PAPER_IMU.scaled(noise).apply(log, seed=100 * seed + i)
-                    paths[name] = str(write_log(noisy, f"{tmp}/{name}_{seed}.csv"))
+                paths = noisy_files(clean, PAPER_IMU.scaled(noise), seed, tmp)
                 for label, names in TRAINING.items():
                     for method, argv in METHODS.items():
-                        out = f"{tmp}/model.json"
-                        with contextlib.redirect_stdout(io.StringIO()), \
-                                contextlib.redirect_stderr(io.StringIO()):  # fmt: skip
-                            code = main([*argv, *(paths[n] for n in names), "-o", out])
-                        if code:
+                        model = model_by_cli(argv, [paths[n] for n in names],
+                                             f"{tmp}/model.json")  # fmt: skip
+                        if model is None:
                             print(f"| {noise:g} | {seed} | {label} | {method} | failed |")
                             continue
-                        model = load_model(out)
                         n = sum(len(t) for t in model.structure.terms.values())
-                        cells = judged(model, truth, speed, ship.steering)
+                        cells = judged(model, truth, speed, ship.steering, DT, 900.0)
                         print(f"| {noise:g} | {seed} | {label} | {method} | {n} | "
                               + " | ".join(cells) + " |", flush=True)
     print(f"\n{time.perf_counter() - start:.0f} s")

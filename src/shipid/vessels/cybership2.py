@@ -20,7 +20,7 @@ import shipid.vessels.cybership2 as _this  # this module: see the entries below
 from shipid.dynamics import kernel
 from shipid.dynamics.steering import SteeringMachine
 
-from .vessel import CompiledDynamics, Vessel
+from .vessel import ConstantRpsDynamics, Vessel
 
 kernel.drop_stale_caches(__file__)
 
@@ -100,25 +100,12 @@ def rhs(ctx, u, v, r, psi):
     return a0, a1, a2, psi_dot, xd, yd
 
 
-class CyberShip2Dynamics(CompiledDynamics):
+class CyberShip2Dynamics(ConstantRpsDynamics):
     """CyberShip II's accelerations, both propellers at ``n_prop`` [rps]."""
 
-    def __init__(self, n_prop: float) -> None:
-        self.n_prop = n_prop
-
-    def derivatives(self, nu: np.ndarray, delta: np.ndarray, thrust=None) -> np.ndarray:
-        """(B, 3) body accelerations at states nu and rudder delta."""
-        return _batch(kernel.c_array(nu), kernel.c_array(delta), float(self.n_prop))
-
-    def integrate_open(self, t, inputs, n_steps, s0, rk4, speed_lim, yaw_lim, out, n_valid):
-        """Free runs driven by (B, N, 5) inputs, the propellers at ``n_prop``."""
-        _open(float(self.n_prop), t, inputs, n_steps, s0, rk4, speed_lim, yaw_lim, out, n_valid)
-
-    def integrate_closed(self, dt, n_steps, s0, params, rk4, speed_lim, yaw_lim, states, rudder,
-                         n_valid):  # fmt: skip
-        """Closed-loop manoeuvres of parameter rows ``params``, the propellers at ``n_prop``."""
-        _closed(float(self.n_prop), dt, n_steps, s0, params, rk4, speed_lim, yaw_lim, states,
-                rudder, n_valid)  # fmt: skip
+    def kernels(self):
+        """This module's compiled entries."""
+        return _batch, _open, _closed
 
 
 # Entries reach ``rhs`` as a module attribute: numba caches them only then.

@@ -31,6 +31,37 @@ class CompiledDynamics:
         raise NotImplementedError
 
 
+class ConstantRpsDynamics(CompiledDynamics):
+    """Dynamics whose propeller turns at a constant ``n_prop`` [rps], trimmed for the approach
+    (the KVLCC2, CyberShip II). A subclass gives its module's compiled entries in ``kernels``:
+    numba caches an entry only where it reaches the ship's ``rhs`` as its own module's
+    attribute, so each ship module keeps its three."""
+
+    def __init__(self, n_prop: float) -> None:
+        self.n_prop = n_prop
+
+    def kernels(self):
+        """(batch accelerations, open runs, closed runs) of the ship's module."""
+        raise NotImplementedError
+
+    def derivatives(self, nu, delta, thrust=None):
+        """(B, 3) body accelerations at states nu and rudder delta, the propeller at n_prop."""
+        from shipid.dynamics import kernel
+
+        return self.kernels()[0](kernel.c_array(nu), kernel.c_array(delta), float(self.n_prop))
+
+    def integrate_open(self, t, inputs, n_steps, s0, rk4, speed_lim, yaw_lim, out, n_valid):
+        """Free runs driven by (B, N, 5) inputs, the propeller at ``n_prop``."""
+        self.kernels()[1](float(self.n_prop), t, inputs, n_steps, s0, rk4, speed_lim, yaw_lim,
+                          out, n_valid)  # fmt: skip
+
+    def integrate_closed(self, dt, n_steps, s0, params, rk4, speed_lim, yaw_lim, states, rudder,
+                         n_valid):  # fmt: skip
+        """Closed-loop manoeuvres of parameter rows ``params``, the propeller at ``n_prop``."""
+        self.kernels()[2](float(self.n_prop), dt, n_steps, s0, params, rk4, speed_lim, yaw_lim,
+                          states, rudder, n_valid)  # fmt: skip
+
+
 @dataclass(frozen=True)
 class Vessel:
     """A truth simulator.
