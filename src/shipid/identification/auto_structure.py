@@ -306,7 +306,7 @@ def _paper_ruled_out(logs, names, physics, estimator, drop) -> str | None:
     wrong way, diverge or end astern, or it has no steady speed).
 
     CyberShip II (its rudders in the race of propellers at a constant rps; two 20°/20°
-    zig-zags at a sixth of the paper's noise, three seeds): ``blanke`` turned the wrong way
+    zig-zags at 0.15 of the paper's noise, three seeds): ``blanke`` turned the wrong way
     under 35° rudder, its tactical diameters 88–97 % short and its 10°/10° first overshoots
     39–46° above the ship's, where ``blanke-speed`` came within 7–9 % and 6.8–7.6°
     (``benchmarks/study_cybership2.py``). Where the paper's fit passes (the paper's own ship,
