@@ -24,13 +24,16 @@ FORMATS = ("canonical", "simman-marin", "simman-hsva", "osaka-frt")
 
 def _read_options(args):
     from shipid.data.io import ReadOptions, parse_column_map
+    from shipid.data.track_velocities import TrackVelocities
 
     return ReadOptions(fmt=args.format, columns=parse_column_map(args.columns),
                        degrees=tuple(c.strip() for c in args.degrees.split(",") if c.strip()),
                        dt=args.dt, start=args.start, end=args.end, lead=args.lead,
                        rudder_positive=args.rudder_positive, scale=args.scale,
                        fill_gaps=args.fill_gaps,
-                       yaw_rate_offset=args.yaw_rate_offset)  # fmt: skip
+                       yaw_rate_offset=args.yaw_rate_offset,
+                       velocities="track" if args.velocities_from_track else "auto",
+                       track=TrackVelocities(args.track_window, args.antenna or (0.0, 0.0)))  # fmt: skip
 
 
 def _read_logs(args, paths=None) -> list:

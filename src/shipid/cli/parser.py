@@ -28,6 +28,17 @@ from shipid.cli.identification import (
 from shipid.cli.trials import cmd_criteria, cmd_manoeuvre
 
 
+def _pair(text: str) -> tuple[float, float]:
+    parts = text.split(",")
+    try:
+        values = tuple(float(p) for p in parts)
+    except ValueError:
+        values = ()
+    if len(values) != 2:
+        raise argparse.ArgumentTypeError(f"expected two numbers FORWARD,STARBOARD [m], got {text!r}")
+    return values
+
+
 def _add_log_options(p: argparse.ArgumentParser) -> None:
     g = p.add_argument_group("log files")
     g.add_argument("--format", default="canonical", choices=FORMATS,
@@ -56,6 +67,15 @@ def _add_log_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--rudder-positive", choices=("port", "starboard"),
                    help="where a positive rudder angle turns the ship (default: the file's "
                    "metadata, else port as in the paper)")
+    g.add_argument("--velocities-from-track", action="store_true",
+                   help="read u, v off the track (x, y) and psi even where the log has them "
+                   "(a log with neither has them read off its track anyway; r too where absent)")
+    g.add_argument("--track-window", type=float, metavar="S",
+                   help="u, v off the track: the local fit's window [s] (default 1 s, at least "
+                   "7 samples)")
+    g.add_argument("--antenna", type=_pair, metavar="FORWARD,STARBOARD",
+                   help="u, v off the track: the position sensor's place [m] from the log's "
+                   "reference point, in the body frame (default 0,0)")
     g.add_argument("--particulars", metavar="FILE",
                    help="ship particulars (YAML or JSON: length, beam, draught, ...; the MARIN "
                    "ship_data.yml reads as is), kept with the logs and the model")

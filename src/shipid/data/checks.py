@@ -113,7 +113,8 @@ def _stamp(value: float) -> str:
     return f"{value:.15g}"
 
 
-def check_log(df: pd.DataFrame, name: str, min_samples: int = 3, fill_gaps: bool = False) -> None:
+def check_log(df: pd.DataFrame, name: str, min_samples: int = 3, fill_gaps: bool = False,
+              required: tuple[str, ...] = REQUIRED) -> None:
     """Required columns, finite numbers, strictly increasing time, enough samples.
 
     Missing values (empty cells, NaN) inside a signal are reported with their span and refused,
@@ -121,7 +122,7 @@ def check_log(df: pd.DataFrame, name: str, min_samples: int = 3, fill_gaps: bool
     """
     if len(df) == 0:
         raise ShipidError(f"{name}: the header has no rows")
-    missing = [c for c in REQUIRED if c not in df.columns]
+    missing = [c for c in required if c not in df.columns]
     if missing:
         have = ", ".join(map(str, df.columns[:20])) + (" ..." if len(df.columns) > 20 else "")
         raise ShipidError(f"{name}: missing column(s) {', '.join(missing)} (columns found: {have}); "

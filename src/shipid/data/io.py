@@ -12,6 +12,7 @@ import dataclasses
 import math
 import mmap
 import re
+import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -30,9 +31,10 @@ from shipid.data.formats import FORMATS, detect_format, read_format
 from shipid.data.header_units import si_factors, split_units
 from shipid.data.log import COLUMNS, REQUIRED, csv_metadata_line, metadata, parse_csv_metadata
 from shipid.data.preprocess import resample
+from shipid.data.track_velocities import TrackVelocities, velocities_from_track
 from shipid.data.trim import trim
 from shipid.data.yaw_rate import correct_yaw_rate
-from shipid.errors import ShipidError
+from shipid.errors import ShipidError, ShipidWarning
 from shipid.outputs import atomic_write
 
 # No log line comes near this: a canonical row is ~200 characters. Longer lines are not logs, and
@@ -57,6 +59,9 @@ class ReadOptions:
     fill_gaps : interpolate missing values inside signals instead of refusing the log.
     yaw_rate_offset : a gyro's offset to subtract from r [rad/s], or 'auto' for each log's own,
         read off its heading (``shipid.data.yaw_rate``); None leaves r as measured.
+    velocities : 'auto': u, v as logged, or read off the track (x, y, psi) where the log has
+        neither; 'track': read off the track even where logged (``shipid.data.track_velocities``).
+    track : how they are read off the track (window, the antenna's place).
     """
 
     fmt: str = "canonical"
@@ -70,8 +75,12 @@ class ReadOptions:
     scale: float | None = None
     fill_gaps: bool = False
     yaw_rate_offset: float | str | None = None
+    velocities: str = "auto"
+    track: TrackVelocities = field(default_factory=TrackVelocities)
 
     def __post_init__(self) -> None:
+        if self.velocities not in ("auto", "track"):
+            raise ShipidError(f"velocities must be 'auto' or 'track', got {self.velocities!r}")
         if not (self.yaw_rate_offset in (None, "auto") or (
                 isinstance(self.yaw_rate_offset, int | float)
                 and math.isfinite(self.yaw_rate_offset))):
@@ -207,6 +216,8 @@ def read_log(path: str | Path, options: ReadOptions | None = None, **overrides) 
         _check_file(path)
         log = read_format(path, options.fmt, options.scale)
         check_log(log, name, fill_gaps=options.fill_gaps)
+        if _from_track(log.columns, options):
+            log = _read_off_track(log, options, name)
         meta = {}
         stated = True
     else:
@@ -223,10 +234,12 @@ def read_log(path: str | Path, options: ReadOptions | None = None, **overrides) 
         if dup:
             raise ShipidError(f"{path}: column {dup[0]!r} appears twice (after --columns)")
         df = df.dropna(how="all").reset_index(drop=True)
+        from_track = _from_track(df.columns, options)
+        required = ("t", "delta", "x", "y", "psi") if from_track else REQUIRED
         try:
-            check_log(df, name, fill_gaps=options.fill_gaps)
+            check_log(df, name, fill_gaps=options.fill_gaps, required=required)
         except ShipidError as exc:
-            if any(c not in df.columns for c in REQUIRED):
+            if any(c not in df.columns for c in required):
                 raise _hint_format(path, exc) from None
             raise
         # Header units and --degrees (si_factors leaves a column --degrees names to it).
@@ -235,6 +248,8 @@ def read_log(path: str | Path, options: ReadOptions | None = None, **overrides) 
             if c in df.columns:
                 df[c] = df[c].to_numpy() * factor
         log = df[[c for c in COLUMNS if c in df.columns]].copy()
+        if from_track:
+            log = _read_off_track(log, options, name)
         log.attrs.update({"source": str(path), "rudder_positive": "port"})
         log.attrs.update(meta)
         stated = "rudder_positive" in meta
@@ -253,6 +268,37 @@ def read_log(path: str | Path, options: ReadOptions | None = None, **overrides) 
     if options.dt is not None:
         log = resample(log, options.dt, name)
     return log
+
+
+def _from_track(columns, options: ReadOptions) -> bool:
+    """Whether u, v are read off the track: asked for, or the log has neither but x, y, psi."""
+    if options.velocities == "track":
+        return True
+    have = set(columns)
+    derive = not have & {"u", "v"} and {"x", "y", "psi"} <= have
+    if not derive and options.track != TrackVelocities():
+        raise ShipidError("--antenna and --track-window apply where u, v are read off the track: "
+                          "the log has u, v (give --velocities-from-track to read them off the "
+                          "track instead)")  # fmt: skip
+    return derive
+
+
+def _read_off_track(log: pd.DataFrame, options: ReadOptions, name: str) -> pd.DataFrame:
+    attrs = dict(log.attrs)
+    derived = velocities_from_track(log, options.track, name)
+    out = derived[[c for c in COLUMNS if c in derived.columns]].copy()
+    out.attrs = {**attrs, **derived.attrs}
+    if options.velocities == "auto":
+        how = out.attrs["velocities"]
+        fore, starboard = how["antenna"]
+        where = (f"the antenna {fore:g} m forward, {starboard:g} m to starboard" if fore or starboard
+                 else "the position taken at the reference point (--antenna FORWARD,STARBOARD "
+                 "otherwise)")
+        also = ", and r off psi," if how["r_from_heading"] else ""
+        warnings.warn(f"{name}: no u, v in the log: read off the track (x, y) and psi{also} over "
+                      f"a {how['window_s']:.2g} s window (--track-window), {where}",
+                      ShipidWarning, stacklevel=3)  # fmt: skip
+    return out
 
 
 def read_logs(paths: Sequence[str | Path], options: ReadOptions | None = None) -> list[pd.DataFrame]:

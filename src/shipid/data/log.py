@@ -6,8 +6,9 @@ Columns: ``t`` [s], ``delta`` [rad], ``u``, ``v`` [m/s], ``r`` [rad/s]; optional
 
 Metadata keys (``METADATA_KEYS``): ``ship``, ``source``, ``rudder_positive`` ('port' or
 'starboard': where a positive rudder angle turns the ship), ``scale`` (λ = ship length / model
-length, 1 at full scale), ``manoeuvre``, ``time_origin`` and ``yaw_rate_offset`` (a gyro's offset
-already subtracted from r, rad/s). They survive a round trip through
+length, 1 at full scale), ``manoeuvre``, ``time_origin``, ``yaw_rate_offset`` (a gyro's offset
+already subtracted from r, rad/s) and ``velocities`` (where u, v were read off the track: its
+window and the antenna's place; ``shipid.data.track_velocities``). They survive a round trip through
 files: Parquet keeps them in its schema metadata, CSV in a first comment line
 ``# shipid-log: {...JSON...}`` (pandas reads such a file with ``comment="#"``).
 """
@@ -30,7 +31,7 @@ OPTIONAL = ("psi", "x", "y", "n", "thrust", "wind_speed", "wind_angle")
 COLUMNS = REQUIRED + OPTIONAL
 RUDDER_SIDES = ("port", "starboard")
 METADATA_KEYS = ("ship", "source", "rudder_positive", "scale", "manoeuvre", "time_origin",
-                 "particulars", "yaw_rate_offset")
+                 "particulars", "yaw_rate_offset", "velocities")
 CSV_METADATA_PREFIX = "# shipid-log: "
 
 

@@ -1,0 +1,168 @@
+"""u, v (and r) read off a position track and heading, as a small craft's GNSS and compass log
+them. The truth is the simulated ship's own u, v, r: its track is their integral turned by ψ."""
+
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+from cli_helpers import run
+
+from shipid.data.io import read_log, write_log
+from shipid.data.track_velocities import (
+    TrackVelocities,
+    local_slope,
+    plug_in_window,
+    velocities_from_track,
+)
+from shipid.errors import ShipidError, ShipidWarning
+from shipid.trials.manoeuvres import zigzag
+from shipid.vessels import cybership2, mariner
+from shipid.vessels.sensors import SensorModel
+
+
+@pytest.fixture(scope="module")
+def cs2_zigzag():
+    return zigzag(cybership2(), 20, 20, duration=60, dt=0.1, approach=5.0).log
+
+
+@pytest.fixture(scope="module")
+def mariner_zigzag():
+    return zigzag(mariner(), 20, 20, duration=300, dt=0.5).log
+
+
+def _track(log, antenna=(0.0, 0.0), heading=0.0):
+    """The log as a GNSS and compass give it: the antenna's positions, the heading turned by
+    ``heading`` (and the track with it), no u, v."""
+    psi = log["psi"].to_numpy() + heading
+    c, s = math.cos(heading), math.sin(heading)
+    x0, y0 = log["x"].to_numpy(), log["y"].to_numpy()
+    x, y = c * x0 - s * y0, s * x0 + c * y0
+    fore, starboard = antenna
+    out = pd.DataFrame({"t": log["t"], "delta": log["delta"], "r": log["r"], "psi": psi,
+                        "x": x + fore * np.cos(psi) - starboard * np.sin(psi),
+                        "y": y + fore * np.sin(psi) + starboard * np.cos(psi)})
+    out.attrs = dict(log.attrs)
+    return out
+
+
+@pytest.mark.parametrize("jitter", [False, True])
+def test_the_local_slope_is_exact_on_a_quadratic(jitter):
+    rng = np.random.default_rng(0)
+    t = np.arange(200) * 0.1 + (rng.uniform(-0.03, 0.03, 200) if jitter else 0.0)
+    y = 3.0 - 2.0 * t + 0.7 * t**2
+    np.testing.assert_allclose(local_slope(t, y, 1.0), -2.0 + 1.4 * t, atol=1e-9)
+
+
+@pytest.mark.parametrize("antenna", [(0.0, 0.0), (0.5, -0.2)])
+def test_noise_free_velocities_are_the_ships(cs2_zigzag, antenna):
+    log = cs2_zigzag
+    got = velocities_from_track(_track(log, antenna), TrackVelocities(antenna=antenna))
+    for c, tol in (("u", 1e-3), ("v", 2e-3)):
+        assert np.max(np.abs(got[c] - log[c])) < tol, c
+    np.testing.assert_allclose(got["x"], log["x"], atol=1e-9)
+    assert got.attrs["velocities"]["antenna"] == list(antenna)
+
+
+def test_an_antenna_left_out_puts_the_lever_on_v(cs2_zigzag):
+    log = cs2_zigzag
+    got = velocities_from_track(_track(log, (0.5, 0.0)))
+    np.testing.assert_allclose(got["v"] - log["v"], 0.5 * log["r"], atol=2e-3)
+
+
+def test_r_is_read_off_the_heading_where_not_logged(cs2_zigzag):
+    got = velocities_from_track(_track(cs2_zigzag).drop(columns="r"))
+    # Within 2.5 % of its peak where the rudder's rate kinks ṙ, and 0.5 % on the whole.
+    error = got["r"] - cs2_zigzag["r"]
+    assert np.max(np.abs(error)) < 5e-3 and np.sqrt(np.mean(error**2)) < 1e-3
+    assert got.attrs["velocities"]["r_from_heading"]
+
+
+@pytest.mark.parametrize("sigma", [0.02, 0.1])
+def test_the_chosen_window_errs_about_as_little_as_the_best_of_a_grid(cs2_zigzag, sigma):
+    noisy = SensorModel(white={"x": sigma, "y": sigma}).apply(cs2_zigzag, seed=3)
+    track = _track(noisy)
+
+    def error(window):
+        got = velocities_from_track(track, TrackVelocities(window))
+        return float(np.sqrt(np.mean((got["v"] - cs2_zigzag["v"]) ** 2)))
+
+    t, x, y = (track[c].to_numpy() for c in ("t", "x", "y"))
+    chosen = plug_in_window(t, x, y)
+    assert 2.0 < chosen < 8.0
+    grid = min(error(w) for w in (1.0, 2.0, 3.0, 4.0, 6.0, 8.0))
+    assert error(None) <= 1.3 * grid
+    # Noise-free, about the shortest (seven samples, 0.6 s): nothing to average.
+    assert plug_in_window(t, *(cs2_zigzag[c].to_numpy() for c in ("x", "y"))) < 1.2
+
+
+@pytest.mark.parametrize("heading_deg, mistake, words", [
+    (0.0, "xy", "x and y swapped"),
+    (90.0, "ccw", "psi counter-clockwise"),
+    (0.0, "offset", "psi looks offset"),
+])  # fmt: skip
+def test_a_track_and_heading_on_other_axes_are_refused(mariner_zigzag, heading_deg, mistake,
+                                                      words):
+    track = _track(mariner_zigzag, heading=math.radians(heading_deg))
+    if mistake == "xy":
+        track["x"], track["y"] = track["y"].to_numpy(), track["x"].to_numpy()
+    elif mistake == "ccw":
+        track["psi"] = -track["psi"]
+    else:
+        track["psi"] = track["psi"] + math.pi / 2
+    with pytest.raises(ShipidError, match=words):
+        velocities_from_track(track, name="gnss.csv")
+    velocities_from_track(_track(mariner_zigzag, heading=math.radians(heading_deg)))
+
+
+def test_a_plain_csv_without_u_v_is_read_off_its_track(cs2_zigzag, tmp_path):
+    path = tmp_path / "gnss.csv"
+    _track(cs2_zigzag).drop(columns="r").to_csv(path, index=False)
+    with pytest.warns(ShipidWarning, match=r"no u, v in the log: read off the track .* and r off"):
+        log = read_log(path)
+    assert list(log.columns[:5]) == ["t", "delta", "u", "v", "r"]
+    assert np.max(np.abs(log["v"] - cs2_zigzag["v"])) < 2e-3
+    back = read_log(write_log(log, tmp_path / "canonical.csv"))
+    assert back.attrs["velocities"]["from"] == "track"
+
+
+def test_the_command_line_reads_an_antenna_and_refuses_it_where_u_v_are_logged(cs2_zigzag,
+                                                                               tmp_path, capsys):
+    gnss = tmp_path / "gnss.csv"
+    _track(cs2_zigzag, (0.3, 0.0)).to_csv(gnss, index=False)
+    out = tmp_path / "log.csv"
+    code, text, err = run(["import", gnss, "--antenna", "0.3,0", "-o", out], capsys)
+    assert code == 0, err
+    assert np.max(np.abs(read_log(out)["v"] - cs2_zigzag["v"])) < 2e-3
+    logged = write_log(cs2_zigzag, tmp_path / "logged.csv")
+    code, text, err = run(["import", logged, "--antenna", "0.3,0", "-o", tmp_path / "b.csv"],
+                          capsys)  # fmt: skip
+    assert code == 1 and "--velocities-from-track" in err and not (tmp_path / "b.csv").exists()
+    with pytest.raises(SystemExit) as exc:
+        run(["import", gnss, "--antenna", "0.3", "-o", tmp_path / "c.csv"], capsys)
+    assert exc.value.code == 2 and "FORWARD,STARBOARD" in capsys.readouterr().err
+    code, text, err = run(["import", gnss, "--track-window", "-1", "-o", tmp_path / "c.csv"], capsys)
+    assert code == 1 and "--track-window" in err and "Traceback" not in err
+
+
+def test_a_track_without_heading_names_what_is_missing(cs2_zigzag, tmp_path):
+    path = tmp_path / "gnss.csv"
+    _track(cs2_zigzag).drop(columns="psi").to_csv(path, index=False)
+    with pytest.raises(ShipidError, match="missing column.*u, v"):
+        read_log(path)
+    with pytest.raises(ShipidError, match=r"missing column\(s\) psi"):
+        read_log(path, velocities="track")
+    track = _track(cs2_zigzag).drop(columns="psi")
+    with pytest.raises(ShipidError, match="needs the columns x, y and psi; missing psi"):
+        velocities_from_track(track)
+
+
+def test_r_off_a_compass_takes_its_own_window(cs2_zigzag):
+    """A 0.2° compass and 0.02 m positions: at the track's window (about 4 s) r erred by
+    0.0069 rad/s rms; ψ's own (about 2 s) makes it a third of that."""
+    noisy = SensorModel(white={"x": 0.02, "y": 0.02, "psi": math.radians(0.2)}).apply(
+        cs2_zigzag, seed=0)
+    got = velocities_from_track(_track(noisy).drop(columns="r"))
+    how = got.attrs["velocities"]
+    assert how["heading_window_s"] < 0.7 * how["window_s"]
+    assert np.sqrt(np.mean((got["r"] - cs2_zigzag["r"]) ** 2)) < 0.004
