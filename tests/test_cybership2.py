@@ -126,9 +126,8 @@ def test_identify_compares_the_inflow_where_the_papers_fit_turns_the_wrong_way(z
 
     assert "n" not in read_log(zigzag_logs[0]).columns  # no rps: the comparison had been skipped
     code, out, err = run(["identify", *zigzag_logs, "-o", tmp_path / "m.json"], capsys)
-    assert code == 0 and out.startswith("structure: blanke-speed (17 terms), since the paper's "
-                                        "blanke, fitted to these logs, is implausible (turns the "
-                                        "wrong way"), err  # fmt: skip
+    assert code == 0 and out.startswith("structure: blanke-speed (17 terms), since their speed "
+                                        "varies by 57 %, more than the paper's rudder force"), err
     assert "turns the other way" not in err
     record = json.loads((tmp_path / "m.json").read_text())
     assert record["identification"]["structure_choice"]["how"] == "compared"
@@ -139,3 +138,46 @@ def test_identify_compares_the_inflow_where_the_papers_fit_turns_the_wrong_way(z
                          steering=ship.steering).indices  # fmt: skip
     assert got["steady_yaw_rate"] > 0
     assert got["tactical_diameter"] == pytest.approx(truth["tactical_diameter"], rel=0.15)
+
+
+def test_the_papers_fit_is_ruled_out_by_its_turns_where_the_speed_varies_less(zigzag_logs,
+                                                                             monkeypatch):
+    """Below ``SPEED_FALLS`` the paper's fit is ruled out only by its plausibility: on these
+    logs its 35° turns go the wrong way."""
+    from shipid.data.io import read_log
+    from shipid.identification import auto_structure
+
+    logs = [read_log(p) for p in zigzag_logs]
+    monkeypatch.setattr(auto_structure, "SPEED_FALLS", 1.0)
+    reason = auto_structure._paper_ruled_out(logs, None, None, "lssvm", None)
+    assert reason.startswith("the paper's blanke, fitted to these logs, is implausible (turns "
+                             "the wrong way")  # fmt: skip
+
+
+def test_a_speed_that_falls_by_a_third_compares_the_inflow_where_the_papers_fit_passes(
+        tmp_path, capsys):
+    """CyberShip II's 10°/10° zig-zags (their speed varies by about 50 %): the paper's blanke
+    passes the plausibility checks, and its 35° turns came 75–87 % short (yaw rate 4–5 times
+    the ship's); the compared structure's 34–37 % (benchmarks/study_cybership2.py)."""
+    from shipid.identification.identify import identify
+    from shipid.identification.plausibility import disqualifying, plausibility_at_approach
+
+    ship = cybership2()
+    logs = [PAPER_IMU.scaled(0.15).apply(
+        zigzag(ship, 10, 10, first=first, duration=120, dt=0.1, approach=5.0).log, seed=2 + i)
+        for i, first in enumerate(("starboard", "port"))]  # fmt: skip
+    paper = identify(logs, model="blanke").model
+    assert not disqualifying(plausibility_at_approach(paper, ship.approach_speed, None)[0], paper)
+    paths = [write_log(log, tmp_path / f"zz10_{i}.csv") for i, log in enumerate(logs)]
+    code, out, err = run(["identify", *paths, "--model", "blanke", "-o", tmp_path / "p.json"],
+                         capsys)  # fmt: skip
+    code, out, err = run(["identify", *paths, "-o", tmp_path / "m.json"], capsys)
+    assert code == 0 and "more than the paper's rudder force" in out, err
+    truth = turning_circle(ship, 35.0, dt=0.1).indices["tactical_diameter"]
+
+    def error(path):
+        got = turning_circle(load_model(path), 35.0, dt=0.1, speed=ship.approach_speed,
+                             steering=ship.steering).indices["tactical_diameter"]  # fmt: skip
+        return abs(got / truth - 1.0)
+
+    assert error(tmp_path / "p.json") > 0.6 and error(tmp_path / "m.json") < 0.45
