@@ -63,3 +63,16 @@ def judged(model, truth: dict, speed: float, steering, dt: float, zigzag_s: floa
     cells.append("–" if first is None or second is None else
                  f"{first - truth['zz10'][0]:+.1f}°, {second - truth['zz10'][1]:+.1f}°")
     return cells
+
+
+def judged_row(cells: list[str], argv: list[str], paths: list[str], out: str, truth: dict, ship,
+               dt: float, zigzag_s: float, structure=None) -> str:
+    """One table row: ``cells``, then the model ``shipid ARGV PATHS -o OUT`` makes (its
+    structure's name, or ``structure(out, model)``) and ``judged``'s cells; 'failed' where the
+    command failed."""
+    model = model_by_cli(argv, paths, out)
+    if model is None:
+        return "| " + " | ".join([*cells, "failed"]) + " |"
+    name = structure(out, model) if structure else model.structure.name
+    return "| " + " | ".join([*cells, name, *judged(model, truth, ship.approach_speed,
+                                                    ship.steering, dt, zigzag_s)]) + " |"  # fmt: skip

@@ -27,7 +27,7 @@ import tempfile
 import time
 import warnings
 
-from cli_models import judged, model_by_cli, noisy_files, truth_indices
+from cli_models import judged_row, noisy_files, truth_indices
 
 from shipid.trials.manoeuvres import zigzag
 from shipid.vessels import PAPER_IMU, cybership2
@@ -75,14 +75,9 @@ def main_study(seeds: int = 3) -> None:
             paths = noisy_files(clean, PAPER_IMU.scaled(NOISE), seed, tmp)
             for label, names in TRAINING.items():
                 for method, argv in METHODS.items():
-                    out = f"{tmp}/model.json"
-                    model = model_by_cli(argv, [paths[n] for n in names], out)
-                    if model is None:
-                        print(f"| {seed} | {label} | {method} | failed |")
-                        continue
-                    cells = judged(model, truth, ship.approach_speed, ship.steering, DT, 120.0)
-                    print(f"| {seed} | {label} | {method} | {structure_of(out, model)} | "
-                          + " | ".join(cells) + " |", flush=True)
+                    print(judged_row([str(seed), label, method], argv, [paths[n] for n in names],
+                                     f"{tmp}/model.json", truth, ship, DT, 120.0, structure_of),
+                          flush=True)  # fmt: skip
     print(f"\n{time.perf_counter() - start:.0f} s")
 
 

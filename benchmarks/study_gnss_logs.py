@@ -30,7 +30,7 @@ import time
 import warnings
 
 import numpy as np
-from cli_models import judged, model_by_cli, noisy_files, truth_indices
+from cli_models import judged_row, noisy_files, truth_indices
 
 from shipid.trials.manoeuvres import zigzag
 from shipid.vessels import PAPER_IMU, cybership2
@@ -65,9 +65,9 @@ def main_study(seeds: int = 3) -> None:
              for first, s in (("starboard", ""), ("port", "-"))}  # fmt: skip
     truth = truth_indices(ship, TURNS, DT, 120.0)
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores\n")
-    print("| seed | logs | read with | made by | 35° starboard: tactical diameter (steady r) "
-          "| 35° port | 20° starboard | 10°/10° overshoots |")
-    print("|---|---|---|---|---|---|---|---|")
+    print("| seed | logs | read with | made by | structure | 35° starboard: tactical diameter "
+          "(steady r) | 35° port | 20° starboard | 10°/10° overshoots |")
+    print("|---|---|---|---|---|---|---|---|---|")
     start = time.perf_counter()
     with tempfile.TemporaryDirectory() as tmp:
         for seed in range(seeds):
@@ -80,14 +80,9 @@ def main_study(seeds: int = 3) -> None:
                 for method, argv in (("identify", ["identify"]),
                                      ("--model blanke-speed", ["identify", "--model",
                                                                "blanke-speed"])):  # fmt: skip
-                    model = model_by_cli(argv + read, list(paths.values()), f"{tmp}/model.json")
-                    how = " ".join(read) or "–"
-                    if model is None:
-                        print(f"| {seed} | {label} | {how} | {method} | failed |")
-                        continue
-                    cells = judged(model, truth, ship.approach_speed, ship.steering, DT, 120.0)
-                    print(f"| {seed} | {label} | {how} | {method} ({model.structure.name}) | "
-                          + " | ".join(cells) + " |", flush=True)
+                    print(judged_row([str(seed), label, " ".join(read) or "–", method],
+                                     argv + read, list(paths.values()), f"{tmp}/model.json",
+                                     truth, ship, DT, 120.0), flush=True)  # fmt: skip
     print(f"\n{time.perf_counter() - start:.0f} s")
 
 
