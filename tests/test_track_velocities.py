@@ -54,6 +54,17 @@ def test_the_local_slope_is_exact_on_a_quadratic(jitter):
     np.testing.assert_allclose(local_slope(t, y, 1.0), -2.0 + 1.4 * t, atol=1e-9)
 
 
+def test_the_even_sampling_filter_is_the_per_sample_fit():
+    """The fixed filter used where samples are evenly spaced against each sample's own fit."""
+    from shipid.data.track_velocities import _local_slope_at
+
+    rng = np.random.default_rng(1)
+    t = 100.0 + 0.1 * np.arange(500)
+    y = np.cumsum(rng.standard_normal(500))
+    np.testing.assert_allclose(local_slope(t, y, 2.0), _local_slope_at(t, y, 1.0, np.arange(500)),
+                               rtol=1e-9, atol=1e-9)  # fmt: skip
+
+
 @pytest.mark.parametrize("antenna", [(0.0, 0.0), (0.5, -0.2)])
 def test_noise_free_velocities_are_the_ships(cs2_zigzag, antenna):
     log = cs2_zigzag

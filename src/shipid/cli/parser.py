@@ -71,8 +71,8 @@ def _add_log_options(p: argparse.ArgumentParser) -> None:
                    help="read u, v off the track (x, y) and psi even where the log has them "
                    "(a log with neither has them read off its track anyway; r too where absent)")
     g.add_argument("--track-window", type=float, metavar="S",
-                   help="u, v off the track: the local fit's window [s] (default 1 s, at least "
-                   "7 samples)")
+                   help="u, v off the track: the local fit's window [s] (default: chosen from the "
+                   "log's noise and the track's curvature, at least 7 samples)")
     g.add_argument("--antenna", type=_pair, metavar="FORWARD,STARBOARD",
                    help="u, v off the track: the position sensor's place [m] from the log's "
                    "reference point, in the body frame (default 0,0)")

@@ -135,24 +135,44 @@ def _third_derivative_gain(step: float, window: float) -> float:
 
 def local_slope(t: np.ndarray, y: np.ndarray, window_s: float) -> np.ndarray:
     """dy/dt at every sample: the slope of a quadratic fitted by least squares to the samples
-    within ``window_s``/2 either side (fewer at the ends)."""
+    within ``window_s``/2 either side (fewer at the ends).
+
+    Where the samples are evenly spaced (the usual log), the slope away from the ends is one
+    fixed filter (a Savitzky–Golay derivative), applied by correlation; the ends, and logs with
+    jitter or gaps, fit each sample's own window."""
     t = np.asarray(t, dtype=float)
     y = np.asarray(y, dtype=float)
     half = 0.5 * window_s
-    lo = np.searchsorted(t, t - half * (1 + 1e-12), side="left")
-    hi = np.searchsorted(t, t + half * (1 + 1e-12), side="right")
-    reach = int(max(np.max(np.arange(len(t)) - lo), np.max(hi - 1 - np.arange(len(t)))))
-    index = np.arange(len(t))
+    step = np.diff(t)
+    reach = int(math.floor(half * (1 + 1e-12) / step.min())) if step.size else 0
+    if step.size and np.ptp(step) <= 1e-9 * step.mean() and len(t) > 4 * reach + 2:
+        tau = np.arange(-reach, reach + 1) * step.mean() / half
+        moments = np.array([[np.sum(tau ** (i + j)) for j in range(3)] for i in range(3)])
+        kernel = np.linalg.solve(moments, np.stack([np.ones_like(tau), tau, tau**2]))[1]
+        out = np.empty(len(t))
+        out[reach:len(t) - reach] = np.correlate(y, kernel, mode="valid") / half
+        ends = np.r_[0:reach, len(t) - reach:len(t)]
+        out[ends] = _local_slope_at(t, y, half, ends)
+        return out
+    return _local_slope_at(t, y, half, np.arange(len(t)))
+
+
+def _local_slope_at(t: np.ndarray, y: np.ndarray, half: float, index: np.ndarray) -> np.ndarray:
+    """``local_slope`` at the samples ``index``, each fitted over its own window."""
+    lo = np.searchsorted(t, t[index] - half * (1 + 1e-12), side="left")
+    hi = np.searchsorted(t, t[index] + half * (1 + 1e-12), side="right")
+    if index.size == 0:
+        return np.empty(0)
+    reach = int(max(np.max(index - lo), np.max(hi - 1 - index)))
     # Moments of τ = (t_j − t_i)/half (scaled: the 3 × 3 systems stay well conditioned).
-    s = np.zeros((5, len(t)))
-    b = np.zeros((3, len(t)))
+    s = np.zeros((5, index.size))
+    b = np.zeros((3, index.size))
     for k in range(-reach, reach + 1):
         j = index + k
         ok = (j >= lo) & (j < hi)
         jj = np.clip(j, 0, len(t) - 1)
-        tau = np.where(ok, (t[jj] - t) / half, 0.0)
-        w = ok.astype(float)
-        p = w.copy()
+        tau = np.where(ok, (t[jj] - t[index]) / half, 0.0)
+        p = ok.astype(float)
         for m in range(5):
             s[m] += p
             if m < 3:

@@ -330,7 +330,7 @@ def _paper_ruled_out(logs, names, physics, estimator, drop) -> str | None:
         return None
     if share > SPEED_FALLS:
         return (f"their speed varies by {100 * share:.0f} %, more than the paper's rudder force "
-                f"(the same at any speed) can follow, so the rudder's inflow is compared")
+                "(the same at any speed) can follow, so the rudder's inflow is compared")
     from shipid.data.log import approach
     from shipid.identification.identify import identify
     from shipid.identification.plausibility import disqualifying, plausibility_at_approach
