@@ -46,7 +46,7 @@ def _add_log_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--scale", type=float, metavar="LAMBDA",
                    help="simman-marin: Froude-scale the full-scale data to model scale 1/λ")
     g.add_argument("--columns", metavar="MAP", help="map file columns to canonical names, "
-                   "e.g. t=time,delta=rudder_angle")
+                   "e.g. t=time,delta=rudder_angle (lat=,lon= for a GNSS's degrees)")
     g.add_argument("--degrees", metavar="COLS", default="",
                    help="angle columns given in degrees, e.g. delta,psi,r")
     g.add_argument("--dt", type=float, help="resample to this uniform sampling time [s]")

@@ -114,11 +114,12 @@ def _stamp(value: float) -> str:
 
 
 def check_log(df: pd.DataFrame, name: str, min_samples: int = 3, fill_gaps: bool = False,
-              required: tuple[str, ...] = REQUIRED) -> None:
+              required: tuple[str, ...] = REQUIRED, extra: tuple[str, ...] = ()) -> None:
     """Required columns, finite numbers, strictly increasing time, enough samples.
 
     Missing values (empty cells, NaN) inside a signal are reported with their span and refused,
     or, with ``fill_gaps``, interpolated linearly in time. Text and infinities are always refused.
+    ``extra``: columns beyond the canonical ones checked alike (a track's lat, lon).
     """
     if len(df) == 0:
         raise ShipidError(f"{name}: the header has no rows")
@@ -129,7 +130,7 @@ def check_log(df: pd.DataFrame, name: str, min_samples: int = 3, fill_gaps: bool
                           "map other names with --columns, e.g. --columns delta=rudder")  # fmt: skip
     convert_types(df, name)
     gaps: dict[str, np.ndarray] = {}
-    for c in [c for c in COLUMNS if c in df.columns]:
+    for c in [c for c in (*COLUMNS, *extra) if c in df.columns]:
         raw = df[c]
         values = pd.to_numeric(raw, errors="coerce").to_numpy(dtype=float)
         gap = raw.isna().to_numpy()

@@ -28,6 +28,7 @@ from shipid.data.checks import (
     check_units,
 )
 from shipid.data.formats import FORMATS, detect_format, read_format
+from shipid.data.geodetic import GEODETIC_COLUMNS, check_geodetic, local_track
 from shipid.data.header_units import si_factors, split_units
 from shipid.data.log import COLUMNS, REQUIRED, csv_metadata_line, metadata, parse_csv_metadata
 from shipid.data.preprocess import resample
@@ -107,8 +108,9 @@ def parse_column_map(spec: str | None) -> dict[str, str]:
         if "=" not in item:
             raise ShipidError(f"--columns expects canonical=file pairs like t=time, got {item!r}")
         canon, name = (s.strip() for s in item.split("=", 1))
-        if canon not in COLUMNS:
-            raise ShipidError(f"--columns: {canon!r} is not a canonical column ({', '.join(COLUMNS)})")
+        if canon not in COLUMNS + GEODETIC_COLUMNS:
+            raise ShipidError(f"--columns: {canon!r} is not a canonical column "
+                              f"({', '.join(COLUMNS + GEODETIC_COLUMNS)})")  # fmt: skip
         out[name] = canon
     return out
 
@@ -234,10 +236,13 @@ def read_log(path: str | Path, options: ReadOptions | None = None, **overrides) 
         if dup:
             raise ShipidError(f"{path}: column {dup[0]!r} appears twice (after --columns)")
         df = df.dropna(how="all").reset_index(drop=True)
-        from_track = _from_track(df.columns, options)
-        required = ("t", "delta", "x", "y", "psi") if from_track else REQUIRED
+        geodetic = set(GEODETIC_COLUMNS) <= set(df.columns) and not {"x", "y"} & set(df.columns)
+        position = GEODETIC_COLUMNS if geodetic else ("x", "y")
+        from_track = _from_track(df.columns, options, geodetic)
+        required = ("t", "delta", *position, "psi") if from_track else REQUIRED
         try:
-            check_log(df, name, fill_gaps=options.fill_gaps, required=required)
+            check_log(df, name, fill_gaps=options.fill_gaps, required=required,
+                      extra=GEODETIC_COLUMNS if geodetic else ())
         except ShipidError as exc:
             if any(c not in df.columns for c in required):
                 raise _hint_format(path, exc) from None
@@ -247,6 +252,11 @@ def read_log(path: str | Path, options: ReadOptions | None = None, **overrides) 
         for c, factor in factors.items():
             if c in df.columns:
                 df[c] = df[c].to_numpy() * factor
+        if geodetic:
+            lat, lon = (df[c].to_numpy(dtype=float) for c in GEODETIC_COLUMNS)
+            check_geodetic(lat, lon, name)
+            df["x"], df["y"] = local_track(lat, lon)
+            meta = {**meta, "track_origin": {"lat": float(lat[0]), "lon": float(lon[0])}}
         log = df[[c for c in COLUMNS if c in df.columns]].copy()
         if from_track:
             log = _read_off_track(log, options, name)
@@ -270,11 +280,12 @@ def read_log(path: str | Path, options: ReadOptions | None = None, **overrides) 
     return log
 
 
-def _from_track(columns, options: ReadOptions) -> bool:
-    """Whether u, v are read off the track: asked for, or the log has neither but x, y, psi."""
+def _from_track(columns, options: ReadOptions, geodetic: bool = False) -> bool:
+    """Whether u, v are read off the track: asked for, or the log has neither but x, y (or
+    lat, lon: ``geodetic``) and psi."""
     if options.velocities == "track":
         return True
-    have = set(columns)
+    have = set(columns) | ({"x", "y"} if geodetic else set())
     derive = not have & {"u", "v"} and {"x", "y", "psi"} <= have
     if not derive and options.track != TrackVelocities():
         raise ShipidError("--antenna and --track-window apply where u, v are read off the track: "

@@ -8,7 +8,9 @@ Metadata keys (``METADATA_KEYS``): ``ship``, ``source``, ``rudder_positive`` ('p
 'starboard': where a positive rudder angle turns the ship), ``scale`` (λ = ship length / model
 length, 1 at full scale), ``manoeuvre``, ``time_origin``, ``yaw_rate_offset`` (a gyro's offset
 already subtracted from r, rad/s) and ``velocities`` (where u, v were read off the track: its
-window and the antenna's place; ``shipid.data.track_velocities``). They survive a round trip through
+window and the antenna's place; ``shipid.data.track_velocities``), ``track_origin`` (where x, y
+were read off a GNSS's latitude and longitude: the first fix's, in degrees;
+``shipid.data.geodetic``). They survive a round trip through
 files: Parquet keeps them in its schema metadata, CSV in a first comment line
 ``# shipid-log: {...JSON...}`` (pandas reads such a file with ``comment="#"``).
 """
@@ -31,7 +33,7 @@ OPTIONAL = ("psi", "x", "y", "n", "thrust", "wind_speed", "wind_angle")
 COLUMNS = REQUIRED + OPTIONAL
 RUDDER_SIDES = ("port", "starboard")
 METADATA_KEYS = ("ship", "source", "rudder_positive", "scale", "manoeuvre", "time_origin",
-                 "particulars", "yaw_rate_offset", "velocities")
+                 "particulars", "yaw_rate_offset", "velocities", "track_origin")
 CSV_METADATA_PREFIX = "# shipid-log: "
 
 
@@ -290,6 +292,12 @@ def check_metadata(meta: Mapping, name: str) -> dict:
         if k == "yaw_rate_offset" and not (isinstance(v, int | float) and not isinstance(v, bool)
                                            and math.isfinite(v)):
             raise ShipidError(f"{name}: metadata yaw_rate_offset must be a number [rad/s], "
+                              f"got {v!r}")  # fmt: skip
+        if k == "track_origin" and not (
+                isinstance(v, Mapping) and set(v) == {"lat", "lon"}
+                and all(isinstance(a, int | float) and not isinstance(a, bool) and math.isfinite(a)
+                        for a in v.values())):
+            raise ShipidError(f"{name}: metadata track_origin must be {{'lat': deg, 'lon': deg}}, "
                               f"got {v!r}")  # fmt: skip
         if k == "particulars":
             from shipid.data.particulars import Particulars
