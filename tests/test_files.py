@@ -288,6 +288,41 @@ def test_datetime_time_becomes_seconds(tmp_path, trial):
     assert log.attrs["time_origin"].startswith("2020-07-31 13:04:24")
 
 
+@pytest.mark.parametrize(("start", "write"), [
+    # A CSV has no datetime type: its times are text. Both were refused as non-numeric.
+    ("2020-07-31 13:04:24", lambda s: s.astype(str)),
+    ("2020-07-31 13:04:24", lambda s: s.dt.strftime("%Y-%m-%dT%H:%M:%S.%fZ")),
+    ("2020-07-31 13:04:24", lambda s: s.dt.strftime("%Y-%m-%dT%H:%M:%S.%f+02:00")),
+    ("2020-07-31 13:04:24", lambda s: s.dt.strftime("%H:%M:%S.%f")),
+    ("2020-07-31 23:59:30", lambda s: s.dt.strftime("%H:%M:%S.%f")),  # past midnight
+])  # fmt: skip
+def test_times_a_csv_writes_as_text_become_seconds(tmp_path, trial, start, write):
+    df = trial.copy()
+    df["t"] = write(pd.Timestamp(start) + pd.to_timedelta(df["t"], unit="s"))
+    log = read_log(_write(tmp_path, df, "log.csv"))
+    np.testing.assert_allclose(log["t"], trial["t"] - trial["t"].iloc[0], atol=1e-9)
+    origin, first = log.attrs["time_origin"], df["t"].iloc[0]
+    # A date's origin is the same instant, in UTC; a time of day's is as written.
+    assert origin == first if ":" in first[:3] else (pd.Timestamp(origin)
+                                                     == pd.to_datetime(first, utc=True))
+
+
+@pytest.mark.parametrize(("row", "value", "match"), [
+    (5, "13:04:25.x", r"'t' is a time of day \(hh:mm:ss\) at data row 1 .* not at data row 6"),
+    (5, "yesterday", r"'t' is an ISO date and time at data row 1 .* not at data row 6"),
+    (5, "", r"'t' is missing at data rows? 6"),
+])  # fmt: skip
+def test_a_text_time_that_does_not_parse_is_named_with_its_row(tmp_path, trial, row, value,
+                                                               match):
+    df = trial.copy()
+    stamps = pd.Timestamp("2020-07-31 13:04:24") + pd.to_timedelta(df["t"], unit="s")
+    df["t"] = (stamps.dt.strftime("%H:%M:%S.%f") if "hh:mm" in match else stamps.astype(str))
+    df["t"] = df["t"].astype(object)
+    df.loc[row, "t"] = value or None
+    with pytest.raises(ShipidError, match=match):
+        read_log(_write(tmp_path, df, "log.csv"))
+
+
 @pytest.mark.parametrize(("change", "match"), [
     (lambda d: d.assign(psi=np.degrees(d["psi"])), "psi looks like degrees"),
     (lambda d: d.assign(t=d["t"] * 1000), "not seconds|milliseconds"),

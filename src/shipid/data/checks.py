@@ -14,6 +14,7 @@ the ship runs ahead, ṙ follows δ with the sign of the side a positive angle t
 from __future__ import annotations
 
 import math
+import re
 import warnings
 from dataclasses import dataclass
 
@@ -85,9 +86,54 @@ def true_runs(mask: np.ndarray) -> list[tuple[int, int]]:
     return list(zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1, strict=True))
 
 
+# Clock times of day as loggers write them: 12:00:00, 12:00:00.1, 9:05:07,25.
+CLOCK_TIME = re.compile(r"^\d{1,2}:\d{2}:\d{2}([.,]\d+)?$")
+# A clock time that falls back by more than this has passed midnight.
+MIDNIGHT_FALL_S = 12 * 3600.0
+
+
+def _times_from_text(col: pd.Series, name: str) -> tuple[pd.Series, str | None]:
+    """A ``t`` a CSV gives as text: ISO dates and times (2026-05-01T12:00:00.1Z, with or without
+    the date's T, the zone or an offset) as datetimes; times of day (12:00:00.1) as seconds from
+    the first, with the first as the origin; numbers are left to the numeric check. A value that
+    is neither is named with its row."""
+    text = col.astype("string").str.strip()
+    present = text.notna().to_numpy()
+    if not present.any() or pd.to_numeric(text[present], errors="coerce").notna().all():
+        return col, None
+    first = str(text[present].iloc[0])
+    if CLOCK_TIME.match(first):
+        parsed = pd.to_timedelta(text.str.replace(",", ".", regex=False), errors="coerce")
+        kind = "a time of day (hh:mm:ss)"
+    else:
+        parsed = pd.to_datetime(text, errors="coerce", utc=True, format="ISO8601")
+        kind = "an ISO date and time"
+    bad = present & parsed.isna().to_numpy()
+    if bad.any():
+        row = int(np.argmax(bad))
+        raise ShipidError(f"{name}: column 't' is {kind} at data row {int(np.argmax(present)) + 1} "
+                          f"({first!r}) but not at data row {row + 1} ({str(text.iloc[row])[:40]!r})")
+    if CLOCK_TIME.match(first):
+        # Seconds from the first sample, as a date's are; where the clock passes midnight a day
+        # is added (it fell by half a day or more between two samples).
+        # In integer nanoseconds: 43200.1 − 43200 in floats is 0.0999999999985.
+        ns = parsed.to_numpy().astype("timedelta64[ns]").astype(np.int64)[present]
+        passed = np.cumsum(np.concatenate([[0], np.diff(ns) < -MIDNIGHT_FALL_S * 1e9]))
+        seconds = np.full(len(col), np.nan)
+        seconds[present] = (ns + 86_400 * 10**9 * passed - ns[0]) / 1e9
+        return pd.Series(seconds, index=col.index), first
+    return parsed, None
+
+
 def convert_types(df: pd.DataFrame, name: str) -> pd.DataFrame:
-    """Refuse boolean columns; a datetime or timedelta ``t`` becomes seconds from its first
-    sample (the datetime origin is kept in ``attrs["time_origin"]``)."""
+    """Refuse boolean columns; a datetime or timedelta ``t`` (or one a CSV writes as ISO dates or
+    times of day) becomes seconds from its first sample (the datetime origin is kept in
+    ``attrs["time_origin"]``)."""
+    if "t" in df.columns and (pd.api.types.is_object_dtype(df["t"])
+                              or pd.api.types.is_string_dtype(df["t"])):
+        df["t"], origin = _times_from_text(df["t"], name)
+        if origin is not None:
+            df.attrs["time_origin"] = origin
     for c in [c for c in COLUMNS if c in df.columns]:
         col = df[c]
         if pd.api.types.is_bool_dtype(col):
