@@ -177,3 +177,21 @@ def test_r_off_a_compass_takes_its_own_window(cs2_zigzag):
     how = got.attrs["velocities"]
     assert how["heading_window_s"] < 0.7 * how["window_s"]
     assert np.sqrt(np.mean((got["r"] - cs2_zigzag["r"]) ** 2)) < 0.004
+
+
+@pytest.mark.parametrize("ship", ["cs2", "mariner"])
+def test_a_heading_in_degrees_is_refused_as_such(cs2_zigzag, mariner_zigzag, ship, tmp_path,
+                                                 capsys):
+    """Read as radians, it put the track 84° off the heading and the log was refused as one whose
+    heading was offset or on other axes."""
+    log = _track(cs2_zigzag if ship == "cs2" else mariner_zigzag).drop(columns="r")
+    noisy = SensorModel(white={"x": 0.02, "y": 0.02, "psi": math.radians(0.2)}).apply(log, seed=1)
+    noisy["psi"] = np.degrees(noisy["psi"]) % 360.0
+    with pytest.raises(ShipidError, match="turns [0-9]+ times as far as the track .* degrees"):
+        velocities_from_track(noisy, name="gnss.csv")
+    path = tmp_path / "gnss.csv"
+    noisy.to_csv(path, index=False)
+    code, _, err = run(["import", path, "-o", tmp_path / "log.csv"], capsys)
+    assert code == 1 and "--degrees psi" in err and not (tmp_path / "log.csv").exists()
+    noisy["psi"] = np.radians(noisy["psi"])
+    assert np.isfinite(velocities_from_track(noisy, name="gnss.csv")["v"]).all()

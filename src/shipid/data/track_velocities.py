@@ -48,6 +48,12 @@ ALTERNATIVE_SHARE = 0.5
 MIN_DRIFT_TO_JUDGE_DEG = 15.0
 # ... and a heading that is offset (from east, astern) runs at 90° and more from the track.
 MAX_MEDIAN_DRIFT_DEG = 75.0
+# A heading in degrees read as radians turns 57 times as far as the track's course. Heading and
+# course changes over 10 s windows have an rms ratio of 0.86-1.10 on the reference ships' 10/10
+# and 20/20 zig-zags and 35° turns (CyberShip II, the paper's ship, Mariner, KVLCC2, noise-free;
+# the drift angle changes too); the position's noise only lowers it.
+HEADING_SCALE_WINDOW_S = 10.0
+MAX_HEADING_TO_COURSE = 8.0
 
 
 @dataclass(frozen=True)
@@ -218,6 +224,7 @@ def velocities_from_track(log: pd.DataFrame, options: TrackVelocities | None = N
         # rad/s rms error in r at the track's 4.1 s window).
         heading_window = options.window(t, psi)
         r = local_slope(t, psi, heading_window)
+    _check_heading_scale(t, xdot, ydot, psi, name)
     c, s = np.cos(psi), np.sin(psi)
     u_antenna, v_antenna = xdot * c + ydot * s, -xdot * s + ydot * c
     _check_axes(xdot, ydot, psi, name)
@@ -233,6 +240,34 @@ def velocities_from_track(log: pd.DataFrame, options: TrackVelocities | None = N
                                "r_from_heading": heading_window is not None,
                                "heading_window_s": heading_window}  # fmt: skip
     return out
+
+
+def _check_heading_scale(t, xdot, ydot, psi, name: str) -> None:
+    """Refuse a heading in degrees read as radians: it turns some 57 times as far as the track.
+
+    Over windows of ``HEADING_SCALE_WINDOW_S`` where the ship makes way, the heading's changes
+    against the course's (the track's direction): their rms ratio is near 1 (the drift angle
+    changes too, within a factor of a few), 57 for degrees. A log whose ψ̇ is checked against a
+    logged r is checked again there (``shipid.data.checks``); without r this is the only check.
+    """
+    speed = np.hypot(xdot, ydot)
+    typical = float(np.percentile(speed, 90))
+    running = speed >= RUNNING_SHARE * typical
+    step = float(np.median(np.diff(t)))
+    k = int(round(HEADING_SCALE_WINDOW_S / step))
+    if not typical > 0 or k < 1 or len(t) <= k + 10:
+        return
+    course = np.unwrap(np.arctan2(ydot, xdot))
+    both = running[k:] & running[:-k]
+    if both.sum() < 10:
+        return
+    turned = (psi[k:] - psi[:-k])[both]
+    steered = (course[k:] - course[:-k])[both]
+    ratio = float(np.sqrt(np.mean(turned**2) / max(np.mean(steered**2), 1e-12)))
+    if ratio > MAX_HEADING_TO_COURSE:
+        raise ShipidError(f"{name}: the heading 'psi' turns {ratio:.0f} times as far as the track "
+                          f"does (rms over {HEADING_SCALE_WINDOW_S:g} s windows): it looks like "
+                          "degrees; give --degrees psi or 'psi [deg]' in the header")  # fmt: skip
 
 
 def _median_drift_deg(xdot, ydot, psi, running) -> float:
