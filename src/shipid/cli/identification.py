@@ -29,7 +29,18 @@ from shipid.cli.common import (
 from shipid.errors import ShipidError
 
 
+def _ruled_out(table) -> str:
+    """What the prefilter's choice ruled out as implausible: 'none (its reason), 2.5 Hz (...)'."""
+    if "implausible" not in table.columns:
+        return ""
+    out = [f"{'none' if c is None or c != c else f'{c:.4g} Hz'} ({why.split('; ')[0]})"
+           for c, why in zip(table["cutoff_hz"], table["implausible"], strict=True)
+           if isinstance(why, str) and why]  # fmt: skip
+    return f"; implausible fits: {', '.join(out)}" if out else ""
+
+
 # ---------------------------------------------------------------------------- commands
+
 def cmd_demo(args) -> int:
     """``shipid demo``: the paper's experiment on the embedded scale ship."""
     from shipid.demo import run_demo, summary
@@ -109,11 +120,13 @@ def cmd_identify(args) -> int:
                             drop=_parse_drop(args.drop), names=names, force=True,
                             estimator=args.estimator, physics=physics).model  # fmt: skip
 
-        cutoff, table = choose_prefilter(logs, fit)
+        from shipid.identification.plausibility import disqualifying_at_approach
+
+        cutoff, table = choose_prefilter(logs, fit, implausible=disqualifying_at_approach(logs))
         filter_by = "free-run error, one-standard-error rule"
         shown = "none" if cutoff is None else f"{cutoff:.4g} Hz"
-        print(f"prefilter of u, v, r: {shown} (chosen by the free-run error on the logs; "
-              "--filter HZ|none to set it)")  # fmt: skip
+        print(f"prefilter of u, v, r: {shown} (chosen by the free-run error on the logs"
+              f"{_ruled_out(table)}; --filter HZ|none to set it)")  # fmt: skip
     elif cutoff == "none":
         cutoff = None
     if cutoff is not None:

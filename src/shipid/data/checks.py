@@ -26,7 +26,7 @@ from shipid.data.preprocess import cumulative_integral
 from shipid.data.yaw_rate import heading_drift
 from shipid.errors import ShipidError, ShipidWarning
 
-ANGLE_COLUMNS = ("delta", "psi", "r", "wind_angle")
+ANGLE_COLUMNS = ("delta", "psi", "r", "wind_angle", "cog")
 # A rudder beyond 60° or a yaw rate beyond 3 rad/s (172 °/s) is not radians.
 # A relative wind's angle is a direction: within a turn either way of 0 in radians (a file in
 # degrees, up to 180° or 360°, was read as radians without a word).

@@ -33,6 +33,8 @@ FACTORS: dict[str, dict[str, float]] = {
     "x": {"m": 1.0}, "y": {"m": 1.0},
     "n": {"rps": 1.0, "1/s": 1.0, "hz": 1.0, "rev/s": 1.0, "rpm": 1.0 / 60.0, "rev/min": 1.0 / 60.0},
     "thrust": {"n": 1.0, "kn": 1e3},
+    # A GNSS's speed and course over ground (``shipid.data.track_velocities``).
+    "sog": _SPEED, "cog": _ANGLE,
     # A GNSS's latitude and longitude are read in degrees (``shipid.data.geodetic``), not SI.
     "lat": {"deg": 1.0, "degree": 1.0, "degrees": 1.0, "°": 1.0, "rad": 1.0 / _DEG},
     "lon": {"deg": 1.0, "degree": 1.0, "degrees": 1.0, "°": 1.0, "rad": 1.0 / _DEG},

@@ -32,7 +32,12 @@ from shipid.data.geodetic import GEODETIC_COLUMNS, check_geodetic, local_track
 from shipid.data.header_units import si_factors, split_units
 from shipid.data.log import COLUMNS, REQUIRED, csv_metadata_line, metadata, parse_csv_metadata
 from shipid.data.preprocess import resample
-from shipid.data.track_velocities import TrackVelocities, velocities_from_track
+from shipid.data.track_velocities import (
+    GROUND_VELOCITY_COLUMNS,
+    TrackVelocities,
+    velocities_from_ground_velocity,
+    velocities_from_track,
+)
 from shipid.data.trim import trim
 from shipid.data.yaw_rate import correct_yaw_rate
 from shipid.errors import ShipidError, ShipidWarning
@@ -108,9 +113,10 @@ def parse_column_map(spec: str | None) -> dict[str, str]:
         if "=" not in item:
             raise ShipidError(f"--columns expects canonical=file pairs like t=time, got {item!r}")
         canon, name = (s.strip() for s in item.split("=", 1))
-        if canon not in COLUMNS + GEODETIC_COLUMNS:
+        known = COLUMNS + GEODETIC_COLUMNS + GROUND_VELOCITY_COLUMNS
+        if canon not in known:
             raise ShipidError(f"--columns: {canon!r} is not a canonical column "
-                              f"({', '.join(COLUMNS + GEODETIC_COLUMNS)})")  # fmt: skip
+                              f"({', '.join(known)})")  # fmt: skip
         out[name] = canon
     return out
 
@@ -236,13 +242,19 @@ def read_log(path: str | Path, options: ReadOptions | None = None, **overrides) 
         if dup:
             raise ShipidError(f"{path}: column {dup[0]!r} appears twice (after --columns)")
         df = df.dropna(how="all").reset_index(drop=True)
-        geodetic = set(GEODETIC_COLUMNS) <= set(df.columns) and not {"x", "y"} & set(df.columns)
+        have = set(df.columns)
+        geodetic = set(GEODETIC_COLUMNS) <= have and not {"x", "y"} & have
         position = GEODETIC_COLUMNS if geodetic else ("x", "y")
-        from_track = _from_track(df.columns, options, geodetic)
-        required = ("t", "delta", *position, "psi") if from_track else REQUIRED
+        # A GNSS's speed and course over ground give u, v where the log has neither.
+        ground = (set(GROUND_VELOCITY_COLUMNS) <= have and not {"u", "v"} & have
+                  and options.velocities == "auto")  # fmt: skip
+        from_track = not ground and _from_track(df.columns, options, geodetic)
+        required = (("t", "delta", *position, "psi") if from_track
+                    else ("t", "delta", *GROUND_VELOCITY_COLUMNS, "psi") if ground
+                    else REQUIRED)  # fmt: skip
+        extra = (GEODETIC_COLUMNS if geodetic else ()) + (GROUND_VELOCITY_COLUMNS if ground else ())
         try:
-            check_log(df, name, fill_gaps=options.fill_gaps, required=required,
-                      extra=GEODETIC_COLUMNS if geodetic else ())
+            check_log(df, name, fill_gaps=options.fill_gaps, required=required, extra=extra)
         except ShipidError as exc:
             if any(c not in df.columns for c in required):
                 raise _hint_format(path, exc) from None
@@ -257,6 +269,9 @@ def read_log(path: str | Path, options: ReadOptions | None = None, **overrides) 
             check_geodetic(lat, lon, name)
             df["x"], df["y"] = local_track(lat, lon)
             meta = {**meta, "track_origin": {"lat": float(lat[0]), "lon": float(lon[0])}}
+        if ground:
+            df = _read_off_ground_velocity(df, options, name)
+            meta = {**meta, "velocities": df.attrs["velocities"]}
         log = df[[c for c in COLUMNS if c in df.columns]].copy()
         if from_track:
             log = _read_off_track(log, options, name)
@@ -292,6 +307,20 @@ def _from_track(columns, options: ReadOptions, geodetic: bool = False) -> bool:
                           "the log has u, v (give --velocities-from-track to read them off the "
                           "track instead)")  # fmt: skip
     return derive
+
+
+def _read_off_ground_velocity(df: pd.DataFrame, options: ReadOptions, name: str) -> pd.DataFrame:
+    out = velocities_from_ground_velocity(df, options.track, name)
+    how = out.attrs["velocities"]
+    fore, starboard = how["antenna"]
+    where = (f"the antenna {fore:g} m forward, {starboard:g} m to starboard" if fore or starboard
+             else "the antenna taken at the reference point (--antenna FORWARD,STARBOARD "
+             "otherwise)")
+    also = (f"; r read off psi over a {how['heading_window_s']:.2g} s window"
+            if how["r_from_heading"] else "")
+    warnings.warn(f"{name}: no u, v in the log: read off its speed and course over ground (sog, "
+                  f"cog) turned by psi, {where}{also}", ShipidWarning, stacklevel=3)  # fmt: skip
+    return out
 
 
 def _read_off_track(log: pd.DataFrame, options: ReadOptions, name: str) -> pd.DataFrame:

@@ -1,4 +1,5 @@
-"""Body velocities from a position track: u, v (and r where it is not logged) from x, y and ψ.
+"""Body velocities from a GNSS: u, v (and r where it is not logged) from a position track x, y
+or a speed and course over ground, and the heading ψ.
 
 Many small craft log a GNSS position and a heading, not the surge and sway the model needs. The
 earth-fixed velocity is the track's slope, read at every sample off a local quadratic fitted by
@@ -17,6 +18,10 @@ ship runs ahead along its heading, give or take its drift angle: where x and y s
 counter-clockwise would put the track much closer to the heading, or the track runs on average
 beyond ``MAX_MEDIAN_DRIFT_DEG`` from it (an offset heading), the log is refused. Where the
 heading lies along the axis a mistake mirrors (45° for the swap, north for ψ) nothing can tell.
+
+Where the receiver gives its speed and course over ground (SOG, COG: from the carrier's Doppler
+shift, centimetres per second where a position's slope is decimetres), u, v are those turned by
+ψ, with the same lever and checks (``velocities_from_ground_velocity``).
 """
 
 from __future__ import annotations
@@ -29,6 +34,8 @@ import pandas as pd
 
 from shipid.errors import ShipidError
 
+# A GNSS's speed [m/s] and course [rad, clockwise from north] over ground, read instead of a track.
+GROUND_VELOCITY_COLUMNS = ("sog", "cog")
 # The window's default is chosen from the log (``plug_in_window``): at least this many samples,
 # and at most this many seconds ...
 MIN_WINDOW_SAMPLES = 7
@@ -268,6 +275,52 @@ def _check_heading_scale(t, xdot, ydot, psi, name: str) -> None:
         raise ShipidError(f"{name}: the heading 'psi' turns {ratio:.0f} times as far as the track "
                           f"does (rms over {HEADING_SCALE_WINDOW_S:g} s windows): it looks like "
                           "degrees; give --degrees psi or 'psi [deg]' in the header")  # fmt: skip
+
+
+def velocities_from_ground_velocity(log: pd.DataFrame, options: TrackVelocities | None = None,
+                                    name: str = "log") -> pd.DataFrame:
+    """The log with u, v from a GNSS's speed and course over ground (columns ``sog`` [m/s],
+    ``cog`` [rad], clockwise from north) turned by the heading ψ, and r off ψ where the log has
+    no r:
+
+        u = SOG cos(COG − ψ),   v = SOG sin(COG − ψ)
+
+    A receiver reads them off the carrier's Doppler shift, far less noisy than its positions'
+    slope, so nothing is differentiated but ψ (for r). The antenna's lever is corrected as for a
+    track (``options.antenna``; ``window_s`` applies to ψ's slope), and the heading is checked
+    against the course as against a track's (degrees, axes, an offset).
+    """
+    options = options or TrackVelocities()
+    t = log["t"].to_numpy(dtype=float)
+    sog, cog = log["sog"].to_numpy(dtype=float), log["cog"].to_numpy(dtype=float)
+    peak = float(np.max(np.abs(cog)))
+    if peak > 2.0 * math.pi + 0.01:
+        raise ShipidError(f"{name}: column 'cog' reaches {peak:.3g}, which looks like degrees; "
+                          "give --degrees cog or 'cog [deg]' in the header")  # fmt: skip
+    psi = np.unwrap(log["psi"].to_numpy(dtype=float))
+    xdot, ydot = sog * np.cos(cog), sog * np.sin(cog)
+    heading_window = None
+    if "r" in log.columns:
+        r = log["r"].to_numpy(dtype=float)
+    else:
+        heading_window = options.window(t, psi)
+        r = local_slope(t, psi, heading_window)
+    _check_heading_scale(t, xdot, ydot, psi, name)
+    _check_axes(xdot, ydot, psi, name)
+    fore, starboard = options.antenna
+    out = log.drop(columns=["sog", "cog"])
+    out.attrs = dict(log.attrs)
+    out["u"] = sog * np.cos(cog - psi) + r * starboard
+    out["v"] = sog * np.sin(cog - psi) - r * fore
+    out["r"] = r
+    if {"x", "y"} <= set(out.columns):
+        c, s = np.cos(psi), np.sin(psi)
+        out["x"] = out["x"].to_numpy() - (fore * c - starboard * s)
+        out["y"] = out["y"].to_numpy() - (fore * s + starboard * c)
+    out.attrs["velocities"] = {"from": "ground velocity", "antenna": list(options.antenna),
+                               "r_from_heading": heading_window is not None,
+                               "heading_window_s": heading_window}  # fmt: skip
+    return out
 
 
 def _median_drift_deg(xdot, ydot, psi, running) -> float:

@@ -354,13 +354,14 @@ def _prefilter(logs, structure, names, physics, estimator) -> float | None:
     """The prefilter cut-off [Hz] ``identify`` chooses for ``structure`` on ``logs`` (None: no
     filter), its fits at γ 1e4 (``shipid.identification.prefilter``)."""
     from shipid.identification.identify import identify
+    from shipid.identification.plausibility import disqualifying_at_approach
     from shipid.identification.prefilter import choose_prefilter
 
     def fit(candidate_logs):
         return identify(candidate_logs, model=structure, names=names, force=True,
                         estimator=estimator, physics=physics).model  # fmt: skip
 
-    return choose_prefilter(logs, fit)[0]
+    return choose_prefilter(logs, fit, implausible=disqualifying_at_approach(logs))[0]
 
 
 def _blocks_penalise_race(logs, cv: str, name: str, scores: Mapping) -> list[str]:

@@ -18,6 +18,7 @@ approach condition (speed u0, propeller speed n):
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 
@@ -26,6 +27,13 @@ from shipid.dynamics.model import ManoeuvringModel
 from shipid.trials.manoeuvres import doubling, turning_circle
 
 SETTLED_FRACTION = 0.02  # of the steady value, over the last 10 % of the run
+# A ship whose propeller keeps turning keeps a share of its approach speed in a steady turn with
+# the largest rudder: the reference ships' 35° turns keep 38 % (KVLCC2, a full-form tanker) to
+# 78 % (Mariner), CyberShip II 62 %. A model left with less than this share has all but stopped
+# in the turn: the errors-in-variables bias of noisy v and r in the surge's v·r and r² terms did
+# it to CyberShip II's zig-zags logged with a GNSS's speed and course (0.2-1 % of its speed, its
+# tactical diameter 98 % short), and a prefilter undid it.
+STALL_SHARE = 0.1
 HELD_DURATION, HELD_MAX_DOUBLINGS = 300.0, 4
 
 
@@ -154,7 +162,18 @@ def failed_checks(report: dict, model: ManoeuvringModel) -> dict[str, tuple[int,
         elif _goes_astern(entry, speed):
             out[key] = (WRONG_WAY, f"{where}: the model ends the turn going astern (steady speed "
                                    f"{entry['steady_speed']:.3g} m/s from {speed:.3g} m/s ahead)")
+        if out.get(key, (0, ''))[0] < WRONG_WAY and _stalls(entry, speed):  # unsettled too
+            out[key] = (WRONG_WAY, f"{where}: the model all but stops in the turn (speed "
+                                   f"{entry['steady_speed']:.3g} m/s from {speed:.3g} m/s ahead, "
+                                   f"under {100 * STALL_SHARE:.0f} %)")  # fmt: skip
     return out
+
+
+def _stalls(entry: dict, approach_speed: float) -> bool:
+    """A turn entered ahead that ends ahead at less than ``STALL_SHARE`` of the approach speed."""
+    steady = entry.get("steady_speed")
+    return (approach_speed > 0 and not entry.get("diverged") and steady is not None
+            and 0 < steady < STALL_SHARE * approach_speed)  # fmt: skip
 
 
 def _goes_astern(entry: dict, approach_speed: float) -> bool:
@@ -174,9 +193,9 @@ def new_failures(reference: dict, candidate: dict, model: ManoeuvringModel) -> l
 
 def disqualifying(report: dict, model: ManoeuvringModel) -> list[str]:
     """The failed checks that rule a model out of a selection: the rudder held to a side
-    diverges, turns the ship the other way or ends the turn going astern, or surge has no steady
-    speed. Straight-line instability (real full-form ships have it) and slow settling stay
-    warnings."""
+    diverges, turns the ship the other way, ends the turn going astern or all but stopped, or
+    surge has no steady speed. Straight-line instability (real full-form ships have it) and slow
+    settling stay warnings."""
     reasons = []
     eq = report.get("surge_equilibrium")
     if "u" in model.structure.dofs and (eq is None or eq <= 0):
@@ -189,4 +208,21 @@ def disqualifying(report: dict, model: ManoeuvringModel) -> list[str]:
             reasons.append(f"turns the wrong way with the rudder to {side}")
         elif _goes_astern(entry, report.get("approach_speed") or 0.0):
             reasons.append(f"ends going astern with the rudder held to {side}")
+        elif _stalls(entry, report.get("approach_speed") or 0.0):
+            reasons.append(f"all but stops with the rudder held to {side}")
+    return reasons
+
+
+def disqualifying_at_approach(logs) -> Callable[[ManoeuvringModel], list[str]]:
+    """``model -> disqualifying reasons`` from the approach of the first of ``logs`` (its speed
+    and rps, as ``identify`` checks its model): for a choice among fits to rule some out."""
+    from shipid.data.log import approach
+
+    speed, rps = approach(logs[0], "u"), approach(logs[0], "n")
+
+    def reasons(model: ManoeuvringModel) -> list[str]:
+        if speed is None or not speed > 0:
+            return []
+        return disqualifying(plausibility_at_approach(model, speed, rps)[0], model)
+
     return reasons
