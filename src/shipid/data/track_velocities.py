@@ -222,6 +222,16 @@ def velocities_from_track(log: pd.DataFrame, options: TrackVelocities | None = N
                           f"{window:g} s (--track-window)")  # fmt: skip
     psi = np.unwrap(log["psi"].to_numpy(dtype=float))
     xdot, ydot = local_slope(t, x, window), local_slope(t, y, window)
+    return _body_velocities(log, t, psi, xdot, ydot, options, name,
+                            {"from": "track", "window_s": window})
+
+
+def _body_velocities(log: pd.DataFrame, t: np.ndarray, psi: np.ndarray, xdot: np.ndarray,
+                     ydot: np.ndarray, options: TrackVelocities, name: str,
+                     how: dict) -> pd.DataFrame:  # fmt: skip
+    """The log with u, v of the earth-fixed velocity (ẋ, ẏ) at the antenna turned by ψ and
+    moved to the reference point, r off ψ where not logged, x, y moved there too; the heading
+    checked against the course; ``how`` and the rest in ``attrs["velocities"]``."""
     heading_window = None
     if "r" in log.columns:
         r = log["r"].to_numpy(dtype=float)
@@ -232,18 +242,18 @@ def velocities_from_track(log: pd.DataFrame, options: TrackVelocities | None = N
         heading_window = options.window(t, psi)
         r = local_slope(t, psi, heading_window)
     _check_heading_scale(t, xdot, ydot, psi, name)
-    c, s = np.cos(psi), np.sin(psi)
-    u_antenna, v_antenna = xdot * c + ydot * s, -xdot * s + ydot * c
     _check_axes(xdot, ydot, psi, name)
+    c, s = np.cos(psi), np.sin(psi)
     fore, starboard = options.antenna
-    out = log.copy()
+    out = log.drop(columns=[col for col in GROUND_VELOCITY_COLUMNS if col in log.columns])
     out.attrs = dict(log.attrs)
-    out["u"] = u_antenna + r * starboard
-    out["v"] = v_antenna - r * fore
+    out["u"] = xdot * c + ydot * s + r * starboard
+    out["v"] = -xdot * s + ydot * c - r * fore
     out["r"] = r
-    out["x"] = x - (fore * c - starboard * s)
-    out["y"] = y - (fore * s + starboard * c)
-    out.attrs["velocities"] = {"from": "track", "window_s": window, "antenna": list(options.antenna),
+    if {"x", "y"} <= set(out.columns):
+        out["x"] = out["x"].to_numpy(dtype=float) - (fore * c - starboard * s)
+        out["y"] = out["y"].to_numpy(dtype=float) - (fore * s + starboard * c)
+    out.attrs["velocities"] = {**how, "antenna": list(options.antenna),
                                "r_from_heading": heading_window is not None,
                                "heading_window_s": heading_window}  # fmt: skip
     return out
@@ -298,29 +308,8 @@ def velocities_from_ground_velocity(log: pd.DataFrame, options: TrackVelocities 
         raise ShipidError(f"{name}: column 'cog' reaches {peak:.3g}, which looks like degrees; "
                           "give --degrees cog or 'cog [deg]' in the header")  # fmt: skip
     psi = np.unwrap(log["psi"].to_numpy(dtype=float))
-    xdot, ydot = sog * np.cos(cog), sog * np.sin(cog)
-    heading_window = None
-    if "r" in log.columns:
-        r = log["r"].to_numpy(dtype=float)
-    else:
-        heading_window = options.window(t, psi)
-        r = local_slope(t, psi, heading_window)
-    _check_heading_scale(t, xdot, ydot, psi, name)
-    _check_axes(xdot, ydot, psi, name)
-    fore, starboard = options.antenna
-    out = log.drop(columns=["sog", "cog"])
-    out.attrs = dict(log.attrs)
-    out["u"] = sog * np.cos(cog - psi) + r * starboard
-    out["v"] = sog * np.sin(cog - psi) - r * fore
-    out["r"] = r
-    if {"x", "y"} <= set(out.columns):
-        c, s = np.cos(psi), np.sin(psi)
-        out["x"] = out["x"].to_numpy() - (fore * c - starboard * s)
-        out["y"] = out["y"].to_numpy() - (fore * s + starboard * c)
-    out.attrs["velocities"] = {"from": "ground velocity", "antenna": list(options.antenna),
-                               "r_from_heading": heading_window is not None,
-                               "heading_window_s": heading_window}  # fmt: skip
-    return out
+    return _body_velocities(log, t, psi, sog * np.cos(cog), sog * np.sin(cog), options, name,
+                            {"from": "ground velocity"})
 
 
 def _median_drift_deg(xdot, ydot, psi, running) -> float:
