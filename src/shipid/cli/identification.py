@@ -30,7 +30,8 @@ from shipid.errors import ShipidError
 
 
 def _ruled_out(table) -> str:
-    """What the prefilter's choice ruled out as implausible: 'none (its reason), 2.5 Hz (...)'."""
+    """The fits the prefilter's choice checked and found implausible, 'none (its reason), 2.5 Hz
+    (...)': passed over, or chosen where none tied on the logs was plausible."""
     if "implausible" not in table.columns:
         return ""
     out = [f"{'none' if c is None or c != c else f'{c:.4g} Hz'} ({why.split('; ')[0]})"

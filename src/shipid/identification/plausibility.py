@@ -31,8 +31,8 @@ SETTLED_FRACTION = 0.02  # of the steady value, over the last 10 % of the run
 # the largest rudder: the reference ships' 35° turns keep 38 % (KVLCC2, a full-form tanker) to
 # 78 % (Mariner), CyberShip II 62 %. A model left with less than this share has all but stopped
 # in the turn: the errors-in-variables bias of noisy v and r in the surge's v·r and r² terms did
-# it to CyberShip II's zig-zags logged with a GNSS's speed and course (0.2-1 % of its speed, its
-# tactical diameter 98 % short), and a prefilter undid it.
+# it to CyberShip II's zig-zags logged with a GNSS's speed and course (under 1 % of its speed,
+# its tactical diameter 98 % short), and a prefilter undid it.
 STALL_SHARE = 0.1
 HELD_DURATION, HELD_MAX_DOUBLINGS = 300.0, 4
 

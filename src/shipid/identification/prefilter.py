@@ -51,7 +51,7 @@ def choose_prefilter(
     runs cannot tell a fit whose turns stall from one whose turns do not (CyberShip II's
     zig-zags logged with a GNSS's speed and course: 2.5 Hz scored 0.185 ± 0.030, 1.25 Hz 0.184,
     but the first all but stopped in a 35° turn, its tactical diameter 98 % short, the second
-    7 % short).
+    9 % short).
     """
     from shipid.data.preprocess import lowpass
     from shipid.dynamics.simulate import simulate_log
