@@ -65,6 +65,17 @@ def judged(model, truth: dict, speed: float, steering, dt: float, zigzag_s: floa
     return cells
 
 
+JUDGED_COLUMNS = ("35° starboard: tactical diameter (steady r)", "35° port", "20° starboard",
+                  "10°/10° overshoots")
+
+
+def judged_header(leading: list[str]) -> str:
+    """The header and separator of a table of ``judged_row``s: ``leading`` columns, then the
+    judged ones (the turns of ``TURNS`` = 35° both sides and 20° starboard, the 10°/10°)."""
+    columns = [*leading, *JUDGED_COLUMNS]
+    return "| " + " | ".join(columns) + " |\n" + "|" + "---|" * len(columns)
+
+
 def judged_row(cells: list[str], argv: list[str], paths: list[str], out: str, truth: dict, ship,
                dt: float, zigzag_s: float, structure=None) -> str:
     """One table row: ``cells``, then the model ``shipid ARGV PATHS -o OUT`` makes (its

@@ -27,7 +27,7 @@ import tempfile
 import time
 import warnings
 
-from cli_models import judged_row, noisy_files, truth_indices
+from cli_models import judged_header, judged_row, noisy_files, truth_indices
 
 from shipid.trials.manoeuvres import zigzag
 from shipid.vessels import PAPER_IMU, cybership2
@@ -66,9 +66,7 @@ def main_study(seeds: int = 3) -> None:
           f"{truth[TURNS[0]][0]:.2f} m ({truth[TURNS[0]][0] / ship.length:.2f} L), steady yaw "
           f"rate {truth[TURNS[0]][1]:.4f} rad/s; 20° {truth[TURNS[2]][0]:.2f} m; 10°/10° "
           f"overshoots {truth['zz10'][0]:.1f}°, {truth['zz10'][1]:.1f}°\n")
-    print("| seed | trained on | made by | structure | 35° starboard: tactical diameter "
-          "(steady r) | 35° port | 20° starboard | 10°/10° overshoots |")
-    print("|---|---|---|---|---|---|---|---|")
+    print(judged_header(["seed", "trained on", "made by", "structure"]))
     start = time.perf_counter()
     with tempfile.TemporaryDirectory() as tmp:
         for seed in range(seeds):

@@ -32,7 +32,7 @@ import time
 import warnings
 
 import numpy as np
-from cli_models import judged_row, noisy_files, truth_indices
+from cli_models import judged_header, judged_row, noisy_files, truth_indices
 
 from shipid.trials.manoeuvres import zigzag
 from shipid.vessels import PAPER_IMU, cybership2
@@ -90,9 +90,7 @@ def main_study(seeds: int = 3) -> None:
              for first, s in (("starboard", ""), ("port", "-"))}  # fmt: skip
     truth = truth_indices(ship, TURNS, DT, 120.0)
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores\n")
-    print("| seed | logs | read with | made by | structure | 35° starboard: tactical diameter "
-          "(steady r) | 35° port | 20° starboard | 10°/10° overshoots |")
-    print("|---|---|---|---|---|---|---|---|---|")
+    print(judged_header(["seed", "logs", "read with", "made by", "structure"]))
     start = time.perf_counter()
     with tempfile.TemporaryDirectory() as tmp:
         for seed in range(seeds):

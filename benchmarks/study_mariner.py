@@ -25,7 +25,7 @@ import time
 import warnings
 
 import numpy as np
-from cli_models import judged, model_by_cli, noisy_files, truth_indices
+from cli_models import judged, judged_header, model_by_cli, noisy_files, truth_indices
 
 from shipid.trials.criteria import imo_criteria
 from shipid.trials.manoeuvres import zigzag
@@ -62,9 +62,7 @@ def main_study(noises=(0.1, 0.3), seeds=3) -> None:
           f"{'pass' if crit.loc[('tactical diameter', 'turning 35° starboard'), 'passed'] else 'FAIL'}"
           f"), 20° {truth[TURNS[2]][0]:.0f} m; 10°/10° overshoots {truth['zz10'][0]:.1f}°, "
           f"{truth['zz10'][1]:.1f}°\n")
-    print("| noise × paper | seed | trained on | made by | terms | 35° starboard: tactical "
-          "diameter (steady r) | 35° port | 20° starboard | 10°/10° overshoots |")
-    print("|---|---|---|---|---|---|---|---|---|")
+    print(judged_header(["noise × paper", "seed", "trained on", "made by", "terms"]))
     start = time.perf_counter()
     with tempfile.TemporaryDirectory() as tmp:
         for noise in noises:

@@ -307,6 +307,16 @@ def test_times_a_csv_writes_as_text_become_seconds(tmp_path, trial, start, write
                                                      == pd.to_datetime(first, utc=True))
 
 
+def test_a_unit_on_text_times_is_refused(tmp_path, trial):
+    """Read as seconds, then scaled by the header's [ms]: 1000 times too short, without a word."""
+    df = trial.copy()
+    df["t"] = (pd.Timestamp("2020-07-31 13:04:24")
+               + pd.to_timedelta(df["t"], unit="s")).dt.strftime("%H:%M:%S.%f")
+    df = df.rename(columns={"t": "t [ms]"})
+    with pytest.raises(ShipidError, match="'t' holds dates or times of day.* drop the unit"):
+        read_log(_write(tmp_path, df, "log.csv"))
+
+
 @pytest.mark.parametrize(("row", "value", "match"), [
     (5, "13:04:25.x", r"'t' is a time of day \(hh:mm:ss\) at data row 1 .* not at data row 6"),
     (5, "yesterday", r"'t' is an ISO date and time at data row 1 .* not at data row 6"),

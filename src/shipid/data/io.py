@@ -259,6 +259,10 @@ def read_log(path: str | Path, options: ReadOptions | None = None, **overrides) 
             if any(c not in df.columns for c in required):
                 raise _hint_format(path, exc) from None
             raise
+        if "t" in factors and "time_origin" in df.attrs:
+            # Dates and clock times are already seconds; a [ms] would have scaled them again.
+            raise ShipidError(f"{path}: column 't' holds dates or times of day, which carry "
+                              "their own unit: drop the unit from its header")  # fmt: skip
         # Header units and --degrees (si_factors leaves a column --degrees names to it).
         factors.update({c: math.pi / 180.0 for c in options.degrees})
         for c, factor in factors.items():
