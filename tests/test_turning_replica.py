@@ -11,17 +11,24 @@ import pytest
 from test_equilibrium import A_UU, B_NN, PROPELLED, steady
 
 from shipid.dynamics.model import ManoeuvringModel
-from shipid.evaluation.validate import steady_log_approach, validate
+from shipid.data.trim import trim
+from shipid.evaluation.validate import (
+    APPROACH_LEAD_S,
+    free_run,
+    steady_log_approach,
+    validate,
+)
 from shipid.trials.manoeuvres import turning_circle
 from shipid.trials.trial import describe_trial
 
 RPS = 10.0
 
 
-def turning_log(side: str, held: float = 0.0, speed: float | None = None, rps: float = RPS):
-    """A 35° turn of ``PROPELLED`` at ``rps``, 10 s of approach with the rudder held at
+def turning_log(side: str, held: float = 0.0, speed: float | None = None, rps: float = RPS,
+                approach: float = 10.0):
+    """A 35° turn of ``PROPELLED`` at ``rps``, ``approach`` s of approach with the rudder held at
     ``held`` [rad], from ``speed`` (default: its steady speed)."""
-    res = turning_circle(PROPELLED, 35.0, side, duration=150.0, dt=0.1, approach=10.0,
+    res = turning_circle(PROPELLED, 35.0, side, duration=140.0 + approach, dt=0.1, approach=approach,
                          speed=speed or steady(rps), rps=rps, method="euler",
                          initial={"delta": held})  # fmt: skip
     log = res.log.copy()
@@ -72,10 +79,49 @@ def test_a_log_that_approaches_accelerating_is_replayed_from_its_own_state():
     trial = describe_trial(log, "turning")
     assert steady_log_approach(log, trial) is None
     (v,) = validate(with_thrust(2.25), log)
-    # No steady approach to compare with: the closed loop starts where the log does.
-    assert v.indices["closed_loop"]["approach_speed"] == pytest.approx(log["u"].iloc[0])
-    assert v.indices["measured"]["approach_speed"] == pytest.approx(log["u"].iloc[0])
+    # No steady approach to compare with: the closed loop starts where the log does, 5 s
+    # before the execute (``manoeuvre_from_approach``).
+    start = log.loc[log["t"] >= trial.execute_time - APPROACH_LEAD_S, "u"].iloc[0]
+    assert v.indices["closed_loop"]["approach_speed"] == pytest.approx(start)
+    assert v.indices["measured"]["approach_speed"] == pytest.approx(start)
     assert not any("steady straight speed" in w for w in v.warnings)
+
+
+@pytest.mark.parametrize("first_speed", [0.01, -0.01])
+def test_a_turn_that_gathers_speed_from_rest_is_judged_from_its_approach(first_speed):
+    """Bug: the Esso Osaka's turning logs start at rest and gather speed for 120 s before the
+    execute. `validate` took the first sample's 0.011 m/s as the measured approach speed, ran
+    the replay and the closed loop through those 120 s (a zig-zag model's +35° tactical
+    diameter 4.1 m from there, 9.9 m from the approach; measured 7.3 m), and a log starting at
+    −0.014 m/s got no closed loop at all, without a word."""
+    log = turning_log("starboard", speed=0.01, approach=120.0)
+    log.loc[0, "u"] = first_speed  # a log at rest reads either side of zero
+    trial = describe_trial(log, "turning")
+    at_execute = float(log["u"].iloc[trial.execute_index])
+    assert at_execute == pytest.approx(steady(RPS), rel=1e-3)  # it is steady by then
+    (true,) = validate(PROPELLED, log)
+    measured, closed = true.indices["measured"], true.indices["closed_loop"]
+    assert measured["approach_speed"] == pytest.approx(at_execute, rel=1e-3)
+    for k in ("advance", "transfer", "tactical_diameter", "steady_yaw_rate"):
+        assert closed[k] == pytest.approx(measured[k], rel=0.01), k
+    (warning,) = [w for w in true.warnings if "approach is not steady" in w]
+    assert f"u {first_speed:.3g} m/s at t = 0 s" in warning
+    # A model 50 % fast: its indices are those of the log cut 5 s before the execute, as
+    # --start auto cuts it, and its errors those of the whole log.
+    fast = with_thrust(2.25)
+    (whole,) = validate(fast, log)
+    cut = trim(log, start="auto", lead=APPROACH_LEAD_S)
+    (part,) = validate(fast, cut)
+    for column in ("measured", "simulated", "closed_loop"):
+        numbers = {k: x for k, x in part.indices[column].items() if isinstance(x, float)}
+        assert len(numbers) >= 6
+        for k, x in numbers.items():
+            assert whole.indices[column][k] == pytest.approx(x, rel=1e-9), (column, k)
+    assert whole.indices["closed_loop"]["approach_speed"] == pytest.approx(1.5 * steady(RPS),
+                                                                          rel=1e-3)
+    assert any("+50 %" in w for w in whole.warnings)
+    assert whole.metrics == free_run(fast, log)[1]
+    assert whole.metrics != part.metrics
 
 
 def test_the_command_line_names_the_approach_and_keeps_going(tmp_path, capsys):

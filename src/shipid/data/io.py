@@ -38,7 +38,7 @@ from shipid.data.track_velocities import (
     velocities_from_ground_velocity,
     velocities_from_track,
 )
-from shipid.data.trim import trim
+from shipid.data.trim import DEFAULT_LEAD_S, trim
 from shipid.data.yaw_rate import correct_yaw_rate
 from shipid.errors import ShipidError, ShipidWarning
 from shipid.outputs import atomic_write
@@ -76,7 +76,7 @@ class ReadOptions:
     dt: float | None = None
     start: float | str | None = None
     end: float | str | None = None
-    lead: float = 5.0
+    lead: float = DEFAULT_LEAD_S
     rudder_positive: str | None = None
     scale: float | None = None
     fill_gaps: bool = False

@@ -17,6 +17,7 @@ EXECUTE_HOLD_S = 5.0  # ... and staying there this long (helm corrections do not
 SWING_STEP_FRACTION = 0.05
 # An automatic trim that keeps less than this fraction of the log is reported.
 TRIM_KEEP_WARN = 0.25
+DEFAULT_LEAD_S = 5.0  # --start auto: seconds kept before the execute
 
 
 def rudder_execute_time(log: pd.DataFrame, name: str = "log") -> float:
@@ -126,7 +127,7 @@ def dropout_end(log: pd.DataFrame, name: str = "log") -> float | None:
 
 
 def trim(log: pd.DataFrame, start: float | str | None = None, end: float | str | None = None,
-         name: str = "log", lead: float = 5.0) -> pd.DataFrame:  # fmt: skip
+         name: str = "log", lead: float = DEFAULT_LEAD_S) -> pd.DataFrame:  # fmt: skip
     """Rows with start ≤ t ≤ end, time kept as is. ``start="auto"`` starts ``lead`` seconds
     before the detected rudder execute (``rudder_execute_time``); ``end="auto"`` ends with the
     manoeuvre (``manoeuvre_end_time``); ``end="dropout"`` before the first span whose logged

@@ -34,6 +34,7 @@ import numpy as np
 import pandas as pd
 
 from shipid.data.log import mean_true_wind, rudder_positive, starboard_sign, steady_start
+from shipid.data.trim import DEFAULT_LEAD_S
 from shipid.dynamics.equilibrium import surge_equilibrium
 from shipid.dynamics.hybrid import HybridModel
 from shipid.dynamics.model import ManoeuvringModel
@@ -137,15 +138,22 @@ def validate_log(model, log: pd.DataFrame, name: str, method: str = "euler",
     cross-validated ``error_band``: the share of the log's samples within it."""
     sim, metrics = free_run(model, log, method)
     trial = describe_trial(log, kind)
+    # The indices from the manoeuvre's approach: the whole log's replay and errors stay.
+    whole, (log, trial), notes = log, manoeuvre_from_approach(log, trial), []
+    if log is not whole:
+        sim_indices = free_run(model, log, method)[0]
+        notes.append(_from_approach_note(whole, log, trial))
+    else:
+        sim_indices = sim
     indices: dict[str, dict] = {}
     if trial.kind != "other":
         measured = manoeuvre_indices(log, smooth_s=smooth_s, trial=trial)
         steady = steady_log_approach(log, trial)
         measured["approach_speed"] = steady if steady else float(log["u"].iloc[0])
-        indices = {"measured": measured, "simulated": _replay_indices(sim, trial)}
+        indices = {"measured": measured, "simulated": _replay_indices(sim_indices, trial)}
         if isinstance(model, ManoeuvringModel | HybridModel | Vessel):
             indices["closed_loop"] = _replica_indices(model, log, method, trial)
-    out = Validation(name, sim, metrics, indices, trial.kind)
+    out = Validation(name, sim, metrics, indices, trial.kind, warnings=notes)
     if indices.get("closed_loop") and start_draws:
         out.start_spread = start_spread(model, log, method, trial, indices["closed_loop"])
     out.warnings += _approach_notes(indices)
@@ -154,12 +162,14 @@ def validate_log(model, log: pd.DataFrame, name: str, method: str = "euler",
     out.warnings += faded_residual_notes(model, sim.log)
     if error_band is not None:
         out.error_band = error_band
-        out.band_shares = error_band.shares_within(log[list(STATES)].to_numpy(dtype=float),
+        out.band_shares = error_band.shares_within(whole[list(STATES)].to_numpy(dtype=float),
                                                    sim.log[list(STATES)].to_numpy())  # fmt: skip
     if ensemble is not None:
-        runs = ensemble_runs(ensemble, log, method)
-        out.bands, out.ensemble_diverged = free_run_bands(runs, len(log))
+        runs = ensemble_runs(ensemble, whole, method)
+        out.bands, out.ensemble_diverged = free_run_bands(runs, len(whole))
         if trial.kind != "other":
+            if log is not whole:
+                runs = ensemble_runs(ensemble, log, method)
             replays = [_replay_indices(r, trial) for r in runs]
             out.intervals["simulated"] = index_intervals(replays)
             out.warnings += _unbounded_notes("replay", out.intervals["simulated"], replays,
@@ -177,6 +187,40 @@ def validate_log(model, log: pd.DataFrame, name: str, method: str = "euler",
                 out.warnings += _unbounded_notes("closed loop", out.intervals["closed_loop"],
                                                  samples, replicas, ensemble.members_label)
     return out
+
+
+# Seconds of the approach kept before the execute where a log's approach is not a steady one
+# (``manoeuvre_from_approach``): ``--start auto``'s default lead.
+APPROACH_LEAD_S = DEFAULT_LEAD_S
+
+
+def manoeuvre_from_approach(log: pd.DataFrame, trial: Trial) -> tuple[pd.DataFrame, Trial]:
+    """``log`` and its ``trial`` from ``APPROACH_LEAD_S`` before the execute where the ship does
+    not run steady and straight up to it (it gathers speed from rest, or starts without
+    headway, or turns), as ``--start auto`` trims; else both as they are.
+
+    A manoeuvre's indices are counted from its execute, but its replay and its closed-loop
+    replica run from the log's first sample. The Esso Osaka's turning logs start at rest and
+    gather speed for 120 s: from there the replay of a model fitted to the zig-zags put the
+    +35° turn's tactical diameter at 4.1 m, from the approach 9.9 m (measured 7.3 m), and the
+    −35° turn, which starts at −0.014 m/s, had no closed loop at all."""
+    t = log["t"].to_numpy(dtype=float)
+    if trial.kind == "other" or trial.execute_time - t[0] <= APPROACH_LEAD_S + (t[1] - t[0]):
+        return log, trial
+    if float(log["u"].iloc[0]) > 0 and steady_start(log, trial.execute_index).steady:
+        return log, trial
+    part = log.loc[t >= trial.execute_time - APPROACH_LEAD_S].reset_index(drop=True)
+    part.attrs = dict(log.attrs)
+    return part, describe_trial(part, trial.kind)
+
+
+def _from_approach_note(whole: pd.DataFrame, part: pd.DataFrame, trial: Trial) -> str:
+    t0, u0 = float(whole["t"].iloc[0]), float(whole["u"].iloc[0])
+    at = float(part["u"].iloc[: trial.execute_index + 1].mean())
+    return (f"its approach is not steady (u {u0:.3g} m/s at t = {t0:g} s, {at:.3g} m/s over the "
+            f"{APPROACH_LEAD_S:g} s before the execute at t = {trial.execute_time:g} s): its "
+            "indices, measured, replayed and run closed loop, are taken from there, as --start "
+            "auto trims (the errors are of the whole log)")
 
 
 def _unbounded_notes(label: str, intervals: dict, samples: Sequence[dict], runs: Sequence,
@@ -497,5 +541,5 @@ def trial_zigzag(model, log: pd.DataFrame, method: str = "euler", trial: Trial |
                   **_replica_run(log, trial, wind))  # fmt: skip
 
 
-__all__ = ["Validation", "free_run", "steady_log_approach", "trial_replica", "trial_turning",
+__all__ = ["Validation", "free_run", "manoeuvre_from_approach", "steady_log_approach", "trial_replica", "trial_turning",
            "trial_zigzag", "validate", "validate_log", "zigzag_indices"]
