@@ -132,6 +132,43 @@ def test_esso_turns_and_trimmed_zigzags_are_recognised():
         assert describe_trial(log).kind == "zigzag", f.name
 
 
+@needs_data
+@pytest.mark.parametrize("name", sorted(f.name for f in (OSAKA / "zigzag").glob("*.csv")))
+def test_esso_zigzags_read_whole_are_the_trimmed_ones(name):
+    """Bug: read whole (no --start auto), four of the nine zig-zags, which start at rest with
+    the helm correcting by 13–19° as the ship gathers speed, had that correction taken for the
+    execute: two read as no zig-zag, one with reversals at −34° and +19°; and every one's
+    overshoots were read from its heading averaged over the whole approach (13_04_24: 6.6° and
+    7.0° against 4.8° and 8.9°). The execute is now the held order, where --start auto's
+    plateau (``rudder_execute_time``, held 5 s) finds it, and the overshoots those of the cut log."""
+    from shipid.data.trim import rudder_execute_time
+
+    whole = read_log(OSAKA / "zigzag" / name, fmt="osaka-frt")
+    cut = read_log(OSAKA / "zigzag" / name, fmt="osaka-frt", start="auto")
+    tr = describe_trial(whole)
+    assert tr.kind == "zigzag"
+    # 13_57_45 orders 12° two seconds before its 20° plateau (``earlier_order``).
+    assert tr.execute_time == pytest.approx(rudder_execute_time(whole), abs=2.0)
+    a, b = zigzag_indices(whole), zigzag_indices(cut)
+    for k in ("first_overshoot_deg", "second_overshoot_deg"):
+        assert a[k] == pytest.approx(b[k], abs=0.4), k
+
+
+def test_a_helm_correction_before_the_order_is_not_the_execute():
+    """The same zig-zag with and without a helm correction to 14° (70 % of its 20° orders,
+    held a second and eased back) 10 s before its execute: the same execute, the same facts."""
+    res = zigzag(SHIP, 20, 20, duration=100.0, dt=0.1, method="euler", approach=20.0)
+    log = res.log
+    helmed = log.copy()
+    t = helmed["t"].to_numpy()
+    bump = np.interp(t, [8.0, 9.5, 10.5, 14.0], [0.0, -14.0, -14.0, 0.0], left=0.0, right=0.0)
+    helmed["delta"] = helmed["delta"] + np.radians(bump)
+    plain, tr = describe_trial(log), describe_trial(helmed)
+    assert tr.kind == "zigzag" and tr.execute_time == pytest.approx(plain.execute_time)
+    assert tr.reversal_headings_deg == pytest.approx(plain.reversal_headings_deg, abs=1e-9)
+    assert zigzag_indices(helmed) == pytest.approx(zigzag_indices(log))
+
+
 def test_forced_kind_and_per_log_errors_in_a_validate_batch(tmp_path, capsys, clean_zigzag_10):
     """Item 9: a run starting astern aborted the whole batch without naming the file."""
     good = write_log(clean_zigzag_10, tmp_path / "good.csv")

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 from test_equilibrium import A_UU, B_NN, PROPELLED, steady
 
-from shipid.dynamics.model import ManoeuvringModel
 from shipid.data.trim import trim
+from shipid.dynamics.model import ManoeuvringModel
 from shipid.evaluation.validate import (
     APPROACH_LEAD_S,
     free_run,

@@ -541,5 +541,6 @@ def trial_zigzag(model, log: pd.DataFrame, method: str = "euler", trial: Trial |
                   **_replica_run(log, trial, wind))  # fmt: skip
 
 
-__all__ = ["Validation", "free_run", "manoeuvre_from_approach", "steady_log_approach", "trial_replica", "trial_turning",
-           "trial_zigzag", "validate", "validate_log", "zigzag_indices"]
+__all__ = ["Validation", "free_run", "manoeuvre_from_approach", "steady_log_approach",
+           "trial_replica", "trial_turning", "trial_zigzag", "validate", "validate_log",
+           "zigzag_indices"]

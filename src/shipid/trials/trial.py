@@ -25,7 +25,7 @@ import pandas as pd
 
 from shipid.data.preprocess import cumulative_integral
 from shipid.data.rudder_signal import ramp_start, rise_rate, rudder_for_events, stand_samples
-from shipid.data.trim import EXECUTE_FRACTION, first_swing_index, swing_start
+from shipid.data.trim import DEFAULT_LEAD_S, EXECUTE_FRACTION, first_swing_index, swing_start
 from shipid.errors import ShipidError
 
 KINDS = ("zigzag", "turning", "pull-out", "other")
@@ -37,6 +37,7 @@ MIN_SWITCH = math.radians(3.0)  # IMO zig-zags switch at 5°–20°; a 2° "swit
 MAX_ZIGZAG_HEADING = math.radians(90.0)
 # Heading change before the first order beyond which the log has no straight approach.
 MAX_APPROACH_TURN = math.radians(90.0)
+APPROACH_HEADING_S = DEFAULT_LEAD_S  # the approach heading: what --start auto keeps of it
 HELD_TOLERANCE = math.radians(3.0)  # a held rudder stays within this of its plateau (or 15 %)
 PLATEAU_TOLERANCE = math.radians(0.5)
 # Heading noise above this is fused with the yaw rate (the Esso Osaka's logs show 0.06-0.1°,
@@ -54,7 +55,7 @@ class Trial:
     kind : 'zigzag', 'turning', 'pull-out' or 'other'.
     reason : why the log is of this kind (for 'other': which test a zig-zag or turn failed).
     execute_index, execute_time : the rudder order (start of the first large swing).
-    psi0 : mean heading over the approach (up to the order).
+    psi0 : mean heading over the approach's last ``APPROACH_HEADING_S`` (up to the order).
     neutral : the rudder's neutral (mid-range) angle.
     amplitude : median rudder deflection from neutral on the plateaus.
     plateau_angle : median |δ| where the rudder is within 80 % of its largest swing from the
@@ -231,15 +232,77 @@ def starts_on_order(log: pd.DataFrame, delta: np.ndarray, i0: int) -> int:
     return i0
 
 
+# A rudder order is held within this spread of its extreme [rad] (``rudder_execute_time``'s
+# plateau) for ``HELD_ORDER_S``, or ``HOLD_SHARE`` of the trial's typical hold where shorter.
+HELD_SPREAD = math.radians(1.0)
+HELD_ORDER_S = 5.0
+HOLD_SHARE = 0.5
+LONG_HOLD = 0.25  # the trial's holds: those longer than this share of the longest
+
+
+def _hold(t: np.ndarray, x: np.ndarray) -> float:
+    """How long [s] ``x`` stays within ``HELD_SPREAD`` of its extreme (the angle an order holds;
+    the samples counted, ``t`` uniform or not)."""
+    k = int(np.argmax(np.abs(x)))
+    near = np.abs(x - x[k]) <= HELD_SPREAD
+    steps = np.diff(t, append=t[-1] + (t[-1] - t[-2] if t.size > 1 else 0.0))
+    return float(np.sum(steps[near]))
+
+
+def held_swing_index(t: np.ndarray, delta: np.ndarray, max_stand: int = 0) -> int:
+    """``first_swing_index``, past swings the helm made before the trial. The trial's orders are
+    the swings beyond half the largest deflection held longest (``LONG_HOLD``); a swing counts
+    as the order where the rudder then stays within ``HELD_SPREAD`` of its extreme for
+    ``HELD_ORDER_S`` or ``HOLD_SHARE`` of their median hold, whichever is shorter (a turn's
+    order), or swings over into a long hold on the other side as fast as the trial's reversals
+    do, within twice their median time (a zig-zag's first leg can be short: the scale ship's
+    20/20 holds 2.2 s against 7.5–8.8 s after), at an angle within ``AMPLITUDE_SPREAD`` of
+    theirs.
+
+    Logs that start at rest carry the helm's corrections as the ship gathers speed: four of
+    the Esso Osaka's nine zig-zags read whole swing to 13–19° in the first seconds (more than
+    half their 15–30° orders; held 1.1–2.1 s against 15–55 s) and drift back, and the first
+    correction was taken for the execute: two read as no zig-zag, one with reversals at −34°
+    and +19° around a 30° switch heading. The first swing where no swing passes."""
+    first = first_swing_index(delta, max_stand)
+    dev = delta - delta[0]
+    peak = float(np.max(np.abs(dev)))
+    if not peak > 0:
+        return first
+    side = np.where(np.abs(dev) >= EXECUTE_FRACTION * peak, np.sign(dev), 0.0)
+    runs = [(a, b, v) for a, b, v in runs_of(side) if v != 0 and b >= first]
+    if len(runs) < 2:
+        return first
+    holds = np.array([_hold(t[a : b + 1], dev[a : b + 1]) for a, b, _ in runs])
+    angles = np.array([np.max(np.abs(dev[a : b + 1])) for a, b, _ in runs])
+    long = holds >= LONG_HOLD * holds.max()
+    needed = min(HELD_ORDER_S, HOLD_SHARE * float(np.median(holds[long])))
+    angle = float(np.median(angles[long]))
+    # The time the rudder takes over from one long hold to the other side's.
+    over = [t[runs[i + 1][0]] - t[runs[i][1]] for i in range(len(runs) - 1)
+            if long[i] and long[i + 1] and runs[i][2] != runs[i + 1][2]]  # fmt: skip
+    reversal = 2.0 * float(np.median(over)) if over else -math.inf
+    for i, ((a, b, v), hold, x) in enumerate(zip(runs, holds, angles, strict=True)):
+        if abs(x - angle) > AMPLITUDE_SPREAD * angle:
+            continue
+        # Held, or reversed into the trial's next leg as its reversals are (in a beam wind the
+        # scale ship's first leg held 1.0 s against 9–11 s after).
+        reversed_ = i + 1 < len(runs) and long[i + 1] and runs[i + 1][2] != v and \
+            t[runs[i + 1][0]] - t[b] <= reversal  # fmt: skip
+        if hold >= needed or reversed_:
+            return first if a <= first else swing_start(delta, a, v, max_stand)
+    return first
+
+
 def execute_index(log: pd.DataFrame, delta: np.ndarray, rudder_noise: float) -> int:
     """The sample of the first rudder order of ``log`` (``delta`` its rudder for events,
-    ``rudder_for_events``): the first swing from the first angle to at least half the largest
-    deflection (``first_swing_index``), or an earlier, smaller one to the trial's plateau
+    ``rudder_for_events``): the first held swing from the first angle to at least half the
+    largest deflection (``held_swing_index``), or an earlier, smaller one to the trial's plateau
     (``earlier_order``); on a noisy rudder the ramp extended back to where it left the approach;
     the first sample where the log starts on the order (``starts_on_order``)."""
     t, raw = log["t"].to_numpy(), log["delta"].to_numpy()
     stand = stand_samples(t) if rudder_noise else 0
-    i0 = earlier_order(t, delta, first_swing_index(delta, stand), stand)
+    i0 = earlier_order(t, delta, held_swing_index(t, delta, stand), stand)
     if rudder_noise:  # the dead band left the approach late: extend the ramp back
         stood = np.flatnonzero(delta[: i0 + 1] != delta[i0])
         level = float(np.median(raw[stood[-1] + 1 if stood.size else 0 : i0 + 1]))
@@ -300,7 +363,11 @@ def describe_trial(
     i0 = (execute_index(log, delta, rudder_noise) if t_order is None
           else min(int(np.searchsorted(t, t_order - 1e-9)), len(t) - 1))  # fmt: skip
     psi = unwrapped_heading(log)
-    psi0 = float(np.mean(psi[: i0 + 1]))
+    # The heading the ship held at the order: over a log that gathers speed from rest the helm
+    # wanders (the Esso Osaka's raw 13_04_24 zig-zag: its overshoots read 6.6° and 7.0° from
+    # the mean over its 44 s, 4.8° and 8.9° from the last 5 s, as --start auto cuts it).
+    approach = int(np.searchsorted(t, t[i0] - APPROACH_HEADING_S))
+    psi0 = float(np.mean(psi[min(approach, i0) : i0 + 1]))
     dpsi = psi - psi0
     neutral = neutral_rudder(delta[i0:])
     if np.ptp(delta[i0:]) < math.radians(1.0):
