@@ -142,7 +142,7 @@ def validate_log(model, log: pd.DataFrame, name: str, method: str = "euler",
     whole, (log, trial), notes = log, manoeuvre_from_approach(log, trial), []
     if log is not whole:
         sim_indices = free_run(model, log, method)[0]
-        notes.append(_from_approach_note(whole, log, trial))
+        notes.append(_from_approach_note(whole, log))
     else:
         sim_indices = sim
     indices: dict[str, dict] = {}
@@ -214,13 +214,13 @@ def manoeuvre_from_approach(log: pd.DataFrame, trial: Trial) -> tuple[pd.DataFra
     return part, describe_trial(part, trial.kind)
 
 
-def _from_approach_note(whole: pd.DataFrame, part: pd.DataFrame, trial: Trial) -> str:
+def _from_approach_note(whole: pd.DataFrame, part: pd.DataFrame) -> str:
     t0, u0 = float(whole["t"].iloc[0]), float(whole["u"].iloc[0])
-    at = float(part["u"].iloc[: trial.execute_index + 1].mean())
-    return (f"its approach is not steady (u {u0:.3g} m/s at t = {t0:g} s, {at:.3g} m/s over the "
-            f"{APPROACH_LEAD_S:g} s before the execute at t = {trial.execute_time:g} s): its "
-            "indices, measured, replayed and run closed loop, are taken from there, as --start "
-            "auto trims (the errors are of the whole log)")
+    t1, u1 = float(part["t"].iloc[0]), float(part["u"].iloc[0])
+    return (f"its approach is not steady (u {u0:.3g} m/s at t = {t0:g} s, {u1:.3g} m/s at "
+            f"t = {t1:g} s, {APPROACH_LEAD_S:g} s before the execute): its indices, measured, "
+            "replayed and run closed loop, are taken from there, as --start auto trims (the "
+            "errors are of the whole log)")
 
 
 def _unbounded_notes(label: str, intervals: dict, samples: Sequence[dict], runs: Sequence,
