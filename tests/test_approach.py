@@ -54,3 +54,41 @@ def test_identify_on_a_log_from_rest_checks_the_running_ship(tmp_path, capsys):
     assert "starts without headway" in err
     prep = json.loads((tmp_path / "m.json").read_text())["identification"]["preprocessing"]
     assert prep["approach_speed"] == pytest.approx(float(np.median(log["u"][ramp >= 1])), rel=0.05)
+
+
+@pytest.mark.parametrize("from_rest", [True, False])
+def test_a_steady_speed_beyond_every_log_is_named(tmp_path, capsys, from_rest):
+    """Logs that start at rest and turn at once never run steady: the Esso Osaka's nine
+    zig-zags read whole reach 0.544 m/s, and their default model balanced at 0.776 m/s at 16.7
+    rps, where its checks, manoeuvres and criteria started, without a word. A model's own steady
+    speed more than 10 % beyond every training sample is named; from a steady approach it is
+    not."""
+    from test_equilibrium import PROPELLED
+
+    from shipid.dynamics.model import ManoeuvringModel
+    from shipid.identification.plausibility import approach_beyond_logs
+
+    # u̇ = a |u|u + b n⁺²: steady at n √(−b/a), 0.632 m/s at 10 rps, reached in minutes.
+    a, b, rps = -0.01, 4e-5, 10.0
+    truth = ManoeuvringModel(PROPELLED.structure, {**PROPELLED.coefficients,
+                                                   "u": {"|u|*u": a, "pos(n)^2": b}})
+    steady = rps * np.sqrt(-b / a)
+    logs = []
+    for first in ("starboard", "port"):
+        res = zigzag(truth, 20, 20, first=first, duration=60, dt=0.1, method="euler",
+                     speed=0.05 if from_rest else steady, rps=rps, approach=3.0)  # fmt: skip
+        logs.append(res.log.assign(n=rps))
+    fastest = max(float(log["u"].max()) for log in logs)
+    assert (fastest < 0.8 * steady) == from_rest
+    paths = [write_log(log, tmp_path / f"zz{i}.csv") for i, log in enumerate(logs)]
+    code, out, err = run(["identify", *paths, "--model", "blanke-rps", "--filter", "none",
+                          "-o", tmp_path / "m.json"], capsys)  # fmt: skip
+    assert code == 0, err
+    named = "beyond the fastest of its training logs" in err
+    assert named == from_rest, err
+    if from_rest:
+        # The fit holds the truth's surge terms: its steady speed is n √(−b/a).
+        assert f"at 10 rps, {steady:.4g} m/s, is" in err and f"({fastest:.4g} m/s)" in err
+        note = approach_beyond_logs({"approach_speed": steady, "rps": rps}, {"u": [0.0, fastest]})
+        assert f"{100 * (steady / fastest - 1):.0f} % beyond" in note
+    assert approach_beyond_logs({"approach_speed": 1.09, "rps": None}, {"u": [0, 1.0]}) is None

@@ -117,6 +117,32 @@ def plausibility_at_approach(model: ManoeuvringModel, trained_speed: float,
     return report, notes
 
 
+# A model's own steady straight speed this much faster than every sample of its training logs
+# is where its surge fit extrapolates to, not a speed any log ran.
+BEYOND_LOGS = 0.10
+
+
+def approach_beyond_logs(report: dict, env: dict) -> str | None:
+    """A warning where the approach of ``report`` (``plausibility_at_approach``: the model's own
+    steady straight speed at the training rps) is more than ``BEYOND_LOGS`` faster than the
+    training envelope ``env``'s fastest sample; else None.
+
+    Logs that start from rest and turn at once never run steady: the Esso Osaka's nine
+    zig-zags read whole reach 0.544 m/s at most, and the default model of them balanced at
+    0.776 m/s at 16.7 rps, where its checks, manoeuvres and criteria started, 43 % beyond any
+    log (the ship's turns approach 0.35 m/s at 10 rps, 0.58 m/s at 16.7 rps by the propeller
+    law)."""
+    speed, fastest = report.get("approach_speed"), (env or {}).get("u", [None, None])[1]
+    if not speed or not fastest or not fastest > 0 or speed <= (1 + BEYOND_LOGS) * fastest:
+        return None
+    at = f" at {report['rps']:.4g} rps" if report.get("rps") is not None else ""
+    return (f"the model's steady straight speed{at}, {speed:.4g} m/s, is "
+            f"{100 * (speed / fastest - 1):.0f} % beyond the fastest of its training logs "
+            f"({fastest:.4g} m/s): no log ran steady there, so the speed its surge balances at "
+            "is the fit's extrapolation, and its manoeuvres and criteria start from it; give "
+            "--steady-speed U@N (a straight run's speed at N rps), or --speed to them")
+
+
 def given_steady_speeds(physics) -> list[tuple[float, float]]:
     """(u, n) of the steady speeds a user gave (``--steady-speed``): the model is checked there
     too, where its manoeuvres will be asked for, not only from the first log's approach."""
