@@ -87,6 +87,19 @@ def test_a_log_that_approaches_accelerating_is_replayed_from_its_own_state():
     assert not any("steady straight speed" in w for w in v.warnings)
 
 
+def test_a_propeller_stopped_at_the_logs_end_does_not_slow_the_replica():
+    """Bug: the replica held the log's mean rps, and a log read whole ends with the propeller
+    stopped (the Esso Osaka's zig-zags for 2–8 s: 13_14_21's mean 15.6 rps for 16.7). Here the
+    true model's turn from an accelerating approach, its last 30 s logged at n = 0."""
+    log = turning_log("starboard", speed=0.6 * steady(RPS))
+    log.loc[log["t"] > log["t"].iloc[-1] - 30.0, "n"] = 0.0
+    assert log["n"].mean() < 0.85 * RPS
+    (v,) = validate(PROPELLED, log)
+    measured, closed = v.indices["measured"], v.indices["closed_loop"]
+    for k in ("advance", "tactical_diameter", "steady_yaw_rate"):
+        assert closed[k] == pytest.approx(measured[k], rel=0.01), k
+
+
 @pytest.mark.parametrize("first_speed", [0.01, -0.01])
 def test_a_turn_that_gathers_speed_from_rest_is_judged_from_its_approach(first_speed):
     """Bug: the Esso Osaka's turning logs start at rest and gather speed for 120 s before the
