@@ -184,12 +184,30 @@ def _approach(log, column: str) -> float | None:
 
 def _warn_approach(logs, names) -> None:
     """Say so when the first log (whose approach the checks and manoeuvres use) starts without
-    headway."""
+    headway, and name the zig-zags and turns read whole from rest (``manoeuvres_from_rest``)."""
     from shipid.data.log import approach_note
 
     note = approach_note(logs[0], names[0]) if logs else None
     if note:
         _warn(note)
+    whole = manoeuvres_from_rest(logs)
+    if whole:
+        _warn(f"{len(whole)} of the logs ({', '.join(Path(names[i]).name for i in whole[:3])}"
+              f"{', …' if len(whole) > 3 else ''}) are zig-zags or turns read whole, from rest: "
+              "--start auto --end auto cuts them to the manoeuvre (the Esso Osaka's nine "
+              "zig-zags read whole put the default model's 35° turns 47 % and 58 % long, cut "
+              "28 % and 2 %: benchmarks/study_esso_whole_logs.py)")
+
+
+def manoeuvres_from_rest(logs) -> list[int]:
+    """The indices of ``logs`` that are zig-zags or turns (``describe_trial``) and start without
+    headway: read whole, with the ship gathering speed under the helm's corrections before the
+    manoeuvre and its propeller stopped after it."""
+    from shipid.data.log import starts_without_headway
+    from shipid.trials.trial import describe_trial
+
+    return [i for i, log in enumerate(logs) if starts_without_headway(log)
+            and describe_trial(log).kind in ("zigzag", "turning")]  # fmt: skip
 
 
 def _std_errors(ident) -> dict:
