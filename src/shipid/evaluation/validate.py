@@ -138,13 +138,13 @@ def validate_log(model, log: pd.DataFrame, name: str, method: str = "euler",
     cross-validated ``error_band``: the share of the log's samples within it."""
     sim, metrics = free_run(model, log, method)
     trial = describe_trial(log, kind)
-    # The indices from the manoeuvre's approach: the whole log's replay and errors stay.
-    whole, (log, trial), notes = log, manoeuvre_from_approach(log, trial), []
+    # The indices come from the manoeuvre's approach; the errors from the whole log's free run.
+    whole = log
+    log, trial = manoeuvre_from_approach(whole, trial)
+    notes, sim_indices = [], sim
     if log is not whole:
         sim_indices = free_run(model, log, method)[0]
         notes.append(_from_approach_note(whole, log))
-    else:
-        sim_indices = sim
     indices: dict[str, dict] = {}
     if trial.kind != "other":
         measured = manoeuvre_indices(log, smooth_s=smooth_s, trial=trial)

@@ -263,7 +263,7 @@ def held_swing_index(t: np.ndarray, delta: np.ndarray, max_stand: int = 0) -> in
     the Esso Osaka's nine zig-zags read whole swing to 13–19° in the first seconds (more than
     half their 15–30° orders; held 1.1–2.1 s against 15–55 s) and drift back, and the first
     correction was taken for the execute: two read as no zig-zag, one with reversals at −34°
-    and +19° around a 30° switch heading. The first swing where no swing passes."""
+    and +19° around a 30° switch heading. Where no swing passes, ``first_swing_index``'s."""
     first = first_swing_index(delta, max_stand)
     dev = delta - delta[0]
     peak = float(np.max(np.abs(dev)))
