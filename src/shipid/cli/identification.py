@@ -72,7 +72,11 @@ def cmd_identify(args) -> int:
     """``shipid identify``: a model from logs (LS-SVM, optional refinement, checks)."""
     from shipid.data.preprocess import lowpass
     from shipid.identification.identify import identify
-    from shipid.identification.plausibility import new_failures, plausibility_at_approach
+    from shipid.identification.plausibility import (
+        new_failures,
+        plausibility_at_approach,
+        sharpest_curvature,
+    )
     from shipid.outputs import atomic_write_text, check_outputs
     from shipid.reporting.modelfile import model_text
 
@@ -225,9 +229,12 @@ def cmd_identify(args) -> int:
         raise ShipidError(f"{names[0]}: the first training log starts without headway (u = "
                           f"{speed}); trim it to the manoeuvre (--start)")  # fmt: skip
     # A hybrid is checked whole: its stability, steady speed and held-rudder turns.
-    plausibility, notes = plausibility_at_approach(hybrid or ident.model, speed, rps)
+    curvature = sharpest_curvature(logs, speed)
+    plausibility, notes = plausibility_at_approach(hybrid or ident.model, speed, rps,
+                                                   curvature=curvature)  # fmt: skip
     if refinement:
-        refined_report, refined_notes = plausibility_at_approach(refinement.model, speed, rps)
+        refined_report, refined_notes = plausibility_at_approach(refinement.model, speed, rps,
+                                                                 curvature=curvature)  # fmt: skip
         worse = new_failures(plausibility, refined_report, ident.model)
         apart = _turns_apart(plausibility, refined_report)
         # Checks the LS-SVM fit fails and output error's passes: its turn is then no reference

@@ -333,7 +333,11 @@ def _paper_ruled_out(logs, names, physics, estimator, drop) -> str | None:
                 "(the same at any speed) can follow, so the rudder's inflow is compared")
     from shipid.data.log import approach
     from shipid.identification.identify import identify
-    from shipid.identification.plausibility import disqualifying, plausibility_at_approach
+    from shipid.identification.plausibility import (
+        disqualifying,
+        plausibility_at_approach,
+        sharpest_curvature,
+    )
 
     speed = approach(logs[0], "u")
     if speed is None or not speed > 0:
@@ -343,7 +347,8 @@ def _paper_ruled_out(logs, names, physics, estimator, drop) -> str | None:
                          force=True, estimator=estimator, physics=physics).model  # fmt: skip
     except ShipidError:
         return None  # identify's own fit says why
-    found = disqualifying(plausibility_at_approach(model, speed, None)[0], model)
+    found = disqualifying(plausibility_at_approach(
+        model, speed, None, curvature=sharpest_curvature(logs, speed))[0], model)  # fmt: skip
     if not found:
         return None
     return (f"the paper's {PAPER}, fitted to these logs, is implausible ({found[0]}) and their "

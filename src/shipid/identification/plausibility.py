@@ -34,7 +34,36 @@ SETTLED_FRACTION = 0.02  # of the steady value, over the last 10 % of the run
 # it to CyberShip II's zig-zags logged with a GNSS's speed and course (under 1 % of its speed,
 # its tactical diameter 98 % short), and a prefilter undid it.
 STALL_SHARE = 0.1
+# The largest rudder held turns the ship on a path about as tight as the trials' (their 95th
+# percentile of |r|/U where running ahead at half the approach speed or more): the reference
+# ships' 35° turns' steady curvature is 0.62–3.2 times that of their 10°/10°, 20°/20° and
+# 30°/30° zig-zags and 20° turns (CyberShip II lowest, the KVLCC2 highest), the Esso Osaka's
+# 1.3–1.7 times its zig-zags'. A model whose path is wider than this share of it has all but
+# lost the rudder: CyberShip II's zig-zags logged with a GNSS's 0.05 m/s speed noise gave a fit
+# whose 35° tactical diameter came 13 times the ship's.
+WIDE_SHARE = 0.25
 HELD_DURATION, HELD_MAX_DOUBLINGS = 300.0, 4
+
+
+def sharpest_curvature(logs, speed: float) -> float | None:
+    """The 95th percentile of |r|/U [1/m] over the samples of ``logs`` running ahead at half
+    ``speed`` (the approach) or more: how tight the trials turned; None without such samples."""
+    parts = []
+    for log in logs:
+        u = log["u"].to_numpy(dtype=float)
+        ahead = u >= 0.5 * speed
+        parts.append(np.abs(log["r"].to_numpy(dtype=float)[ahead])
+                     / np.hypot(u, log["v"].to_numpy(dtype=float))[ahead])  # fmt: skip
+    values = np.concatenate(parts) if parts else np.empty(0)
+    return float(np.percentile(values, 95)) if values.size else None
+
+
+def _too_wide(entry: dict, curvature: float | None) -> bool:
+    """A held-rudder turn whose steady path is wider than ``WIDE_SHARE`` of ``curvature``."""
+    r, speed = entry.get("steady_yaw_rate"), entry.get("steady_speed")
+    if not curvature or entry.get("diverged") or r is None or not speed or not speed > 0:
+        return False
+    return abs(r) / speed < WIDE_SHARE * curvature
 
 
 def straight_line_stability(model: ManoeuvringModel, speed: float, rps: float | None = None) -> dict:
@@ -91,19 +120,23 @@ def check_plausibility(
     rps: float | None = None,
     rudder_deg: float = 35.0,
     duration: float | None = None,
+    curvature: float | None = None,
 ) -> tuple[dict, list[str]]:
-    """All checks, and one warning per failed one."""
+    """All checks, and one warning per failed one; ``curvature``: the training logs' sharpest
+    (``sharpest_curvature``), for the held rudder's path (``WIDE_SHARE``)."""
     report = {"approach_speed": speed, "rps": rps,
               "straight_line": straight_line_stability(model, speed, rps),
               "surge_equilibrium": surge_equilibrium(model, speed, rps),
               "held_rudder": held_rudder(model, speed, rps, rudder_deg, duration),
-              "rudder_deg": rudder_deg, "duration": duration}  # fmt: skip
+              "rudder_deg": rudder_deg, "duration": duration,
+              "logs_curvature": curvature}  # fmt: skip
     return report, [note for _, note in failed_checks(report, model).values()]
 
 
 def plausibility_at_approach(model: ManoeuvringModel, trained_speed: float,
                              trained_rps: float | None, speed: float | None = None,
-                             rps: float | None = None) -> tuple[dict, list[str]]:  # fmt: skip
+                             rps: float | None = None, curvature: float | None = None
+                             ) -> tuple[dict, list[str]]:  # fmt: skip
     """``check_plausibility`` from the approach the model's manoeuvres start from
     (``shipid.dynamics.equilibrium.steady_approach``): a model with propeller terms at its own
     steady straight speed at the training rps, so that straight-line stability is judged about
@@ -112,7 +145,7 @@ def plausibility_at_approach(model: ManoeuvringModel, trained_speed: float,
     from shipid.dynamics.equilibrium import steady_approach
 
     app = steady_approach(model, trained_speed, trained_rps, speed=speed, rps=rps)
-    report, notes = check_plausibility(model, app.speed, app.rps)
+    report, notes = check_plausibility(model, app.speed, app.rps, curvature=curvature)
     report["approach"] = app.describe()
     return report, notes
 
@@ -192,6 +225,13 @@ def failed_checks(report: dict, model: ManoeuvringModel) -> dict[str, tuple[int,
             out[key] = (WRONG_WAY, f"{where}: the model all but stops in the turn (speed "
                                    f"{entry['steady_speed']:.3g} m/s from {speed:.3g} m/s ahead, "
                                    f"under {100 * STALL_SHARE:.0f} %)")  # fmt: skip
+        curvature = report.get("logs_curvature")
+        if key not in out and _too_wide(entry, curvature):
+            radius = entry["steady_speed"] / abs(entry["steady_yaw_rate"])
+            out[key] = (WRONG_WAY, f"{where}: the model turns on a path {radius:.3g} m in "
+                                   f"radius, wider than {1 / WIDE_SHARE:g} times the tightest "
+                                   f"the training logs run ({1 / curvature:.3g} m): it has all "
+                                   "but lost the rudder")  # fmt: skip
     return out
 
 
@@ -219,9 +259,9 @@ def new_failures(reference: dict, candidate: dict, model: ManoeuvringModel) -> l
 
 def disqualifying(report: dict, model: ManoeuvringModel) -> list[str]:
     """The failed checks that rule a model out of a selection: the rudder held to a side
-    diverges, turns the ship the other way, ends the turn going astern or all but stopped, or
-    surge has no steady speed. Straight-line instability (real full-form ships have it) and slow
-    settling stay warnings."""
+    diverges, turns the ship the other way, ends the turn going astern or all but stopped or on
+    a path far wider than the logs' (``WIDE_SHARE``), or surge has no steady speed.
+    Straight-line instability (real full-form ships have it) and slow settling stay warnings."""
     reasons = []
     eq = report.get("surge_equilibrium")
     if "u" in model.structure.dofs and (eq is None or eq <= 0):
@@ -236,6 +276,9 @@ def disqualifying(report: dict, model: ManoeuvringModel) -> list[str]:
             reasons.append(f"ends going astern with the rudder held to {side}")
         elif _stalls(entry, report.get("approach_speed") or 0.0):
             reasons.append(f"all but stops with the rudder held to {side}")
+        elif _too_wide(entry, report.get("logs_curvature")):
+            reasons.append(f"turns on a path over {1 / WIDE_SHARE:g} times wider than the "
+                           f"training logs' with the rudder held to {side}")  # fmt: skip
     return reasons
 
 
@@ -245,10 +288,12 @@ def disqualifying_at_approach(logs) -> Callable[[ManoeuvringModel], list[str]]:
     from shipid.data.log import approach
 
     speed, rps = approach(logs[0], "u"), approach(logs[0], "n")
+    curvature = sharpest_curvature(logs, speed) if speed and speed > 0 else None
 
     def reasons(model: ManoeuvringModel) -> list[str]:
         if speed is None or not speed > 0:
             return []
-        return disqualifying(plausibility_at_approach(model, speed, rps)[0], model)
+        return disqualifying(plausibility_at_approach(model, speed, rps, curvature=curvature)[0],
+                             model)  # fmt: skip
 
     return reasons

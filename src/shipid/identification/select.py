@@ -554,6 +554,7 @@ def select(
         disqualifying,
         given_steady_speeds,
         plausibility_at_approach,
+        sharpest_curvature,
     )
 
     options = dataclasses.replace(options or SelectOptions(), **overrides)
@@ -573,6 +574,7 @@ def select(
     if speed is None or not speed > 0:
         raise ShipidError(f"{names[0]}: starts without headway; give the plausibility condition "
                           "(speed=..., --speed)")  # fmt: skip
+    curvature = sharpest_curvature(logs, speed)
     bar = _progress(options)
 
     def evaluate(terms, gamma, stage) -> Candidate:
@@ -597,7 +599,8 @@ def select(
                 plausibility_cache[cand.key] = (False, "the constraints cannot be met on all logs")
             else:
                 model = _model_from_theta(data, cand.terms, theta, "candidate")
-                report, _ = plausibility_at_approach(model, speed, rps, options.speed, options.rps)
+                report, _ = plausibility_at_approach(model, speed, rps, options.speed, options.rps,
+                                                     curvature)  # fmt: skip
                 reasons = disqualifying(report, model)
                 for u, n in given:  # where the user says the ship runs steady
                     at = plausibility_at_approach(model, u, n, u, n)[0]
@@ -663,7 +666,8 @@ def select(
         weights = [(c, c.share) for c in shared]
         averaged = _averaged_model(data, weights, current, range(len(logs)), options,
                                    f"average of {len(shared)} candidates from {library.name}")
-        checked = plausibility_at_approach(averaged, speed, rps, options.speed, options.rps)
+        checked = plausibility_at_approach(averaged, speed, rps, options.speed, options.rps,
+                                           curvature)  # fmt: skip
         reasons = disqualifying(checked[0], averaged) if options.plausibility else []
         if reasons:
             notes.append(f"the average of the candidates is implausible ({'; '.join(reasons)}); "
@@ -673,7 +677,8 @@ def select(
         else:
             model = averaged
     if checked is None:
-        checked = plausibility_at_approach(model, speed, rps, options.speed, options.rps)
+        checked = plausibility_at_approach(model, speed, rps, options.speed, options.rps,
+                                           curvature)  # fmt: skip
     folds_report, held_out_runs = _fold_report(data, scorer, weights, current, logs, names)
     table = _table(scorer.cache.values(), current)
     failed = [c for c in scorer.cache.values() if c.folds_diverged == len(scorer.held)]
