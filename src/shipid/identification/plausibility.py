@@ -226,7 +226,7 @@ def failed_checks(report: dict, model: ManoeuvringModel) -> dict[str, tuple[int,
                                    f"{entry['steady_speed']:.3g} m/s from {speed:.3g} m/s ahead, "
                                    f"under {100 * STALL_SHARE:.0f} %)")  # fmt: skip
         curvature = report.get("logs_curvature")
-        if key not in out and _too_wide(entry, curvature):
+        if out.get(key, (0, ''))[0] < WRONG_WAY and _too_wide(entry, curvature):  # unsettled too
             radius = entry["steady_speed"] / abs(entry["steady_yaw_rate"])
             out[key] = (WRONG_WAY, f"{where}: the model turns on a path {radius:.3g} m in "
                                    f"radius, wider than {1 / WIDE_SHARE:g} times the tightest "
