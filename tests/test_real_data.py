@@ -66,6 +66,47 @@ def test_truncated_and_wrong_format_files(tmp_path):
 
 
 @needs_data
+@pytest.mark.parametrize(("path", "fmt", "scale"), [
+    (MARIN / "MARIN_FREE_KVLCC2_zz_20_m.dat", "simman-marin", None),
+    (MARIN / "MARIN_FREE_KVLCC2_zz_20_m.dat", "simman-marin", LAMBDA),
+    (DATA / "kvlcc2-hsva" / "HSVA_CPMC_KVLCC2_Z_20_10_P.dat", "simman-hsva", None),
+    (OSAKA / "turning" / "turn_14-Sep-2020_13_39_32.csv", "osaka-frt", None)])
+def test_a_known_format_is_read_without_format_and_says_so(path, fmt, scale):
+    """Before, `shipid identify MARIN_FREE_KVLCC2_zz_20_m.dat` stopped with "read it with
+    --format simman-marin"; it is read as that, with a line saying so."""
+    import pandas as pd
+
+    from shipid.errors import ShipidWarning
+
+    given = read_log(path, fmt=fmt, scale=scale)
+    with pytest.warns(ShipidWarning, match=f"not a canonical log; read as {fmt}"):
+        found = read_log(path, scale=scale)
+    pd.testing.assert_frame_equal(found, given)
+    assert found.attrs == given.attrs
+
+
+def test_a_file_in_a_formats_layout_but_not_its_own_is_not_read_as_it(tmp_path):
+    """Only MARIN's files start with its name: a tab-separated log of eleven numeric columns
+    has their layout, and reading it as one would give another ship's columns silently."""
+    rows = ["\t".join(f"{i + k}.0" for k in range(11)) for i in range(5)]
+    for first, read in (("time\tdelta", False), ("MARIN (Maritime Research Institute)", True)):
+        path = tmp_path / "eleven.dat"
+        path.write_text(f"{first}\nzig-zag\n\n" + "\n".join(rows) + "\n")
+        if read:
+            with pytest.warns(Warning, match="read as simman-marin"):
+                log = read_log(path)
+            assert list(log["t"]) == [0.0, 1.0, 2.0, 3.0, 4.0] and len(log) == 5
+        else:
+            with pytest.raises(ShipidError, match="layout is that of simman-marin"):
+                read_log(path)
+    # --columns says the file is meant as a canonical log: no format is guessed.
+    marin = tmp_path / "marin.dat"
+    marin.write_text("MARIN\nzig-zag\n\n" + "\n".join(rows) + "\n")
+    with pytest.raises(ShipidError, match="layout is that of simman-marin"):
+        read_log(marin, columns={"time": "t"})
+
+
+@needs_data
 @pytest.mark.parametrize("structure, r_std", [("blanke", 0.0065), ("blanke-speed", 0.004),
                                               ("blanke-race", 0.0022)])
 def test_kvlcc2_identified_on_zz20_predicts_zz_minus20_and_turns_plausibly(structure, r_std):

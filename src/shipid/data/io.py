@@ -201,6 +201,33 @@ def _hint_format(path: Path, exc: ShipidError) -> ShipidError:
                        f"with --format {fmt}")
 
 
+# The first line a known format's file starts with, beyond the layout ``detect_format`` reads:
+# a file read as one without --format must be one (a tab-separated log of eleven numeric columns
+# has MARIN's layout).
+SIGNATURES = {"simman-marin": "MARIN", "simman-hsva": "HSVA"}
+
+
+def _known_format(path: Path, options: ReadOptions) -> str | None:
+    """The known format of a file that is not a canonical log, where it can be read as that
+    without --format: its layout and first line are the format's, and no option of the
+    canonical reader (--columns, --degrees) was given. None otherwise."""
+    if options.columns or options.degrees:
+        return None
+    fmt = detect_format(path)
+    if fmt is None or fmt not in SIGNATURES:
+        return fmt
+    with open(path, "rb") as fh:
+        lines = [ln.strip() for ln in fh.read(512).decode("latin-1").splitlines() if ln.strip()]
+    return fmt if lines and lines[0].startswith(SIGNATURES[fmt]) else None
+
+
+def _as_known_format(path: Path, options: ReadOptions, fmt: str) -> pd.DataFrame:
+    """``path`` read as ``fmt`` (``_known_format``), saying so."""
+    warnings.warn(f"{path}: not a canonical log; read as {fmt}, whose layout it has (--format "
+                  f"{fmt} says so)", ShipidWarning, stacklevel=3)  # fmt: skip
+    return read_log(path, dataclasses.replace(options, fmt=fmt))
+
+
 def read_log(path: str | Path, options: ReadOptions | None = None, **overrides) -> pd.DataFrame:
     """Read a trial log: canonical CSV/Parquet, or a known format (see ``shipid.data.formats``).
 
@@ -215,6 +242,11 @@ def read_log(path: str | Path, options: ReadOptions | None = None, **overrides) 
         options = dataclasses.replace(options, **overrides)
     path = Path(path)
     name = str(path)
+    if options.scale is not None and options.fmt == "canonical":
+        # A SIMMAN file given its scale without --format.
+        fmt = _known_format(path, options) if path.is_file() else None
+        if fmt in SIGNATURES:
+            return _as_known_format(path, options, fmt)
     if options.scale is not None and options.fmt in ("canonical", "osaka-frt"):
         # It was ignored: a user who gave it believed the log Froude-scaled.
         raise ShipidError(f"{name}: --scale applies to the SIMMAN files (MARIN's are full scale, "
@@ -232,6 +264,9 @@ def read_log(path: str | Path, options: ReadOptions | None = None, **overrides) 
         try:
             df, meta = _read_table(path)
         except ShipidError as exc:
+            fmt = _known_format(path, options) if path.is_file() else None
+            if fmt is not None:
+                return _as_known_format(path, options, fmt)
             raise _hint_format(path, exc) from None
         # "r [deg/s]" → "r" in °/s: a canonical column's unit is converted, others' are notes.
         bare, units = split_units(df.columns)
@@ -257,6 +292,9 @@ def read_log(path: str | Path, options: ReadOptions | None = None, **overrides) 
             check_log(df, name, fill_gaps=options.fill_gaps, required=required, extra=extra)
         except ShipidError as exc:
             if any(c not in df.columns for c in required):
+                fmt = _known_format(path, options)
+                if fmt is not None:
+                    return _as_known_format(path, options, fmt)
                 raise _hint_format(path, exc) from None
             raise
         if "t" in factors and "time_origin" in df.attrs:
