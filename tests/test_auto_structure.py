@@ -173,6 +173,19 @@ def test_a_speed_that_varies_at_constant_rps_compares_the_rudders_inflow(paper_l
     assert [w for w in tied.warnings if w.startswith("blanke, blanke-race+race-damping predict")]
 
 
+def test_logs_that_cannot_be_fitted_together_are_named_not_called_implausible(paper_log):
+    """Bug: two logs at different sampling times (MARIN's 0.02 s and HSVA's 0.05 s at model
+    scale) made every structure of the comparison fail, and the choice said "none of blanke,
+    blanke-speed, blanke-race+race-damping is plausible" before the fit named the real reason."""
+    from shipid.data.preprocess import resample
+    from shipid.errors import ShipidError
+
+    fine = paper_log.assign(n=10.0)
+    coarse = resample(fine, 0.4, "coarse")
+    with pytest.raises(ShipidError, match="sampling time 0.4 s differs from 0.2 s"):
+        auto_structure([fine, coarse], ["fine.csv", "coarse.csv"])
+
+
 def test_structures_the_logs_cannot_tell_apart_but_that_turn_apart_are_named():
     """The KVLCC2's MMG model through a noisy 20/20 zig-zag with its rps logged: blanke,
     blanke-speed and blanke-race+race-damping score alike. The simplest, blanke, was fitted,

@@ -248,7 +248,7 @@ def _paper_or_race(logs, names, physics, cv, estimator, drop=None, announce=_qui
 
     cv = cv or ("logo" if len(logs) >= 2 else "blocks:4")
     announce(f"comparing {', '.join(candidates)} by free-run cross-validation ({cv})…")
-    scores, models = {}, {}
+    scores, models, failed = {}, {}, []
     for name in candidates:
         structure = _without(get_structure(name), drop)
         try:
@@ -261,12 +261,17 @@ def _paper_or_race(logs, names, physics, cv, estimator, drop=None, announce=_qui
                     fitted_on = [lowpass(log, prefilters[name]) for log in logs]
             sel = select(fitted_on, library=structure, search="none", cv=cv, gammas=(1e4,),
                          physics=physics, estimator=estimator, names=names)  # fmt: skip
-        except ShipidError:
+        except ShipidError as exc:
+            failed.append(exc)
             continue
         row = sel.candidates.iloc[0]
         if bool(row["plausible"]):
             scores[name] = (float(row["score"]), float(row["score_se"]))
             models[name] = sel.model
+    if not scores and len(failed) == len(candidates):
+        # Not a verdict on the structures: the logs cannot be fitted as they are (their
+        # sampling times differ, say), which "none is plausible" hid until the next fit said so.
+        raise failed[0]
     if not scores:
         return StructureChoice(get_structure(PAPER), "paper", notes=[
             f"{reason}, but none of {', '.join(candidates)} is plausible"])  # fmt: skip
