@@ -52,7 +52,7 @@ def test_identify_on_a_log_from_rest_checks_the_running_ship(tmp_path, capsys):
     code, out, err = run(["identify", path, "--force", "-o", tmp_path / "m.json"], capsys)
     assert code == 0, err
     assert "starts without headway" in err
-    assert "1 of the logs (from_rest.csv) are zig-zags or turns read whole, from rest" in err
+    assert "1 of the logs (from_rest.csv) is a zig-zag or turn read whole, from rest" in err
     prep = json.loads((tmp_path / "m.json").read_text())["identification"]["preprocessing"]
     assert prep["approach_speed"] == pytest.approx(float(np.median(log["u"][ramp >= 1])), rel=0.05)
 

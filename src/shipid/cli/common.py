@@ -192,8 +192,10 @@ def _warn_approach(logs, names) -> None:
         _warn(note)
     whole = manoeuvres_from_rest(logs)
     if whole:
-        _warn(f"{len(whole)} of the logs ({', '.join(Path(names[i]).name for i in whole[:3])}"
-              f"{', …' if len(whole) > 3 else ''}) are zig-zags or turns read whole, from rest: "
+        which = (f"{len(whole)} of the logs ({', '.join(Path(names[i]).name for i in whole[:3])}"
+                 f"{', …' if len(whole) > 3 else ''})")
+        _warn(f"{which} {'is a zig-zag or turn' if len(whole) == 1 else 'are zig-zags or turns'}"
+              " read whole, from rest: "
               "--start auto --end auto cuts them to the manoeuvre (the Esso Osaka's nine "
               "zig-zags read whole put the default model's 35° turns 47 % and 58 % long, cut "
               "28 % and 2 %: benchmarks/study_esso_whole_logs.py)")
