@@ -153,6 +153,43 @@ def test_criteria_refuse_the_length_of_another_ship(tmp_path, capsys):
     assert code == 1 and "runs as a ship of 4.389 m" in err and "reference ship" in err
 
 
+def test_criteria_refuse_the_scale_of_another_ship(tmp_path, capsys):
+    """A model of MARIN's full-scale KVLCC2 files (read without --scale: λ = 1, 8.1 m/s) judged
+    with the 7 m model's particulars (λ = 45.7) ran its manoeuvres at 8.1 m/s over a 7 m ship's
+    times, printed not one value and said: NOT all criteria met. A scale other than the
+    training logs' is refused, naming --scale and rescale; the rescaled model is judged (an
+    explicit --scale stays the user's override, ``test_files``)."""
+    from shipid.data.io import write_log
+    from shipid.data.log import make_log
+    from shipid.trials.manoeuvres import zigzag
+    from shipid.vessels import scale_ship
+
+    run_log = zigzag(scale_ship(rudder_rate_deg=9.6), 20, 20, duration=60, dt=0.2,
+                     approach=2).log  # fmt: skip
+    log = make_log({c: run_log[c].to_numpy() for c in run_log.columns}, name="zz.csv",
+                   ship="scale ship", source="test", rudder_positive="port", scale=1.0)
+    path = write_log(log, tmp_path / "zz.csv")
+    (tmp_path / "model-scale.yml").write_text("length: 0.259\nscale: 16.95\n")
+    model = tmp_path / "m.json"
+    assert run(["identify", path, "--no-output-error", "-o", model], capsys)[0] == 0
+    out = tmp_path / "c.json"
+    for argv in (["criteria", model, "--particulars", tmp_path / "model-scale.yml"],
+                 ["validate", model, path, "--particulars", tmp_path / "model-scale.yml"]):
+        code, _, err = run([*argv, "--json", out], capsys)
+        lines = [ln for ln in err.splitlines() if not ln.startswith("warning:")]
+        assert code == 1 and len(lines) == 1, err
+        assert "gives the ship at 1:16.95, but" in lines[0] and "logs at 1:1:" in lines[0]
+        assert "--scale 16.95" in lines[0] and "--factor 0.059" in lines[0]
+        assert not out.exists()
+    small = tmp_path / "small.json"
+    assert run(["rescale", model, "--factor", f"{1 / 16.95:.6g}", "-o", small], capsys)[0] == 0
+    code, _, err = run(["criteria", small, "--particulars", tmp_path / "model-scale.yml",
+                        "--no-bands", "--json", out], capsys)  # fmt: skip
+    assert code == 0, err
+    rows = json.loads(out.read_text())["criteria"]
+    assert all(r["value"] is not None for r in rows if r["criterion"] != "stopping track reach")
+
+
 def test_cli_criteria_of_a_reference_ship_and_of_a_model_file(tmp_path, capsys):
     code, out, err = run(["criteria", "scale-ship"], capsys)
     assert code == 0 and "instantaneous rudder" in out  # the paper's ship: no rate stated

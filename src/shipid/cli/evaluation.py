@@ -10,6 +10,7 @@ from pathlib import Path
 
 from shipid.cli.common import (
     _check_length,
+    _check_scale,
     _json_text,
     _particulars,
     _pd,
@@ -69,6 +70,7 @@ def cmd_validate(args) -> int:
     given = _particulars(args)  # checked before the runs: the criteria of the logs need it
     if given is not None:
         _check_length(args.model, model, cond, given.length, f"--particulars {args.particulars}")
+        _check_scale(args.model, cond, given.scale, f"--particulars {args.particulars}")
     env = cond["envelope"]
     from shipid.data.io import read_log
     from shipid.data.log import common_rudder_convention

@@ -11,6 +11,7 @@ from shipid.cli.common import (
     CRITERIA_STEP,
     MANOEUVRE_STEP,
     _check_length,
+    _check_scale,
     _json_text,
     _pd,
     _run_approach,
@@ -40,6 +41,8 @@ def cmd_criteria(args) -> int:
     elif args.particulars:
         _check_length(args.model, target, cond, particulars.length,
                       f"--particulars {args.particulars}")  # fmt: skip
+    if args.particulars and not args.scale:  # --scale is the user's to override with
+        _check_scale(args.model, cond, particulars.scale, f"--particulars {args.particulars}")
     speed, rps, _ = _run_approach(target, cond, args.speed, args.rps)  # imo_criteria notes it
     # Given, else the ship's gear or the training logs' rate, else imo_criteria's SOLAS rate.
     steering, _ = _steering(target, cond, args.rudder_rate, fallback="caller")
