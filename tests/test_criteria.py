@@ -284,3 +284,19 @@ def test_a_verdict_beyond_the_training_logs_says_so(tmp_path, capsys):
     verdict = [line for line in out.splitlines() if "criteria met" in line][0]
     beyond = sum(bool(r["beyond the logs"]) for r in rows if r["passed"] is not None)
     assert f"{beyond} of the {len(rows)} verdicts are on manoeuvres beyond the training" in verdict
+
+
+@pytest.mark.parametrize(("passed", "verdict"), [
+    ([True, True], "all criteria met"),
+    ([True, None], "all criteria judged met; 1 of 2 gave no value"),
+    ([True, False], "NOT all criteria met"),
+    ([None, None], "no criterion judged: no manoeuvre gave its value (see the warnings)")])
+def test_the_verdict_says_what_was_judged(passed, verdict):
+    """A model of full-scale logs judged over a 7 m ship's times gave no value at all, and the
+    verdict read "NOT all criteria met"."""
+    import pandas as pd
+
+    from shipid.trials.criteria import Criteria
+
+    table = pd.DataFrame({"criterion": ["a", "b"], "passed": pd.Series(passed, dtype=object)})
+    assert Criteria(table, {}).verdict() == verdict

@@ -92,7 +92,7 @@ def cmd_criteria(args) -> int:
           f"m/s, λ = {c['scale']:g} (full-scale L/V = {c['L_over_V_full_scale']:.3g} s), " + (
               f"rudder rate {c['rudder_rate_deg_s']:.3g} °/s" if c["rudder_rate_deg_s"]
               else "instantaneous rudder"))
-    verdict = "all criteria met" if crit.passed else "NOT all criteria met"
+    verdict = crit.verdict()
     extrapolated = [] if beyond is None else [
         b for b, ok in zip(beyond, crit.table["passed"], strict=True) if b and ok is not None]
     if extrapolated:

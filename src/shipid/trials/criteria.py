@@ -64,6 +64,18 @@ class Criteria:
         judged = self.table["passed"].dropna()
         return bool(len(judged)) and bool(judged.all())
 
+    def verdict(self) -> str:
+        """One line: met, NOT met, or not judged where no manoeuvre gave its value (a model of
+        full-scale logs run over a 7 m ship's times never turned far enough, and "NOT all
+        criteria met" was said of it)."""
+        judged, total = int(self.table["passed"].notna().sum()), len(self.table)
+        if not judged:
+            return "no criterion judged: no manoeuvre gave its value (see the warnings)"
+        if not self.passed:
+            return "NOT all criteria met"
+        return "all criteria met" if judged == total else \
+            f"all criteria judged met; {total - judged} of {total} gave no value"  # fmt: skip
+
     def to_dict(self) -> dict:
         """The criteria as JSON-ready data (``criteria --json``)."""
         return {"conditions": self.conditions, "passed": self.passed, "notes": self.notes,
