@@ -411,11 +411,12 @@ def test_a_log_at_another_scale_than_the_training_logs_is_named(tmp_path, capsys
     code, _, err = run(["validate", model, full], capsys)
     assert code == 0, err
     assert f"at scale 1:1 and the model's training logs were at 1:{lam:g}" in err
-    assert f"--scale {lam:g}" in err
+    # A canonical log takes no --scale (only MARIN's reader Froude-scales by it): rescale.
+    assert f"shipid rescale --factor {lam:g}" in err and "--scale" not in err
     code, _, err = run(["validate", model, train], capsys)
     assert "training logs were at" not in err
     code, _, err = run(["simulate", model, full, "-o", tmp_path / "sim.csv"], capsys)
-    assert code == 0 and f"--scale {lam:g}" in err
+    assert code == 0 and f"shipid rescale --factor {lam:g}" in err
     rescaled = tmp_path / "full.json"
     assert run(["rescale", model, "--factor", str(lam), "-o", rescaled], capsys)[0] == 0
     prep = json.loads(rescaled.read_text())["identification"]["preprocessing"]

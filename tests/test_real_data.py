@@ -233,3 +233,22 @@ def test_the_kernel_residual_on_the_kvlcc2_is_the_readmes():
                         for s in "uvr"]  # fmt: skip
     np.testing.assert_allclose(errors["physical"], [0.0152, 0.0123, 0.0038], atol=6e-5)
     np.testing.assert_allclose(errors["hybrid"], [0.0091, 0.0101, 0.0031], atol=6e-5)
+
+
+@needs_data
+def test_a_scale_mismatch_names_scale_only_for_marins_files(tmp_path, capsys):
+    """validate named '--scale' as the remedy for any log at another scale; only MARIN's reader
+    Froude-scales its data by it. HSVA's data are the 7 m model's whatever --scale says (a
+    label), and a canonical log refuses it: for those the remedy is rescale."""
+    from cli_helpers import run
+
+    zz20 = MARIN / "MARIN_FREE_KVLCC2_zz_20_m.dat"
+    model = tmp_path / "full.json"
+    assert run(["identify", "--format", "simman-marin", zz20, "--model", "blanke-speed",
+                "--filter", "none", "--no-output-error", "-o", model], capsys)[0] == 0
+    code, _, err = run(["validate", model, "--format", "simman-marin", "--scale", "45.7",
+                        MARIN / "MARIN_FREE_KVLCC2_zz_-20_m.dat", "--no-bands"], capsys)
+    assert code == 0 and "read it with --scale 1, or carry the model over" in err, err
+    code, _, err = run(["validate", model, "--format", "simman-hsva", "--no-bands",
+                        DATA / "kvlcc2-hsva" / "HSVA_CPMC_KVLCC2_Z_20_10_P.dat"], capsys)
+    assert code == 0 and "training logs were at 1:1: carry the model over" in err, err

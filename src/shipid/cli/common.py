@@ -313,10 +313,13 @@ def _scale_notes(cond: dict, logs, names) -> list[str]:
     for log, name in zip(logs, names, strict=True):
         lam = log.attrs.get("scale")
         if trained and lam and abs(lam / trained - 1) > 0.01:
+            # Only MARIN's reader Froude-scales its data by --scale; HSVA's (model scale) takes
+            # λ as a label, and "--scale 1" there called the 7 m model's data full scale.
+            read = (f"read it with --scale {trained:g}, or "
+                    if str(log.attrs.get("source", "")).startswith("MARIN") else "")
             out.append(f"{name}: this log is at scale 1:{lam:g} and the model's training logs were"
-                       f" at 1:{trained:g}: read it with --scale {trained:g} (if its format "
-                       f"takes one), or carry the model over with shipid rescale --factor "
-                       f"{trained / lam:g}")  # fmt: skip
+                       f" at 1:{trained:g}: {read}carry the model over with shipid rescale "
+                       f"--factor {trained / lam:g}")  # fmt: skip
     return out
 
 
