@@ -458,6 +458,9 @@ def _check_length(name: str, target, cond: dict, given: float | None, source: st
                           f"divided by another's; {remedy}")  # fmt: skip
 
 
+SCALE_SLACK = 0.01  # a scale this close to the training logs' is theirs (rounding, 45.7 vs 45.71)
+
+
 def _check_scale(name: str, cond: dict, scale: float | None, source: str) -> None:
     """Refuse a scale λ that is not the one of the logs the model was identified from: its
     manoeuvres run at their ship's size and speed. A model of MARIN's full-scale KVLCC2 files
@@ -472,9 +475,6 @@ def _check_scale(name: str, cond: dict, scale: float | None, source: str) -> Non
                       f"identify from the trial files read with --scale {scale:g}, or carry the "
                       f"model over first (shipid rescale {name} --factor {trained / scale:.4g} -o "
                       "OUT.json)")  # fmt: skip
-
-
-SCALE_SLACK = 0.01
 
 
 def _run_approach(target, cond: dict, speed: float | None, rps: float | None):
