@@ -73,3 +73,23 @@ def test_the_warning_names_both_paths():
     assert note == (f"35° rudder held to starboard: the model turns on a path {radius:.3g} m in "
                     f"radius, wider than 4 times the tightest the training logs run "
                     f"({1 / curvature:.3g} m): it has all but lost the rudder")
+
+
+def test_the_reference_ships_turn_far_tighter_than_the_rule():
+    """The figures of ``WIDE_SHARE``'s comment and the README: the reference ships' 35° turns are
+    0.62–3.2 times as curved as their own 10°/10°, 20°/20°, 30°/30° zig-zags and 20° turns, so
+    no true ship is ruled out by the rule at 0.25."""
+    from shipid.vessels import get_vessel
+
+    ratios = []
+    for name in ("scale-ship", "mariner", "kvlcc2", "cybership2"):
+        ship = get_vessel(name)
+        period = ship.length / ship.approach_speed
+        turn = turning_circle(ship, 35, duration=30 * period).indices
+        path = abs(turn["steady_yaw_rate"]) / turn["steady_speed"]
+        trials = [zigzag(ship, a, a, duration=20 * period).log for a in (10, 20, 30)]
+        trials.append(turning_circle(ship, 20, duration=30 * period).log)
+        ratios += [path / sharpest_curvature([log], ship.approach_speed) for log in trials]
+    assert min(ratios) == pytest.approx(0.62, abs=0.005)
+    assert max(ratios) == pytest.approx(3.2, abs=0.05)
+    assert min(ratios) > 2 * WIDE_SHARE
