@@ -176,8 +176,13 @@ def _all_numbers(line: str, count: int) -> bool:
     return len(fields) == count and all(_NUMBER.match(f) for f in fields)
 
 
+# The first line a SIMMAN file starts with, beside its layout: a tab-separated log of eleven
+# numeric columns under a header has MARIN's layout, and was read (or hinted) as MARIN's.
+SIGNATURES = {"simman-marin": "MARIN", "simman-hsva": "HSVA"}
+
+
 def detect_format(path: str | Path) -> str | None:
-    """The known format whose layout the file's first lines match, or None."""
+    """The known format whose layout and first line the file's first lines match, or None."""
     try:
         with open(path, "rb") as fh:
             head = fh.read(8192)
@@ -187,8 +192,9 @@ def detect_format(path: str | Path) -> str | None:
     if lines and all(c in lines[0] for c in ("u_velo [m/s]", "delta_rudder [rad]")):
         return "osaka-frt"
     data = [ln for ln in lines[:12] if ln.strip()]
+    fmt = None
     if len(data) >= 4 and not _all_numbers(data[0], 11) and _all_numbers(data[2], 11):
-        return "simman-marin"
-    if len(data) >= 6 and _all_numbers(data[HSVA_HEADER_LINES], 12) and not _all_numbers(data[0], 12):
-        return "simman-hsva"
-    return None
+        fmt = "simman-marin"
+    elif len(data) >= 6 and _all_numbers(data[HSVA_HEADER_LINES], 12) and not _all_numbers(data[0], 12):
+        fmt = "simman-hsva"
+    return fmt if fmt and data[0].strip().startswith(SIGNATURES[fmt]) else None

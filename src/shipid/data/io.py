@@ -201,24 +201,11 @@ def _hint_format(path: Path, exc: ShipidError) -> ShipidError:
                        f"with --format {fmt}")
 
 
-# The first line a known format's file starts with, beyond the layout ``detect_format`` reads:
-# a file read as one without --format must be one (a tab-separated log of eleven numeric columns
-# has MARIN's layout).
-SIGNATURES = {"simman-marin": "MARIN", "simman-hsva": "HSVA"}
-
-
 def _known_format(path: Path, options: ReadOptions) -> str | None:
-    """The known format of a file that is not a canonical log, where it can be read as that
-    without --format: its layout and first line are the format's, and no option of the
-    canonical reader (--columns, --degrees) was given. None otherwise."""
-    if options.columns or options.degrees:
-        return None
-    fmt = detect_format(path)
-    if fmt is None or fmt not in SIGNATURES:
-        return fmt
-    with open(path, "rb") as fh:
-        lines = [ln.strip() for ln in fh.read(512).decode("latin-1").splitlines() if ln.strip()]
-    return fmt if lines and lines[0].startswith(SIGNATURES[fmt]) else None
+    """The known format (``detect_format``) of a file that is not a canonical log, where it can
+    be read as that without --format: no option of the canonical reader (--columns,
+    --degrees) was given. None otherwise."""
+    return None if options.columns or options.degrees else detect_format(path)
 
 
 def _as_known_format(path: Path, options: ReadOptions, fmt: str) -> pd.DataFrame:
@@ -245,7 +232,7 @@ def read_log(path: str | Path, options: ReadOptions | None = None, **overrides) 
     if options.scale is not None and options.fmt == "canonical":
         # A SIMMAN file given its scale without --format.
         fmt = _known_format(path, options) if path.is_file() else None
-        if fmt in SIGNATURES:
+        if fmt in ("simman-marin", "simman-hsva"):
             return _as_known_format(path, options, fmt)
     if options.scale is not None and options.fmt in ("canonical", "osaka-frt"):
         # It was ignored: a user who gave it believed the log Froude-scaled.
