@@ -59,7 +59,8 @@ def _add_log_options(p: argparse.ArgumentParser) -> None:
                    "propeller still running), or 'dropout': before the first span where the "
                    "ship gains headway with the propeller stopped (its logging dropped out)")
     g.add_argument("--fill-gaps", action="store_true",
-                   help="interpolate missing values inside signals (default: refuse the log)")
+                   help="interpolate missing values inside signals, and with --dt across gaps in "
+                   "time (default: refuse the log)")
     g.add_argument("--yaw-rate-offset", type=_offset_or_auto, metavar="DEG_S|auto",
                    help="subtract a gyro's offset from r: in °/s, or 'auto': each log's own, "
                    "read off the drift of psi − ∫r dt (default: r as measured, and a warning "

@@ -62,7 +62,8 @@ class ReadOptions:
     lead : with ``start='auto'``, seconds kept before the rudder execute.
     rudder_positive : overrides the file's rudder convention ('port' or 'starboard').
     scale : Froude scale λ (simman formats).
-    fill_gaps : interpolate missing values inside signals instead of refusing the log.
+    fill_gaps : interpolate missing values inside signals, and with ``dt`` across gaps in time,
+        instead of refusing the log.
     yaw_rate_offset : a gyro's offset to subtract from r [rad/s], or 'auto' for each log's own,
         read off its heading (``shipid.data.yaw_rate``); None leaves r as measured.
     velocities : 'auto': u, v as logged, or read off the track (x, y, psi) where the log has
@@ -320,7 +321,7 @@ def read_log(path: str | Path, options: ReadOptions | None = None, **overrides) 
     check_propulsion(log, name)
     check_rudder_convention(log, name, stated)
     if options.dt is not None:
-        log = resample(log, options.dt, name)
+        log = resample(log, options.dt, name, fill_gaps=options.fill_gaps)
     return log
 
 

@@ -3,17 +3,39 @@
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 import pandas as pd
 
-from shipid.errors import ShipidError
+from shipid.errors import ShipidError, ShipidWarning
 from shipid.limits import check_samples
 
 SIGNALS = ("u", "v", "r")
 MAX_UPSAMPLING = 100.0
 # A --dt below this share of the log's own sampling interpolates samples between the measured ones.
 UPSAMPLED = 0.99
+# An interval longer than this many of the log's median sampling intervals is a gap: samples
+# missing, not a sampling that varies. Resampling would draw straight lines across it, and a
+# free run would take one step across it with the rudder unknown (a 20/20 zig-zag with 30 s
+# missing: the replay diverged, the fit came from 150 invented samples).
+GAP_INTERVALS = 10.0
+
+
+def time_gaps(t: np.ndarray) -> list[int]:
+    """Indices k where t[k + 1] − t[k] exceeds ``GAP_INTERVALS`` median intervals."""
+    dts = np.diff(np.asarray(t, dtype=float))
+    if dts.size == 0:
+        return []
+    return [int(k) for k in np.flatnonzero(dts > GAP_INTERVALS * float(np.median(dts)))]
+
+
+def gap_text(t: np.ndarray, gaps: list[int]) -> str:
+    """'no samples for 30.2 s (t = 50–80.2, after data row 251)' and how many more."""
+    k = gaps[0]
+    more = f" and {len(gaps) - 1} more gap(s)" if len(gaps) > 1 else ""
+    return (f"no samples for {t[k + 1] - t[k]:.3g} s (t = {t[k]:.6g}–{t[k + 1]:.6g}, after data "
+            f"row {k + 1}){more}")
 
 
 
@@ -37,14 +59,24 @@ def white_noise_variance(x: np.ndarray) -> float:
     return (1.4826 * mad) ** 2 / 6.0
 
 
-def resample(log: pd.DataFrame, dt: float, name: str = "log") -> pd.DataFrame:
+def resample(log: pd.DataFrame, dt: float, name: str = "log", fill_gaps: bool = False
+             ) -> pd.DataFrame:  # fmt: skip
     """Linear interpolation of every column onto t0, t0 + dt, ... (heading unwrapped first).
 
     A ``dt`` finer than the log's own sampling keeps that sampling in ``attrs["measured_dt"]``.
+    A gap in time (``time_gaps``) is refused, or with ``fill_gaps`` interpolated with a warning.
     """
     if not (isinstance(dt, int | float) and math.isfinite(dt) and dt > 0):
         raise ShipidError(f"--dt must be a finite number > 0, got {dt!r}")
     t = log["t"].to_numpy()
+    gaps = time_gaps(t)
+    if gaps and not fill_gaps:
+        raise ShipidError(f"{name}: {gap_text(t, gaps)}: resampling would draw straight lines "
+                          "across it; cut the log there (--start/--end) or split it into two "
+                          "logs (--fill-gaps interpolates it anyway)")  # fmt: skip
+    if gaps:
+        warnings.warn(f"{name}: {gap_text(t, gaps)}, interpolated in straight lines "
+                      "(--fill-gaps)", ShipidWarning, stacklevel=2)  # fmt: skip
     own = float(np.median(np.diff(t)))
     if dt < own / MAX_UPSAMPLING:
         raise ShipidError(f"{name}: --dt {dt:g} s is {own / dt:.3g} times finer than the log's "

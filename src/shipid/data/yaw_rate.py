@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from shipid.data.preprocess import cumulative_integral, white_noise_variance
+from shipid.data.preprocess import cumulative_integral, time_gaps, white_noise_variance
 from shipid.errors import ShipidError
 
 
@@ -70,12 +70,21 @@ def heading_drift(t: np.ndarray, psi: np.ndarray, r: np.ndarray) -> HeadingDrift
 
     Fitted beside a term in r: a heading sampled a time τ later or earlier than the rate (or
     integrated by Euler steps, a simulator's half step) puts −τ r into ψ − ∫r dt, which would
-    otherwise count as scatter (a degree on the paper ship's zig-zag at Δk 0.2 s)."""
+    otherwise count as scatter (a degree on the paper ship's zig-zag at Δk 0.2 s).
+    Across a gap in time (``time_gaps``) neither ψ nor r says how the heading turned: the log
+    is read as its pieces joined, the gap closed to one sampling interval."""
     t = np.asarray(t, dtype=float)
     if len(t) < 10 or not t[-1] > t[0]:
         return None
     r = np.asarray(r, dtype=float)
+    gaps = time_gaps(t)
+    if gaps:
+        dts = np.diff(t)
+        dts[gaps] = float(np.median(dts))
+        t = t[0] + np.concatenate([[0.0], np.cumsum(dts)])
     drift = np.unwrap(np.asarray(psi, dtype=float)) - cumulative_integral(r, t)
+    for k in gaps:
+        drift[k + 1:] -= drift[k + 1] - drift[k]
     design = np.column_stack([np.ones_like(t), t - t.mean(), r])
     coef, *_ = np.linalg.lstsq(design, drift, rcond=None)
     slope = float(coef[1])

@@ -20,7 +20,8 @@ from typing import Protocol
 import numpy as np
 import pandas as pd
 
-from shipid.data.log import input_columns, make_log
+from shipid.data.log import input_columns, log_name, make_log
+from shipid.data.preprocess import gap_text, time_gaps
 from shipid.dynamics import codegen, kernel
 from shipid.dynamics.hybrid import HybridModel
 from shipid.dynamics.model import ManoeuvringModel
@@ -395,6 +396,11 @@ def simulate_log(
 ) -> SimulationResult:
     """Free-run simulation from a log's measured initial state, driven by its measured rudder (and
     thrust, propeller speed and wind where the model uses them): the paper's validation (§ 4)."""
+    gaps = time_gaps(log["t"].to_numpy())
+    if gaps:
+        raise ShipidError(f"{log_name(log)}: {gap_text(log['t'].to_numpy(), gaps)}: a free run "
+                          "would step across it with the rudder unknown; cut the log there "
+                          "(--start/--end) or split it into two logs")  # fmt: skip
     first = log.iloc[0]
     initial = {k: float(first[k]) for k in STATE_NAMES if k in log.columns}
     for k in ("psi", "x", "y"):

@@ -20,6 +20,7 @@ import numpy as np
 import pandas as pd
 
 from shipid.data.log import input_columns
+from shipid.data.preprocess import gap_text, time_gaps
 from shipid.dynamics.model import ModelStructure
 from shipid.dynamics.terms import parse_term, required_inputs, term_matrix
 from shipid.errors import ShipidError
@@ -50,6 +51,11 @@ def sampling_time(log: pd.DataFrame, name: str = "log") -> float:
     dts = np.diff(t)
     dt = float(np.median(dts))
     if np.max(np.abs(dts - dt)) > DT_RTOL * dt:
+        gaps = time_gaps(t)
+        if gaps:
+            raise ShipidError(f"{name}: {gap_text(t, gaps)}: a one-step regression needs "
+                              "consecutive samples; cut the log there (--start/--end) or split "
+                              "it into two logs (--dt with --fill-gaps interpolates it)")  # fmt: skip
         k = int(np.argmax(np.abs(dts - dt)))
         raise ShipidError(f"{name}: sampling is not uniform (Δt = {dts[k]:.6g} s at data row "
                           f"{k + 2}, median {dt:.6g} s); resample it with --dt {dt:.6g}")  # fmt: skip

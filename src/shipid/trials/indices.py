@@ -19,10 +19,12 @@ import numba
 import numpy as np
 import pandas as pd
 
-from shipid.data.preprocess import cumulative_integral, white_noise_variance
+from shipid.data.log import log_name
+from shipid.data.preprocess import cumulative_integral, gap_text, time_gaps, white_noise_variance
 from shipid.errors import ShipidError
 from shipid.trials.trial import (
     KINDS,
+    TURN_KINDS,
     Trial,
     describe_trial,
     moving_average,
@@ -368,6 +370,18 @@ def detect_manoeuvre(log: pd.DataFrame) -> str:
     return describe_trial(log).kind
 
 
+def _refuse_gap_after_execute(log: pd.DataFrame, trial: Trial) -> None:
+    """A manoeuvre's indices read the heading, rate and track after the execute: a gap in time
+    there (``time_gaps``) hides an overshoot's peak or a turn's advance (a 20/20 zig-zag with 7 s
+    missing read its first overshoot 23.5° for 27.4°)."""
+    t = log["t"].to_numpy()
+    gaps = [k for k in time_gaps(t) if k + 1 > trial.execute_index]
+    if gaps:
+        raise ShipidError(f"{log_name(log)}: {gap_text(t, gaps)}, after the {trial.kind}'s "
+                          f"execute at t = {trial.execute_time:.6g}: its indices would miss what "
+                          f"the ship did there; cut the log before it (--end {t[gaps[0]]:.6g})")
+
+
 def manoeuvre_indices(
     log: pd.DataFrame,
     kind: str | None = None,
@@ -380,6 +394,8 @@ def manoeuvre_indices(
     log is neither a zig-zag, a turning circle nor a pull-out)."""
     if trial is None:
         trial = describe_trial(log, kind, heading_deg)
+    if trial.kind in ("zigzag", *TURN_KINDS):
+        _refuse_gap_after_execute(log, trial)
     if trial.kind == "zigzag":
         out = zigzag_indices(log, heading_deg=heading_deg, smooth_s=smooth_s, length=length,
                              trial=trial)  # fmt: skip
