@@ -42,19 +42,42 @@ def test_a_log_from_rest_gives_its_running_condition():
     assert note.startswith("a.csv starts without headway (0.0") and "2 m/s at 10 rps" in note
 
 
-def test_identify_on_a_log_from_rest_checks_the_running_ship(tmp_path, capsys):
+def test_identify_cuts_a_manoeuvre_from_rest_to_its_approach(tmp_path, capsys):
+    """A zig-zag or turn that starts at rest is cut to its manoeuvre, as --start auto --end auto
+    cuts it (the Esso Osaka's nine zig-zag files read whole put the default model's 35° turns
+    47 % and 58 % long, cut 28 % and 2 %); --start 0 reads it whole, and the running ship is
+    checked all the same."""
     log = zigzag(scale_ship(rudder_rate_deg=9.6), 20, 20, duration=90, dt=0.2, method="euler",
                  approach=20.0).log  # fmt: skip
     # The first 10 s at rest, then as simulated (no track: it would no longer follow u).
     ramp = np.clip(log["t"].to_numpy() / 10.0, 0.0, 1.0)
     log = log.drop(columns=["x", "y"]).assign(u=log["u"] * ramp)
     path = write_log(log, tmp_path / "from_rest.csv")
-    code, out, err = run(["identify", path, "--force", "-o", tmp_path / "m.json"], capsys)
+    flags = ["--force", "--filter", "none", "--no-output-error"]
+    code, out, err = run(["identify", path, *flags, "-o", tmp_path / "m.json"], capsys)
+    assert code == 0, err
+    assert ("1 of the logs (from_rest.csv) is a zig-zag or turn that starts from rest: cut to "
+            "the manoeuvre, from 5 s before the rudder's execute to its end") in err
+    assert "starts without headway" not in err and "turn read whole, from rest" not in err
+    doc = json.loads((tmp_path / "m.json").read_text())
+    prep = doc["identification"]["preprocessing"]
+    assert prep["cut_to_manoeuvre"] == ["from_rest.csv"]
+    # The same fit as the file cut by hand.
+    code, _, err = run(["identify", path, *flags, "--start", "auto", "--end", "auto",
+                        "-o", tmp_path / "cut.json"], capsys)  # fmt: skip
+    assert code == 0, err
+    by_hand = json.loads((tmp_path / "cut.json").read_text())
+    assert doc["model"]["coefficients"] == by_hand["model"]["coefficients"]
+    assert by_hand["identification"]["preprocessing"]["cut_to_manoeuvre"] is None
+    # Read whole on request: the running ship's condition is still the one checked.
+    code, out, err = run(["identify", path, *flags, "--start", "0", "-o", tmp_path / "w.json"],
+                         capsys)  # fmt: skip
     assert code == 0, err
     assert "starts without headway" in err
     assert "1 of the logs (from_rest.csv) is a zig-zag or turn read whole, from rest" in err
-    prep = json.loads((tmp_path / "m.json").read_text())["identification"]["preprocessing"]
+    prep = json.loads((tmp_path / "w.json").read_text())["identification"]["preprocessing"]
     assert prep["approach_speed"] == pytest.approx(float(np.median(log["u"][ramp >= 1])), rel=0.05)
+    assert prep["cut_to_manoeuvre"] is None
 
 
 @pytest.mark.parametrize("from_rest", [True, False])

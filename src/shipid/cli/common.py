@@ -36,12 +36,29 @@ def _read_options(args):
                        track=TrackVelocities(args.track_window, args.antenna or (0.0, 0.0)))  # fmt: skip
 
 
-def _read_logs(args, paths=None) -> list:
+def _read_logs(args, paths=None, cut_from_rest: bool = False) -> list:
+    """The logs of ``paths`` (default: the command's) read with the log options, each given the
+    particulars; with ``cut_from_rest``, zig-zags and turns read whole from rest are cut to
+    their manoeuvre (``_cut_to_manoeuvre``)."""
     from shipid.data.io import read_log
 
     options = _read_options(args)
-    logs = [read_log(p, options) for p in (paths or args.logs)]
-    _print_yaw_rate_offsets(args, paths or args.logs, logs)
+    paths = paths or args.logs
+    if cut_from_rest and args.start is None and args.end is None:
+        logs = [_cut_to_manoeuvre(p, options) for p in paths]
+        cut = [Path(p).name for p, log in zip(paths, logs, strict=True)
+               if log.attrs.get("cut_to_manoeuvre")]  # fmt: skip
+        if cut:
+            what = ("is a zig-zag or turn that starts" if len(cut) == 1
+                    else "are zig-zags or turns that start")  # fmt: skip
+            _warn(f"{_count_logs(cut)} {what} from rest: cut to the manoeuvre, from "
+                  f"{options.lead:g} s before the rudder's execute to its end, as --start auto "
+                  "--end auto cuts (the Esso Osaka's nine zig-zags read whole put the default "
+                  "model's 35° turns 47 % and 58 % long, cut 28 % and 2 %: "
+                  "benchmarks/study_esso_whole_logs.py); --start 0 reads them whole")
+    else:
+        logs = [read_log(p, options) for p in paths]
+    _print_yaw_rate_offsets(args, paths, logs)
     particulars = _particulars(args)
     if particulars is not None:
         for log in logs:
@@ -49,10 +66,41 @@ def _read_logs(args, paths=None) -> list:
     return logs
 
 
+def _count_logs(names) -> str:
+    """'1 of the logs (a.csv)', '4 of the logs (a.csv, b.csv, c.csv, …)'."""
+    return f"{len(names)} of the logs ({', '.join(names[:3])}{', …' if len(names) > 3 else ''})"
+
+
+def _cut_to_manoeuvre(path, options):
+    """The log of ``path``, cut to its manoeuvre as ``--start auto --end auto`` cuts where it is
+    a zig-zag or turn that starts without headway (``manoeuvres_from_rest``; marked
+    ``attrs['cut_to_manoeuvre']``), else as read. The checks' warnings are those of the log
+    kept: a whole log's (its gathering speed, a dropout after the run) do not hold for the cut."""
+    import dataclasses
+
+    from shipid.data.io import read_log
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        whole = read_log(path, options)
+    if manoeuvres_from_rest([whole]):
+        try:
+            cut = read_log(path, dataclasses.replace(options, start="auto", end="auto"))
+        except ShipidError:
+            pass  # kept whole; identify names it (_warn_approach)
+        else:
+            cut.attrs["cut_to_manoeuvre"] = True
+            return cut
+    for w in caught:
+        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno, source=w.source)
+    return whole
+
+
 def _training_logs(args) -> list:
-    """The logs a model is fitted to: ``_read_logs``, refused when they are at different
-    scales (a model-scale and a full-scale run fitted together mix two ships' time scales)."""
-    logs = _read_logs(args)
+    """The logs a model is fitted to: ``_read_logs``, zig-zags and turns read from rest cut to
+    their manoeuvre, refused when they are at different scales (a model-scale and a
+    full-scale run fitted together mix two ships' time scales)."""
+    logs = _read_logs(args, cut_from_rest=True)
     scales, upsampled = {}, []
     for path, log in zip(args.logs, logs, strict=True):
         if "scale" in log.attrs:
@@ -192,8 +240,7 @@ def _warn_approach(logs, names) -> None:
         _warn(note)
     whole = manoeuvres_from_rest(logs)
     if whole:
-        which = (f"{len(whole)} of the logs ({', '.join(Path(names[i]).name for i in whole[:3])}"
-                 f"{', …' if len(whole) > 3 else ''})")
+        which = _count_logs([Path(names[i]).name for i in whole])
         _warn(f"{which} {'is a zig-zag or turn' if len(whole) == 1 else 'are zig-zags or turns'}"
               " read whole, from rest: "
               "--start auto --end auto cuts them to the manoeuvre (the Esso Osaka's nine "
@@ -273,7 +320,9 @@ def _log_record(args, logs) -> dict:
     """The model file's ``preprocessing`` record of how the training logs were read (the read
     options given) and what they hold (approach, rudder, convention, scale, gyro offsets), as
     ``identify`` and ``select`` both write it."""
+    cut = [log.attrs.get("name") for log in logs if log.attrs.get("cut_to_manoeuvre")]
     return {"dt": args.dt, "start": args.start, "end": args.end, "lead": args.lead,
+            "cut_to_manoeuvre": cut or None,
             "columns": args.columns, "degrees": args.degrees, "format": args.format,
             "scale": args.scale, "approach_speed": _approach(logs[0], "u"),
             "approach_rps": _approach(logs[0], "n"), **_rudder_record(logs),

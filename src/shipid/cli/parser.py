@@ -51,7 +51,10 @@ def _add_log_options(p: argparse.ArgumentParser) -> None:
                    help="angle columns given in degrees, e.g. delta,psi,r")
     g.add_argument("--dt", type=float, help="resample to this uniform sampling time [s]")
     g.add_argument("--start", type=_time_or_auto, metavar="S|auto",
-                   help="trim: first time [s], or 'auto': --lead s before the detected rudder execute")
+                   help="trim: first time [s], or 'auto': --lead s before the detected rudder "
+                   "execute (default: the whole log; logs a model is fitted to that are zig-zags "
+                   "or turns from rest are cut as --start auto --end auto, --start 0 keeps them "
+                   "whole)")
     g.add_argument("--lead", type=float, default=5.0, metavar="S",
                    help="with --start auto: seconds kept before the execute (default %(default)s)")
     g.add_argument("--end", type=_end_time, metavar="S|auto|dropout",
