@@ -62,9 +62,10 @@ def main() -> None:
             for sampling, dt in SAMPLING.items():
                 print(_row(reading, sampling, trim + dt, paths, f"{tmp}/m.json", turns, randoms))
         print("\nThe raw files a user hands `identify` (no flags but --format): the nine "
-              "zig-zags and three random runs, the fourth random run held out in turn; the "
-              "random runs read whole either way (they are not manoeuvres; the one that runs "
-              "into a propulsion dropout keeps it, with a warning)\n")
+              "zig-zags and three random runs, the fourth random run held out in turn; read "
+              "whole (--start 0: the random run that runs into a propulsion dropout keeps it, "
+              "with a warning) or as the default reads them (the zig-zags cut to the "
+              "manoeuvre, that random run up to its dropout)\n")
         print("| held-out random run | zig-zags read | terms | 35° turns, closed loop: TD +35°, "
               "−35° (steady r) | held-out random run: r / u error over spread | steady speed "
               "at 16.7 rps (fastest log) |")

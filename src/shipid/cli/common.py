@@ -38,16 +38,18 @@ def _read_options(args):
 
 def _read_logs(args, paths=None, cut_from_rest: bool = False) -> list:
     """The logs of ``paths`` (default: the command's) read with the log options, each given the
-    particulars; with ``cut_from_rest``, zig-zags and turns read whole from rest are cut to
-    their manoeuvre (``_cut_to_manoeuvre``)."""
+    particulars; with ``cut_from_rest`` and neither --start nor --end, zig-zags and turns read
+    whole from rest are cut to their manoeuvre and other logs end before a propulsion dropout
+    (``_training_read``)."""
     from shipid.data.io import read_log
 
     options = _read_options(args)
     paths = paths or args.logs
     if cut_from_rest and args.start is None and args.end is None:
-        logs = [_cut_to_manoeuvre(p, options) for p in paths]
-        cut = [Path(p).name for p, log in zip(paths, logs, strict=True)
-               if log.attrs.get("cut_to_manoeuvre")]  # fmt: skip
+        logs = [_training_read(p, options) for p in paths]
+        named = [(Path(p).name, log.attrs) for p, log in zip(paths, logs, strict=True)]
+        cut, ended = ([name for name, attrs in named if attrs.get(key)]
+                      for key in ("cut_to_manoeuvre", "cut_at_dropout"))  # fmt: skip
         if cut:
             what = ("is a zig-zag or turn that starts" if len(cut) == 1
                     else "are zig-zags or turns that start")  # fmt: skip
@@ -56,6 +58,14 @@ def _read_logs(args, paths=None, cut_from_rest: bool = False) -> list:
                   "--end auto cuts (the Esso Osaka's nine zig-zags read whole put the default "
                   "model's 35° turns 47 % and 58 % long, cut 28 % and 2 %: "
                   "benchmarks/study_esso_whole_logs.py); --start 0 reads them whole")
+        if ended:
+            what = "runs" if len(ended) == 1 else "run"
+            _warn(f"{_count_logs(ended)} {what} into a propulsion dropout (the propeller logged "
+                  "stopped or astern while the ship gains headway): read up to it, as --end "
+                  "dropout cuts (with the Esso Osaka's random run that ends in one among its "
+                  "training logs, the default's 35° turns came 2–22 % off, cut 4–10 %: "
+                  "benchmarks/study_esso_whole_logs.py); --start 0 reads "
+                  f"{'it' if len(ended) == 1 else 'them'} whole")
     else:
         logs = [read_log(p, options) for p in paths]
     _print_yaw_rate_offsets(args, paths, logs)
@@ -71,26 +81,34 @@ def _count_logs(names) -> str:
     return f"{len(names)} of the logs ({', '.join(names[:3])}{', …' if len(names) > 3 else ''})"
 
 
-def _cut_to_manoeuvre(path, options):
-    """The log of ``path``, cut to its manoeuvre as ``--start auto --end auto`` cuts where it is
-    a zig-zag or turn that starts without headway (``manoeuvres_from_rest``; marked
-    ``attrs['cut_to_manoeuvre']``), else as read. The checks' warnings are those of the log
-    kept: a whole log's (its gathering speed, a dropout after the run) do not hold for the cut."""
+def _training_read(path, options):
+    """The log of ``path`` as a model is fitted to it: cut to its manoeuvre as ``--start auto
+    --end auto`` cuts where it is a zig-zag or turn that starts without headway
+    (``manoeuvres_from_rest``; marked ``attrs['cut_to_manoeuvre']``), else up to its first
+    propulsion dropout as ``--end dropout`` cuts (``attrs['cut_at_dropout']``), else as read.
+    The checks' warnings are those of the log kept: a whole log's (its gathering speed, the
+    dropout) do not hold for the cut."""
     import dataclasses
 
+    from shipid.data.checks import propulsion_dropouts
     from shipid.data.io import read_log
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         whole = read_log(path, options)
+    cuts = []
     if manoeuvres_from_rest([whole]):
+        cuts.append(("cut_to_manoeuvre", {"start": "auto", "end": "auto"}))
+    dropouts = propulsion_dropouts(whole)
+    if dropouts and dropouts[0].before is not None:
+        cuts.append(("cut_at_dropout", {"end": "dropout"}))
+    for key, trim in cuts:
         try:
-            cut = read_log(path, dataclasses.replace(options, start="auto", end="auto"))
+            cut = read_log(path, dataclasses.replace(options, **trim))
         except ShipidError:
-            pass  # kept whole; identify names it (_warn_approach)
-        else:
-            cut.attrs["cut_to_manoeuvre"] = True
-            return cut
+            continue  # kept whole; identify names it (_warn_approach, the dropout's warning)
+        cut.attrs[key] = True
+        return cut
     for w in caught:
         warnings.warn_explicit(w.message, w.category, w.filename, w.lineno, source=w.source)
     return whole
@@ -320,9 +338,10 @@ def _log_record(args, logs) -> dict:
     """The model file's ``preprocessing`` record of how the training logs were read (the read
     options given) and what they hold (approach, rudder, convention, scale, gyro offsets), as
     ``identify`` and ``select`` both write it."""
-    cut = [log.attrs.get("name") for log in logs if log.attrs.get("cut_to_manoeuvre")]
+    cut, ended = ([log.attrs.get("name") for log in logs if log.attrs.get(key)]
+                  for key in ("cut_to_manoeuvre", "cut_at_dropout"))  # fmt: skip
     return {"dt": args.dt, "start": args.start, "end": args.end, "lead": args.lead,
-            "cut_to_manoeuvre": cut or None,
+            "cut_to_manoeuvre": cut or None, "cut_at_dropout": ended or None,
             "columns": args.columns, "degrees": args.degrees, "format": args.format,
             "scale": args.scale, "approach_speed": _approach(logs[0], "u"),
             "approach_rps": _approach(logs[0], "n"), **_rudder_record(logs),
