@@ -78,6 +78,17 @@ def test_identify_cuts_a_manoeuvre_from_rest_to_its_approach(tmp_path, capsys):
     prep = json.loads((tmp_path / "w.json").read_text())["identification"]["preprocessing"]
     assert prep["approach_speed"] == pytest.approx(float(np.median(log["u"][ramp >= 1])), rel=0.05)
     assert prep["cut_to_manoeuvre"] is None
+    # validate reads it as it was fitted: cut, and so judged on the manoeuvre.
+    tables, errs = {}, {}
+    for label, trim in (("default", []), ("by hand", ["--start", "auto", "--end", "auto"])):
+        code, out, errs[label] = run(["validate", tmp_path / "m.json", path, *trim,
+                                      "--no-bands"], capsys)  # fmt: skip
+        assert code == 0, errs[label]
+        tables[label] = out.split("\n\n")[0]
+    assert tables["default"] == tables["by hand"]
+    assert ("is a zig-zag or turn that starts from rest: cut to the manoeuvre" in errs["default"]
+            and "--start 0 validates it whole" in errs["default"])  # fmt: skip
+    assert "cut to the manoeuvre" not in errs["by hand"]
 
 
 @pytest.mark.parametrize("from_rest", [True, False])

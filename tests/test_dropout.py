@@ -112,7 +112,8 @@ def test_a_model_is_fitted_up_to_a_dropout_unless_told(tmp_path, capsys):
     code, _, err = run(["identify", path, *flags, "-o", tmp_path / "m.json"], capsys)
     assert code == 0, err
     assert ("1 of the logs (run.csv) runs into a propulsion dropout (the propeller logged "
-            "stopped or astern while the ship gains headway): read up to it") in err
+            "stopped or astern while the ship gains headway, so the logged inputs did not "
+            "drive it): read up to it, as --end dropout cuts") in err
     assert "the propeller is stopped or astern from" not in err  # the cut log has none
     doc = json.loads((tmp_path / "m.json").read_text())
     assert doc["identification"]["preprocessing"]["cut_at_dropout"] == ["run.csv"]

@@ -47,25 +47,7 @@ def _read_logs(args, paths=None, cut_from_rest: bool = False) -> list:
     paths = paths or args.logs
     if cut_from_rest and args.start is None and args.end is None:
         logs = [_training_read(p, options) for p in paths]
-        named = [(Path(p).name, log.attrs) for p, log in zip(paths, logs, strict=True)]
-        cut, ended = ([name for name, attrs in named if attrs.get(key)]
-                      for key in ("cut_to_manoeuvre", "cut_at_dropout"))  # fmt: skip
-        if cut:
-            what = ("is a zig-zag or turn that starts" if len(cut) == 1
-                    else "are zig-zags or turns that start")  # fmt: skip
-            _warn(f"{_count_logs(cut)} {what} from rest: cut to the manoeuvre, from "
-                  f"{options.lead:g} s before the rudder's execute to its end, as --start auto "
-                  "--end auto cuts (the Esso Osaka's nine zig-zags read whole put the default "
-                  "model's 35° turns 47 % and 58 % long, cut 28 % and 2 %: "
-                  "benchmarks/study_esso_whole_logs.py); --start 0 reads them whole")
-        if ended:
-            what = "runs" if len(ended) == 1 else "run"
-            _warn(f"{_count_logs(ended)} {what} into a propulsion dropout (the propeller logged "
-                  "stopped or astern while the ship gains headway): read up to it, as --end "
-                  "dropout cuts (with the Esso Osaka's random run that ends in one among its "
-                  "training logs, the default's 35° turns came 2–22 % off, cut 4–10 %: "
-                  "benchmarks/study_esso_whole_logs.py); --start 0 reads "
-                  f"{'it' if len(ended) == 1 else 'them'} whole")
+        _warn_cut(paths, logs, options.lead)
     else:
         logs = [read_log(p, options) for p in paths]
     _print_yaw_rate_offsets(args, paths, logs)
@@ -74,6 +56,33 @@ def _read_logs(args, paths=None, cut_from_rest: bool = False) -> list:
         for log in logs:
             log.attrs["particulars"] = particulars.to_dict()
     return logs
+
+
+def _warn_cut(paths, logs, lead: float, judged: bool = False) -> None:
+    """Name the logs ``_training_read`` cut (to their manoeuvre, before a dropout); ``judged``:
+    they are logs a model is judged on (validate), not fitted to."""
+    named = [(Path(p).name, log.attrs) for p, log in zip(paths, logs, strict=True)]
+    cut, ended = ([name for name, attrs in named if attrs.get(key)]
+                  for key in ("cut_to_manoeuvre", "cut_at_dropout"))  # fmt: skip
+    whole = "validates" if judged else "reads"
+    if cut:
+        what = ("is a zig-zag or turn that starts" if len(cut) == 1
+                else "are zig-zags or turns that start")  # fmt: skip
+        _warn(f"{_count_logs(cut)} {what} from rest: cut to the manoeuvre, from {lead:g} s "
+              "before the rudder's execute to its end, as --start auto --end auto cuts (the "
+              "Esso Osaka's nine zig-zags read whole put the default model's 35° turns 47 % and "
+              f"58 % long, cut 28 % and 2 %: benchmarks/study_esso_whole_logs.py); --start 0 "
+              f"{whole} {'it' if len(cut) == 1 else 'them'} whole")
+    if ended:
+        what = "runs" if len(ended) == 1 else "run"
+        why = ("a free run driven by them there is no prediction" if judged else
+               "with the Esso Osaka's random run that ends in one among its training logs, the "
+               "default's 35° turns came 2–22 % off, cut 4–10 %: "
+               "benchmarks/study_esso_whole_logs.py")  # fmt: skip
+        _warn(f"{_count_logs(ended)} {what} into a propulsion dropout (the propeller logged "
+              "stopped or astern while the ship gains headway, so the logged inputs did not "
+              f"drive it): read up to it, as --end dropout cuts ({why}); --start 0 {whole} "
+              f"{'it' if len(ended) == 1 else 'them'} whole")
 
 
 def _count_logs(names) -> str:

@@ -20,8 +20,10 @@ from shipid.cli.common import (
     _scale_notes,
     _ship_or_model,
     _simulated_metadata,
+    _training_read,
     _warn,
     _warn_beyond_training,
+    _warn_cut,
     _yaw_rate_notes,
 )
 from shipid.errors import ShipidError
@@ -76,13 +78,17 @@ def cmd_validate(args) -> int:
     from shipid.data.log import common_rudder_convention
 
     options = _read_options(args)
+    # Read as the logs a model is fitted to (a zig-zag or turn from rest cut to its manoeuvre,
+    # a run ended before a propulsion dropout) unless --start or --end says otherwise.
+    read = _training_read if args.start is None and args.end is None else read_log
     logs, names, failed = [], [], []
     for p in args.logs:
         try:
-            logs.append(read_log(p, options))
+            logs.append(read(p, options))
             names.append(str(p))
         except ShipidError as exc:
             failed.append(str(exc))
+    _warn_cut(names, logs, options.lead, judged=True)
     _print_yaw_rate_offsets(args, names, logs)
     if cond["rudder_positive"]:  # a file that does not say its convention: no guess
         logs, notes = common_rudder_convention(logs, cond["rudder_positive"])
