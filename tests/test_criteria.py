@@ -300,3 +300,38 @@ def test_the_verdict_says_what_was_judged(passed, verdict):
 
     table = pd.DataFrame({"criterion": ["a", "b"], "passed": pd.Series(passed, dtype=object)})
     assert Criteria(table, {}).verdict() == verdict
+
+
+def test_a_rudder_faster_than_any_ships_gear_is_judged_at_the_solas_rate(tmp_path, capsys):
+    """The Esso Osaka's pond runs turn their rudder at 109 °/s, 10.5 °/s at full scale (4.5
+    times SOLAS's 2.32 °/s); criteria judged the full-scale ship with it, and the default
+    model's 20/20 first overshoots came 2.7–2.8° smaller than at the SOLAS rate."""
+    from shipid.cli.trials import GEAR_BEYOND_SOLAS, _gear_beyond_ships
+    from shipid.data.io import write_log
+    from shipid.dynamics.steering import SteeringMachine
+    from shipid.trials.manoeuvres import zigzag
+    from shipid.vessels import scale_ship
+
+    solas = math.radians(2.32 * math.sqrt(16.95))
+    fast = SteeringMachine(max_rate=1.01 * GEAR_BEYOND_SOLAS * solas)
+    judged, note = _gear_beyond_ships(fast, 16.95)
+    assert judged.max_rate == pytest.approx(solas, rel=1e-12) and "SOLAS" in note
+    for steering, scale in ((fast, None), (fast, 1.0), (SteeringMachine(max_rate=2 * solas), 16.95),
+                            (SteeringMachine(), 16.95)):  # fmt: skip
+        assert _gear_beyond_ships(steering, scale) == (steering, None)
+    # Through the command line: a model of trials at 48 °/s, five times SOLAS at 1:16.95.
+    log = zigzag(scale_ship(rudder_rate_deg=48.0), 20, 20, duration=60, dt=0.2, approach=2).log
+    path = write_log(log, tmp_path / "zz.csv")
+    assert run(["identify", path, "--no-output-error", "-o", tmp_path / "m.json"], capsys)[0] == 0
+    (tmp_path / "p.yml").write_text("length: 4.389\nscale: 16.95\n")
+    tables = {}
+    for label, extra in (("default", []), ("solas", ["--rudder-rate", f"{math.degrees(solas)}"]),
+                         ("logs", ["--rudder-rate", "48"])):  # fmt: skip
+        code, out, err = run(["criteria", tmp_path / "m.json", "--particulars", tmp_path / "p.yml",
+                              "--no-bands", "--json", tmp_path / f"{label}.json", *extra], capsys)
+        assert code == 0, err
+        tables[label] = json.loads((tmp_path / f"{label}.json").read_text())["criteria"]
+        if label == "default":
+            assert "is 11.7 °/s at full scale (1:16.95), 5 times SOLAS's 2.32 °/s" in err
+            assert "rudder rate 9.55 °/s" in out
+    assert tables["default"] == tables["solas"] != tables["logs"]

@@ -24,6 +24,39 @@ from shipid.cli.common import (
 )
 from shipid.errors import ShipidError
 
+# A model's training rudder faster than this many times the SOLAS rate at its scale turns no
+# ship's gear: a model basin's or pond's rudder turned by hand or by a fast servo. The KVLCC2's
+# MARIN runs turn theirs at 1.0 times it (15.9 °/s at 1:45.7), the paper's trials at 1.0; the
+# Esso Osaka's pond runs at 4.5 (109 °/s at 1:108.3), where their default model's 20/20 first
+# overshoots came 2.7–2.8° smaller than at the SOLAS rate.
+GEAR_BEYOND_SOLAS = 3.0
+
+
+def _gear_beyond_ships(steering, scale: float | None):
+    """``steering`` (the training logs' rudder rate) and None, or the SOLAS rate at the model's
+    scale and a note where the training rate is more than ``GEAR_BEYOND_SOLAS`` times it: the
+    criteria judge the full-scale ship, whose gear the model's rudder does not stand for. Only
+    where the scale is known and above 1: a ship judged at its own scale (a USV) has the gear
+    its logs show."""
+    import dataclasses
+
+    from shipid.trials.criteria import SOLAS_RUDDER_RATE_DEG
+
+    if steering is None or not steering.max_rate or not (scale and scale > 1):
+        return steering, None
+    solas = math.radians(SOLAS_RUDDER_RATE_DEG * math.sqrt(scale))
+    if not steering.max_rate > GEAR_BEYOND_SOLAS * solas:
+        return steering, None
+    ratio = steering.max_rate / solas
+    note = (f"rudder: the training logs' rate, {math.degrees(steering.max_rate):.3g} °/s, is "
+            f"{math.degrees(steering.max_rate) / math.sqrt(scale):.3g} °/s at full scale (1:"
+            f"{scale:g}), {ratio:.2g} times SOLAS's {SOLAS_RUDDER_RATE_DEG:g} °/s: no ship's "
+            f"steering gear, so the criteria are judged at the SOLAS rate, "
+            f"{math.degrees(solas):.3g} °/s at this scale (a faster rudder checks a yaw sooner: "
+            f"smaller overshoots); --rudder-rate {math.degrees(steering.max_rate):.3g} judges "
+            "at the logs' rate")  # fmt: skip
+    return dataclasses.replace(steering, max_rate=solas), note
+
 
 def cmd_criteria(args) -> int:
     """``shipid criteria``: the IMO MSC.137(76) criteria of a model or vessel."""
@@ -48,10 +81,14 @@ def cmd_criteria(args) -> int:
     steering, _ = _steering(target, cond, args.rudder_rate, fallback="caller")
     # The scale the training logs were read at, where neither option nor particulars give one.
     scale = args.scale or (particulars.scale if particulars else None) or cond.get("log_scale")
+    rate_note = None
+    if args.rudder_rate is None and getattr(target, "steering", None) is None:
+        steering, rate_note = _gear_beyond_ships(steering, scale)
     run = partial(imo_criteria, particulars=particulars, length=args.length, speed=speed,
                   scale=scale, rps=rps, steering=steering, astern_rps=args.astern_rps,
                   dt=args.dt)  # fmt: skip
     crit = run(target)
+    crit.notes += [rate_note] if rate_note else []
     crit.notes += _unused_inputs(target, args)
     crit.notes += [n for n in (_step_note(cond, args.dt, CRITERIA_STEP),) if n]
     from shipid.evaluation.validate import faded_residual_notes
