@@ -190,8 +190,10 @@ def test_validate_names_the_logs_the_model_was_fitted_to(tmp_path, files, trial,
     assert code == 0, err
     records = json.loads((tmp_path / "v.json").read_text())["logs"]
     assert [r["fitted_to"] for r in records] == [True, True, False]
-    assert f"renamed.csv: the model was fitted to this log (the same file as its training log " \
-           f"{log})" in err
+    # Said of the log and its copy alike: one line names both.
+    (line,) = [ln for ln in err.splitlines() if "the model was fitted to this log" in ln]
+    assert line.startswith(f"warning: 2 logs ({Path(log).name}, renamed.csv): the model was "
+                           f"fitted to this log (the same file as its training log {log})")
     assert "zz10.csv: the model was fitted" not in err
     header = next(ln for ln in out.splitlines() if ln.startswith("| log"))
     assert header.rstrip("| ").endswith("fitted to")
@@ -695,3 +697,15 @@ def test_simulated_logs_carry_the_simulated_ships_metadata(files, tmp_path, caps
     assert run(["manoeuvre", tmp_path / "b.json", "turning", "--duration", "30",
                 "-o", tmp_path / "bt.csv"], capsys)[0] == 0  # fmt: skip
     assert "scale" not in read_log(tmp_path / "bt.csv").attrs
+
+
+def test_warnings_that_say_the_same_of_several_logs_are_one_line():
+    from shipid.cli import _grouped
+
+    texts = ["d/a.csv: not a canonical log", "other: a.csv says", "d/b.csv: not a canonical log",
+             "d/a.csv: its own", "d/a.csv: not a canonical log", "d/c.csv: not a canonical log",
+             "d/d.csv: not a canonical log", "x.csv: not a canonical log"]
+    assert _grouped(texts, ["d/a.csv", "d/b.csv", "d/c.csv", "d/d.csv"]) == [
+        "4 logs (a.csv, b.csv, c.csv, …): not a canonical log", "other: a.csv says",
+        "d/a.csv: its own", "x.csv: not a canonical log"]
+    assert _grouped(texts[:2], ["d/a.csv"]) == texts[:2]

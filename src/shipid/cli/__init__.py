@@ -197,12 +197,34 @@ def main(argv: list[str] | None = None) -> int:
 
             gc.collect()  # the finalisers of cycles, while they are still ignored
         sys.unraisablehook = unraisablehook
-    seen = set()
-    for w in caught:
-        if issubclass(w.category, ShipidWarning) and str(w.message) not in seen:
-            seen.add(str(w.message))
-            print(f"warning: {_one_line(w.message)}", file=sys.stderr)
+    texts = [_one_line(w.message) for w in caught if issubclass(w.category, ShipidWarning)]
+    for text in _grouped(texts, [str(p) for p in getattr(args, "logs", None) or []]):
+        print(f"warning: {text}", file=sys.stderr)
     return code
+
+
+def _grouped(texts: list[str], paths: list[str]) -> list[str]:
+    """The warnings once each, in order; those that say the same of several of the command's
+    logs ('PATH: text') as one line naming the logs (nine zig-zag files read without --format
+    gave nine lines of the same sentence)."""
+    known = set(paths)
+    by_text: dict[str, list[str]] = {}
+    for text in dict.fromkeys(texts):
+        path, sep, rest = text.partition(": ")
+        if sep and path in known:
+            by_text.setdefault(rest, []).append(path)
+    out, done = [], set()
+    for text in dict.fromkeys(texts):
+        path, sep, rest = text.partition(": ")
+        logs = by_text.get(rest) if sep and path in known else None
+        if not logs or len(logs) == 1:
+            out.append(text)
+        elif rest not in done:
+            done.add(rest)
+            names = [p.rsplit("/", 1)[-1] for p in logs]
+            out.append(f"{len(logs)} logs ({', '.join(names[:3])}{', …' if len(names) > 3 else ''})"
+                       f": {rest}")
+    return out
 
 
 def _one_line(exc) -> str:
