@@ -133,7 +133,7 @@ def test_only_manoeuvres_read_whole_from_rest_are_named():
     """A zig-zag or turn that starts at rest is a file read whole (--start auto cuts it; the
     Esso Osaka's nine zig-zags read whole put the default's 35° turns 47 % and 58 % long, cut
     28 % and 2 %); a random run or straight run begun at rest is not named."""
-    from shipid.cli.common import manoeuvres_from_rest
+    from shipid.trials.reading import manoeuvres_from_rest
 
     zz = zigzag(scale_ship(rudder_rate_deg=9.6), 20, 20, duration=90, dt=0.2, method="euler",
                 approach=20.0).log  # fmt: skip

@@ -17,6 +17,7 @@ _EXPORTS = {
     "ShipidError": "shipid.errors",
     "ShipidWarning": "shipid.errors",
     "read_log": "shipid.data.io",
+    "read_trial_log": "shipid.trials.reading",
     "write_log": "shipid.data.io",
     "make_log": "shipid.data.log",
     "lowpass": "shipid.data.preprocess",

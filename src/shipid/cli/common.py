@@ -40,13 +40,15 @@ def _read_logs(args, paths=None, cut_from_rest: bool = False) -> list:
     """The logs of ``paths`` (default: the command's) read with the log options, each given the
     particulars; with ``cut_from_rest`` and neither --start nor --end, zig-zags and turns read
     whole from rest are cut to their manoeuvre and other logs end before a propulsion dropout
-    (``_training_read``)."""
+    (``shipid.trials.reading.read_trial_log``)."""
     from shipid.data.io import read_log
 
     options = _read_options(args)
     paths = paths or args.logs
     if cut_from_rest and args.start is None and args.end is None:
-        logs = [_training_read(p, options) for p in paths]
+        from shipid.trials.reading import read_trial_log
+
+        logs = [read_trial_log(p, options) for p in paths]
         _warn_cut(paths, logs, options.lead)
     else:
         logs = [read_log(p, options) for p in paths]
@@ -59,7 +61,7 @@ def _read_logs(args, paths=None, cut_from_rest: bool = False) -> list:
 
 
 def _warn_cut(paths, logs, lead: float, judged: bool = False) -> None:
-    """Name the logs ``_training_read`` cut (to their manoeuvre, before a dropout); ``judged``:
+    """Name the logs ``read_trial_log`` cut (to their manoeuvre, before a dropout); ``judged``:
     they are logs a model is judged on (validate), not fitted to."""
     named = [(Path(p).name, log.attrs) for p, log in zip(paths, logs, strict=True)]
     cut, ended = ([name for name, attrs in named if attrs.get(key)]
@@ -88,39 +90,6 @@ def _warn_cut(paths, logs, lead: float, judged: bool = False) -> None:
 def _count_logs(names) -> str:
     """'1 of the logs (a.csv)', '4 of the logs (a.csv, b.csv, c.csv, …)'."""
     return f"{len(names)} of the logs ({', '.join(names[:3])}{', …' if len(names) > 3 else ''})"
-
-
-def _training_read(path, options):
-    """The log of ``path`` as a model is fitted to it: cut to its manoeuvre as ``--start auto
-    --end auto`` cuts where it is a zig-zag or turn that starts without headway
-    (``manoeuvres_from_rest``; marked ``attrs['cut_to_manoeuvre']``), else up to its first
-    propulsion dropout as ``--end dropout`` cuts (``attrs['cut_at_dropout']``), else as read.
-    The checks' warnings are those of the log kept: a whole log's (its gathering speed, the
-    dropout) do not hold for the cut."""
-    import dataclasses
-
-    from shipid.data.checks import propulsion_dropouts
-    from shipid.data.io import read_log
-
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        whole = read_log(path, options)
-    cuts = []
-    if manoeuvres_from_rest([whole]):
-        cuts.append(("cut_to_manoeuvre", {"start": "auto", "end": "auto"}))
-    dropouts = propulsion_dropouts(whole)
-    if dropouts and dropouts[0].before is not None:
-        cuts.append(("cut_at_dropout", {"end": "dropout"}))
-    for key, trim in cuts:
-        try:
-            cut = read_log(path, dataclasses.replace(options, **trim))
-        except ShipidError:
-            continue  # kept whole; identify names it (_warn_approach, the dropout's warning)
-        cut.attrs[key] = True
-        return cut
-    for w in caught:
-        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno, source=w.source)
-    return whole
 
 
 def _training_logs(args) -> list:
@@ -261,6 +230,7 @@ def _warn_approach(logs, names) -> None:
     """Say so when the first log (whose approach the checks and manoeuvres use) starts without
     headway, and name the zig-zags and turns read whole from rest (``manoeuvres_from_rest``)."""
     from shipid.data.log import approach_note
+    from shipid.trials.reading import manoeuvres_from_rest
 
     note = approach_note(logs[0], names[0]) if logs else None
     if note:
@@ -273,17 +243,6 @@ def _warn_approach(logs, names) -> None:
               "--start auto --end auto cuts them to the manoeuvre (the Esso Osaka's nine "
               "zig-zags read whole put the default model's 35° turns 47 % and 58 % long, cut "
               "28 % and 2 %: benchmarks/study_esso_whole_logs.py)")
-
-
-def manoeuvres_from_rest(logs) -> list[int]:
-    """The indices of ``logs`` that are zig-zags or turns (``describe_trial``) and start without
-    headway: read whole, with the ship gathering speed under the helm's corrections before the
-    manoeuvre and its propeller stopped after it."""
-    from shipid.data.log import starts_without_headway
-    from shipid.trials.trial import describe_trial
-
-    return [i for i, log in enumerate(logs) if starts_without_headway(log)
-            and describe_trial(log).kind in ("zigzag", "turning")]  # fmt: skip
 
 
 def _std_errors(ident) -> dict:

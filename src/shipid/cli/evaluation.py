@@ -20,7 +20,6 @@ from shipid.cli.common import (
     _scale_notes,
     _ship_or_model,
     _simulated_metadata,
-    _training_read,
     _warn,
     _warn_beyond_training,
     _warn_cut,
@@ -74,17 +73,16 @@ def cmd_validate(args) -> int:
         _check_length(args.model, model, cond, given.length, f"--particulars {args.particulars}")
         _check_scale(args.model, cond, given.scale, f"--particulars {args.particulars}")
     env = cond["envelope"]
-    from shipid.data.io import read_log
     from shipid.data.log import common_rudder_convention
+    from shipid.trials.reading import read_trial_log
 
     options = _read_options(args)
-    # Read as the logs a model is fitted to (a zig-zag or turn from rest cut to its manoeuvre,
-    # a run ended before a propulsion dropout) unless --start or --end says otherwise.
-    read = _training_read if args.start is None and args.end is None else read_log
     logs, names, failed = [], [], []
     for p in args.logs:
         try:
-            logs.append(read(p, options))
+            # As the logs a model is fitted to are read (a zig-zag or turn from rest cut to its
+            # manoeuvre, a run ended before a propulsion dropout) unless --start or --end is given.
+            logs.append(read_trial_log(p, options))
             names.append(str(p))
         except ShipidError as exc:
             failed.append(str(exc))
