@@ -63,9 +63,11 @@ def _read_logs(args, paths=None, cut_from_rest: bool = False) -> list:
 def _warn_cut(paths, logs, lead: float, judged: bool = False) -> None:
     """Name the logs ``read_trial_log`` cut (to their manoeuvre, before a dropout); ``judged``:
     they are logs a model is judged on (validate), not fitted to."""
+    from shipid.trials.reading import CUT_AT_DROPOUT, CUT_TO_MANOEUVRE
+
     named = [(Path(p).name, log.attrs) for p, log in zip(paths, logs, strict=True)]
     cut, ended = ([name for name, attrs in named if attrs.get(key)]
-                  for key in ("cut_to_manoeuvre", "cut_at_dropout"))  # fmt: skip
+                  for key in (CUT_TO_MANOEUVRE, CUT_AT_DROPOUT))  # fmt: skip
     whole = "validates" if judged else "reads"
     if cut:
         what = ("is a zig-zag or turn that starts" if len(cut) == 1
@@ -93,9 +95,10 @@ def _count_logs(names) -> str:
 
 
 def _training_logs(args) -> list:
-    """The logs a model is fitted to: ``_read_logs``, zig-zags and turns read from rest cut to
-    their manoeuvre, refused when they are at different scales (a model-scale and a
-    full-scale run fitted together mix two ships' time scales)."""
+    """The logs a model is fitted to: ``_read_logs``, cut to the trials they hold (zig-zags and
+    turns from rest to their manoeuvre, other runs before a propulsion dropout), refused when
+    they are at different scales (a model-scale and a full-scale run fitted together mix two
+    ships' time scales)."""
     logs = _read_logs(args, cut_from_rest=True)
     scales, upsampled = {}, []
     for path, log in zip(args.logs, logs, strict=True):
@@ -306,8 +309,10 @@ def _log_record(args, logs) -> dict:
     """The model file's ``preprocessing`` record of how the training logs were read (the read
     options given) and what they hold (approach, rudder, convention, scale, gyro offsets), as
     ``identify`` and ``select`` both write it."""
+    from shipid.trials.reading import CUT_AT_DROPOUT, CUT_TO_MANOEUVRE
+
     cut, ended = ([log.attrs.get("name") for log in logs if log.attrs.get(key)]
-                  for key in ("cut_to_manoeuvre", "cut_at_dropout"))  # fmt: skip
+                  for key in (CUT_TO_MANOEUVRE, CUT_AT_DROPOUT))  # fmt: skip
     return {"dt": args.dt, "start": args.start, "end": args.end, "lead": args.lead,
             "cut_to_manoeuvre": cut or None, "cut_at_dropout": ended or None,
             "columns": args.columns, "degrees": args.degrees, "format": args.format,
