@@ -39,6 +39,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/study_esso.py
 	$(BIN)/python benchmarks/study_esso_port_turn.py
 	$(BIN)/python benchmarks/study_esso_whole_logs.py
+	$(BIN)/python benchmarks/study_esso_single_logs.py
 	$(BIN)/python benchmarks/study_esso_extrapolation.py
 	$(BIN)/python benchmarks/study_selection_uncertainty.py
 	$(BIN)/python benchmarks/study_kvlcc2_average.py

@@ -153,8 +153,9 @@ def _auto_structure(logs, names, physics, cv, estimator, drop, announce) -> Stru
         choice = _paper_or_race(logs, names, physics, cv, estimator, drop, announce,
                                 suffix="+wind")  # fmt: skip
         if choice.how == "paper":
-            return StructureChoice(get_structure(PAPER + "+wind"), "named",
-                                   reasons + choice.reasons, notes=choice.notes,
+            # The wind is why it is not the paper's; the comparison, how it was kept.
+            return StructureChoice(get_structure(PAPER + "+wind"), "named", reasons,
+                                   notes=choice.reasons + choice.notes,
                                    warnings=choice.warnings, cv=choice.cv,
                                    alternatives=choice.alternatives)  # fmt: skip
         choice.reasons = reasons + choice.reasons

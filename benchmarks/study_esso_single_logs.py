@@ -1,0 +1,75 @@
+"""The default `shipid identify` on one Esso Osaka zig-zag file, as it comes (no flags but
+`--format`), judged on the other eight zig-zags and the two 35° turns, each read as the
+README's `import` cuts it. What a user with a single trial gets: which structure, and how far
+its free runs miss logs it never saw (yaw rate error std over the log's spread; most of them
+at another propeller speed, which a structure without n cannot know).
+
+Run: .venv/bin/python benchmarks/study_esso_single_logs.py
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+import os
+import tempfile
+import time
+import warnings
+
+import numpy as np
+from esso_logs import DATA
+
+from shipid.cli import main as shipid
+from shipid.evaluation.validate import validate
+from shipid.reporting.modelfile import load_model
+from shipid.trials.reading import read_trial_log
+
+
+def main() -> None:
+    warnings.simplefilter("ignore")
+    if not DATA.is_dir():
+        print("../shared/data is absent")
+        return
+    zigzags = sorted((DATA / "zigzag").glob("*.csv"))
+    files = zigzags + sorted((DATA / "turning").glob("*.csv"))
+    held = {f: read_trial_log(f, fmt="osaka-frt") for f in files}
+    print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores\n")
+    print("| trained on | rps | structure (how) | held-out logs: r error / spread, median (worst) "
+          "| diverged | seconds |")
+    print("|---|---|---|---|---|---|")
+    start = time.perf_counter()
+    with tempfile.TemporaryDirectory() as tmp:
+        out = f"{tmp}/m.json"
+        for f in zigzags:
+            t0 = time.perf_counter()
+            with contextlib.redirect_stdout(io.StringIO()), \
+                    contextlib.redirect_stderr(io.StringIO()):  # fmt: skip
+                code = shipid(["identify", "--format", "osaka-frt", str(f), "-o", out])
+            seconds = time.perf_counter() - t0
+            if code:
+                print(f"| {f.stem[-8:]} | | failed | | | |")
+                continue
+            how = (json.loads(open(out).read())["identification"].get("structure_choice")
+                   or {}).get("how")  # fmt: skip
+            model = load_model(out)
+            errors = []
+            for g, log in held.items():
+                if g == f:
+                    continue
+                v = validate(model, log, start_draws=False)[0]
+                diverged = v.error is not None or v.simulation.diverged
+                errors.append(np.inf if diverged else
+                              v.metrics["r"]["std"] / float(np.std(log["r"])))  # fmt: skip
+            errors = np.array(errors)
+            finite = errors[np.isfinite(errors)]
+            rps = float(np.median(held[f]["n"]))
+            worst = f"{finite.max():.2f}" if finite.size else "–"
+            print(f"| {f.stem[-8:]} | {rps:.4g} | {model.structure.name} ({how}) | "
+                  f"{np.median(errors):.2f} ({worst}) | {int(np.isinf(errors).sum())} of "
+                  f"{len(errors)} | {seconds:.1f} |")
+    print(f"\n{time.perf_counter() - start:.0f} s")
+
+
+if __name__ == "__main__":
+    main()
