@@ -1,8 +1,9 @@
 """The default `shipid identify` on one Esso Osaka zig-zag file, as it comes (no flags but
 `--format`), judged on the other eight zig-zags and the two 35° turns, each read as the
-README's `import` cuts it. What a user with a single trial gets: which structure, and how far
-its free runs miss logs it never saw (yaw rate error std over the log's spread; most of them
-at another propeller speed, which a structure without n cannot know).
+README's `import` cuts it; then on every pair of zig-zag files, judged on the other nine logs.
+What a user with one or two trials gets: which structure, and how far its free runs miss logs
+it never saw (yaw rate error std over the log's spread; most of them at another propeller
+speed, which a structure without n cannot know).
 
 Run: .venv/bin/python benchmarks/study_esso_single_logs.py
 """
@@ -11,6 +12,7 @@ from __future__ import annotations
 
 import contextlib
 import io
+import itertools
 import json
 import os
 import tempfile
@@ -53,22 +55,49 @@ def main() -> None:
             how = (json.loads(open(out).read())["identification"].get("structure_choice")
                    or {}).get("how")  # fmt: skip
             model = load_model(out)
-            errors = []
-            for g, log in held.items():
-                if g == f:
-                    continue
-                v = validate(model, log, start_draws=False)[0]
-                diverged = v.error is not None or v.simulation.diverged
-                errors.append(np.inf if diverged else
-                              v.metrics["r"]["std"] / float(np.std(log["r"])))  # fmt: skip
-            errors = np.array(errors)
+            errors = _errors(model, {g: log for g, log in held.items() if g != f})
             finite = errors[np.isfinite(errors)]
             rps = float(np.median(held[f]["n"]))
             worst = f"{finite.max():.2f}" if finite.size else "–"
             print(f"| {f.stem[-8:]} | {rps:.4g} | {model.structure.name} ({how}) | "
                   f"{np.median(errors):.2f} ({worst}) | {int(np.isinf(errors).sum())} of "
                   f"{len(errors)} | {seconds:.1f} |")
+        print("\nEvery pair of zig-zag files, by how the default chose the structure: held-out "
+              "logs' r error / spread, the median over the pairs of each pair's median, and the "
+              "runs that diverged\n")
+        print("| structure chosen | pairs | median r error / spread | diverged |")
+        print("|---|---|---|---|")
+        by_how: dict[str, list[tuple[float, int, int]]] = {}
+        for a, b in itertools.combinations(zigzags, 2):
+            with contextlib.redirect_stdout(io.StringIO()), \
+                    contextlib.redirect_stderr(io.StringIO()):  # fmt: skip
+                code = shipid(["identify", "--format", "osaka-frt", str(a), str(b), "-o", out])
+            if code:
+                by_how.setdefault("failed", []).append((np.nan, 0, 0))
+                continue
+            choice = json.loads(open(out).read())["identification"].get("structure_choice") or {}
+            model = load_model(out)
+            how = choice.get("how")
+            label = (f"{model.structure.name} ({how})" if how != "select"
+                     else "terms chosen by select")  # fmt: skip
+            errors = _errors(model, {g: log for g, log in held.items() if g not in (a, b)})
+            by_how.setdefault(label, []).append(
+                (float(np.median(errors)), int(np.isinf(errors).sum()), len(errors)))
+        for label, rows in sorted(by_how.items(), key=lambda kv: -len(kv[1])):
+            medians = [r[0] for r in rows]
+            print(f"| {label} | {len(rows)} | {np.median(medians):.2f} | "
+                  f"{sum(r[1] for r in rows)} of {sum(r[2] for r in rows)} |")
     print(f"\n{time.perf_counter() - start:.0f} s")
+
+
+def _errors(model, logs) -> np.ndarray:
+    """The free runs' yaw rate error std over each log's spread (inf where one diverged)."""
+    out = []
+    for log in logs.values():
+        v = validate(model, log, start_draws=False)[0]
+        diverged = v.error is not None or v.simulation.diverged
+        out.append(np.inf if diverged else v.metrics["r"]["std"] / float(np.std(log["r"])))
+    return np.array(out)
 
 
 if __name__ == "__main__":
