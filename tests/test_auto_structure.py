@@ -156,21 +156,27 @@ KVLCC2 = DATA.parent / "kvlcc2-marin" / "MARIN_FREE_KVLCC2_zz_20_m.dat"
 def test_a_speed_that_varies_at_constant_rps_compares_the_rudders_inflow(paper_log):
     """The KVLCC2's MARIN zig-zag loses 30 % of its speed at a constant 10.3 rps: the paper's
     rudder force in δ assumes one speed. Plain `identify` fitted blanke to it; blanke-speed
-    predicts the unseen −20° run with 37 % and 35 % lower sway and yaw errors (README)."""
+    predicts the unseen −20° run with 37 % and 35 % lower sway and yaw errors (README). Four
+    blocks of the one log then chose blanke-speed, as the first block, the approach, held speeds
+    no other block reached; scored on the other three, the race structure ties, and fitted on
+    the whole log it predicts the unseen run better still."""
     log = read_log(KVLCC2, fmt="simman-marin", scale=45.7, dt=0.2)
     choice = auto_structure([log])
-    assert choice.how == "compared" and choice.structure.name == "blanke-speed"
-    # Alone within one standard error: no tie to name. But four blocks of one log penalise the
-    # race structure, which predicts both unseen real runs better (study_kvlcc2_sampling.py).
-    (warning,) = choice.warnings
-    assert warning.startswith("the rudder's inflow was compared on blocks of one log")
-    assert "score 0.463 against blanke-speed's 0.294" in warning
+    assert choice.how == "compared" and choice.structure.name == "blanke-race+race-damping"
+    assert "on blocks 2, 3, 4: block 1 reached speeds beyond the others'" in choice.describe()
     assert "the speed varies by 30 % at a constant 10.33 rps" in choice.describe()
-    # The paper's ship with a logged rps: blanke (its truth) ties with the race structure, which
-    # is fitted (the rudder in the race a constant rps implies), and the tie is named.
-    tied = auto_structure([paper_log.assign(n=10.0)])
-    assert tied.structure.name == "blanke-race+race-damping"
-    assert [w for w in tied.warnings if w.startswith("blanke, blanke-race+race-damping predict")]
+    assert not [w for w in choice.warnings if "compared on blocks of one log" in w]
+    # The other MARIN run, never seen: the chosen structure's free run against blanke-speed's.
+    held = read_log(KVLCC2.parent / "MARIN_FREE_KVLCC2_zz_-20_m.dat", fmt="simman-marin",
+                    scale=45.7, dt=0.2)  # fmt: skip
+    errors = {name: validate(identify([log], model=name).model, held, start_draws=False)[0]
+              .metrics for name in ("blanke-speed", choice.structure.name)}  # fmt: skip
+    for state in ("v", "r"):
+        assert errors[choice.structure.name][state]["std"] < 0.7 * errors["blanke-speed"][state]["std"]
+    # The paper's ship with a logged rps: the race structure is fitted (the rudder in the race a
+    # constant rps implies), on the blocks inside the approach's speed as well.
+    raced = auto_structure([paper_log.assign(n=10.0)])
+    assert raced.structure.name == "blanke-race+race-damping"
 
 
 def test_a_wind_at_constant_rps_compares_the_rudders_inflow_with_the_winds_terms(paper_log):
@@ -218,11 +224,12 @@ def test_logs_that_cannot_be_fitted_together_are_named_not_called_implausible(pa
 
 
 def test_structures_the_logs_cannot_tell_apart_but_that_turn_apart_are_named():
-    """The KVLCC2's MMG model through a noisy 20/20 zig-zag with its rps logged: blanke,
-    blanke-speed and blanke-race+race-damping score alike. The simplest, blanke, was fitted,
-    whose 35° turns' steady yaw rates are 2.7–3.9 times the truth's; now the race structure is
-    (within 14 %; benchmarks/study_auto_inflow.py). Fitted as identify fits them their turns
-    differ by a factor of two, and the choice says so."""
+    """The KVLCC2's MMG model through a noisy 20/20 zig-zag with its rps logged: blanke and
+    blanke-race+race-damping score alike (blanke-speed too, before the blocks beyond the
+    approach's speed were left out of the score). The simplest, blanke, was fitted, whose 35°
+    turns' steady yaw rates are 2.7–3.9 times the truth's; now the race structure is (within
+    14 %; benchmarks/study_auto_inflow.py). Fitted as identify fits them their turns differ by
+    a factor of two, and the choice says so."""
     from shipid.vessels import kvlcc2
     from shipid.vessels.kvlcc2 import trimmed_revolutions
 
@@ -236,14 +243,15 @@ def test_structures_the_logs_cannot_tell_apart_but_that_turn_apart_are_named():
              if "rad/s" in x]  # fmt: skip
     assert len(rates) >= 2 and max(rates) > 1.25 * min(rates)
     assert warning.startswith("blanke, ") and "blanke-race+race-damping" in warning
-    # Their 10°/10° zig-zags too (blanke's second overshoot 16.1°, blanke-speed's 10.1°), and
-    # the truth's own overshoots lie between the tied fits': the spread is the uncertainty.
+    # Their 10°/10° zig-zags too (blanke's second overshoot 16.1°, the race structure's 12.8°),
+    # and the truth's own second overshoot (13.6°) lies between the tied fits': the spread is
+    # the uncertainty; its first (4.9°) within 0.2° of the race structure's.
     (warning,) = [w for w in choice.warnings if "10°/10° zig-zag apart" in w]
     named = [[float(x) for x in re.findall(r"(-?\d+\.\d)°", part)]
-             for part in warning.split("fits: ")[1].split(";")[:3]]  # fmt: skip
+             for part in warning.split("fits: ")[1].split(";")[:2]]  # fmt: skip
     first, second = zip(*named, strict=True)
     truth = zigzag(ship, 10, 10, dt=0.2, method="euler").indices
-    assert min(first) <= truth["first_overshoot_deg"] <= max(first)
+    assert min(first) - 0.2 <= truth["first_overshoot_deg"] <= max(first)
     assert min(second) <= truth["second_overshoot_deg"] <= max(second)
     assert max(second) - min(second) > 1.5
 
@@ -269,8 +277,8 @@ def test_the_real_kvlccs_zig_zags_tie_on_structures_whose_10_10_zig_zags_differ(
 
 @pytest.fixture(scope="module")
 def mmg_tied(tmp_path_factory):
-    """The KVLCC2's MMG model through a noisy 20/20 zig-zag with its rps logged (the three
-    inflow structures tie), identified by the plain command."""
+    """The KVLCC2's MMG model through a noisy 20/20 zig-zag with its rps logged (blanke and
+    blanke-race+race-damping tie), identified by the plain command."""
     from shipid.vessels import kvlcc2
     from shipid.vessels.kvlcc2 import trimmed_revolutions
 
@@ -327,7 +335,9 @@ def test_manoeuvre_runs_the_structures_the_logs_could_not_tell_apart(mmg_tied, t
     doc = load_document(mmg_tied)
     alternatives = alternatives_from_document(doc, mmg_tied)
     assert doc["identification"]["structure_choice"]["how"] == "compared"
-    assert set(alternatives) == {"blanke", "blanke-speed"}  # the fitted one is the third
+    # blanke ties with the race structure fitted; blanke-speed, worse on the blocks within the
+    # approach's speed, does not.
+    assert set(alternatives) == {"blanke"}
     out = tmp_path / "zz.json"
     code, text, err = run(["manoeuvre", mmg_tied, "zigzag", "--rudder", "10", "--no-bands",
                            "--json", out], capsys)  # fmt: skip
