@@ -18,6 +18,7 @@ import math
 import signal
 import sys
 import warnings
+from pathlib import Path
 
 from shipid.blas import one_thread
 from shipid.cli.common import FORMATS
@@ -221,7 +222,7 @@ def _grouped(texts: list[str], paths: list[str]) -> list[str]:
             out.append(text)
         elif rest not in done:
             done.add(rest)
-            names = [p.rsplit("/", 1)[-1] for p in logs]
+            names = [Path(p).name for p in logs]
             out.append(f"{len(logs)} logs ({', '.join(names[:3])}{', …' if len(names) > 3 else ''})"
                        f": {rest}")
     return out

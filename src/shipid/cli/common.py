@@ -38,14 +38,14 @@ def _read_options(args):
 
 def _read_logs(args, paths=None, cut_from_rest: bool = False) -> list:
     """The logs of ``paths`` (default: the command's) read with the log options, each given the
-    particulars; with ``cut_from_rest`` and neither --start nor --end, zig-zags and turns read
-    whole from rest are cut to their manoeuvre and other logs end before a propulsion dropout
-    (``shipid.trials.reading.read_trial_log``)."""
+    particulars; with ``cut_from_rest``, cut to the trials they hold unless --start or --end is
+    given (zig-zags and turns from rest to their manoeuvre, other runs before a propulsion
+    dropout: ``shipid.trials.reading.read_trial_log``)."""
     from shipid.data.io import read_log
 
     options = _read_options(args)
     paths = paths or args.logs
-    if cut_from_rest and args.start is None and args.end is None:
+    if cut_from_rest:
         from shipid.trials.reading import read_trial_log
 
         logs = [read_trial_log(p, options) for p in paths]
