@@ -41,6 +41,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/study_esso_whole_logs.py
 	$(BIN)/python benchmarks/study_esso_single_logs.py
 	$(BIN)/python benchmarks/study_esso_extrapolation.py
+	$(BIN)/python benchmarks/study_kept_terms.py
 	$(BIN)/python benchmarks/study_selection_uncertainty.py
 	$(BIN)/python benchmarks/study_kvlcc2_average.py
 	$(BIN)/python benchmarks/study_kvlcc2_sampling.py

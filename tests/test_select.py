@@ -137,6 +137,40 @@ def test_a_candidate_diverging_in_every_fold_is_reported_and_the_others_scored(p
     assert any("diverged in every fold" in w for w in sel.warnings)
 
 
+@pytest.mark.parametrize("search", ["stepwise", "frols", "stlsq"])
+def test_kept_terms_are_in_every_candidate_of_the_search(paper_trials, search):
+    """--keep: the terms physics says a ship has stay in every candidate the search makes and
+    in the model (one the library lacks is added), where the search alone drops them."""
+    training, _ = paper_trials
+    keep = "v: u*r; r: v*delta"
+    plain = select(training[:3], library="blanke", gammas=(1e4,), search=search)
+    kept = select(training[:3], library="blanke", gammas=(1e4,), search=search, keep=keep)
+    assert "v*delta" not in select_module.get_structure("blanke").terms["r"]
+    assert "v*delta" in kept.library.terms["r"]
+    assert "u*r" in kept.model.structure.terms["v"] and "v*delta" in kept.model.structure.terms["r"]
+    searched = kept.candidates[~kept.candidates["stage"].str.startswith("γ on the library")]
+    assert len(searched) >= 1
+    assert all("u*r" in t.split(", ") for t in searched["terms_v"])
+    assert all("v*delta" in t.split(", ") for t in searched["terms_r"])
+    # the search alone drops u·r from the sway of this paper ship's three zig-zags
+    if search == "stepwise":
+        assert "u*r" not in plain.model.structure.terms["v"]
+
+
+def test_bad_terms_to_keep(paper_trials):
+    training, _ = paper_trials
+    with pytest.raises(ShipidError, match="constant '1'"):
+        SelectOptions(keep="v: u*r, 1")
+    with pytest.raises(ShipidError, match="unknown signal"):
+        SelectOptions(keep="v: w")
+    with pytest.raises(ShipidError, match=r"'neg\(u\)\^2' \(u\) is zero along every log"):
+        select(training[:2], library="blanke", keep="u: neg(u)^2", search="none")
+    with pytest.raises(ShipidError, match="needs the log column 'n'"):
+        select(training[:2], library="blanke", keep="r: n*delta", search="none")
+    with pytest.raises(ShipidError, match="has no r equation"):
+        select(training[:2], library="u: |u|*u, 1; v: delta, u*v", keep="r: u*r", search="none")
+
+
 @pytest.mark.parametrize("estimator", ["ols", "ridge", "lasso", "svr"])
 def test_linear_estimators_recover_a_known_regression(estimator):
     rng = np.random.default_rng(1)
@@ -189,6 +223,15 @@ def test_cli_select_compare_and_gamma_auto(paper_trials, tmp_path, capsys):
     capsys.readouterr()
     rec = json.loads((tmp_path / "v.json").read_text())["logs"][0]
     assert rec["ensemble_diverged"] == 0  # bands drawn from the 12 replicates, none diverged
+    kept = tmp_path / "kept.json"
+    code = main(["select", *map(str, paths[:3]), "--library", "blanke", "--quiet", "--gammas",
+                 "1e4", "--keep", "v: u*r; r: v*delta", "-o", str(kept)])  # fmt: skip
+    assert code == 0, capsys.readouterr().err
+    capsys.readouterr()
+    doc = json.loads(kept.read_text())
+    assert doc["identification"]["selection"]["options"]["keep"] == {"v": ["u*r"],
+                                                                    "r": ["v*delta"]}
+    assert "v*delta" in model_from_document(doc, kept).structure.terms["r"]
     code = main(["identify", *map(str, paths), "--gamma", "auto", "-o", str(tmp_path / "g.json")])
     out, err = capsys.readouterr()
     assert code == 0, err and "γ chosen by free-run cross-validation" in out
@@ -290,6 +333,7 @@ def test_the_default_library_leaves_out_what_the_logs_cannot_give(tmp_path, caps
     (["--gammas", "-1"], "--gammas must be numbers > 0, got '-1'"),
     (["--gammas", "1,x"], "--gammas expects numbers separated by commas"),
     (["--library", "blanke-speed+"], "'blanke-speed+': an empty name between '+' signs"),
+    (["--keep", "v: u*w"], "unknown signal"),
 ])
 def test_cli_select_checks_its_options_before_reading_the_logs(tmp_path, capsys, option, message):
     """The logs are not there: an option's error must come first, and alone (it came after the

@@ -556,6 +556,8 @@ def cmd_select(args) -> int:
     gammas = _parse_gammas(args.gammas)
     try:
         given = get_structure(args.library) if args.library is not None else None
+        if args.keep is not None:
+            get_structure(args.keep)
     except ValueError as exc:
         raise ShipidError(str(exc)) from None
     logs = _training_logs(args)
@@ -569,7 +571,7 @@ def cmd_select(args) -> int:
                             plausibility=not args.no_plausibility, speed=args.speed,
                             rps=args.rps, one_standard_error=not args.best,
                             progress=not args.quiet, physics=_physics(args, logs, library),
-                            average=args.average,
+                            average=args.average, keep=args.keep,
                             **({"gammas": gammas} if gammas else {}))
     sel = select(logs, options, names=names)
     ident = sel.identification

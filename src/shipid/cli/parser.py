@@ -289,6 +289,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--average", action="store_true",
                    help="write the average of the candidates the choice picks on resampled "
                    "held-out logs, weighted by how often (bagging), instead of the chosen one")
+    p.add_argument("--keep", metavar="TERMS",
+                   help="terms every candidate holds, whatever the cross-validation says, e.g. "
+                   "'v: u*v, u*r; r: u*v, u*r' (added to the library where it lacks them)")
     p.add_argument("--no-plausibility", action="store_true",
                    help="do not restrict the choice to plausible models")
     p.add_argument("--speed", type=float, help="plausibility checks at this speed [m/s] "

@@ -101,6 +101,10 @@ class SelectOptions:
     average : the model is the average of the candidates the choice rule picks on resampled
         held-out logs, each fitted on all logs and weighted by its share (bagging the selection),
         instead of the chosen candidate alone (kept as ``Selection.chosen_model``).
+    keep : terms every candidate holds, whatever the cross-validation says (a structure name,
+        sum or spec 'v: u*v, u*r; r: u*v, u*r'): the terms physics says a ship has, which logs
+        of one kind of manoeuvre may not tell from the rest. Added to the library where it
+        lacks them; the search chooses among the other terms.
     """
 
     library: str | ModelStructure | None = None
@@ -118,6 +122,7 @@ class SelectOptions:
     progress: bool = False
     physics: PhysicsOptions | None = None
     average: bool = False
+    keep: str | ModelStructure | None = None
 
     def __post_init__(self) -> None:
         if self.search not in SEARCHES:
@@ -135,6 +140,12 @@ class SelectOptions:
             raise ShipidError(f"--max-evaluations must be ≥ 1, got {self.max_evaluations!r}")
         if not (math.isfinite(self.divergence_penalty) and self.divergence_penalty > 0):
             raise ShipidError("divergence_penalty must be > 0")
+        if self.keep is not None:
+            kept = get_structure(self.keep)
+            if "1" in kept.all_terms:
+                raise ShipidError("--keep: the constant '1' is not chosen by the search (it is "
+                                  "in every candidate whose library has it); leave it out")
+            object.__setattr__(self, "keep", kept)
 
 
 @dataclass
@@ -199,6 +210,8 @@ class Selection:
         """The search record as JSON-ready data (kept in the model file)."""
         opts = {k: getattr(self.options, k) for k in ("search", "gammas", "cv", "estimator",
                                                        "method", "divergence_penalty", "average")}
+        kept = self.options.keep
+        opts["keep"] = {d: list(t) for d, t in kept.terms.items()} if kept else None
         return {"options": {**opts, "library": self.library.to_dict()}, "gamma": self.gamma,
                 "score": self.score, "ranking": {d: [[t, e] for t, e in r]
                                                  for d, r in self.ranking.items()},
@@ -529,10 +542,33 @@ def _setup(logs, names, options: SelectOptions):
             library = options.library
     except ValueError as exc:
         raise ShipidError(str(exc)) from None
+    if options.keep is not None:
+        library = _with_kept(library, options.keep, logs, names)
     data = _prepare(logs, names, library)
     data.library_note = note
     folds = _folds(len(logs), options.cv)
     return logs, names, data, folds, _Scorer(data, options, folds)
+
+
+def _with_kept(library: ModelStructure, keep: ModelStructure, logs, names) -> ModelStructure:
+    """The library with the terms to keep added (a term zero along every log refused: its
+    column would make every fit singular; one whose column a log lacks is named by
+    ``_prepare``, as a library's term is)."""
+    for dof, terms in keep.terms.items():
+        if dof not in library.terms:
+            raise ShipidError(f"--keep: the library {library.name} has no {dof} equation")
+        for term in terms:
+            if any(c not in log.columns for log in logs for c in parse_term(term).inputs):
+                continue
+            if all(not np.any(log_terms(log, [term], name))
+                   for log, name in zip(logs, names, strict=True)):  # fmt: skip
+                raise ShipidError(f"--keep: the term {term!r} ({dof}) is zero along every log, "
+                                  "which never excite it: it has no coefficient to find")
+    added = {d: [t for t in ts if t not in library.terms[d]] for d, ts in keep.terms.items()}
+    if not any(added.values()):
+        return library
+    extra = ModelStructure("kept", {d: tuple(ts) for d, ts in added.items() if ts})
+    return ModelStructure(library.name, (library + extra).terms)
 
 
 # ---------------------------------------------------------------------------- the search
@@ -630,16 +666,17 @@ def select(
         notes.append("no plausible model with the whole library; the search starts from the "
                      "best-scoring one")  # fmt: skip
     gamma = start.gamma
-    ranking = _rankings(data, full)
+    kept = {d: tuple(options.keep.terms.get(d, ())) if options.keep else () for d in full}
+    ranking = _rankings(data, full, kept)
     current = start
     if options.search == "stepwise":
-        current = _stepwise(full, ranking, gamma, evaluate, best, current)
+        current = _stepwise(full, ranking, gamma, evaluate, best, current, kept)
     elif options.search == "frols":
-        cands = [evaluate(_by_rho(full, ranking, rho), gamma, f"frols ρ = {rho:g}")
+        cands = [evaluate(_by_rho(full, ranking, rho, kept), gamma, f"frols ρ = {rho:g}")
                  for rho in RHO_GRID]  # fmt: skip
         current = best(cands + [current]) or current
     elif options.search == "stlsq":
-        cands = [evaluate(_stlsq(data, full, thr, gamma), gamma, f"stlsq threshold {thr:g}")
+        cands = [evaluate(_stlsq(data, full, thr, gamma, kept), gamma, f"stlsq threshold {thr:g}")
                  for thr in STLSQ_GRID]  # fmt: skip
         current = best(cands + [current]) or current
     # γ again, for the chosen structure.
@@ -764,8 +801,10 @@ def _stacked(data: _Data, dof: str, terms) -> tuple[list[str], np.ndarray, np.nd
 HULL_RESISTANCE = "|u|*u"
 
 
-def _rankings(data: _Data, full) -> dict[str, list[tuple[str, float]]]:
-    """Per equation, the terms ranked by forward orthogonal least squares; in the surge of a
+def _rankings(data: _Data, full, kept: Mapping[str, Sequence[str]] | None = None
+              ) -> dict[str, list[tuple[str, float]]]:  # fmt: skip
+    """Per equation, the terms ranked by forward orthogonal least squares, the terms to keep
+    (``kept``) first; in the surge of a
     library with propeller terms, the hull's resistance |u|u first. The ranking decides which
     terms a candidate of k terms holds, and on equation error alone u·|n| (the propeller's
     thrust falling with advance) can stand in for it: the Esso Osaka's surge chosen at the
@@ -779,6 +818,8 @@ def _rankings(data: _Data, full) -> dict[str, list[tuple[str, float]]]:
         propelled = any("n" in parse_term(t).inputs for t in terms)
         if dof == "u" and propelled and any(t == HULL_RESISTANCE for t, _ in ranked):
             ranked = sorted(ranked, key=lambda item: item[0] != HULL_RESISTANCE)
+        if kept and kept.get(dof):
+            ranked = sorted(ranked, key=lambda item: item[0] not in kept[dof])
         out[dof] = ranked
     return out
 
@@ -787,8 +828,10 @@ def _with_const(full, dof, names) -> tuple[str, ...]:
     return tuple(names) + (("1",) if "1" in full[dof] else ())
 
 
-def _stepwise(full, ranking, gamma, evaluate, best, current: Candidate) -> Candidate:
+def _stepwise(full, ranking, gamma, evaluate, best, current: Candidate,
+              kept: Mapping[str, Sequence[str]] | None = None) -> Candidate:  # fmt: skip
     sizes = {d: len(ranking[d]) for d in full}
+    fewest = {d: max(1, len((kept or {}).get(d, ()))) for d in full}  # the kept rank first
 
     def terms_for(s):
         return {d: _with_const(full, d, [t for t, _ in ranking[d][: s[d]]]) for d in full}
@@ -797,7 +840,7 @@ def _stepwise(full, ranking, gamma, evaluate, best, current: Candidate) -> Candi
         improved = False
         for dof in full:
             trials = []
-            for k in range(1, len(ranking[dof]) + 1):
+            for k in range(fewest[dof], len(ranking[dof]) + 1):
                 s = dict(sizes, **{dof: k})
                 trials.append((k, evaluate(terms_for(s), gamma, f"stepwise {dof} ≤ {k} terms")))
             chosen = best([c for _, c in trials] + [current])
@@ -810,13 +853,13 @@ def _stepwise(full, ranking, gamma, evaluate, best, current: Candidate) -> Candi
     return current
 
 
-def _by_rho(full, ranking, rho: float):
+def _by_rho(full, ranking, rho: float, kept: Mapping[str, Sequence[str]] | None = None):
     out = {}
     for dof, ranked in ranking.items():
         total = sum(e for _, e in ranked)
         acc, keep = 0.0, []
         for t, e in ranked:
-            if acc >= (1.0 - rho) * total and keep:
+            if acc >= (1.0 - rho) * total and keep and t not in (kept or {}).get(dof, ()):
                 break
             keep.append(t)
             acc += e
@@ -824,11 +867,14 @@ def _by_rho(full, ranking, rho: float):
     return out
 
 
-def _stlsq(data: _Data, full, threshold: float, gamma: float):
+def _stlsq(data: _Data, full, threshold: float, gamma: float,
+           kept: Mapping[str, Sequence[str]] | None = None):  # fmt: skip
     out = {}
     for dof, terms in full.items():
         names, X, y = _stacked(data, dof, terms)
-        out[dof] = _with_const(full, dof, _stlsq_terms(X, y, names, threshold, gamma))
+        chosen = _stlsq_terms(X, y, names, threshold, gamma)
+        held = [t for t in (kept or {}).get(dof, ()) if t not in chosen]
+        out[dof] = _with_const(full, dof, [t for t in names if t in chosen or t in held])
     return out
 
 
