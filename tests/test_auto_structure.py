@@ -14,7 +14,7 @@ import pytest
 from cli_helpers import run
 
 from shipid.data.io import read_log, write_log
-from shipid.dynamics.model import ManoeuvringModel
+from shipid.dynamics.model import ManoeuvringModel, ModelStructure
 from shipid.evaluation.validate import validate
 from shipid.identification.auto_structure import auto_structure
 from shipid.identification.identify import identify
@@ -128,10 +128,31 @@ def test_plain_identify_predicts_the_esso_turns_it_never_saw(tmp_path, capsys):
     assert "chosen by shipid select" in out
     assert "choosing the terms from" in err  # the search is announced: it takes seconds
     assert "warning: structure: only 3 folds" in err  # and its weakness said
-    ident = json.loads((tmp_path / "esso.json").read_text())["identification"]
+    doc = json.loads((tmp_path / "esso.json").read_text())
+    ident = doc["identification"]
     assert ident["structure_choice"]["how"] == "select"
     assert ident["gamma"] == ident["structure_choice"]["gamma"]  # select's γ
     model = load_model(tmp_path / "esso.json")
+    # The model is the average of the candidates select's choice picks on resampled held-out
+    # logs, each identified on the logs as read (and prefiltered) at its own γ, weighted by its
+    # share: re-solved here one candidate at a time.
+    members = ident["structure_choice"]["members"]
+    assert len(members) >= 2 and "average" in model.name and "the average of" in out
+    assert sum(m["weight"] for m in members) == pytest.approx(1.0)
+    read = [read_log(p, fmt="osaka-frt", end="dropout", dt=0.5) for p in train]
+    cutoff = ident["preprocessing"].get("filter_hz")
+    if cutoff:
+        from shipid.data.preprocess import lowpass
+
+        read = [lowpass(x, cutoff) for x in read]
+    fits = [(identify(read, model=ModelStructure("m", {d: tuple(t) for d, t in m["terms"].items()}),
+                      gamma=m["gamma"], force=True).model, m["weight"]) for m in members]
+    for dof, terms in model.coefficients.items():
+        for term, value in terms.items():
+            expected = sum(w * f.coefficients.get(dof, {}).get(term, 0.0) for f, w in fits)
+            assert value == pytest.approx(expected, rel=1e-9, abs=1e-15), (dof, term)
+    assert all(t in model.structure.terms[d] for m in members for d, ts in m["terms"].items()
+               for t in ts)  # fmt: skip
     turns = [read_log(p, fmt="osaka-frt", start="auto", end="auto", dt=0.5)
              for p in sorted((DATA / "turning").glob("*.csv"))]  # fmt: skip
     for v in validate(model, turns):

@@ -28,6 +28,9 @@ from shipid.cli.common import (
 )
 from shipid.errors import ShipidError
 
+# The name of the model `identify` fits where select's candidates are averaged.
+AVERAGED = "average of the candidates select's choice picks"
+
 
 def _ruled_out(table) -> str:
     """The fits the prefilter's choice checked and found implausible, 'none (its reason), 2.5 Hz
@@ -71,7 +74,7 @@ def _free_run_table(refinement) -> str:
 def cmd_identify(args) -> int:
     """``shipid identify``: a model from logs (LS-SVM, optional refinement, checks)."""
     from shipid.data.preprocess import lowpass
-    from shipid.identification.identify import identify
+    from shipid.identification.identify import averaged_model, identify
     from shipid.identification.plausibility import (
         new_failures,
         plausibility_at_approach,
@@ -113,17 +116,31 @@ def cmd_identify(args) -> int:
     logs = _training_logs(args)
     raw_logs = logs  # the output-error fit needs the noise as measured, not prefiltered
     names = [str(p) for p in args.logs]
+    gamma_given = args.gamma is not None
     choice = _choose_structure(args, logs, names)
     physics = _physics(args, logs, _structure(args))
+    # Terms chosen by select: the model is the average of the candidates its choice rule picks
+    # on resampled held-out logs (each at its own γ), as `select --average` writes it, where no
+    # γ or physics (a prior, constraints: per structure) is given.
+    members = choice.members if choice is not None and physics is None and not gamma_given \
+        else []  # fmt: skip
+
+    def fit_model(fit_logs, fit_gamma, fit_names=None):
+        """The model of ``fit_logs`` fitted as the file's is: the structure, or the average
+        of select's candidates."""
+        if members:
+            return averaged_model(fit_logs, members, first=args.model, name=AVERAGED,
+                                  form=args.form, names=fit_names, estimator=args.estimator)
+        return identify(fit_logs, model=args.model, form=args.form, gamma=fit_gamma,
+                        drop=_parse_drop(args.drop), names=fit_names, force=True,
+                        estimator=args.estimator, physics=physics).model  # fmt: skip
+
     cutoff, filter_by = args.filter, "given"
     if cutoff == "auto":
         from shipid.identification.prefilter import choose_prefilter
 
         def fit(candidate_logs):
-            return identify(candidate_logs, model=args.model, form=args.form,
-                            gamma=1e4 if args.gamma == "auto" else args.gamma,
-                            drop=_parse_drop(args.drop), names=names, force=True,
-                            estimator=args.estimator, physics=physics).model  # fmt: skip
+            return fit_model(candidate_logs, 1e4 if args.gamma == "auto" else args.gamma, names)
 
         from shipid.identification.plausibility import disqualifying_at_approach
 
@@ -142,6 +159,16 @@ def cmd_identify(args) -> int:
     ident = identify(logs, model=args.model, form=args.form, gamma=gamma,
                      drop=_parse_drop(args.drop), names=names, force=args.force,
                      estimator=args.estimator, physics=physics)  # fmt: skip
+    if members:
+        averaged = fit_model(logs, gamma, names)
+        worse = _average_fails(averaged, ident.model, logs)
+        if worse:
+            # As select --average: never an average that fails checks the chosen one passes.
+            members = choice.members = []
+            ident.warnings.append(f"structure: the average of select's candidates is implausible "
+                                  f"({'; '.join(worse[:2])}); the model is the chosen candidate")
+        else:
+            ident.model = averaged
     if choice is not None and choice.alternatives:
         choice.alternatives, refitted = _refit_alternatives(choice, args, logs, names, gamma)
         choice.alternatives_fit = "model" if refitted else "comparison"
@@ -150,18 +177,23 @@ def cmd_identify(args) -> int:
     prep = {**_log_record(args, logs), "filter_hz": cutoff,
             "filter_by": filter_by if cutoff is not None else None}
     refinement = None
-    print(ident.model.equations(std_errors=_std_errors(ident)))
-    print("(± standard errors of the equation-error fit: they hold the scatter of the fitted "
-          "accelerations, not the bias that noise in u, v, r leaves in the coefficients; "
-          "--output-error gives intervals that hold the true values, --bootstrap N intervals "
-          "of the predictions)")  # fmt: skip
+    if members:
+        print(ident.model.equations())
+        print(f"(the average of {len(members)} candidates, each at its own γ; --bootstrap N "
+              "intervals of the coefficients and predictions)")  # fmt: skip
+    else:
+        print(ident.model.equations(std_errors=_std_errors(ident)))
+        print("(± standard errors of the equation-error fit: they hold the scatter of the fitted "
+              "accelerations, not the bias that noise in u, v, r leaves in the coefficients; "
+              "--output-error gives intervals that hold the true values, --bootstrap N "
+              "intervals of the predictions)")  # fmt: skip
     for dof, d in ident.diagnostics.items():
         print(f"{dof}: condition number {d['condition_number']:.3g}, one-step R² "
               f"{d['one_step_r2']:.4f}, bias b = {ident.discrete[dof]['bias']:.4g}")
     residual, hybrid = None, None
     if args.residual:  # no refinement goes with it: the model is the LS-SVM one
-        residual, hybrid = _kernel_residual(args, ident.model, logs, raw_logs, names, cutoff,
-                                            gamma, physics, ident.warnings)  # fmt: skip
+        residual, hybrid = _kernel_residual(args, ident.model, logs, cutoff, fit_model, gamma,
+                                            raw_logs, names, ident.warnings)  # fmt: skip
     def cv_band(cv):
         """The cross-validated error band of this fit: the same prefilter, structure, γ,
         physics and residual without each log (or block)."""
@@ -169,10 +201,7 @@ def cmd_identify(args) -> int:
 
         def refit_without(train):
             fitted_on = [lowpass(x, cutoff) for x in train] if cutoff is not None else train
-            model = identify(fitted_on, model=args.model, form=args.form, gamma=gamma,
-                             drop=_parse_drop(args.drop), force=True, estimator=args.estimator,
-                             physics=physics).model  # fmt: skip
-            return _with_residual(model, fitted_on, residual)
+            return _with_residual(fit_model(fitted_on, gamma), fitted_on, residual)
 
         found = cross_validated_band(refit_without, raw_logs, names, cv)
         chosen = "γ, the prefilter and the kernel residual's γ and σ" if residual and \
@@ -188,9 +217,12 @@ def cmd_identify(args) -> int:
         from shipid.identification.identify import weighted_refit
         from shipid.identification.uncertainty import bootstrap
 
-        refit = weighted_refit(logs, model=args.model, form=args.form, gamma=gamma,
-                               drop=_parse_drop(args.drop), names=names,
-                               estimator=args.estimator, physics=physics)  # fmt: skip
+        if members:
+            refit = _averaged_refit(logs, members, args, names)
+        else:
+            refit = weighted_refit(logs, model=args.model, form=args.form, gamma=gamma,
+                                   drop=_parse_drop(args.drop), names=names,
+                                   estimator=args.estimator, physics=physics)  # fmt: skip
         ensemble = bootstrap(logs, refit, args.bootstrap, args.block, args.seed, progress=True)
         table = ensemble.coefficient_table()
         table["term"] = [_term_display(t) for t in table["term"]]
@@ -483,21 +515,19 @@ def _print_prime(record: dict | None) -> None:
     print(_pd().DataFrame(rows).to_markdown(index=False, floatfmt=".5g"))
 
 
-def _kernel_residual(args, physical, logs, raw_logs, names, cutoff, gamma, physics, warnings):
+def _kernel_residual(args, physical, logs, cutoff, fit_model, gamma, raw_logs, names, warnings):
     """``identify --residual``: the residual's γ and σ (or none) by free-run cross-validation of
-    the hybrid, each fold's physical model fitted as this one (structure, γ, prefilter,
-    physics); then the residual of ``physical`` on all logs. Returns the model file's record
-    (the residual, None when none won, and the search) and the hybrid (None likewise)."""
+    the hybrid, each fold's physical model fitted as this one (``fit_model``: structure, γ,
+    physics; the prefilter here); then the residual of ``physical`` on all logs. Returns the
+    model file's record (the residual, None when none won, and the search) and the hybrid (None
+    likewise)."""
     from shipid.data.preprocess import lowpass
     from shipid.dynamics.hybrid import HybridModel
-    from shipid.identification.identify import identify
     from shipid.identification.residual import choose_residual, fit_residual
 
     def fit(train):
         fitted_on = [lowpass(x, cutoff) for x in train] if cutoff is not None else list(train)
-        return identify(fitted_on, model=args.model, form=args.form, gamma=gamma,
-                        drop=_parse_drop(args.drop), force=True, estimator=args.estimator,
-                        physics=physics).model, fitted_on  # fmt: skip
+        return fit_model(fitted_on, gamma), fitted_on
 
     print("choosing the kernel residual by free-run cross-validation…", file=sys.stderr)
     choice = choose_residual(fit, raw_logs, names, cv=args.cv or "auto")
@@ -511,6 +541,42 @@ def _kernel_residual(args, physical, logs, raw_logs, names, cutoff, gamma, physi
     print(hybrid.equations().splitlines()[-1])
     record["residual"] = residual.to_dict()
     return record, hybrid
+
+
+def _average_fails(averaged, chosen, logs) -> list[str]:
+    """The checks that rule a candidate out of select's choice (``disqualifying``: the rudder
+    held diverges, turns the wrong way, ends astern...) the average of select's candidates
+    fails and the chosen candidate passes, from the first log's approach: as ``select
+    --average`` falls back to the chosen candidate."""
+    from shipid.identification.plausibility import (
+        disqualifying,
+        plausibility_at_approach,
+        sharpest_curvature,
+    )
+
+    speed, rps = _approach(logs[0], "u"), _approach(logs[0], "n")
+    if speed is None or not speed > 0:
+        return []
+    curvature = sharpest_curvature(logs, speed)
+    chosen_fails, averaged_fails = (
+        disqualifying(plausibility_at_approach(m, speed, rps, curvature=curvature)[0], m)
+        for m in (chosen, averaged))  # fmt: skip
+    return [r for r in averaged_fails if r not in chosen_fails]
+
+
+def _averaged_refit(logs, members, args, names):
+    """The bootstrap's ``fit(weights)`` of the average of select's candidates: each
+    candidate's weighted refit, averaged as the model is (the point refit equals it)."""
+    from shipid.identification.identify import average_models, weighted_refit
+
+    refits = [(weighted_refit(logs, model=s, form=args.form, gamma=g, names=names,
+                              estimator=args.estimator), w) for s, g, w in members]  # fmt: skip
+    total = float(sum(w for _, w in refits))
+
+    def fit(weights):
+        return average_models([(f(weights), w / total) for f, w in refits], args.model, AVERAGED)
+
+    return fit
 
 
 def _with_residual(model, logs, record):

@@ -65,6 +65,10 @@ class StructureChoice:
     alternatives: dict = field(default_factory=dict)
     # How they were fitted: 'comparison' (γ 1e4, unfiltered) or 'model' (refitted as the model).
     alternatives_fit: str = "comparison"
+    # Terms chosen by select: the candidates its choice rule picks on resampled held-out logs,
+    # (structure, γ, share), most often chosen first; ``identify`` fits the model as their
+    # average weighted by the shares (as ``select --average``), where two or more have one.
+    members: list = field(default_factory=list)
 
     def describe(self) -> str:
         """One paragraph for the command line."""
@@ -83,10 +87,17 @@ class StructureChoice:
         if self.how == "named":
             return (f"structure: {self.structure.name} ({n} terms), since {why}, which the "
                     f"paper's {PAPER} does not hold (--model to choose another){notes}")
+        averaged = ""
+        if len(self.members) > 1:
+            union = ModelStructure("members").union(*(m.terms for m, _, _ in self.members))
+            shares = ", ".join(f"{w:.0%}" if w >= 0.005 else "<1%" for _, _, w in self.members)
+            averaged = (f"; the model is the average of the {len(self.members)} candidates the "
+                        f"choice picks on resampled held-out logs, weighted by how often "
+                        f"({shares}; {sum(len(t) for t in union.terms.values())} terms)")
         return (f"structure: {n} terms chosen by shipid select from {self.library} (free-run "
                 f"cross-validation, {self.cv}; γ {self.gamma:g}, score {self.score:.4f} over "
                 f"{self.candidates} candidates), since {why}: the paper's {PAPER} cannot hold "
-                "that (--model to choose one; shipid select for the search's table, --average "
+                f"that{averaged} (--model to choose one; shipid select for the search's table "
                 "and intervals over the choice)")
 
     def to_dict(self) -> dict:
@@ -96,7 +107,9 @@ class StructureChoice:
                 "candidates": self.candidates, "notes": list(self.notes),
                 "warnings": list(self.warnings),
                 "alternatives": {k: m.to_dict() for k, m in self.alternatives.items()},
-                "alternatives_fit": self.alternatives_fit}  # fmt: skip
+                "alternatives_fit": self.alternatives_fit,
+                "members": [{"terms": {d: list(t) for d, t in m.terms.items()}, "gamma": g,
+                             "weight": w} for m, g, w in self.members]}  # fmt: skip
 
 
 def _without(structure: ModelStructure, drop: Mapping[str, Sequence[str]] | None
@@ -197,7 +210,10 @@ def _auto_structure(logs, names, physics, cv, estimator, drop, announce) -> Stru
     # The chosen fit's own notes per equation (a constraint held, a prior) the fit of the chosen
     # structure repeats; the search's (few folds, the library trimmed) are passed on.
     structure = ModelStructure(f"selected from {library_name}", chosen.terms)
+    members = [(ModelStructure(f"selected from {library_name}", c.terms), float(c.gamma),
+                float(c.share)) for c in sel.shares]  # fmt: skip
     return StructureChoice(structure, "select", reasons, gamma=float(sel.gamma),
+                           members=members if len(members) > 1 else [],
                            library=library_name, cv=cv, score=float(sel.score),
                            candidates=len(sel.candidates), notes=[note] if note else [],
                            warnings=[w for w in sel.warnings

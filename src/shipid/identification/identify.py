@@ -484,3 +484,35 @@ def identify(
                           else type(estimator).__name__,
                           physics.describe() if physics is not None and physics.active
                           else None)  # fmt: skip
+
+
+def averaged_model(
+    logs: Sequence[pd.DataFrame] | pd.DataFrame,
+    members: Sequence[tuple[ModelStructure, float, float]],
+    first: ModelStructure | None = None,
+    name: str = "",
+    **options,
+) -> ManoeuvringModel:
+    """The candidates ``members`` ((structure, γ, weight) each) fitted on ``logs`` by
+    ``identify(logs, model=structure, gamma=γ, force=True, **options)``, their coefficients
+    averaged with the weights (a candidate's coefficient of a term it lacks is 0): bagging the
+    choice of terms, as ``select --average`` does. Terms: ``first``'s, then the others'."""
+    if not members:
+        raise ShipidError("an average of candidates needs at least one candidate")
+    total = float(sum(w for _, _, w in members))
+    if not total > 0:
+        raise ShipidError("the candidates' weights must add up to more than 0")
+    fits = [(identify(logs, model=s, gamma=g, force=True, **options).model, w / total)
+            for s, g, w in members]  # fmt: skip
+    return average_models(fits, first, name)
+
+
+def average_models(fits: Sequence[tuple[ManoeuvringModel, float]],
+                   first: ModelStructure | None = None, name: str = "") -> ManoeuvringModel:
+    """The weighted average of fitted models ((model, weight) each, weights adding up to 1) on
+    the union of their terms (``first``'s first); a term a model lacks counts 0."""
+    structure = (first or fits[0][0].structure).union(*(m.structure.terms for m, _ in fits),
+                                                      name=name or "average")  # fmt: skip
+    coefficients = {d: {t: sum(w * m.coefficients.get(d, {}).get(t, 0.0) for m, w in fits)
+                        for t in ts} for d, ts in structure.terms.items()}  # fmt: skip
+    return ManoeuvringModel(structure, coefficients, name=name or "average")
