@@ -179,8 +179,9 @@ def cmd_identify(args) -> int:
     refinement = None
     if members:
         print(ident.model.equations())
-        print(f"(the average of {len(members)} candidates, each at its own γ; --bootstrap N "
-              "intervals of the coefficients and predictions)")  # fmt: skip
+        hint = "" if args.bootstrap is not None else "; --bootstrap N intervals of the " \
+            "coefficients and predictions"  # fmt: skip
+        print(f"(the average of {len(members)} candidates, each at its own γ{hint})")
     else:
         print(ident.model.equations(std_errors=_std_errors(ident)))
         print("(± standard errors of the equation-error fit: they hold the scatter of the fitted "
