@@ -292,3 +292,37 @@ def test_identify_refuses_a_malformed_cv_before_reading(tmp_path, capsys):
     code, _, err = run(["identify", tmp_path / "absent.csv", "--cv", "foo", "-o",
                         tmp_path / "m.json"], capsys)  # fmt: skip
     assert code == 1 and err.count("\n") == 1 and "--cv must be 'logo'" in err
+
+
+def test_the_average_of_candidates_and_its_bootstrap_refit():
+    """identify's default where select chooses the terms: the weighted average of the candidates'
+    own fits (each at its own γ; a term a candidate lacks counts 0), and the bootstrap's point
+    refit of it equal to it to the bit, on the same terms in the same order."""
+    from types import SimpleNamespace
+
+    from shipid.cli.identification import _averaged_refit
+    from shipid.dynamics.model import get_structure
+    from shipid.identification.identify import averaged_model
+
+    logs = synthesise_trials(seed=0)
+    train = [lowpass(logs[TRAINING], 0.5)]
+    members = [(get_structure("blanke"), 1e4, 3.0), (get_structure("blanke-speed"), 1e3, 1.0)]
+    model = averaged_model(train, members, first=get_structure("blanke"), name="avg")
+    a = identify(train, model="blanke", gamma=1e4, force=True).model
+    b = identify(train, model="blanke-speed", gamma=1e3, force=True).model
+    assert model.structure.terms["v"][:len(a.structure.terms["v"])] == a.structure.terms["v"]
+    assert "u^2*delta" in model.structure.terms["r"] and "delta" in model.structure.terms["r"]
+    for dof, terms in model.coefficients.items():
+        for term, value in terms.items():
+            expected = 0.75 * a.coefficients[dof].get(term, 0.0) + \
+                0.25 * b.coefficients[dof].get(term, 0.0)  # fmt: skip
+            assert value == pytest.approx(expected, rel=1e-12, abs=1e-15), (dof, term)
+    args = SimpleNamespace(form="increment", estimator="lssvm", model=get_structure("blanke"))
+    refit = _averaged_refit(train, members, args, None)
+    point = refit(None)
+    assert point.term_texts == model.term_texts
+    np.testing.assert_array_equal(point.theta, model.theta)
+    weights = np.random.default_rng(0).integers(0, 3, size=len(train[0]) - 1).astype(float)
+    assert refit(weights).term_texts == model.term_texts
+    with pytest.raises(ShipidError, match="weights"):
+        averaged_model(train, [(get_structure("blanke"), 1e4, 0.0)])
