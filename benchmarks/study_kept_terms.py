@@ -5,7 +5,7 @@ logs a selection was not fitted to better? ``select`` with and without them on t
 * Esso Osaka, the README's library at Δk 0.5 s: the three folds beyond the training conditions
   of ``study_esso_extrapolation.py`` and each random run held out in turn (the README's fold
   among them); and the nine zig-zags
-  alone at their own 0.1 s with the default library (what ``shipid identify`` gets from them);
+  alone at their own 0.1 s with the default library (as ``shipid identify`` searches them);
   judged on the two ±35° turns (tactical diameter, advance and steady yaw rate as the log's
   rudder replays them) and the held-out zig-zags and random runs (free-run error over spread).
 * KVLCC2, ``blanke-speed+abkowitz3`` at Δk 0.2 s: each of the three real zig-zags held out,
