@@ -26,8 +26,8 @@ from pathlib import Path
 
 import numpy as np
 from esso_logs import condition_folds, esso_logs, random_run_folds
+from kvlcc2_logs import kvlcc2_logs
 
-from shipid.data.io import read_log
 from shipid.evaluation.validate import validate
 from shipid.identification.select import select
 
@@ -86,13 +86,7 @@ def esso() -> None:
 
 
 def kvlcc2() -> None:
-    marin = DATA / "kvlcc2-marin"
-    logs = {"MARIN zz 20°": read_log(marin / "MARIN_FREE_KVLCC2_zz_20_m.dat", fmt="simman-marin",
-                                     scale=45.7, dt=0.2),
-            "MARIN zz −20°": read_log(marin / "MARIN_FREE_KVLCC2_zz_-20_m.dat",
-                                      fmt="simman-marin", scale=45.7, dt=0.2),
-            "HSVA zz 20/10": read_log(DATA / "kvlcc2-hsva" / "HSVA_CPMC_KVLCC2_Z_20_10_P.dat",
-                                      fmt="simman-hsva", dt=0.2)}  # fmt: skip
+    logs = kvlcc2_logs()
     print(f"\nKVLCC2, {KVLCC2_LIBRARY}: held-out logs' free-run error std u / v / r and "
           "closed-loop overshoots (measured)\n")  # fmt: skip
     print("| trained on | held out | kept | terms | CV score | u / v / r error std | overshoots "

@@ -16,7 +16,7 @@ import time
 import warnings
 from pathlib import Path
 
-from shipid.data.io import read_log
+from kvlcc2_logs import kvlcc2_logs
 from shipid.evaluation.validate import validate
 from shipid.identification.physics import PhysicsOptions
 from shipid.identification.select import select
@@ -29,13 +29,7 @@ def main() -> None:
     if not DATA.is_dir():
         print("../shared/data is absent")
         return
-    marin = DATA / "kvlcc2-marin"
-    logs = {"MARIN zz 20°": read_log(marin / "MARIN_FREE_KVLCC2_zz_20_m.dat", fmt="simman-marin",
-                                     scale=45.7, dt=0.2),
-            "MARIN zz −20°": read_log(marin / "MARIN_FREE_KVLCC2_zz_-20_m.dat",
-                                      fmt="simman-marin", scale=45.7, dt=0.2),
-            "HSVA zz 20/10": read_log(DATA / "kvlcc2-hsva" / "HSVA_CPMC_KVLCC2_Z_20_10_P.dat",
-                                      fmt="simman-hsva", dt=0.2)}  # fmt: skip
+    logs = kvlcc2_logs()
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores\n")
     print("| library | held out | overshoots measured | chosen: u / v / r error std, overshoots | "
           "--average: u / v / r error std, overshoots | --constraints signs: u / v / r error "
