@@ -17,6 +17,7 @@ import warnings
 from pathlib import Path
 
 from kvlcc2_logs import kvlcc2_logs
+
 from shipid.evaluation.validate import validate
 from shipid.identification.physics import PhysicsOptions
 from shipid.identification.select import select
