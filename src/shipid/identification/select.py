@@ -735,11 +735,15 @@ def select(
 def _averaged_model(data: _Data, weights, first: Candidate, train, options: SelectOptions,
                     name: str) -> ManoeuvringModel:  # fmt: skip
     """The candidates fitted on the logs ``train``, their coefficients averaged with the weights
-    (a candidate's coefficient of a term it lacks is 0); terms: ``first``'s, then the others'."""
-    theta = sum(w * _fit_theta(data, c.terms, c.gamma, train, options.estimator, options.physics)
-                for c, w in weights) / sum(w for _, w in weights)  # fmt: skip
-    structure = ModelStructure("first", first.terms).union(*(c.terms for c, _ in weights))
-    return _model_from_theta(data, structure.terms, theta, name)
+    (``average_models``: a candidate's coefficient of a term it lacks is 0); terms: ``first``'s,
+    then the others'."""
+    from shipid.identification.identify import average_models
+
+    total = sum(w for _, w in weights)
+    fits = [(_model_from_theta(data, c.terms, _fit_theta(data, c.terms, c.gamma, train,
+                                                         options.estimator, options.physics),
+                               name), w / total) for c, w in weights]  # fmt: skip
+    return average_models(fits, ModelStructure("first", first.terms), name)
 
 
 def selection_shares(cands: Sequence[Candidate], plausible, one_standard_error: bool = True,
