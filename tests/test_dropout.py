@@ -104,9 +104,10 @@ def test_a_model_is_fitted_up_to_a_dropout_unless_told(tmp_path, capsys):
     after = np.concatenate([np.full(30, 0.05), np.linspace(0.05, 0.25, 41)[1:], np.full(40, 0.25)])
     u, n = _speeds(after)
     t = np.arange(len(u)) * 0.5
-    # A rudder that moves (the fit needs it) and a yaw rate that answers it.
+    # A rudder that moves (the fit needs it), a yaw rate that answers it and a drift.
     delta = 0.1 * np.sign(np.sin(2 * np.pi * t / 40.0))
-    log = _log(u, n).assign(delta=delta, r=np.convolve(delta, np.full(9, 0.02), "same"))
+    r = np.convolve(delta, np.full(9, 0.02), "same")
+    log = _log(u, n).assign(delta=delta, r=r, v=-0.3 * r)
     path = write_log(log, tmp_path / "run.csv")
     flags = ["--model", "blanke-rps", "--filter", "none", "--no-output-error", "--force"]
     code, _, err = run(["identify", path, *flags, "-o", tmp_path / "m.json"], capsys)

@@ -206,6 +206,24 @@ def test_cli_constant_rudder_names_the_unidentifiable_terms(tmp_path, capsys):
     assert not (tmp_path / "m.json").exists()
 
 
+@pytest.mark.parametrize(("column", "says"), [("v", "the ship turns, so it drifts"),
+                                              ("r", "the ship is steered, so it turns")])
+def test_cli_a_state_filled_with_a_constant_is_refused(tmp_path, capsys, column, says):
+    """A log whose v (or r) is a constant while the ship turns (or is steered) had that state
+    not measured: identify fitted its equation to nothing and wrote every term of it as
+    0 ± ∞, with one warning per term."""
+    t = np.arange(0, 60, 0.2)
+    delta = 0.2 * np.sign(np.sin(2 * np.pi * t / 30))
+    log = pd.DataFrame({"t": t, "delta": delta, "u": 1.9 + 0.01 * np.sin(t),
+                        "v": 0.02 * np.cos(0.2 * t), "r": 0.03 * np.sin(0.2 * t)})
+    log[column] = 0.0
+    log.to_csv(tmp_path / "gnss.csv", index=False)
+    code, _, err = run(["identify", tmp_path / "gnss.csv", "-o", tmp_path / "m.json"], capsys)
+    assert code == 1 and err.count("\n") == 1
+    assert f"gnss.csv: column {column!r} is 0 throughout: it was not measured" in err and says in err
+    assert not (tmp_path / "m.json").exists()
+
+
 def test_cli_usage_error_exits_2(capsys):
     with pytest.raises(SystemExit) as exc:
         main(["identify"])

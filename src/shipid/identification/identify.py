@@ -289,6 +289,35 @@ def _check_rudder_excitation(logs, structure: ModelStructure, fixed: Mapping) ->
                           "the rudder terms")
 
 
+# Ranges below which a log's sway velocity or yaw rate did not change [m/s, rad/s]: no sensor
+# resolves them, so such a column was filled with a constant (v = 0 from a GNSS that gives only
+# the speed over ground). A constant u is a run at constant speed, which a sway-yaw model may
+# well be fitted to; v = r = 0 with the rudder amidships is a straight run, simulated exactly.
+STILL_V, STILL_R, STILL_DELTA = 1e-6, 1e-8, math.radians(0.1)
+
+
+def _check_states_measured(logs, structure: ModelStructure, names) -> None:
+    """Refuse a training log that turns with a constant v, or whose rudder or sway moves with a
+    constant r: that state was not measured. Alone, every term of it would be 0 ± ∞; beside
+    other logs, its false values would pull the fit."""
+    used = set(structure.dofs) | {s for terms in structure.terms.values() for n in terms
+                                  for s in parse_term(n).signals}  # fmt: skip
+    names = names or [f"log {i + 1}" for i in range(len(logs))]
+    for log, name in zip(logs, names, strict=False):
+        span = {c: float(np.ptp(log[c].to_numpy(dtype=float))) for c in ("delta", "v", "r")}
+        if "v" in used and span["v"] < STILL_V and span["r"] >= STILL_R:
+            why, hint = "v", ("the ship turns, so it drifts: derive u, v from the track (x, y "
+                              "or lat, lon) with --velocities-from-track")  # fmt: skip
+        elif "r" in used and span["r"] < STILL_R and (span["v"] >= STILL_V
+                                                      or span["delta"] >= STILL_DELTA):
+            why, hint = "r", ("the ship is steered, so it turns: give the gyro's or the IMU's "
+                              "yaw rate")  # fmt: skip
+        else:
+            continue
+        raise ShipidError(f"{name}: column {why!r} is {float(log[why].iloc[0]):.4g} throughout: "
+                          f"it was not measured, and its terms cannot be identified; {hint}")
+
+
 def _prepare(logs, model, form, gamma, drop, fixed, names, estimator, physics):
     """identify's checks and its per-equation regression problems: (logs in one rudder
     convention, structure, fixed terms, problems by DOF, notes)."""
@@ -313,6 +342,7 @@ def _prepare(logs, model, form, gamma, drop, fixed, names, estimator, physics):
         raise ShipidError(str(exc)) from None
     fixed = {d: {parse_term(k).text: float(c) for k, c in v.items()}
              for d, v in (fixed or {}).items()}  # fmt: skip
+    _check_states_measured(logs, structure, names)
     notes: list[str] = list(convention_notes)
     problems = {}
     for dof in structure.dofs:
