@@ -33,7 +33,7 @@ def precompile() -> list[str]:
     from shipid.identification.residual import fit_residual
     from shipid.lssvm.selection import PrimalLOOPath
     from shipid.trials.manoeuvres import turning_circle, zigzag
-    from shipid.vessels import cybership2, kvlcc2, mariner
+    from shipid.vessels import cybership2, kvlcc2, mariner, tanker
 
     done = []
     logs = synthesise_trials(seed=0)
@@ -52,7 +52,7 @@ def precompile() -> list[str]:
     simulate_log(hybrid, held[0])
     zigzag(hybrid, 20, 20, duration=5.0, speed=speed)
     done.append("hybrid")
-    for ship in (mariner(), kvlcc2(), cybership2()):
+    for ship in (mariner(), kvlcc2(), cybership2(), tanker()):
         run = zigzag(ship, 10, 10, duration=5.0)
         simulate(ship.dynamics, run.log["t"], run.log["delta"], np.r_[ship.approach_speed, np.zeros(5)])
         ship.dynamics.derivatives(np.array([[ship.approach_speed, 0.0, 0.0]]), np.zeros(1))

@@ -11,7 +11,7 @@ from pathlib import Path
 
 from shipid.errors import ShipidError, ShipidWarning
 
-VESSEL_NAMES = ("scale-ship", "mariner", "kvlcc2", "cybership2")
+VESSEL_NAMES = ("scale-ship", "mariner", "kvlcc2", "cybership2", "tanker")
 LINEAR_ESTIMATORS = ("lssvm", "ols", "ridge", "lasso", "svr")
 KINDS = ("zigzag", "turning", "pull-out", "other")  # trials.trial.KINDS, without its imports
 

@@ -455,7 +455,7 @@ def build_parser() -> argparse.ArgumentParser:
         p = sub.add_parser(name, help=helptext)
         p.add_argument("model", metavar="MODEL.json|VESSEL")
         p.add_argument("--truth", metavar="VESSEL", help="reference ship to test the controller "
-                       "on (scale-ship, mariner, kvlcc2, cybership2)")
+                       "on (scale-ship, mariner, kvlcc2, cybership2, tanker)")
         p.add_argument("--speed", type=float, help="approach speed [m/s] (default: training)")
         p.add_argument("--rps", type=float, help="propeller speed for models with n terms")
         p.add_argument("--rudder-rate", type=float, metavar="DEG/S",
