@@ -93,3 +93,50 @@ def test_the_reference_ships_turn_far_tighter_than_the_rule():
     assert min(ratios) == pytest.approx(0.62, abs=0.005)
     assert max(ratios) == pytest.approx(3.2, abs=0.05)
     assert min(ratios) > 2 * WIDE_SHARE
+
+
+def _with_surge_drag(delta2: float) -> ManoeuvringModel:
+    """The scale ship's model with its surge δ² coefficient set to ``delta2``."""
+    truth = scale_ship_model()
+    coefficients = {d: dict(c) for d, c in truth.coefficients.items()}
+    coefficients["u"]["delta^2"] = delta2
+    return ManoeuvringModel(truth.structure, coefficients)
+
+
+def _rudder_reversing_beyond(angle: float) -> ManoeuvringModel:
+    """The scale ship's model whose yaw rudder moment c δ gains − c δ³ / angle²: it turns as
+    the ship at small rudder and the other way beyond ``angle`` [rad]."""
+    from shipid.dynamics.model import ModelStructure
+
+    truth = scale_ship_model()
+    terms = {d: tuple(t) for d, t in truth.structure.terms.items()}
+    terms["r"] += ("delta^3",)
+    coefficients = {d: dict(c) for d, c in truth.coefficients.items()}
+    coefficients["r"]["delta^3"] = -coefficients["r"]["delta"] / angle**2
+    return ManoeuvringModel(ModelStructure("reversing rudder", terms), coefficients)
+
+
+def test_the_average_yields_to_the_chosen_candidate_check_by_check():
+    """identify's default wrote the chosen candidate where the average of select's candidates
+    ended its 35° turns going astern, though the chosen one turned them the wrong way: the two
+    reasons' words differ, and were compared as words (the tanker of study_tanker.py, from
+    zig-zags at 80 and 50 rpm). Compared by check and severity, the average stays there, and
+    yields where the chosen candidate passes or fails less badly."""
+    from shipid.cli.identification import _average_fails
+    from shipid.identification.plausibility import DIVERGED, WRONG_WAY, disqualifying_checks
+
+    logs = [zigzag(SHIP, 20, 20, duration=60, dt=0.1, method="euler").log]
+    diverging, wrong_way = _with_surge_drag(-2.0), _rudder_reversing_beyond(0.45)
+    checks = {m: disqualifying_checks(plausibility_at_approach(m, SHIP.approach_speed, None)[0], m)
+              for m in (diverging, wrong_way)}  # fmt: skip
+    assert checks[diverging] == {f"held_rudder_{s}": (DIVERGED, f"diverges with the rudder held "
+                                                                f"to {s}")
+                                 for s in ("starboard", "port")}  # fmt: skip
+    assert checks[wrong_way] == {f"held_rudder_{s}": (WRONG_WAY, f"turns the wrong way with the "
+                                                                 f"rudder to {s}")
+                                 for s in ("starboard", "port")}  # fmt: skip
+    reasons = [r for _, r in checks[diverging].values()]
+    assert _average_fails(diverging, wrong_way, logs) == reasons  # less badly: yields
+    assert _average_fails(diverging, scale_ship_model(), logs) == reasons  # passes: yields
+    assert _average_fails(wrong_way, diverging, logs) == []  # worse: the average stays
+    assert _average_fails(wrong_way, _rudder_reversing_beyond(0.4), logs) == []  # as bad: stays

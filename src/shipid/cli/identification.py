@@ -548,9 +548,12 @@ def _average_fails(averaged, chosen, logs) -> list[str]:
     """The checks that rule a candidate out of select's choice (``disqualifying``: the rudder
     held diverges, turns the wrong way, ends astern...) the average of select's candidates
     fails and the chosen candidate passes, from the first log's approach: as ``select
-    --average`` falls back to the chosen candidate."""
+    --average`` falls back to the chosen candidate. Compared check by check, by severity: a
+    chosen candidate that turns the wrong way where the average ends astern is no better (the
+    reasons' words differ, and the chosen one was handed out), one that does where the average
+    diverges is."""
     from shipid.identification.plausibility import (
-        disqualifying,
+        disqualifying_checks,
         plausibility_at_approach,
         sharpest_curvature,
     )
@@ -560,9 +563,10 @@ def _average_fails(averaged, chosen, logs) -> list[str]:
         return []
     curvature = sharpest_curvature(logs, speed)
     chosen_fails, averaged_fails = (
-        disqualifying(plausibility_at_approach(m, speed, rps, curvature=curvature)[0], m)
+        disqualifying_checks(plausibility_at_approach(m, speed, rps, curvature=curvature)[0], m)
         for m in (chosen, averaged))  # fmt: skip
-    return [r for r in averaged_fails if r not in chosen_fails]
+    return [reason for check, (severity, reason) in averaged_fails.items()
+            if severity > chosen_fails.get(check, (0, ""))[0]]
 
 
 def _averaged_refit(logs, members, args, names):

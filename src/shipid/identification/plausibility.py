@@ -262,23 +262,31 @@ def disqualifying(report: dict, model: ManoeuvringModel) -> list[str]:
     diverges, turns the ship the other way, ends the turn going astern or all but stopped or on
     a path far wider than the logs' (``WIDE_SHARE``), or surge has no steady speed.
     Straight-line instability (real full-form ships have it) and slow settling stay warnings."""
-    reasons = []
+    return [reason for _, reason in disqualifying_checks(report, model).values()]
+
+
+def disqualifying_checks(report: dict, model: ManoeuvringModel) -> dict[str, tuple[int, str]]:
+    """``disqualifying``'s reasons by the check that fails (``surge_equilibrium``,
+    ``held_rudder_starboard``, ``held_rudder_port``) with their severity (``DIVERGED`` above
+    ``WRONG_WAY``), to compare two models check by check."""
+    reasons = {}
     eq = report.get("surge_equilibrium")
     if "u" in model.structure.dofs and (eq is None or eq <= 0):
-        reasons.append("no steady straight speed")
+        reasons["surge_equilibrium"] = (WRONG_WAY, "no steady straight speed")
     for side, entry in (report.get("held_rudder") or {}).items():
+        key, speed = f"held_rudder_{side}", report.get("approach_speed") or 0.0
         if entry.get("diverged"):
-            reasons.append(f"diverges with the rudder held to {side}")
+            reasons[key] = (DIVERGED, f"diverges with the rudder held to {side}")
         elif entry.get("steady_yaw_rate") is not None and math.copysign(
                 1.0, entry["steady_yaw_rate"]) != (1.0 if side == "starboard" else -1.0):
-            reasons.append(f"turns the wrong way with the rudder to {side}")
-        elif _goes_astern(entry, report.get("approach_speed") or 0.0):
-            reasons.append(f"ends going astern with the rudder held to {side}")
-        elif _stalls(entry, report.get("approach_speed") or 0.0):
-            reasons.append(f"all but stops with the rudder held to {side}")
+            reasons[key] = (WRONG_WAY, f"turns the wrong way with the rudder to {side}")
+        elif _goes_astern(entry, speed):
+            reasons[key] = (WRONG_WAY, f"ends going astern with the rudder held to {side}")
+        elif _stalls(entry, speed):
+            reasons[key] = (WRONG_WAY, f"all but stops with the rudder held to {side}")
         elif _too_wide(entry, report.get("logs_curvature")):
-            reasons.append(f"turns on a path over {1 / WIDE_SHARE:g} times wider than the "
-                           f"training logs' with the rudder held to {side}")  # fmt: skip
+            reasons[key] = (WRONG_WAY, f"turns on a path over {1 / WIDE_SHARE:g} times wider "
+                                       f"than the training logs' with the rudder held to {side}")
     return reasons
 
 

@@ -588,6 +588,7 @@ def select(
     from shipid.identification.identify import identify
     from shipid.identification.plausibility import (
         disqualifying,
+        disqualifying_checks,
         given_steady_speeds,
         plausibility_at_approach,
         sharpest_curvature,
@@ -705,10 +706,16 @@ def select(
                                    f"average of {len(shared)} candidates from {library.name}")
         checked = plausibility_at_approach(averaged, speed, rps, options.speed, options.rps,
                                            curvature)  # fmt: skip
-        reasons = disqualifying(checked[0], averaged) if options.plausibility else []
-        if reasons:
-            notes.append(f"the average of the candidates is implausible ({'; '.join(reasons)}); "
-                         "the model is the chosen candidate")  # fmt: skip
+        failing = disqualifying_checks(checked[0], averaged) if options.plausibility else {}
+        if failing:
+            # Check by check: the chosen candidate only where it fails them less badly.
+            own = disqualifying_checks(plausibility_at_approach(
+                model, speed, rps, options.speed, options.rps, curvature)[0], model)
+            failing = {k: f for k, f in failing.items() if f[0] > own.get(k, (0, ""))[0]}
+        if failing:
+            notes.append(f"the average of the candidates is implausible "
+                         f"({'; '.join(r for _, r in failing.values())}); the model is the "
+                         "chosen candidate")  # fmt: skip
             weights = [(current, 1.0)]
             checked = None
         else:
