@@ -99,3 +99,24 @@ def test_the_cli_knows_the_tanker_and_its_rudder_limit(capsys):
         tanker(rudder_limit_deg=0.0)
     with pytest.raises(ValueError, match="rpm"):
         tanker(rpm=-5.0)
+
+
+def test_the_inflow_comparison_names_the_structures_it_leaves_out(tmp_path, capsys):
+    """From the tanker's 20/20 zig-zags at 80 rpm, identify compares the rudder's inflow and
+    two of its three structures end their 35° turns astern: the note said only 'free-run
+    scores blanke-speed 0.347; blanke-race+race-damping where within one standard error of the
+    best', as if the race structure had been scored and lost."""
+    from shipid.data.io import write_log
+
+    ship = tanker(rudder_limit_deg=35.0)
+    paths = [write_log(zigzag(ship, 20, 20, first=side, duration=1200, dt=1.0, approach=60.0)
+                       .log.assign(n=80 / 60), tmp_path / f"zz_{side}.csv")
+             for side in ("starboard", "port")]  # fmt: skip
+    code, out, err = run(["identify", *paths, "--filter", "none", "--no-output-error",
+                          "-o", tmp_path / "m.json"], capsys)  # fmt: skip
+    assert code == 0, err
+    (line,) = [x for x in out.splitlines() if x.startswith("structure: ")]
+    assert line.startswith("structure: blanke-speed")
+    assert ("implausible, not scored: blanke (ends going astern with the rudder held to "
+            "starboard; ends going astern with the rudder held to port), "
+            "blanke-race+race-damping (ends going astern") in line

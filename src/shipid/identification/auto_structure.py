@@ -335,9 +335,12 @@ def _paper_or_race(logs, names, physics, cv, estimator, drop=None, announce=_qui
     if prefilters is not None:
         table += " (each through its prefilter: " + ", ".join(
             f"{k} {'none' if c is None else f'{c:.4g} Hz'}" for k, c in prefilters.items()) + ")"
-        implausible = [k for k in candidates if k not in scores]
-        if implausible:
-            table += f"; {', '.join(implausible)} implausible"
+    # The ones left out are named with why: the note read as if they had been scored (the
+    # Esso tanker's 20/20 zig-zags: blanke and the race structure end their 35° turns astern).
+    implausible = [f"{k} ({faults[k][2]})" if k in faults else k for k in candidates
+                   if k not in scores]  # fmt: skip
+    if implausible:
+        table += f"; implausible, not scored: {', '.join(implausible)}"
     warnings = _predictions_apart({k: models[k] for k in tied}, logs) if len(tied) > 1 \
         else []  # fmt: skip
     alternatives = {k: models[k] for k in tied if k != name}
