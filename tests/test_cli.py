@@ -277,6 +277,12 @@ def test_version_and_defaults_in_help(capsys):
     # argparse may break a name at its hyphen.
     text = "".join(out.split())
     assert all(name in text for name in STRUCTURES), [n for n in STRUCTURES if n not in text]
+    # select's help gave its default library without astern, long after astern joined it.
+    from shipid.identification.select import DEFAULT_LIBRARY
+
+    with pytest.raises(SystemExit):
+        main(["select", "--help"])
+    assert f"(default{DEFAULT_LIBRARY}," in "".join(capsys.readouterr().out.split())
 
 
 # ---------------------------------------------------------------------------- 20: interruption

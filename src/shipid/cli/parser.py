@@ -200,7 +200,7 @@ def build_parser() -> argparse.ArgumentParser:
                    "and blanke-race+race-damping compared by free-run CV), blanke, blanke-thrust, "
                    "blanke-speed, blanke-race, "
                    "blanke-rps, abkowitz3, low-speed, wind, race-damping, propeller-asymmetry, "
-                   "astern, linear-sway-yaw, nomoto1; combine "
+                   "astern, rudder-drift, linear-sway-yaw, nomoto1; combine "
                    "with + (blanke-rps+wind, blanke-race+race-damping) or write terms: "
                    "'u: |u|u, v*r, 1; v: ...; r: ...'")
     p.add_argument("--form", default="increment", choices=("increment", "paper"),
@@ -272,7 +272,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("logs", nargs="+", metavar="LOG")
     p.add_argument("--library",
                    help="candidate terms: a structure name, a sum (abkowitz3+blanke) or written "
-                   "terms 'u: ...; v: ...; r: ...' (default low-speed+wind+propeller-asymmetry, "
+                   "terms 'u: ...; v: ...; r: ...' (default low-speed+wind+propeller-asymmetry+astern, "
                    "less the terms whose log columns the logs lack, said so)")
     p.add_argument("--search", default="stepwise", choices=("stepwise", "frols", "stlsq", "none"),
                    help="how candidates are generated (default %(default)s)")

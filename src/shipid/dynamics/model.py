@@ -105,6 +105,16 @@ STRUCTURES: dict[str, dict[str, tuple[str, ...]]] = {
     # and the lift of its drift (neg(u) v, neg(u) r, beside u v and |u| r) are those of another
     # body. Added to a library (low-speed+wind+propeller-asymmetry+astern).
     "astern": {"u": ("neg(u)^2",), "v": ("neg(u)*v", "neg(u)*r"), "r": ("neg(u)*v", "neg(u)*r")},
+    # The rudder in the race at the hull's drift (Norrbin's c²|β|β|δ| and c²βδ, van Berlekom &
+    # Goddard 1972; the `tanker` vessel): in a tight turn the drift straightens the flow at the
+    # rudder and changes its lift and drag far beyond what zig-zags show. sin β, not β, so the
+    # terms stay bounded at low speed and astern. Opt-in: from the tanker's zig-zags and one
+    # 35° turn, the four 35° turns at 50 and 80 rpm within 3 % (10–29 % short without); on the
+    # Esso Osaka's zig-zags alone, the held-out turns 30–47 % long and the random runs' yaw rate
+    # twice as far off (benchmarks/study_tanker.py, study_esso_extrapolation.py).
+    "rudder-drift": {"u": ("sin(beta)*pos(n)^2*delta",),
+                     "v": ("sin(beta)*pos(n)^2*|delta|", "sin(beta)^3*pos(n)^2*|delta|"),
+                     "r": ("sin(beta)*pos(n)^2*|delta|", "sin(beta)^3*pos(n)^2*|delta|")},
     # Linear sway–yaw (Davidson–Schiff) model at the held surge speed; its yaw transfer function is
     # Nomoto's second-order model, see ``nomoto_parameters``.
     "linear-sway-yaw": {"v": ("v", "r", "delta", "1"), "r": ("v", "r", "delta", "1")},
