@@ -48,6 +48,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/study_auto_structure.py
 	$(BIN)/python benchmarks/study_sampling.py
 	$(BIN)/python benchmarks/study_auto_inflow.py
+	$(BIN)/python benchmarks/study_tanker.py
 	$(BIN)/python benchmarks/study_trim.py
 	$(BIN)/python benchmarks/study_gyro_offset.py
 	$(BIN)/python benchmarks/study_event_timing.py
