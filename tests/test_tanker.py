@@ -120,6 +120,13 @@ def test_the_inflow_comparison_names_the_structures_it_leaves_out(tmp_path, caps
     assert ("implausible, not scored: blanke (ends going astern with the rudder held to "
             "starboard; ends going astern with the rudder held to port), "
             "blanke-race+race-damping (ends going astern") in line
+    # They predict the logs better, and a 10°/10° zig-zag apart: the 35° check, beyond the
+    # logs' 20°, made the choice, and the user is told (the race structure puts the ship's
+    # 10°/10° second overshoot within 0.7°, blanke-speed 6.3° low: study_tanker.py).
+    (warning,) = [x for x in err.splitlines() if "blanke-race+race-damping predicts the logs" in x]
+    assert "predicts the logs better than blanke-speed (free-run scores 0." in warning
+    assert "left out for its 35° rudder held, beyond the logs' 20°" in warning
+    assert warning.endswith("or --model blanke-race+race-damping, decides")
 
 
 def test_rudder_drift_terms_are_the_race_at_the_drift_and_stay_bounded_astern():

@@ -30,6 +30,7 @@ do in one (README, *The default structure*).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 
@@ -285,7 +286,7 @@ def _paper_or_race(logs, names, physics, cv, estimator, drop=None, announce=_qui
     cv = cv or ("logo" if len(logs) >= 2 else "blocks:4")
     announce(f"comparing {', '.join(candidates)} by free-run cross-validation ({cv})…")
     inside = _blocks_inside(logs, cv)
-    scores, models, failed, faults = {}, {}, [], {}
+    scores, models, failed, faults, ruled_out = {}, {}, [], {}, {}
     for name in candidates:
         structure = _without(get_structure(name), drop)
         try:
@@ -311,6 +312,7 @@ def _paper_or_race(logs, names, physics, cv, estimator, drop=None, announce=_qui
         elif np.isfinite(float(row["score"])):
             why = str(row["note"]).removeprefix("implausible: ")
             faults[name] = (len(why.split("; ")), float(row["score"]), why)
+            ruled_out[name] = sel.model
     if not scores and len(failed) == len(candidates):
         # Not a verdict on the structures: the logs cannot be fitted as they are (their
         # sampling times differ, say), which "none is plausible" hid until the next fit said so.
@@ -345,6 +347,12 @@ def _paper_or_race(logs, names, physics, cv, estimator, drop=None, announce=_qui
         else []  # fmt: skip
     alternatives = {k: models[k] for k in tied if k != name}
     warnings += _blocks_penalise_race(logs, cv, name, scores, preferred)
+    # Left out for a held 35° rudder beyond the logs, a structure may predict the logs as well
+    # and the manoeuvres inside their rudder quite otherwise: from the tanker's 20/20 zig-zags
+    # the race structure, ruled out so (its 35° turns end astern), puts the 10°/10° second
+    # overshoot within 0.7° of the ship's, the blanke-speed fitted 6.3° low (study_tanker.py).
+    warnings += _ruled_out_apart(models[name], name, scores[name][0], {
+        k: m for k, m in ruled_out.items() if faults[k][1] <= limit}, faults, logs)
     if name == paper:
         return StructureChoice(get_structure(paper), "paper", [reason], cv=cv,
                                notes=[f"free-run scores {table}"], warnings=warnings,
@@ -511,6 +519,9 @@ TURNS_APART = 1.25
 OVERSHOOTS_APART_DEG = 1.5
 # The unseen zig-zag run on the tied fits: the IMO's 10°/10°, to starboard first.
 ZIGZAG_APART = (10.0, 10.0)
+# The rudder the plausibility checks hold [deg], and how far below it the logs' largest must
+# stay for a check there to be beyond them.
+HELD_RUDDER_DEG, BEYOND_RUDDER_DEG = 35.0, 5.0
 
 
 def rates_apart(rates) -> bool:
@@ -519,6 +530,59 @@ def rates_apart(rates) -> bool:
     weighs between its output-error and LS-SVM fits."""
     known = [abs(r) for r in rates if r is not None and np.isfinite(r) and r != 0]
     return len(known) < len(rates) or max(known) > TURNS_APART * min(known)
+
+
+def _ruled_out_apart(chosen, name: str, score: float, ruled_out: Mapping[str, object], faults,
+                     logs) -> list[str]:  # fmt: skip
+    """Warnings where a structure ruled out by the plausibility checks (held 35° rudder) scored
+    within one standard error of the best on the logs and runs a 10°/10° zig-zag more than
+    ``OVERSHOOTS_APART_DEG`` from the chosen one's: inside the logs' rudder, what the model
+    predicts rests on a check beyond them."""
+    reach = max(float(np.max(np.abs(log["delta"].to_numpy(dtype=float)))) for log in logs)
+    if not ruled_out or math.degrees(reach) > HELD_RUDDER_DEG - BEYOND_RUDDER_DEG:
+        return []  # the logs reach the held rudder: the check is theirs
+    out = []
+    for k, model in ruled_out.items():
+        overshoots = _zigzag_overshoots({name: chosen, k: model}, logs)
+        if overshoots is None:
+            continue
+        a, b = overshoots[name], overshoots[k]
+        if None in a + b or max(abs(a[0] - b[0]), abs(a[1] - b[1])) <= OVERSHOOTS_APART_DEG:
+            continue
+        relation = "better than" if faults[k][1] < score else "as well as"
+        out.append(f"{k} predicts the logs {relation} {name} (free-run scores {faults[k][1]:.3f} "
+                   f"and {score:.3f}) but was left out for its {HELD_RUDDER_DEG:g}° rudder held, "
+                   f"beyond the logs' {math.degrees(reach):.3g}° ({faults[k][2]}); their "
+                   f"{ZIGZAG_APART[0]:g}°/{ZIGZAG_APART[1]:g}° zig-zags come apart (overshoots "
+                   f"{name} {a[0]:.1f}°, {a[1]:.1f}°; {k} {b[0]:.1f}°, {b[1]:.1f}°): inside the "
+                   "logs' rudder the choice rests on a check beyond them; a zig-zag log of that "
+                   f"kind, or --model {k}, decides")  # fmt: skip
+    return out
+
+
+def _zigzag_overshoots(models: Mapping[str, object], logs) -> dict | None:
+    """{name: [first, second overshoot]} of each model's ``ZIGZAG_APART`` zig-zag from the first
+    log's approach at the logs' rudder rate (None for one it does not reach); None without an
+    approach speed."""
+    from shipid.data.log import approach
+    from shipid.dynamics.steering import SteeringMachine
+    from shipid.trials.manoeuvres import zigzag
+    from shipid.trials.trial import logs_rudder_rate
+
+    speed, rps = approach(logs[0], "u"), approach(logs[0], "n")
+    if not speed or not speed > 0:
+        return None
+    dt = float(np.median(np.diff(logs[0]["t"].to_numpy())))
+    rate = logs_rudder_rate(logs)  # the gear identify records in the model file
+    steering = SteeringMachine(max_rate=rate) if rate else None
+    out = {}
+    for name, model in models.items():
+        zz = zigzag(model, *ZIGZAG_APART, speed=speed, rps=rps, steering=steering,
+                    method="euler", dt=dt)  # fmt: skip
+        ind = {} if zz.diverged else (zz.indices or {})
+        values = [ind.get(k) for k in ("first_overshoot_deg", "second_overshoot_deg")]
+        out[name] = [x if x is not None and np.isfinite(x) else None for x in values]
+    return out
 
 
 def _predictions_apart(models: Mapping[str, object], logs) -> list[str]:
@@ -536,25 +600,18 @@ def _predictions_apart(models: Mapping[str, object], logs) -> list[str]:
     On the real KVLCC2's three zig-zags the turns agree and the 10°/10° second overshoots do
     not. The logs cannot tell; the user is told."""
     from shipid.data.log import approach
-    from shipid.dynamics.steering import SteeringMachine
-    from shipid.trials.manoeuvres import turning_circle, zigzag
-    from shipid.trials.trial import logs_rudder_rate
+    from shipid.trials.manoeuvres import turning_circle
 
-    speed, rps = approach(logs[0], "u"), approach(logs[0], "n")
-    if not speed or not speed > 0:
+    overshoots = _zigzag_overshoots(models, logs)
+    if overshoots is None:
         return []
+    speed, rps = approach(logs[0], "u"), approach(logs[0], "n")
     dt = float(np.median(np.diff(logs[0]["t"].to_numpy())))
-    rates, overshoots = {}, {}
-    rate = logs_rudder_rate(logs)  # the gear identify records in the model file
-    steering = SteeringMachine(max_rate=rate) if rate else None
+    rates = {}
     for name, model in models.items():
         res = turning_circle(model, 35.0, speed=speed, rps=rps, method="euler", dt=dt)
         r = None if res.diverged else (res.indices or {}).get("steady_yaw_rate")
         rates[name] = abs(r) if r is not None and np.isfinite(r) else None
-        zz = zigzag(model, *ZIGZAG_APART, speed=speed, rps=rps, steering=steering,
-                    method="euler", dt=dt)  # fmt: skip
-        ind = {} if zz.diverged else (zz.indices or {})
-        overshoots[name] = [ind.get(k) for k in ("first_overshoot_deg", "second_overshoot_deg")]
     alike = (f"{', '.join(models)} predict the logs alike (free-run scores within one standard "
              "error) but")  # fmt: skip
     out = []
