@@ -149,3 +149,23 @@ def test_rudder_drift_terms_are_the_race_at_the_drift_and_stay_bounded_astern():
                                                         s**3 * race * abs(delta),
                                                         s * race * delta]), atol=1e-12)
     assert np.all(np.abs(values) <= 1.4**2 * 0.6 + 1e-12)
+
+
+def test_the_criteria_turn_it_at_its_largest_rudder(capsys):
+    """MSC.137(76) turns a ship with 35° or the largest rudder its gear allows; `criteria
+    tanker` stopped with 'rudder 35.0° is beyond the steering machine's limit of 10°'."""
+    from shipid.trials.criteria import imo_criteria
+
+    c = imo_criteria(tanker(), dt=1.0)
+    table = c.table.set_index(["criterion", "manoeuvre"])
+    own = turning_circle(tanker(), 10, side="port", dt=1.0, duration=c.runs[
+        "turning 10° port"].log["t"].iloc[-1]).indices  # fmt: skip
+    assert table.loc[("tactical diameter", "turning 10° port"), "value"] == pytest.approx(
+        own["tactical_diameter"] / L, rel=1e-9)  # fmt: skip
+    assert not table.loc[("tactical diameter", "turning 10° port"), "passed"]  # 5.39 L > 5 L
+    assert "20/20 first overshoot" not in set(c.table["criterion"])
+    assert any("largest rudder is 10°" in n for n in c.notes)
+    assert any("20/20 first overshoot not judged" in n for n in c.notes)
+    code, out, err = run(["criteria", "tanker", "--no-bands"], capsys)
+    assert code == 0, err
+    assert "turning 10° starboard" in out

@@ -147,14 +147,21 @@ def imo_criteria(
         unsteady = unsteady_warning(ship, V, rps if ship.uses_rps else None)
         notes += [unsteady] if unsteady else []
 
+    # 35°, or the largest rudder the gear allows (MSC.137(76) §4.2: the maximum rudder angle
+    # permissible at the test speed; the tanker's is 10°, and `criteria tanker` stopped on it).
+    turn_deg = min(35.0, round(math.degrees(steering.max_angle), 6))
+    if turn_deg < 35.0:
+        notes.append(f"the steering gear's largest rudder is {turn_deg:g}°: the turning circles "
+                     "are run with it, the maximum rudder angle the standard allows for")
     for side in SIDES:
-        res = turning_circle(ship, 35.0, side=side, duration=duration, **kw)
-        runs[f"turning 35° {side}"] = res
+        res = turning_circle(ship, turn_deg, side=side, duration=duration, **kw)
+        runs[f"turning {turn_deg:g}° {side}"] = res
         if res.diverged:
-            notes.append(f"turning circle 35° to {side}: {res.reason}")
+            notes.append(f"turning circle {turn_deg:g}° to {side}: {res.reason}")
         ind = res.indices
-        rows.append(_row("advance", f"turning 35° {side}", _in_l(ind.get("advance"), L), 4.5, "L"))
-        rows.append(_row("tactical diameter", f"turning 35° {side}",
+        rows.append(_row("advance", f"turning {turn_deg:g}° {side}", _in_l(ind.get("advance"), L),
+                         4.5, "L"))  # fmt: skip
+        rows.append(_row("tactical diameter", f"turning {turn_deg:g}° {side}",
                          _in_l(ind.get("tactical_diameter"), L), 5.0, "L"))  # fmt: skip
     for side in SIDES:
         res = zigzag(ship, 10.0, 10.0, first=side, duration=duration, **kw)
@@ -166,11 +173,14 @@ def imo_criteria(
                          ind.get("first_overshoot_deg"), first_lim, "deg"))  # fmt: skip
         rows.append(_row("10/10 second overshoot", f"zigzag 10/10 {side}",
                          ind.get("second_overshoot_deg"), second_lim, "deg"))  # fmt: skip
-    for side in SIDES:
+    for side in SIDES if turn_deg >= 20.0 else ():
         res = zigzag(ship, 20.0, 20.0, first=side, duration=duration, **kw)
         runs[f"zigzag 20/20 {side}"] = res
         rows.append(_row("20/20 first overshoot", f"zigzag 20/20 {side}",
                          res.indices.get("first_overshoot_deg"), 25.0, "deg"))  # fmt: skip
+    if turn_deg < 20.0:
+        notes.append(f"20/20 first overshoot not judged: the gear's {turn_deg:g}° cannot run a "
+                     "20°/20° zig-zag")
     dyn = getattr(ship, "dynamics", ship)
     if getattr(dyn, "uses_rps", False) and rps:
         res = stopping(ship, rps, astern_rps, reversal_time=10.0 / math.sqrt(lam),
