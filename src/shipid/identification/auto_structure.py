@@ -338,7 +338,7 @@ def _paper_or_race(logs, names, physics, cv, estimator, drop=None, announce=_qui
         table += " (each through its prefilter: " + ", ".join(
             f"{k} {'none' if c is None else f'{c:.4g} Hz'}" for k, c in prefilters.items()) + ")"
     # The ones left out are named with why: the note read as if they had been scored (the
-    # Esso tanker's 20/20 zig-zags: blanke and the race structure end their 35° turns astern).
+    # `tanker` vessel's 20/20 zig-zags: blanke and the race structure end their 35° turns astern).
     implausible = [f"{k} ({faults[k][2]})" if k in faults else k for k in candidates
                    if k not in scores]  # fmt: skip
     if implausible:
@@ -352,7 +352,8 @@ def _paper_or_race(logs, names, physics, cv, estimator, drop=None, announce=_qui
     # the race structure, ruled out so (its 35° turns end astern), puts the 10°/10° second
     # overshoot within 0.7° of the ship's, the blanke-speed fitted 6.3° low (study_tanker.py).
     warnings += _ruled_out_apart(models[name], name, scores[name][0], {
-        k: m for k, m in ruled_out.items() if faults[k][1] <= limit}, faults, logs)
+        k: m for k, m in ruled_out.items() if faults[k][1] <= limit
+        and all("with the rudder" in why for why in faults[k][2].split("; "))}, faults, logs)
     if name == paper:
         return StructureChoice(get_structure(paper), "paper", [reason], cv=cv,
                                notes=[f"free-run scores {table}"], warnings=warnings,
@@ -534,8 +535,8 @@ def rates_apart(rates) -> bool:
 
 def _ruled_out_apart(chosen, name: str, score: float, ruled_out: Mapping[str, object], faults,
                      logs) -> list[str]:  # fmt: skip
-    """Warnings where a structure ruled out by the plausibility checks (held 35° rudder) scored
-    within one standard error of the best on the logs and runs a 10°/10° zig-zag more than
+    """Warnings where a structure ruled out by the held 35° rudder checks alone scored within
+    one standard error of the best on the logs and runs a 10°/10° zig-zag more than
     ``OVERSHOOTS_APART_DEG`` from the chosen one's: inside the logs' rudder, what the model
     predicts rests on a check beyond them."""
     reach = max(float(np.max(np.abs(log["delta"].to_numpy(dtype=float)))) for log in logs)
