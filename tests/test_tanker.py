@@ -97,8 +97,9 @@ def test_the_cli_knows_the_tanker_and_its_rudder_limit(capsys):
     assert code == 1 and "beyond the steering machine's limit of 10°" in err
     with pytest.raises(ValueError, match="rudder_limit_deg"):
         tanker(rudder_limit_deg=0.0)
-    with pytest.raises(ValueError, match="rpm"):
-        tanker(rpm=-5.0)
+    for rpm in (-5.0, 0.0, 81.0, float("nan")):
+        with pytest.raises(ValueError, match="rpm must be in"):
+            tanker(rpm=rpm)
 
 
 def test_the_inflow_comparison_names_the_structures_it_leaves_out(tmp_path, capsys):

@@ -102,8 +102,8 @@ def equilibrium_speed(rpm: float) -> float:
     """Straight-running surge speed [m/s] at which thrust balances resistance at ``rpm``: the
     positive root of (Xuu + Tuu (1 − t)) u² + L Tun n (1 − t) u + L² Tnn n² (1 − t) = 0
     (u̇ = 0 with v = r = δ = 0; n = rpm / 60)."""
-    if not (math.isfinite(rpm) and rpm > 0):
-        raise ValueError(f"rpm must be > 0, got {rpm!r}")
+    if not (math.isfinite(rpm) and 0 < rpm <= NOMINAL_RPM):
+        raise ValueError(f"rpm must be in (0, {NOMINAL_RPM:g}] (the shaft's limit), got {rpm!r}")
     n, keep = rpm / 60.0, 1.0 - THRUST_DEDUCTION
     a, b, c = XUU + TUU * keep, L * TUN * n * keep, L * L * TNN * n * n * keep
     return (-b - math.sqrt(b * b - 4.0 * a * c)) / (2.0 * a)
