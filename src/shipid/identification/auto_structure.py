@@ -347,12 +347,12 @@ def _paper_or_race(logs, names, physics, cv, estimator, drop=None, announce=_qui
         else []  # fmt: skip
     alternatives = {k: models[k] for k in tied if k != name}
     warnings += _blocks_penalise_race(logs, cv, name, scores, preferred)
-    # Left out for a held 35° rudder beyond the logs, a structure may predict the logs as well
+    # Left out for a held 35° rudder beyond the logs, a structure may predict the logs better
     # and the manoeuvres inside their rudder quite otherwise: from the tanker's 20/20 zig-zags
     # the race structure, ruled out so (its 35° turns end astern), puts the 10°/10° second
     # overshoot within 0.7° of the ship's, the blanke-speed fitted 6.3° low (study_tanker.py).
     warnings += _ruled_out_apart(models[name], name, scores[name][0], {
-        k: m for k, m in ruled_out.items() if faults[k][1] <= limit
+        k: m for k, m in ruled_out.items() if faults[k][1] < scores[name][0]
         and all("with the rudder" in why for why in faults[k][2].split("; "))}, faults, logs)
     if name == paper:
         return StructureChoice(get_structure(paper), "paper", [reason], cv=cv,
@@ -535,10 +535,11 @@ def rates_apart(rates) -> bool:
 
 def _ruled_out_apart(chosen, name: str, score: float, ruled_out: Mapping[str, object], faults,
                      logs) -> list[str]:  # fmt: skip
-    """Warnings where a structure ruled out by the held 35° rudder checks alone scored within
-    one standard error of the best on the logs and runs a 10°/10° zig-zag more than
-    ``OVERSHOOTS_APART_DEG`` from the chosen one's: inside the logs' rudder, what the model
-    predicts rests on a check beyond them."""
+    """Warnings where a structure ruled out by the held 35° rudder checks alone predicted the
+    held-out logs better than the chosen one and runs a 10°/10° zig-zag more than
+    ``OVERSHOOTS_APART_DEG`` from its: inside the logs' rudder, what the model predicts rests
+    on a check beyond them. (On the MARIN KVLCC2 zig-zag, ``blanke`` is left out so and scores
+    within one standard error but worse, 0.41 against 0.36: the other MARIN run confirms it.)"""
     reach = max(float(np.max(np.abs(log["delta"].to_numpy(dtype=float)))) for log in logs)
     if not ruled_out or math.degrees(reach) > HELD_RUDDER_DEG - BEYOND_RUDDER_DEG:
         return []  # the logs reach the held rudder: the check is theirs
@@ -550,8 +551,7 @@ def _ruled_out_apart(chosen, name: str, score: float, ruled_out: Mapping[str, ob
         a, b = overshoots[name], overshoots[k]
         if None in a + b or max(abs(a[0] - b[0]), abs(a[1] - b[1])) <= OVERSHOOTS_APART_DEG:
             continue
-        relation = "better than" if faults[k][1] < score else "as well as"
-        out.append(f"{k} predicts the logs {relation} {name} (free-run scores {faults[k][1]:.3f} "
+        out.append(f"{k} predicts the logs better than {name} (free-run scores {faults[k][1]:.3f} "
                    f"and {score:.3f}) but was left out for its {HELD_RUDDER_DEG:g}° rudder held, "
                    f"beyond the logs' {math.degrees(reach):.3g}° ({faults[k][2]}); their "
                    f"{ZIGZAG_APART[0]:g}°/{ZIGZAG_APART[1]:g}° zig-zags come apart (overshoots "
