@@ -22,8 +22,6 @@ Run: .venv/bin/python benchmarks/study_tanker.py [noise × SEA_SENSORS, default 
 
 from __future__ import annotations
 
-import contextlib
-import io
 import math
 import os
 import sys
@@ -31,10 +29,8 @@ import tempfile
 import time
 import warnings
 
-from cli_models import noisy_files
+from cli_models import model_by_cli, noisy_files
 
-from shipid.cli import main
-from shipid.reporting.modelfile import load_model
 from shipid.trials.manoeuvres import turning_circle, zigzag
 from shipid.vessels import SensorModel, tanker
 
@@ -144,12 +140,6 @@ def summary(rows: list[dict]) -> list[str]:
 
     return [med_max(td, " %"), med_max(r, " %"), f"{np.nanmedian(td20):+.0f} %",
             med_max(zz, "°")]
-
-
-def model_by_cli(argv, paths, out):
-    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
-        code = main([*argv, *paths, "-o", out])
-    return None if code else load_model(out)
 
 
 def main_study(noise: float = 1.0, seeds: int = 3) -> None:
