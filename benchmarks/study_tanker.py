@@ -22,15 +22,18 @@ Run: .venv/bin/python benchmarks/study_tanker.py [noise × SEA_SENSORS, default 
 
 from __future__ import annotations
 
+import json
 import math
 import os
 import sys
 import tempfile
 import time
 import warnings
+from pathlib import Path
 
 from cli_models import model_by_cli, noisy_files
 
+from shipid.identification.plausibility import disqualifying
 from shipid.trials.manoeuvres import turning_circle, zigzag
 from shipid.vessels import SensorModel, tanker
 
@@ -182,6 +185,55 @@ def main_study(noise: float = 1.0, seeds: int = 3) -> None:
     print(f"\n{time.perf_counter() - start:.0f} s")
 
 
+INFLOW = ("blanke-speed", "blanke-race", "blanke-race+race-damping")
+
+
+def inflow_structures(noise: float = 1.0, seeds: int = 3) -> None:
+    """The three structures of identify's inflow comparison, each fitted by ``identify --model``
+    on the 20/20 zig-zags at 80 rpm, judged at the logs' own 80 rpm (what the comparison could
+    have chosen): the 10°/10° overshoots' errors [deg] and the 10°, 20° and 35° turns' tactical
+    diameter errors, and what identify's checks rule out in the file's fit (its prefilter and
+    γ; the comparison's own unfiltered fits at γ = 1e4 can fail where these pass)."""
+    warnings.simplefilter("ignore")
+    ship = ship_at(80)
+    zz = zigzag(ship, 10, 10, duration=1800, dt=DT).indices
+    truth_zz = (zz["first_overshoot_deg"], zz["second_overshoot_deg"])
+    angles = (10.0, 20.0, 35.0)
+    truth_td = {a: turning_circle(ship, a, dt=DT, duration=3000).indices["tactical_diameter"]
+                for a in angles}  # fmt: skip
+    print(f"\nThe inflow comparison's structures from the 20/20 zig-zags at 80 rpm, judged at 80 "
+          f"rpm (the ship: 10°/10° overshoots {truth_zz[0]:.1f}°, {truth_zz[1]:.1f}°; tactical "
+          + ", ".join(f"{a:g}° {truth_td[a]:.0f} m" for a in angles) + ")\n")
+    print("| seed | structure | 10°/10° overshoots, error | TD error 10°, 20°, 35° | identify's "
+          "checks |\n|---|---|---|---|---|")
+    clean = trials()
+    with tempfile.TemporaryDirectory() as tmp:
+        for seed in range(seeds):
+            paths = noisy_files(clean, SEA_SENSORS.scaled(noise), seed, tmp)
+            files = [paths["zz20_80"], paths["zz-20_80"]]
+            for name in INFLOW:
+                model = model_by_cli(["identify", "--model", name], files, f"{tmp}/m.json")
+                if model is None:
+                    print(f"| {seed} | {name} | failed | | |")
+                    continue
+                kw = {"dt": DT, "speed": ship.approach_speed, "steering": ship.steering}
+                ind = zigzag(model, 10, 10, duration=1800, **kw).indices
+                first, second = ind.get("first_overshoot_deg"), ind.get("second_overshoot_deg")
+                os_cell = "–" if first is None or second is None else (
+                    f"{first - truth_zz[0]:+.1f}°, {second - truth_zz[1]:+.1f}°")
+                tds = []
+                for a in angles:
+                    res = turning_circle(model, a, duration=3000, **kw)
+                    td = None if res.diverged else (res.indices or {}).get("tactical_diameter")
+                    tds.append("–" if td is None else f"{100 * (td / truth_td[a] - 1):+.0f} %")
+                report = json.loads(Path(f"{tmp}/m.json").read_text())["identification"][
+                    "plausibility"]  # fmt: skip
+                failed = disqualifying(report, model)
+                print(f"| {seed} | {name} | {os_cell} | {', '.join(tds)} | "
+                      f"{'; '.join(failed) if failed else 'pass'} |", flush=True)
+
+
 if __name__ == "__main__":
     args = sys.argv[1:]
     main_study(float(args[0]) if args else 1.0, int(args[1]) if len(args) > 1 else 3)
+    inflow_structures(float(args[0]) if args else 1.0, int(args[1]) if len(args) > 1 else 3)
