@@ -140,3 +140,30 @@ def test_the_average_yields_to_the_chosen_candidate_check_by_check():
     assert _average_fails(diverging, scale_ship_model(), logs) == reasons  # passes: yields
     assert _average_fails(wrong_way, diverging, logs) == []  # worse: the average stays
     assert _average_fails(wrong_way, _rudder_reversing_beyond(0.4), logs) == []  # as bad: stays
+
+
+def test_an_unsettled_turn_is_read_as_the_selection_reads_it():
+    """A held turn that has not settled after 4800 s was 'no steady turn' in identify's warnings
+    (a warning's severity, which a refit may add) while the comparison ruled the same fit out
+    as ending astern or turning the wrong way, from the last tenth's mean: the tanker's race
+    structure wanders astern and back for over an hour."""
+    from shipid.identification.plausibility import UNSETTLED, WRONG_WAY, failed_checks
+
+    model = scale_ship_model()
+    entry = {"diverged": False, "settled": False, "duration": 4800.0}
+    report = {"approach_speed": 8.0, "surge_equilibrium": 8.0, "rudder_deg": 35.0, "held_rudder": {
+        "starboard": {**entry, "steady_yaw_rate": 0.2, "steady_speed": -0.18},
+        "port": {**entry, "steady_yaw_rate": 0.0004, "steady_speed": 2.0}}}  # fmt: skip
+    failed = failed_checks(report, model)
+    assert failed["held_rudder_starboard"] == (
+        WRONG_WAY, "35° rudder held to starboard: the model goes astern at the end of 4800 s, "
+        "still changing (mean speed -0.18 m/s from 8 m/s ahead)")  # fmt: skip
+    assert failed["held_rudder_port"] == (
+        WRONG_WAY, "35° rudder held to port: the model turns the other way at the end of 4800 s, "
+        "still changing (mean yaw rate 0.0004 rad/s)")  # fmt: skip
+    assert disqualifying(report, model) == ["ends going astern with the rudder held to starboard",
+                                            "turns the wrong way with the rudder to port"]
+    # Unsettled, ahead and the right way: a warning still, as before.
+    report["held_rudder"]["port"]["steady_yaw_rate"] = -0.0004
+    assert failed_checks(report, model)["held_rudder_port"][0] == UNSETTLED
+    assert disqualifying(report, model) == ["ends going astern with the rudder held to starboard"]

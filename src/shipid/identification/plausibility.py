@@ -221,6 +221,19 @@ def failed_checks(report: dict, model: ManoeuvringModel) -> dict[str, tuple[int,
         elif _goes_astern(entry, speed):
             out[key] = (WRONG_WAY, f"{where}: the model ends the turn going astern (steady speed "
                                    f"{entry['steady_speed']:.3g} m/s from {speed:.3g} m/s ahead)")
+        if out.get(key, (0, ''))[0] == UNSETTLED:
+            # Read as ``disqualifying`` reads it, from the last tenth's mean: a turn that wanders
+            # astern and back for an hour was 'no steady turn' here and 'ends going astern' in
+            # the comparison that ruled it out (the tanker's race structure).
+            still = f"at the end of {held:g} s, still changing"
+            if math.copysign(1.0, entry["steady_yaw_rate"]) != (1.0 if side == "starboard"
+                                                               else -1.0):  # fmt: skip
+                out[key] = (WRONG_WAY, f"{where}: the model turns the other way {still} (mean "
+                                       f"yaw rate {entry['steady_yaw_rate']:.3g} rad/s)")
+            elif _goes_astern(entry, speed):
+                out[key] = (WRONG_WAY, f"{where}: the model goes astern {still} (mean speed "
+                                       f"{entry['steady_speed']:.3g} m/s from {speed:.3g} m/s "
+                                       "ahead)")  # fmt: skip
         if out.get(key, (0, ''))[0] < WRONG_WAY and _stalls(entry, speed):  # unsettled too
             out[key] = (WRONG_WAY, f"{where}: the model all but stops in the turn (speed "
                                    f"{entry['steady_speed']:.3g} m/s from {speed:.3g} m/s ahead, "
