@@ -215,7 +215,7 @@ def failed_checks(report: dict, model: ManoeuvringModel) -> dict[str, tuple[int,
             held = entry.get("duration") or report.get("duration") or HELD_DURATION
             out[key] = (UNSETTLED, f"{where}: no steady turn after {held:g} s (yaw rate or "
                                    "speed still changing)")  # fmt: skip
-        elif math.copysign(1.0, entry["steady_yaw_rate"]) != (1.0 if side == "starboard" else -1.0):
+        elif _turns_wrong_way(entry, side):
             out[key] = (WRONG_WAY, f"{where}: the model turns the other way (steady yaw rate "
                                    f"{entry['steady_yaw_rate']:.3g} rad/s)")  # fmt: skip
         elif _goes_astern(entry, speed):
@@ -226,8 +226,7 @@ def failed_checks(report: dict, model: ManoeuvringModel) -> dict[str, tuple[int,
             # astern and back for an hour was 'no steady turn' here and 'ends going astern' in
             # the comparison that ruled it out (the tanker's race structure).
             still = f"at the end of {held:g} s, still changing"
-            if math.copysign(1.0, entry["steady_yaw_rate"]) != (1.0 if side == "starboard"
-                                                               else -1.0):  # fmt: skip
+            if _turns_wrong_way(entry, side):
                 out[key] = (WRONG_WAY, f"{where}: the model turns the other way {still} (mean "
                                        f"yaw rate {entry['steady_yaw_rate']:.3g} rad/s)")
             elif _goes_astern(entry, speed):
@@ -246,6 +245,12 @@ def failed_checks(report: dict, model: ManoeuvringModel) -> dict[str, tuple[int,
                                    f"the training logs run ({1 / curvature:.3g} m): it has all "
                                    "but lost the rudder")  # fmt: skip
     return out
+
+
+def _turns_wrong_way(entry: dict, side: str) -> bool:
+    """A held turn whose (last tenth's mean) yaw rate has the other side's sign."""
+    r = entry.get("steady_yaw_rate")
+    return r is not None and math.copysign(1.0, r) != (1.0 if side == "starboard" else -1.0)
 
 
 def _stalls(entry: dict, approach_speed: float) -> bool:
@@ -290,8 +295,7 @@ def disqualifying_checks(report: dict, model: ManoeuvringModel) -> dict[str, tup
         key, speed = f"held_rudder_{side}", report.get("approach_speed") or 0.0
         if entry.get("diverged"):
             reasons[key] = (DIVERGED, f"diverges with the rudder held to {side}")
-        elif entry.get("steady_yaw_rate") is not None and math.copysign(
-                1.0, entry["steady_yaw_rate"]) != (1.0 if side == "starboard" else -1.0):
+        elif _turns_wrong_way(entry, side):
             reasons[key] = (WRONG_WAY, f"turns the wrong way with the rudder to {side}")
         elif _goes_astern(entry, speed):
             reasons[key] = (WRONG_WAY, f"ends going astern with the rudder held to {side}")
