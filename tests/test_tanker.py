@@ -56,7 +56,12 @@ def test_the_approach_is_the_straight_running_equilibrium(rpm):
     assert _as_written(1.01 * u, 0.0, 0.0, 0.0, rpm / 60)[0] < 0  # a stable speed
     if rpm == 80.0:
         assert u == pytest.approx(8.23, abs=0.005)  # the design speed, 16 kn
-    assert equilibrium_speed(rpm) == u
+    # The closed form against a brute-force root of the transcription (bisection).
+    low, high = 0.1, 20.0
+    for _ in range(100):
+        mid = 0.5 * (low + high)
+        low, high = (mid, high) if _as_written(mid, 0.0, 0.0, 0.0, rpm / 60)[0] > 0 else (low, mid)
+    assert equilibrium_speed(rpm) == pytest.approx(0.5 * (low + high), abs=1e-10)
 
 
 # §4.6, computed from the same equations: n = 80 rpm, deep water, 10° at 2.33 °/s, "equilibrium
