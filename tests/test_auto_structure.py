@@ -340,8 +340,14 @@ def test_the_tied_structures_are_fitted_as_the_models_own_fit(mmg_tied):
     assert prep["filter_hz"] is not None  # the noisy log is prefiltered: the case that differs
     log = lowpass(read_log(mmg_tied.parent / "zz.csv"), prep["filter_hz"])
     gamma = doc["identification"]["gamma"]
+    # At the log's one rps each is written to scale with it, as the model is.
+    from shipid.dynamics.model import get_structure
+    from shipid.dynamics.similarity import rps_similar
+
+    rps = doc["identification"]["rps_similarity"]["rps"]
     for name, model in alternatives_from_document(doc, mmg_tied).items():
-        want = identify(log, model=model.structure, gamma=gamma, force=True).model
+        want = rps_similar(identify(log, model=get_structure(name), gamma=gamma,
+                                    force=True).model, rps)  # fmt: skip
         for dof, terms in want.coefficients.items():
             for term, value in terms.items():
                 assert model.coefficients[dof][term] == pytest.approx(value, rel=1e-9), (name, term)
@@ -370,7 +376,8 @@ def test_manoeuvre_runs_the_structures_the_logs_could_not_tell_apart(mmg_tied, t
 
     gear = SteeringMachine(max_rate=np.radians(rec["rudder_rate_deg_s"]))
     for name, model in alternatives.items():
-        alone = zigzag(model, 10, 10, speed=speed, steering=gear, dt=0.05).indices
+        alone = zigzag(model, 10, 10, speed=speed, rps=rec["approach"]["rps"], steering=gear,
+                       dt=0.05).indices  # fmt: skip
         for key in ("first_overshoot_deg", "second_overshoot_deg"):
             assert rec["tied_structures"][name][key] == pytest.approx(alone[key], abs=1e-9)
         assert f"  {name}: switch_heading_deg 10, first_overshoot_deg " in text
@@ -453,7 +460,8 @@ def test_criteria_give_the_tied_structures_values_beside_the_models(mmg_tied, tm
     alternatives = alternatives_from_document(load_document(mmg_tied), mmg_tied)
     assert set(rec["tied_structures"]) == set(alternatives)
     for name, model in alternatives.items():
-        alone = imo_criteria(model, length=7.0, scale=45.7, speed=cond["speed"], steering=gear)
+        alone = imo_criteria(model, length=7.0, scale=45.7, speed=cond["speed"], rps=cond["rps"],
+                             steering=gear)  # fmt: skip
         keys = zip(alone.table["criterion"], alone.table["manoeuvre"], strict=True)
         expected = dict(zip(keys, alone.table["value"], strict=True))
         for row in rec["criteria"]:

@@ -253,3 +253,28 @@ def test_a_scale_mismatch_names_scale_only_for_marins_files(tmp_path, capsys):
     code, _, err = run(["validate", model, "--format", "simman-hsva", "--no-bands",
                         DATA / "kvlcc2-hsva" / "HSVA_CPMC_KVLCC2_Z_20_10_P.dat"], capsys)
     assert code == 0 and "training logs were at 1:1: carry the model over" in err, err
+
+
+@needs_data
+def test_one_esso_file_predicts_the_logs_at_other_rps_by_similarity(tmp_path):
+    """One zig-zag file at 12 rps (14_03_39), the default identify: carried to other propeller
+    speeds by advance-ratio similarity, its free runs follow the zig-zags at 10, 15 and 16.7 rps
+    closer than the fit's own terms, which answer every rps as 12 (yaw rate error over the
+    log's spread, median: 0.15 against 0.38 over the other ten logs,
+    ``benchmarks/study_esso_single_logs.py``)."""
+    from shipid.reporting.modelfile import load_model
+    from shipid.trials.reading import read_trial_log
+
+    train = OSAKA / "zigzag" / "zigzag_31-Jul-2020_14_03_39.csv"
+    held = [read_trial_log(OSAKA / "zigzag" / f"zigzag_31-Jul-2020_{s}.csv", fmt="osaka-frt")
+            for s in ("13_14_21", "13_22_52", "13_57_45")]  # 16.7, 10 and 15 rps
+    errors = {}
+    for key, extra in (("similar", []), ("plain", ["--no-rps-similarity"])):
+        out = tmp_path / f"{key}.json"
+        assert main(["identify", "--format", "osaka-frt", str(train), "-o", str(out),
+                     *extra]) == 0  # fmt: skip
+        model = load_model(out)
+        errors[key] = [validate(model, log, start_draws=False)[0].metrics["r"]["std"]
+                       / float(np.std(log["r"])) for log in held]  # fmt: skip
+    assert np.median(errors["similar"]) < 0.8 * np.median(errors["plain"]), errors
+    assert all(a < b for a, b in zip(errors["similar"], errors["plain"], strict=True)), errors

@@ -142,6 +142,14 @@ def _block(text: str) -> float | str:
     return value
 
 
+def _add_similarity_option(p) -> None:
+    p.add_argument("--no-rps-similarity", dest="rps_similarity", action="store_false",
+                   help="logs at one propeller speed: keep the fit's terms, which answer every "
+                   "other rps as that one (default: each term that does not grow with the "
+                   "speeds gains the power of n it needs to scale as advance-ratio similarity "
+                   "has it; the model at the logs' rps is the fit)")
+
+
 def _add_block_option(p: argparse.ArgumentParser) -> None:
     """``--block`` of identify's and select's bootstrap (the numbers are
     ``shipid.identification.uncertainty``'s MIN_WHOLE_LOGS and BLOCK_S, not imported: the parser
@@ -261,6 +269,7 @@ def build_parser() -> argparse.ArgumentParser:
                    "one-step acceleration residual, γ and σ (or none) chosen by the free-run "
                    "error of the hybrid on each log left out (--cv); it fades out beyond the "
                    "training logs' envelope. Validate, simulate, manoeuvre and criteria run it")
+    _add_similarity_option(p)
     # --out spelled out: since --output-error, argparse no longer takes it for --output.
     p.add_argument("-o", "--output", "--out", required=True, metavar="MODEL.json")
     _add_physics_options(p)
@@ -310,6 +319,7 @@ def build_parser() -> argparse.ArgumentParser:
                    "(default %(default)s)")
     p.add_argument("--table", metavar="OUT.csv", help="write every candidate with its scores")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    _add_similarity_option(p)
     p.add_argument("-o", "--output", required=True, metavar="MODEL.json")
     _add_physics_options(p)
     _add_log_options(p)

@@ -318,6 +318,10 @@ class ManoeuvringModel:
     coefficients : mapping dof → {term: value}; terms of the structure that are missing are 0.
         Term texts in any spelling of the algebra ('vr' or 'v*r').
     name : str, optional
+    similar_at_rps : float, optional
+        The one propeller speed of the logs of a model carried to every other by advance-ratio
+        similarity (``shipid.dynamics.similarity``): its manoeuvres start, as a model's without
+        propeller terms do, from the training logs' approach speed, times n over this elsewhere.
 
     Attributes
     ----------
@@ -330,9 +334,16 @@ class ManoeuvringModel:
         structure: ModelStructure | str,
         coefficients: Mapping[str, Mapping[str, float]],
         name: str = "",
+        similar_at_rps: float | None = None,
     ) -> None:
         self.structure = get_structure(structure) if isinstance(structure, str) else structure
         self.name = name or self.structure.name
+        if similar_at_rps is not None and not (isinstance(similar_at_rps, int | float)
+                                               and math.isfinite(similar_at_rps)
+                                               and similar_at_rps > 0):  # fmt: skip
+            raise ShipidError(f"similar_at_rps must be a positive propeller speed, got "
+                              f"{similar_at_rps!r}")  # fmt: skip
+        self.similar_at_rps = None if similar_at_rps is None else float(similar_at_rps)
         if not isinstance(coefficients, Mapping):
             raise ShipidError("coefficients must map u/v/r to {term: value}")
         self.coefficients: dict[str, dict[str, float]] = {}
@@ -501,14 +512,18 @@ class ManoeuvringModel:
     # ------------------------------------------------------------------ serialisation
     def to_dict(self) -> dict:
         """The model as JSON-ready data (what model files store)."""
-        return {"name": self.name, "structure": self.structure.to_dict(),
-                "coefficients": self.coefficients}  # fmt: skip
+        out = {"name": self.name, "structure": self.structure.to_dict(),
+               "coefficients": self.coefficients}  # fmt: skip
+        if self.similar_at_rps is not None:
+            out["similar_at_rps"] = self.similar_at_rps
+        return out
 
     @classmethod
     def from_dict(cls, data: Mapping) -> ManoeuvringModel:
         """The model of ``to_dict`` data (term texts in any spelling)."""
         return cls(ModelStructure.from_dict(data["structure"]), data["coefficients"],
-                   name=str(data.get("name", "")))  # fmt: skip
+                   name=str(data.get("name", "")),
+                   similar_at_rps=data.get("similar_at_rps"))  # fmt: skip
 
     def save(self, path, particulars: Mapping | None = None):
         """Write the model alone as a model file (no identification record), atomically;

@@ -104,14 +104,19 @@ def froude_scaled(model: ManoeuvringModel, factor: float, rho: float = RHO,
     """The model of a geometrically similar ship ``factor`` times as long, at equal Froude
     number (speeds × √factor, times × √factor); ``to_rho`` the other water's density (thrust
     terms only)."""
-    return scaled(model, froude_ratios(model.structure, factor, rho, to_rho))
+    return scaled(model, froude_ratios(model.structure, factor, rho, to_rho),
+                  rps_ratio=1 / math.sqrt(factor))  # fmt: skip
 
 
-def scaled(model: ManoeuvringModel, ratios: Mapping[str, Mapping[str, float]]) -> ManoeuvringModel:
-    """The model with each coefficient multiplied by its ratio ({dof: {term: ratio}})."""
+def scaled(model: ManoeuvringModel, ratios: Mapping[str, Mapping[str, float]],
+           rps_ratio: float = 1.0) -> ManoeuvringModel:  # fmt: skip
+    """The model with each coefficient multiplied by its ratio ({dof: {term: ratio}}); the
+    propeller speed its similarity is anchored at (``similar_at_rps``) times ``rps_ratio``."""
     coefs = {dof: {t: c * ratios[dof][t] for t, c in terms.items()}
              for dof, terms in model.coefficients.items()}  # fmt: skip
-    return ManoeuvringModel(model.structure, coefs, name=model.name)
+    anchor = model.similar_at_rps
+    return ManoeuvringModel(model.structure, coefs, name=model.name,
+                            similar_at_rps=None if anchor is None else anchor * rps_ratio)
 
 
 def signal_scale(signal: str, factor: float, rho: float = RHO, to_rho: float | None = None) -> float:

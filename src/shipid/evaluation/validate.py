@@ -352,6 +352,10 @@ def _own_approach(model, log: pd.DataFrame, trial: Trial, wind: tuple[float, flo
     start from); else None."""
     if not getattr(model, "uses_rps", False) or "n" not in log.columns:
         return None
+    if getattr(model, "similar_at_rps", None):
+        # Its n terms come from similarity, not from logs at several rps: it starts where the
+        # log does, as the model without them did (``shipid.dynamics.similarity``).
+        return None
     measured = steady_log_approach(log, trial)
     if measured is None:
         return None

@@ -229,6 +229,11 @@ def _check_model_data(data, key: str, path) -> None:
                 raise ShipidError(f"{path}: {where} is {c}; coefficients must be finite")
     if "name" in data:
         _expect(data["name"], "text", f"{key}.name", path)
+    if data.get("similar_at_rps") is not None:
+        _expect(data["similar_at_rps"], "number", f"{key}.similar_at_rps", path)
+        if not (math.isfinite(data["similar_at_rps"]) and data["similar_at_rps"] > 0):
+            raise ShipidError(f"{path}: {key}.similar_at_rps is {data['similar_at_rps']}; it "
+                              "must be a positive propeller speed")  # fmt: skip
 
 
 def check_document(doc, path) -> None:
@@ -454,7 +459,7 @@ def rescaled_document(doc: Mapping, factor: float, to_rho: float | None = None,
     out = copy.deepcopy(dict(doc))
 
     def scale_model(data: dict) -> dict:
-        return scaled(model_from_document({"model": data}, path), ratios).to_dict()
+        return scaled(model_from_document({"model": data}, path), ratios, 1 / k).to_dict()
 
     out["model"] = scale_model(doc["model"])
     ident = out.get("identification") or {}
@@ -474,10 +479,10 @@ def rescaled_document(doc: Mapping, factor: float, to_rho: float | None = None,
     if chosen:  # select --average keeps the chosen candidate beside the averaged model
         sparse = model_from_document({"model": chosen}, path)
         out["identification"]["selection"]["chosen_model"] = scaled(
-            sparse, froude_ratios(sparse.structure, factor, rho, to_rho)).to_dict()
+            sparse, froude_ratios(sparse.structure, factor, rho, to_rho), 1 / k).to_dict()
     for key, alt in alternatives_from_document(doc, path).items():  # the tied structures' fits
         out["identification"]["structure_choice"]["alternatives"][key] = scaled(
-            alt, froude_ratios(alt.structure, factor, rho, to_rho)).to_dict()
+            alt, froude_ratios(alt.structure, factor, rho, to_rho), 1 / k).to_dict()
     if out.get("uncertainty"):
         unc = out["uncertainty"]
         # The members' structure: the model's, or a superset of it (select --bootstrap).
@@ -507,6 +512,8 @@ def rescaled_document(doc: Mapping, factor: float, to_rho: float | None = None,
             prep[key] = prep[key] * scale
     if isinstance(ident.get("dt"), int | float):
         ident["dt"] = ident["dt"] * k
+    if isinstance((ident.get("rps_similarity") or {}).get("rps"), int | float):
+        ident["rps_similarity"]["rps"] = ident["rps_similarity"]["rps"] / k
     # The LS-SVM fit's standard errors are printed beside the coefficients: they scale with
     # them (a rescaled model's report printed ṙ's u·v as 0.0054 ± 0.0009, the error of 0.54).
     from shipid.dynamics.prime import prime_factor
@@ -529,6 +536,115 @@ def rescaled_document(doc: Mapping, factor: float, to_rho: float | None = None,
         "note": "viscous (Reynolds) effects are not scaled; identification.discrete and "
                 "diagnostics (but their standard errors) are those of the fit at the original "
                 "scale"})  # fmt: skip
+    return _fingerprinted(out)
+
+
+def rps_similar_document(doc: Mapping, rps: float, path: str | Path = "model file") -> dict:
+    """The model file of a fit to logs at the one propeller speed ``rps`` with its model carried
+    to every other by advance-ratio similarity (``shipid.dynamics.similarity``): the model, the
+    refinement's, the tied structures' and the chosen candidate's, every bootstrap replicate,
+    the standard errors, covariances, priors and bounds, their terms renamed and coefficients
+    scaled as one. The LS-SVM's own record (``identification.discrete``) stays the fit's;
+    ``identification.rps_similarity`` says what was done. None where no term gains a factor of
+    n, or the bootstrap replicates' terms would merge."""
+    import copy
+
+    import numpy as np
+
+    from shipid.dynamics.model import DOFS
+    from shipid.dynamics.similarity import rps_similar, similar_term, similarity_map
+    from shipid.dynamics.terms import parse_term
+
+    model = model_from_document(dict(doc), path)
+    found = similarity_map(model.structure, rps)
+    if not found.changes:
+        return None
+    out = copy.deepcopy(dict(doc))
+
+    def convert(data: Mapping) -> dict:
+        return rps_similar(model_from_document({"model": data}, path), rps).to_dict()
+
+    def rename(dof: str, term: str) -> tuple[str, float]:
+        """(similar term, ratio) of a term of the model's ``dof`` equation (of another
+        structure's: as similarity writes it alone)."""
+        given = found.renamed.get(dof, {}).get(parse_term(term).text)
+        if given is not None:
+            return given
+        new, k = similar_term(term)
+        return new, rps**-k
+
+    def mapped(values: Mapping, dof: str) -> dict:
+        """{term: value} of equation ``dof`` renamed, each value (or pair) times its ratio."""
+        res = {}
+        for t, v in values.items():
+            new, ratio = rename(dof, t)
+            res[new] = [b * ratio for b in v] if isinstance(v, list) else \
+                (None if v is None else v * ratio)  # fmt: skip
+        return res
+
+    unc = out.get("uncertainty")
+    if unc:
+        # Each replicate's row of each equation, renamed as that equation's terms are.
+        thetas = np.asarray(unc["thetas"], dtype=float)
+        names = [[rename(dof, t) for t in unc["terms"]] for dof in DOFS]
+        columns = list(dict.fromkeys(n for row in names for n, _ in row))
+        moved = np.zeros((thetas.shape[0], 3, len(columns)))
+        for i, row in enumerate(names):
+            targets = [columns.index(n) for n, _ in row]
+            live = [j for j in range(len(row)) if np.any(thetas[:, i, j] != 0)]
+            if len({targets[j] for j in live}) < len(live):
+                return None  # two of a replicate's terms would become one
+            for j in live:
+                moved[:, i, targets[j]] = thetas[:, i, j] * row[j][1]
+        unc["thetas"], unc["terms"] = moved.tolist(), columns
+    out["model"] = convert(doc["model"])
+    ident = out.get("identification") or {}
+    refinement = ident.get("refinement")
+    if refinement:
+        for key in ("initial_model", "refined_model"):
+            if refinement.get(key):
+                refinement[key] = convert(refinement[key])
+        stats = refinement.get("statistics") or {}
+        for key in ("standard_errors", "bounds"):
+            if stats.get(key):
+                stats[key] = {d: mapped(v, d) for d, v in stats[key].items()}
+        cov = stats.get("covariance")
+        if cov:
+            pairs = [rename(d, t) for d, t in cov["terms"]]
+            cov["matrix"] = [[c * pairs[i][1] * pairs[j][1] for j, c in enumerate(row)]
+                             for i, row in enumerate(cov["matrix"])]  # fmt: skip
+            cov["terms"] = [[d, p[0]] for (d, _), p in zip(cov["terms"], pairs, strict=True)]
+        if stats.get("at_bound"):
+            stats["at_bound"] = [[d, rename(d, t)[0]] for d, t in stats["at_bound"]]
+    chosen = (ident.get("selection") or {}).get("chosen_model")
+    if chosen:
+        ident["selection"]["chosen_model"] = convert(chosen)
+    for key, alt in ((ident.get("structure_choice") or {}).get("alternatives") or {}).items():
+        ident["structure_choice"]["alternatives"][key] = convert(alt)
+    for dof, diag in (ident.get("diagnostics") or {}).items():
+        if not isinstance(diag, dict):
+            continue
+        if diag.get("std_errors"):
+            diag["std_errors"] = mapped(diag["std_errors"], dof)
+        for pair in diag.get("most_collinear") or []:
+            pair["terms"] = [rename(dof, t)[0] for t in pair["terms"]]
+        for key in ("constant_terms", "at_bound"):
+            if diag.get(key):
+                diag[key] = [rename(dof, t)[0] for t in diag[key]]
+    physics = ident.get("physics")
+    if physics:
+        for key in ("prior", "bounds"):
+            if physics.get(key):
+                physics[key] = {d: mapped(v, d) for d, v in physics[key].items()}
+    model_out = model_from_document(out, path)
+    out["prime"] = prime_record(model_out, out.get("particulars"),
+                                (ident.get("preprocessing") or {}).get("approach_speed"))
+    ident["rps_similarity"] = {
+        "rps": float(rps), "terms": found.describe(),
+        "note": "logs at one propeller speed cannot show how a force depends on it; each term "
+                "is written to scale with it as advance-ratio similarity has it, so the model "
+                "is the fit at this rps and scales to others; identification.discrete is the "
+                "fit's"}  # fmt: skip
     return _fingerprinted(out)
 
 

@@ -1,0 +1,224 @@
+"""A model of logs at one propeller speed carried to every other by advance-ratio similarity
+(``shipid.dynamics.similarity``): the fit itself at its rps, the similarity law through the
+simulator elsewhere, and the model file's records carried with it."""
+
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+from cli_helpers import run
+
+from shipid.data.io import write_log
+from shipid.dynamics.model import ManoeuvringModel
+from shipid.dynamics.prime import froude_scaled
+from shipid.dynamics.similarity import rps_similar, similar_term, similarity_map, speed_degree
+from shipid.dynamics.simulate import simulate_log
+from shipid.trials.manoeuvres import zigzag
+from shipid.vessels import PAPER_IMU, scale_ship
+
+N0 = 12.0
+# Blanke's terms with the race's and the wind's: every degree from 0 to 2, and a wind term.
+TERMS = {
+    "u": ["|u|*u", "v*r", "delta^2", "1"],
+    "v": ["u*r", "u*v", "|v|*v", "u^2*delta", "u*delta", "delta", "v", "1",
+          "wind_speed^2*sin(wind_angle)"],
+    "r": ["u*r", "u*v", "|v|*r", "u^2*delta", "u*delta", "delta", "r", "1"],
+}
+COEFS = {
+    "u": [-0.04, 0.9, -0.02, 0.012],
+    "v": [-0.4, -0.5, -0.8, -0.10, 0.08, -0.02, -0.3, 0.002, -4e-4],
+    "r": [-0.35, -0.3, -0.5, -0.13, 0.1, -0.01, 0.05, -0.001],
+}
+
+
+def _fitted() -> ManoeuvringModel:
+    """A model as a fit at N0 rps gives it: no term in n."""
+    structure = "; ".join(f"{d}: {', '.join(t)}" for d, t in TERMS.items())
+    return ManoeuvringModel(structure, {d: dict(zip(TERMS[d], COEFS[d], strict=True))
+                                        for d in TERMS})  # fmt: skip
+
+
+def _log(c: float = 1.0) -> pd.DataFrame:
+    """A rudder and wind history at N0 and, with ``c``, the same manoeuvre at c·N0: time over c,
+    speeds and rates times c (the wind, an outside speed, scaled alike for the law to hold)."""
+    t = np.arange(0, 150, 0.1)
+    return pd.DataFrame({
+        "t": t / c, "delta": np.radians(25) * np.sin(2 * np.pi * t / 50),
+        "u": 0.4 * c, "v": 0.0, "r": 0.0, "n": N0 * c + 0 * t,
+        "wind_speed": (1.5 + np.sin(t / 7)) * c, "wind_angle": np.radians(40) + 0 * t,
+    })  # fmt: skip
+
+
+def test_at_its_rps_the_similar_model_is_the_fit():
+    fitted = _fitted()
+    similar = rps_similar(fitted, N0)
+    assert similar.uses_rps and not fitted.uses_rps and similar.similar_at_rps == N0
+    rng = np.random.default_rng(0)
+    u, v, r, d = rng.uniform(0.1, 0.6, 40), rng.normal(0, .05, 40), rng.normal(0, .05, 40), \
+        rng.normal(0, .3, 40)  # fmt: skip
+    wind = {"wind_speed": rng.uniform(0, 3, 40), "wind_angle": rng.uniform(-3, 3, 40)}
+    at = similar.accelerations(u, v, r, d, rps=np.full(40, N0), **wind)
+    np.testing.assert_allclose(at, fitted.accelerations(u, v, r, d, rps=np.full(40, N0), **wind),
+                               rtol=1e-13, atol=1e-17)  # fmt: skip
+    # Elsewhere the rudder alone (δ, degree 0) is four times as strong at twice the rps.
+    one = {k: np.zeros(1) for k in ("wind_speed", "wind_angle")}
+    ratio = (similar.accelerations(0.0, 0.0, 0.0, 0.2, rps=np.array([2 * N0]), **one)[0, 1]
+             - similar.accelerations(0.0, 0.0, 0.0, 0.0, rps=np.array([2 * N0]), **one)[0, 1]) \
+        / (fitted.accelerations(0.0, 0.0, 0.0, 0.2, **one)[0, 1]
+           - fitted.accelerations(0.0, 0.0, 0.0, 0.0, **one)[0, 1])  # fmt: skip
+    assert ratio == pytest.approx(4.0, rel=1e-12)
+
+
+@pytest.mark.parametrize("c", [2.0, 0.5, 1.39])
+def test_the_similar_model_runs_the_same_path_at_another_rps(c):
+    """The similarity law through the simulator: at c·n₀ every speed is c times, time 1/c, the
+    path the same. The fit itself (its thrust and rudder force the same at every rps) does not."""
+    similar = rps_similar(_fitted(), N0)
+    slow = simulate_log(similar, _log()).log
+    fast = simulate_log(similar, _log(c)).log
+    for col, scale in (("u", c), ("v", c), ("r", c), ("psi", 1.0), ("x", 1.0), ("y", 1.0)):
+        np.testing.assert_allclose(fast[col], slow[col] * scale, rtol=1e-9, atol=1e-12,
+                                   err_msg=col)  # fmt: skip
+    plain = simulate_log(_fitted(), _log(c)).log
+    assert np.max(np.abs(plain["y"] - slow["y"])) > 1.0  # metres apart: not similar
+
+
+def test_terms_keep_their_form_where_similarity_cannot_write_them():
+    assert speed_degree("wind_speed^2*sin(wind_angle)") is None
+    assert speed_degree("thrust") == 2 and speed_degree("|u|*u*delta") == 2
+    assert similar_term("1") == ("|n|*n", 2)
+    assert similar_term("u*delta") == ("u*|n|*delta", 1)
+    assert similar_term("u^3") == ("u^3", 0)
+    # blanke-rps has its own |n|n beside the constant: the constant stays as fitted.
+    found = similarity_map(ManoeuvringModel("blanke-rps", {}).structure, 10.0)
+    assert found.renamed["u"]["1"] == ("1", 1.0)
+    assert found.renamed["v"]["1"] == ("|n|*n", 0.01)
+    cubic = similarity_map(ManoeuvringModel("u: u^3, 1; v: v^3, delta", {}).structure, 10.0)
+    assert "u³" in cubic.describe() and cubic.renamed["u"]["u^3"] == ("u^3", 1.0)
+    with pytest.raises(ValueError, match="positive"):
+        similarity_map(_fitted().structure, 0.0)
+
+
+def test_froude_scaling_carries_the_anchor():
+    similar = rps_similar(_fitted(), N0)
+    assert froude_scaled(similar, 4.0).similar_at_rps == pytest.approx(N0 / 2)
+    assert ManoeuvringModel.from_dict(similar.to_dict()).similar_at_rps == N0
+    assert "similar_at_rps" not in _fitted().to_dict()
+
+
+# ---------------------------------------------------------------------------- the command line
+@pytest.fixture(scope="module")
+def one_rps(tmp_path_factory):
+    """The paper's ship's noisy 20/20 zig-zag with a constant propeller speed logged, and
+    the default identify of it with and without similarity, with a bootstrap."""
+    folder = tmp_path_factory.mktemp("similar")
+    log = zigzag(scale_ship(rudder_rate_deg=9.6), 20, 20, duration=90, dt=0.2, method="euler",
+                 approach=2.0).log  # fmt: skip
+    path = write_log(PAPER_IMU.apply(log, seed=3).assign(n=N0), folder / "zz.csv")
+    import contextlib
+    import io
+
+    from shipid.cli import main
+
+    out = {}
+    for key, extra in (("similar", []), ("plain", ["--no-rps-similarity"])):
+        out[key] = folder / f"{key}.json"
+        with contextlib.redirect_stdout(io.StringIO()) as said, \
+                contextlib.redirect_stderr(io.StringIO()):  # fmt: skip
+            assert main(["identify", str(path), "--no-output-error", "--bootstrap", "10",
+                         "-o", str(out[key]), *extra]) == 0  # fmt: skip
+        out[f"{key}_said"] = said.getvalue()
+    return out
+
+
+def test_identify_writes_the_one_rps_fit_to_scale_with_the_propeller(one_rps):
+    doc = json.loads(one_rps["similar"].read_text())
+    plain = json.loads(one_rps["plain"].read_text())
+    assert "propeller speed: the logs run at one 12 rps" in one_rps["similar_said"]
+    assert "propeller speed" not in one_rps["plain_said"]
+    rec = doc["identification"]["rps_similarity"]
+    assert rec["rps"] == pytest.approx(N0) and "δ → n² δ" in rec["terms"]
+    assert doc["model"]["similar_at_rps"] == pytest.approx(N0)
+    assert "|n|*n" in doc["model"]["structure"]["terms"]["v"]
+    assert "n^2*delta" in doc["model"]["structure"]["terms"]["r"]
+    # Every record keyed by term follows the model: coefficients and standard errors scaled as
+    # one (their ratio is the fit's), the bootstrap's columns renamed.
+    for dof in ("v", "r"):
+        c, se = doc["model"]["coefficients"][dof], doc["identification"]["diagnostics"][dof]
+        c0, se0 = plain["model"]["coefficients"][dof], plain["identification"]["diagnostics"][dof]
+        assert c["n^2*delta"] == pytest.approx(c0["delta"] / N0**2, rel=1e-12)
+        assert se["std_errors"]["n^2*delta"] / c["n^2*delta"] == pytest.approx(
+            se0["std_errors"]["delta"] / c0["delta"], rel=1e-12)
+    assert set(doc["uncertainty"]["terms"]) == set(doc["model"]["structure"]["terms"]["u"]
+                                                   + doc["model"]["structure"]["terms"]["v"])
+    assert doc["identification"]["discrete"] == plain["identification"]["discrete"]
+
+
+def test_at_the_logs_rps_manoeuvres_are_the_fits_and_elsewhere_they_scale(one_rps, tmp_path,
+                                                                          capsys):
+    """At the logs' rps the similar model's turn, with its bootstrap intervals, is the fit's; at
+    twice the rps its approach is twice the logs', and the fit ignores the rps."""
+    turns = {}
+    for key in ("similar", "plain"):
+        out = tmp_path / f"{key}.json"
+        code, text, err = run(["manoeuvre", one_rps[key], "turning", "--rudder", "20",
+                               "--json", out], capsys)  # fmt: skip
+        assert code == 0, err
+        turns[key] = json.loads(out.read_text())
+        assert "approach: " in text and "the training logs' approach speed" in text
+    for k, v in turns["plain"]["indices"].items():
+        if isinstance(v, float):
+            assert turns["similar"]["indices"][k] == pytest.approx(v, rel=1e-9, abs=1e-12), k
+    for k, (lo, hi) in turns["plain"]["index_intervals"].items():
+        assert turns["similar"]["index_intervals"][k] == pytest.approx([lo, hi], rel=1e-9), k
+    code, text, err = run(["manoeuvre", one_rps["similar"], "turning", "--rudder", "20",
+                           "--rps", 2 * N0, "--no-bands"], capsys)  # fmt: skip
+    speed = turns["similar"]["approach"]["speed"]
+    assert f"approach: {2 * speed:.4g} m/s at 24 rps (the training logs' approach speed at 12 " \
+        "rps, scaled with the propeller speed" in text  # fmt: skip
+    code, text, err = run(["manoeuvre", one_rps["plain"], "turning", "--rps", 2 * N0,
+                           "--no-bands"], capsys)  # fmt: skip
+    assert "--rps 24 changes nothing" in err
+
+
+def test_rescale_carries_the_anchor_of_a_similar_model(one_rps, tmp_path, capsys):
+    out = tmp_path / "big.json"
+    assert run(["rescale", one_rps["similar"], "--factor", "16", "-o", out], capsys)[0] == 0
+    doc = json.loads(out.read_text())
+    assert doc["model"]["similar_at_rps"] == pytest.approx(N0 / 4)
+    assert doc["identification"]["rps_similarity"]["rps"] == pytest.approx(N0 / 4)
+    assert doc["identification"]["preprocessing"]["approach_rps"] == pytest.approx(N0 / 4)
+
+
+def test_a_bad_anchor_in_a_model_file_is_one_line(one_rps, tmp_path, capsys):
+    doc = json.loads(one_rps["similar"].read_text())
+    doc["model"]["similar_at_rps"] = -3
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps(doc))
+    code, _, err = run(["manoeuvre", bad, "turning", "--no-bands"], capsys)
+    assert code == 1 and "model.similar_at_rps is -3" in err and "Traceback" not in err
+
+
+def test_an_output_error_fit_is_carried_with_its_statistics(one_rps, tmp_path, capsys):
+    """The output-error fit's standard errors, covariance and draws follow the model's terms:
+    each equation's covariance in the ratio of its coefficients (one to one, as the fit's)."""
+    log = one_rps["similar"].parent / "zz.csv"
+    files = {}
+    for key, extra in (("similar", []), ("plain", ["--no-rps-similarity"])):
+        files[key] = tmp_path / f"{key}.json"
+        code, _, err = run(["identify", log, "--output-error", "-o", files[key], *extra], capsys)
+        assert code == 0, err
+    doc, plain = (json.loads(files[k].read_text()) for k in ("similar", "plain"))
+    stats = doc["identification"]["refinement"]["statistics"]
+    stats0 = plain["identification"]["refinement"]["statistics"]
+    terms = doc["model"]["structure"]["terms"]
+    for dof, errors in stats["standard_errors"].items():
+        assert set(errors) <= set(terms[dof])
+    labels = [tuple(x) for x in stats["covariance"]["terms"]]
+    i, i0 = labels.index(("r", "n^2*delta")), [tuple(x) for x in
+                                                stats0["covariance"]["terms"]].index(("r", "delta"))
+    assert stats["covariance"]["matrix"][i][i] == pytest.approx(
+        stats0["covariance"]["matrix"][i0][i0] / N0**4, rel=1e-12)
+    code, text, err = run(["validate", files["similar"], log, "--no-bands"], capsys)
+    assert code == 0, err
