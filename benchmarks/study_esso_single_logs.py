@@ -38,9 +38,10 @@ def main() -> None:
     held = {f: read_trial_log(f, fmt="osaka-frt") for f in files}
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores\n")
     print("| trained on | rps | structure (how) | held-out logs: r error / spread, median (worst) "
-          "| diverged | seconds |")
-    print("|---|---|---|---|---|---|")
+          "| the same, --no-rps-similarity | diverged | seconds |")
+    print("|---|---|---|---|---|---|---|")
     start = time.perf_counter()
+    other_rps = []  # (with, without similarity) on the held-out logs at another rps
     with tempfile.TemporaryDirectory() as tmp:
         out = f"{tmp}/m.json"
         for f in zigzags:
@@ -50,18 +51,34 @@ def main() -> None:
                 code = shipid(["identify", "--format", "osaka-frt", str(f), "-o", out])
             seconds = time.perf_counter() - t0
             if code:
-                print(f"| {f.stem[-8:]} | | failed | | | |")
+                print(f"| {f.stem[-8:]} | | failed | | | | |")
                 continue
             how = (json.loads(open(out).read())["identification"].get("structure_choice")
                    or {}).get("how")  # fmt: skip
             model = load_model(out)
-            errors = _errors(model, {g: log for g, log in held.items() if g != f})
+            others = {g: log for g, log in held.items() if g != f}
+            errors = _errors(model, others)
+            with contextlib.redirect_stdout(io.StringIO()), \
+                    contextlib.redirect_stderr(io.StringIO()):  # fmt: skip
+                shipid(["identify", "--format", "osaka-frt", str(f), "--no-rps-similarity",
+                        "-o", f"{tmp}/plain.json"])  # fmt: skip
+            plain = _errors(load_model(f"{tmp}/plain.json"), others)
             finite = errors[np.isfinite(errors)]
             rps = float(np.median(held[f]["n"]))
+            for g, a, b in zip(others, errors, plain, strict=True):
+                if abs(float(np.median(held[g]["n"])) - rps) > 0.1:
+                    other_rps.append((a, b))
             worst = f"{finite.max():.2f}" if finite.size else "–"
             print(f"| {f.stem[-8:]} | {rps:.4g} | {model.structure.name} ({how}) | "
-                  f"{np.median(errors):.2f} ({worst}) | {int(np.isinf(errors).sum())} of "
+                  f"{np.median(errors):.2f} ({worst}) | {np.median(plain):.2f} "
+                  f"({plain[np.isfinite(plain)].max():.2f}) | {int(np.isinf(errors).sum())} of "
                   f"{len(errors)} | {seconds:.1f} |")
+        pairs = np.array(other_rps)
+        print(f"\nHeld-out logs at another propeller speed than the file's ({len(pairs)} runs): "
+              f"r error / spread median {np.median(pairs[:, 0]):.2f} with the default's "
+              f"advance-ratio similarity, {np.median(pairs[:, 1]):.2f} without "
+              f"(--no-rps-similarity); better in {int(np.sum(pairs[:, 0] < pairs[:, 1]))}, worse "
+              f"in {int(np.sum(pairs[:, 0] > pairs[:, 1]))}")
         print("\nEvery pair of zig-zag files, by how the default chose the structure: held-out "
               "logs' r error / spread, the median over the pairs of each pair's median, and the "
               "runs that diverged\n")

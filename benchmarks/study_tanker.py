@@ -216,7 +216,8 @@ def inflow_structures(noise: float = 1.0, seeds: int = 3) -> None:
                 if model is None:
                     print(f"| {seed} | {name} | failed | | |")
                     continue
-                kw = {"dt": DT, "speed": ship.approach_speed, "steering": ship.steering}
+                kw = {"dt": DT, "speed": ship.approach_speed, "steering": ship.steering,
+                      "rps": 80 / 60 if model.uses_rps else None}  # fmt: skip
                 ind = zigzag(model, 10, 10, duration=1800, **kw).indices
                 first, second = ind.get("first_overshoot_deg"), ind.get("second_overshoot_deg")
                 os_cell = "–" if first is None or second is None else (
