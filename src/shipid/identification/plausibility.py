@@ -99,7 +99,7 @@ def held_rudder(model: ManoeuvringModel, speed: float, rps: float | None = None,
 
 def _held(model, speed, rps, rudder_deg, side, duration, dt) -> dict:
     res = turning_circle(model, rudder_deg, side=side, duration=duration, dt=dt, speed=speed,
-                         rps=rps)  # fmt: skip
+                         rps=rps, indices=False)  # fmt: skip
     entry = {"diverged": res.diverged, "reason": res.reason, "duration": duration,
              "settled": False}  # fmt: skip
     if not res.diverged:

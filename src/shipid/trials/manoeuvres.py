@@ -411,12 +411,15 @@ def turning_circle(
     wind: tuple[float, float] | None = None,
     initial: Mapping[str, float] | None = None,
     release: float = math.inf,
+    indices: bool = True,
 ) -> ManoeuvreResult:
     """Turning circle: rudder to ``side`` at t = ``approach`` (the rudder execute), held.
     ``duration`` [s]: by default 240 s, doubled until the heading has turned 180° and the turn is
     steady. ``initial`` (u, v, r, psi, delta) starts the run from a given state, the rudder held
     at its ``delta`` until ``approach`` (as ``zigzag``'s). ``release``: the time the rudder goes
-    back to midships (a measured turn that ends in a pull-out; the indices are the held turn's)."""
+    back to midships (a measured turn that ends in a pull-out; the indices are the held turn's).
+    ``indices=False`` (with a ``duration``): the run alone, for a check that reads its states
+    (the plausibility checks' held rudder: the indices were a third of their time)."""
     vessel = as_vessel(ship, speed, steering, rps)
     value = _rudder_to(side, vessel, rudder_deg)
     held = float((initial or {}).get("delta", 0.0))
@@ -426,7 +429,7 @@ def turning_circle(
     def run(length: float) -> ManoeuvreResult:
         res = run_closed_loop(vessel, params, length, dt, method, initial=initial, rps=rps)
         res.log.attrs["manoeuvre"] = f"turning circle {rudder_deg:g}° to {side}"
-        if not res.diverged:
+        if not res.diverged and indices:
             res.indices = turning_indices(res.log, t_order=approach,
                                           length=_finite_or_none(vessel.length))  # fmt: skip
             if res.indices.get("time_to_180") is None:
@@ -436,6 +439,8 @@ def turning_circle(
                 res.incomplete = f"the turn is not steady within {length:g} s"  # fmt: skip
         return res
 
+    if not indices and duration is None:
+        raise ShipidError("a turning circle without its indices needs a duration")
     return run(duration) if duration is not None else _extended(run, TURNING_DURATION)
 
 
