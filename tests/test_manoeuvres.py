@@ -98,6 +98,20 @@ def test_manoeuvre_log_replays_exactly_with_simulate_log():
     np.testing.assert_allclose(again.log.to_numpy(), res.log.to_numpy(), rtol=1e-12, atol=1e-12)
 
 
+def test_a_turn_without_its_indices_is_the_same_run():
+    """``indices=False``, for checks that read only a held turn's states: the same run to the
+    bit, no indices; without a duration it would not know when to stop, and says so."""
+    from shipid.errors import ShipidError
+
+    ship = scale_ship()
+    full = turning_circle(ship, 35, duration=120, dt=0.1)
+    bare = turning_circle(ship, 35, duration=120, dt=0.1, indices=False)
+    assert full.indices["tactical_diameter"] > 0 and bare.indices == {}
+    np.testing.assert_array_equal(bare.log.to_numpy(), full.log.to_numpy())
+    with pytest.raises(ShipidError, match="needs a duration"):
+        turning_circle(ship, 35, indices=False)
+
+
 def test_a_model_s_manoeuvre_says_no_scale_it_does_not_know():
     # Bug: a model (which carries no scale) wrote its runs at scale 1, read back as full scale.
     ship = scale_ship()
