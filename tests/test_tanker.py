@@ -107,32 +107,106 @@ def test_the_cli_knows_the_tanker_and_its_rudder_limit(capsys):
             tanker(rpm=rpm)
 
 
-def test_the_inflow_comparison_names_the_structures_it_leaves_out(tmp_path, capsys):
-    """From the tanker's 20/20 zig-zags at 80 rpm, identify compares the rudder's inflow and
-    two of its three structures end their 35° turns astern: the note said only 'free-run
-    scores blanke-speed 0.347; blanke-race+race-damping where within one standard error of the
-    best', as if the race structure had been scored and lost."""
+def _zigzags_at_80_rpm(ship):
+    return [zigzag(ship, 20, 20, first=side, duration=1200, dt=1.0, approach=60.0).log.assign(
+        n=80 / 60) for side in ("starboard", "port")]  # fmt: skip
+
+
+def test_the_inflow_comparison_widens_the_race_where_its_best_is_ruled_out(tmp_path, capsys):
+    """From the tanker's 20/20 zig-zags at 80 rpm, two of the three structures compared end
+    their 35° turns astern, among them the race structure, which predicts the logs best: the
+    logs prefer what physics rejects. The race with the rudder's lift at the hull's drift is
+    compared too and fitted; its turns and 10°/10° zig-zag come within 2 % and 1.5° of the
+    ship's, where blanke-speed, fitted before, put the steady yaw rate 39 % low and the second
+    overshoot 6.3° low (study_tanker.py). The note still names what it left out, and why (it
+    read as if the race structure had been scored and lost)."""
     from shipid.data.io import write_log
+    from shipid.reporting.modelfile import load_model
 
     ship = tanker(rudder_limit_deg=35.0)
-    paths = [write_log(zigzag(ship, 20, 20, first=side, duration=1200, dt=1.0, approach=60.0)
-                       .log.assign(n=80 / 60), tmp_path / f"zz_{side}.csv")
-             for side in ("starboard", "port")]  # fmt: skip
+    paths = [write_log(log, tmp_path / f"zz_{i}.csv")
+             for i, log in enumerate(_zigzags_at_80_rpm(ship))]  # fmt: skip
     code, out, err = run(["identify", *paths, "--filter", "none", "--no-output-error",
                           "-o", tmp_path / "m.json"], capsys)  # fmt: skip
     assert code == 0, err
     (line,) = [x for x in out.splitlines() if x.startswith("structure: ")]
-    assert line.startswith("structure: blanke-speed")
+    assert line.startswith("structure: blanke-race+race-damping+rudder-drift")
     assert ("implausible, not scored: blanke (ends going astern with the rudder held to "
             "starboard; ends going astern with the rudder held to port), "
             "blanke-race+race-damping (ends going astern") in line
-    # They predict the logs better, and a 10°/10° zig-zag apart: the 35° check, beyond the
-    # logs' 20°, made the choice, and the user is told (the race structure puts the ship's
-    # 10°/10° second overshoot within 0.7°, blanke-speed 6.3° low: study_tanker.py).
-    (warning,) = [x for x in err.splitlines() if "blanke-race+race-damping predicts the logs" in x]
-    assert "predicts the logs better than blanke-speed (free-run scores 0." in warning
+    assert ("blanke-race+race-damping+rudder-drift compared because blanke-race+race-damping, "
+            "the best on the logs, is ruled out by its held rudder alone") in line
+    model = load_model(tmp_path / "m.json")
+    kw = {"dt": 1.0, "speed": ship.approach_speed, "steering": ship.steering, "rps": 80 / 60}
+    for side in ("starboard", "port"):
+        own = turning_circle(ship, 35, side=side, dt=1.0, duration=3000).indices
+        fit = turning_circle(model, 35, side=side, duration=3000, **kw).indices
+        assert fit["tactical_diameter"] == pytest.approx(own["tactical_diameter"], rel=0.02)
+        assert fit["steady_yaw_rate"] == pytest.approx(own["steady_yaw_rate"], rel=0.03)
+    own = zigzag(ship, 10, 10, dt=1.0, duration=1800).indices
+    fit = zigzag(model, 10, 10, duration=1800, **kw).indices
+    for key in ("first_overshoot_deg", "second_overshoot_deg"):
+        assert fit[key] == pytest.approx(own[key], abs=1.5)
+
+
+def test_a_structure_ruled_out_beyond_the_logs_is_named_where_it_predicts_them_better():
+    """Where a structure left out for its held 35° rudder alone predicts the logs better than
+    the one fitted and a 10°/10° zig-zag apart from it, the user is told: inside the logs'
+    rudder the choice rests on a check beyond them (the tanker's race structure puts the
+    10°/10° second overshoot within 0.7°, blanke-speed 6.3° low)."""
+    from shipid.identification.auto_structure import _ruled_out_apart
+    from shipid.identification.identify import identify
+
+    logs = _zigzags_at_80_rpm(tanker(rudder_limit_deg=35.0))
+    chosen = identify(logs, model="blanke-speed").model
+    race = identify(logs, model="blanke-race+race-damping").model
+    why = "ends going astern with the rudder held to starboard"
+    (warning,) = _ruled_out_apart(chosen, "blanke-speed", 0.283,
+                                  {"blanke-race+race-damping": race},
+                                  {"blanke-race+race-damping": (1, 0.05, why)}, logs)
+    assert warning.startswith("blanke-race+race-damping predicts the logs better than "
+                              "blanke-speed (free-run scores 0.050 and 0.283)")
     assert "left out for its 35° rudder held, beyond the logs' 20°" in warning
     assert warning.endswith("or --model blanke-race+race-damping, decides")
+    # Logs that reach the held rudder hold the check themselves: no warning.
+    wide = [log.assign(delta=log["delta"] * 35 / 20) for log in logs]
+    assert _ruled_out_apart(chosen, "blanke-speed", 0.283, {"blanke-race+race-damping": race},
+                            {"blanke-race+race-damping": (1, 0.05, why)}, wide) == []
+
+
+def test_the_default_library_is_widened_where_the_logs_best_fit_is_ruled_out():
+    """From the tanker's zig-zags at 80 and 50 rpm, every best-scoring candidate of select's
+    default library ends its held 35° turns astern or turns the wrong way: the logs prefer what
+    physics rejects (noise-free, none of its candidates passes). The default then chooses again
+    with the rudder's lift at the hull's drift (rudder-drift), whose choice passes and turns
+    within 3 % (steady yaw rates 5 %) of the ship at both propeller speeds; identify's model of
+    noisy logs turned 37–41 % short before (benchmarks/study_tanker.py)."""
+    from shipid.identification.auto_structure import auto_structure
+    from shipid.identification.identify import identify
+
+    logs = []
+    for rpm, amplitude, side in ((80, 10, "starboard"), (80, 20, "starboard"),
+                                 (50, 10, "starboard"), (50, 20, "port")):  # fmt: skip
+        ship = tanker(rpm, rudder_limit_deg=35.0)
+        logs.append(zigzag(ship, amplitude, amplitude, first=side, duration=600, dt=1.0,
+                           approach=60.0).log.assign(n=rpm / 60))  # fmt: skip
+    choice = auto_structure(logs)
+    assert choice.how == "select"
+    assert choice.library.startswith("low-speed+wind+propeller-asymmetry+astern+rudder-drift")
+    (note,) = [n for n in choice.notes if "ruled out" in n]
+    assert note.startswith("the best-scoring candidate of low-speed+wind+propeller-asymmetry"
+                           "+astern is ruled out (")
+    assert note.endswith("whose choice passes the checks, where the default library's chosen "
+                         "candidate does not")
+    assert any("sin(beta)" in t for t in choice.structure.all_terms)
+    model = identify(logs, model=choice.structure, gamma=choice.gamma).model
+    for rpm in (80, 50):
+        ship = tanker(rpm, rudder_limit_deg=35.0)
+        own = turning_circle(ship, 35, dt=1.0, duration=3000).indices
+        fit = turning_circle(model, 35, dt=1.0, duration=3000, speed=ship.approach_speed,
+                             steering=ship.steering, rps=rpm / 60).indices  # fmt: skip
+        assert fit["tactical_diameter"] == pytest.approx(own["tactical_diameter"], rel=0.03)
+        assert fit["steady_yaw_rate"] == pytest.approx(own["steady_yaw_rate"], rel=0.05)
 
 
 def test_rudder_drift_terms_are_the_race_at_the_drift_and_stay_bounded_astern():

@@ -199,6 +199,10 @@ class Selection:
     # The plausibility checks of ``model`` from its steady approach, and their warnings.
     plausibility: dict | None = None
     plausibility_notes: list[str] = field(default_factory=list)
+    # Why the best-scoring candidate is ruled out by the plausibility checks ('' where it passes
+    # or is the chosen one): the logs then prefer a fit that physics rejects, a sign that the
+    # library lacks what the ship does beyond them (``auto_structure`` widens it).
+    best_ruled_out: str = ""
 
     @property
     def chosen_share(self) -> float:
@@ -492,14 +496,16 @@ def cross_validate(
 DEFAULT_LIBRARY = "low-speed+wind+propeller-asymmetry+astern"
 
 
-def default_library(logs: Sequence[pd.DataFrame]) -> tuple[ModelStructure, str]:
-    """``DEFAULT_LIBRARY`` less the terms that need a log column some log lacks (the wind of a
-    basin's logs, the propeller speed of a log without it) and the terms that are zero along
-    every log (astern propeller terms where the propeller never reverses), and a note saying
-    which were left out ('' when none): the library asked for by name refuses such logs instead.
-    A term the logs never excite has no coefficient to find; kept, it made every fit of the
-    library singular (condition number 5.7e14 on zig-zags at 8 and 12 rps)."""
-    library = get_structure(DEFAULT_LIBRARY)
+def default_library(logs: Sequence[pd.DataFrame], name: str = DEFAULT_LIBRARY
+                    ) -> tuple[ModelStructure, str]:  # fmt: skip
+    """``DEFAULT_LIBRARY`` (or the library ``name``) less the terms that need a log column some
+    log lacks (the wind of a basin's logs, the propeller speed of a log without it) and the
+    terms that are zero along every log (astern propeller terms where the propeller never
+    reverses), and a note saying which were left out ('' when none): the library asked for by
+    name refuses such logs instead. A term the logs never excite has no coefficient to find;
+    kept, it made every fit of the library singular (condition number 5.7e14 on zig-zags at 8
+    and 12 rps)."""
+    library = get_structure(name)
     missing = sorted({c for log in logs for c in library.inputs if c not in log.columns})
     drop = {d: [t for t in ts if set(parse_term(t).inputs) & set(missing)]
             for d, ts in library.terms.items()}  # fmt: skip
@@ -693,6 +699,10 @@ def select(
     if not plausible(current):
         notes.append(f"the chosen model is implausible ({current.note}); no candidate passed "
                      "the checks")  # fmt: skip
+    scored = [c for c in scorer.cache.values() if c.score < math.inf]
+    top = min(scored, key=lambda c: c.score) if scored else current
+    best_ruled_out = "" if top is current or plausible(top) else top.note.removeprefix(
+        "implausible: ")
     structure = ModelStructure(f"selected from {library.name}", current.terms)
     ident = identify(logs, model=structure, gamma=current.gamma, names=names, force=True,
                      estimator=options.estimator, physics=options.physics)  # fmt: skip
@@ -736,7 +746,7 @@ def select(
     band = error_band(held_out_runs, held_out=held) if held_out_runs else None
     return Selection(model, ident, current.gamma, current.score, table, folds_report,
                      options, library, ranking, notes + ident.warnings, shared, band,
-                     ident.model, *checked)  # fmt: skip
+                     ident.model, *checked, best_ruled_out=best_ruled_out)  # fmt: skip
 
 
 def _averaged_model(data: _Data, weights, first: Candidate, train, options: SelectOptions,
