@@ -1,13 +1,15 @@
 """A model that has all but lost its rudder is implausible: CyberShip II's zig-zags logged with a
 GNSS's speed and course (0.05 m/s of noise) gave a fit whose 35° tactical diameter came 13 times
 the ship's, which passed every check. The largest rudder held must turn the ship on a path at
-least ``WIDE_SHARE`` as curved as the tightest the training logs run."""
+least ``WIDE_SHARE`` as curved as the tightest the training logs run, and at most
+``TIGHT_FACTOR`` times as curved: a model that spins is no ship either."""
 
 import numpy as np
 import pytest
 
 from shipid.dynamics.model import ManoeuvringModel
 from shipid.identification.plausibility import (
+    TIGHT_FACTOR,
     WIDE_SHARE,
     disqualifying,
     plausibility_at_approach,
@@ -93,6 +95,42 @@ def test_the_reference_ships_turn_far_tighter_than_the_rule():
     assert min(ratios) == pytest.approx(0.62, abs=0.005)
     assert max(ratios) == pytest.approx(3.2, abs=0.05)
     assert min(ratios) > 2 * WIDE_SHARE
+    # The tanker, course-unstable, turns 3.8 times as tight at 35° as in its 10°/10° zig-zag:
+    # the tightest of the reference ships, a third of TIGHT_FACTOR.
+    from shipid.vessels import tanker
+
+    ship = tanker(rudder_limit_deg=35.0)
+    turn = turning_circle(ship, 35, dt=0.5).indices
+    path = abs(turn["steady_yaw_rate"]) / turn["steady_speed"]
+    zz10 = zigzag(ship, 10, 10, dt=0.5).log
+    assert path / sharpest_curvature([zz10], ship.approach_speed) == pytest.approx(3.8, abs=0.1)
+    assert 3.9 < TIGHT_FACTOR / 3
+
+
+def test_a_model_that_spins_is_ruled_out():
+    """From the tanker's zig-zags at three times a ship's sensor noise, fits whose held 35° turns
+    settled on paths 21–43 times as curved as the logs' (steady yaw rates 4–9 times the ship's,
+    at a tenth of its speed) passed every check (``benchmarks/study_tanker.py 3``)."""
+    from shipid.identification.plausibility import WRONG_WAY, failed_checks
+
+    model = scale_ship_model()
+    curvature = 0.002  # the logs' sharpest [1/m]
+    held = {"diverged": False, "settled": True, "duration": 1200.0, "steady_speed": 0.86}
+    report = {"approach_speed": 8.2, "surge_equilibrium": 8.2, "rudder_deg": 35.0,
+              "logs_curvature": curvature, "held_rudder": {
+                  "starboard": {**held, "steady_yaw_rate": 0.0714},  # 41.5 times the logs'
+                  "port": {**held, "steady_yaw_rate": -0.0200}}}  # 11.6 times: a tight turn
+    assert disqualifying(report, model) == [
+        "spins on a path over 12 times tighter than the training logs' with the rudder held to "
+        "starboard"]
+    radius = 0.86 / 0.0714
+    assert failed_checks(report, model)["held_rudder_starboard"] == (
+        WRONG_WAY, f"35° rudder held to starboard: the model turns on a path {radius:.3g} m in "
+        "radius, 12 times tighter than the tightest the training logs run (500 m) or more: it "
+        "spins")  # fmt: skip
+    # Without the logs' curvature (a model file judged alone) the check is not made.
+    report["logs_curvature"] = None
+    assert disqualifying(report, model) == []
 
 
 def _with_surge_drag(delta2: float) -> ManoeuvringModel:

@@ -42,6 +42,13 @@ STALL_SHARE = 0.1
 # lost the rudder: CyberShip II's zig-zags logged with a GNSS's 0.05 m/s speed noise gave a fit
 # whose 35° tactical diameter came 13 times the ship's.
 WIDE_SHARE = 0.25
+# ... and a model whose path is tighter than this many times it spins rather than turns: the
+# reference ships' 35° turns are at most 3.8 times as curved as their own zig-zags (the tanker's
+# 10°/10°; ``tests/test_plausibility_paths.py``). From the tanker's zig-zags at three times a
+# ship's sensor noise, fits whose held 35° turns settled on paths 21–43 times as curved as the
+# logs' (steady yaw rates 4–9 times the ship's, at a tenth of its speed) passed every check
+# (``benchmarks/study_tanker.py 3``).
+TIGHT_FACTOR = 12.0
 HELD_DURATION, HELD_MAX_DOUBLINGS = 300.0, 4
 
 
@@ -64,6 +71,15 @@ def _too_wide(entry: dict, curvature: float | None) -> bool:
     if not curvature or entry.get("diverged") or r is None or not speed or not speed > 0:
         return False
     return abs(r) / speed < WIDE_SHARE * curvature
+
+
+def _too_tight(entry: dict, curvature: float | None) -> bool:
+    """A held-rudder turn whose steady path is tighter than ``TIGHT_FACTOR`` times
+    ``curvature``: a spin."""
+    r, speed = entry.get("steady_yaw_rate"), entry.get("steady_speed")
+    if not curvature or entry.get("diverged") or r is None or not speed or not speed > 0:
+        return False
+    return abs(r) / speed > TIGHT_FACTOR * curvature
 
 
 def straight_line_stability(model: ManoeuvringModel, speed: float, rps: float | None = None) -> dict:
@@ -244,6 +260,12 @@ def failed_checks(report: dict, model: ManoeuvringModel) -> dict[str, tuple[int,
                                    f"radius, wider than {1 / WIDE_SHARE:g} times the tightest "
                                    f"the training logs run ({1 / curvature:.3g} m): it has all "
                                    "but lost the rudder")  # fmt: skip
+        if out.get(key, (0, ''))[0] < WRONG_WAY and _too_tight(entry, curvature):  # unsettled too
+            radius = entry["steady_speed"] / abs(entry["steady_yaw_rate"])
+            out[key] = (WRONG_WAY, f"{where}: the model turns on a path {radius:.3g} m in "
+                                   f"radius, {TIGHT_FACTOR:g} times tighter than the tightest the "
+                                   f"training logs run ({1 / curvature:.3g} m) or more: it "
+                                   "spins")  # fmt: skip
     return out
 
 
@@ -278,7 +300,8 @@ def new_failures(reference: dict, candidate: dict, model: ManoeuvringModel) -> l
 def disqualifying(report: dict, model: ManoeuvringModel) -> list[str]:
     """The failed checks that rule a model out of a selection: the rudder held to a side
     diverges, turns the ship the other way, ends the turn going astern or all but stopped or on
-    a path far wider than the logs' (``WIDE_SHARE``), or surge has no steady speed.
+    a path far wider (``WIDE_SHARE``) or tighter (``TIGHT_FACTOR``) than the logs', or surge has
+    no steady speed.
     Straight-line instability (real full-form ships have it) and slow settling stay warnings."""
     return [reason for _, reason in disqualifying_checks(report, model).values()]
 
@@ -303,6 +326,9 @@ def disqualifying_checks(report: dict, model: ManoeuvringModel) -> dict[str, tup
             reasons[key] = (WRONG_WAY, f"all but stops with the rudder held to {side}")
         elif _too_wide(entry, report.get("logs_curvature")):
             reasons[key] = (WRONG_WAY, f"turns on a path over {1 / WIDE_SHARE:g} times wider "
+                                       f"than the training logs' with the rudder held to {side}")
+        elif _too_tight(entry, report.get("logs_curvature")):
+            reasons[key] = (WRONG_WAY, f"spins on a path over {TIGHT_FACTOR:g} times tighter "
                                        f"than the training logs' with the rudder held to {side}")
     return reasons
 
