@@ -98,17 +98,19 @@ def steady_approach(model: ManoeuvringModel, trained_speed: float | None,
     if trained_speed is None or not trained_speed > 0:
         raise ValueError("the training approach speed is unknown")
     anchor = getattr(model, "similar_at_rps", None)
-    if anchor and n is not None and n > 0 and unsteady_warning(model, trained_speed, anchor) is None:
+    # The rps the training approach speed was run at (the first log's), where it is known.
+    home = trained_rps if trained_rps is not None and trained_rps > 0 else anchor
+    if anchor and n is not None and n > 0 and unsteady_warning(model, trained_speed, home) is None:
         # The model of logs at one rps is the fit there and holds their approach: it starts
         # there (as a model without n did), elsewhere at that speed scaled with n, as its
         # forces are. Its own balance would put the MARIN KVLCC2's race structure 6 % faster
         # than the logs' approach, and its closed-loop first overshoot of the unseen −20° run
         # 1.8° high instead of 1.0°. Where it does not hold the logs' approach (logs that never
         # ran steady, a surge that balances elsewhere), its own steady speed, as below.
-        if abs(n / anchor - 1) < 1e-9:
+        if abs(n / home - 1) < 1e-9:
             return Approach(trained_speed, n, "the training logs' approach speed")
-        scaled = trained_speed * n / anchor
-        return Approach(scaled, n, f"the training logs' approach speed at {anchor:.4g} rps, "
+        scaled = trained_speed * n / home
+        return Approach(scaled, n, f"the training logs' approach speed at {home:.4g} rps, "
                         "scaled with the propeller speed (advance-ratio similarity)",
                         unsteady_warning(model, scaled, n))  # fmt: skip
     if uses_rps and n is not None and "u" in model.structure.dofs:
