@@ -3,6 +3,7 @@ whose rudder sits in the propeller's race: its compiled accelerations against §
 here as written (shallow-water terms included, at z = 0), its straight-running equilibrium, the
 computed check values of §4.6 and its port–starboard asymmetry."""
 
+import json
 import math
 
 import numpy as np
@@ -174,7 +175,43 @@ def test_a_structure_ruled_out_beyond_the_logs_is_named_where_it_predicts_them_b
                             {"blanke-race+race-damping": (1, 0.05, why)}, wide) == []
 
 
-def test_the_default_library_is_widened_where_the_logs_best_fit_is_ruled_out():
+@pytest.fixture(scope="module")
+def two_rps_zigzags():
+    """The tanker's noise-free 10/10 and 20/20 zig-zags at 80 and 50 rpm (600 s each)."""
+    logs = []
+    for rpm, amplitude, side in ((80, 10, "starboard"), (80, 20, "starboard"),
+                                 (50, 10, "starboard"), (50, 20, "port")):  # fmt: skip
+        ship = tanker(rpm, rudder_limit_deg=35.0)
+        logs.append(zigzag(ship, amplitude, amplitude, first=side, duration=600, dt=1.0,
+                           approach=60.0).log.assign(n=rpm / 60))  # fmt: skip
+    return logs
+
+
+def test_select_widens_its_default_library_as_identify_does(two_rps_zigzags, tmp_path, capsys):
+    """`shipid select` without --library searched the default library alone and wrote a model
+    whose 35° turns end astern, with warnings; it widens it as identify's default does, and
+    its model file names the library searched."""
+    from shipid.data.io import write_log
+
+    paths = [write_log(log, tmp_path / f"zz{i}.csv") for i, log in enumerate(two_rps_zigzags)]
+    code, out, err = run(["select", "--quiet", *paths, "-o", tmp_path / "m.json"], capsys)
+    assert code == 0, err
+    (line,) = [x for x in out.splitlines() if x.startswith("library: ")]
+    assert line.startswith("library: the best-scoring candidate of low-speed+wind+propeller-"
+                           "asymmetry+astern is ruled out (")
+    assert "so the library is widened by rudder-drift" in line
+    doc = json.loads((tmp_path / "m.json").read_text())
+    searched = doc["identification"]["selection"]["options"]["library"]
+    assert any("sin(beta)" in t for t in searched["terms"]["r"])
+    # With --library given, the library is the user's.
+    code, out, err = run(["select", "--quiet", "--library", "low-speed+propeller-asymmetry",
+                          "--search", "none", *paths, "-o", tmp_path / "own.json"],
+                         capsys)  # fmt: skip
+    assert code == 0, err
+    assert "library: " not in out
+
+
+def test_the_default_library_is_widened_where_the_logs_best_fit_is_ruled_out(two_rps_zigzags):
     """From the tanker's zig-zags at 80 and 50 rpm, every best-scoring candidate of select's
     default library ends its held 35° turns astern or turns the wrong way: the logs prefer what
     physics rejects (noise-free, none of its candidates passes). The default then chooses again
@@ -184,12 +221,7 @@ def test_the_default_library_is_widened_where_the_logs_best_fit_is_ruled_out():
     from shipid.identification.auto_structure import auto_structure
     from shipid.identification.identify import identify
 
-    logs = []
-    for rpm, amplitude, side in ((80, 10, "starboard"), (80, 20, "starboard"),
-                                 (50, 10, "starboard"), (50, 20, "port")):  # fmt: skip
-        ship = tanker(rpm, rudder_limit_deg=35.0)
-        logs.append(zigzag(ship, amplitude, amplitude, first=side, duration=600, dt=1.0,
-                           approach=60.0).log.assign(n=rpm / 60))  # fmt: skip
+    logs = two_rps_zigzags
     choice = auto_structure(logs)
     assert choice.how == "select"
     assert choice.library.startswith("low-speed+wind+propeller-asymmetry+astern+rudder-drift")

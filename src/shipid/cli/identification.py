@@ -712,6 +712,17 @@ def cmd_select(args) -> int:
                             average=args.average, keep=args.keep,
                             **({"gammas": gammas} if gammas else {}))
     sel = select(logs, options, names=names)
+    if args.library is None and sel.best_ruled_out:
+        from shipid.identification.auto_structure import widened_selection
+
+        # As identify's default: where the logs' best fit from the default library is ruled out
+        # by the checks, the search again with the rudder's lift at the hull's drift.
+        wider, said = widened_selection(sel, logs, names, options,
+                                        announce=lambda m: print(m, file=sys.stderr))
+        if wider is not None:
+            sel = wider[0]
+        for note in said:  # the model file's selection record names the library searched
+            print(f"library: {note}")
     ident = sel.identification
     if sel.model is not sel.chosen_model:
         print(f"The chosen candidate:\n{sel.chosen_model.equations()}\n\nThe model written, "

@@ -12,7 +12,8 @@ from the logs:
   the logs lack or never excite) by free-run cross-validation on the logs (leave one log out; four
   blocks of a single log), with its γ; where its best-scoring candidate is ruled out by the
   plausibility checks (the logs prefer what physics rejects), the search is repeated with
-  ``rudder-drift`` added and kept where it predicts the held-out logs better (``_widened``);
+  ``rudder-drift`` added and kept where it predicts the held-out logs better
+  (``widened_selection``);
   ``blanke-rps`` where none of its candidates is plausible or predicts the held-out logs
   better than their mean;
 - a varying thrust without rps: ``blanke-thrust``;
@@ -202,7 +203,9 @@ def _auto_structure(logs, names, physics, cv, estimator, drop, announce) -> Stru
                                notes=[f"select found no structure ({exc}); {fallback} instead"])
     widening = []
     if sel.best_ruled_out:
-        wider, widening = _widened(sel, logs, names, physics, cv, estimator, drop, announce)
+        wider, widening = widened_selection(
+            sel, logs, names, SelectOptions(cv=cv, physics=physics, estimator=estimator), drop,
+            announce)  # fmt: skip
         if wider is not None:
             sel, library_name, note = wider
     chosen_row = sel.candidates[sel.candidates["chosen"]]
@@ -233,7 +236,7 @@ def _auto_structure(logs, names, physics, cv, estimator, drop, announce) -> Stru
 
 
 # What the default structures lack where the logs' best fit is ruled out by the plausibility
-# checks (``_widened``, and the inflow comparison of ``_paper_or_race``): the rudder's lift in the
+# checks (``widened_selection``, the inflow comparison of ``_paper_or_race``): the rudder's lift in the
 # propeller's race at the hull's drift, which a tight turn reaches far beyond any zig-zag. On the
 # single-screw tanker (``benchmarks/study_tanker.py``, 3 seeds) every best-scoring fit ends its
 # held 35° turns astern or turns the wrong way: from its zig-zags at 80 and 50 rpm the default
@@ -249,29 +252,35 @@ def _auto_structure(logs, names, physics, cv, estimator, drop, announce) -> Stru
 WIDENING = "rudder-drift"
 
 
-def _widened(sel, logs, names, physics, cv, estimator, drop, announce):
-    """``select`` on the default library widened by ``WIDENING``, for logs whose best-scoring
-    candidate from the default library the plausibility checks rule out (``sel.best_ruled_out``):
-    the logs then prefer what physics rejects, a sign that the library lacks what the ship does
-    beyond them. ((selection, library name, note) where its chosen candidate is plausible and
-    predicts the held-out logs better than ``sel``'s, else None; the notes that say so)."""
-    from shipid.identification.select import DEFAULT_LIBRARY, SelectOptions, default_library, select
+def widened_selection(sel, logs, names, options, drop=None, announce=_quiet):
+    """``select`` (with ``options``, a ``SelectOptions``) on the default library widened by
+    ``WIDENING``, for logs whose best-scoring candidate from the default library the
+    plausibility checks rule out (``sel.best_ruled_out``): the logs then prefer what physics
+    rejects, a sign that the library lacks what the ship does beyond them. ((selection, library
+    name, note) where its chosen candidate is plausible and predicts the held-out logs better
+    than ``sel``'s, else None; the notes that say so). ``identify``'s default and ``shipid
+    select`` without ``--library`` widen so."""
+    import dataclasses
+
+    from shipid.identification.select import DEFAULT_LIBRARY, default_library, select
 
     name = f"{DEFAULT_LIBRARY}+{WIDENING}"
     why = (f"the best-scoring candidate of {DEFAULT_LIBRARY} is ruled out ({sel.best_ruled_out}"
            f"): the logs prefer what physics rejects")  # fmt: skip
     library, note = default_library(logs, name)
-    announce(f"{why}; choosing again from {name} ({cv})…")
+    added = set(get_structure(WIDENING).all_terms)
+    if not added & set(_without(library, drop).all_terms):
+        return None, []  # its terms need what the logs lack (the propeller speed)
+    announce(f"{why}; choosing again from {name} ({options.cv})…")
     try:
-        wide = select(logs, SelectOptions(library=_without(library, drop), cv=cv,
-                                          physics=physics, estimator=estimator), names=names)
+        wide = select(logs, dataclasses.replace(options, library=_without(library, drop)),
+                      names=names)  # fmt: skip
     except ShipidError as exc:
         return None, [f"{why}; {name} found no structure ({exc})"]
     def passes(selection) -> bool:
         chosen = selection.candidates[selection.candidates["chosen"]]
         return bool(len(chosen) and chosen["plausible"].all())
 
-    added = set(get_structure(WIDENING).all_terms)
     if not added & set(wide.chosen_model.structure.all_terms):
         return None, [f"{why}; {name}, tried, chooses none of the {WIDENING} terms"]
     if not passes(wide) or (passes(sel) and not wide.score < sel.score):
