@@ -65,21 +65,26 @@ def sharpest_curvature(logs, speed: float) -> float | None:
     return float(np.percentile(values, 95)) if values.size else None
 
 
-def _too_wide(entry: dict, curvature: float | None) -> bool:
-    """A held-rudder turn whose steady path is wider than ``WIDE_SHARE`` of ``curvature``."""
+def _path_over_logs(entry: dict, curvature: float | None) -> float | None:
+    """A held-rudder turn's steady path curvature over the logs' sharpest ``curvature`` (None
+    where either is unknown: a turn that diverged or ended astern, a model judged alone)."""
     r, speed = entry.get("steady_yaw_rate"), entry.get("steady_speed")
     if not curvature or entry.get("diverged") or r is None or not speed or not speed > 0:
-        return False
-    return abs(r) / speed < WIDE_SHARE * curvature
+        return None
+    return abs(r) / speed / curvature
+
+
+def _too_wide(entry: dict, curvature: float | None) -> bool:
+    """A held-rudder turn whose steady path is wider than ``WIDE_SHARE`` of ``curvature``."""
+    ratio = _path_over_logs(entry, curvature)
+    return ratio is not None and ratio < WIDE_SHARE
 
 
 def _too_tight(entry: dict, curvature: float | None) -> bool:
     """A held-rudder turn whose steady path is tighter than ``TIGHT_FACTOR`` times
     ``curvature``: a spin."""
-    r, speed = entry.get("steady_yaw_rate"), entry.get("steady_speed")
-    if not curvature or entry.get("diverged") or r is None or not speed or not speed > 0:
-        return False
-    return abs(r) / speed > TIGHT_FACTOR * curvature
+    ratio = _path_over_logs(entry, curvature)
+    return ratio is not None and ratio > TIGHT_FACTOR
 
 
 def straight_line_stability(model: ManoeuvringModel, speed: float, rps: float | None = None) -> dict:
@@ -254,18 +259,15 @@ def failed_checks(report: dict, model: ManoeuvringModel) -> dict[str, tuple[int,
                                    f"{entry['steady_speed']:.3g} m/s from {speed:.3g} m/s ahead, "
                                    f"under {100 * STALL_SHARE:.0f} %)")  # fmt: skip
         curvature = report.get("logs_curvature")
-        if out.get(key, (0, ''))[0] < WRONG_WAY and _too_wide(entry, curvature):  # unsettled too
+        wide, tight = _too_wide(entry, curvature), _too_tight(entry, curvature)
+        if out.get(key, (0, ''))[0] < WRONG_WAY and (wide or tight):  # unsettled too
             radius = entry["steady_speed"] / abs(entry["steady_yaw_rate"])
+            how = (f"wider than {1 / WIDE_SHARE:g} times" if wide
+                   else f"{TIGHT_FACTOR:g} times tighter than")  # fmt: skip
             out[key] = (WRONG_WAY, f"{where}: the model turns on a path {radius:.3g} m in "
-                                   f"radius, wider than {1 / WIDE_SHARE:g} times the tightest "
-                                   f"the training logs run ({1 / curvature:.3g} m): it has all "
-                                   "but lost the rudder")  # fmt: skip
-        if out.get(key, (0, ''))[0] < WRONG_WAY and _too_tight(entry, curvature):  # unsettled too
-            radius = entry["steady_speed"] / abs(entry["steady_yaw_rate"])
-            out[key] = (WRONG_WAY, f"{where}: the model turns on a path {radius:.3g} m in "
-                                   f"radius, {TIGHT_FACTOR:g} times tighter than the tightest the "
-                                   f"training logs run ({1 / curvature:.3g} m) or more: it "
-                                   "spins")  # fmt: skip
+                                   f"radius, {how} the tightest the training logs run "
+                                   f"({1 / curvature:.3g} m){'' if wide else ' or more'}: "
+                                   f"{'it has all but lost the rudder' if wide else 'it spins'}")
     return out
 
 
