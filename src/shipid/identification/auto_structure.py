@@ -277,22 +277,24 @@ def widened_selection(sel, logs, names, options, drop=None, announce=_quiet):
                       names=names)  # fmt: skip
     except ShipidError as exc:
         return None, [f"{why}; {name} found no structure ({exc})"]
-    def passes(selection) -> bool:
-        chosen = selection.candidates[selection.candidates["chosen"]]
-        return bool(len(chosen) and chosen["plausible"].all())
-
     if not added & set(wide.chosen_model.structure.all_terms):
         return None, [f"{why}; {name}, tried, chooses none of the {WIDENING} terms"]
-    if not passes(wide) or (passes(sel) and not wide.score < sel.score):
+    if not _chosen_passes(wide) or (_chosen_passes(sel) and not wide.score < sel.score):
         return None, [f"{why}; {name}, tried, predicts the held-out logs no better (score "
                       f"{wide.score:.4f} against {sel.score:.4f}) and is not kept"]
     label = name + (" (less what the logs lack)" if note else "")
     better = (f"predicts the held-out logs better (score {wide.score:.4f} against "
-              f"{sel.score:.4f})" if passes(sel) else "passes the checks, where the default "
-              "library's chosen candidate does not")  # fmt: skip
+              f"{sel.score:.4f})" if _chosen_passes(sel) else "passes the checks, where the "
+              "default library's chosen candidate does not")  # fmt: skip
     return (wide, label, note), [
         f"{why}, so the library is widened by {WIDENING} (the rudder's lift in the propeller's "
         f"race at the hull's drift), whose choice {better}"]
+
+
+def _chosen_passes(selection) -> bool:
+    """Whether a selection's chosen candidate passes the plausibility checks."""
+    chosen = selection.candidates[selection.candidates["chosen"]]
+    return bool(len(chosen) and chosen["plausible"].all())
 
 
 # A rudder behind a propeller at constant rps in logs whose speed varies by more than this share
