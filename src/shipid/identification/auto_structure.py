@@ -208,9 +208,8 @@ def _auto_structure(logs, names, physics, cv, estimator, drop, announce) -> Stru
             announce)  # fmt: skip
         if wider is not None:
             sel, library_name, note = wider
-    chosen_row = sel.candidates[sel.candidates["chosen"]]
     why = None
-    if not bool(chosen_row["plausible"].all()):
+    if not _chosen_passes(sel):
         why = (f"none of select's {len(sel.candidates)} candidates from its default library is "
                "plausible")  # fmt: skip
     elif not sel.score < 1.0:
