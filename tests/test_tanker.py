@@ -122,6 +122,7 @@ def test_the_inflow_comparison_widens_the_race_where_its_best_is_ruled_out(tmp_p
     overshoot 6.3° low (study_tanker.py). The note still names what it left out, and why (it
     read as if the race structure had been scored and lost)."""
     from shipid.data.io import write_log
+    from shipid.dynamics.model import get_structure
     from shipid.reporting.modelfile import load_model
 
     ship = tanker(rudder_limit_deg=35.0)
@@ -148,6 +149,14 @@ def test_the_inflow_comparison_widens_the_race_where_its_best_is_ruled_out(tmp_p
     fit = zigzag(model, 10, 10, duration=1800, **kw).indices
     for key in ("first_overshoot_deg", "second_overshoot_deg"):
         assert fit[key] == pytest.approx(own[key], abs=1.5)
+    # Where --drop takes the drift terms, there is nothing to widen by: the race structure is
+    # not compared again under the other name.
+    drop = ",".join(f"{d}:{t}" for d in "uvr" for t in get_structure("rudder-drift").terms[d])
+    code, out, err = run(["identify", *paths, "--filter", "none", "--no-output-error", "--drop",
+                          drop, "-o", tmp_path / "d.json"], capsys)  # fmt: skip
+    assert code == 0, err
+    (line,) = [x for x in out.splitlines() if x.startswith("structure: ")]
+    assert line.startswith("structure: blanke-speed") and "rudder-drift" not in line
 
 
 def test_a_structure_ruled_out_beyond_the_logs_is_named_where_it_predicts_them_better():

@@ -395,7 +395,9 @@ def _paper_or_race(logs, names, physics, cv, estimator, drop=None, announce=_qui
         compare(name)
     widened = RACE_PREFERRED + "+" + WIDENING + suffix
     top = _best_of(scores, faults)
-    if found is not None and top in faults and _beyond_the_logs_only(faults[top][2]):
+    adds = set(_without(get_structure(widened), drop).all_terms) - set(
+        _without(get_structure(preferred), drop).all_terms)  # none where --drop took them
+    if found is not None and top in faults and _beyond_the_logs_only(faults[top][2]) and adds:
         # The logs' best fit is ruled out by its held rudder alone: the rudder's lift at the
         # hull's drift, which a tight turn reaches far beyond the logs, is what the structures
         # lack (WIDENING); the race structure with it joins the comparison.
