@@ -101,11 +101,14 @@ class StructureChoice:
             averaged = (f"; the model is the average of the {len(self.members)} candidates the "
                         f"choice picks on resampled held-out logs, weighted by how often "
                         f"({shares}; {sum(len(t) for t in union.terms.values())} terms)")
+        # The search's own notes are its warnings too (the library trimmed to the logs); the
+        # widening of the library is said here.
+        said = "".join(f"; {note}" for note in self.notes if note not in self.warnings)
         return (f"structure: {n} terms chosen by shipid select from {self.library} (free-run "
                 f"cross-validation, {self.cv}; γ {self.gamma:g}, score {self.score:.4f} over "
                 f"{self.candidates} candidates), since {why}: the paper's {PAPER} cannot hold "
-                f"that{averaged} (--model to choose one; shipid select for the search's table "
-                "and intervals over the choice)")
+                f"that{averaged}{said} (--model to choose one; shipid select for the search's "
+                "table and intervals over the choice)")
 
     def to_dict(self) -> dict:
         """The model file's record (``identification.structure_choice``)."""
