@@ -396,7 +396,7 @@ def _rps_similar(text: str, rps: float | None, path) -> dict | None:
     """The model file ``text`` with its model carried to every propeller speed from the one its
     logs run at (``_one_rps``), said on the command line; None where there is none, or no term
     changes. The Esso Osaka's one-file models predicted the held-out logs at another rps with a
-    yaw rate error of 0.39 of their spread instead of 0.48 (median of 70;
+    yaw rate error of 0.37 of their spread instead of 0.48 (median of 70;
     ``benchmarks/study_esso_single_logs.py``)."""
     from shipid.reporting.modelfile import rps_similar_document
 

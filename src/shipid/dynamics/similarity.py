@@ -19,7 +19,7 @@ factor of the term algebra) and terms of the wind (an external speed) keep their
 
 Measured on the Esso Osaka (``benchmarks/study_esso_single_logs.py``): the default model of one
 zig-zag file predicts the held-out logs at another propeller speed with a yaw rate error of
-0.39 of their spread against 0.48 (median of 70 logs × models, better in 48 of them).
+0.37 of their spread against 0.48 (median of 70 logs × models, better in 49 of them).
 """
 
 from __future__ import annotations
