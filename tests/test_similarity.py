@@ -257,3 +257,19 @@ def test_the_anchor_does_not_depend_on_the_order_of_the_logs(tmp_path):
     approach = steady_approach(models[0], 1.9, 12.0)
     assert approach.speed == 1.9 and approach.source == "the training logs' approach speed"
     assert steady_approach(models[0], 1.9, 12.0, rps=24.0).speed == pytest.approx(3.8)
+
+
+def test_bounds_with_an_open_side_are_carried(one_rps, tmp_path, capsys):
+    """identify --bound on logs at one rps stopped with an internal error (TypeError): a
+    bound's open side, stored as None, was multiplied by the similarity's ratio. The bounds
+    are carried as the terms are: renamed, scaled, the open side left open."""
+    log = one_rps["similar"].parent / "zz.csv"
+    out = tmp_path / "bounded.json"
+    code, text, err = run(["identify", log, "--no-output-error", "--bound", "u: v*r >= 0.5",
+                           "--bound", "v: delta >= 0.01", "--bound", "r: delta <= 0",
+                           "-o", out], capsys)  # fmt: skip
+    assert code == 0, err
+    bounds = json.loads(out.read_text())["identification"]["physics"]["bounds"]
+    assert bounds["u"] == {"v*r": [0.5, None]}
+    assert bounds["v"]["n^2*delta"] == [pytest.approx(0.01 / N0**2, rel=1e-12), None]
+    assert bounds["r"] == {"n^2*delta": [None, 0.0]}

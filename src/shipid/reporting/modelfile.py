@@ -574,12 +574,16 @@ def rps_similar_document(doc: Mapping, rps: float, path: str | Path = "model fil
         return new, rps**-k
 
     def mapped(values: Mapping, dof: str) -> dict:
-        """{term: value} of equation ``dof`` renamed, each value (or pair) times its ratio."""
+        """{term: value} of equation ``dof`` renamed, each value (or pair) times its ratio;
+        None (a bound's open side) stays None."""
+
+        def times(x, ratio):
+            return None if x is None else x * ratio
+
         res = {}
         for t, v in values.items():
             new, ratio = rename(dof, t)
-            res[new] = [b * ratio for b in v] if isinstance(v, list) else \
-                (None if v is None else v * ratio)  # fmt: skip
+            res[new] = [times(b, ratio) for b in v] if isinstance(v, list) else times(v, ratio)
         return res
 
     unc = out.get("uncertainty")
