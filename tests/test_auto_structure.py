@@ -195,9 +195,15 @@ def test_a_speed_that_varies_at_constant_rps_compares_the_rudders_inflow(paper_l
     for state in ("v", "r"):
         assert errors[choice.structure.name][state]["std"] < 0.7 * errors["blanke-speed"][state]["std"]
     # The paper's ship with a logged rps: the race structure is fitted (the rudder in the race a
-    # constant rps implies), on the blocks inside the approach's speed as well.
+    # constant rps implies), on the blocks inside the approach's speed as well. blanke-speed
+    # scores best on them but is ruled out by its 35° rudder held (this ship, whose own 35° turn
+    # diverges, far beyond its trials), so the race with the drift terms is compared too, and
+    # fitted (held-out 20° turns' yaw rate
+    # 1.17–1.42 times the noise floor over three such seeds, where the race structure alone had
+    # 1.60–1.93; benchmarks/study_auto_inflow.py).
     raced = auto_structure([paper_log.assign(n=10.0)])
-    assert raced.structure.name == "blanke-race+race-damping"
+    assert raced.structure.name == "blanke-race+race-damping+rudder-drift"
+    assert "compared because blanke-speed, the best on the logs, is ruled out" in raced.describe()
 
 
 def test_a_wind_at_constant_rps_compares_the_rudders_inflow_with_the_winds_terms(paper_log):
@@ -223,7 +229,7 @@ def test_one_esso_zig_zag_takes_the_structure_with_the_fewest_faults():
     choice = auto_structure([train])
     assert choice.structure.name == "blanke-race+race-damping+wind"
     (warning,) = [w for w in choice.warnings if w.startswith("none of the structures")]
-    assert "blanke+wind 0.477 (no steady straight speed; diverges" in warning
+    assert "blanke+wind 0.500 (no steady straight speed; diverges" in warning
     spread = float(np.std(held["r"]))
     errors = {name: validate(identify([train], model=name, force=True).model, held,
                              start_draws=False)[0].metrics["r"]["std"] / spread

@@ -316,9 +316,9 @@ RACE_CANDIDATES = (PAPER, "blanke-speed", "blanke-race+race-damping")
 # (``benchmarks/study_auto_inflow.py``). On the real KVLCC2's three zig-zags it ties with
 # ``blanke-speed`` and predicts every held-out log best in sway and yaw (README). The cost: on
 # the paper's own ship with an rps logged (its rudder force in δ alone, ``blanke`` the truth) it
-# is fitted in 3 of 12 cases and predicts the held-out 20° turns' yaw rate 1.3–1.9 times the
-# noise floor against ``blanke``'s 1.1–1.2 (``study_auto_inflow.paper_ship``); a warning names
-# the tie.
+# is fitted in 4 of 12 cases (three with the drift terms) and predicts the held-out 20° turns'
+# yaw rate 1.2–1.4 times the noise floor against ``blanke``'s 1.1–1.2
+# (``study_auto_inflow.paper_ship``); a warning names the tie.
 RACE_PREFERRED = "blanke-race+race-damping"
 
 
@@ -386,15 +386,18 @@ def _paper_or_race(logs, names, physics, cv, estimator, drop=None, announce=_qui
             failed.append(exc)
             return
         row = sel.candidates.iloc[0]
+        score, se = float(row["score"]), float(row["score_se"])
+        if inside is not None and sel.fold_scores:
+            # Plausible or not, scored on the same blocks: the best of a comparison is read
+            # across both (``_best_of``).
+            kept = np.asarray(sel.fold_scores)[inside]
+            score, se = float(kept.mean()), float(kept.std(ddof=1) / np.sqrt(kept.size))
         if bool(row["plausible"]):
-            scores[name] = (float(row["score"]), float(row["score_se"]))
-            if inside is not None and sel.shares:
-                kept = np.asarray(sel.shares[0].fold_scores)[inside]
-                scores[name] = (float(kept.mean()), float(kept.std(ddof=1) / np.sqrt(kept.size)))
+            scores[name] = (score, se)
             models[name] = sel.model
-        elif np.isfinite(float(row["score"])):
+        elif np.isfinite(score):
             why = str(row["note"]).removeprefix("implausible: ")
-            faults[name] = (len(why.split("; ")), float(row["score"]), why)
+            faults[name] = (len(why.split("; ")), score, why)
             ruled_out[name] = sel.model
 
     for name in candidates:

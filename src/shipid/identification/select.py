@@ -203,6 +203,8 @@ class Selection:
     # or is the chosen one): the logs then prefer a fit that physics rejects, a sign that the
     # library lacks what the ship does beyond them (``auto_structure`` widens it).
     best_ruled_out: str = ""
+    # The chosen candidate's score on each held-out fold (log or block), plausible or not.
+    fold_scores: list[float] = field(default_factory=list)
 
     @property
     def chosen_share(self) -> float:
@@ -746,7 +748,8 @@ def select(
     band = error_band(held_out_runs, held_out=held) if held_out_runs else None
     return Selection(model, ident, current.gamma, current.score, table, folds_report,
                      options, library, ranking, notes + ident.warnings, shared, band,
-                     ident.model, *checked, best_ruled_out=best_ruled_out)  # fmt: skip
+                     ident.model, *checked, best_ruled_out=best_ruled_out,
+                     fold_scores=list(current.fold_scores))  # fmt: skip
 
 
 def _averaged_model(data: _Data, weights, first: Candidate, train, options: SelectOptions,
