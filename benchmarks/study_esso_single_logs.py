@@ -82,8 +82,9 @@ def main() -> None:
         print("\nEvery pair of zig-zag files, by how the default chose the structure: held-out "
               "logs' r error / spread, the median over the pairs of each pair's median, and the "
               "runs that diverged\n")
-        print("| structure chosen | pairs | median r error / spread | diverged |")
-        print("|---|---|---|---|")
+        print("| structure chosen | pairs | median r error / spread | diverged | 35° turns: "
+              "tactical diameter, abs error median (largest) |")
+        print("|---|---|---|---|---|")
         by_how: dict[str, list[tuple[float, int, int]]] = {}
         for a, b in itertools.combinations(zigzags, 2):
             with contextlib.redirect_stdout(io.StringIO()), \
@@ -98,13 +99,40 @@ def main() -> None:
             label = (f"{model.structure.name} ({how})" if how != "select"
                      else "terms chosen by select")  # fmt: skip
             errors = _errors(model, {g: log for g, log in held.items() if g not in (a, b)})
+            turns = _turn_errors(model, {g: log for g, log in held.items() if "turn" in g.stem})
             by_how.setdefault(label, []).append(
-                (float(np.median(errors)), int(np.isinf(errors).sum()), len(errors)))
+                (float(np.median(errors)), int(np.isinf(errors).sum()), len(errors), turns))
         for label, rows in sorted(by_how.items(), key=lambda kv: -len(kv[1])):
             medians = [r[0] for r in rows]
+            turns = np.abs(np.concatenate([r[3] for r in rows]))
             print(f"| {label} | {len(rows)} | {np.median(medians):.2f} | "
-                  f"{sum(r[1] for r in rows)} of {sum(r[2] for r in rows)} |")
+                  f"{sum(r[1] for r in rows)} of {sum(r[2] for r in rows)} | "
+                  f"{_turn_cell(turns)} |")  # fmt: skip
+        every = np.abs(np.concatenate([r[3] for rows in by_how.values() for r in rows]))
+        print(f"\nThe two 35° turns (closed loop) over the 36 pairs: tactical diameter "
+              f"{_turn_cell(every)}, mean {np.mean(every[np.isfinite(every)]):.0f} %")
     print(f"\n{time.perf_counter() - start:.0f} s")
+
+
+def _turn_errors(model, turns) -> np.ndarray:
+    """The 35° turns' closed-loop tactical diameter error [%] (inf where there is none)."""
+    out = []
+    for log in turns.values():
+        v = validate(model, log, start_draws=False)[0]
+        try:
+            out.append(100 * (v.indices["closed_loop"]["tactical_diameter"]
+                              / v.indices["measured"]["tactical_diameter"] - 1))  # fmt: skip
+        except (KeyError, TypeError):
+            out.append(np.inf)
+    return np.array(out)
+
+
+def _turn_cell(errors: np.ndarray) -> str:
+    """|error| median (largest) [%], and how many turns had no index."""
+    finite = errors[np.isfinite(errors)]
+    none = len(errors) - len(finite)
+    cell = f"{np.median(finite):.0f} % ({finite.max():.0f} %)" if len(finite) else "–"
+    return cell + (f", {none} without" if none else "")
 
 
 def _errors(model, logs) -> np.ndarray:

@@ -278,3 +278,24 @@ def test_one_esso_file_predicts_the_logs_at_other_rps_by_similarity(tmp_path):
                        / float(np.std(log["r"])) for log in held]  # fmt: skip
     assert np.median(errors["similar"]) < 0.8 * np.median(errors["plain"]), errors
     assert all(a < b for a, b in zip(errors["similar"], errors["plain"], strict=True)), errors
+
+
+@needs_data
+def test_two_esso_files_no_longer_give_a_model_that_turns_on_a_far_wider_path(tmp_path):
+    """Two zig-zag files at 10 and 15 rps (13_22_52, 13_57_45), the default identify: `select`'s
+    widened average, whose held 35° turn ran on a path 0.30 as curved as the logs' sharpest (at
+    5.4 times its approach speed), passed the rule of a quarter and put the 35° turns at 10 rps
+    8.8 and 5.5 times the ship's tactical diameter. At 0.4 it is ruled out and the fallback's
+    turns come within 64 % (``benchmarks/study_esso_single_logs.py``'s pairs)."""
+    from shipid.reporting.modelfile import load_model
+    from shipid.trials.reading import read_trial_log
+
+    train = [OSAKA / "zigzag" / f"zigzag_31-Jul-2020_{s}.csv" for s in ("13_22_52", "13_57_45")]
+    out = tmp_path / "pair.json"
+    assert main(["identify", "--format", "osaka-frt", *map(str, train), "-o", str(out)]) == 0
+    model = load_model(out)
+    for path in sorted((OSAKA / "turning").glob("*.csv")):
+        turn = validate(model, read_trial_log(path, fmt="osaka-frt"), start_draws=False)[0]
+        ratio = (turn.indices["closed_loop"]["tactical_diameter"]
+                 / turn.indices["measured"]["tactical_diameter"])  # fmt: skip
+        assert 0.5 < ratio < 1.8, (path.name, ratio)

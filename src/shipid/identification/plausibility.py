@@ -40,8 +40,13 @@ STALL_SHARE = 0.1
 # 30°/30° zig-zags and 20° turns (CyberShip II lowest, the KVLCC2 highest), the Esso Osaka's
 # 1.3–1.7 times its zig-zags'. A model whose path is wider than this share of it has all but
 # lost the rudder: CyberShip II's zig-zags logged with a GNSS's 0.05 m/s speed noise gave a fit
-# whose 35° tactical diameter came 13 times the ship's.
-WIDE_SHARE = 0.25
+# whose 35° tactical diameter came 13 times the ship's; two of the Esso's zig-zag files (10 and
+# 15 rps) gave a `select` average whose 35° turns at 10 rps came 8.8 and 5.5 times the ship's
+# tactical diameter, its held turn 0.30 as curved as the logs' (at 5.4 times its approach
+# speed); a quarter, the rule until then, let it pass. At 0.4, 1.5 times below the least curved
+# reference ship, the default fits its fallback there, +64 % and +32 % (benchmarks/README.md,
+# one Esso Osaka zig-zag file as it comes).
+WIDE_SHARE = 0.4
 # ... and a model whose path is tighter than this many times it spins rather than turns: the
 # reference ships' 35° turns are at most 3.8 times as curved as their own zig-zags (the tanker's
 # 10°/10°; ``tests/test_plausibility_paths.py``). From the tanker's zig-zags at three times a
