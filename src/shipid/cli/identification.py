@@ -666,10 +666,11 @@ def _with_residual(model, logs, record):
 def _auto_gamma(args, logs, names, physics=None) -> tuple[float, dict]:
     """γ for the given structure: exact LOO of the LS-SVM pre-screens the grid, free-run
     cross-validation over the logs decides (``shipid.identification.select``)."""
+    from shipid.identification.cross_validation import choice_cv
     from shipid.identification.select import select
 
     structure = _structure(args)
-    cv = args.cv or ("logo" if len(logs) >= 2 else "blocks:4")
+    cv = args.cv or choice_cv(len(logs))
     sel = select(logs, library=structure, search="none", names=names, cv=cv,
                  estimator=args.estimator, plausibility=False, physics=physics)  # fmt: skip
     table = sel.candidates[["gamma", "score", "score_se", "folds_diverged"]]

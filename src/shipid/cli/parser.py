@@ -218,8 +218,9 @@ def build_parser() -> argparse.ArgumentParser:
                    "over the logs (default 1e4, or the γ select chose with --model auto)")
     p.add_argument("--estimator", default="lssvm", choices=LINEAR_ESTIMATORS,
                    help="equation-error estimator (default %(default)s, the paper's)")
-    p.add_argument("--cv", help="with --gamma auto or --residual: logo, kfold:K (--gamma) or "
-                   "blocks:K (default: logo, blocks:4 for one log)")
+    p.add_argument("--cv", help="the free-run cross-validation of the structure's choice, "
+                   "--gamma auto and --residual: logo, kfold:K (--gamma) or blocks:K (default: "
+                   "logo from three logs, blocks:4 of one or two; --residual: logo from two)")
     p.add_argument("--drop", help="terms to drop, e.g. u:r^2 (the paper drops r²)")
     p.add_argument("--filter", type=_number_or_auto_or_none, default="auto", metavar="HZ|auto|none",
                    help="zero-phase low-pass of u, v, r against the errors-in-variables bias: a "

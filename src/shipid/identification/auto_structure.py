@@ -9,8 +9,9 @@ from the logs:
 
 - a varying propeller speed: the terms ``select`` chooses from its default library (the
   four-quadrant ``low-speed`` terms, ``wind``, ``propeller-asymmetry`` and ``astern``, less what
-  the logs lack or never excite) by free-run cross-validation on the logs (leave one log out; four
-  blocks of a single log), with its γ; where its best-scoring candidate is ruled out by the
+  the logs lack or never excite) by free-run cross-validation on the logs (leave one log out;
+  four blocks of each of one or two logs: ``cross_validation.choice_cv``), with its γ; where its
+  best-scoring candidate is ruled out by the
   plausibility checks (the logs prefer what physics rejects), the search is repeated with
   ``rudder-drift`` added and kept where it predicts the held-out logs better
   (``widened_selection``);
@@ -45,6 +46,7 @@ import pandas as pd
 
 from shipid.dynamics.model import ModelStructure, get_structure
 from shipid.errors import ShipidError
+from shipid.identification.cross_validation import choice_cv
 from shipid.identification.identify import material_wind, spread, varies, varying_propulsion
 from shipid.identification.physics import PhysicsOptions
 
@@ -134,8 +136,9 @@ def auto_structure(logs: Sequence[pd.DataFrame], names: Sequence[str] | None = N
                    estimator: str = "lssvm", drop: Mapping[str, Sequence[str]] | None = None,
                    announce: Callable[[str], None] | None = None) -> StructureChoice:  # fmt: skip
     """The structure for ``logs`` (see the module): ``blanke`` unless they hold a varying
-    propulsion input or a material wind. ``cv`` for the selection (default: leave one log out,
-    four blocks of a single log); ``physics`` goes into every fit of the search; the ``drop``
+    propulsion input or a material wind. ``cv`` for the selection (default
+    ``cross_validation.choice_cv``: leave one log out, four blocks of each of one or two logs);
+    ``physics`` goes into every fit of the search; the ``drop``
     terms (e.g. ``{"u": ["r^2"]}``) are left out of every candidate, and of the choice;
     ``announce`` is told before a search starts (it takes seconds where a fit takes less)."""
     choice = _auto_structure(logs, names, physics, cv, estimator, drop, announce or _quiet)
@@ -192,7 +195,7 @@ def _auto_structure(logs, names, physics, cv, estimator, drop, announce) -> Stru
 
     library, note = default_library(logs)
     library_name = DEFAULT_LIBRARY + (" (less what the logs lack)" if note else "")
-    cv = cv or ("logo" if len(logs) >= 2 else "blocks:4")
+    cv = cv or choice_cv(len(logs))
     fallback = "blanke-rps" + ("+wind" if wind else "")
     try:
         # The default library is passed as None (select trims it and says so) unless terms
@@ -364,7 +367,7 @@ def _paper_or_race(logs, names, physics, cv, estimator, drop=None, announce=_qui
         candidates, prefilters = tuple(k for k in candidates if k != paper), {}
     from shipid.identification.select import select
 
-    cv = cv or ("logo" if len(logs) >= 2 else "blocks:4")
+    cv = cv or choice_cv(len(logs))
     announce(f"comparing {', '.join(candidates)} by free-run cross-validation ({cv})…")
     inside = _blocks_inside(logs, cv)
     scores, models, failed, faults, ruled_out = {}, {}, [], {}, {}
