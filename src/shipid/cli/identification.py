@@ -670,7 +670,7 @@ def _auto_gamma(args, logs, names, physics=None) -> tuple[float, dict]:
     from shipid.identification.select import select
 
     structure = _structure(args)
-    cv = args.cv or choice_cv(len(logs))
+    cv = args.cv or choice_cv(logs)
     sel = select(logs, library=structure, search="none", names=names, cv=cv,
                  estimator=args.estimator, plausibility=False, physics=physics)  # fmt: skip
     table = sel.candidates[["gamma", "score", "score_se", "folds_diverged"]]

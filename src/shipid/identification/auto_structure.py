@@ -195,7 +195,7 @@ def _auto_structure(logs, names, physics, cv, estimator, drop, announce) -> Stru
 
     library, note = default_library(logs)
     library_name = DEFAULT_LIBRARY + (" (less what the logs lack)" if note else "")
-    cv = cv or choice_cv(len(logs))
+    cv = cv or choice_cv(logs)
     fallback = "blanke-rps" + ("+wind" if wind else "")
     try:
         # The default library is passed as None (select trims it and says so) unless terms
@@ -367,7 +367,7 @@ def _paper_or_race(logs, names, physics, cv, estimator, drop=None, announce=_qui
         candidates, prefilters = tuple(k for k in candidates if k != paper), {}
     from shipid.identification.select import select
 
-    cv = cv or choice_cv(len(logs))
+    cv = cv or choice_cv(logs)
     announce(f"comparing {', '.join(candidates)} by free-run cross-validation ({cv})…")
     inside = _blocks_inside(logs, cv)
     scores, models, failed, faults, ruled_out = {}, {}, [], {}, {}

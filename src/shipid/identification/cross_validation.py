@@ -19,12 +19,22 @@ from shipid.errors import ShipidError
 # three files leaving each out is as good as blocks (ad hoc, 12 triples).
 LOGS_LEFT_OUT = 3
 BLOCKS = 4
+BLOCK_SAMPLES = 10  # the fewest samples a block may hold (``split_blocks``)
 
 
-def choice_cv(n_logs: int) -> str:
-    """The default cross-validation of a choice made on ``n_logs`` logs: 'logo' from
-    ``LOGS_LEFT_OUT`` logs, else 'blocks:BLOCKS'."""
-    return "logo" if n_logs >= LOGS_LEFT_OUT else f"blocks:{BLOCKS}"
+def choice_cv(logs) -> str:
+    """The default cross-validation of a choice made on ``logs`` (DataFrames, or their number):
+    'logo' from ``LOGS_LEFT_OUT`` logs, else 'blocks:BLOCKS', but 'logo' for two logs one of
+    which is too short to cut into blocks (a single log has no other choice)."""
+    if isinstance(logs, int):
+        count, shortest = logs, None
+    else:
+        count, shortest = len(logs), min((len(log) for log in logs), default=0)
+    if count >= LOGS_LEFT_OUT:
+        return "logo"
+    if count == 2 and shortest is not None and shortest < BLOCKS * (BLOCK_SAMPLES + 1):
+        return "logo"
+    return f"blocks:{BLOCKS}"
 
 
 def parse_cv(cv: str, option: str = "--cv", kinds: tuple[str, ...] = ("kfold", "blocks")
@@ -51,7 +61,7 @@ def split_blocks(logs, names, k: int) -> tuple[list[pd.DataFrame], list[str]]:
     for log, name in zip(logs, names, strict=True):
         edges = np.linspace(0, len(log), k + 1).round().astype(int)
         for j, (a, b) in enumerate(zip(edges[:-1], edges[1:], strict=True)):
-            if b - a < 10:
+            if b - a < BLOCK_SAMPLES:
                 raise ShipidError(f"{name}: too short for --cv blocks:{k} ({len(log)} samples)")
             block = log.iloc[a:b].reset_index(drop=True)
             block.attrs = dict(log.attrs)
