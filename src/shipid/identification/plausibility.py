@@ -44,8 +44,9 @@ STALL_SHARE = 0.1
 # 15 rps) gave a `select` average whose 35° turns at 10 rps came 8.8 and 5.5 times the ship's
 # tactical diameter, its held turn 0.30 as curved as the logs' (at 5.4 times its approach
 # speed); a quarter, the rule until then, let it pass. At 0.4, 1.5 times below the least curved
-# reference ship, the default fits its fallback there, +64 % and +32 % (benchmarks/README.md,
-# one Esso Osaka zig-zag file as it comes).
+# reference ship, it is ruled out: the default fitted its fallback there, +64 % and +32 %, and
+# since its choices on two logs use four blocks of each, `select`'s terms, +11 % and −17 %
+# (benchmarks/README.md, one Esso Osaka zig-zag file as it comes).
 WIDE_SHARE = 0.4
 # ... and a model whose path is tighter than this many times it spins rather than turns: the
 # reference ships' 35° turns are at most 3.8 times as curved as their own zig-zags (the tanker's
