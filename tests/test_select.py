@@ -266,21 +266,12 @@ def test_compare_names_logs_its_default_structure_cannot_hold(tmp_path, capsys, 
     assert "cannot hold" not in capsys.readouterr().err
 
 
-def test_cli_select_cuts_one_log_into_blocks_and_refuses_logo_on_it(tmp_path, capsys,
-                                                                    paper_trials):
-    """Without --cv, select cross-validates as identify's choices do (``choice_cv``): one or two
-    logs cut into four blocks each (it refused one log before); --cv logo on one log is refused
-    in one line, and no file is written."""
+def test_cli_select_refuses_one_log(tmp_path, capsys, paper_trials):
     training, _ = paper_trials
     path = write_log(training[0], tmp_path / "one.csv")
-    code = main(["select", str(path), "-o", str(tmp_path / "m.json"), "--library", "blanke",
-                 "--search", "none", "--gammas", "1e4", "--quiet"])  # fmt: skip
-    out = capsys.readouterr().out
-    assert code == 0 and "(blocks:4;" in out and (tmp_path / "m.json").exists()
-    code = main(["select", str(path), "-o", str(tmp_path / "n.json"), "--library", "blanke",
-                 "--cv", "logo"])  # fmt: skip
+    code = main(["select", str(path), "-o", str(tmp_path / "m.json"), "--library", "blanke"])
     err = capsys.readouterr().err
-    assert code == 1 and "at least 2 logs" in err and not (tmp_path / "n.json").exists()
+    assert code == 1 and "at least 2 logs" in err and not (tmp_path / "m.json").exists()
 
 
 def test_a_choice_from_few_folds_is_reported_as_weak(paper_trials):

@@ -684,15 +684,14 @@ def cmd_select(args) -> int:
     """``shipid select``: structure and γ by cross-validated free-run error."""
     from shipid.dynamics.model import get_structure
     from shipid.dynamics.similarity import rps_similar, similarity_map
-    from shipid.identification.cross_validation import choice_cv, parse_cv
+    from shipid.identification.cross_validation import parse_cv
     from shipid.identification.select import RESAMPLES, SelectOptions, default_library, select
     from shipid.outputs import OutputSet, check_outputs
     from shipid.reporting.modelfile import model_text
 
     check_outputs({"-o": (args.output, "json"), "--table": (args.table, "log")}, args.logs)
     # The options logs do not decide, checked before the logs are read.
-    if args.cv is not None:
-        parse_cv(args.cv)
+    parse_cv(args.cv)
     gammas = _parse_gammas(args.gammas)
     try:
         given = get_structure(args.library) if args.library is not None else None
@@ -705,7 +704,7 @@ def cmd_select(args) -> int:
     library = given if given is not None else default_library(logs)[0]
     # The default library is passed as None: select trims it to the logs and says so.
     options = SelectOptions(library=library if args.library is not None else None,
-                            search=args.search, cv=args.cv or choice_cv(logs),
+                            search=args.search, cv=args.cv,
                             estimator=args.estimator, method=args.method,
                             max_evaluations=args.max_evaluations,
                             plausibility=not args.no_plausibility, speed=args.speed,

@@ -287,9 +287,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--search", default="stepwise", choices=("stepwise", "frols", "stlsq", "none"),
                    help="how candidates are generated (default %(default)s)")
     p.add_argument("--gammas", metavar="G,G,...", help="γ grid (default 1e2,1e3,1e4,1e5,1e6)")
-    p.add_argument("--cv", help="logo (leave one log out), kfold:K or blocks:K (every log cut "
-                   "into K blocks); default logo from three logs, blocks:4 of one or two, as "
-                   "identify's choices")
+    p.add_argument("--cv", default="logo", help="logo (leave one log out, default), kfold:K or "
+                   "blocks:K (every log cut into K blocks)")
     p.add_argument("--estimator", default="lssvm", choices=LINEAR_ESTIMATORS,
                    help="equation-error estimator (default %(default)s)")
     p.add_argument("--method", default="euler", choices=("euler", "rk4"),
