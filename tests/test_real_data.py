@@ -322,3 +322,28 @@ def test_two_esso_files_choose_on_four_blocks_of_each(tmp_path):
     run = validate(load_model(out), held, start_draws=False)[0]
     assert not run.simulation.diverged
     assert run.metrics["r"]["std"] / float(np.std(held["r"])) < 0.7
+
+
+@needs_data
+def test_a_model_that_breaks_below_the_logs_rps_says_so(tmp_path, capsys):
+    """Two zig-zag files at 12 and 15 rps (13_50_28, 13_57_45): the default model turns
+    plausibly at both and fails at 10 rps, where the Esso's turns were run (their closed loops
+    end without a tactical diameter). identify says so where the model is made: at 0.6 of the
+    logs' lowest rps its held 35° turn fails a check (``plausibility.below_the_logs_rps``). The
+    MARIN KVLCC2 model (one rps) gets no such warning."""
+    from shipid.reporting.modelfile import load_model
+    from shipid.trials.reading import read_trial_log
+
+    train = [OSAKA / "zigzag" / f"zigzag_31-Jul-2020_{s}.csv" for s in ("13_50_28", "13_57_45")]
+    out = tmp_path / "pair.json"
+    assert main(["identify", "--format", "osaka-frt", *map(str, train), "-o", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert "below the logs' propeller speeds the model extrapolates: at 7.2 rps (0.6 of the " \
+           "lowest, 12) it" in err, err  # fmt: skip
+    turn = read_trial_log(sorted((OSAKA / "turning").glob("*.csv"))[0], fmt="osaka-frt")
+    assert "tactical_diameter" not in validate(load_model(out), turn,
+                                               start_draws=False)[0].indices.get("closed_loop", {})
+    marin = DATA / "kvlcc2-marin" / "MARIN_FREE_KVLCC2_zz_20_m.dat"
+    assert main(["identify", "--format", "simman-marin", "--scale", "45.7", str(marin), "-o",
+                 str(tmp_path / "kv.json")]) == 0  # fmt: skip
+    assert "below the logs' propeller speeds" not in capsys.readouterr().err

@@ -329,11 +329,18 @@ def cmd_identify(args) -> int:
               f"{plausibility['approach']}"
               + (", with its kernel residual" if hybrid else ""))  # fmt: skip
     ident.warnings.extend(f"plausibility: {n}" for n in notes)
-    from shipid.identification.plausibility import approach_beyond_logs, given_steady_speeds
+    from shipid.identification.plausibility import (
+        approach_beyond_logs,
+        below_the_logs_rps,
+        given_steady_speeds,
+    )
 
     beyond = approach_beyond_logs(plausibility, ident.envelope)
     if beyond:
         ident.warnings.append(beyond)
+    below = below_the_logs_rps(hybrid or as_written(final), plausibility, logs)
+    if below:
+        ident.warnings.append(below)
 
     for u, n in given_steady_speeds(physics):  # where the user says the ship runs steady
         at = plausibility_at_approach(hybrid or as_written(final), u, n, u, n)[1]

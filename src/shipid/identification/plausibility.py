@@ -24,6 +24,7 @@ import numpy as np
 
 from shipid.dynamics.equilibrium import still_air_accelerations, surge_equilibrium
 from shipid.dynamics.model import ManoeuvringModel
+from shipid.errors import ShipidError
 from shipid.trials.manoeuvres import doubling, turning_circle
 
 SETTLED_FRACTION = 0.02  # of the steady value, over the last 10 % of the run
@@ -201,6 +202,44 @@ def approach_beyond_logs(report: dict, env: dict) -> str | None:
             f"({fastest:.4g} m/s): no log ran steady there, so the speed its surge balances at "
             "is the fit's extrapolation, and its manoeuvres and criteria start from it; give "
             "--steady-speed U@N (a straight run's speed at N rps), or --speed to them")
+
+
+# Below the logs' propeller speeds a model extrapolates: from two Esso zig-zag files at 12 and
+# 15 rps the default model turned plausibly at both and diverged in a 35° turn at 10 rps (at 0.6
+# of the lowest training rps, 7.2 rps, its held turns diverge too). Said where the model is
+# made, as `validate` says the same of a log beyond the training range.
+LOWER_RPS_SHARE = 0.6
+
+
+def below_the_logs_rps(model: ManoeuvringModel, report: dict, logs) -> str | None:
+    """A warning where ``model`` (with propeller terms, checked at the logs' approach in
+    ``report``) fails a disqualifying check with the rudder held at ``LOWER_RPS_SHARE`` of the
+    lowest rps of ``logs``, each run at a constant rps, from its own steady speed there; else
+    None (also for logs whose rps varies within them: random runs cover the low rps)."""
+    from shipid.data.log import approach
+    from shipid.identification.identify import varies
+
+    if not getattr(model, "uses_rps", False) or not report.get("approach_speed"):
+        return None
+    if any("n" not in log.columns or varies(log["n"].to_numpy(dtype=float)) for log in logs):
+        return None
+    found = [approach(log, "n") for log in logs]
+    found = [float(n) for n in found if n is not None and n > 0]
+    if not found or not report.get("rps"):
+        return None
+    lowest = min(found)
+    rps = LOWER_RPS_SHARE * lowest
+    near = report["approach_speed"] * rps / float(report["rps"])
+    try:
+        low = plausibility_at_approach(model, near, rps, None, rps)[0]
+    except (ShipidError, ValueError):
+        return None
+    reasons = [("has " + r if r.startswith("no ") else r) for r in disqualifying(low, model)]
+    if not reasons:
+        return None
+    return (f"below the logs' propeller speeds the model extrapolates: at {rps:.3g} rps "
+            f"({LOWER_RPS_SHARE:g} of the lowest, {lowest:.4g}) it {' and '.join(reasons[:2])}; "
+            "validate it on a log at the propeller speed you need before using it there")
 
 
 def given_steady_speeds(physics) -> list[tuple[float, float]]:
