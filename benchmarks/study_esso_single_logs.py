@@ -3,7 +3,9 @@
 README's `import` cuts it; then on every pair of zig-zag files, judged on the other nine logs.
 What a user with one or two trials gets: which structure, and how far its free runs miss logs
 it never saw (yaw rate error std over the log's spread; most of them at another propeller
-speed, which a structure without n cannot know).
+speed, which a structure without n cannot know). For the pairs also the 35° turns' tactical
+diameters (closed loop), the four random runs (read whole) and whether `identify` warned below
+the logs' propeller speeds. Every held-out log is validated once per model.
 
 Run: .venv/bin/python benchmarks/study_esso_single_logs.py
 """
@@ -36,6 +38,7 @@ def main() -> None:
     zigzags = sorted((DATA / "zigzag").glob("*.csv"))
     files = zigzags + sorted((DATA / "turning").glob("*.csv"))
     held = {f: read_trial_log(f, fmt="osaka-frt") for f in files}
+    randoms = {f: read_trial_log(f, fmt="osaka-frt") for f in sorted((DATA / "random").glob("*.csv"))}
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores\n")
     print("| trained on | rps | structure (how) | held-out logs: r error / spread, median (worst) "
           "| the same, --no-rps-similarity | diverged | seconds |")
@@ -57,12 +60,13 @@ def main() -> None:
                    or {}).get("how")  # fmt: skip
             model = load_model(out)
             others = {g: log for g, log in held.items() if g != f}
-            errors = _errors(model, others)
+            errors = _errors(_validations(model, others), others)
             with contextlib.redirect_stdout(io.StringIO()), \
                     contextlib.redirect_stderr(io.StringIO()):  # fmt: skip
                 shipid(["identify", "--format", "osaka-frt", str(f), "--no-rps-similarity",
                         "-o", f"{tmp}/plain.json"])  # fmt: skip
-            plain = _errors(load_model(f"{tmp}/plain.json"), others)
+            plain_model = load_model(f"{tmp}/plain.json")
+            plain = _errors(_validations(plain_model, others), others)
             finite = errors[np.isfinite(errors)]
             rps = float(np.median(held[f]["n"]))
             for g, a, b in zip(others, errors, plain, strict=True):
@@ -85,23 +89,29 @@ def main() -> None:
         print("| structure chosen | pairs | median r error / spread | diverged | 35° turns: "
               "tactical diameter, abs error median (largest) |")
         print("|---|---|---|---|---|")
-        by_how: dict[str, list[tuple[float, int, int]]] = {}
+        by_how: dict[str, list[tuple[float, int, int, np.ndarray]]] = {}
+        warned: dict[bool, list[np.ndarray]] = {True: [], False: []}
+        random_errors = []  # each pair's median over the random runs
         for a, b in itertools.combinations(zigzags, 2):
-            with contextlib.redirect_stdout(io.StringIO()), \
-                    contextlib.redirect_stderr(io.StringIO()):  # fmt: skip
+            said = io.StringIO()
+            with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(said):
                 code = shipid(["identify", "--format", "osaka-frt", str(a), str(b), "-o", out])
             if code:
-                by_how.setdefault("failed", []).append((np.nan, 0, 0))
+                by_how.setdefault("failed", []).append((np.nan, 0, 0, np.empty(0)))
                 continue
             choice = json.loads(open(out).read())["identification"].get("structure_choice") or {}
             model = load_model(out)
             how = choice.get("how")
             label = (f"{model.structure.name} ({how})" if how != "select"
                      else "terms chosen by select")  # fmt: skip
-            errors = _errors(model, {g: log for g, log in held.items() if g not in (a, b)})
-            turns = _turn_errors(model, {g: log for g, log in held.items() if "turn" in g.stem})
+            others = {g: log for g, log in held.items() if g not in (a, b)}
+            runs = _validations(model, others)
+            errors = _errors(runs, others)
+            turns = _turn_errors([v for g, v in zip(others, runs, strict=True) if "turn" in g.stem])
             by_how.setdefault(label, []).append(
                 (float(np.median(errors)), int(np.isinf(errors).sum()), len(errors), turns))
+            warned["below the logs' propeller speeds" in said.getvalue()].append(turns)
+            random_errors.append(float(np.median(_errors(_validations(model, randoms), randoms))))
         for label, rows in sorted(by_how.items(), key=lambda kv: -len(kv[1])):
             medians = [r[0] for r in rows]
             turns = np.abs(np.concatenate([r[3] for r in rows]))
@@ -111,14 +121,26 @@ def main() -> None:
         every = np.abs(np.concatenate([r[3] for rows in by_how.values() for r in rows]))
         print(f"\nThe two 35° turns (closed loop) over the 36 pairs: tactical diameter "
               f"{_turn_cell(every)}, mean {np.mean(every[np.isfinite(every)]):.0f} %")
+        print(f"The held-out logs' r error / spread, median over the pairs of each pair's median: "
+              f"{np.median([r[0] for rows in by_how.values() for r in rows]):.3f}; the four "
+              f"random runs' (read whole), {np.median(random_errors):.2f}")
+        for flag, rows in warned.items():
+            turns = np.abs(np.concatenate(rows)) if rows else np.empty(0)
+            print(f"Pairs {'warned' if flag else 'not warned'} below the logs' propeller speeds "
+                  f"(identify's warning): {len(rows)}, their turns {_turn_cell(turns)}")
     print(f"\n{time.perf_counter() - start:.0f} s")
 
 
-def _turn_errors(model, turns) -> np.ndarray:
-    """The 35° turns' closed-loop tactical diameter error [%] (inf where there is none)."""
+def _validations(model, logs) -> list:
+    """``validate`` of ``model`` on each of ``logs`` ({path: log}), once."""
+    return [validate(model, log, start_draws=False)[0] for log in logs.values()]
+
+
+def _turn_errors(runs) -> np.ndarray:
+    """The 35° turns' closed-loop tactical diameter error [%] of their validations ``runs``
+    (inf where there is none)."""
     out = []
-    for log in turns.values():
-        v = validate(model, log, start_draws=False)[0]
+    for v in runs:
         try:
             out.append(100 * (v.indices["closed_loop"]["tactical_diameter"]
                               / v.indices["measured"]["tactical_diameter"] - 1))  # fmt: skip
@@ -135,11 +157,11 @@ def _turn_cell(errors: np.ndarray) -> str:
     return cell + (f", {none} without" if none else "")
 
 
-def _errors(model, logs) -> np.ndarray:
-    """The free runs' yaw rate error std over each log's spread (inf where one diverged)."""
+def _errors(runs, logs) -> np.ndarray:
+    """The free runs' yaw rate error std over each log's spread, from their validations
+    ``runs`` (inf where one diverged)."""
     out = []
-    for log in logs.values():
-        v = validate(model, log, start_draws=False)[0]
+    for v, log in zip(runs, logs.values(), strict=True):
         diverged = v.error is not None or v.simulation.diverged
         out.append(np.inf if diverged else v.metrics["r"]["std"] / float(np.std(log["r"])))
     return np.array(out)

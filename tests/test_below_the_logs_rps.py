@@ -11,11 +11,7 @@ import pandas as pd
 import pytest
 
 from shipid.dynamics.model import ManoeuvringModel, get_structure
-from shipid.identification.plausibility import (
-    LOWER_RPS_SHARE,
-    below_the_logs_rps,
-    plausibility_at_approach,
-)
+from shipid.identification.plausibility import below_the_logs_rps, plausibility_at_approach
 
 A, C = 0.0321, 0.0012  # |u|u and |n|n coefficients
 
@@ -43,9 +39,7 @@ def test_a_model_without_a_steady_speed_below_the_logs_rps_is_named(drag, warned
     report = plausibility_at_approach(model, speed, 10.0)[0]
     assert report["approach_speed"] == pytest.approx(speed, rel=1e-3)
     found = below_the_logs_rps(model, report, logs)
-    assert LOWER_RPS_SHARE == 0.6
     if warned:
-        assert C * 36 < drag  # the closed form: no balance at 6 rps
         assert found is not None and found.startswith(
             "below the logs' propeller speeds the model extrapolates: at 6 rps (0.6 of the "
             "lowest, 10) it has no steady straight speed")  # fmt: skip

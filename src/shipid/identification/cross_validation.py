@@ -23,18 +23,24 @@ BLOCK_SAMPLES = 10  # the fewest samples a block may hold (``split_blocks``)
 
 
 def choice_cv(logs) -> str:
-    """The default cross-validation of a choice made on ``logs`` (DataFrames, or their number):
-    'logo' from ``LOGS_LEFT_OUT`` logs, else 'blocks:BLOCKS', but 'logo' for two logs one of
-    which is too short to cut into blocks (a single log has no other choice)."""
-    if isinstance(logs, int):
-        count, shortest = logs, None
-    else:
-        count, shortest = len(logs), min((len(log) for log in logs), default=0)
-    if count >= LOGS_LEFT_OUT:
+    """The default cross-validation of a choice made on ``logs``: 'logo' from ``LOGS_LEFT_OUT``
+    logs, else 'blocks:BLOCKS', but 'logo' for two logs one of which is too short to cut into
+    blocks (``split_blocks`` would refuse it; a single log has no other choice)."""
+    if len(logs) >= LOGS_LEFT_OUT:
         return "logo"
-    if count == 2 and shortest is not None and shortest < BLOCKS * (BLOCK_SAMPLES + 1):
+    if len(logs) == 2 and not all(_blocks_fit(len(log), BLOCKS) for log in logs):
         return "logo"
     return f"blocks:{BLOCKS}"
+
+
+def _block_edges(n: int, k: int) -> np.ndarray:
+    """The sample indices that cut ``n`` samples into ``k`` contiguous blocks."""
+    return np.linspace(0, n, k + 1).round().astype(int)
+
+
+def _blocks_fit(n: int, k: int) -> bool:
+    """Whether ``n`` samples cut into ``k`` blocks leave each at least ``BLOCK_SAMPLES``."""
+    return bool(np.diff(_block_edges(n, k)).min() >= BLOCK_SAMPLES)
 
 
 def parse_cv(cv: str, option: str = "--cv", kinds: tuple[str, ...] = ("kfold", "blocks")
@@ -59,10 +65,10 @@ def split_blocks(logs, names, k: int) -> tuple[list[pd.DataFrame], list[str]]:
     """Every log cut into ``k`` contiguous blocks (each a log of its own, named after it)."""
     out, out_names = [], []
     for log, name in zip(logs, names, strict=True):
-        edges = np.linspace(0, len(log), k + 1).round().astype(int)
+        if not _blocks_fit(len(log), k):
+            raise ShipidError(f"{name}: too short for --cv blocks:{k} ({len(log)} samples)")
+        edges = _block_edges(len(log), k)
         for j, (a, b) in enumerate(zip(edges[:-1], edges[1:], strict=True)):
-            if b - a < BLOCK_SAMPLES:
-                raise ShipidError(f"{name}: too short for --cv blocks:{k} ({len(log)} samples)")
             block = log.iloc[a:b].reset_index(drop=True)
             block.attrs = dict(log.attrs)
             out.append(block)
