@@ -254,7 +254,8 @@ def _auto_structure(logs, names, physics, cv, estimator, drop, announce) -> Stru
 # zig-zag files and pairs as they come, it and the spin check (``plausibility.TIGHT_FACTOR``)
 # change 6 (``study_esso_single_logs.py``): the held-out logs' yaw rate better in 4 (the
 # 30°/30° file at 16.7 rps 0.47 → 0.34 of its spread), worse in 2 (a pair at 10 and 15 rps,
-# 0.27 → 0.48, where two folds chose), the mean over the 45 0.29 as before. The drift terms
+# 0.27 → 0.48, where two folds chose, before two logs were cut into blocks), the mean over
+# the 45 0.29 as before. The drift terms
 # are not in the default library: chosen from the Esso's zig-zags, they put its held-out turns
 # 30–47 % long (``study_esso_extrapolation.py``).
 WIDENING = "rudder-drift"
