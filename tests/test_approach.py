@@ -142,3 +142,21 @@ def test_only_manoeuvres_read_whole_from_rest_are_named():
     straight = _log(np.concatenate([np.linspace(0.0, 1.5, 200), np.full(800, 2.0)]),
                     np.full(1000, 10.0))  # fmt: skip
     assert manoeuvres_from_rest([zz, from_rest, straight]) == [1]
+
+
+def test_identify_refuses_a_log_astern_before_fitting_it(tmp_path, capsys):
+    """A log run astern throughout has no approach ahead for the checks and manoeuvres to start
+    from. It was fitted in full (output error included) and refused only then, with its speed
+    printed to 17 digits; now one line before the fit, and no model file."""
+    log = zigzag(scale_ship(rudder_rate_deg=9.6), 20, 20, duration=60, dt=0.2,
+                 method="euler").log  # fmt: skip
+    path = write_log(log.drop(columns=["x", "y"]).assign(u=-log["u"]), tmp_path / "astern.csv")
+    code, out, err = run(["identify", path, "-o", tmp_path / "m.json"], capsys)
+    assert code == 1
+    speed = -float(log["u"].iloc[: len(log) // 50].mean())
+    assert err.strip() == (f"shipid: error: {path}: the first training log goes astern at its "
+                           f"approach (u = {speed:.3g} m/s); the checks and manoeuvres start from "
+                           "its approach ahead: trim it to the manoeuvre (--start), or give a log "
+                           "that runs ahead first")  # fmt: skip
+    assert "prefilter" not in out and "output error" not in out  # refused before the fit
+    assert not (tmp_path / "m.json").exists()

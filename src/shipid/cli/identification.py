@@ -72,6 +72,19 @@ def _free_run_table(refinement) -> str:
     return "\n".join(lines)
 
 
+def _refuse_no_headway(log, name: str) -> None:
+    """One line where the first training log, whose approach the plausibility checks and the
+    manoeuvres start from, has none ahead (a log run astern throughout was fitted in full
+    before, and refused only then, its speed printed to 17 digits)."""
+    speed = _approach(log, "u")
+    if speed is None or not speed > 0:
+        how = "goes astern" if speed is not None and speed < 0 else "starts without headway"
+        shown = "no u" if speed is None else f"u = {speed:.3g} m/s"
+        raise ShipidError(f"{name}: the first training log {how} at its approach ({shown}); the "
+                          "checks and manoeuvres start from its approach ahead: trim it to the "
+                          "manoeuvre (--start), or give a log that runs ahead first")
+
+
 def cmd_identify(args) -> int:
     """``shipid identify``: a model from logs (LS-SVM, optional refinement, checks)."""
     from shipid.data.preprocess import lowpass
@@ -118,6 +131,7 @@ def cmd_identify(args) -> int:
     raw_logs = logs  # the output-error fit needs the noise as measured, not prefiltered
     one_rps = _one_rps(logs, args)
     names = [str(p) for p in args.logs]
+    _refuse_no_headway(logs[0], names[0])  # before the fit: the checks start from it
     gamma_given = args.gamma is not None
     choice = _choose_structure(args, logs, names)
     physics = _physics(args, logs, _structure(args))
@@ -260,9 +274,8 @@ def cmd_identify(args) -> int:
     elif args.output_error == "auto" and not (args.refine or given_physics):
         prep["output_error"] = _output_error_passed_over(ident, raw_logs, args, explicit_band)
     final = ident.model
-    if speed is None or not speed > 0:
-        raise ShipidError(f"{names[0]}: the first training log starts without headway (u = "
-                          f"{speed}); trim it to the manoeuvre (--start)")  # fmt: skip
+    if speed is None or not speed > 0:  # the prefilter moved it (checked before the fit)
+        _refuse_no_headway(logs[0], names[0])
     # A hybrid is checked whole: its stability, steady speed and held-rudder turns.
     curvature = sharpest_curvature(logs, speed)
     if residual is not None:
