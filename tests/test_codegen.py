@@ -15,9 +15,11 @@ from shipid.trials.manoeuvres import zigzag
 from shipid.vessels import scale_ship
 from shipid.vessels.scale_ship import scale_ship_model
 
-# Every factor operation (x, |x|, pos, neg, sin, cos), powers, U and β, the propeller, the wind.
+# Every factor operation (x, |x|, pos, neg, sin, cos, the hull's cross-flow), powers, U and β,
+# the propeller, the wind.
 RICH = ("|u|u", "v*r", "1", "u*r", "u*v", "|v|v", "|v|r", "delta", "v^3", "pos(n)^2*delta",
-        "neg(v)*r", "U^2*sin(2*beta)", "wind_speed^2*cos(wind_angle)", "u^2*delta^2")  # fmt: skip
+        "neg(v)*r", "U^2*sin(2*beta)", "wind_speed^2*cos(wind_angle)", "u^2*delta^2",
+        "crossflow_sway(4)", "u*crossflow_yaw(4)")  # fmt: skip
 
 
 def rich_model() -> ManoeuvringModel:

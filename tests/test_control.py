@@ -117,13 +117,15 @@ def test_exports_reproduce_the_simulator(tmp_path, method):
     import control
 
     m = ManoeuvringModel(
-        "u: |u|u, v*r, delta^2, |n|*n, 1; v: u*r, u*v, |v|v, pos(n)^2*delta, U^2*sin(2*beta); "
-        "r: u*r, u*v, |v|r, delta, wind_speed^2*sin(2*wind_angle), 1",
+        "u: |u|u, v*r, delta^2, |n|*n, 1; v: u*r, u*v, |v|v, pos(n)^2*delta, U^2*sin(2*beta), "
+        "crossflow_sway(4); r: u*r, u*v, |v|r, delta, wind_speed^2*sin(2*wind_angle), 1, "
+        "crossflow_yaw(4)",
         {"u": {"|u|u": -0.03, "v*r": -2.0, "delta^2": -0.2, "|n|*n": 1e-3, "1": 0.0},
          "v": {"u*r": -0.45, "u*v": -0.52, "|v|v": -0.5, "pos(n)^2*delta": 1e-4,
-               "U^2*sin(2*beta)": 0.01},
+               "U^2*sin(2*beta)": 0.01, "crossflow_sway(4)": -0.3},
          "r": {"u*r": -1.17, "u*v": -0.67, "|v|r": 3.9, "delta": -0.55,
-               "wind_speed^2*sin(2*wind_angle)": 1e-3, "1": -0.005}})  # fmt: skip
+               "wind_speed^2*sin(2*wind_angle)": 1e-3, "1": -0.005,
+               "crossflow_yaw(4)": -0.4}})  # fmt: skip
     t = np.arange(0, 60, 0.1)
     d, n = 0.3 * np.sign(np.sin(t / 8)), 5 + np.sin(t / 5)
     ws, wa = 2 + np.cos(t / 3), np.sin(t / 7)

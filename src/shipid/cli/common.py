@@ -128,6 +128,23 @@ def _particulars(args):
     return read_particulars(args.particulars)
 
 
+def _structure_edit(args, logs):
+    """--drop and --crossflow as one ``StructureEdit`` (the length from the particulars)."""
+    from shipid.dynamics.model import StructureEdit
+
+    length = None
+    if getattr(args, "crossflow", False):
+        found = _particulars(args) or _log_particulars(logs)
+        if found is None:
+            raise ShipidError("--crossflow needs the hull's length: give --particulars FILE "
+                              "(length, or Lpp)")  # fmt: skip
+        from shipid.data.particulars import Particulars
+
+        length = found.length if isinstance(found, Particulars) else \
+            Particulars.from_mapping(found).length  # fmt: skip
+    return StructureEdit(_parse_drop(getattr(args, "drop", None)) or None, length)
+
+
 def _log_particulars(logs) -> dict | None:
     return next((log.attrs["particulars"] for log in logs if log.attrs.get("particulars")), None)
 

@@ -22,6 +22,7 @@ from shipid.cli.common import (
     _physics,
     _std_errors,
     _structure,
+    _structure_edit,
     _term_display,
     _training_logs,
     _warn,
@@ -132,6 +133,7 @@ def cmd_identify(args) -> int:
     one_rps = _one_rps(logs, args)
     names = [str(p) for p in args.logs]
     _refuse_no_headway(logs[0], names[0])  # before the fit: the checks start from it
+    _crossflow_into_model(args, logs)
     gamma_given = args.gamma is not None
     choice = _choose_structure(args, logs, names)
     physics = _physics(args, logs, _structure(args))
@@ -447,7 +449,7 @@ def _choose_structure(args, logs, names):
         # The search fits with the same physics, as select does: a prior over its library.
         physics = _physics(args, logs, default_library(logs)[0])
         choice = auto_structure(logs, names, physics, args.cv, args.estimator,
-                                _parse_drop(args.drop),
+                                _structure_edit(args, logs),
                                 announce=lambda m: print(m, file=sys.stderr))  # fmt: skip
         print(choice.describe())
         for w in choice.warnings:
@@ -456,6 +458,21 @@ def _choose_structure(args, logs, names):
     if args.gamma is None:
         args.gamma = choice.gamma if choice is not None and choice.gamma else 1e4
     return choice
+
+
+def _crossflow_into_model(args, logs) -> None:
+    """--crossflow with a given structure: the structure (less --drop) with the hull's
+    cross-flow drag, put into ``args.model`` (``auto`` takes it into every candidate)."""
+    from shipid.identification.auto_structure import AUTO
+
+    if not args.crossflow or args.model == AUTO:
+        return
+    edit = _structure_edit(args, logs)
+    given = _structure(args)
+    args.model, args.drop = edit.apply(given), None
+    if args.model is given or args.model == given:
+        _warn(f"--crossflow: {given.name} has none of the hull's nonlinear damping terms "
+              "(|v|v, |v|r, |r|r, v|r|) in sway or yaw; fitted as it is")  # fmt: skip
 
 
 def _refit_alternatives(choice, args, logs, names, gamma) -> tuple[dict, bool]:
@@ -722,8 +739,12 @@ def cmd_select(args) -> int:
     logs = _training_logs(args)
     names = [str(p) for p in args.logs]
     library = given if given is not None else default_library(logs)[0]
+    edit = _structure_edit(args, logs)
+    if edit.crossflow_length is not None:
+        # The default library passed as given: the trimmed one, with the hull's cross-flow drag.
+        given = library = edit.apply(library)
     # The default library is passed as None: select trims it to the logs and says so.
-    options = SelectOptions(library=library if args.library is not None else None,
+    options = SelectOptions(library=library if given is not None else None,
                             search=args.search, cv=args.cv,
                             estimator=args.estimator, method=args.method,
                             max_evaluations=args.max_evaluations,
@@ -738,7 +759,7 @@ def cmd_select(args) -> int:
 
         # As identify's default: where the logs' best fit from the default library is ruled out
         # by the checks, the search again with the rudder's lift at the hull's drift.
-        wider, said = widened_selection(sel, logs, names, options,
+        wider, said = widened_selection(sel, logs, names, options, edit,
                                         announce=lambda m: print(m, file=sys.stderr))
         if wider is not None:
             sel = wider[0]

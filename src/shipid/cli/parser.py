@@ -85,6 +85,13 @@ def _add_log_options(p: argparse.ArgumentParser) -> None:
                    "ship_data.yml reads as is), kept with the logs and the model")
 
 
+def _add_crossflow_option(p) -> None:
+    p.add_argument("--crossflow", action="store_true",
+                   help="the hull's nonlinear sway and yaw damping (|v|v, |v|r, |r|r, v|r|) as "
+                   "the cross-flow drag over its length, one term per equation, in whichever "
+                   "structure is fitted or searched; needs the length (--particulars)")
+
+
 def _number_or_auto(text: str) -> float | str:
     return _time_or_auto(text)
 
@@ -222,6 +229,7 @@ def build_parser() -> argparse.ArgumentParser:
                    "--gamma auto and --residual: logo, kfold:K (--gamma) or blocks:K (default: "
                    "logo from three logs, blocks:4 of one or two; --residual: logo from two)")
     p.add_argument("--drop", help="terms to drop, e.g. u:r^2 (the paper drops r²)")
+    _add_crossflow_option(p)
     p.add_argument("--filter", type=_number_or_auto_or_none, default="auto", metavar="HZ|auto|none",
                    help="zero-phase low-pass of u, v, r against the errors-in-variables bias: a "
                    "cut-off, 'none', or 'auto' (default): the cut-off whose model has the "
@@ -320,6 +328,7 @@ def build_parser() -> argparse.ArgumentParser:
                    "(default %(default)s)")
     p.add_argument("--table", metavar="OUT.csv", help="write every candidate with its scores")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    _add_crossflow_option(p)
     _add_similarity_option(p)
     p.add_argument("-o", "--output", required=True, metavar="MODEL.json")
     _add_physics_options(p)

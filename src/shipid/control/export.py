@@ -100,6 +100,8 @@ _SIGNAL_EXPR = {"U": "np.sqrt(u * u + v * v)", "beta": "np.arctan2(-v, u)"}
 def _factor_expr(f) -> str:
     x = _SIGNAL_EXPR.get(f.name, f.name)
     op = OPS[f.op]
+    if f.crossflow:  # the module's own copy of shipid.dynamics.terms.crossflow
+        return f"crossflow(v, r, {f.k!r})[{0 if op == 'crossflow_sway' else 1}]"
     if op == "pow":
         base = x
     elif op == "abs":
@@ -111,6 +113,17 @@ def _factor_expr(f) -> str:
     else:
         base = f"np.{op}({f.k} * {x})" if f.k != 1 else f"np.{op}({x})"
     return base if f.power == 1 else f"{base} ** {f.power}"
+
+
+def _crossflow_source(model: ManoeuvringModel) -> list[str]:
+    """The cross-flow factors' function, where the model has them (its source, as shipid runs it)."""
+    if not any(parse_term(t).crossflow for terms in model.coefficients.values() for t in terms):
+        return []
+    import inspect
+
+    from shipid.dynamics.terms import crossflow
+
+    return [*inspect.getsource(crossflow).splitlines(), "", ""]
 
 
 def _array_literal(a: np.ndarray) -> str:
@@ -196,6 +209,7 @@ def numpy_source(model: ManoeuvringModel | HybridModel, rudder_positive: str | N
         f"RUDDER_POSITIVE = {rudder_positive!r}  # which way positive delta turns the ship",
         "",
         "",
+        *_crossflow_source(model),
         f"def accelerations(u, v, r, delta{''.join(f', {s}=0.0' for s in inputs)}):",
         '    """(u̇, v̇, ṙ) at arrays of states and inputs."""',
         "    u, v, r, delta = (np.asarray(a, dtype=float) for a in (u, v, r, delta))",

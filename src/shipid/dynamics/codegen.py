@@ -35,7 +35,7 @@ from types import ModuleType
 import numpy as np
 
 from shipid import __version__
-from shipid.dynamics.terms import SIGNALS, TermCode
+from shipid.dynamics.terms import CROSSFLOW, OPS, SIGNALS, TermCode
 
 ENGINES = ("auto", "generated", "interpreted")
 # Below this many state-steps a run takes well under a second on the interpreter: not worth
@@ -60,6 +60,9 @@ def cache_dir() -> Path:
 
 def _factor_expr(signal: int, op: int, k: float, power: int, name: str) -> list[str]:
     """Lines assigning factor ``name``: op(k·s)^power, as ``kernel._factor`` computes it."""
+    if OPS[op] in CROSSFLOW:  # of v and r together, k the hull's length
+        part = 0 if OPS[op] == "crossflow_sway" else 1
+        return [f"{name} = _kernel.crossflow(s1, s2, {k!r})[{part}]"]
     s = f"s{signal}"
     base = {0: s, 1: f"abs({s})", 2: f"({s} if {s} > 0.0 else 0.0)",
             3: f"(-{s} if {s} < 0.0 else 0.0)", 4: f"math.sin({k!r} * {s})",

@@ -91,6 +91,25 @@ def c_array(a, dtype=np.float64) -> np.ndarray:
     return np.require(a, dtype, ("C", "W"))
 
 
+@numba.njit(cache=True)
+def crossflow(v, r, length):
+    """(1/L ∫ |w|w dx, 1/L² ∫ x |w|w dx), w = v + x r over the hull's length: the closed form of
+    ``shipid.dynamics.terms.crossflow`` for one state."""
+    h = 0.5 * length
+    if abs(v) >= abs(r) * h:  # w keeps v's sign along the hull
+        sign = 1.0 if v > 0.0 else (-1.0 if v < 0.0 else 0.0)
+        return sign * (v * v + r * r * h * h / 3.0), sign * r * v * h / 3.0
+    s2, s1 = v + r * h, v - r * h
+    c2, c1 = abs(s2) ** 3, abs(s1) ** 3
+    return ((c2 - c1) / (3.0 * r) / length,
+            ((s2 * c2 - s1 * c1) / 4.0 - v * (c2 - c1) / 3.0) / (r * r) / (length * length))
+
+
+# Op codes of the cross-flow factors (``shipid.dynamics.terms.OPS``, checked by a test): of v and
+# r together, k the hull's length.
+CROSSFLOW_SWAY, CROSSFLOW_YAW = 6, 7
+
+
 @numba.njit(cache=True, inline="always")
 def _factor(x, op, k, p):
     if op == 0:
@@ -123,7 +142,11 @@ def _acc(th, start, sig, op, kk, pw, s):
             continue
         phi = 1.0
         for f in range(start[j], start[j + 1]):
-            phi *= _factor(s[sig[f]], op[f], kk[f], pw[f])
+            if op[f] >= CROSSFLOW_SWAY:
+                cf = crossflow(s[1], s[2], kk[f])
+                phi *= cf[0] if op[f] == CROSSFLOW_SWAY else cf[1]
+            else:
+                phi *= _factor(s[sig[f]], op[f], kk[f], pw[f])
         a0 += c0 * phi
         a1 += c1 * phi
         a2 += c2 * phi

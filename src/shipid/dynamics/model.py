@@ -61,6 +61,9 @@ _LOW_SPEED_SURGE = ("|u|u", "v*r", "r^2", "v^2", "pos(n)^2", "neg(n)^2", "u*|n|"
                     "u^2*delta^2", "pos(n)^2*delta^2", "1")  # fmt: skip
 _LOW_SPEED_LATERAL = ("u*v", "|u|*r", "|v|v", "|v|r", "|r|r", "v*|r|", "u*|u|*delta",
                       "pos(n)^2*delta", "neg(n)^2*delta", "neg(n)^2", "v*|n|", "r*|n|", "1")  # fmt: skip
+# The hull's nonlinear sway and yaw damping as the structures split it, which the cross-flow drag
+# (``ModelStructure.with_crossflow_hull``) takes in one term per equation.
+HULL_DRAG = ("|v|v", "|v|r", "|r|r", "v*|r|")
 # Wind load terms on the relative wind (Isherwood-type, to second order in the angle).
 _WIND_SURGE = ("U_A^2*cos(gamma_A)",)
 _WIND_LATERAL = ("U_A^2*sin(gamma_A)", "U_A^2*sin(2*gamma_A)")
@@ -223,6 +226,29 @@ class ModelStructure:
         suffix = ",".join(f"{d}-{'-'.join(n)}" for d, n in dropped.items() if n)
         return ModelStructure(f"{self.name}[drop {suffix}]" if suffix else self.name, terms)
 
+    def with_crossflow_hull(self, length: float) -> ModelStructure:
+        """The structure with its hull's nonlinear damping in sway and yaw (``HULL_DRAG``:
+        |v|v, |v|r, |r|r, v|r|, however many it splits it into) as the cross-flow drag of a
+        hull ``length`` m long, one term per equation (``crossflow_sway(L)``, ``crossflow_yaw(L)``,
+        in the first replaced term's place). An equation without them is left as it is: the
+        terms a selection chose without them, a linear model."""
+        if not (math.isfinite(length) and length > 0):
+            raise ShipidError(f"the cross-flow hull needs a length > 0 m, got {length!r}")
+        drag = {parse_term(t).text for t in HULL_DRAG}
+        terms = dict(self.terms)
+        for dof, fn in (("v", "crossflow_sway"), ("r", "crossflow_yaw")):
+            if dof not in terms:
+                continue
+            have = terms[dof]
+            at = next((i for i, t in enumerate(have) if t in drag), None)
+            if at is None:
+                continue
+            kept = [t for t in have if t not in drag]
+            terms[dof] = tuple(kept[:at] + [parse_term(f"{fn}({length:.12g})").text] + kept[at:])
+        if terms == dict(self.terms):
+            return self
+        return ModelStructure(f"{self.name}+crossflow({length:.4g} m)", terms)
+
     def __add__(self, other: ModelStructure) -> ModelStructure:
         terms = {d: tuple(dict.fromkeys(self.terms.get(d, ()) + other.terms.get(d, ())))
                  for d in DOFS if d in self.terms or d in other.terms}  # fmt: skip
@@ -235,6 +261,27 @@ class ModelStructure:
     @classmethod
     def from_dict(cls, data: Mapping) -> ModelStructure:
         return cls(str(data["name"]), {d: tuple(t) for d, t in data["terms"].items()})
+
+
+@dataclass(frozen=True)
+class StructureEdit:
+    """What a user changes in whichever structure is fitted or chosen: terms dropped (``drop``,
+    {dof: [term]}, passed over where a structure lacks them) and the hull's nonlinear damping as
+    the cross-flow drag of a hull ``crossflow_length`` m long (``with_crossflow_hull``)."""
+
+    drop: Mapping[str, Sequence[str]] | None = None
+    crossflow_length: float | None = None
+
+    def __bool__(self) -> bool:
+        return bool(self.drop) or self.crossflow_length is not None
+
+    def apply(self, structure: ModelStructure) -> ModelStructure:
+        """``structure`` so edited."""
+        if self.drop:
+            structure = structure.without(self.drop, missing_ok=True)
+        if self.crossflow_length is not None:
+            structure = structure.with_crossflow_hull(self.crossflow_length)
+        return structure
 
 
 def parse_structure_spec(spec: str, name: str = "custom") -> ModelStructure:

@@ -22,7 +22,7 @@ import math
 from collections.abc import Mapping
 
 from shipid.dynamics.model import ManoeuvringModel, ModelStructure
-from shipid.dynamics.terms import OPS, Term, parse_term
+from shipid.dynamics.terms import CROSSFLOW, OPS, Factor, Term, parse_term
 from shipid.errors import ShipidError
 
 SPEEDS = ("u", "v", "U", "wind_speed")
@@ -36,6 +36,8 @@ def _factor_scale(name: str, op: str, power: int, length: float, speed: float,
                   rho: float) -> float:  # fmt: skip
     if op in ("sin", "cos") or name in ANGLES:
         return 1.0
+    if op in CROSSFLOW:  # |w|w, w = v + x r: a speed squared
+        return speed ** (2 * power)
     if name in SPEEDS:
         base = speed
     elif name in RATES:
@@ -103,9 +105,42 @@ def froude_scaled(model: ManoeuvringModel, factor: float, rho: float = RHO,
                   to_rho: float | None = None) -> ManoeuvringModel:  # fmt: skip
     """The model of a geometrically similar ship ``factor`` times as long, at equal Froude
     number (speeds × √factor, times × √factor); ``to_rho`` the other water's density (thrust
-    terms only)."""
-    return scaled(model, froude_ratios(model.structure, factor, rho, to_rho),
-                  rps_ratio=1 / math.sqrt(factor))  # fmt: skip
+    terms only). Its cross-flow terms take the longer hull (``lengthened_terms``)."""
+    out = scaled(model, froude_ratios(model.structure, factor, rho, to_rho),
+                 rps_ratio=1 / math.sqrt(factor))  # fmt: skip
+    renamed = lengthened_terms(model.structure.all_terms, factor)
+    if not renamed:
+        return out
+    coefs = {d: {renamed.get(t, t): c for t, c in terms.items()}
+             for d, terms in out.coefficients.items()}  # fmt: skip
+    structure = ModelStructure(model.structure.name, {
+        d: tuple(renamed.get(t, t) for t in ts) for d, ts in model.structure.terms.items()})
+    return ManoeuvringModel(structure, coefs, name=out.name, similar_at_rps=out.similar_at_rps)
+
+
+def lengthened_terms(terms, factor: float) -> dict[str, str]:
+    """{term: the same term on a hull ``factor`` times as long} for the cross-flow terms among
+    ``terms`` (their argument is the hull's length); the others keep their text."""
+    out = {}
+    for text in terms:
+        term = parse_term(text)
+        if term.crossflow:
+            factors = [Factor(f.signal, f.op, f.k * factor, f.power) if f.crossflow else f
+                       for f in term.factors]  # fmt: skip
+            out[term.text] = Term(tuple(factors)).text
+    return out
+
+
+def renamed_terms(obj, renamed: Mapping[str, str]):
+    """``obj`` (a model file's JSON data) with every key and string equal to a term of
+    ``renamed`` written as its new text."""
+    if isinstance(obj, Mapping):
+        return {renamed.get(k, k): renamed_terms(v, renamed) for k, v in obj.items()}
+    if isinstance(obj, list):
+        return [renamed_terms(v, renamed) for v in obj]
+    if isinstance(obj, str):
+        return renamed.get(obj, obj)
+    return obj
 
 
 def scaled(model: ManoeuvringModel, ratios: Mapping[str, Mapping[str, float]],

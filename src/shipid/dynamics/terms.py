@@ -12,6 +12,15 @@ relative wind wind_speed [m/s] (alias U_A) and wind_angle [rad] (alias gamma_A).
 Factors: ``x`` or ``x^p`` (integer p ≥ 1), ``|x|`` or ``|x|^p``, ``pos(x)`` = max(x, 0) and
 ``neg(x)`` = max(−x, 0) (four-quadrant propeller and rudder terms), and ``sin(k*a)``, ``cos(k*a)``
 of an angle signal a (beta, delta, wind_angle) with an integer k ≥ 1, each with an optional power.
+The hull's cross-flow drag (``crossflow_sway(L)``, ``crossflow_yaw(L)``, L the hull's length in
+metres) is a factor of v and r together: the sway force and yaw moment of a drag on each section
+that goes as |w|w, w = v + x r its lateral velocity at x along the hull (Hooft 1994; Fossen 2011,
+sec. 6.7), one coefficient for what ``|v|v``, ``|v|r`` and ``|r|r`` split among them::
+
+    crossflow_sway(L) = 1/L ∫ |w| w dx,     crossflow_yaw(L) = 1/L² ∫ x |w| w dx,   x ∈ [−L/2, L/2]
+
+in closed form (``crossflow``). Where a zig-zag's small drift leaves the split of |v|v and |v|r
+free, the integral carries the drag to a turn's drift and yaw rate by the hull's geometry.
 Factors are joined by ``*`` or written side by side (``vr``, ``|u|u``: the names of the original
 Blanke terms parse unchanged). Like factors merge (``u*u`` is ``u^2``), factors are put in one
 order, so each term has one canonical text (``Term.text``), which model files store.
@@ -22,6 +31,7 @@ factor table the simulator's kernel interprets), for any set of terms.
 
 from __future__ import annotations
 
+import math
 import re
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
@@ -42,9 +52,11 @@ INPUT_SIGNALS = ("delta", "n", "thrust", "wind_speed", "wind_angle")
 ANGLE_SIGNALS = ("beta", "delta", "wind_angle")
 ALIASES = {"T": "thrust", "U_A": "wind_speed", "gamma_A": "wind_angle"}
 DISPLAY = {"delta": "δ", "beta": "β", "thrust": "T", "wind_speed": "U_A", "wind_angle": "γ_A"}
-OPS = ("pow", "abs", "pos", "neg", "sin", "cos")
+OPS = ("pow", "abs", "pos", "neg", "sin", "cos", "crossflow_sway", "crossflow_yaw")
 OP_CODE = {op: i for i, op in enumerate(OPS)}
 FUNCTIONS = ("abs", "pos", "neg", "sin", "cos")
+# Factors of v and r together, with the hull's length [m] as their argument.
+CROSSFLOW = ("crossflow_sway", "crossflow_yaw")
 # Order of factors in a term's text: states, derived, propulsion, wind, the rudder last (u² δ).
 FACTOR_ORDER = {s: i for i, s in enumerate(("u", "v", "r", "U", "beta", "n", "thrust",
                                             "wind_speed", "wind_angle", "delta"))}  # fmt: skip
@@ -56,12 +68,18 @@ _NAMES = sorted([*SIGNALS, *ALIASES], key=len, reverse=True)
 
 @dataclass(frozen=True, order=True)
 class Factor:
-    """op(k·signal)^power, op one of ``OPS`` (k only for sin/cos)."""
+    """op(k·signal)^power, op one of ``OPS`` (k only for sin/cos); for a cross-flow factor
+    (signal v, r read beside it) k is the hull's length [m]."""
 
     signal: int  # index into SIGNALS
     op: int  # index into OPS
-    k: int = 1
+    k: float = 1
     power: int = 1
+
+    @property
+    def crossflow(self) -> bool:
+        """Whether this is a cross-flow factor (of v and r, k the hull's length)."""
+        return OPS[self.op] in CROSSFLOW
 
     @property
     def name(self) -> str:
@@ -72,6 +90,8 @@ class Factor:
     def text(self) -> str:
         """The factor's canonical text (``|u|``, ``delta^2``, ``sin(2*beta)``)."""
         op, name = OPS[self.op], self.name
+        if op in CROSSFLOW:
+            return f"{op}({self.k:.12g})"
         if op == "pow":
             base = name
         elif op == "abs":
@@ -85,6 +105,8 @@ class Factor:
     def display(self) -> str:
         """The factor as printed in equations (``|u|``, ``δ²``, ``sin(2β)``)."""
         op, name = OPS[self.op], DISPLAY.get(self.name, self.name)
+        if op in CROSSFLOW:
+            return f"{'Y' if op == 'crossflow_sway' else 'N'}_cf(v, r; {self.k:.12g} m)"
         sup = str(self.power).translate(SUPERSCRIPT) if self.power != 1 else ""
         if op == "pow":
             return f"{name}{sup}"
@@ -95,9 +117,13 @@ class Factor:
         arg = f"{self.k}{name}" if self.k != 1 else name
         return f"{op}{sup}({arg})" if sup else f"{op}({arg})"
 
-    def values(self, x: np.ndarray) -> np.ndarray:
-        """The factor's values for the signal's values ``x``."""
+    def values(self, x: np.ndarray, r: np.ndarray | None = None) -> np.ndarray:
+        """The factor's values for the signal's values ``x`` (and the yaw rate ``r``, which a
+        cross-flow factor reads beside v)."""
         op = OPS[self.op]
+        if op in CROSSFLOW:
+            sway, yaw = crossflow(x, r, self.k)
+            return sway if op == "crossflow_sway" else yaw
         if op == "pow":
             base = x
         elif op == "abs":
@@ -127,7 +153,13 @@ class Term:
     @property
     def signals(self) -> tuple[str, ...]:
         """The signals the term uses, in signal order."""
-        return tuple(sorted({f.name for f in self.factors}, key=SIGNAL_INDEX.get))
+        names = {f.name for f in self.factors} | ({"v", "r"} if self.crossflow else set())
+        return tuple(sorted(names, key=SIGNAL_INDEX.get))
+
+    @property
+    def crossflow(self) -> bool:
+        """Whether the term has a cross-flow factor (of v and r, with the hull's length)."""
+        return any(f.crossflow for f in self.factors)
 
     @property
     def inputs(self) -> tuple[str, ...]:
@@ -148,16 +180,20 @@ class Term:
         return "".join(parts)
 
     def degree_in(self, signal: str) -> int:
-        """Total power of ``signal`` in the term (abs/pos/neg count; sin/cos do not)."""
+        """Total power of ``signal`` in the term (abs/pos/neg count; sin/cos do not). A
+        cross-flow factor counts 2 in v: |w|w, w = v + x r, is a speed squared (its r comes with
+        a length), which is how it scales (prime form, Froude, advance-ratio similarity)."""
         i = SIGNAL_INDEX[signal]
-        return sum(f.power for f in self.factors if f.signal == i and OPS[f.op] not in ("sin", "cos"))
+        return sum(2 * f.power if f.crossflow else f.power for f in self.factors
+                   if f.signal == i and OPS[f.op] not in ("sin", "cos"))
 
     def __str__(self) -> str:
         return self.text
 
 
 # ---------------------------------------------------------------------------- parsing
-_TOKEN = re.compile(r"\s*(?:(?P<num>\d+)|(?P<name>[A-Za-z_][A-Za-z_0-9]*)|(?P<sym>[|*^()]))")
+_TOKEN = re.compile(r"\s*(?:(?P<num>\d+(?:\.\d+)?(?:[eE][-+]?\d+)?)|(?P<name>[A-Za-z_][A-Za-z_0-9]*)"
+                    r"|(?P<sym>[|*^()]))")
 
 
 def _tokens(text: str) -> list[tuple[str, str]]:
@@ -170,7 +206,7 @@ def _tokens(text: str) -> list[tuple[str, str]]:
         pos = m.end()
         kind = m.lastgroup
         value = m.group(kind)
-        if kind == "name" and value not in FUNCTIONS:
+        if kind == "name" and value not in FUNCTIONS + CROSSFLOW:
             out.extend(("name", n) for n in _split_names(value, text))
         else:
             out.append((kind, value))
@@ -216,11 +252,17 @@ class _Parser:
         name = self.take("name")
         return SIGNAL_INDEX[ALIASES.get(name, name)]
 
+    def integer(self) -> int:
+        text = self.take("num")
+        if not text.isdigit():
+            raise self.error(f"expected a whole number, got {text!r}")
+        return int(text)
+
     def power(self) -> int:
         tok = self.peek()
         if tok == ("sym", "^"):
             self.i += 1
-            p = int(self.take("num"))
+            p = self.integer()
             if not 1 <= p <= MAX_POWER:
                 raise self.error(f"power {p} out of range 1–{MAX_POWER}")
             return p
@@ -228,6 +270,19 @@ class _Parser:
 
     def factor(self) -> Factor:
         tok = self.peek()
+        if tok is not None and tok[0] == "name" and tok[1] in CROSSFLOW:
+            fn = self.take("name")
+            self.take("sym", "(")
+            text = self.take("num") if self.peek() and self.peek()[0] == "num" else None
+            if text is None or self.peek() != ("sym", ")"):
+                raise self.error(f"{fn}(L) takes the hull's length L in metres, e.g. {fn}(3)")
+            self.take("sym", ")")
+            length = float(text)
+            if not (math.isfinite(length) and length > 0):
+                raise self.error(f"{fn}'s hull length must be > 0 m, got {text}")
+            if self.peek() == ("sym", "^"):
+                raise self.error(f"{fn}(L) takes no power")
+            return Factor(SIGNAL_INDEX["v"], OP_CODE[fn], length, 1)
         if tok == ("sym", "|"):
             self.i += 1
             sig = self.signal()
@@ -238,7 +293,7 @@ class _Parser:
             self.take("sym", "(")
             k = 1
             if self.peek() is not None and self.peek()[0] == "num":
-                k = int(self.take("num"))
+                k = self.integer()
                 self.take("sym", "*")
                 if fn not in ("sin", "cos") or not 1 <= k <= MAX_POWER:
                     raise self.error(f"a multiple k*x is allowed in sin/cos only, k in 1–{MAX_POWER}")
@@ -273,6 +328,8 @@ def _canonical(factors: list[Factor], parser: _Parser) -> Term:
         merged[key] = merged.get(key, 0) + f.power
     out = []
     for (sig, op, k), p in sorted(merged.items()):
+        if OPS[op] in CROSSFLOW and p > 1:
+            raise parser.error(f"{OPS[op]} appears twice: a term has it once")
         if p > MAX_POWER:
             raise parser.error(f"power {p} of {SIGNALS[sig]} out of range 1–{MAX_POWER}")
         out.append(Factor(sig, op, k, p))
@@ -349,9 +406,30 @@ def term_matrix(terms: Sequence[str | Term], u, v, r, inputs: Mapping[str, np.nd
     for j, term in enumerate(parsed):
         col = np.ones(n)
         for f in term.factors:
-            col = col * f.values(np.atleast_1d(sig[f.name]))
+            col = col * f.values(np.atleast_1d(sig[f.name]), np.atleast_1d(sig["r"]))
         out[:, j] = col
     return out
+
+
+def crossflow(v, r, length: float) -> tuple[np.ndarray, np.ndarray]:
+    """The cross-flow factors (1/L ∫ |w|w dx, 1/L² ∫ x |w|w dx over x ∈ [−L/2, L/2], w = v + x r)
+    at arrays of v [m/s], r [rad/s], in closed form: where w keeps its sign along the hull
+    (|v| ≥ |r| L/2), |w|w = ±w² integrates to ±L (v² + r²L²/12) and ±r v L³/6; where it
+    changes sign, ∫|w|w dx = [|w|³/3r] and ∫x|w|w dx = [(w|w|³/4 − v|w|³/3)/r²] between the ends
+    (r ≠ 0 there). The compiled kernel's ``shipid.dynamics.kernel.crossflow`` is the same."""
+    v, r = np.broadcast_arrays(np.asarray(v, dtype=float), np.asarray(r, dtype=float))
+    h = 0.5 * length
+    same = np.abs(v) >= np.abs(r) * h
+    sign = np.sign(v)
+    sway = np.where(same, sign * (v * v + r * r * h * h / 3.0), 0.0)
+    yaw = np.where(same, sign * r * v * h / 3.0, 0.0)
+    if not same.all():
+        a, b = v[~same], r[~same]
+        s2, s1 = a + b * h, a - b * h
+        c2, c1 = np.abs(s2) ** 3, np.abs(s1) ** 3
+        sway[~same] = (c2 - c1) / (3.0 * b) / length
+        yaw[~same] = ((s2 * c2 - s1 * c1) / 4.0 - a * (c2 - c1) / 3.0) / (b * b) / length**2
+    return sway, yaw
 
 
 @dataclass(frozen=True)

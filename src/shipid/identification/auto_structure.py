@@ -44,7 +44,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from shipid.dynamics.model import ModelStructure, get_structure
+from shipid.dynamics.model import ModelStructure, StructureEdit, get_structure
 from shipid.errors import ShipidError
 from shipid.identification.cross_validation import choice_cv
 from shipid.identification.identify import material_wind, spread, varies, varying_propulsion
@@ -124,22 +124,27 @@ class StructureChoice:
                              "weight": w} for m, g, w in self.members]}  # fmt: skip
 
 
-def _without(structure: ModelStructure, drop: Mapping[str, Sequence[str]] | None
-             ) -> ModelStructure:  # fmt: skip
+def _without(structure: ModelStructure,
+             drop: Mapping[str, Sequence[str]] | StructureEdit | None) -> ModelStructure:
     """``structure`` less those of the ``drop`` terms it has: the user's drop says which terms
-    never to use, whichever structure is chosen."""
+    never to use, whichever structure is chosen; a ``StructureEdit`` may also put the hull's
+    cross-flow drag in place of its nonlinear damping terms."""
+    if isinstance(drop, StructureEdit):
+        return drop.apply(structure)
     return structure.without(drop, missing_ok=True) if drop else structure
 
 
 def auto_structure(logs: Sequence[pd.DataFrame], names: Sequence[str] | None = None,
                    physics: PhysicsOptions | None = None, cv: str | None = None,
-                   estimator: str = "lssvm", drop: Mapping[str, Sequence[str]] | None = None,
+                   estimator: str = "lssvm",
+                   drop: Mapping[str, Sequence[str]] | StructureEdit | None = None,
                    announce: Callable[[str], None] | None = None) -> StructureChoice:  # fmt: skip
     """The structure for ``logs`` (see the module): ``blanke`` unless they hold a varying
     propulsion input or a material wind. ``cv`` for the selection (default
     ``cross_validation.choice_cv``: leave one log out, four blocks of each of one or two logs);
     ``physics`` goes into every fit of the search; the ``drop``
-    terms (e.g. ``{"u": ["r^2"]}``) are left out of every candidate, and of the choice;
+    terms (e.g. ``{"u": ["r^2"]}``) are left out of every candidate, and of the choice (a
+    ``StructureEdit`` also puts the hull's cross-flow drag in each, ``--crossflow``);
     ``announce`` is told before a search starts (it takes seconds where a fit takes less)."""
     choice = _auto_structure(logs, names, physics, cv, estimator, drop, announce or _quiet)
     choice.structure = _without(choice.structure, drop)

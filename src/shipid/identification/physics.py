@@ -24,6 +24,8 @@ s = +1 when a positive rudder angle turns the ship to starboard, −1 when to po
   thrust ≥ 0 (propeller thrust ahead); neg(n)² ≤ 0 (propeller astern pulls back).
 * v̇: uv, |u|v, Uv, |v|v, v|n|, v ≤ 0 (sway damping).
 * ṙ: ur, |u|r, Ur, |r|r, r|n|, r ≤ 0 (yaw damping).
+* v̇: crossflow_sway(L) ≤ 0, ṙ: crossflow_yaw(L) ≤ 0 (cross-flow drag opposes the hull's lateral
+  motion), whatever the length L.
 * ṙ: δ, uδ, |u|δ, Uδ, u²δ, |u|uδ, U²δ, pos(n)²δ have the sign s (the rudder turns the ship its
   way); in v̇ the same terms have the sign −s (the rudder pushes the stern the other way).
 
@@ -42,7 +44,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from shipid.dynamics.terms import parse_term, term_matrix
+from shipid.dynamics.terms import OP_CODE, parse_term, term_matrix
 from shipid.errors import ShipidError
 
 RUDDER = "rudder"
@@ -180,7 +182,16 @@ def rudder_sign(logs: Sequence[pd.DataFrame], given: str | None = None) -> float
     return 1.0 if side == "starboard" else -1.0
 
 
+# The hull's cross-flow drag (``crossflow_sway(L)`` in sway, ``crossflow_yaw(L)`` in yaw, whatever
+# the length) opposes each section's lateral motion.
+CROSSFLOW_RULE = (-1, "cross-flow drag opposes the hull's lateral motion")
+
+
 def _sign_bounds(dof: str, term: str, s: float | None) -> tuple[float, float, str] | None:
+    parsed = parse_term(term)
+    if dof in ("v", "r") and len(parsed.factors) == 1 and parsed.factors[0].crossflow \
+            and (parsed.factors[0].op == OP_CODE["crossflow_sway"]) == (dof == "v"):  # fmt: skip
+        return (-math.inf, 0.0, CROSSFLOW_RULE[1])
     for eq, terms, sign, why in SIGN_RULES:
         if eq != dof or term not in terms:
             continue

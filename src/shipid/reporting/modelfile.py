@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING
 from shipid import __version__
 from shipid.dynamics.hybrid import HybridModel, KernelResidual
 from shipid.dynamics.model import ManoeuvringModel
+from shipid.dynamics.terms import CROSSFLOW, parse_term
 from shipid.errors import ShipidError
 from shipid.outputs import atomic_write_text
 
@@ -435,6 +436,20 @@ def error_band_from_document(doc: Mapping, path: str | Path):
     return ErrorBand.from_dict(data, f"{path}: {where}")
 
 
+def _crossflow_texts(obj) -> set[str]:
+    """The keys and strings of a model file's data that name a cross-flow term."""
+    if isinstance(obj, Mapping):
+        return set().union(*(_crossflow_texts(k) | _crossflow_texts(v) for k, v in obj.items()))
+    if isinstance(obj, list):
+        return set().union(*(_crossflow_texts(v) for v in obj))
+    if not (isinstance(obj, str) and any(name in obj for name in CROSSFLOW)):
+        return set()
+    try:
+        return {obj} if parse_term(obj).crossflow else set()
+    except ShipidError:  # a note that names one
+        return set()
+
+
 def rescaled_document(doc: Mapping, factor: float, to_rho: float | None = None,
                       path: str | Path = "model file") -> dict:  # fmt: skip
     """The model file of a geometrically similar ship ``factor`` times as long (Froude scaling,
@@ -448,7 +463,14 @@ def rescaled_document(doc: Mapping, factor: float, to_rho: float | None = None,
 
     from shipid.data.particulars import Particulars
     from shipid.dynamics.model import DOFS
-    from shipid.dynamics.prime import RHO, froude_ratios, scaled, signal_scale
+    from shipid.dynamics.prime import (
+        RHO,
+        froude_ratios,
+        lengthened_terms,
+        renamed_terms,
+        scaled,
+        signal_scale,
+    )
 
     particulars = Particulars.from_mapping(doc["particulars"]) if doc.get("particulars") else None
     rho = particulars.rho if particulars is not None else RHO
@@ -528,6 +550,10 @@ def rescaled_document(doc: Mapping, factor: float, to_rho: float | None = None,
     for signal, bounds in envelope.items():
         scale = signal_scale(signal, factor, rho, to_rho)
         envelope[signal] = [b * scale for b in bounds]
+    # The cross-flow terms' argument is the hull's length: every record of them takes the new.
+    renamed = lengthened_terms(_crossflow_texts(out), factor)
+    if renamed:
+        out = renamed_terms(out, renamed)
     model_out = model_from_document(out, path)
     out["prime"] = prime_record(model_out, out.get("particulars"), prep.get("approach_speed"))
     out.setdefault("scaling", []).append({
