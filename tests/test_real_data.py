@@ -52,6 +52,26 @@ def test_osaka_reader_unwraps_heading_and_drops_empty_rows():
     assert np.max(np.abs(np.diff(log["psi"]))) < 1.0
 
 
+@needs_data
+def test_osaka_logs_carry_the_models_particulars(tmp_path, capsys):
+    """The Esso Osaka 3 m model's particulars come with its files (the files do not carry them;
+    a model of them had no length for the criteria, the prime form or --crossflow); consistent:
+    its mass is ρ·Cb·L·B·T within 0.1 % in the pond's fresh water."""
+    from shipid.data.particulars import Particulars
+
+    path = OSAKA / "zigzag" / "zigzag_31-Jul-2020_13_22_52.csv"
+    p = Particulars.from_mapping(read_log(path, fmt="osaka-frt").attrs["particulars"])
+    assert (p.length, p.beam, p.draught, p.rho) == (3.0, 0.489, 0.201, 1000.0)
+    assert p.mass == pytest.approx(p.rho * p.block_coefficient * 3.0 * 0.489 * 0.201, rel=1e-3)
+    out = tmp_path / "m.json"
+    code = main(["identify", "--format", "osaka-frt", str(path), "--crossflow", "--model",
+                 "blanke-speed+wind", "--filter", "none", "-o", str(out)])  # fmt: skip
+    assert code == 0
+    assert "crossflow_sway(3)" in out.read_text() and "Y_cf(v, r; 3 m)" in capsys.readouterr().out
+    assert main(["criteria", str(out), "--no-bands"]) == 0  # in lengths of its own 3 m
+    assert "L = 3 m" in capsys.readouterr().out
+
+
 def test_truncated_and_wrong_format_files(tmp_path):
     dat = tmp_path / "cut.dat"
     dat.write_text("MARIN\nzig-zag\n\n" + "\t".join(["1.00E+00"] * 11) + "\n" + "1.0E+00\t2.0\n")

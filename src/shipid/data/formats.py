@@ -16,6 +16,7 @@
   positive rudder turns the ship to starboard. The relative wind at midship becomes the canonical
   ``wind_speed`` and ``wind_angle`` (the direction the apparent wind comes from, clockwise from the
   bow: the same convention as the file's, checked against its true wind and the ship's velocity).
+  The model's particulars (``ESSO_OSAKA_MODEL``, from the dataset's publication) come with it.
 
 ``detect_format`` recognises each layout from the first lines of a file, so that reading one
 without ``--format`` can say which ``--format`` it needs.
@@ -44,6 +45,13 @@ OSAKA_COLUMNS = {"t [s]": "t", "x_position_mid [m]": "x", "u_velo [m/s]": "u",
                  "delta_rudder [rad]": "delta"}  # fmt: skip
 OSAKA_WIND = {"wind_velo_relative_mid [m/s]": "wind_speed",
               "wind_dir_relative_mid [rad]": "wind_angle"}  # fmt: skip
+# The Esso Osaka 3 m model of the Osaka University free-running tests (FRT-DS-ESSO; Wakita et al.
+# 2022, J. Mar. Sci. Technol. 27:772–785), in the fresh water of Inukai pond: what its files do not
+# carry and every model of them needs for ship lengths, the prime form, --prior clarke and
+# --crossflow. The files do not say which full-scale ship it is of: no scale.
+ESSO_OSAKA_MODEL = {"length": 3.0, "beam": 0.489, "draught": 0.201, "block_coefficient": 0.830,
+                    "mass": 244.6, "rudder_area": 0.0106, "propeller_diameter": 0.084,
+                    "xg": 0.094, "rho": 1000.0}  # fmt: skip
 _NUMBER = re.compile(r"^[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")
 
 
@@ -157,7 +165,8 @@ def read_osaka_frt(path: str | Path) -> pd.DataFrame:
         cols["wind_angle"] = np.angle(np.exp(1j * cols["wind_angle"]))  # (−π, π]
     # No scale: the files do not give the ship the model is of, and 1 would say full scale.
     return make_log(cols, name=path.name, ship="Esso Osaka 3 m model",
-                    source=f"Osaka University FRT: {path}", rudder_positive="starboard")
+                    source=f"Osaka University FRT: {path}", rudder_positive="starboard",
+                    particulars=dict(ESSO_OSAKA_MODEL))  # fmt: skip
 
 
 def read_format(path: str | Path, fmt: str, scale: float | None = None) -> pd.DataFrame:
