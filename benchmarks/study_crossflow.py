@@ -50,18 +50,6 @@ def _fit(argv: list[str], out: str) -> bool:
         return shipid([*argv, "-o", out]) == 0
 
 
-def _steady_rate_errors(runs) -> np.ndarray:
-    """The 35° turns' closed-loop steady yaw rate error [%] (inf where there is none)."""
-    out = []
-    for v in runs:
-        try:
-            out.append(100 * (v.indices["closed_loop"]["steady_yaw_rate"]
-                              / v.indices["measured"]["steady_yaw_rate"] - 1))  # fmt: skip
-        except (KeyError, TypeError):
-            out.append(np.inf)
-    return np.array(out)
-
-
 def _median_mean(errors: np.ndarray) -> str:
     finite = np.abs(errors[np.isfinite(errors)])
     none = len(errors) - len(finite)
@@ -100,7 +88,7 @@ def esso(pairs: bool) -> None:
                 medians.append(float(np.median(_errors(runs, others))))
                 turn_runs = [v for g, v in zip(others, runs, strict=True) if "turn" in g.stem]
                 td.append(_turn_errors(turn_runs))
-                rate.append(_steady_rate_errors(turn_runs))
+                rate.append(_turn_errors(turn_runs, "steady_yaw_rate"))
                 rnd.append(_errors(_validations(model, randoms), randoms))
             rnd_all = np.concatenate(rnd)
             print(f"| {label} | {np.median(medians):.3f} | {_median_mean(np.concatenate(td))} | "

@@ -136,14 +136,13 @@ def _validations(model, logs) -> list:
     return [validate(model, log, start_draws=False)[0] for log in logs.values()]
 
 
-def _turn_errors(runs) -> np.ndarray:
-    """The 35° turns' closed-loop tactical diameter error [%] of their validations ``runs``
-    (inf where there is none)."""
+def _turn_errors(runs, key: str = "tactical_diameter") -> np.ndarray:
+    """The 35° turns' closed-loop error [%] in the index ``key`` (the tactical diameter) of
+    their validations ``runs`` (inf where there is none)."""
     out = []
     for v in runs:
         try:
-            out.append(100 * (v.indices["closed_loop"]["tactical_diameter"]
-                              / v.indices["measured"]["tactical_diameter"] - 1))  # fmt: skip
+            out.append(100 * (v.indices["closed_loop"][key] / v.indices["measured"][key] - 1))
         except (KeyError, TypeError):
             out.append(np.inf)
     return np.array(out)
