@@ -142,7 +142,8 @@ def _structure_edit(args, logs):
 
         length = found.length if isinstance(found, Particulars) else \
             Particulars.from_mapping(found).length  # fmt: skip
-    return StructureEdit(_parse_drop(getattr(args, "drop", None)) or None, length)
+    return StructureEdit(_parse_drop(getattr(args, "drop", None)) or None, length,
+                         compare_crossflow=getattr(args, "crossflow", None) is not False)
 
 
 def _log_particulars(logs) -> dict | None:

@@ -86,10 +86,13 @@ def _add_log_options(p: argparse.ArgumentParser) -> None:
 
 
 def _add_crossflow_option(p) -> None:
-    p.add_argument("--crossflow", action="store_true",
+    p.add_argument("--crossflow", action=argparse.BooleanOptionalAction, default=None,
                    help="the hull's nonlinear sway and yaw damping (|v|v, |v|r, |r|r, v|r|) as "
                    "the cross-flow drag over its length, one term per equation, in whichever "
-                   "structure is fitted or searched; needs the length (--particulars)")
+                   "structure is fitted or searched; needs the length (--particulars). Default: "
+                   "identify's structure comparison offers it beside the terms where the logs' "
+                   "particulars give the length, and takes it where they tie; --no-crossflow "
+                   "never")
 
 
 def _number_or_auto(text: str) -> float | str:

@@ -267,13 +267,16 @@ class ModelStructure:
 class StructureEdit:
     """What a user changes in whichever structure is fitted or chosen: terms dropped (``drop``,
     {dof: [term]}, passed over where a structure lacks them) and the hull's nonlinear damping as
-    the cross-flow drag of a hull ``crossflow_length`` m long (``with_crossflow_hull``)."""
+    the cross-flow drag of a hull ``crossflow_length`` m long (``with_crossflow_hull``);
+    ``compare_crossflow`` False keeps the drag out of the default's comparison, which otherwise
+    offers it beside the terms where the logs' particulars give the length."""
 
     drop: Mapping[str, Sequence[str]] | None = None
     crossflow_length: float | None = None
+    compare_crossflow: bool = True
 
     def __bool__(self) -> bool:
-        return bool(self.drop) or self.crossflow_length is not None
+        return bool(self.drop) or self.crossflow_length is not None or not self.compare_crossflow
 
     def apply(self, structure: ModelStructure) -> ModelStructure:
         """``structure`` so edited."""

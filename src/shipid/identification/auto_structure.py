@@ -373,6 +373,17 @@ def _paper_or_race(logs, names, physics, cv, estimator, drop=None, announce=_qui
         candidates, prefilters = tuple(k for k in candidates if k != paper), {}
     from shipid.identification.select import select
 
+    # Each with the hull's cross-flow drag too, where the logs' particulars give the length.
+    structures = {k: get_structure(k) for k in candidates}
+    crossflow = {}
+    length = _hull_length(logs, drop)
+    if length is not None:
+        for k in candidates:
+            edited = structures[k].with_crossflow_hull(length)
+            if edited is not structures[k]:
+                crossflow[k] = edited.name
+                structures[edited.name] = edited
+        candidates = tuple(structures)
     cv = cv or choice_cv(logs)
     announce(f"comparing {', '.join(candidates)} by free-run cross-validation ({cv})…")
     inside = _blocks_inside(logs, cv)
@@ -380,7 +391,7 @@ def _paper_or_race(logs, names, physics, cv, estimator, drop=None, announce=_qui
 
     def compare(name: str) -> None:
         """Fit ``name`` as the comparison fits each candidate and file its score or faults."""
-        structure = _without(get_structure(name), drop)
+        structure = _without(structures[name], drop)
         try:
             fitted_on = logs
             if prefilters is not None:
@@ -421,6 +432,7 @@ def _paper_or_race(logs, names, physics, cv, estimator, drop=None, announce=_qui
         # lack (WIDENING); the race structure with it joins the comparison.
         announce(f"{top} predicts the logs best but is ruled out ({faults[top][2]}); comparing "
                  f"{widened} too…")  # fmt: skip
+        structures[widened] = get_structure(widened)
         compare(widened)
         candidates += (widened,)
         widening = (f"; {widened} compared because {top}, the best on the logs, is ruled out "
@@ -434,7 +446,7 @@ def _paper_or_race(logs, names, physics, cv, estimator, drop=None, announce=_qui
         raise failed[0]
     if not scores and faults and prefilters is None:
         # The paper's among them (where it was ruled out first, its faults are not weighed).
-        return _fewest_faults(faults, paper, reason, cv)
+        return _fewest_faults(faults, paper, reason, cv, structures)
     if not scores:
         return StructureChoice(get_structure(paper), "paper", notes=[
             f"{reason}, but none of {', '.join(candidates)} is plausible"])  # fmt: skip
@@ -442,6 +454,15 @@ def _paper_or_race(logs, names, physics, cv, estimator, drop=None, announce=_qui
     limit = scores[best][0] + scores[best][1]
     tied = [k for k in candidates if k in scores and scores[k][0] <= limit]
     name = preferred if preferred in tied else tied[0]
+    tied_crossflow = [k for k in tied if k in crossflow.values()]
+    hull = ("; the hull's cross-flow drag (its length from the particulars) where a structure "
+            "with it is within too (--no-crossflow: never)") if crossflow else ""  # fmt: skip
+    if tied_crossflow:
+        # Where the logs cannot tell a hull of terms from one of cross-flow drag, the drag: it
+        # carries the damping to drifts beyond the logs by the hull's length, where the terms'
+        # split of it is free (the Esso Osaka's single zig-zag files: 35° turns 35 % wide in
+        # the median, 23 % so; the tanker's zig-zags, whose truth is of the terms, choose them).
+        name = crossflow.get(preferred) if crossflow.get(preferred) in tied else tied_crossflow[0]
     table = ", ".join(f"{k} {v[0]:.3f}" for k, v in scores.items())
     if inside is not None:
         k = int(cv.split(":")[1])
@@ -473,13 +494,30 @@ def _paper_or_race(logs, names, physics, cv, estimator, drop=None, announce=_qui
         return StructureChoice(get_structure(paper), "paper", [reason], cv=cv,
                                notes=[f"free-run scores {table}{widening}"], warnings=warnings,
                                alternatives=alternatives)  # fmt: skip
-    return StructureChoice(get_structure(name), "compared", [reason], cv=cv,
+    return StructureChoice(structures[name], "compared", [reason], cv=cv,
                            score=scores[name][0], candidates=len(scores),
                            alternatives=alternatives,
                            notes=[f"free-run scores ({cv}) {table}; {preferred} where "
                                   "within one standard error of the best (the rudder in the "
-                                  f"propeller's race), else the simplest within it{widening}"],
+                                  f"propeller's race), else the simplest within it{hull}"
+                                  f"{widening}"],
                            warnings=warnings)  # fmt: skip
+
+
+def _hull_length(logs, drop) -> float | None:
+    """The hull's length [m] for the comparison's cross-flow candidates: the logs' particulars'
+    (``--particulars``, or the Esso Osaka files' own), unless ``drop`` (a ``StructureEdit``)
+    already puts the drag in every candidate (``--crossflow``) or leaves it out
+    (``--no-crossflow``)."""
+    if isinstance(drop, StructureEdit) and (drop.crossflow_length is not None
+                                            or not drop.compare_crossflow):
+        return None
+    found = next((log.attrs["particulars"] for log in logs if log.attrs.get("particulars")), None)
+    if found is None:
+        return None
+    from shipid.data.particulars import Particulars
+
+    return Particulars.from_mapping(found).length
 
 
 def _best_of(scores: Mapping[str, tuple[float, float]],
@@ -529,7 +567,7 @@ def _blocks_inside(logs, cv: str) -> list[int] | None:
 
 
 def _fewest_faults(faults: Mapping[str, tuple[int, float, str]], paper: str, reason: str,
-                   cv: str) -> StructureChoice:  # fmt: skip
+                   cv: str, structures: Mapping[str, ModelStructure]) -> StructureChoice:  # fmt: skip
     """Where no candidate of the comparison is plausible: the one with the fewest of the faults
     that rule candidates out, the best-scoring among those, with a warning. The Esso Osaka's
     20/20 zig-zag at a constant 16.7 rps, accelerating throughout, leaves every candidate
@@ -543,7 +581,7 @@ def _fewest_faults(faults: Mapping[str, tuple[int, float, str]], paper: str, rea
                f"{name} has the fewest faults and is fitted (--steady-speed U@N where a straight "
                "run's speed at N rps is known; --model to choose another)")  # fmt: skip
     how = "paper" if name == paper else "compared"
-    return StructureChoice(get_structure(name), how, [reason], cv=cv, score=faults[name][1],
+    return StructureChoice(structures[name], how, [reason], cv=cv, score=faults[name][1],
                            candidates=0, warnings=[warning],
                            notes=[f"none plausible; {name} has the fewest faults"])  # fmt: skip
 
