@@ -3,13 +3,17 @@ v|r| a structure splits the hull's nonlinear damping into) against the structure
 on logs the models were not fitted to (issue #10):
 
 1. the Esso Osaka's nine zig-zag files one at a time, as ``study_esso_single_logs.py`` reads
-   them: the default ``identify`` and the fixed ``blanke-speed+wind``, each with and without it,
-   judged on the other eight zig-zags, the two 35° turns and the four random runs;
-2. with ``pairs``: every pair of the files, the default with and without it;
+   them (they carry the 3 m model's length): the default ``identify`` without the drag
+   (``--no-crossflow``, as before), as it is (its comparison offers the drag beside the terms and
+   takes it on a tie) and with the drag in every candidate; the fixed ``blanke-speed+wind``
+   without and with it; judged on the other eight zig-zags, the two 35° turns and the four
+   random runs;
+2. with ``pairs``: every pair of the files, the default three ways;
 3. the real KVLCC2, each of its three logs left out, ``blanke-race+race-damping`` and
    ``blanke-speed`` fitted on the other two with and without it (MARIN's particulars);
 4. the single-screw ``tanker`` (a truth whose hull is Norrbin's |v|v-type terms), the default
-   ``identify`` from its zig-zags as ``study_tanker.py`` makes them, 3 seeds.
+   ``identify`` three ways from its zig-zags as ``study_tanker.py`` makes them, its length
+   given, 3 seeds.
 
 Run: .venv/bin/python benchmarks/study_crossflow.py [pairs]
 """
@@ -40,7 +44,10 @@ from shipid.reporting.modelfile import load_model
 from shipid.trials.reading import read_trial_log
 
 MARIN_PARTICULARS = DATA.parent / "kvlcc2-marin" / "ship_data.yml"
-ESSO_CONFIGS = {"default": [], "default --crossflow": ["--crossflow"],
+# The default before the comparison offered the drag (--no-crossflow), the default, the drag in
+# every candidate; then one fixed structure without and with it.
+ESSO_CONFIGS = {"default --no-crossflow": ["--no-crossflow"], "default": [],
+                "default --crossflow": ["--crossflow"],
                 "blanke-speed+wind": ["--model", "blanke-speed+wind"],
                 "blanke-speed+wind --crossflow": ["--model", "blanke-speed+wind", "--crossflow"]}
 
@@ -70,7 +77,7 @@ def esso(pairs: bool) -> None:
           "runs' yaw rate error / spread (median of the models' medians; diverged)\n")
     print("| made by | zig-zags and turns: r / spread | 35° TD | 35° steady r | random runs |")
     print("|---|---|---|---|---|")
-    configs = ESSO_CONFIGS if not pairs else {k: ESSO_CONFIGS[k] for k in list(ESSO_CONFIGS)[:2]}
+    configs = ESSO_CONFIGS if not pairs else {k: ESSO_CONFIGS[k] for k in list(ESSO_CONFIGS)[:3]}
     with tempfile.TemporaryDirectory() as tmp:
         out = f"{tmp}/m.json"
         trainings = [[z] for z in zigzags]
@@ -134,9 +141,10 @@ def tanker(seeds: int = 3) -> None:
 
     clean, truth = st.trials(), st.truth_indices()
     print("\nThe tanker (truth of Norrbin's form; study_tanker.py's logs at the sea sensors' "
-          "noise), the default identify with and without --crossflow (L = 304.8 m), over "
-          f"{seeds} seeds: 35° TD and steady r |error| median (largest), 20° TD error median, "
-          "10°/10° worst overshoot error median (largest)\n")
+          "noise, with its length, 304.8 m, as particulars), the default identify, without the "
+          f"drag, comparing it and with it in every candidate, over {seeds} seeds: 35° TD and "
+          "steady r |error| median (largest), 20° TD error median, 10°/10° worst overshoot "
+          "error median (largest)\n")
     print("| trained on | made by | 35° TD | 35° steady r | 20° TD | 10°/10° |")
     print("|---|---|---|---|---|---|")
     with tempfile.TemporaryDirectory() as tmp:
@@ -147,9 +155,10 @@ def tanker(seeds: int = 3) -> None:
             paths = noisy_files(clean, st.SEA_SENSORS, seed, tmp)
             for label in list(st.TRAINING)[:2]:
                 files = [paths[f"{n}_{rpm}"] for n, rpm in st.TRAINING[label]]
-                for made, flags in (("identify", []), ("identify --crossflow",
-                                    ["--crossflow", "--particulars", str(particulars)])):
-                    model = model_by_cli(["identify", *flags], files, f"{tmp}/model.json")
+                for made, flags in (("identify --no-crossflow", ["--no-crossflow"]),
+                                    ("identify", []), ("identify --crossflow", ["--crossflow"])):
+                    model = model_by_cli(["identify", "--particulars", str(particulars), *flags],
+                                         files, f"{tmp}/model.json")  # fmt: skip
                     if model is not None:
                         rows.setdefault((label, made), []).append(st.judged(model, truth))
         for (label, made), judged in rows.items():
