@@ -25,8 +25,10 @@ from the logs:
   ``blanke-race+race-damping`` where it lies within one standard error of the best, else the
   simplest within it (``_paper_or_race``); where the best-scoring of them is ruled out by its
   held rudder alone, ``blanke-race+race-damping+rudder-drift`` is compared too; where none is
-  plausible, the one with the fewest faults, with a warning (``_fewest_faults``). Logs whose
-  speed varies without a
+  plausible, the one with the fewest faults, with a warning (``_fewest_faults``). Where the
+  logs' particulars give the hull's length, each is compared with the hull's cross-flow drag
+  too, and one with it taken where it ties with the best (``ModelStructure.with_crossflow_hull``).
+  Logs whose speed varies without a
   logged rps are compared so too where ``blanke`` fitted to them is implausible (turns the wrong
   way under 35° rudder, say: CyberShip II's zig-zags, ``_paper_ruled_out``).
 
@@ -356,7 +358,10 @@ def _paper_or_race(logs, names, physics, cv, estimator, drop=None, announce=_qui
     three real zig-zags, ``blanke-race+race-damping``.
     Logs without a logged rps (the paper's own trials) are compared only where the paper's fit
     is ruled out (``_paper_ruled_out``). ``suffix`` ('+wind') is added to every candidate's
-    name (the choice stays 'paper' where the paper's wins; the caller names its structure)."""
+    name (the choice stays 'paper' where the paper's wins; the caller names its structure).
+    Where the logs' particulars give the hull's length (``_hull_length``), every candidate is
+    compared with the hull's cross-flow drag in place of its |v|v, |v|r too, and one with it is
+    fitted where it lies within one standard error of the best (the race structure's first)."""
     found = _speed_varies_at_constant_rps(logs)
     paper, preferred = PAPER + suffix, RACE_PREFERRED + suffix
     candidates, prefilters = tuple(k + suffix for k in RACE_CANDIDATES), None
