@@ -266,6 +266,18 @@ def test_the_comparison_offers_the_hulls_cross_flow_where_the_logs_give_its_leng
         assert plain.structure.name == "blanke-speed+wind" and "crossflow" not in plain.notes[0]
     widened = auto_structure([log("13_14_21")])
     assert "rudder-drift" in widened.structure.name
+    # The rudder in the race comes first: from the KVLCC2's MARIN 20/20 zig-zag with its
+    # particulars, blanke-speed with the drag ties with the race structure (its −20° run's yaw
+    # rate error 4.6 times the race structure's) and was taken; the race structure is.
+    from shipid.data.particulars import read_particulars
+
+    marin = DATA.parent / "kvlcc2-marin"
+    kvlcc2 = read_log(marin / "MARIN_FREE_KVLCC2_zz_20_m.dat", fmt="simman-marin", scale=45.7,
+                      dt=0.2)  # fmt: skip
+    kvlcc2.attrs["particulars"] = read_particulars(marin / "ship_data.yml").to_dict()
+    choice = auto_structure([kvlcc2])
+    assert choice.structure.name == "blanke-race+race-damping"
+    assert "blanke-speed+crossflow(7 m) " in choice.notes[0]
 
 
 def test_logs_that_cannot_be_fitted_together_are_named_not_called_implausible(paper_log):
