@@ -24,7 +24,7 @@ from shipid.trials.manoeuvres import turning_circle, zigzag
 L = 4.0
 # Drift alone, yaw alone, the flow keeping its sign along the hull and changing it, both signs.
 STATES = [(0.3, 0.0), (0.0, 0.05), (0.2, 0.02), (-0.2, 0.02), (0.05, 0.1), (-0.05, -0.1),
-          (0.01, -0.3), (0.0, 0.0), (1e-12, 1e-9)]  # fmt: skip
+          (0.01, -0.3), (0.0, 0.0), (1e-12, 1e-9), (1e-120, 1e-100)]  # fmt: skip
 
 
 def _by_quadrature(v: float, r: float, length: float) -> tuple[float, float]:
@@ -43,6 +43,15 @@ def test_the_closed_form_is_the_integral(v, r):
     assert yaw[0] == pytest.approx(want[1], rel=1e-9, abs=1e-15)
     # The compiled kernel's own copy, one state at a time.
     assert kernel.crossflow(v, r, L) == pytest.approx((sway[0], yaw[0]), rel=1e-12, abs=1e-18)
+
+
+@pytest.mark.parametrize(("v", "r"), [(0.0, 1e-200), (-1e-300, 1e-170), (1e-160, -1e-155)])
+def test_a_vanishing_flow_gives_no_drag_not_a_division_by_zero(v, r):
+    # Bug: 1/r² of the sign-changing form underflowed to 0/0 (NaN in NumPy, ZeroDivisionError
+    # in the compiled kernel, which stopped the run).
+    sway, yaw = crossflow(np.array([v]), np.array([r]), L)
+    assert (sway[0], yaw[0]) == pytest.approx((0.0, 0.0), abs=1e-200)
+    assert kernel.crossflow(v, r, L) == pytest.approx((0.0, 0.0), abs=1e-200)
 
 
 def test_it_is_the_drag_blanke_splits_where_the_flow_keeps_its_sign():

@@ -121,9 +121,9 @@ def _crossflow_source(model: ManoeuvringModel) -> list[str]:
         return []
     import inspect
 
-    from shipid.dynamics.terms import crossflow
+    from shipid.dynamics.terms import TINY, crossflow
 
-    return [*inspect.getsource(crossflow).splitlines(), "", ""]
+    return [f"TINY = {TINY!r}", "", "", *inspect.getsource(crossflow).splitlines(), "", ""]
 
 
 def _array_literal(a: np.ndarray) -> str:

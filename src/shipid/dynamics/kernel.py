@@ -31,6 +31,7 @@ import numpy as np
 # numba caches a function that hands ``terms_rhs`` on only when it reaches it as a module
 # attribute, not as a bare global.
 import shipid.dynamics.kernel as _kernel  # noqa: E402  (this module)
+from shipid.dynamics.terms import TINY
 
 N_INPUTS = 5
 N_SIGNALS = 10
@@ -91,12 +92,19 @@ def c_array(a, dtype=np.float64) -> np.ndarray:
     return np.require(a, dtype, ("C", "W"))
 
 
+# Op codes of the cross-flow factors (``shipid.dynamics.terms.OPS``, checked by a test): of v and
+# r together, k the hull's length; below CROSSFLOW_TINY [m/s] at the hull's ends, no drag.
+CROSSFLOW_SWAY, CROSSFLOW_YAW = 6, 7
+CROSSFLOW_TINY = TINY
+
+
 @numba.njit(cache=True)
 def crossflow(v, r, length):
     """(1/L ∫ |w|w dx, 1/L² ∫ x |w|w dx), w = v + x r over the hull's length: the closed form of
     ``shipid.dynamics.terms.crossflow`` for one state."""
     h = 0.5 * length
-    if abs(v) >= abs(r) * h:  # w keeps v's sign along the hull
+    if abs(v) >= abs(r) * h or abs(r) * h < CROSSFLOW_TINY:  # w keeps v's sign along the hull
+        # (or is too small for the 1/r² below)
         sign = 1.0 if v > 0.0 else (-1.0 if v < 0.0 else 0.0)
         return sign * (v * v + r * r * h * h / 3.0), sign * r * v * h / 3.0
     s2, s1 = v + r * h, v - r * h
@@ -105,9 +113,6 @@ def crossflow(v, r, length):
             ((s2 * c2 - s1 * c1) / 4.0 - v * (c2 - c1) / 3.0) / (r * r) / (length * length))
 
 
-# Op codes of the cross-flow factors (``shipid.dynamics.terms.OPS``, checked by a test): of v and
-# r together, k the hull's length.
-CROSSFLOW_SWAY, CROSSFLOW_YAW = 6, 7
 
 
 @numba.njit(cache=True, inline="always")

@@ -411,6 +411,9 @@ def term_matrix(terms: Sequence[str | Term], u, v, r, inputs: Mapping[str, np.nd
     return out
 
 
+TINY = 1e-150  # [m/s] the flow at the hull's ends below which the cross-flow drag is 0
+
+
 def crossflow(v, r, length: float) -> tuple[np.ndarray, np.ndarray]:
     """The cross-flow factors (1/L ∫ |w|w dx, 1/L² ∫ x |w|w dx over x ∈ [−L/2, L/2], w = v + x r)
     at arrays of v [m/s], r [rad/s], in closed form: where w keeps its sign along the hull
@@ -419,7 +422,9 @@ def crossflow(v, r, length: float) -> tuple[np.ndarray, np.ndarray]:
     (r ≠ 0 there). The compiled kernel's ``shipid.dynamics.kernel.crossflow`` is the same."""
     v, r = np.broadcast_arrays(np.asarray(v, dtype=float), np.asarray(r, dtype=float))
     h = 0.5 * length
-    same = np.abs(v) >= np.abs(r) * h
+    # Below TINY the sign-changing form's 1/r² would underflow to 0/0; the drag there is
+    # smaller than any double anyway, and the same-sign form gives it (as 0).
+    same = (np.abs(v) >= np.abs(r) * h) | (np.abs(r) * h < TINY)
     sign = np.sign(v)
     sway = np.where(same, sign * (v * v + r * r * h * h / 3.0), 0.0)
     yaw = np.where(same, sign * r * v * h / 3.0, 0.0)
