@@ -5,7 +5,8 @@ on logs the models were not fitted to (issue #10):
 1. the Esso Osaka's nine zig-zag files one at a time, as ``study_esso_single_logs.py`` reads
    them (they carry the 3 m model's length): the default ``identify`` without the drag
    (``--no-crossflow``, as before), as it is (its comparison offers the drag beside the terms and
-   takes it on a tie) and with the drag in every candidate; the fixed ``blanke-speed+wind``
+   takes it on a tie; on one or two logs its ``select`` searches with it too) and with the drag
+   in every candidate; the fixed ``blanke-speed+wind``
    without and with it; judged on the other eight zig-zags, the two 35° turns and the four
    random runs;
 2. with ``pairs``: every pair of the files, the default three ways;

@@ -90,9 +90,9 @@ def _add_crossflow_option(p) -> None:
                    help="the hull's nonlinear sway and yaw damping (|v|v, |v|r, |r|r, v|r|) as "
                    "the cross-flow drag over its length, one term per equation, in whichever "
                    "structure is fitted or searched; needs the length (--particulars). Default: "
-                   "identify's structure comparison offers it beside the terms where the logs' "
-                   "particulars give the length, and takes it where they tie; --no-crossflow "
-                   "never")
+                   "where the logs' particulars give the length, identify's structure comparison "
+                   "offers it beside the terms and takes it where they tie, and on one or two "
+                   "logs its select searches with it too; --no-crossflow never")
 
 
 def _number_or_auto(text: str) -> float | str:
