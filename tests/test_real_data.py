@@ -307,13 +307,16 @@ def test_two_esso_files_no_longer_give_a_model_that_turns_on_a_far_wider_path(tm
     5.4 times its approach speed), passed the rule of a quarter and put the 35° turns at 10 rps
     8.8 and 5.5 times the ship's tactical diameter. At 0.4 it is ruled out: the fallback's turns
     came within 64 %, and since the choice is made on four blocks of each file, `select`'s terms
-    within 17 % (``benchmarks/study_esso_single_logs.py``'s pairs)."""
+    within 17 % (``benchmarks/study_esso_single_logs.py``'s pairs). The rule acts inside the
+    search whatever its library: its second search, with the hull's cross-flow drag, is left out
+    (--no-crossflow) to keep the case as it was found."""
     from shipid.reporting.modelfile import load_model
     from shipid.trials.reading import read_trial_log
 
     train = [OSAKA / "zigzag" / f"zigzag_31-Jul-2020_{s}.csv" for s in ("13_22_52", "13_57_45")]
     out = tmp_path / "pair.json"
-    assert main(["identify", "--format", "osaka-frt", *map(str, train), "-o", str(out)]) == 0
+    assert main(["identify", "--format", "osaka-frt", *map(str, train), "--no-crossflow", "-o",
+                 str(out)]) == 0  # fmt: skip
     model = load_model(out)
     for path in sorted((OSAKA / "turning").glob("*.csv")):
         turn = validate(model, read_trial_log(path, fmt="osaka-frt"), start_draws=False)[0]
