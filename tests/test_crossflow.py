@@ -15,7 +15,14 @@ from shipid.data.io import write_log
 from shipid.dynamics import kernel
 from shipid.dynamics.model import ManoeuvringModel, ModelStructure, StructureEdit, get_structure
 from shipid.dynamics.prime import froude_scaled, prime_coefficients
-from shipid.dynamics.terms import OP_CODE, crossflow, parse_term, term_matrix
+from shipid.dynamics.terms import (
+    CROSSFLOW_SLOTS,
+    OP_CODE,
+    crossflow,
+    parse_term,
+    term_code,
+    term_matrix,
+)
 from shipid.errors import ShipidError
 from shipid.identification.identify import identify
 from shipid.identification.physics import PhysicsOptions, coefficient_bounds
@@ -68,8 +75,13 @@ def test_the_terms_parse_display_and_scale_as_a_speed_squared():
     assert term.text == "crossflow_sway(4)" and term.crossflow
     assert term.signals == ("v", "r") and term.degree_in("v") == 2 and term.degree_in("r") == 0
     assert parse_term("u * crossflow_yaw(7.5)").display() == "u N_cf(v, r; 7.5 m)"
-    assert (OP_CODE["crossflow_sway"], OP_CODE["crossflow_yaw"]) == (kernel.CROSSFLOW_SWAY,
-                                                                    kernel.CROSSFLOW_YAW)
+    # The compiled kernel reads them from the signal buffer's slots it fills once per state.
+    code = term_code(["crossflow_sway(4)", "u*crossflow_yaw(4)"])
+    assert code.signal.tolist() == [CROSSFLOW_SLOTS[0], 0, CROSSFLOW_SLOTS[1]]
+    assert code.op.tolist() == [OP_CODE["pow"]] * 3 and code.k.tolist() == [4.0, 1.0, 4.0]
+    assert (kernel.SWAY_SLOT, kernel.YAW_SLOT) == CROSSFLOW_SLOTS
+    with pytest.raises(ShipidError, match="one hull length, got 3, 4 m"):
+        term_code(["crossflow_sway(3)", "crossflow_yaw(4)"])
     np.testing.assert_allclose(
         term_matrix(["crossflow_sway(4)", "crossflow_yaw(4)"], [1.0], [0.2], [0.02])[0],
         [c[0] for c in crossflow(np.array([0.2]), np.array([0.02]), 4.0)])

@@ -29,7 +29,11 @@ def hybrid_rhs(ctx, u, v, r, psi):
     scale, standardised centres (M, d), weights (M, 3), intercept (3,), 1/σ², 1/reach, feature
     indices into (u, v, r, δ, n), buffers of 5 for the raw and the standardised features)."""
     tctx, mean, scale, centres, weights, intercept, inv_s2, inv_reach, fidx, x, z = ctx
-    a0, a1, a2, rd, xd, yd = kernel.terms_rhs(tctx, u, v, r, psi)
+    # A hybrid's own cost dwarfs the choice (its centres' kernel sums): made per evaluation.
+    if tctx[12] > 0.0:
+        a0, a1, a2, rd, xd, yd = kernel.terms_rhs_crossflow(tctx, u, v, r, psi)
+    else:
+        a0, a1, a2, rd, xd, yd = kernel.terms_rhs(tctx, u, v, r, psi)
     inp = tctx[8]
     x[0], x[1], x[2], x[3], x[4] = u, v, r, inp[0], inp[1]
     d = fidx.size

@@ -55,8 +55,11 @@ DISPLAY = {"delta": "δ", "beta": "β", "thrust": "T", "wind_speed": "U_A", "win
 OPS = ("pow", "abs", "pos", "neg", "sin", "cos", "crossflow_sway", "crossflow_yaw")
 OP_CODE = {op: i for i, op in enumerate(OPS)}
 FUNCTIONS = ("abs", "pos", "neg", "sin", "cos")
-# Factors of v and r together, with the hull's length [m] as their argument.
+# Factors of v and r together, with the hull's length [m] as their argument. The compiled kernel
+# evaluates them once per state into the signal buffer's slots after ``SIGNALS`` (sway, yaw): in
+# its factor table they are plain signals there, k the length.
 CROSSFLOW = ("crossflow_sway", "crossflow_yaw")
+CROSSFLOW_SLOTS = (len(SIGNALS), len(SIGNALS) + 1)
 # Order of factors in a term's text: states, derived, propulsion, wind, the rudder last (u² δ).
 FACTOR_ORDER = {s: i for i, s in enumerate(("u", "v", "r", "U", "beta", "n", "thrust",
                                             "wind_speed", "wind_angle", "delta"))}  # fmt: skip
@@ -467,14 +470,23 @@ def term_code(terms: Sequence[str | Term]) -> TermCode:
     """The factor table (``TermCode``) of a term set, for the compiled kernel."""
     parsed = [parse_term(t) if isinstance(t, str) else t for t in terms]
     start, sig, op, k, power = [0], [], [], [], []
+    lengths = set()
     for t in parsed:
         for f in t.factors:
-            sig.append(f.signal)
-            op.append(f.op)
+            if f.crossflow:  # its value's slot, read as it is (the kernel fills it per state)
+                sig.append(CROSSFLOW_SLOTS[CROSSFLOW.index(OPS[f.op])])
+                op.append(OP_CODE["pow"])
+                lengths.add(f.k)
+            else:
+                sig.append(f.signal)
+                op.append(f.op)
             k.append(float(f.k))
             power.append(f.power)
         start.append(len(sig))
-    derived = any(SIGNALS[s] in DERIVED_SIGNALS for s in sig)
+    if len(lengths) > 1:
+        raise ShipidError(f"the cross-flow terms of one model take one hull length, got "
+                          f"{', '.join(f'{x:g}' for x in sorted(lengths))} m")  # fmt: skip
+    derived = any(s < len(SIGNALS) and SIGNALS[s] in DERIVED_SIGNALS for s in sig)
     return TermCode(tuple(t.text for t in parsed), np.array(start, dtype=np.int64),
                     np.array(sig, dtype=np.int64), np.array(op, dtype=np.int64),
                     np.array(k, dtype=np.float64), np.array(power, dtype=np.int64), derived)
