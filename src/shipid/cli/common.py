@@ -130,24 +130,25 @@ def _particulars(args):
 
 def _structure_edit(args, logs):
     """--drop and --crossflow as one ``StructureEdit`` (the length from the particulars)."""
+    from shipid.data.particulars import logs_particulars
     from shipid.dynamics.model import StructureEdit
 
     length = None
     if getattr(args, "crossflow", False):
-        found = _particulars(args) or _log_particulars(logs)
+        found = logs_particulars(logs)  # --particulars among them (``_training_logs``)
         if found is None:
             raise ShipidError("--crossflow needs the hull's length: give --particulars FILE "
                               "(length, or Lpp)")  # fmt: skip
-        from shipid.data.particulars import Particulars
-
-        length = found.length if isinstance(found, Particulars) else \
-            Particulars.from_mapping(found).length  # fmt: skip
+        length = found.length
     return StructureEdit(_parse_drop(getattr(args, "drop", None)) or None, length,
                          compare_crossflow=getattr(args, "crossflow", None) is not False)
 
 
 def _log_particulars(logs) -> dict | None:
-    return next((log.attrs["particulars"] for log in logs if log.attrs.get("particulars")), None)
+    from shipid.data.particulars import logs_particulars
+
+    found = logs_particulars(logs)
+    return None if found is None else found.to_dict()
 
 
 BOUND_PATTERN = r"^\s*([uvr])\s*:\s*(.+?)\s*(<=|>=)\s*(\S+)\s*$"
@@ -191,13 +192,13 @@ def _physics(args, logs, structure):
     bounds = _parse_bounds(args.bound)
     prior = None
     if args.prior == "clarke":
-        from shipid.data.particulars import Particulars
+        from shipid.data.particulars import logs_particulars
         from shipid.identification.priors import clarke_prior
 
-        found = _particulars(args) or _log_particulars(logs)
-        if found is None:
+        # --particulars is among them (``_training_logs``): the file is not read again.
+        part = logs_particulars(logs)
+        if part is None:
             raise ShipidError("--prior clarke needs the ship's particulars (--particulars FILE)")
-        part = found if isinstance(found, Particulars) else Particulars.from_mapping(found)
         sign = rudder_sign(logs)
         side = None if sign is None else ("starboard" if sign > 0 else "port")
         speed = _approach(logs[0], "u")

@@ -137,6 +137,13 @@ class Particulars:
             raise ShipidError(f"{where}: {str(exc).removeprefix('particulars: ')}") from None
 
 
+def logs_particulars(logs) -> Particulars | None:
+    """The particulars the logs carry (the first that has them: ``--particulars``, which every
+    log read is given, or a known format's own), or None."""
+    found = next((log.attrs["particulars"] for log in logs if log.attrs.get("particulars")), None)
+    return None if found is None else Particulars.from_mapping(found)
+
+
 def read_particulars(path: str | Path) -> Particulars:
     """Particulars from a YAML (``key: value`` lines, comments) or JSON file."""
     path = Path(path)

@@ -270,8 +270,9 @@ def _crossflow_selection(sel, logs, names, library, drop, options, announce):
 
     from shipid.identification.select import select
 
-    edited = _without(library, drop).with_crossflow_hull(length)
-    if edited is _without(library, drop):
+    searched = _without(library, drop)
+    edited = searched.with_crossflow_hull(length)
+    if edited is searched:
         return None
     announce(f"choosing again with the hull's cross-flow drag ({length:.4g} m)…")
     try:
@@ -497,21 +498,18 @@ def _paper_or_race(logs, names, physics, cv, estimator, drop=None, announce=_qui
     best = min(scores, key=lambda k: scores[k][0])
     limit = scores[best][0] + scores[best][1]
     tied = [k for k in candidates if k in scores and scores[k][0] <= limit]
-    name = preferred if preferred in tied else tied[0]
-    tied_crossflow = [k for k in tied if k in crossflow.values()]
+    # Among the tied: the race with the hull's cross-flow drag, the race, any with the drag,
+    # else the simplest. Where the logs cannot tell a hull of terms from one of cross-flow drag,
+    # the drag: it carries the damping to drifts beyond the logs by the hull's length, where the
+    # terms' split of it is free (the Esso Osaka's single zig-zag files: 35° turns 35 % wide in
+    # the median, 23 % so; the tanker's zig-zags, whose truth is of the terms, choose them). The
+    # rudder in the race comes first, as without the drag: from the KVLCC2's MARIN 20/20 zig-zag
+    # blanke-speed with the drag, tied with the race structure, predicted the −20° run's yaw
+    # rate with 4.6 times the race structure's error.
+    order = [crossflow.get(preferred), preferred, *crossflow.values()]
+    name = next((k for k in order if k in tied), tied[0])
     hull = ("; the hull's cross-flow drag (its length from the particulars) where a structure "
             "with it is within too (--no-crossflow: never)") if crossflow else ""  # fmt: skip
-    if crossflow.get(preferred) in tied:
-        name = crossflow[preferred]
-    elif tied_crossflow and preferred not in tied:
-        # Where the logs cannot tell a hull of terms from one of cross-flow drag, the drag: it
-        # carries the damping to drifts beyond the logs by the hull's length, where the terms'
-        # split of it is free (the Esso Osaka's single zig-zag files: 35° turns 35 % wide in
-        # the median, 23 % so; the tanker's zig-zags, whose truth is of the terms, choose them).
-        # The rudder in the race comes first, as without the drag: from the KVLCC2's MARIN
-        # 20/20 zig-zag blanke-speed with the drag, tied with the race structure, predicted the
-        # −20° run's yaw rate with 4.6 times the race structure's error.
-        name = tied_crossflow[0]
     table = ", ".join(f"{k} {v[0]:.3f}" for k, v in scores.items())
     if inside is not None:
         k = int(cv.split(":")[1])
@@ -561,12 +559,10 @@ def _hull_length(logs, drop) -> float | None:
     if isinstance(drop, StructureEdit) and (drop.crossflow_length is not None
                                             or not drop.compare_crossflow):
         return None
-    found = next((log.attrs["particulars"] for log in logs if log.attrs.get("particulars")), None)
-    if found is None:
-        return None
-    from shipid.data.particulars import Particulars
+    from shipid.data.particulars import logs_particulars
 
-    return Particulars.from_mapping(found).length
+    found = logs_particulars(logs)
+    return None if found is None else found.length
 
 
 def _best_of(scores: Mapping[str, tuple[float, float]],

@@ -44,7 +44,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from shipid.dynamics.terms import OP_CODE, parse_term, term_matrix
+from shipid.dynamics.terms import OPS, parse_term, term_matrix
 from shipid.errors import ShipidError
 
 RUDDER = "rudder"
@@ -182,16 +182,15 @@ def rudder_sign(logs: Sequence[pd.DataFrame], given: str | None = None) -> float
     return 1.0 if side == "starboard" else -1.0
 
 
-# The hull's cross-flow drag (``crossflow_sway(L)`` in sway, ``crossflow_yaw(L)`` in yaw, whatever
-# the length) opposes each section's lateral motion.
-CROSSFLOW_RULE = (-1, "cross-flow drag opposes the hull's lateral motion")
+# The hull's cross-flow drag, whatever the length, opposes each section's lateral motion: ≤ 0 in
+# the equation of its own kind (its sway force in v̇, its yaw moment in ṙ).
+CROSSFLOW_SIGNS = {"v": "crossflow_sway", "r": "crossflow_yaw"}
 
 
 def _sign_bounds(dof: str, term: str, s: float | None) -> tuple[float, float, str] | None:
-    parsed = parse_term(term)
-    if dof in ("v", "r") and len(parsed.factors) == 1 and parsed.factors[0].crossflow \
-            and (parsed.factors[0].op == OP_CODE["crossflow_sway"]) == (dof == "v"):  # fmt: skip
-        return (-math.inf, 0.0, CROSSFLOW_RULE[1])
+    factors = parse_term(term).factors
+    if len(factors) == 1 and OPS[factors[0].op] == CROSSFLOW_SIGNS.get(dof):
+        return (-math.inf, 0.0, "cross-flow drag opposes the hull's lateral motion")
     for eq, terms, sign, why in SIGN_RULES:
         if eq != dof or term not in terms:
             continue
