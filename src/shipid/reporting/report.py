@@ -12,7 +12,7 @@ from shipid.evaluation.validate import Validation
 
 INDEX_KEYS = ("approach_speed", "first_overshoot_deg", "second_overshoot_deg", "initial_turning_time",
               "advance", "transfer", "tactical_diameter", "steady_turning_diameter",
-              "steady_yaw_rate", "yaw_rate_at_release", "residual_yaw_rate")  # fmt: skip
+              "steady_yaw_rate", "steady_speed", "yaw_rate_at_release", "residual_yaw_rate")  # fmt: skip
 
 
 def error_table(validations: Sequence[Validation], paper: dict | None = None) -> str:
