@@ -677,8 +677,12 @@ def _paper_ruled_out(logs, names, physics, estimator, drop, paper: str = PAPER
     if speed is None or not speed > 0:
         return None  # identify says why
     try:
+        # Unforced: a fit whose regressors the logs cannot tell apart rules nothing out, and
+        # identify's own fit says so (sway logged as a multiple of the yaw rate gave a paper
+        # fit that ran away when its turn was entered drifting, and a comparison before the
+        # refusal).
         model = identify(logs, model=_without(get_structure(paper), drop), names=names,
-                         force=True, estimator=estimator, physics=physics).model  # fmt: skip
+                         force=False, estimator=estimator, physics=physics).model  # fmt: skip
     except ShipidError:
         return None  # identify's own fit says why
     found = disqualifying(plausibility_at_approach(
