@@ -416,7 +416,7 @@ def _turn_notes(indices: dict) -> list[str]:
     ``TURN_TOLERANCE``: which of its two factors, the speed in the turn or the yaw rate, carries
     the miss. A steady turn's diameter is 2U/|r|, so the two say which equation to look at: the
     surge's loss of speed in the turn, which zig-zags hardly excite (from one Esso Osaka zig-zag
-    the 35° turns held 1.15–2.1 times the measured speed where their yaw rates came within
+    the 35° turns held 1.2–2.1 times the measured speed where their yaw rates came within
     10 %; benchmarks/README.md), or the sway and yaw equations'."""
     measured, closed = indices.get("measured") or {}, indices.get("closed_loop") or {}
     values = [d.get(k) for d in (measured, closed)
