@@ -4,6 +4,7 @@ check, but entered at an inward drift of 0.05 m/s, or in a 3 m/s beam wind, its 
 ran away to 2.3 m/s ahead and 3.4 m/s sideways; `validate`'s closed loop of the ship's 35° turn,
 in the turn log's gusts, did so. The checks now enter each held turn drifting either way too."""
 
+import json
 import math
 from pathlib import Path
 
@@ -119,8 +120,38 @@ def test_the_esso_zigzag_whose_fit_ran_away_gets_a_structure_that_does_not(tmp_p
     assert ("blanke-race+race-damping+wind+crossflow(3 m) (runs away with the rudder held to "
             "starboard when entered drifting)") in line
     model = load_model(tmp_path / "m.json")
+    # identify runs the crash stop on the model it hands out and files it (this one stops).
+    doc = json.loads((tmp_path / "m.json").read_text())
+    assert doc["identification"]["plausibility"]["astern"]["diverged"] is False
     turn = read_trial_log(ESSO / "turning" / "turn_14-Sep-2020_13_39_32.csv", fmt="osaka-frt")
     (v,) = validate(model, turn, start_draws=False)
     measured, closed = v.indices["measured"], v.indices["closed_loop"]
     # The race structure's fit ran to 25 times the turn's measured speed in its gusts.
     assert closed["steady_speed"] < 1.5 * measured["steady_speed"]
+
+
+@pytest.mark.parametrize(("resistance", "diverges"), [("|u|*u", False), ("u^2", True)])
+def test_a_model_that_runs_away_astern_is_named_not_ruled_out(resistance, diverges):
+    """A crash stop (the propeller reversed, the rudder amidships) of the model a command hands
+    out. Ahead, a|u|u and a u² are one resistance; astern, a u² (a < 0) drives the ship ever
+    faster astern, u̇ = a u² − b n², which blows up in finite time, where a|u|u settles at
+    −n √(−b/a). From one Esso zig-zag file, three of nine default models diverged so, the three
+    whose free runs of all four random runs diverged astern (benchmarks/README.md)."""
+    structure = ModelStructure("astern", {"u": (resistance, "|n|*n"), "v": ("u*v", "u*r", "delta"),
+                                          "r": ("u*v", "u*r", "delta")})  # fmt: skip
+    model = ManoeuvringModel(structure, {
+        "u": {resistance: A_UU, "|n|*n": B_NN},
+        "v": {"u*r": -0.3, "u*v": -0.6, "delta": 0.01},
+        "r": {"u*r": -0.8, "u*v": -0.2, "delta": -0.05}})  # fmt: skip
+    report, notes = check_plausibility(model, U0, RPS, astern=True)
+    assert report["astern"]["diverged"] is diverges
+    named = [n for n in notes if "crash stop" in n]
+    assert len(named) == int(diverges)
+    assert disqualifying(report, model) == []  # a warning only
+    # Without ``astern`` (the thousands of candidates a search checks) no stop is run.
+    assert "astern" not in check_plausibility(model, U0, RPS)[0]
+    if not diverges:
+        from shipid.trials.manoeuvres import stopping
+
+        res = stopping(model, RPS, duration=600, dt=0.1, speed=U0)
+        assert res.log["u"].iloc[-1] == pytest.approx(-U0, rel=1e-3)

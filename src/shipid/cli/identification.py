@@ -289,10 +289,11 @@ def cmd_identify(args) -> int:
         return _similar_or_fitted(model, one_rps)
 
     plausibility, notes = plausibility_at_approach(hybrid or as_written(ident.model), speed, rps,
-                                                   curvature=curvature)  # fmt: skip
+                                                   curvature=curvature, astern=True)  # fmt: skip
     if refinement:
         refined_report, refined_notes = plausibility_at_approach(
-            as_written(refinement.model), speed, rps, curvature=curvature)  # fmt: skip
+            as_written(refinement.model), speed, rps, curvature=curvature,
+            astern=True)  # fmt: skip
         worse = new_failures(plausibility, refined_report, ident.model)
         apart = _turns_apart(plausibility, refined_report)
         # Checks the LS-SVM fit fails and output error's passes: its turn is then no reference

@@ -28,7 +28,7 @@ import numpy as np
 from shipid.dynamics.equilibrium import still_air_accelerations, surge_equilibrium
 from shipid.dynamics.model import ManoeuvringModel
 from shipid.errors import ShipidError
-from shipid.trials.manoeuvres import doubling, turning_circle
+from shipid.trials.manoeuvres import doubling, stopping, turning_circle
 
 SETTLED_FRACTION = 0.02  # of the steady value, over the last 10 % of the run
 # A ship whose propeller keeps turning keeps a share of its approach speed in a steady turn with
@@ -150,6 +150,21 @@ def held_rudder(model: ManoeuvringModel, speed: float, rps: float | None = None,
     return out
 
 
+def crash_stop(model, speed: float, rps: float | None, duration: float | None = None,
+               dt: float = 0.1) -> dict | None:  # fmt: skip
+    """The propeller reversed to −``rps`` from the approach, the rudder amidships (the IMO
+    stopping test): bounded? {"diverged", "reason", "at"}; None for a model without propeller
+    terms or without an approach rps."""
+    if not getattr(model, "uses_rps", False) or not rps or not rps > 0 or not speed > 0:
+        return None
+    length = max(2 * HELD_DURATION, 2 * (duration or 0.0))
+    try:
+        res = stopping(model, rps, duration=length, dt=dt, speed=speed)
+    except ShipidError as err:
+        return {"diverged": False, "reason": str(err), "at": None, "skipped": True}
+    return {"diverged": bool(res.diverged), "reason": res.reason, "at": res.diverged_at}
+
+
 def _runaway_from_drift(model, speed, rps, rudder_deg, side, duration, dt,
                         reference: float) -> dict | None:  # fmt: skip
     """Of the held turns entered drifting (v = ± ``DRIFT_START_SHARE`` of ``speed``), the first
@@ -196,9 +211,12 @@ def check_plausibility(
     rudder_deg: float = 35.0,
     duration: float | None = None,
     curvature: float | None = None,
+    astern: bool = False,
 ) -> tuple[dict, list[str]]:
     """All checks, and one warning per failed one; ``curvature``: the training logs' sharpest
-    (``sharpest_curvature``), for the held rudder's path (``WIDE_SHARE``)."""
+    (``sharpest_curvature``), for the held rudder's path (``WIDE_SHARE``); ``astern``: also a
+    crash stop (``crash_stop``), a warning, not a reason to rule a model out (for the model a
+    command hands out, not the thousands a search checks)."""
     report = {"approach_speed": speed, "rps": rps,
               "straight_line": straight_line_stability(model, speed, rps),
               "surge_equilibrium": surge_equilibrium(model, speed, rps),
@@ -206,13 +224,15 @@ def check_plausibility(
               "logs_curvature": curvature}  # fmt: skip
     report["held_rudder"] = held_rudder(model, speed, rps, rudder_deg, duration,
                                         drift_speed=_straight_speed(report))  # fmt: skip
+    if astern:
+        report["astern"] = crash_stop(model, speed, rps, duration)
     return report, [note for _, note in failed_checks(report, model).values()]
 
 
 def plausibility_at_approach(model: ManoeuvringModel, trained_speed: float,
                              trained_rps: float | None, speed: float | None = None,
-                             rps: float | None = None, curvature: float | None = None
-                             ) -> tuple[dict, list[str]]:  # fmt: skip
+                             rps: float | None = None, curvature: float | None = None,
+                             astern: bool = False) -> tuple[dict, list[str]]:  # fmt: skip
     """``check_plausibility`` from the approach the model's manoeuvres start from
     (``shipid.dynamics.equilibrium.steady_approach``): a model with propeller terms at its own
     steady straight speed at the training rps, so that straight-line stability is judged about
@@ -221,7 +241,8 @@ def plausibility_at_approach(model: ManoeuvringModel, trained_speed: float,
     from shipid.dynamics.equilibrium import steady_approach
 
     app = steady_approach(model, trained_speed, trained_rps, speed=speed, rps=rps)
-    report, notes = check_plausibility(model, app.speed, app.rps, curvature=curvature)
+    report, notes = check_plausibility(model, app.speed, app.rps, curvature=curvature,
+                                       astern=astern)  # fmt: skip
     report["approach"] = app.describe()
     return report, notes
 
@@ -321,6 +342,11 @@ def failed_checks(report: dict, model: ManoeuvringModel) -> dict[str, tuple[int,
         out["surge_equilibrium"] = (1, "no steady straight speed with the rudder amidships: the "
                                        f"surge equation does not balance between 0 and "
                                        f"{3 * speed:.3g} m/s")  # fmt: skip
+    astern = report.get("astern")
+    if astern and astern.get("diverged"):
+        out["astern"] = (1, f"propeller reversed to −{report['rps']:.4g} rps from the approach "
+                         f"(a crash stop): {astern['reason']}: the model is not for going "
+                         "astern; logs that go astern give it the terms for it")  # fmt: skip
     for side, entry in (report.get("held_rudder") or {}).items():
         where, key = f"{rudder_deg:g}° rudder held to {side}", f"held_rudder_{side}"
         if entry["diverged"]:

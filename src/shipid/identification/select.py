@@ -595,8 +595,10 @@ def select(
 
     from shipid.identification.identify import identify
     from shipid.identification.plausibility import (
+        crash_stop,
         disqualifying,
         disqualifying_checks,
+        failed_checks,
         given_steady_speeds,
         plausibility_at_approach,
         sharpest_curvature,
@@ -735,6 +737,11 @@ def select(
     if checked is None:
         checked = plausibility_at_approach(model, speed, rps, options.speed, options.rps,
                                            curvature)  # fmt: skip
+    # The model handed out is also run through a crash stop (a warning: the thousands of
+    # candidates above are not).
+    checked[0]["astern"] = crash_stop(model, checked[0]["approach_speed"], checked[0]["rps"],
+                                      checked[0].get("duration"))  # fmt: skip
+    checked = (checked[0], [note for _, note in failed_checks(checked[0], model).values()])
     folds_report, held_out_runs = _fold_report(data, scorer, weights, current, logs, names)
     table = _table(scorer.cache.values(), current)
     failed = [c for c in scorer.cache.values() if c.folds_diverged == len(scorer.held)]
