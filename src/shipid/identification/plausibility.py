@@ -16,6 +16,9 @@ approach condition (speed u0, propeller speed n):
   way (``DRIFT_START_SHARE``), the turn must not diverge nor run away to a second, faster one
   (``SPEEDUP_FACTOR``): a model can hold a runaway turn that a start without drift never
   reaches, and a gust or a sea does.
+* crash stop (``astern``, for the model a command hands out): the propeller reversed from the
+  approach must not make the model diverge; a warning, since logs run ahead only leave going
+  astern to extrapolation, and ruling models out for it made the Esso's pairs predict worse.
 """
 
 from __future__ import annotations
