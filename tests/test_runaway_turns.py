@@ -2,7 +2,7 @@
 Osaka's 30°/30° zig-zag at 10 rps turned at 0.20 m/s from a straight start and passed every
 check, but entered at an inward drift of 0.05 m/s, or in a 3 m/s beam wind, its starboard turn
 ran away to 2.3 m/s ahead and 3.4 m/s sideways; `validate`'s closed loop of the ship's 35° turn,
-in the turn log's gusts, did so. The checks now enter each held turn drifting either way too."""
+in the turn log's gusts, did so. The checks now enter each held turn drifting inward too."""
 
 import json
 import math

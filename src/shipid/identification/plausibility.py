@@ -12,8 +12,8 @@ approach condition (speed u0, propeller speed n):
   and settle to a steady turn (yaw rate and speed no longer changing): for ``duration`` seconds
   when given, else from 300 s doubled up to HELD_MAX_DOUBLINGS times while still settling (a
   full-scale ship turns ten times slower than its 1:100 model; 300 s fixed called the full-scale
-  KVLCC2 unsettled where its model-scale twin was not). Entered with the ship drifting either
-  way (``DRIFT_START_SHARE``), the turn must not diverge nor run away to a second, faster one
+  KVLCC2 unsettled where its model-scale twin was not). Entered with the ship drifting inward
+  (``DRIFT_START_SHARE``), the turn must not diverge nor run away to a second, faster one
   (``SPEEDUP_FACTOR``): a model can hold a runaway turn that a start without drift never
   reaches, and a gust or a sea does.
 * crash stop (``astern``, for the model a command hands out): the propeller reversed from the
@@ -68,13 +68,13 @@ HELD_DURATION, HELD_MAX_DOUBLINGS = 300.0, 4
 # run alone is no rule: the paper's own scale ship, whose surge has v·r at −2.7, speeds up from
 # 2.0 to 3.5 m/s in its 35° turns.)
 SPEEDUP_FACTOR = 1.2
-# The held turns are also entered with the ship drifting, v = ± this share of the approach
-# speed (11°; the Esso Osaka's 35° turns drift 17° steady): the default model of the Esso's
-# 30°/30° zig-zag at 10 rps (13_42_53) turned at 0.20 m/s from a straight start and passed
-# every check, but entered at an inward drift of 0.05 m/s, or in a 3 m/s beam wind (its logs'
-# median true wind is 2.4 m/s), its starboard turn ran away to 2.3 m/s ahead and 3.4 m/s
-# sideways, seven times its approach: `validate`'s closed loop of the ship's 35° turn, in the
-# turn log's gusts, did so (benchmarks/README.md).
+# The held turns are also entered with the ship drifting inward, v = ± this share of the
+# approach speed (11°; the Esso Osaka's 35° turns drift 17° steady, outward): the default model
+# of the Esso's 30°/30° zig-zag at 10 rps (13_42_53) turned at 0.20 m/s from a straight start
+# and passed every check, but entered at an inward drift of 0.05 m/s, or in a 3 m/s beam wind
+# (its logs' median true wind is 2.4 m/s), its starboard turn ran away to 2.3 m/s ahead and
+# 3.4 m/s sideways, seven times its approach: `validate`'s closed loop of the ship's 35° turn,
+# in the turn log's gusts, did so (benchmarks/README.md).
 DRIFT_START_SHARE = 0.2
 
 
@@ -143,7 +143,7 @@ def held_rudder(model: ManoeuvringModel, speed: float, rps: float | None = None,
             duration or HELD_DURATION,
             lambda entry: duration is not None or entry["diverged"] or entry["settled"],
             2**HELD_MAX_DOUBLINGS)  # fmt: skip
-        if not out[side]["diverged"]:
+        if _worth_entering_drifting(out[side], side, speed):
             start = drift_speed or speed
             reference = max(start, out[side].get("steady_speed") or 0.0)
             runaway = _runaway_from_drift(model, start, rps, rudder_deg, side,
@@ -151,6 +151,15 @@ def held_rudder(model: ManoeuvringModel, speed: float, rps: float | None = None,
             if runaway:
                 out[side]["runaway"] = runaway
     return out
+
+
+def _worth_entering_drifting(entry: dict, side: str, speed: float) -> bool:
+    """Whether a held turn is to be entered drifting too: only one that settled and passed the
+    other checks; a turn that diverged, never settled, turned the wrong way, ended astern or all
+    but stopped is judged already (the drift runs of the unsettled full-scale turns, up to
+    4800 s each, made select's searches on the tanker's logs half as slow again)."""
+    return (entry["settled"] and not entry["diverged"] and not _turns_wrong_way(entry, side)
+            and not _goes_astern(entry, speed) and not _stalls(entry, speed))  # fmt: skip
 
 
 def crash_stop(model, speed: float, rps: float | None, duration: float | None = None,
@@ -170,24 +179,25 @@ def crash_stop(model, speed: float, rps: float | None, duration: float | None = 
 
 def _runaway_from_drift(model, speed, rps, rudder_deg, side, duration, dt,
                         reference: float) -> dict | None:  # fmt: skip
-    """Of the held turns entered drifting (v = ± ``DRIFT_START_SHARE`` of ``speed``), the first
-    that diverges, else the faster where it ends over ``SPEEDUP_FACTOR`` times ``reference``
-    (the faster of ``speed`` and the turn's own steady speed entered straight): {"v0",
-    "diverged", "reason" | "speed", "sway"}; None where neither does."""
+    """The held turn entered drifting inward, toward the turn's centre (v = ±
+    ``DRIFT_START_SHARE`` of ``speed``, the side's sign: a ship in a steady turn drifts outward,
+    so this start comes at the turn's balance from the other side), where it diverges or ends
+    over ``SPEEDUP_FACTOR`` times ``reference`` (the faster of ``speed`` and the turn's own
+    steady speed entered straight): {"v0", "diverged", "reason" | "speed", "sway"}; else None.
+    Every runaway found so far came from the inward start (the Esso's, the tanker's
+    ``blanke-speed`` fits to either side): the outward one, tried too, doubled the cost."""
     if not speed > 0:
         return None
-    fastest = None
-    for share in (DRIFT_START_SHARE, -DRIFT_START_SHARE):
-        v0 = share * speed
-        res = turning_circle(model, rudder_deg, side=side, duration=duration, dt=dt,
-                             speed=speed, rps=rps, indices=False, initial={"v": v0})  # fmt: skip
-        if res.diverged:
-            return {"v0": v0, "diverged": True, "reason": res.reason}
-        tail = res.log.iloc[int(0.9 * len(res.log)) :]
-        u = float(np.mean(tail["u"]))
-        if u > SPEEDUP_FACTOR * reference and (fastest is None or u > fastest["speed"]):
-            fastest = {"v0": v0, "diverged": False, "speed": u, "sway": float(np.mean(tail["v"]))}
-    return fastest
+    v0 = (1.0 if side == "starboard" else -1.0) * DRIFT_START_SHARE * speed
+    res = turning_circle(model, rudder_deg, side=side, duration=duration, dt=dt, speed=speed,
+                         rps=rps, indices=False, initial={"v": v0})  # fmt: skip
+    if res.diverged:
+        return {"v0": v0, "diverged": True, "reason": res.reason}
+    tail = res.log.iloc[int(0.9 * len(res.log)) :]
+    u = float(np.mean(tail["u"]))
+    if u > SPEEDUP_FACTOR * reference:
+        return {"v0": v0, "diverged": False, "speed": u, "sway": float(np.mean(tail["v"]))}
+    return None
 
 
 def _held(model, speed, rps, rudder_deg, side, duration, dt) -> dict:
