@@ -52,6 +52,8 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/study_trim.py
 	$(BIN)/python benchmarks/study_gyro_offset.py
 	$(BIN)/python benchmarks/study_event_timing.py
+	$(BIN)/python benchmarks/study_crossflow.py
+	$(BIN)/python benchmarks/study_turn_speed.py
 	$(BIN)/python benchmarks/bench_blas_threads.py
 
 clean:
