@@ -429,7 +429,7 @@ def _turn_notes(indices: dict) -> list[str]:
     speed, yaw = u_model / u_meas, abs(r_model / r_meas)
     if abs(math.log(speed)) > 2 * abs(math.log(yaw)):
         what = ("mostly the speed: the surge equation's loss of speed in the turn, which "
-                "zig-zags hardly excite; a turning log among the training logs pins it")
+                "zig-zags hardly excite; train on a turning log too")
     elif abs(math.log(yaw)) > 2 * abs(math.log(speed)):
         what = "mostly the yaw rate: the sway and yaw equations' balance in the turn"
     else:
