@@ -10,6 +10,10 @@ factors say which equation to look at; ``validate`` now says which (``_turn_note
    (tried, not kept): v·r at (m + m_y)/(m + m_x) ± 5 % (m_y from Clarke et al. 1983's Y′v̇, m_x
    5 % of m, as the Esso 190 000 dwt tanker's m11 = 1.05), r² in [0, 2 x_G m/(m + m_x)], and
    ``--constraints signs`` (the rudder's drag δ² ≤ 0 among them).
+3. Going astern: which default models ``identify`` warns of in a crash stop, against how many of
+   the four random runs (astern spans in each) their free runs diverge in.
+4. What ``validate``'s note advises: each file with one 35° turn among the training logs, judged
+   on the other turn.
 
 Run: .venv/bin/python benchmarks/study_turn_speed.py
 """
@@ -50,9 +54,16 @@ def surge_turn_bounds(p: Particulars) -> list[str]:
             "--constraints", "signs"]  # fmt: skip
 
 
-def _fit(argv: list[str], out: str) -> bool:
-    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+def _fit(argv: list[str], out: str, stderr: io.StringIO | None = None) -> bool:
+    with contextlib.redirect_stdout(io.StringIO()), \
+            contextlib.redirect_stderr(stderr if stderr is not None else io.StringIO()):
         return shipid([*argv, "-o", out]) == 0
+
+
+def _diverged(model, logs: dict) -> int:
+    """How many of ``logs`` the model's free run diverges in."""
+    runs = (validate(model, log, start_draws=False)[0] for log in logs.values())
+    return sum(v.simulation is None or v.simulation.diverged for v in runs)
 
 
 def _structure_flags(name: str) -> list[str]:
@@ -105,13 +116,19 @@ def main() -> None:
           "the other zig-zags' yaw-rate error / spread (median)\n")
     print("| file | made by | 35° TD | speed in the turn | yaw rate | note names | zig-zags r |")
     print("|---|---|---|---|---|---|---|")
+    randoms = {f: read_trial_log(f, fmt="osaka-frt")
+               for f in sorted((DATA / "random").glob("*.csv"))}  # fmt: skip
     summary: dict[str, dict[str, list]] = {}
+    astern: list[tuple[str, bool, int]] = []
     with tempfile.TemporaryDirectory() as tmp:
         out = f"{tmp}/m.json"
         for z in zig_files:
-            if not _fit(["identify", "--format", "osaka-frt", str(z)], out):
+            err = io.StringIO()
+            if not _fit(["identify", "--format", "osaka-frt", str(z)], out, err):
                 print(f"| {z.stem[-8:]} | default failed | | | | | |")
                 continue
+            astern.append((z.stem[-8:], "crash stop" in err.getvalue(),
+                           _diverged(load_model(out), randoms)))
             structure = load_model(out).structure.name
             pinned = ["identify", "--format", "osaka-frt", str(z),
                       *_structure_flags(structure), *bounds]  # fmt: skip
@@ -144,7 +161,55 @@ def main() -> None:
               f"{counts['both']}, none (within 10 %) {counts['–']} of {len(s['named'])}; where "
               f"the yaw rate came within 10 % ({len(s['speed'])} turns) the speed in the turn "
               f"was {min(s['speed']):.2f}–{max(s['speed']):.2f} times the measured")
+    print("\nGoing astern: the default models identify warns of in a crash stop, and the random "
+          "runs (of 4) their free runs diverge in\n")
+    print("| file | crash-stop warning | random runs diverging |")
+    print("|---|---|---|")
+    for name, warned, diverged in astern:
+        print(f"| {name} | {'yes' if warned else 'no'} | {diverged} |")
+    turn_with_other(zig_files, turns)
     print(f"\n{time.perf_counter() - start:.0f} s")
+
+
+def turn_with_other(zig_files, turns: dict) -> None:
+    """Each zig-zag file alone and with one 35° turn among the training logs, judged on the
+    other turn (closed loop): tactical diameter error and the speed in the steady turn over the
+    measured."""
+    print("\nWhat a turning log among the training logs does: the held-out turn's tactical "
+          "diameter error, the speed in its steady turn over the measured\n")
+    print("| file | held-out turn | the file alone | with the other turn |")
+    print("|---|---|---|---|")
+    files = list(turns)
+    results: dict[str, list[tuple[float, float]]] = {"alone": [], "with": []}
+    with tempfile.TemporaryDirectory() as tmp:
+        out = f"{tmp}/m.json"
+        for z in zig_files:
+            for trained, held in ((files[0], files[1]), (files[1], files[0])):
+                cells = []
+                for label, train in (("alone", [z]), ("with", [z, trained])):
+                    if not _fit(["identify", "--format", "osaka-frt", *map(str, train)], out):
+                        cells.append("failed")
+                        continue
+                    v = validate(load_model(out), turns[held], start_draws=False)[0]
+                    m, c = v.indices["measured"], v.indices.get("closed_loop") or {}
+                    try:
+                        td = 100 * (c["tactical_diameter"] / m["tactical_diameter"] - 1)
+                        speed = c["steady_speed"] / m["steady_speed"]
+                    except (KeyError, TypeError):
+                        td, speed = np.inf, np.nan
+                    results[label].append((td, speed))
+                    cells.append("no turn" if not np.isfinite(td) else f"{td:+.0f} %, {speed:.2f}")
+                print(f"| {z.stem[-8:]} | {held.stem[-8:]} | {' | '.join(cells)} |", flush=True)
+    print()
+    for label, rows in results.items():
+        td = np.abs(np.array([r[0] for r in rows]))
+        finite = td[np.isfinite(td)]
+        speeds = np.array([r[1] for r in rows if np.isfinite(r[0])])
+        inner = speeds[(speeds >= 0.6) & (speeds <= 1.5)]
+        print(f"{label}: held-out turn's TD |error| median {np.median(finite):.0f} %, mean "
+              f"{np.mean(finite):.0f} % (largest {finite.max():.0f} %, {td.size - finite.size} "
+              f"without); speed in the turn {speeds.min():.2f}–{speeds.max():.2f} times the "
+              f"measured, within 0.6–1.5 in {inner.size} of {speeds.size}")
 
 
 if __name__ == "__main__":

@@ -85,10 +85,11 @@ def source(code: TermCode, pairs: np.ndarray | None = None) -> str:
         body.append("s3 = math.sqrt(u * u + v * v)")
     if 4 in used:
         body.append("s4 = math.atan2(-v, u)")
-    slots = CROSSFLOW_SLOTS[:2]
-    if used & set(slots):  # the hull's cross-flow drag, its length the factors' k
-        length = next(float(code.k[f]) for f in range(len(code.signal)) if code.signal[f] in slots)
-        body.append(f"s{slots[0]}, s{slots[1]} = _kernel.crossflow(v, r, {length!r})")
+    if used & set(CROSSFLOW_SLOTS):  # the hull's cross-flow drag, its length the factors' k
+        length = next(float(code.k[f]) for f in range(len(code.signal))
+                      if code.signal[f] in CROSSFLOW_SLOTS)  # fmt: skip
+        sway, yaw = CROSSFLOW_SLOTS
+        body.append(f"s{sway}, s{yaw} = _kernel.crossflow(v, r, {length!r})")
     for i in (5, 6, 7):
         if i in used:
             body.append(f"s{i} = inp[{i - 5}]")

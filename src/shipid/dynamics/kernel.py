@@ -115,8 +115,6 @@ def crossflow(v, r, length):
             ((s2 * c2 - s1 * c1) / 4.0 - v * (c2 - c1) / 3.0) / (r * r) / (length * length))
 
 
-
-
 @numba.njit(cache=True, inline="always")
 def _factor(x, op, k, p):
     if op == 0:

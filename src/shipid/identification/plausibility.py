@@ -166,14 +166,14 @@ def crash_stop(model, speed: float, rps: float | None, duration: float | None = 
                dt: float = 0.1) -> dict | None:  # fmt: skip
     """The propeller reversed to −``rps`` from the approach, the rudder amidships (the IMO
     stopping test): bounded? {"diverged", "reason", "at"}; None for a model without propeller
-    terms or without an approach rps."""
+    terms or without an approach rps, or one the stopping test refuses."""
     if not getattr(model, "uses_rps", False) or not rps or not rps > 0 or not speed > 0:
         return None
     length = max(2 * HELD_DURATION, 2 * (duration or 0.0))
     try:
         res = stopping(model, rps, duration=length, dt=dt, speed=speed)
-    except ShipidError as err:
-        return {"diverged": False, "reason": str(err), "at": None, "skipped": True}
+    except ShipidError:
+        return None
     return {"diverged": bool(res.diverged), "reason": res.reason, "at": res.diverged_at}
 
 
