@@ -89,13 +89,15 @@ def test_a_drift_start_that_diverges_is_named_as_such():
         disqualifying(report, model)  # fmt: skip
 
 
-@pytest.mark.parametrize("name", ["scale-ship", "kvlcc2", "tanker"])
+@pytest.mark.parametrize("name", ["scale-ship", "mariner", "kvlcc2", "cybership2", "tanker"])
 def test_the_reference_ships_turn_the_same_way_entered_drifting(name):
     """No truth is ruled out: the paper's scale ship (whose surge speeds it up from 2.0 to 3.5
-    m/s in its own 35° turns, v·r at −2.7), the KVLCC2 (MMG) and the course-unstable tanker."""
+    m/s in its own 35° turns, v·r at −2.7), the Mariner, the KVLCC2 (MMG), CyberShip II and the
+    course-unstable tanker."""
     ship = scale_ship_model() if name == "scale-ship" else \
         tanker(rudder_limit_deg=35.0) if name == "tanker" else get_vessel(name)  # fmt: skip
-    speed = {"scale-ship": 1.933, "kvlcc2": 1.179, "tanker": 8.23}[name]
+    speed = {"scale-ship": 1.933, "mariner": 7.72, "kvlcc2": 1.179, "cybership2": 0.30,
+             "tanker": 8.23}[name]  # fmt: skip
     held = held_rudder(ship, speed)
     assert all(not e["diverged"] and e["settled"] for e in held.values())
     assert not any("runaway" in e for e in held.values())

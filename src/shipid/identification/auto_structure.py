@@ -502,7 +502,7 @@ def _paper_or_race(logs, names, physics, cv, estimator, drop=None, announce=_qui
     # else the simplest. Where the logs cannot tell a hull of terms from one of cross-flow drag,
     # the drag: it carries the damping to drifts beyond the logs by the hull's length, where the
     # terms' split of it is free (the Esso Osaka's single zig-zag files: 35° turns 35 % wide in
-    # the median, 23 % so; the tanker's zig-zags, whose truth is of the terms, choose them). The
+    # the median, 22 % so; the tanker's zig-zags, whose truth is of the terms, choose them). The
     # rudder in the race comes first, as without the drag: from the KVLCC2's MARIN 20/20 zig-zag
     # blanke-speed with the drag, tied with the race structure, predicted the −20° run's yaw
     # rate with 4.6 times the race structure's error.
