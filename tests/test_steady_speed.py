@@ -12,7 +12,7 @@ from test_equilibrium import PROPELLED, steady
 from test_turning_replica import turning_log
 
 from shipid.data.io import write_log
-from shipid.data.log import steady_start
+from shipid.data.log import relative_wind, steady_start
 from shipid.dynamics.equilibrium import surge_equilibrium
 from shipid.errors import ShipidError
 from shipid.identification.identify import identify
@@ -159,3 +159,28 @@ def test_every_surge_candidate_of_a_propelled_library_holds_the_hull_resistance(
     sel = select(logs, library=library, gammas=(1e4,))
     assert sel.ranking["u"][0][0] == "|u|*u"
     assert "|u|*u" in sel.model.structure.terms["u"]
+
+
+def test_a_wind_model_holds_the_given_speed_in_still_air():
+    """In still air the anemometer reads the ship's own motion (a head wind of its speed), and
+    the closed loop runs the wind's terms with it: the equality u̇ = 0 must too. It took the
+    wind's terms at 0 and put a wind model's straight run off the speed it was given."""
+    logs = []
+    for rps, side in ((8.0, "port"), (14.0, "starboard")):
+        log = speeding_up(rps, side)
+        speed, angle = relative_wind(log["u"], log["v"], log["psi"], (1.5, 0.7))
+        logs.append(log.assign(wind_speed=speed, wind_angle=angle))
+    given = 1.1 * steady(10.0)
+    fit = identify(logs, SPEC.replace("pos(n)^2;", "pos(n)^2, U_A^2*cos(gamma_A);"), force=True,
+                   physics=PhysicsOptions(steady_speed=True, approach={"u": given, "n": 10.0}))
+    model = fit.model
+    assert surge_equilibrium(model, given, 10.0) == pytest.approx(given, rel=1e-9)
+    # The wind's term carries part of the balance: taken at 0 it leaves the model's straight run
+    # 0.05 % off, 10⁵ times the tolerance above.
+    def surge(speed: float, wind: float) -> float:
+        return model.accelerations([speed], [0.0], [0.0], [0.0], None, [10.0],
+                                   wind_speed=[wind], wind_angle=[0.0])[0, 0]  # fmt: skip
+
+    h = 1e-3 * given
+    slope = (surge(given + h, given + h) - surge(given - h, given - h)) / (2 * h)
+    assert abs(surge(given, 0.0) / slope) > 1e-4 * given

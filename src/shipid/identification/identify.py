@@ -26,6 +26,7 @@ from shipid.identification.physics import (
     PhysicsOptions,
     dof_physics,
     inequality_notes,
+    still_air,
     with_stability,
 )
 from shipid.identification.regression import FORMS, RegressionProblem, regression_problem
@@ -144,9 +145,9 @@ def _equality_cost(p: RegressionProblem, g, b, estimator, gamma, extra) -> list[
     h = 1e-4
     longest = EQUALITY_TIME_CONSTANT_LOGS * p.dt * len(p.y)
     for u0, n0 in extra.approaches:
-        given = {"delta": np.zeros(2), "n": np.full(2, n0), "wind_speed": np.zeros(2),
-                 "wind_angle": np.zeros(2)}  # fmt: skip
-        rows = term_matrix(p.names, np.array([u0 + h, u0 - h]), np.zeros(2), np.zeros(2), given)
+        speeds = np.array([u0 + h, u0 - h])
+        rows = term_matrix(p.names, speeds, np.zeros(2), np.zeros(2),
+                           still_air(speeds, np.zeros(2), np.zeros(2), np.full(2, n0)))
         slope = float((rows[0] - rows[1]) @ g / (2 * h))
         if not slope < -1.0 / longest:
             return [f"{p.dof}: with the steady-speed constraint the surge equation has no speed "

@@ -248,6 +248,17 @@ def _steady_starts(logs: Sequence[pd.DataFrame]) -> list[pd.DataFrame]:
     return kept
 
 
+def still_air(u, v, delta, n) -> dict[str, np.ndarray]:
+    """The inputs of ``term_matrix`` at states (u, v) in still air: the relative wind an
+    anemometer reads is then the ship's own motion, as ``shipid.data.log.relative_wind`` gives
+    it with no true wind and the closed loop and ``surge_equilibrium`` run the model. (A
+    steady-speed equality with the wind's terms at 0 put a wind model's straight run off the
+    speed it was given.)"""
+    u, v = np.asarray(u, dtype=float), np.asarray(v, dtype=float)
+    return {"delta": np.asarray(delta, dtype=float), "n": np.asarray(n, dtype=float),
+            "wind_speed": np.hypot(u, v), "wind_angle": np.arctan2(v, u)}
+
+
 def _straight_running_slopes(texts: Sequence[str], u0: float, n0: float,
                              wrt: Sequence[str] = ("v", "r")) -> np.ndarray:
     """(len(wrt), len(texts)): ∂/∂x of each term for x in ``wrt`` (of u, v, r, delta) at
@@ -270,9 +281,8 @@ def _term_slopes(text: str, u0: float, n0: float, wrt: tuple[str, ...]) -> tuple
 
     def value(du: float, dv: float, dr: float, dd: float) -> float:
         u, v, r = np.array([u0 + du]), np.array([dv]), np.array([dr])
-        given = {"delta": np.array([dd]), "n": np.array([n0]), "wind_speed": np.hypot(u, v),
-                 "wind_angle": np.arctan2(v, u)}  # fmt: skip
-        return float(term_matrix([text], u, v, r, given)[0, 0])
+        return float(term_matrix([text], u, v, r, still_air(u, v, np.array([dd]),
+                                                            np.array([n0])))[0, 0])
 
     def central(h: float) -> np.ndarray:
         out = np.zeros(len(wrt))
@@ -379,8 +389,7 @@ def _approach_rows(dof_terms: Sequence[str], fixed: Mapping[str, float], has_con
     u0 = np.array([s[0] for s in states])
     n0 = np.array([s[1] for s in states])
     zero = np.zeros(len(states))
-    given = {"delta": zero, "n": n0, "wind_speed": zero, "wind_angle": zero}
-    rows = term_matrix(texts, u0, zero, zero, given)
+    rows = term_matrix(texts, u0, zero, zero, still_air(u0, zero, zero, n0))
     k = len(dof_terms)
     E = np.column_stack([rows[:, :k], np.full(len(states), 1.0 if has_constant else 0.0)])
     f = -(rows[:, k:] @ np.array([fixed[t] for t in fixed])) if fixed else np.zeros(len(states))
