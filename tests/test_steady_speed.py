@@ -16,7 +16,8 @@ from shipid.data.log import relative_wind, steady_start
 from shipid.dynamics.equilibrium import surge_equilibrium
 from shipid.errors import ShipidError
 from shipid.identification.identify import identify
-from shipid.identification.physics import PhysicsOptions
+from shipid.identification.physics import PhysicsOptions, similar_steady_speeds
+from shipid.identification.plausibility import missed_steady_speed
 from shipid.reporting.modelfile import load_model
 
 SPEC = "u: |u|u, pos(n)^2; v: u*r, u*v, delta; r: u*r, u*v, delta"
@@ -184,3 +185,47 @@ def test_a_wind_model_holds_the_given_speed_in_still_air():
     h = 1e-3 * given
     slope = (surge(given + h, given + h) - surge(given - h, given - h)) / (2 * h)
     assert abs(surge(given, 0.0) / slope) > 1e-4 * given
+
+
+def test_a_speed_given_at_another_rps_than_the_logs_one_is_held_there(tmp_path, capsys):
+    """Logs at one rps: the model file carries the fit to every rps by similarity (speed ∝ rps).
+    The equality took the fit's terms at the rps given instead, so a speed given at 14 rps to a
+    fit of logs at 10 was held wherever the similarity put it, not at 14."""
+    path = write_log(speeding_up(10.0), tmp_path / "a.csv")
+    given = 1.1 * steady(14.0)
+    # The thrust in the fit's constant, as the paper's surge has it: similarity writes it |n|n.
+    unpropelled = SPEC.replace("|u|u, pos(n)^2", "|u|u, 1")
+    code, _, err = run(["identify", path, "--model", unpropelled, "--steady-speed",
+                        f"{given}@14", "-o", tmp_path / "m.json"], capsys)  # fmt: skip
+    assert code == 0, err
+    model = load_model(tmp_path / "m.json")
+    assert surge_equilibrium(model, given, 14.0) == pytest.approx(given, rel=1e-6)
+    assert surge_equilibrium(model, given, 10.0) == pytest.approx(given * 10 / 14, rel=1e-6)
+    assert f"{given * 10 / 14:.4g} m/s at 10 rps, the logs' one rps" in err
+    assert f"puts the {given:.4g} m/s at 14 rps given" in err
+    assert "not the speed given" not in err
+    # Two speeds similarity cannot both hold: one clear error, no model file.
+    code, _, err = run(["identify", path, "--model", SPEC, "--steady-speed", "0.30@10",
+                        "--steady-speed", "0.45@14", "-o", tmp_path / "two.json"], capsys)
+    assert code == 1 and "which one straight run cannot all hold" in err
+    assert "0.3, 0.3214 m/s at 10 rps" in err and not (tmp_path / "two.json").exists()
+
+
+def test_similar_steady_speeds_carries_them_to_the_logs_rps():
+    assert similar_steady_speeds([{"u": 0.42, "n": 12.0}], None) == [{"u": 0.42, "n": 12.0}]
+    (one,) = similar_steady_speeds([{"u": 0.42, "n": 12.0}], 10.0)
+    assert one == {"u": pytest.approx(0.35), "n": 10.0, "given_u": 0.42, "given_n": 12.0}
+    # Given twice, rounded (within 1 %): one speed, their mean.
+    (both,) = similar_steady_speeds([{"u": 0.35, "n": 10.0}, {"u": 0.421, "n": 12.0}], 10.0)
+    assert both["u"] == pytest.approx((0.35 + 0.421 * 10 / 12) / 2) and both["n"] == 10.0
+    with pytest.raises(ShipidError, match="cannot all hold"):
+        similar_steady_speeds([{"u": 0.35, "n": 10.0}, {"u": 0.45, "n": 12.0}], 10.0)
+    # A speed given without rps to a fit of propelled logs: at their rps.
+    assert similar_steady_speeds([{"u": 0.35, "n": 0.0}], 10.0) == [{"u": 0.35, "n": 10.0}]
+
+
+def test_a_model_that_does_not_hold_a_given_speed_is_named():
+    assert missed_steady_speed(PROPELLED, steady(10.0), 10.0) is None
+    note = missed_steady_speed(PROPELLED, 1.2 * steady(10.0), 10.0)
+    assert note.startswith(f"--steady-speed {1.2 * steady(10.0):.4g}@10: the model holds "
+                           f"{steady(10.0):.4g} m/s straight at 10 rps, not the speed given")

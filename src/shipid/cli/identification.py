@@ -16,6 +16,7 @@ from shipid.cli.common import (
     _json_text,
     _log_particulars,
     _log_record,
+    _one_rps,
     _parse_drop,
     _parse_gammas,
     _pd,
@@ -349,10 +350,11 @@ def cmd_identify(args) -> int:
         approach_beyond_logs,
         below_the_logs_rps,
         given_steady_speeds,
+        missed_steady_speed,
     )
 
     beyond = approach_beyond_logs(plausibility, ident.envelope)
-    if beyond:
+    if beyond and not given_steady_speeds(physics):  # a speed given is no extrapolation
         ident.warnings.append(beyond)
     below = below_the_logs_rps(hybrid or as_written(final), plausibility, logs)
     if below:
@@ -362,6 +364,9 @@ def cmd_identify(args) -> int:
         at = plausibility_at_approach(hybrid or as_written(final), u, n, u, n)[1]
         ident.warnings.extend(f"plausibility at {u:.4g} m/s, {n:.4g} rps (--steady-speed): {w}"
                               for w in at)  # fmt: skip
+        missed = missed_steady_speed(hybrid or as_written(final), u, n)
+        if missed:
+            ident.warnings.append(missed)
     if refinement:
         ident.warnings.extend(f"refinement: {n}" for n in refinement.warnings)
     text = model_text(ident, args.logs, preprocessing=prep, refinement=refinement,
@@ -382,27 +387,6 @@ def cmd_identify(args) -> int:
         _warn(w)
     print(f"model written to {args.output}")
     return 0
-
-
-def _one_rps(logs, args) -> float | None:
-    """The propeller speed every training log runs at (their approach's, as the model file
-    records it), where it is one and positive and the model is to be carried to the others by
-    advance-ratio similarity (``shipid.dynamics.similarity``; not with --no-rps-similarity);
-    else None."""
-    import numpy as np
-
-    from shipid.identification.identify import varies
-
-    if not getattr(args, "rps_similarity", True) or not all("n" in log.columns for log in logs):
-        return None
-    n = np.concatenate([log["n"].to_numpy(dtype=float) for log in logs])
-    # Anchored at the median of the logs' approach rps, which the fit stands for whatever their
-    # order: anchored at the first log's, the KVLCC2's MARIN and HSVA runs (10.33 and 10.23 rps,
-    # one rps to the fit) gave models whose held-out errors moved by up to 11 % with the order
-    # the files were given in.
-    approaches = [a for a in (_approach(log, "n") for log in logs) if a is not None]
-    rps = float(np.median(approaches)) if approaches else None
-    return rps if rps is not None and rps > 0 and not varies(n) else None
 
 
 def _similar_or_fitted(model, rps: float | None):
@@ -745,13 +729,14 @@ def cmd_select(args) -> int:
         # The default library passed as given: the trimmed one, with the hull's cross-flow drag.
         given = library = edit.apply(library)
     # The default library is passed as None: select trims it to the logs and says so.
+    physics = _physics(args, logs, library)
     options = SelectOptions(library=library if given is not None else None,
                             search=args.search, cv=args.cv,
                             estimator=args.estimator, method=args.method,
                             max_evaluations=args.max_evaluations,
                             plausibility=not args.no_plausibility, speed=args.speed,
                             rps=args.rps, one_standard_error=not args.best,
-                            progress=not args.quiet, physics=_physics(args, logs, library),
+                            progress=not args.quiet, physics=physics,
                             average=args.average, keep=args.keep,
                             **({"gammas": gammas} if gammas else {}))
     sel = select(logs, options, names=names)
@@ -803,6 +788,14 @@ def cmd_select(args) -> int:
             rps_similar(sel.model, one_rps), speed, one_rps,
             curvature=sharpest_curvature(logs, speed))  # fmt: skip
     ident.warnings.extend(f"plausibility: {n}" for n in notes)
+    from shipid.identification.plausibility import given_steady_speeds, missed_steady_speed
+
+    written = rps_similar(sel.model, one_rps) if one_rps is not None and \
+        similarity_map(sel.model.structure, one_rps).changes else sel.model  # fmt: skip
+    for u, n in given_steady_speeds(physics):
+        missed = missed_steady_speed(written, u, n)
+        if missed:
+            ident.warnings.append(missed)
     prep = _log_record(args, logs)
     ensemble = None
     others = len(sel.shares) - (sel.chosen_share > 0)

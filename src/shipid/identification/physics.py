@@ -154,6 +154,40 @@ def parse_steady_speeds(items: Sequence[str] | None) -> list[dict[str, float]]:
     return out
 
 
+# Given steady speeds that similarity puts this far apart at the logs' one rps are one speed
+# given twice, rounded; further apart, no straight run of one model holds them.
+SIMILAR_SPEEDS_TOLERANCE = 0.01
+
+
+def similar_steady_speeds(approaches: Sequence[Mapping[str, float]], rps: float | None
+                          ) -> list[dict[str, float]]:  # fmt: skip
+    """``--steady-speed`` approaches for a fit to logs that all run at one ``rps``, which the
+    model file carries to every rps by advance-ratio similarity (``shipid.dynamics.similarity``:
+    its straight speed ∝ rps): U at N is imposed as U·rps/N at ``rps``, where the fit's terms
+    stand for the logs' propeller (the given U and N kept as ``given_u``, ``given_n``). Imposed
+    with the fit's terms at N instead, a speed given at 12 rps to a fit of logs at 10 was held
+    at 10 rps, and the model ran 20 % faster at 12. ``rps`` None: as given."""
+    out = [dict(a) for a in approaches]
+    if rps is None or not out:
+        return out
+    for a in out:
+        if a.get("n") and a["n"] != rps:
+            a.update(given_u=a["u"], given_n=a["n"], u=a["u"] * rps / a["n"], n=rps)
+        elif not a.get("n"):
+            a["n"] = rps  # a model with propeller terms runs at the logs' rps
+    speeds = [a["u"] for a in out]
+    if max(speeds) > (1.0 + SIMILAR_SPEEDS_TOLERANCE) * min(speeds):
+        said = ", ".join(f"{a.get('given_u', a['u']):.4g}@{a.get('given_n', a['n']):.4g}"
+                         for a in out)  # fmt: skip
+        at = ", ".join(f"{u:.4g}" for u in speeds)
+        raise ShipidError(f"--steady-speed {said}: the logs run at one {rps:.4g} rps, from which "
+                          f"the model is carried to other rps by advance-ratio similarity (its "
+                          f"straight speed ∝ rps); these are {at} m/s at {rps:.4g} rps, which one "
+                          "straight run cannot all hold: give the one at the rps the model is "
+                          "for, or train on logs at several propeller speeds")  # fmt: skip
+    return [{**out[0], "u": float(np.mean(speeds))}] if len(out) > 1 else out
+
+
 @dataclass
 class DofPhysics:
     """The solver's inputs for one equation: prior, bounds, tied bias, and what they mean."""
@@ -445,6 +479,11 @@ def dof_physics(options: PhysicsOptions | None, dof: str, names: Sequence[str], 
         E, f, out.approaches = _approach_rows(names, fixed, has_constant, options, logs)
         out.equalities = (E, f)
         where = ", ".join(f"{a:.4g} m/s at {b:.4g} rps" for a, b in out.approaches)
+        carried = [a for a in ([options.approach] if isinstance(options.approach, Mapping)
+                               else options.approach or ()) if "given_n" in a]  # fmt: skip
+        if carried:
+            where += ", the logs' one rps, where advance-ratio similarity puts the " + ", ".join(
+                f"{a['given_u']:.4g} m/s at {a['given_n']:.4g} rps" for a in carried) + " given"
         out.notes.append(f"u: steady speed imposed on the approach ({where})")
     return out
 

@@ -332,7 +332,30 @@ def given_steady_speeds(physics) -> list[tuple[float, float]]:
     if not approach:
         return []
     items = [approach] if isinstance(approach, dict) else list(approach)
-    return [(float(a["u"]), float(a.get("n", 0.0))) for a in items]
+    return [(float(a.get("given_u", a["u"])), float(a.get("given_n", a.get("n", 0.0))))
+            for a in items]  # fmt: skip
+
+
+# A model whose straight run settles this far from a speed it was given does not hold it.
+GIVEN_SPEED_TOLERANCE = 1e-3
+
+
+def missed_steady_speed(model, speed: float, rps: float) -> str | None:
+    """A warning where ``model`` (as the model file has it) does not hold the straight ``speed``
+    a user gave at ``rps`` (``--steady-speed``): the fit's equality holds on its own terms,
+    which the model file may carry to other rps, and a surge with no propeller term holds one
+    speed at every rps."""
+    from shipid.dynamics.equilibrium import surge_equilibrium
+
+    if not hasattr(model, "structure") or "u" not in model.structure.dofs:
+        return None
+    held = surge_equilibrium(model, speed, rps or None)
+    if held is not None and abs(held - speed) <= GIVEN_SPEED_TOLERANCE * speed:
+        return None
+    where = "no steady speed" if held is None else f"{held:.4g} m/s"
+    return (f"--steady-speed {speed:.4g}@{rps:.4g}: the model holds {where} straight at "
+            f"{rps:.4g} rps, not the speed given (the fit's surge balances there on its own "
+            "terms; a surge without propeller-speed terms holds one speed at every rps)")
 
 
 # How badly a check fails, to compare two models check by check: a rudder held to a side that
