@@ -191,6 +191,43 @@ def test_rescale_carries_the_anchor_of_a_similar_model(one_rps, tmp_path, capsys
     assert doc["identification"]["preprocessing"]["approach_rps"] == pytest.approx(N0 / 4)
 
 
+
+def test_a_rescaled_model_starts_its_manoeuvres_as_its_original(one_rps, tmp_path, capsys):
+    """Whether a model holds its training approach is judged over 10 s; its Froude-rescaled
+    copy must be judged over √λ times as long, or a training approach it leaves slowly at model
+    scale passes for steady at full scale and its manoeuvres start elsewhere (the one-file Esso
+    model at 300 m turned a 960 m tactical diameter, its original 8.53 m)."""
+    from shipid.data.log import STEADY_WINDOW
+    from shipid.dynamics.equilibrium import still_air_accelerations, surge_equilibrium
+    from shipid.reporting.modelfile import model_from_document
+
+    doc = json.loads(one_rps["similar"].read_text())
+    model = model_from_document(doc, one_rps["similar"])
+    steady = surge_equilibrium(model, doc["identification"]["preprocessing"]["approach_speed"],
+                               N0)  # fmt: skip
+    # A training approach the model leaves by 5–50 % in 10 s: not steady at its scale, steady
+    # over the tenth of a window 10 s at 100 times the length are.
+    grid = np.linspace(0.5, 0.99, 50) * steady
+    change = still_air_accelerations(model, grid, 0 * grid, 0 * grid, 0 * grid, N0)[:, 0] \
+        * STEADY_WINDOW / grid  # fmt: skip
+    speed = float(grid[np.flatnonzero((np.abs(change) > 0.08) & (np.abs(change) < 0.4))[0]])
+    doc["identification"]["preprocessing"]["approach_speed"] = speed
+    original, big = tmp_path / "original.json", tmp_path / "big.json"
+    original.write_text(json.dumps(doc))
+    assert run(["rescale", original, "--factor", "100", "-o", big], capsys)[0] == 0
+    runs = {}
+    for key, path in (("original", original), ("big", big)):
+        out = tmp_path / f"{key}-turn.json"
+        code, said, err = run(["manoeuvre", path, "turning", "--no-bands", "--json", out],
+                              capsys)  # fmt: skip
+        assert code == 0, err
+        assert "the model's steady straight speed" in said
+        runs[key] = json.loads(out.read_text())
+    speeds = [runs[k]["approach"]["speed"] for k in ("original", "big")]
+    assert speeds[1] == pytest.approx(10 * speeds[0], rel=1e-9)
+    first, second = (runs[k]["indices"]["tactical_diameter"] for k in ("original", "big"))
+    assert second == pytest.approx(100 * first, rel=1e-4)  # each run at its own step
+
 def test_a_bad_anchor_in_a_model_file_is_one_line(one_rps, tmp_path, capsys):
     doc = json.loads(one_rps["similar"].read_text())
     doc["model"]["similar_at_rps"] = -3

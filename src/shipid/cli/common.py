@@ -574,7 +574,10 @@ def _run_approach(target, cond: dict, speed: float | None, rps: float | None):
         return speed, rps, None
     if speed is None and not cond["speed"]:
         return None, rps if rps is not None else cond["rps"], None  # the run names what is missing
-    app = steady_approach(target, cond["speed"], cond["rps"], speed, rps)
+    from shipid.data.log import STEADY_WINDOW
+
+    app = steady_approach(target, cond["speed"], cond["rps"], speed, rps,
+                          window=STEADY_WINDOW * cond.get("time_scale", 1.0))  # fmt: skip
     print(app.describe())
     return app.speed, app.rps, app.warning
 

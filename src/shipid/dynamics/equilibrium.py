@@ -79,8 +79,10 @@ class Approach:
 
 def steady_approach(model: ManoeuvringModel, trained_speed: float | None,
                     trained_rps: float | None, speed: float | None = None,
-                    rps: float | None = None) -> Approach:  # fmt: skip
-    """The approach of a manoeuvre on ``model``.
+                    rps: float | None = None, window: float = STEADY_WINDOW) -> Approach:  # fmt: skip
+    """The approach of a manoeuvre on ``model``; steady as ``unsteady_warning`` judges over
+    ``window`` seconds (a model carried to another scale, ``time_scale``, judged over the window
+    its original was, so that both start alike).
 
     ``rps`` (else the training logs') drives a model with propeller terms. A given ``speed`` is
     kept, with a warning when the model does not hold it (its speed changes by more than 5 % in
@@ -94,13 +96,14 @@ def steady_approach(model: ManoeuvringModel, trained_speed: float | None,
     uses_rps = model.uses_rps
     n = (rps if rps is not None else trained_rps) if uses_rps else None
     if speed is not None:
-        return Approach(speed, n, "given", unsteady_warning(model, speed, n))
+        return Approach(speed, n, "given", unsteady_warning(model, speed, n, window))
     if trained_speed is None or not trained_speed > 0:
         raise ValueError("the training approach speed is unknown")
     anchor = getattr(model, "similar_at_rps", None)
     # The rps the training approach speed was run at (the first log's), where it is known.
     home = trained_rps if trained_rps is not None and trained_rps > 0 else anchor
-    if anchor and n is not None and n > 0 and unsteady_warning(model, trained_speed, home) is None:
+    if anchor and n is not None and n > 0 and \
+            unsteady_warning(model, trained_speed, home, window) is None:
         # The model of logs at one rps is the fit there and holds their approach: it starts
         # there (as a model without n did), elsewhere at that speed scaled with n, as its
         # forces are. Its own balance would put the MARIN KVLCC2's race structure 6 % faster
@@ -112,7 +115,7 @@ def steady_approach(model: ManoeuvringModel, trained_speed: float | None,
         scaled = trained_speed * n / home
         return Approach(scaled, n, f"the training logs' approach speed at {home:.4g} rps, "
                         "scaled with the propeller speed (advance-ratio similarity)",
-                        unsteady_warning(model, scaled, n))  # fmt: skip
+                        unsteady_warning(model, scaled, n, window))  # fmt: skip
     if uses_rps and n is not None and "u" in model.structure.dofs:
         steady = surge_equilibrium(model, trained_speed, n, SEARCH_SPAN)
         if steady is not None and steady > 0:
@@ -122,15 +125,17 @@ def steady_approach(model: ManoeuvringModel, trained_speed: float | None,
                         f"manoeuvre starts from the training approach, {trained_speed:.4g} m/s, "
                         "and its speed drifts")  # fmt: skip
     return Approach(trained_speed, n, "the training logs' approach speed",
-                    unsteady_warning(model, trained_speed, n))  # fmt: skip
+                    unsteady_warning(model, trained_speed, n, window))  # fmt: skip
 
 
-def unsteady_warning(model: ManoeuvringModel, speed: float, rps: float | None) -> str | None:
-    """A warning when ``model`` does not hold ``speed`` straight ahead with the rudder amidships."""
+def unsteady_warning(model: ManoeuvringModel, speed: float, rps: float | None,
+                     window: float = STEADY_WINDOW) -> str | None:  # fmt: skip
+    """A warning when ``model`` does not hold ``speed`` straight ahead with the rudder amidships:
+    its speed would change by more than ``STEADY_SHARE`` in ``window`` seconds."""
     if "u" not in model.structure.dofs:
         return None
     udot = float(still_air_accelerations(model, speed, 0.0, 0.0, 0.0, rps)[0, 0])
-    change = udot * STEADY_WINDOW / speed
+    change = udot * window / speed
     if not math.isfinite(change) or abs(change) <= STEADY_SHARE:
         return None
     at = f" at {rps:.4g} rps" if rps is not None else ""
@@ -138,6 +143,6 @@ def unsteady_warning(model: ManoeuvringModel, speed: float, rps: float | None) -
     hint = (f"; its steady straight speed{at} is {steady:.4g} m/s" if steady
             else f"; it has no steady straight speed{at}")  # fmt: skip
     return (f"the approach at {speed:.4g} m/s{at} is not steady: the model's speed changes by "
-            f"{100 * change:+.0f} % in the first {STEADY_WINDOW:g} s{hint}, so the manoeuvre's "
+            f"{100 * change:+.0f} % in the first {window:.3g} s{hint}, so the manoeuvre's "
             "indices are those of a ship still "
             + ("accelerating" if change > 0 else "slowing down"))

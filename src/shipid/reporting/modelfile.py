@@ -700,6 +700,22 @@ def _scale_statistics(stats: dict, ratios: Mapping, factor: float, rho: float, t
                 x0[s] *= signal_scale(s, factor, rho, to_rho)
 
 
+def time_scale(doc: Mapping) -> float:
+    """How much slower the model file's ship lives than the one it was identified as: √λ for
+    every Froude rescaling by λ it went through (``rescaled_document``), 1 for none. A model's
+    judgements in seconds (is its approach steady over 10 s?) are made over so many times as
+    long, so that the rescaled model runs the same manoeuvres as its original (the one-file Esso
+    model carried to 300 m judged its approach over 10 s, a tenth of its original's window, and
+    started its 35° turn from another speed: tactical diameter 960 m against the original's
+    8.53 m × 100)."""
+    out = 1.0
+    for record in doc.get("scaling") or ():
+        factor = record.get("factor") if isinstance(record, Mapping) else None
+        if isinstance(factor, int | float) and math.isfinite(factor) and factor > 0:
+            out *= math.sqrt(factor)
+    return out
+
+
 def training_conditions(doc: Mapping) -> dict:
     """Approach speed, propeller speed and envelope of a model file's training logs."""
     ident = doc.get("identification") or {}
@@ -711,7 +727,8 @@ def training_conditions(doc: Mapping) -> dict:
            "log_scale": prep.get("log_scale"),
            "rudder_positive": prep.get("rudder_positive"),
            "yaw_rate_offset_deg_s": prep.get("yaw_rate_offset_deg_s"),
-           "dt": ident.get("dt") if isinstance(ident.get("dt"), int | float) else None}  # fmt: skip
+           "dt": ident.get("dt") if isinstance(ident.get("dt"), int | float) else None,
+           "time_scale": time_scale(doc)}  # fmt: skip
     if doc.get("particulars"):
         from shipid.data.particulars import Particulars
 
