@@ -334,6 +334,9 @@ def cmd_identify(args) -> int:
                                                  f"fails checks it passes ({lssvm_fails[0]})")
                 print(f"output error: kept; {prep['output_error']['turns']}")
             final, plausibility, notes = refinement.model, refined_report, refined_notes
+    if ensemble is not None and args.bootstrap is not None and hybrid is None:
+        _report_replicates(ensemble, _replicates_checked(
+            ensemble, plausibility, final, as_written, speed, rps, curvature), ident)
     if args.error_band is None and final is ident.model and len(raw_logs) >= 2:
         # By default, from two logs on: how far the free runs stray from a log left out.
         band, said = cv_band("logo")
@@ -387,6 +390,60 @@ def cmd_identify(args) -> int:
         _warn(w)
     print(f"model written to {args.output}")
     return 0
+
+
+def _replicates_checked(ensemble, report: dict, model, as_written, speed, rps, curvature
+                        ) -> dict:  # fmt: skip
+    """``members_plausibility`` of the bootstrap ``ensemble``: each replicate, as the model file
+    will have it, through the checks that rule a model out, counting those it fails where
+    ``model`` (its check ``report``) does not, by kind (a reason up to its details)."""
+    from shipid.identification.plausibility import disqualifying_checks, plausibility_at_approach
+    from shipid.identification.uncertainty import members_plausibility
+
+    passed = disqualifying_checks(report, model)
+
+    def reasons(member) -> list[str]:
+        written = as_written(member)
+        found = disqualifying_checks(plausibility_at_approach(
+            written, speed, rps, curvature=curvature)[0], written)  # fmt: skip
+        return [note.split(":")[0].split(" (")[0] for check, (severity, note) in found.items()
+                if severity > passed.get(check, (0, ""))[0]]  # fmt: skip
+
+    return members_plausibility(ensemble, reasons)
+
+
+def _report_replicates(ensemble, record: dict, ident) -> None:
+    """Keep ``record`` (``_replicates_checked``) with ``ensemble``, print it, and warn where
+    many replicates fail the checks."""
+    from shipid.identification.uncertainty import implausible_members_note
+
+    ensemble.plausibility = record
+    print(f"plausibility of {record['checked']} of the {ensemble.replicates} replicates: "
+          f"{record['implausible']} fail checks the model passes" + "".join(
+              f"; {why}: {count}" for why, count in list(record["reasons"].items())[:3]))
+    weak = implausible_members_note(record, ensemble.members_label)
+    if weak:
+        ident.warnings.append(f"bootstrap: {weak}")
+
+
+def _check_replicates(ensemble, report: dict, model, one_rps, logs, args, ident) -> None:
+    """``_report_replicates`` of select's ensemble, each replicate checked from the approach
+    its model was (``report``), as the model file will have it."""
+    from shipid.dynamics.similarity import rps_similar, similarity_map
+    from shipid.identification.plausibility import sharpest_curvature
+
+    def as_written(member):
+        if one_rps is None or not similarity_map(member.structure, one_rps).changes:
+            return member
+        return rps_similar(member, one_rps)
+
+    speed = args.speed if args.speed is not None else _approach(logs[0], "u")
+    rps = args.rps if args.rps is not None else (one_rps or _approach(logs[0], "n"))
+    if speed is None or not speed > 0:
+        return
+    curvature = sharpest_curvature(logs, speed)
+    _report_replicates(ensemble, _replicates_checked(ensemble, report, model, as_written, speed,
+                                                     rps, curvature), ident)  # fmt: skip
 
 
 def _similar_or_fitted(model, rps: float | None):
@@ -813,6 +870,7 @@ def cmd_select(args) -> int:
               f"{ensemble.resampling}; a term outside the model "
               "has value 0, inclusion the share of replicates that hold it):")  # fmt: skip
         print(table.to_markdown(index=False, floatfmt=".4g"))
+        _check_replicates(ensemble, plausibility, sel.model, one_rps, logs, args, ident)
     text = model_text(ident, args.logs, preprocessing=prep, plausibility=plausibility,
                       model=sel.model, selection=sel.to_dict(), particulars=_log_particulars(logs),
                       uncertainty=ensemble.to_dict() if ensemble else None)  # fmt: skip
@@ -825,7 +883,9 @@ def cmd_select(args) -> int:
             from shipid.data.io import write_table
 
             write_table(sel.candidates, args.table, out)
-    for w in sel.warnings:
+    # And those added here (the model as the file has it, the replicates, the speeds given):
+    # sel.warnings is the list select made.
+    for w in [*sel.warnings, *(w for w in ident.warnings if w not in sel.warnings)]:
         _warn(w)
     print(f"model written to {args.output}")
     return 0
