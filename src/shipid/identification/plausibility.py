@@ -342,9 +342,9 @@ GIVEN_SPEED_TOLERANCE = 1e-3
 
 def missed_steady_speed(model, speed: float, rps: float) -> str | None:
     """A warning where ``model`` (as the model file has it) does not hold the straight ``speed``
-    a user gave at ``rps`` (``--steady-speed``): the fit's equality holds on its own terms,
-    which the model file may carry to other rps, and a surge with no propeller term holds one
-    speed at every rps."""
+    a user gave at ``rps`` (``--steady-speed``; 0: none given): the fit's equality holds on the
+    fit's own terms, and what the file holds may differ from them (carried to every rps, a
+    kernel residual added, refined by output error)."""
     from shipid.dynamics.equilibrium import surge_equilibrium
 
     if not hasattr(model, "structure") or "u" not in model.structure.dofs:
@@ -353,9 +353,11 @@ def missed_steady_speed(model, speed: float, rps: float) -> str | None:
     if held is not None and abs(held - speed) <= GIVEN_SPEED_TOLERANCE * speed:
         return None
     where = "no steady speed" if held is None else f"{held:.4g} m/s"
-    return (f"--steady-speed {speed:.4g}@{rps:.4g}: the model holds {where} straight at "
-            f"{rps:.4g} rps, not the speed given (the fit's surge balances there on its own "
-            "terms; a surge without propeller-speed terms holds one speed at every rps)")
+    given, at = (f"{speed:.4g}@{rps:.4g}", f" at {rps:.4g} rps") if rps else (f"{speed:.4g}", "")
+    return (f"--steady-speed {given}: the model holds {where} straight{at}, not the speed given "
+            "(the fit's surge balances there on its own terms; the model file's may hold "
+            "another: a kernel residual added, a refinement, or a surge without propeller-speed "
+            "terms, which holds one speed at every rps)")
 
 
 # How badly a check fails, to compare two models check by check: a rudder held to a side that
