@@ -130,6 +130,14 @@ def test_unknown_output_extensions_are_refused_before_any_work(tmp_path, trial_c
     ["validate", "{model}", "{log}", "--json", "{model}"],
     ["simulate", "{model}", "{log}", "-o", "{log}"],
     ["import", "{log}", "-o", "{link}"],
+    # The prior and the particulars are read too: `identify LOG --prior m.json -o m.json`
+    # overwrote the prior with the fit.
+    ["identify", "{log}", "--prior", "{model}", "-o", "{model}"],
+    ["select", "{log}", "--prior", "{model}", "-o", "{model}"],
+    ["compare", "{log}", "--particulars", "{part}", "--json", "{part}"],
+    ["validate", "{model}", "{log}", "--particulars", "{part}", "--json", "{part}"],
+    ["criteria", "{model}", "--particulars", "{part}", "--json", "{part}"],
+    ["follow", "{model}", "--waypoints", "0,0;50,0", "--json", "{model}"],
 ])  # fmt: skip
 def test_an_output_that_is_an_input_is_refused_and_the_input_kept(tmp_path, trial_csv, capsys,
                                                                    cmd):  # fmt: skip
@@ -137,8 +145,10 @@ def test_an_output_that_is_an_input_is_refused_and_the_input_kept(tmp_path, tria
     assert run(["identify", trial_csv, "-o", model], capsys)[0] == 0
     link = tmp_path / "link.csv"
     link.symlink_to(trial_csv)
-    before = {p: p.read_bytes() for p in (trial_csv, model)}
-    argv = [a.format(log=trial_csv, model=model, link=link) for a in cmd]
+    part = tmp_path / "particulars.json"
+    part.write_text('{"length": 4.0, "beam": 0.6, "draught": 0.2}')
+    before = {p: p.read_bytes() for p in (trial_csv, model, part)}
+    argv = [a.format(log=trial_csv, model=model, link=link, part=part) for a in cmd]
     code, _, err = run(argv, capsys)
     assert code == 1 and "is also an input" in err and err.count("\n") == 1
     assert {p: p.read_bytes() for p in before} == before

@@ -176,6 +176,18 @@ def _parse_bounds(specs) -> dict[str, dict[str, tuple[float, float]]]:
     return out
 
 
+def _read_files(args, *given) -> list:
+    """The files a command reads besides its logs: ``given`` and the ``--particulars`` and
+    ``--prior`` files, for ``check_outputs`` to protect (``identify LOG --prior m.json -o
+    m.json`` overwrote the prior with the fit)."""
+    files = [g for g in given if g is not None]
+    for option in ("particulars", "prior"):
+        value = getattr(args, option, None)
+        if isinstance(value, str | Path) and str(value) != "clarke":
+            files.append(value)
+    return files
+
+
 def _one_rps(logs, args) -> float | None:
     """The propeller speed every training log runs at (their approach's, as the model file
     records it), where it is one and positive and the model is to be carried to the others by

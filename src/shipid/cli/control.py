@@ -11,6 +11,7 @@ from shipid.cli.common import (
     _json_text,
     _np,
     _pd,
+    _read_files,
     _run_approach,
     _ship_or_model,
     _steering,
@@ -116,12 +117,19 @@ def cmd_export(args) -> int:
     return 0
 
 
+def _model_inputs(args) -> list:
+    """The files autopilot and follow read: the model file (not a reference ship's name) and the
+    true ship's, where they are files (``follow m.json --json m.json`` overwrote the model)."""
+    names = [getattr(args, key, None) for key in ("model", "truth")]
+    return _read_files(args, *(n for n in names if n is not None and Path(n).is_file()))
+
+
 def cmd_autopilot(args) -> int:
     """``shipid autopilot``: heading step of a PID tuned on the model, run on model and truth."""
     from shipid.control.autopilot import heading_step
     from shipid.outputs import check_outputs
 
-    check_outputs({"-o": (args.output, "figure")}, [])
+    check_outputs({"-o": (args.output, "figure")}, _model_inputs(args))
     target, truth, speed, rps, steering, cond = _controlled(args)
     nm, pid = _tuned(target, speed, rps, args.omega)
     print(f"PID tuned on {args.model} (Nomoto K = {nm['K']:.4g} 1/s, T = {nm['T']:.4g} s): "
@@ -178,7 +186,8 @@ def cmd_follow(args) -> int:
     from shipid.control.autopilot import follow_path
     from shipid.outputs import OutputSet, check_outputs
 
-    check_outputs({"-o": (args.output, "figure"), "--json": (args.json, "json")}, [])
+    check_outputs({"-o": (args.output, "figure"), "--json": (args.json, "json")},
+                  _model_inputs(args))  # fmt: skip
     waypoints = _parse_waypoints(args.waypoints)  # before the model is loaded and run
     target, truth, speed, rps, steering, cond = _controlled(args)
     # A reference ship's length, else the model file's particulars', else the --truth ship's

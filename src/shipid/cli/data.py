@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from shipid.cli.common import _json_text, _read_logs, _warn
+from shipid.cli.common import _json_text, _read_files, _read_logs, _warn
 from shipid.errors import ShipidError
 
 
@@ -20,7 +20,7 @@ def cmd_plot(args) -> int:
     from shipid.outputs import check_outputs
     from shipid.reporting.plots import logs_figure
 
-    check_outputs({"-o": (args.output, "figure")}, args.logs)
+    check_outputs({"-o": (args.output, "figure")}, [*args.logs, *_read_files(args)])
     # One rudder convention on one axis: a port-positive and a starboard-positive log drew the
     # same rudder with opposite signs, side by side.
     logs, notes = common_rudder_convention(_read_logs(args))
@@ -38,7 +38,7 @@ def cmd_indices(args) -> int:
     from shipid.trials.indices import manoeuvre_indices
     from shipid.trials.trial import describe_trial
 
-    check_outputs({"--json": (args.json, "json")}, args.logs)
+    check_outputs({"--json": (args.json, "json")}, [*args.logs, *_read_files(args)])
     logs = _read_logs(args)
     out = []
     for path, log in zip(args.logs, logs, strict=True):
@@ -71,15 +71,16 @@ def cmd_import(args) -> int:
     # keeps its name with the extension of --ext.
     several = len(args.logs) > 1 or Path(args.output).is_dir()
     if several:
-        check_outputs({"-o": (args.output, "dir")}, args.logs)
+        check_outputs({"-o": (args.output, "dir")}, [*args.logs, *_read_files(args)])
         targets = [Path(args.output) / (Path(p).stem + args.ext) for p in args.logs]
-        check_outputs({f"-o {t.name}": (t, "log") for t in targets}, args.logs)
+        check_outputs({f"-o {t.name}": (t, "log") for t in targets},
+                      [*args.logs, *_read_files(args)])  # fmt: skip
         stems = [t.name for t in targets]
         dup = next((n for n in stems if stems.count(n) > 1), None)
         if dup:
             raise ShipidError(f"-o {args.output}: two inputs would both be written as {dup}")
     else:
-        check_outputs({"-o": (args.output, "log")}, args.logs)
+        check_outputs({"-o": (args.output, "log")}, [*args.logs, *_read_files(args)])
         targets = [Path(args.output)]
     logs = _read_logs(args)
     with OutputSet() as out:

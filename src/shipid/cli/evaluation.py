@@ -15,6 +15,7 @@ from shipid.cli.common import (
     _particulars,
     _pd,
     _print_yaw_rate_offsets,
+    _read_files,
     _read_options,
     _sampling_notes,
     _scale_notes,
@@ -59,7 +60,8 @@ def cmd_validate(args) -> int:
     )
 
     check_outputs({"--json": (args.json, "json"), "--plots": (args.plots, "dir"),
-                   "--report": (args.report, "dir")}, [args.model, *args.logs])  # fmt: skip
+                   "--report": (args.report, "dir")},
+                  [args.model, *args.logs, *_read_files(args)])  # fmt: skip
     doc = load_document(args.model)
     if args.lssvm and not has_refinement(doc):
         _warn(f"{args.model} has no refinement: its model is the LS-SVM one, which --lssvm "
@@ -351,7 +353,7 @@ def cmd_simulate(args) -> int:
     from shipid.outputs import check_outputs
 
     log_path = args.log
-    check_outputs({"-o": (args.output, "log")}, [args.model, log_path])
+    check_outputs({"-o": (args.output, "log")}, [args.model, log_path, *_read_files(args)])
     from shipid.data.log import in_rudder_convention
 
     target, cond = _ship_or_model(args.model, hybrid=True)

@@ -21,6 +21,7 @@ from shipid.cli.common import (
     _parse_gammas,
     _pd,
     _physics,
+    _read_files,
     _std_errors,
     _structure,
     _structure_edit,
@@ -99,7 +100,7 @@ def cmd_identify(args) -> int:
     from shipid.outputs import atomic_write_text, check_outputs
     from shipid.reporting.modelfile import model_text
 
-    check_outputs({"-o": (args.output, "json")}, args.logs)
+    check_outputs({"-o": (args.output, "json")}, [*args.logs, *_read_files(args)])
     if args.bootstrap is not None and args.refine:
         raise ShipidError("--bootstrap describes the LS-SVM fit; it does not go with --refine")
     asked = args.output_error == "always"
@@ -768,7 +769,8 @@ def cmd_select(args) -> int:
     from shipid.outputs import OutputSet, check_outputs
     from shipid.reporting.modelfile import model_text
 
-    check_outputs({"-o": (args.output, "json"), "--table": (args.table, "log")}, args.logs)
+    check_outputs({"-o": (args.output, "json"), "--table": (args.table, "log")},
+                  [*args.logs, *_read_files(args)])  # fmt: skip
     # The options logs do not decide, checked before the logs are read.
     parse_cv(args.cv)
     gammas = _parse_gammas(args.gammas)
@@ -925,7 +927,7 @@ def cmd_compare(args) -> int:
     from shipid.identification.estimators import BLACK_BOX_ESTIMATORS
     from shipid.outputs import OutputSet, check_outputs
 
-    check_outputs({"--json": (args.json, "json")}, args.logs)
+    check_outputs({"--json": (args.json, "json")}, [*args.logs, *_read_files(args)])
     methods = [m.strip() for m in args.methods.split(",") if m.strip()]
     logs = _training_logs(args)
     names = [Path(p).name for p in args.logs]

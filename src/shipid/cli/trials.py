@@ -14,6 +14,7 @@ from shipid.cli.common import (
     _check_scale,
     _json_text,
     _pd,
+    _read_files,
     _run_approach,
     _ship_or_model,
     _simulated_metadata,
@@ -66,7 +67,7 @@ def cmd_criteria(args) -> int:
     from shipid.trials.criteria import imo_criteria
 
     check_outputs({"--json": (args.json, "json")},
-                  [args.model] if Path(args.model).exists() else [])  # fmt: skip
+                  _read_files(args, args.model if Path(args.model).exists() else None))
     target, cond = _ship_or_model(args.model, hybrid=True)
     particulars = read_particulars(args.particulars) if args.particulars else cond["particulars"]
     if args.length:
@@ -258,7 +259,7 @@ def cmd_manoeuvre(args) -> int:
     )
 
     check_outputs({"--json": (args.json, "json"), "-o": (args.output, "log")},
-                  [args.model] if Path(args.model).exists() else [])  # fmt: skip
+                  _read_files(args, args.model if Path(args.model).exists() else None))
     target, cond = _ship_or_model(args.model, hybrid=True)
     speed, rps, unsteady = _run_approach(target, cond, args.speed, args.rps)
     steering, rudder_note = _steering(target, cond, args.rudder_rate)
