@@ -121,6 +121,10 @@ def test_varied_structure_members_file_and_rescale(zigzags, tmp_path, capsys):
     doc = json.loads((tmp_path / "m.json").read_text(encoding="utf-8"))
     model = model_from_document(doc, "m.json")
     ens = ensemble_from_document(doc, "m.json", model)
+    # Its replicates through the checks, as identify's: counted, kept, printed.
+    record = doc["uncertainty"]["plausibility"]
+    assert record["checked"] == 40 and ens.plausibility == record
+    assert f"plausibility of 40 of the 40 replicates: {record['implausible']} fail" in out
     shares = [c for c in doc["identification"]["selection"]["candidates"] if c["share"] > 0]
     assert sum(c["share"] for c in shares) == pytest.approx(1.0)
     assert len(shares) > 1 and ens.varies_structure  # these logs leave the choice open

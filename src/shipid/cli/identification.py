@@ -393,11 +393,12 @@ def cmd_identify(args) -> int:
     return 0
 
 
-def _replicates_checked(ensemble, report: dict, model, as_written, speed, rps, curvature
-                        ) -> dict:  # fmt: skip
+def _replicates_checked(ensemble, report: dict, model, as_written, speed, rps, curvature,
+                        given: tuple = (None, None)) -> dict:  # fmt: skip
     """``members_plausibility`` of the bootstrap ``ensemble``: each replicate, as the model file
-    will have it, through the checks that rule a model out, counting those it fails where
-    ``model`` (its check ``report``) does not, by kind (a reason up to its details)."""
+    will have it, through the checks that rule a model out (from the approach ``model``'s were:
+    ``speed``, ``rps``, or the ``given`` speed and rps), counting those it fails where ``model``
+    (its check ``report``) does not, by kind (a reason up to its details)."""
     from shipid.identification.plausibility import disqualifying_checks, plausibility_at_approach
     from shipid.identification.uncertainty import members_plausibility
 
@@ -406,7 +407,7 @@ def _replicates_checked(ensemble, report: dict, model, as_written, speed, rps, c
     def reasons(member) -> list[str]:
         written = as_written(member)
         found = disqualifying_checks(plausibility_at_approach(
-            written, speed, rps, curvature=curvature)[0], written)  # fmt: skip
+            written, speed, rps, *given, curvature=curvature)[0], written)  # fmt: skip
         return [note.split(":")[0].split(" (")[0] for check, (severity, note) in found.items()
                 if severity > passed.get(check, (0, ""))[0]]  # fmt: skip
 
@@ -430,21 +431,16 @@ def _report_replicates(ensemble, record: dict, ident) -> None:
 def _check_replicates(ensemble, report: dict, model, one_rps, logs, args, ident) -> None:
     """``_report_replicates`` of select's ensemble, each replicate checked from the approach
     its model was (``report``), as the model file will have it."""
-    from shipid.dynamics.similarity import rps_similar, similarity_map
     from shipid.identification.plausibility import sharpest_curvature
 
-    def as_written(member):
-        if one_rps is None or not similarity_map(member.structure, one_rps).changes:
-            return member
-        return rps_similar(member, one_rps)
-
-    speed = args.speed if args.speed is not None else _approach(logs[0], "u")
-    rps = args.rps if args.rps is not None else (one_rps or _approach(logs[0], "n"))
+    speed = _approach(logs[0], "u")
+    rps = one_rps or _approach(logs[0], "n")
     if speed is None or not speed > 0:
         return
     curvature = sharpest_curvature(logs, speed)
-    _report_replicates(ensemble, _replicates_checked(ensemble, report, model, as_written, speed,
-                                                     rps, curvature), ident)  # fmt: skip
+    _report_replicates(ensemble, _replicates_checked(
+        ensemble, report, model, lambda member: _similar_or_fitted(member, one_rps), speed, rps,
+        curvature, (args.speed, args.rps)), ident)  # fmt: skip
 
 
 def _similar_or_fitted(model, rps: float | None):
@@ -849,10 +845,8 @@ def cmd_select(args) -> int:
     ident.warnings.extend(f"plausibility: {n}" for n in notes)
     from shipid.identification.plausibility import given_steady_speeds, missed_steady_speed
 
-    written = rps_similar(sel.model, one_rps) if one_rps is not None and \
-        similarity_map(sel.model.structure, one_rps).changes else sel.model  # fmt: skip
     for u, n in given_steady_speeds(physics):
-        missed = missed_steady_speed(written, u, n)
+        missed = missed_steady_speed(_similar_or_fitted(sel.model, one_rps), u, n)
         if missed:
             ident.warnings.append(missed)
     prep = _log_record(args, logs)
