@@ -198,8 +198,8 @@ class Ensemble:
 # zig-zag of the paper's ship: none; the KVLCC2's MARIN zig-zag with the README's physics: 3 %).
 WEAK_REPLICATES = 0.10
 # Replicates checked at most: the replicates are independent draws, so the first ones are a
-# sample of them; 40 put a share of 70 % within ±7 % (one standard error) at 0.7–1.6 s (a
-# check costs 17–40 ms, eight times a replicate's refit on the demo's log).
+# sample of them; 40 put a share of 70 % within ±7 % (one standard error) at 0.5–1.9 s (a
+# check costs 12–46 ms, seven times a replicate's refit on the demo's log).
 CHECKED_REPLICATES = 40
 
 
