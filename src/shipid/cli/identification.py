@@ -803,7 +803,9 @@ def cmd_select(args) -> int:
         wider, said = widened_selection(sel, logs, names, options, edit,
                                         announce=lambda m: print(m, file=sys.stderr))
         if wider is not None:
-            sel = wider[0]
+            sel, apart = wider[0], wider[3]
+            if apart:
+                sel.identification.warnings.append(f"library: {apart}")
         for note in said:  # the model file's selection record names the library searched
             print(f"library: {note}")
     ident = sel.identification

@@ -214,17 +214,18 @@ def _auto_structure(logs, names, physics, cv, estimator, drop, announce) -> Stru
     except ShipidError as exc:  # too little data to hold logs out, say
         return StructureChoice(get_structure(fallback), "named", reasons,
                                notes=[f"select found no structure ({exc}); {fallback} instead"])
-    widening = []
+    widening, apart = [], None
     if sel.best_ruled_out:
         wider, widening = widened_selection(
             sel, logs, names, SelectOptions(cv=cv, physics=physics, estimator=estimator), drop,
             announce)  # fmt: skip
         if wider is not None:
-            sel, library_name, note = wider
+            sel, library_name, note, apart = wider
     crossflow = _crossflow_selection(sel, logs, names, library, drop, SelectOptions(
         cv=cv, physics=physics, estimator=estimator), announce)  # fmt: skip
     if crossflow is not None:
         sel, library_name = crossflow, f"{library_name} with the hull's cross-flow drag"
+        apart = None  # said of a choice the cross-flow search replaced
     why = None
     if not _chosen_passes(sel):
         why = (f"none of select's {len(sel.candidates)} candidates from its default library is "
@@ -248,7 +249,8 @@ def _auto_structure(logs, names, physics, cv, estimator, drop, announce) -> Stru
                            candidates=len(sel.candidates),
                            notes=([note] if note else []) + widening,
                            warnings=[w for w in sel.warnings
-                                     if not w.startswith(("u: ", "v: ", "r: "))])  # fmt: skip
+                                     if not w.startswith(("u: ", "v: ", "r: "))]
+                           + ([apart] if apart else []))  # fmt: skip
 
 
 # The most logs the default's ``select`` path also searches the library with the hull's
@@ -312,9 +314,10 @@ def widened_selection(sel, logs, names, options, drop=None, announce=_quiet):
     ``WIDENING``, for logs whose best-scoring candidate from the default library the
     plausibility checks rule out (``sel.best_ruled_out``): the logs then prefer what physics
     rejects, a sign that the library lacks what the ship does beyond them. ((selection, library
-    name, note) where its chosen candidate is plausible and predicts the held-out logs better
-    than ``sel``'s, else None; the notes that say so). ``identify``'s default and ``shipid
-    select`` without ``--library`` widen so."""
+    name, note, warning) where its chosen candidate is plausible and predicts the held-out logs
+    better than ``sel``'s, else None; the notes that say so). The warning (or None): where both
+    choices pass the checks and turn far apart (``_held_turns_apart``). ``identify``'s default
+    and ``shipid select`` without ``--library`` widen so."""
     import dataclasses
 
     from shipid.identification.select import DEFAULT_LIBRARY, default_library, select
@@ -341,9 +344,37 @@ def widened_selection(sel, logs, names, options, drop=None, announce=_quiet):
     better = (f"predicts the held-out logs better (score {wide.score:.4f} against "
               f"{sel.score:.4f})" if _chosen_passes(sel) else "passes the checks, where the "
               "default library's chosen candidate does not")  # fmt: skip
-    return (wide, label, note), [
+    apart = _held_turns_apart(sel, wide) if _chosen_passes(sel) else None
+    return (wide, label, note, apart), [
         f"{why}, so the library is widened by {WIDENING} (the rudder's lift in the propeller's "
         f"race at the hull's drift), whose choice {better}"]
+
+
+def _held_turns_apart(narrow, wide) -> str | None:
+    """A warning where the default library's choice (``narrow``, plausible too) and the widened
+    one's (``wide``) turn their held 35° turns far apart (``rates_apart``): the logs score the
+    widened choice better inside their range and cannot show which turn holds. From the Esso's
+    nine zig-zags at 0.1 s given 0.35 m/s at 10 rps, the widened choice (CV score 0.370 against
+    0.424) turned its 35° turns +91 % and +85 % wide, the default library's +33 % and +5 %
+    (``benchmarks/study_sampling.py``); on the tanker the widening brought them from 37–41 %
+    short to within 5 % (``study_tanker.py``)."""
+    sides = []
+    for side in ("starboard", "port"):
+        entries = [((x.plausibility or {}).get("held_rudder") or {}).get(side) or {}
+                   for x in (narrow, wide)]  # fmt: skip
+        rates = [e.get("steady_yaw_rate") if e.get("settled") and not e.get("diverged") else None
+                 for e in entries]  # fmt: skip
+        if any(r is None for r in rates) or not rates_apart(rates):
+            continue
+        radii = [e["steady_speed"] / abs(r) for e, r in zip(entries, rates, strict=True)]
+        sides.append(f"{side} {radii[0]:.3g} m against {radii[1]:.3g} m")
+    if not sides:
+        return None
+    rudder = (narrow.plausibility or {}).get("rudder_deg", 35.0)
+    return (f"the default library's choice and the widened one turn their held {rudder:g}° turns "
+            f"far apart (path radii {', '.join(sides)}): the logs score the widened choice "
+            "better where they run, and cannot show which turn holds beyond them; validate on a "
+            "turning log, or train on one")
 
 
 def _chosen_passes(selection) -> bool:
