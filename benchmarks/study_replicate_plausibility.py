@@ -30,17 +30,19 @@ from shipid.cli import main as shipid
 ROOT = Path(__file__).resolve().parents[1]
 SHARED = ROOT.parent / "shared" / "data"
 REPLICATES = 100
+CHECKED = cli_identification._replicates_checked
+DEFAULT_LIMIT = uncertainty.CHECKED_REPLICATES
 
 
-def identify(args: list[str], out: Path, count: bool = True, limit: int = 40
+def identify(args: list[str], out: Path, count: bool = True, limit: int = DEFAULT_LIMIT
              ) -> tuple[dict, float]:  # fmt: skip
     """The model file's replicate record after ``identify ARGS --bootstrap`` and the wall time;
+    ``limit``: how many replicates the count checks (identify's own, or all for the share);
     ``count`` False: the same run with the count skipped (its cost is the difference)."""
     if not count:
         cli_identification._replicates_checked = lambda *a, **k: {
             "checked": 0, "implausible": 0, "reasons": {}}
-    uncertainty.CHECKED_REPLICATES = limit
-    uncertainty.members_plausibility.__defaults__ = (limit,)
+    uncertainty.members_plausibility.__defaults__ = (limit,)  # the count's limit, this run
     t0 = time.perf_counter()
     try:
         with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
@@ -54,13 +56,9 @@ def identify(args: list[str], out: Path, count: bool = True, limit: int = 40
     return json.loads(out.read_text())["uncertainty"].get("plausibility") or {}, took
 
 
-CHECKED = cli_identification._replicates_checked
-DEFAULT_LIMIT = uncertainty.CHECKED_REPLICATES
-
-
 def row(name: str, args: list[str], out: Path) -> dict:
     record = identify(args, out, limit=REPLICATES)[0]  # all of them, for the share
-    with_count = identify(args, out)[1]  # as identify counts: the first 40
+    with_count = identify(args, out)[1]  # as identify counts: the first DEFAULT_LIMIT
     _, without = identify(args, out, count=False)
     reasons = "; ".join(f"{k} ({v})" for k, v in list(record["reasons"].items())[:3]) or "–"
     print(f"| {name} | {record['implausible']} of {record['checked']} | {reasons} | "
