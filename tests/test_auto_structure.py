@@ -519,7 +519,7 @@ def test_criteria_give_the_tied_structures_values_beside_the_models(mmg_tied, tm
 
 def test_a_widened_choice_that_turns_far_from_the_default_librarys_is_named():
     """The Esso's nine zig-zags at 0.1 s given 0.35 m/s at 10 rps: the widened library's choice
-    scored the held-out zig-zags better and turned its 35° turns 85–91 % wide where the default
+    scored the held-out zig-zags better and turned its 35° turns 85–92 % wide where the default
     library's (plausible too) turned 5–33 %: the held turns' paths say so where both pass."""
     from types import SimpleNamespace
 
