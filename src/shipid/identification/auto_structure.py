@@ -355,9 +355,9 @@ def _held_turns_apart(narrow, wide) -> str | None:
     one's (``wide``) turn their held 35° turns far apart (``rates_apart``): the logs score the
     widened choice better inside their range and cannot show which turn holds. From the Esso's
     nine zig-zags at 0.1 s given 0.35 m/s at 10 rps, the widened choice (CV score 0.370 against
-    0.424) turned its 35° turns +91 % and +85 % wide, the default library's +33 % and +5 %
-    (``benchmarks/study_sampling.py``); on the tanker the widening brought them from 37–41 %
-    short to within 5 % (``study_tanker.py``)."""
+    0.424) turned its 35° turns +92 % and +85 % wide (``benchmarks/study_sampling.py``), the
+    default library's +33 % and +5 % (ad hoc); on the tanker the widening brought them from
+    37–41 % short to within 5 % (``study_tanker.py``)."""
     sides = []
     for side in ("starboard", "port"):
         entries = [((x.plausibility or {}).get("held_rudder") or {}).get(side) or {}
