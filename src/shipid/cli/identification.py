@@ -800,12 +800,12 @@ def cmd_select(args) -> int:
 
         # As identify's default: where the logs' best fit from the default library is ruled out
         # by the checks, the search again with the rudder's lift at the hull's drift.
-        wider, said = widened_selection(sel, logs, names, options, edit,
-                                        announce=lambda m: print(m, file=sys.stderr))
+        wider, said, apart = widened_selection(sel, logs, names, options, edit,
+                                               announce=lambda m: print(m, file=sys.stderr))
         if wider is not None:
-            sel, apart = wider[0], wider[3]
-            if apart:
-                sel.identification.warnings.append(f"library: {apart}")
+            sel = wider[0]
+        if apart:
+            sel.identification.warnings.append(f"library: {apart}")
         for note in said:  # the model file's selection record names the library searched
             print(f"library: {note}")
     ident = sel.identification
