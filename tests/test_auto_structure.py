@@ -536,3 +536,18 @@ def test_the_held_turns_of_two_choices_are_compared_by_their_paths():
         "starboard 3.75 m against 5.45 m, port 3.75 m against 5.45 m")
     # Yaw rates within TURNS_APART (1.25) of each other: nothing to say.
     assert _held_turns_apart(narrow, selection(0.32, 0.070)) is None
+
+
+def test_a_turn_among_the_logs_lets_the_scores_decide_how_the_model_turns():
+    """The widened choice is kept over the default library's, where both pass and turn apart,
+    only when a training log is a held turn: its free run is then scored (the tanker's 35°
+    turn decided for the widened choice, 1 % off against 18 %)."""
+    from test_turning_replica import turning_log
+
+    from shipid.identification.auto_structure import _logs_hold_a_turn
+    from shipid.trials.manoeuvres import zigzag
+    from shipid.vessels import scale_ship
+
+    zz = zigzag(scale_ship(), 20, 20, duration=60, dt=0.2).log
+    assert not _logs_hold_a_turn([zz])
+    assert _logs_hold_a_turn([zz, turning_log("port")])
