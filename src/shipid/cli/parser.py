@@ -265,7 +265,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--bootstrap", type=int, metavar="N",
                    help="uncertainty: N bootstrap refits (≥ 10; e.g. 200; --block), stored in "
                    "the model file: coefficient intervals here, prediction bands and index "
-                   "intervals in validate, manoeuvre and criteria")
+                   "intervals in validate, manoeuvre and criteria; the first 40 replicates "
+                   "run through the plausibility checks, and how many fail is said")
     _add_block_option(p)
     p.add_argument("--seed", type=int, default=0, help="with --bootstrap or --output-error: "
                    "random seed "
@@ -325,7 +326,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="uncertainty of the selected model: N replicates (≥ 10), each a "
                    "candidate drawn by how often it is chosen on resampled held-out logs, "
                    "refitted on a resample (--block); stored in the model file for bands "
-                   "and intervals")
+                   "and intervals; the first 40 run through the plausibility checks")
     _add_block_option(p)
     p.add_argument("--seed", type=int, default=0, help="with --bootstrap: random seed "
                    "(default %(default)s)")
