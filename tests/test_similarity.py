@@ -310,3 +310,20 @@ def test_bounds_with_an_open_side_are_carried(one_rps, tmp_path, capsys):
     assert bounds["u"] == {"v*r": [0.5, None]}
     assert bounds["v"]["n^2*delta"] == [pytest.approx(0.01 / N0**2, rel=1e-12), None]
     assert bounds["r"] == {"n^2*delta": [None, 0.0]}
+
+
+def test_select_checks_its_one_rps_model_as_the_file_has_it_crash_stop_too(one_rps, tmp_path,
+                                                                            capsys):  # fmt: skip
+    """select re-checks the model it writes from logs at one rps as similarity carries it; that
+    report lost the crash stop its own check of the fit had (identify's kept it)."""
+    log = one_rps["similar"].parent / "zz.csv"
+    out = tmp_path / "sel.json"
+    code, _, err = run(["select", log, "--library", "blanke", "--cv", "blocks:3", "--quiet", "-o",
+                        out], capsys)  # fmt: skip
+    assert code == 0, err
+    doc = json.loads(out.read_text())
+    assert doc["model"]["similar_at_rps"] == pytest.approx(N0)
+    astern = doc["identification"]["plausibility"]["astern"]
+    # This fit diverges going astern (its logs never do), and says so.
+    assert astern["diverged"] is True
+    assert "(a crash stop)" in err and "the model is not for going astern" in err

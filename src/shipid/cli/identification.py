@@ -398,7 +398,7 @@ def _replicates_checked(ensemble, report: dict, model, as_written, speed, rps, c
     """``members_plausibility`` of the bootstrap ``ensemble``: each replicate, as the model file
     will have it, through the checks that rule a model out (from the approach ``model``'s were:
     ``speed``, ``rps``, or the ``given`` speed and rps), counting those it fails where ``model``
-    (its check ``report``) does not, by kind (a reason up to its details)."""
+    (its check ``report``) does not, by reason."""
     from shipid.identification.plausibility import disqualifying_checks, plausibility_at_approach
     from shipid.identification.uncertainty import members_plausibility
 
@@ -408,7 +408,7 @@ def _replicates_checked(ensemble, report: dict, model, as_written, speed, rps, c
         written = as_written(member)
         found = disqualifying_checks(plausibility_at_approach(
             written, speed, rps, *given, curvature=curvature)[0], written)  # fmt: skip
-        return [note.split(":")[0].split(" (")[0] for check, (severity, note) in found.items()
+        return [note for check, (severity, note) in found.items()
                 if severity > passed.get(check, (0, ""))[0]]  # fmt: skip
 
     return members_plausibility(ensemble, reasons)
@@ -540,13 +540,11 @@ def _turns_apart(lssvm: dict, refined: dict) -> str | None:
     (``auto_structure.rates_apart``), or None; a turn that diverges or never settles has no
     steady yaw rate, and sides where neither turns steadily are left to the plausibility
     checks."""
-    from shipid.identification.auto_structure import rates_apart
+    from shipid.identification.auto_structure import rates_apart, settled_yaw_rates
 
     shown = []
     for side in ("starboard", "port"):
-        rates = [e.get("steady_yaw_rate") if e.get("settled") and not e.get("diverged") else None
-                 for e in ((report.get("held_rudder") or {}).get(side, {})
-                           for report in (lssvm, refined))]  # fmt: skip
+        rates = settled_yaw_rates((lssvm, refined), side)
         if all(r is None for r in rates):
             continue
         shown.append(f"{side} " + " against ".join(
@@ -841,9 +839,10 @@ def cmd_select(args) -> int:
         )
 
         speed = _approach(logs[0], "u")
+        # With the crash stop, as select's own report of the fit has it.
         plausibility, notes = plausibility_at_approach(
             rps_similar(sel.model, one_rps), speed, one_rps,
-            curvature=sharpest_curvature(logs, speed))  # fmt: skip
+            curvature=sharpest_curvature(logs, speed), astern=True)  # fmt: skip
     ident.warnings.extend(f"plausibility: {n}" for n in notes)
     from shipid.identification.plausibility import given_steady_speeds, missed_steady_speed
 
