@@ -181,24 +181,34 @@ def turn_with_other(zig_files, turns: dict) -> None:
     print("|---|---|---|---|")
     files = list(turns)
     results: dict[str, list[tuple[float, float]]] = {"alone": [], "with": []}
+
+    def held_out(model_path: str, held) -> tuple[float, float]:
+        v = validate(load_model(model_path), turns[held], start_draws=False)[0]
+        m, c = v.indices["measured"], v.indices.get("closed_loop") or {}
+        try:
+            return (100 * (c["tactical_diameter"] / m["tactical_diameter"] - 1),
+                    c["steady_speed"] / m["steady_speed"])  # fmt: skip
+        except (KeyError, TypeError):
+            return np.inf, np.nan
+
+    def cell(label: str, judged: tuple[float, float] | None) -> str:
+        if judged is None:
+            return "failed"
+        results[label].append(judged)
+        td, speed = judged
+        return "no turn" if not np.isfinite(td) else f"{td:+.0f} %, {speed:.2f}"
+
     with tempfile.TemporaryDirectory() as tmp:
         out = f"{tmp}/m.json"
         for z in zig_files:
+            # The file alone is one model, judged on each turn (fitted once, not per turn).
+            alone = ({held: held_out(out, held) for held in files}
+                     if _fit(["identify", "--format", "osaka-frt", str(z)], out) else None)
             for trained, held in ((files[0], files[1]), (files[1], files[0])):
-                cells = []
-                for label, train in (("alone", [z]), ("with", [z, trained])):
-                    if not _fit(["identify", "--format", "osaka-frt", *map(str, train)], out):
-                        cells.append("failed")
-                        continue
-                    v = validate(load_model(out), turns[held], start_draws=False)[0]
-                    m, c = v.indices["measured"], v.indices.get("closed_loop") or {}
-                    try:
-                        td = 100 * (c["tactical_diameter"] / m["tactical_diameter"] - 1)
-                        speed = c["steady_speed"] / m["steady_speed"]
-                    except (KeyError, TypeError):
-                        td, speed = np.inf, np.nan
-                    results[label].append((td, speed))
-                    cells.append("no turn" if not np.isfinite(td) else f"{td:+.0f} %, {speed:.2f}")
+                with_turn = (held_out(out, held) if _fit(
+                    ["identify", "--format", "osaka-frt", str(z), str(trained)], out) else None)
+                cells = [cell("alone", None if alone is None else alone[held]),
+                         cell("with", with_turn)]  # fmt: skip
                 print(f"| {z.stem[-8:]} | {held.stem[-8:]} | {' | '.join(cells)} |", flush=True)
     print()
     for label, rows in results.items():
