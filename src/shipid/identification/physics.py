@@ -288,9 +288,11 @@ def still_air(u, v, delta, n) -> dict[str, np.ndarray]:
     it with no true wind and the closed loop and ``surge_equilibrium`` run the model. (A
     steady-speed equality with the wind's terms at 0 put a wind model's straight run off the
     speed it was given.)"""
-    u, v = np.asarray(u, dtype=float), np.asarray(v, dtype=float)
+    from shipid.data.log import relative_wind
+
+    speed, angle = relative_wind(u, v, 0.0, (0.0, 0.0))
     return {"delta": np.asarray(delta, dtype=float), "n": np.asarray(n, dtype=float),
-            "wind_speed": np.hypot(u, v), "wind_angle": np.arctan2(v, u)}
+            "wind_speed": speed, "wind_angle": angle}
 
 
 def _straight_running_slopes(texts: Sequence[str], u0: float, n0: float,
