@@ -42,14 +42,14 @@ def identify(args: list[str], out: Path, count: bool = True, limit: int = DEFAUL
     if not count:
         cli_identification._replicates_checked = lambda *a, **k: {
             "checked": 0, "implausible": 0, "reasons": {}}
-    uncertainty.members_plausibility.__defaults__ = (limit,)  # the count's limit, this run
+    uncertainty.CHECKED_REPLICATES = limit  # the count's limit, this run
     t0 = time.perf_counter()
     try:
         with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
             code = shipid(["identify", *args, "--bootstrap", str(REPLICATES), "-o", str(out)])
     finally:
         cli_identification._replicates_checked = CHECKED
-        uncertainty.members_plausibility.__defaults__ = (DEFAULT_LIMIT,)
+        uncertainty.CHECKED_REPLICATES = DEFAULT_LIMIT
     took = time.perf_counter() - t0
     if code:
         raise SystemExit(f"identify {' '.join(args)} failed")

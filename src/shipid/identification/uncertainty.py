@@ -204,13 +204,13 @@ CHECKED_REPLICATES = 40
 
 
 def members_plausibility(ensemble: Ensemble, reasons: Callable[[ManoeuvringModel], list[str]],
-                         limit: int = CHECKED_REPLICATES) -> dict:  # fmt: skip
-    """How many of ``ensemble``'s first ``limit`` members fail the checks (``reasons(member)``:
-    the reasons that rule a model out, ``shipid.identification.plausibility.disqualifying``),
-    and the first reason of each, counted: {"checked", "implausible", "reasons": {reason:
-    count}}."""
+                         limit: int | None = None) -> dict:  # fmt: skip
+    """How many of ``ensemble``'s first ``limit`` (default ``CHECKED_REPLICATES``) members
+    fail the checks (``reasons(member)``: the reasons that rule a model out,
+    ``shipid.identification.plausibility.disqualifying``), and the first reason of each,
+    counted: {"checked", "implausible", "reasons": {reason: count}}."""
     counted: dict[str, int] = {}
-    members = ensemble.members()[:limit]
+    members = ensemble.members()[:CHECKED_REPLICATES if limit is None else limit]
     for member in members:
         found = reasons(member)
         if found:
