@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from cli_helpers import run
+from cli_helpers import copy_identified, identify_in, run
 
 from shipid.cli import main
 from shipid.data.io import write_log
@@ -28,12 +28,26 @@ def trial():
     return zigzag(SHIP, 20, 20, duration=90, dt=0.2, method="euler", approach=2.0).log
 
 
+@pytest.fixture(scope="module")
+def identified(tmp_path_factory, trial):
+    folder = tmp_path_factory.mktemp("identified")
+    write_log(trial, folder / "zz.csv")
+    return identify_in(folder)
+
+
 @pytest.fixture()
-def files(tmp_path, trial, capsys):
-    log = write_log(trial, tmp_path / "zz.csv")
-    model = tmp_path / "m.json"
-    assert run(["identify", log, "-o", model], capsys)[0] == 0
-    return log, model
+def files(tmp_path, identified):
+    """The trial and its model by plain identify, in the test's own folder."""
+    return copy_identified(identified, tmp_path)
+
+
+def test_a_copied_identify_run_is_the_run_in_its_folder(tmp_path, identified, capsys):
+    """What ``files`` rests on: identify run in the test's folder writes, byte for byte, the
+    copy of the module's run (its training log's path moved with it)."""
+    log, copied = copy_identified(identified, tmp_path)
+    assert run(["identify", log, "-o", tmp_path / "own.json"], capsys)[0] == 0
+    assert (tmp_path / "own.json").read_bytes() == copied.read_bytes()
+    assert str(log) in copied.read_text() and str(identified) not in copied.read_text()
 
 
 def one_line_error(code, err, match=None):

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from cli_helpers import run
+from cli_helpers import copy_identified, identify_in, run
 
 from shipid.data.io import read_log, write_log
 from shipid.errors import ShipidError
@@ -203,10 +203,17 @@ def test_a_failed_multi_output_command_leaves_no_files(tmp_path, trial_csv, caps
 
 
 # ---------------------------------------------------------------------------- 18, 23: model files
+@pytest.fixture(scope="module")
+def identified(tmp_path_factory, trial):
+    folder = tmp_path_factory.mktemp("identified")
+    write_log(trial, folder / "zz.csv")
+    return identify_in(folder)
+
+
 @pytest.fixture()
-def model_doc(tmp_path, trial_csv, capsys):
-    model = tmp_path / "m.json"
-    assert run(["identify", trial_csv, "-o", model], capsys)[0] == 0
+def model_doc(tmp_path, trial_csv, identified):
+    """The trial's model by plain identify (``trial_csv`` is the same log in the same folder)."""
+    _, model = copy_identified(identified, tmp_path)
     return model, json.loads(model.read_text())
 
 
