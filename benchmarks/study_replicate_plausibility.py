@@ -23,14 +23,14 @@ from pathlib import Path
 
 from esso_logs import DATA
 
-import shipid.cli.identification as cli_identification
+import shipid.cli.identify as cli_identify
 import shipid.identification.uncertainty as uncertainty
 from shipid.cli import main as shipid
 
 ROOT = Path(__file__).resolve().parents[1]
 SHARED = ROOT.parent / "shared" / "data"
 REPLICATES = 100
-CHECKED = cli_identification._replicates_checked
+CHECKED = cli_identify._replicates_checked
 DEFAULT_LIMIT = uncertainty.CHECKED_REPLICATES
 
 
@@ -40,7 +40,7 @@ def identify(args: list[str], out: Path, count: bool = True, limit: int = DEFAUL
     ``limit``: how many replicates the count checks (identify's own, or all for the share);
     ``count`` False: the same run with the count skipped (its cost is the difference)."""
     if not count:
-        cli_identification._replicates_checked = lambda *a, **k: {
+        cli_identify._replicates_checked = lambda *a, **k: {
             "checked": 0, "implausible": 0, "reasons": {}}
     uncertainty.CHECKED_REPLICATES = limit  # the count's limit, this run
     t0 = time.perf_counter()
@@ -48,7 +48,7 @@ def identify(args: list[str], out: Path, count: bool = True, limit: int = DEFAUL
         with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
             code = shipid(["identify", *args, "--bootstrap", str(REPLICATES), "-o", str(out)])
     finally:
-        cli_identification._replicates_checked = CHECKED
+        cli_identify._replicates_checked = CHECKED
         uncertainty.CHECKED_REPLICATES = DEFAULT_LIMIT
     took = time.perf_counter() - t0
     if code:

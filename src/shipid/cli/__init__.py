@@ -8,8 +8,9 @@ are written together at its end (``shipid.outputs.OutputSet``). Warnings print a
 lines on stderr and go into the JSON outputs.
 
 One module per concern: ``parser`` (every command's options), ``common`` (reading logs, physics
-options, the model or ship a command runs on), and the commands by what they do:
-``identification``, ``evaluation``, ``trials``, ``control``, ``data``.
+options, the model or ship a command runs on), and the commands by what they do: ``identify``,
+``selection`` (select, compare), ``rescale``, ``evaluation``, ``trials``, ``control``, ``data``,
+``experiments`` (demo, study).
 """
 
 from __future__ import annotations

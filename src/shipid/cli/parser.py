@@ -17,14 +17,10 @@ from shipid.cli.common import (
 from shipid.cli.control import cmd_autopilot, cmd_export, cmd_follow, cmd_linearise
 from shipid.cli.data import cmd_import, cmd_indices, cmd_plot
 from shipid.cli.evaluation import cmd_simulate, cmd_validate
-from shipid.cli.identification import (
-    cmd_compare,
-    cmd_demo,
-    cmd_identify,
-    cmd_rescale,
-    cmd_select,
-    cmd_study,
-)
+from shipid.cli.experiments import cmd_demo, cmd_study
+from shipid.cli.identify import cmd_identify
+from shipid.cli.rescale import cmd_rescale
+from shipid.cli.selection import cmd_compare, cmd_select
 from shipid.cli.trials import cmd_criteria, cmd_manoeuvre
 
 

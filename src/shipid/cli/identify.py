@@ -1,24 +1,20 @@
-"""``shipid identify``, ``select``, ``compare``, ``rescale``, ``study``, ``demo``: models from logs."""
+"""``shipid identify``: a model from logs, the structure, prefilter, γ and fit chosen for them
+(LS-SVM, output error, a kernel residual), checked for plausibility, with its bootstrap."""
 
 from __future__ import annotations
 
 import json
-import math
 import sys
-import time
-from pathlib import Path
 from types import SimpleNamespace
 
 from shipid.cli.common import (
     _approach,
-    _cores,
     _fmt_speed,
     _json_text,
     _log_particulars,
     _log_record,
     _one_rps,
     _parse_drop,
-    _parse_gammas,
     _pd,
     _physics,
     _read_files,
@@ -45,22 +41,6 @@ def _ruled_out(table) -> str:
            for c, why in zip(table["cutoff_hz"], table["implausible"], strict=True)
            if isinstance(why, str) and why]  # fmt: skip
     return f"; implausible fits: {', '.join(out)}" if out else ""
-
-
-# ---------------------------------------------------------------------------- commands
-
-def cmd_demo(args) -> int:
-    """``shipid demo``: the paper's experiment on the embedded scale ship."""
-    from shipid.demo import run_demo, summary
-    from shipid.outputs import check_outputs
-
-    check_outputs({"--out": (args.out, "dir")})
-    t0 = time.perf_counter()
-    result = run_demo(args.out, args.seed, progress=lambda m: print(m, file=sys.stderr))
-    print(summary(result))
-    print(f"figures and report written to {Path(args.out) / 'report.md'} "
-          f"({time.perf_counter() - t0:.1f} s)")
-    return 0
 
 
 def _free_run_table(refinement) -> str:
@@ -428,21 +408,6 @@ def _report_replicates(ensemble, record: dict, ident) -> None:
         ident.warnings.append(f"bootstrap: {weak}")
 
 
-def _check_replicates(ensemble, report: dict, model, one_rps, logs, args, ident) -> None:
-    """``_report_replicates`` of select's ensemble, each replicate checked from the approach
-    its model was (``report``), as the model file will have it."""
-    from shipid.identification.plausibility import sharpest_curvature
-
-    speed = _approach(logs[0], "u")
-    rps = one_rps or _approach(logs[0], "n")
-    if speed is None or not speed > 0:
-        return
-    curvature = sharpest_curvature(logs, speed)
-    _report_replicates(ensemble, _replicates_checked(
-        ensemble, report, model, lambda member: _similar_or_fitted(member, one_rps), speed, rps,
-        curvature, (args.speed, args.rps)), ident)  # fmt: skip
-
-
 def _similar_or_fitted(model, rps: float | None):
     """``model`` carried to every propeller speed from ``rps`` (None: as it is), as the model
     file will have it; as it is where no term changes or two would merge."""
@@ -752,304 +717,3 @@ def _auto_gamma(args, logs, names, physics=None) -> tuple[float, dict]:
     print(table.to_markdown(index=False, floatfmt=".4g"))
     print()
     return sel.gamma, {"gamma_by": "free-run CV", **sel.to_dict()}
-
-
-def cmd_select(args) -> int:
-    """``shipid select``: structure and γ by cross-validated free-run error."""
-    from shipid.dynamics.model import get_structure
-    from shipid.dynamics.similarity import rps_similar, similarity_map
-    from shipid.identification.cross_validation import parse_cv
-    from shipid.identification.select import RESAMPLES, SelectOptions, default_library, select
-    from shipid.outputs import OutputSet, check_outputs
-    from shipid.reporting.modelfile import model_text
-
-    check_outputs({"-o": (args.output, "json"), "--table": (args.table, "log")},
-                  [*args.logs, *_read_files(args)])  # fmt: skip
-    # The options logs do not decide, checked before the logs are read.
-    parse_cv(args.cv)
-    gammas = _parse_gammas(args.gammas)
-    try:
-        given = get_structure(args.library) if args.library is not None else None
-        if args.keep is not None:
-            get_structure(args.keep)
-    except ValueError as exc:
-        raise ShipidError(str(exc)) from None
-    logs = _training_logs(args)
-    names = [str(p) for p in args.logs]
-    library = given if given is not None else default_library(logs)[0]
-    edit = _structure_edit(args, logs)
-    if edit.crossflow_length is not None:
-        # The default library passed as given: the trimmed one, with the hull's cross-flow drag.
-        given = library = edit.apply(library)
-    # The default library is passed as None: select trims it to the logs and says so.
-    physics = _physics(args, logs, library)
-    options = SelectOptions(library=library if given is not None else None,
-                            search=args.search, cv=args.cv,
-                            estimator=args.estimator, method=args.method,
-                            max_evaluations=args.max_evaluations,
-                            plausibility=not args.no_plausibility, speed=args.speed,
-                            rps=args.rps, one_standard_error=not args.best,
-                            progress=not args.quiet, physics=physics,
-                            average=args.average, keep=args.keep,
-                            **({"gammas": gammas} if gammas else {}))
-    sel = select(logs, options, names=names)
-    if args.library is None and sel.best_ruled_out:
-        from shipid.identification.auto_structure import widened_selection
-
-        # As identify's default: where the logs' best fit from the default library is ruled out
-        # by the checks, the search again with the rudder's lift at the hull's drift.
-        wider, said, apart = widened_selection(sel, logs, names, options, edit,
-                                               announce=lambda m: print(m, file=sys.stderr))
-        if wider is not None:
-            sel = wider[0]
-        if apart:
-            sel.identification.warnings.append(f"library: {apart}")
-        for note in said:  # the model file's selection record names the library searched
-            print(f"library: {note}")
-    ident = sel.identification
-    if sel.model is not sel.chosen_model:
-        print(f"The chosen candidate:\n{sel.chosen_model.equations()}\n\nThe model written, "
-              f"the average of {len(sel.shares)} candidates weighted by how often the choice "
-              "rule picks them on resampled held-out logs (--average):")  # fmt: skip
-    print(sel.model.equations())
-    whose = " of the chosen candidate" if sel.model is not sel.chosen_model else ""
-    print(f"\nγ = {sel.gamma:g}; free-run CV score{whose} {sel.score:.4f} ({options.cv}; 1 ≈ "
-          f"predicting the mean); {len(sel.candidates)} candidates")
-    cols = ["chosen", "score", "score_se", "score_u", "score_v", "score_r", "gamma", "n_terms",
-            "folds_diverged", "plausible", "share", "stage", "note"]
-    shown = sel.candidates.head(args.show)
-    if not shown["chosen"].any():
-        shown = _pd().concat([shown, sel.candidates[sel.candidates["chosen"]]])
-    print(shown[cols].to_markdown(index=False, floatfmt=".4g"))
-    fitted = "the average" if sel.model is not sel.chosen_model else "the chosen structure"
-    print(f"\nHeld-out logs ({fitted} fitted without each):")
-    print(_fold_table(sel.folds))
-    if sel.error_band is not None:
-        print(f"Their {sel.error_band.describe()}; stored in the model file, validate reports "
-              "each log's share of samples inside it.")  # fmt: skip
-    _warn_approach(logs, names)
-    plausibility, notes = sel.plausibility, sel.plausibility_notes
-    one_rps = _one_rps(logs, args)
-    if one_rps is not None and args.speed is None and args.rps is None \
-            and similarity_map(sel.model.structure, one_rps).changes:  # fmt: skip
-        # Checked as the file will have it: at the logs' rps from their approach, as identify's.
-        from shipid.identification.plausibility import (
-            plausibility_at_approach,
-            sharpest_curvature,
-        )
-
-        speed = _approach(logs[0], "u")
-        # With the crash stop, as select's own report of the fit has it.
-        plausibility, notes = plausibility_at_approach(
-            rps_similar(sel.model, one_rps), speed, one_rps,
-            curvature=sharpest_curvature(logs, speed), astern=True)  # fmt: skip
-    ident.warnings.extend(f"plausibility: {n}" for n in notes)
-    from shipid.identification.plausibility import given_steady_speeds, missed_steady_speed
-
-    for u, n in given_steady_speeds(physics):
-        missed = missed_steady_speed(_similar_or_fitted(sel.model, one_rps), u, n)
-        if missed:
-            ident.warnings.append(missed)
-    prep = _log_record(args, logs)
-    ensemble = None
-    others = len(sel.shares) - (sel.chosen_share > 0)
-    print(f"\nThe choice on {RESAMPLES} resamples of the held-out logs: this candidate "
-          f"{100 * sel.chosen_share:.0f} %, {others} other(s) the rest (column share)")
-    if args.bootstrap is not None:
-        from shipid.identification.selection_ensemble import selection_ensemble
-
-        # Each replicate: a candidate drawn by its share, refitted on a resample.
-        ensemble = selection_ensemble(logs, sel, args.bootstrap, args.block, args.seed,
-                                      names=names, progress=not args.quiet)  # fmt: skip
-        table = ensemble.coefficient_table()
-        table["term"] = [_term_display(t) for t in table["term"]]
-        print(f"\n95 % intervals of the coefficients ({ensemble.replicates} replicates: "
-              f"{ensemble.resampling}; a term outside the model "
-              "has value 0, inclusion the share of replicates that hold it):")  # fmt: skip
-        print(table.to_markdown(index=False, floatfmt=".4g"))
-        _check_replicates(ensemble, plausibility, sel.model, one_rps, logs, args, ident)
-    text = model_text(ident, args.logs, preprocessing=prep, plausibility=plausibility,
-                      model=sel.model, selection=sel.to_dict(), particulars=_log_particulars(logs),
-                      uncertainty=ensemble.to_dict() if ensemble else None)  # fmt: skip
-    similar = _rps_similar(text, one_rps, args.output)
-    if similar is not None:
-        text = _json_text(similar)
-    with OutputSet() as out:
-        out.write(args.output, lambda p: p.write_text(text, encoding="utf-8"))
-        if args.table:
-            from shipid.data.io import write_table
-
-            write_table(sel.candidates, args.table, out)
-    # And those added here (the model as the file has it, the replicates, the speeds given):
-    # sel.warnings is the list select made.
-    for w in [*sel.warnings, *(w for w in ident.warnings if w not in sel.warnings)]:
-        _warn(w)
-    print(f"model written to {args.output}")
-    return 0
-
-
-def _fold_table(folds) -> str:
-    from shipid.trials.trial import TURN_KINDS
-
-    pd = _pd()
-
-    rows = []
-    for f in folds:
-        if "error" in f:
-            rows.append({"held-out log": f["held_out"], "error": f["error"]})
-            continue
-        m, sp = f["metrics"], f["spread"]
-        ind = (f.get("indices") or {})
-        meas = ind.get("measured", {})
-        # Zig-zags: the closed-loop run of the trial on the model, not the open-loop replay.
-        sim = ind.get("closed_loop") or {} if f.get("kind") == "zigzag" else ind.get("simulated", {})
-        key = "tactical_diameter" if f.get("kind") in TURN_KINDS else "first_overshoot_deg"
-        rows.append({"held-out log": Path(f["held_out"]).name, "kind": f.get("kind"),
-                     "u err / spread": f"{m['u']:.4f} / {sp['u']:.4f}",
-                     "v err / spread": f"{m['v']:.4f} / {sp['v']:.4f}",
-                     "r err / spread": f"{m['r']:.4f} / {sp['r']:.4f}",
-                     "diverged": f["diverged"],
-                     key.replace("_", " ") + " meas / pred": (
-                         f"{meas.get(key):.3g} / {sim.get(key):.3g}"
-                         if meas.get(key) is not None and sim.get(key) is not None else "–")})
-    return pd.DataFrame(rows).to_markdown(index=False)
-
-
-def cmd_compare(args) -> int:
-    """``shipid compare``: methods × held-out logs in one table."""
-    from shipid.evaluation.compare import compare, summary
-    from shipid.identification.auto_structure import PAPER, beyond_the_paper
-    from shipid.identification.estimators import BLACK_BOX_ESTIMATORS
-    from shipid.outputs import OutputSet, check_outputs
-
-    check_outputs({"--json": (args.json, "json")}, [*args.logs, *_read_files(args)])
-    methods = [m.strip() for m in args.methods.split(",") if m.strip()]
-    logs = _training_logs(args)
-    names = [Path(p).name for p in args.logs]
-    structure = args.model or PAPER
-    semiphysical = [m for m in methods if not m.startswith("select:")
-                    and m not in BLACK_BOX_ESTIMATORS]  # fmt: skip
-    if args.model is None and semiphysical:
-        reasons = beyond_the_paper(logs)[0]
-        if reasons:
-            # Scored through a structure that cannot hold the logs, every method looks bad and
-            # the table ranks them by luck (the Esso's zig-zags: scores 0.9–5.7, worse than
-            # the logs' means).
-            _warn(f"{'; '.join(reasons)}: the paper's blanke cannot hold that, so these scores "
-                  "judge the structure, not the methods; give --model (e.g. blanke-rps+wind, "
-                  "or the structure identify chooses) or a term search (--methods "
-                  "select:low-speed+wind)")  # fmt: skip
-    table = compare(logs, structure, methods, names, gamma=args.gamma, cv=args.cv,
-                    method=args.method, progress=not args.quiet)  # fmt: skip
-    print(f"Free-run score per held-out log ({args.cv}; error RMS over the log's spread, mean of "
-          "u, v, r; 1 ≈ predicting the mean), model structure " + structure + ":")
-    print(summary(table).to_markdown(floatfmt=".3f"))
-    with OutputSet() as out:
-        if args.json:
-            doc = {"structure": structure, "cv": args.cv, "gamma": args.gamma,
-                   "rows": table.to_dict(orient="records")}  # fmt: skip
-            out.write(args.json, lambda p: p.write_text(_json_text(doc), "utf-8"))
-    return 0
-
-
-def cmd_rescale(args) -> int:
-    """``shipid rescale``: a model file carried to a similar ship of another length (Froude)."""
-    from shipid.data.particulars import Particulars
-    from shipid.outputs import atomic_write_text, check_outputs
-    from shipid.reporting.modelfile import load_document, model_from_document, rescaled_document
-
-    check_outputs({"-o": (args.output, "json")}, [args.model])
-    doc = load_document(args.model)
-    length = Particulars.from_mapping(doc["particulars"]).length if doc.get("particulars") else None
-    if (args.factor is None) == (args.length is None):
-        raise ShipidError("give the scale factor --factor F (new length / old) or the new --length")
-    factor = args.factor
-    if args.length is not None:
-        if length is None:
-            raise ShipidError(f"{args.model}: --length needs the model's particulars (its length); "
-                              "give --factor instead")  # fmt: skip
-        factor = args.length / length
-    out = rescaled_document(doc, factor, args.rho, args.model)
-    model = model_from_document(out, args.output)
-    k = math.sqrt(factor)
-    what = f"{length:g} m → {length * factor:g} m" if length else f"× {factor:g} in length"
-    print(f"Froude scaling {what}: speeds × {k:.4g}, times × {k:.4g}, rates ÷ {k:.4g}")
-    speed = ((out.get("identification") or {}).get("preprocessing") or {}).get("approach_speed")
-    if speed:
-        print(f"approach speed {speed:.4g} m/s")
-    print(model.equations())
-    _print_prime(out.get("prime"))
-    atomic_write_text(args.output, _json_text(out))
-    print(f"model written to {args.output}")
-    return 0
-
-
-def cmd_study(args) -> int:
-    """``shipid study``: a Monte Carlo study, or the identification of many log sets, on Dask."""
-    from shipid.data.io import write_table
-    from shipid.evaluation.study import GRID_KEYS, read_spec, run_study, summary
-    from shipid.outputs import OutputSet, check_outputs
-
-    check_outputs({"-o": (args.output, "log")}, [args.spec])
-    spec = read_spec(args.spec)
-    where = ("this process" if args.scheduler == "serial" else args.scheduler
-             or f"a local Dask cluster of {args.workers or _cores()} workers")  # fmt: skip
-    if hasattr(spec, "jobs"):
-        return _study_logs(args, spec, where)
-    if args.models:
-        raise ShipidError("--models is for a study of kind logs (model files of its jobs)")
-    n = len(spec.trials())
-    print(f"{n} trials ({len(spec.seeds)} seeds × {n // len(spec.seeds)} grid points) on {where}")
-    start = time.perf_counter()
-    results = run_study(spec, scheduler=args.scheduler, workers=args.workers,
-                        progress=not args.quiet)  # fmt: skip
-    wall = time.perf_counter() - start
-    print("Held-out error std of the identified model over the true model's on the same noisy "
-          "log (1 = as good as the truth):")  # fmt: skip
-    table = summary(results)
-    varying = [k for k in GRID_KEYS if table[k].nunique() > 1]
-    fixed = ", ".join(f"{k} {table[k].iloc[0]:g}" if isinstance(table[k].iloc[0], float)
-                      else f"{k} {table[k].iloc[0]}" for k in GRID_KEYS if k not in varying)
-    print(f"({fixed}; per held-out manoeuvre: the median over the seeds and the largest)")
-    table.index = [", ".join(f"{k} {row[k]}" for k in varying) or "all"
-                   for _, row in table.iterrows()]  # fmt: skip
-    print(table.drop(columns=list(GRID_KEYS)).T.to_markdown(floatfmt=".3g"))
-    print(f"\n{n} trials in {wall:.1f} s wall ({results['seconds'].sum():.1f} s of trial time)")
-    with OutputSet() as out:
-        write_table(results, args.output, out)
-    failed = results[results["error"] != ""]
-    if len(failed):
-        _warn(f"{len(failed)} of {n} trials failed (first: seed {failed['seed'].iloc[0]}: "
-              f"{failed['error'].iloc[0]}); their rows have the error")  # fmt: skip
-    print(f"results written to {args.output}")
-    return 0
-
-
-def _study_logs(args, spec, where: str) -> int:
-    """A study of kind logs: every job's model file into --models, the table to -o."""
-    from shipid.data.io import write_table
-    from shipid.identification.batch import run_batch
-    from shipid.outputs import OutputSet, check_outputs
-
-    if not args.models:
-        raise ShipidError(f"{args.spec}: a study of kind logs writes model files: give --models DIR")
-    inputs = [args.spec, *(p for job in spec.jobs for p in job.logs)]
-    check_outputs({"-o": (args.output, "log"), "--models": (args.models, "dir")}, inputs)
-    print(f"{len(spec.jobs)} jobs ({sum(len(j.logs) for j in spec.jobs)} logs) on {where}")
-    start = time.perf_counter()
-    table, texts = run_batch(spec, scheduler=args.scheduler, workers=args.workers,
-                             progress=not args.quiet)  # fmt: skip
-    cols = ["name", "command", "logs", "terms", "gamma", "prefilter_hz", "cv_score", "seconds",
-            "error"]
-    print(table[[c for c in cols if c in table]].to_markdown(index=False, floatfmt=".4g"))
-    print(f"\n{len(spec.jobs)} jobs in {time.perf_counter() - start:.1f} s wall")
-    models = Path(args.models)
-    with OutputSet() as out:
-        for name, text in texts.items():
-            out.write(models / f"{name}.json", lambda p, t=text: p.write_text(t, encoding="utf-8"))
-        write_table(table, args.output, out)
-    failed = table[table["error"] != ""]
-    print(f"{len(texts)} model files written to {models}, the table to {args.output}")
-    for _, row in failed.iterrows():  # as validate's batch: the others are written, exit 1
-        print(f"shipid: error: job {row['name']}: {row['error']}", file=sys.stderr)
-    return 1 if len(failed) else 0
