@@ -119,6 +119,8 @@ def cmd_identify(args) -> int:
     gamma_given = args.gamma is not None
     choice = _choose_structure(args, logs, names)
     physics = _physics(args, logs, _structure(args))
+    if physics is not None and physics.prior_source:
+        print(f"prior: {physics.prior_source}")
     # Terms chosen by select: the model is the average of the candidates its choice rule picks
     # on resampled held-out logs (each at its own γ), as `select --average` writes it, where no
     # γ or physics (a prior, constraints: per structure) is given.
@@ -451,7 +453,7 @@ def _choose_structure(args, logs, names):
         from shipid.identification.select import default_library
 
         # The search fits with the same physics, as select does: a prior over its library.
-        physics = _physics(args, logs, default_library(logs)[0])
+        physics = _physics(args, logs, default_library(logs)[0], searched=True)
         choice = auto_structure(logs, names, physics, args.cv, args.estimator,
                                 _structure_edit(args, logs),
                                 announce=lambda m: print(m, file=sys.stderr))  # fmt: skip

@@ -74,7 +74,7 @@ def cmd_select(args) -> int:
         # The default library passed as given: the trimmed one, with the hull's cross-flow drag.
         given = library = edit.apply(library)
     # The default library is passed as None: select trims it to the logs and says so.
-    physics = _physics(args, logs, library)
+    physics = _physics(args, logs, library, searched=True)
     options = SelectOptions(library=library if given is not None else None,
                             search=args.search, cv=args.cv,
                             estimator=args.estimator, method=args.method,

@@ -95,6 +95,7 @@ class PhysicsOptions:
         ``derivatives`` and ``stable`` hold at (default: each training log's start;
         ``with_approaches`` resolves them once for fits that repeat, as ``select``'s).
     rudder_positive : 'port' or 'starboard' (default: the logs' metadata).
+    prior_source : where the prior comes from, in words (the model file keeps it).
     """
 
     prior: Mapping[str, Mapping[str, float]] | None = None
@@ -105,6 +106,7 @@ class PhysicsOptions:
     rudder_positive: str | None = None
     stable: bool = False
     derivatives: bool = False
+    prior_source: str = ""
 
     @property
     def active(self) -> bool:
@@ -115,6 +117,7 @@ class PhysicsOptions:
     def describe(self) -> dict:
         """A JSON-safe record for the model file."""
         return {"prior": {d: dict(v) for d, v in (self.prior or {}).items()},
+                **({"prior_source": self.prior_source} if self.prior_source else {}),
                 "signs": self.signs, "steady_speed": self.steady_speed,
                 "bounds": {d: {t: list(b) for t, b in v.items()}
                            for d, v in (self.bounds or {}).items()},
