@@ -55,6 +55,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/study_crossflow.py
 	$(BIN)/python benchmarks/study_turn_speed.py
 	$(BIN)/python benchmarks/study_replicate_plausibility.py
+	$(BIN)/python benchmarks/study_reference_prior.py
 	$(BIN)/python benchmarks/bench_blas_threads.py
 
 clean:
