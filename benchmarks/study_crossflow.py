@@ -65,7 +65,9 @@ def _median_mean(errors: np.ndarray) -> str:
             + (f", {none} without" if none else ""))  # fmt: skip
 
 
-def esso(pairs: bool) -> None:
+def esso(pairs: bool, configs: dict[str, list[str]] | None = None) -> None:
+    """The Esso rows: ``configs`` ({label: identify's flags}; default ``ESSO_CONFIGS``, its
+    first three for ``pairs``) from each zig-zag file alone, or from every pair."""
     zigzags = sorted((DATA / "zigzag").glob("*.csv"))
     turns = sorted((DATA / "turning").glob("*.csv"))
     held = {f: read_trial_log(f, fmt="osaka-frt") for f in zigzags + turns}
@@ -78,7 +80,9 @@ def esso(pairs: bool) -> None:
           "runs' yaw rate error / spread (median of the models' medians; diverged)\n")
     print("| made by | zig-zags and turns: r / spread | 35° TD | 35° steady r | random runs |")
     print("|---|---|---|---|---|")
-    configs = ESSO_CONFIGS if not pairs else {k: ESSO_CONFIGS[k] for k in list(ESSO_CONFIGS)[:3]}
+    if configs is None:
+        configs = ESSO_CONFIGS if not pairs else \
+            {k: ESSO_CONFIGS[k] for k in list(ESSO_CONFIGS)[:3]}  # fmt: skip
     with tempfile.TemporaryDirectory() as tmp:
         out = f"{tmp}/m.json"
         trainings = [[z] for z in zigzags]
@@ -88,7 +92,7 @@ def esso(pairs: bool) -> None:
             medians, td, rate, rnd = [], [], [], []
             for files in trainings:
                 if not _fit(["identify", "--format", "osaka-frt", *map(str, files), *flags], out):
-                    print(f"| {label} | {files} failed | | | |")
+                    print(f"| {label.rstrip()} | {files} failed | | | |")
                     continue
                 model = load_model(out)
                 others = {g: log for g, log in held.items() if g not in files}
@@ -99,7 +103,8 @@ def esso(pairs: bool) -> None:
                 rate.append(_turn_errors(turn_runs, "steady_yaw_rate"))
                 rnd.append(_errors(_validations(model, randoms), randoms))
             rnd_all = np.concatenate(rnd)
-            print(f"| {label} | {np.median(medians):.3f} | {_median_mean(np.concatenate(td))} | "
+            print(f"| {label.rstrip()} | {np.median(medians):.3f} | "
+                  f"{_median_mean(np.concatenate(td))} | "
                   f"{_median_mean(np.concatenate(rate))} | "
                   f"{np.median([np.median(r) for r in rnd]):.2f}; "
                   f"{int(np.isinf(rnd_all).sum())} of {rnd_all.size} |", flush=True)  # fmt: skip

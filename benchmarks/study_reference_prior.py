@@ -3,14 +3,16 @@ trials fitted in the structure identified and carried to the ship's length at eq
 number, the LS-SVM drawn toward it. Judged on logs the models were not fitted to:
 
 1. the Esso Osaka's nine zig-zag files one at a time (the 3 m model's length comes with its
-   files), the KVLCC2 (a VLCC like the Esso) or the Mariner (a cargo liner) as the reference,
-   at several γ, with the hull's cross-flow drag and with the split |v|v, |v|r; judged on the
+   files), the KVLCC2 (a VLCC like the Esso), the ``tanker`` (another VLCC, van Berlekom and
+   Goddard's, whose rudder stops at 10°) or the Mariner (a cargo liner) as the reference, at
+   several γ, with the hull's cross-flow drag and with the split |v|v, |v|r; judged on the
    other eight zig-zags, the two 35° turns and the four random runs, as
-   ``study_crossflow.py`` judges;
+   ``study_crossflow.py`` judges; with ``pairs``, every pair of the files too (the cross-flow
+   rows at γ 1 and 10, as ``study_crossflow.py pairs`` judges);
 2. the real KVLCC2: identified on MARIN's 20/20 zig-zag (its particulars), judged on the −20/−20
    run and HSVA's 20/10, the KVLCC2's own MMG model as the reference.
 
-Run: .venv/bin/python benchmarks/study_reference_prior.py
+Run: .venv/bin/python benchmarks/study_reference_prior.py [pairs]
 """
 
 from __future__ import annotations
@@ -21,16 +23,13 @@ import tempfile
 import time
 import warnings
 
-import numpy as np
 from esso_logs import DATA
 from kvlcc2_logs import kvlcc2_logs
-from study_crossflow import MARIN_PARTICULARS, _fit, _median_mean
-from study_esso_single_logs import _errors, _turn_errors, _validations
+from study_crossflow import MARIN_PARTICULARS, _fit, esso
 
 from shipid.data.io import write_log
 from shipid.evaluation.validate import validate
 from shipid.reporting.modelfile import load_model
-from shipid.trials.reading import read_trial_log
 
 CROSSFLOW = ["--model", "blanke-speed+wind", "--crossflow"]
 SPLIT = ["--model", "blanke-speed+wind"]
@@ -39,47 +38,12 @@ ESSO_CONFIGS = {
     "blanke-speed+wind --crossflow": CROSSFLOW,
     **{f"  --prior kvlcc2 --gamma {g}": [*CROSSFLOW, "--prior", "kvlcc2", "--gamma", g]
        for g in ("0.1", "1", "10", "100")},
+    "  --prior tanker --gamma 1": [*CROSSFLOW, "--prior", "tanker", "--gamma", "1"],
     "  --prior mariner --gamma 1": [*CROSSFLOW, "--prior", "mariner", "--gamma", "1"],
-    "blanke-speed+wind (|v|v, |v|r)": SPLIT,
+    "blanke-speed+wind (no --crossflow)": SPLIT,
     "  --prior kvlcc2 --gamma 1 ": [*SPLIT, "--prior", "kvlcc2", "--gamma", "1"],
     "  --prior kvlcc2 --gamma 100 ": [*SPLIT, "--prior", "kvlcc2", "--gamma", "100"],
 }  # fmt: skip
-
-
-def esso() -> None:
-    zigzags = sorted((DATA / "zigzag").glob("*.csv"))
-    turns = sorted((DATA / "turning").glob("*.csv"))
-    held = {f: read_trial_log(f, fmt="osaka-frt") for f in zigzags + turns}
-    randoms = {f: read_trial_log(f, fmt="osaka-frt") for f in sorted((DATA / "random").glob("*.csv"))}
-    print("Esso Osaka, one zig-zag file at a time (9 models): held-out zig-zags' and turns' yaw "
-          "rate error / spread (median of the models' medians), the two 35° turns' closed-loop "
-          "tactical diameter and steady yaw rate, |error| median / mean (largest) over every "
-          "model's two, the four random runs' yaw rate error / spread (median of the models' "
-          "medians; diverged)\n")
-    print("| made by | zig-zags and turns: r / spread | 35° TD | 35° steady r | random runs |")
-    print("|---|---|---|---|---|")
-    with tempfile.TemporaryDirectory() as tmp:
-        out = f"{tmp}/m.json"
-        for label, flags in ESSO_CONFIGS.items():
-            medians, td, rate, rnd = [], [], [], []
-            for z in zigzags:
-                if not _fit(["identify", "--format", "osaka-frt", str(z), *flags], out):
-                    print(f"| {label} | {z.name} failed | | | |")
-                    continue
-                model = load_model(out)
-                others = {g: log for g, log in held.items() if g != z}
-                runs = _validations(model, others)
-                medians.append(float(np.median(_errors(runs, others))))
-                turn_runs = [v for g, v in zip(others, runs, strict=True) if "turn" in g.stem]
-                td.append(_turn_errors(turn_runs))
-                rate.append(_turn_errors(turn_runs, "steady_yaw_rate"))
-                rnd.append(_errors(_validations(model, randoms), randoms))
-            rnd_all = np.concatenate(rnd)
-            print(f"| {label.rstrip()} | {np.median(medians):.3f} | "
-                  f"{_median_mean(np.concatenate(td))} | "
-                  f"{_median_mean(np.concatenate(rate))} | "
-                  f"{np.median([np.median(r) for r in rnd]):.2f}; "
-                  f"{int(np.isinf(rnd_all).sum())} of {rnd_all.size} |", flush=True)  # fmt: skip
 
 
 def kvlcc2() -> None:
@@ -125,6 +89,11 @@ if __name__ == "__main__":
         sys.exit(0)
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores\n")
     start = time.perf_counter()
-    esso()
+    esso(False, ESSO_CONFIGS)
     kvlcc2()
+    if "pairs" in sys.argv[1:]:
+        print()
+        esso(True, {k: ESSO_CONFIGS[k] for k in ("blanke-speed+wind --crossflow",
+                                                 "  --prior kvlcc2 --gamma 1",
+                                                 "  --prior kvlcc2 --gamma 10")})
     print(f"\n{time.perf_counter() - start:.0f} s")
