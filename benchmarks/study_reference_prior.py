@@ -17,13 +17,11 @@ Run: .venv/bin/python benchmarks/study_reference_prior.py [pairs]
 
 from __future__ import annotations
 
-import os
 import sys
 import tempfile
-import time
 import warnings
 
-from esso_logs import DATA
+from esso_logs import run_with_files
 from kvlcc2_logs import kvlcc2_logs
 from study_crossflow import MARIN_PARTICULARS, _fit, esso
 
@@ -82,18 +80,14 @@ def kvlcc2() -> None:
     print(f"\nmeasured overshoots: {'; '.join(measured)}")
 
 
+def pairs() -> None:
+    print()
+    esso(True, {k: ESSO_CONFIGS[k] for k in ("blanke-speed+wind --crossflow",
+                                             "  --prior kvlcc2 --gamma 1",
+                                             "  --prior kvlcc2 --gamma 10")})
+
+
 if __name__ == "__main__":
     warnings.simplefilter("ignore")
-    if not DATA.is_dir():
-        print("../shared/data is absent")
-        sys.exit(0)
-    print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores\n")
-    start = time.perf_counter()
-    esso(False, ESSO_CONFIGS)
-    kvlcc2()
-    if "pairs" in sys.argv[1:]:
-        print()
-        esso(True, {k: ESSO_CONFIGS[k] for k in ("blanke-speed+wind --crossflow",
-                                                 "  --prior kvlcc2 --gamma 1",
-                                                 "  --prior kvlcc2 --gamma 10")})
-    print(f"\n{time.perf_counter() - start:.0f} s")
+    run_with_files(lambda _: esso(False, ESSO_CONFIGS), lambda _: kvlcc2(),
+                   *([lambda _: pairs()] if "pairs" in sys.argv[1:] else []))
