@@ -251,7 +251,7 @@ def _physics(args, logs, structure, searched: bool = False):
         side = None if sign is None else ("starboard" if sign > 0 else "port")
         speed = _approach(logs[0], "u")
         prior = clarke_prior(part, structure, speed or 0.0, side)
-    elif args.prior in _vessel_names():
+    elif args.prior and args.prior in _vessel_names():
         from shipid.data.particulars import logs_particulars
 
         if searched:
