@@ -228,6 +228,38 @@ def test_a_rescaled_model_starts_its_manoeuvres_as_its_original(one_rps, tmp_pat
     first, second = (runs[k]["indices"]["tactical_diameter"] for k in ("original", "big"))
     assert second == pytest.approx(100 * first, rel=1e-4)  # each run at its own step
 
+def test_the_criteria_of_a_rescaled_model_judge_its_approach_as_its_original(one_rps, tmp_path,
+                                                                             capsys):  # fmt: skip
+    """The criteria's note on an approach the model does not hold judged over a fixed 10 s: at
+    100 times the length, whose times are 10 times as long, a speed the original leaves by 8 %
+    in 10 s passed for steady (0.8 %) and the note went missing. Now over √λ × 10 s, the same
+    note at both scales."""
+    from shipid.data.log import STEADY_WINDOW
+    from shipid.dynamics.equilibrium import still_air_accelerations, surge_equilibrium
+    from shipid.reporting.modelfile import model_from_document
+
+    doc = json.loads(one_rps["similar"].read_text())
+    model = model_from_document(doc, one_rps["similar"])
+    steady = surge_equilibrium(model, doc["identification"]["preprocessing"]["approach_speed"],
+                               N0)  # fmt: skip
+    grid = np.linspace(0.5, 0.99, 50) * steady
+    change = still_air_accelerations(model, grid, 0 * grid, 0 * grid, 0 * grid, N0)[:, 0] \
+        * STEADY_WINDOW / grid  # fmt: skip
+    speed = float(grid[np.flatnonzero((np.abs(change) > 0.08) & (np.abs(change) < 0.4))[0]])
+    big = tmp_path / "big.json"
+    assert run(["rescale", one_rps["similar"], "--factor", "100", "-o", big], capsys)[0] == 0
+    notes = {}
+    for key, path, k in (("original", one_rps["similar"], 1), ("big", big, 10)):
+        code, _, err = run(["criteria", path, "--speed", repr(k * speed), "--length",
+                            repr(4.389 * k * k), "--no-bands"], capsys)  # fmt: skip
+        assert code == 0, err
+        (note,) = [ln for ln in err.splitlines() if "is not steady" in ln]
+        notes[key] = note
+    assert "in the first 10 s" in notes["original"] and "in the first 100 s" in notes["big"]
+    share = [n.split("changes by ")[1].split(" in")[0] for n in notes.values()]
+    assert share[0] == share[1], notes
+
+
 def test_a_bad_anchor_in_a_model_file_is_one_line(one_rps, tmp_path, capsys):
     doc = json.loads(one_rps["similar"].read_text())
     doc["model"]["similar_at_rps"] = -3

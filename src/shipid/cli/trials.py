@@ -85,9 +85,11 @@ def cmd_criteria(args) -> int:
     rate_note = None
     if args.rudder_rate is None and getattr(target, "steering", None) is None:
         steering, rate_note = _gear_beyond_ships(steering, scale)
+    from shipid.data.log import STEADY_WINDOW
+
     run = partial(imo_criteria, particulars=particulars, length=args.length, speed=speed,
                   scale=scale, rps=rps, steering=steering, astern_rps=args.astern_rps,
-                  dt=args.dt)  # fmt: skip
+                  dt=args.dt, steady_window=STEADY_WINDOW * cond.get("time_scale", 1.0))  # fmt: skip
     crit = run(target)
     crit.notes += [rate_note] if rate_note else []
     crit.notes += _unused_inputs(target, args)

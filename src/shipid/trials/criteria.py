@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
+from shipid.data.log import STEADY_WINDOW
 from shipid.data.particulars import Particulars
 from shipid.dynamics.equilibrium import unsteady_warning
 from shipid.dynamics.hybrid import HybridModel
@@ -101,6 +102,7 @@ def imo_criteria(
     astern_rps: float | None = None,
     dt: float = 0.05,
     method: str = "rk4",
+    steady_window: float | None = None,
 ) -> Criteria:
     """Run the IMO standard manoeuvres on ``ship`` and judge them against MSC.137(76).
 
@@ -108,6 +110,8 @@ def imo_criteria(
     the scale, if none is known, to 1 with a note);
     ``speed`` to the ship's approach speed or the particulars' design speed; ``rps`` is the
     propeller speed of models with propeller terms (also the stopping test's approach).
+    ``steady_window``: the seconds over which a model's approach is judged steady (default
+    ``STEADY_WINDOW``; a model carried to another scale, √λ times its original's).
     """
     vessel_length = getattr(ship, "length", math.nan)
     L = length or (particulars.length if particulars else None) or (
@@ -144,7 +148,8 @@ def imo_criteria(
     kw = {"dt": dt, "speed": V, "steering": steering, "method": method, "rps": rps}
     rows, runs, notes = [], {}, [scale_note] if scale_note else []
     if isinstance(ship, ManoeuvringModel | HybridModel):  # a reference ship's is trimmed
-        unsteady = unsteady_warning(ship, V, rps if ship.uses_rps else None)
+        unsteady = unsteady_warning(ship, V, rps if ship.uses_rps else None,
+                                    steady_window or STEADY_WINDOW)  # fmt: skip
         notes += [unsteady] if unsteady else []
 
     # 35°, or the largest rudder the gear allows (MSC.137(76) §4.2: the maximum rudder angle
