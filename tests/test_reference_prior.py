@@ -1,6 +1,7 @@
 """A reference ship as the prior (``--prior SHIP``, issue #10 item 2): the reference's trials
 fitted in the structure identified, carried to the ship's length at equal Froude number."""
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -111,9 +112,10 @@ def test_the_kvlcc2_as_the_esso_osakas_prior_brings_one_files_turns_closer(tmp_p
     errors = {}
     for label, extra in (("none", []), ("kvlcc2", ["--prior", "kvlcc2", "--gamma", "1"])):
         out = tmp_path / f"{label}.json"
-        code, _, err = run([*base, "--crossflow", *extra, "-o", out], capsys)
+        code, said, err = run([*base, "--crossflow", *extra, "-o", out], capsys)
         assert code == 0, err
         assert "|v|v" not in err
+        assert ("prior: the reference ship kvlcc2's" in said) == bool(extra)
         model = load_model(out)
         ratios = []
         for turn in turns:
@@ -123,6 +125,9 @@ def test_the_kvlcc2_as_the_esso_osakas_prior_brings_one_files_turns_closer(tmp_p
         errors[label] = np.abs(ratios)
     assert np.all(errors["kvlcc2"] < 0.25), errors
     assert errors["none"].max() > 0.35, errors
-    code, _, err = run([*base, "--prior", "kvlcc2", "--gamma", "1", "-o", tmp_path / "s.json"],
-                       capsys)  # fmt: skip
+    code, said, err = run([*base, "--prior", "kvlcc2", "--gamma", "1", "--bootstrap", "5", "-o",
+                           tmp_path / "s.json"], capsys)  # fmt: skip
     assert code == 0 and "warning: --prior kvlcc2: the structure splits" in err, err
+    assert "the bootstrap resamples the logs, not the reference" in said
+    doc = json.loads((tmp_path / "s.json").read_text())
+    assert doc["identification"]["physics"]["prior_source"].startswith("the reference ship kvlcc2")

@@ -120,7 +120,9 @@ def cmd_identify(args) -> int:
     choice = _choose_structure(args, logs, names)
     physics = _physics(args, logs, _structure(args))
     if physics is not None and physics.prior_source:
-        print(f"prior: {physics.prior_source}")
+        print(f"prior: {physics.prior_source}" + (
+            "; the bootstrap resamples the logs, not the reference: its intervals do not hold "
+            "how far the reference is from the ship" if args.bootstrap is not None else ""))
     # Terms chosen by select: the model is the average of the candidates its choice rule picks
     # on resampled held-out logs (each at its own γ), as `select --average` writes it, where no
     # γ or physics (a prior, constraints: per structure) is given.
