@@ -125,7 +125,7 @@ def test_the_kvlcc2_as_the_esso_osakas_prior_brings_one_files_turns_closer(tmp_p
         errors[label] = np.abs(ratios)
     assert np.all(errors["kvlcc2"] < 0.25), errors
     assert errors["none"].max() > 0.35, errors
-    code, said, err = run([*base, "--prior", "kvlcc2", "--gamma", "1", "--bootstrap", "5", "-o",
+    code, said, err = run([*base, "--prior", "kvlcc2", "--gamma", "1", "--bootstrap", "10", "-o",
                            tmp_path / "s.json"], capsys)  # fmt: skip
     assert code == 0 and "warning: --prior kvlcc2: the structure splits" in err, err
     assert "the bootstrap resamples the logs, not the reference" in said
