@@ -36,6 +36,7 @@ ESSO_CONFIGS = {
     "blanke-speed+wind --crossflow": CROSSFLOW,
     **{f"  --prior kvlcc2 --gamma {g}": [*CROSSFLOW, "--prior", "kvlcc2", "--gamma", g]
        for g in ("0.1", "1", "10", "100")},
+    "  --prior kvlcc2 --gamma auto": [*CROSSFLOW, "--prior", "kvlcc2", "--gamma", "auto"],
     "  --prior tanker --gamma 1": [*CROSSFLOW, "--prior", "tanker", "--gamma", "1"],
     "  --prior mariner --gamma 1": [*CROSSFLOW, "--prior", "mariner", "--gamma", "1"],
     "blanke-speed+wind (no --crossflow)": SPLIT,

@@ -28,6 +28,8 @@ from shipid.cli.common import (
 )
 from shipid.errors import ShipidError
 
+# γ grid of --gamma auto with a reference ship's prior (select's default starts at 1e2).
+REFERENCE_PRIOR_GAMMAS = (0.1, 1.0, 10.0, 1e2, 1e3, 1e4, 1e5, 1e6)
 # The name of the model `identify` fits where select's candidates are averaged.
 AVERAGED = "average of the candidates select's choice picks"
 
@@ -714,8 +716,11 @@ def _auto_gamma(args, logs, names, physics=None) -> tuple[float, dict]:
 
     structure = _structure(args)
     cv = args.cv or choice_cv(logs)
+    # A reference ship's prior covers the terms it can: the grid goes down to where it leads.
+    grid = REFERENCE_PRIOR_GAMMAS if physics is not None and physics.prior_source else None
     sel = select(logs, library=structure, search="none", names=names, cv=cv,
-                 estimator=args.estimator, plausibility=False, physics=physics)  # fmt: skip
+                 estimator=args.estimator, plausibility=False, physics=physics,
+                 **({"gammas": grid} if grid else {}))  # fmt: skip
     table = sel.candidates[["gamma", "score", "score_se", "folds_diverged"]]
     print(f"γ chosen by free-run cross-validation ({cv}): {sel.gamma:g}")
     print(table.to_markdown(index=False, floatfmt=".4g"))
