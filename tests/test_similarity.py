@@ -192,25 +192,30 @@ def test_rescale_carries_the_anchor_of_a_similar_model(one_rps, tmp_path, capsys
 
 
 
+def _a_speed_the_model_leaves(path):
+    """The model file's document and a speed its model leaves by 8–40 % in 10 s straight ahead:
+    not steady at its scale; over the tenth of a window, as 10 s are at 100 times the length,
+    it would pass for steady."""
+    from shipid.data.log import STEADY_WINDOW
+    from shipid.dynamics.equilibrium import still_air_accelerations, surge_equilibrium
+    from shipid.reporting.modelfile import model_from_document
+
+    doc = json.loads(path.read_text())
+    model = model_from_document(doc, path)
+    steady = surge_equilibrium(model, doc["identification"]["preprocessing"]["approach_speed"],
+                               N0)  # fmt: skip
+    grid = np.linspace(0.5, 0.99, 50) * steady
+    change = still_air_accelerations(model, grid, 0 * grid, 0 * grid, 0 * grid, N0)[:, 0] \
+        * STEADY_WINDOW / grid  # fmt: skip
+    return doc, float(grid[np.flatnonzero((np.abs(change) > 0.08) & (np.abs(change) < 0.4))[0]])
+
+
 def test_a_rescaled_model_starts_its_manoeuvres_as_its_original(one_rps, tmp_path, capsys):
     """Whether a model holds its training approach is judged over 10 s; its Froude-rescaled
     copy must be judged over √λ times as long, or a training approach it leaves slowly at model
     scale passes for steady at full scale and its manoeuvres start elsewhere (the one-file Esso
     model at 300 m turned a 960 m tactical diameter, its original 8.53 m)."""
-    from shipid.data.log import STEADY_WINDOW
-    from shipid.dynamics.equilibrium import still_air_accelerations, surge_equilibrium
-    from shipid.reporting.modelfile import model_from_document
-
-    doc = json.loads(one_rps["similar"].read_text())
-    model = model_from_document(doc, one_rps["similar"])
-    steady = surge_equilibrium(model, doc["identification"]["preprocessing"]["approach_speed"],
-                               N0)  # fmt: skip
-    # A training approach the model leaves by 5–50 % in 10 s: not steady at its scale, steady
-    # over the tenth of a window 10 s at 100 times the length are.
-    grid = np.linspace(0.5, 0.99, 50) * steady
-    change = still_air_accelerations(model, grid, 0 * grid, 0 * grid, 0 * grid, N0)[:, 0] \
-        * STEADY_WINDOW / grid  # fmt: skip
-    speed = float(grid[np.flatnonzero((np.abs(change) > 0.08) & (np.abs(change) < 0.4))[0]])
+    doc, speed = _a_speed_the_model_leaves(one_rps["similar"])
     doc["identification"]["preprocessing"]["approach_speed"] = speed
     original, big = tmp_path / "original.json", tmp_path / "big.json"
     original.write_text(json.dumps(doc))
@@ -228,24 +233,14 @@ def test_a_rescaled_model_starts_its_manoeuvres_as_its_original(one_rps, tmp_pat
     first, second = (runs[k]["indices"]["tactical_diameter"] for k in ("original", "big"))
     assert second == pytest.approx(100 * first, rel=1e-4)  # each run at its own step
 
+
 def test_the_criteria_of_a_rescaled_model_judge_its_approach_as_its_original(one_rps, tmp_path,
                                                                              capsys):  # fmt: skip
     """The criteria's note on an approach the model does not hold judged over a fixed 10 s: at
     100 times the length, whose times are 10 times as long, a speed the original leaves by 8 %
     in 10 s passed for steady (0.8 %) and the note went missing. Now over √λ × 10 s, the same
     note at both scales."""
-    from shipid.data.log import STEADY_WINDOW
-    from shipid.dynamics.equilibrium import still_air_accelerations, surge_equilibrium
-    from shipid.reporting.modelfile import model_from_document
-
-    doc = json.loads(one_rps["similar"].read_text())
-    model = model_from_document(doc, one_rps["similar"])
-    steady = surge_equilibrium(model, doc["identification"]["preprocessing"]["approach_speed"],
-                               N0)  # fmt: skip
-    grid = np.linspace(0.5, 0.99, 50) * steady
-    change = still_air_accelerations(model, grid, 0 * grid, 0 * grid, 0 * grid, N0)[:, 0] \
-        * STEADY_WINDOW / grid  # fmt: skip
-    speed = float(grid[np.flatnonzero((np.abs(change) > 0.08) & (np.abs(change) < 0.4))[0]])
+    _, speed = _a_speed_the_model_leaves(one_rps["similar"])
     big = tmp_path / "big.json"
     assert run(["rescale", one_rps["similar"], "--factor", "100", "-o", big], capsys)[0] == 0
     notes = {}
