@@ -64,6 +64,11 @@ def test_the_rudder_terms_follow_the_ships_convention():
             sign = -1.0 if "delta" in term else 1.0
             assert flipped[dof][term] == pytest.approx(sign * value, rel=1e-9), (dof, term)
     assert "u^2*delta" in own["v"] and "u^2*delta" in own["r"]
+    # Not known: the rudder's terms get none (the reference's sign could be the wrong one).
+    unknown = reference_prior("scale-ship", structure, ship.length, None)
+    assert {d: set(t) for d, t in unknown.items()} == \
+        {d: {t for t in terms if "delta" not in t} for d, terms in own.items()}  # fmt: skip
+    assert unknown["v"]["u*v"] == pytest.approx(own["v"]["u*v"], rel=1e-12)
 
 
 def test_the_cross_flow_terms_are_fitted_on_the_references_hull():

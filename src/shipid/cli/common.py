@@ -267,6 +267,10 @@ def _physics(args, logs, structure, searched: bool = False):
             raise ShipidError(f"--prior {args.prior} needs the ship's length (--particulars FILE)")
         sign = rudder_sign(logs)
         side = None if sign is None else ("starboard" if sign > 0 else "port")
+        if side is None:
+            _warn(f"--prior {args.prior}: the logs do not say which way a positive rudder turns "
+                  "the ship (rudder_positive), so the rudder's terms get no prior (the "
+                  "reference's sign could be the opposite of the logs')")  # fmt: skip
         prior = reference_prior(args.prior, structure, part.length, side)
         source = (f"the reference ship {args.prior}'s 10°/10° and 20°/20° zig-zags and 35° turns "
                   f"fitted in this structure, carried to L = {part.length:g} m at equal Froude "

@@ -171,7 +171,8 @@ def reference_prior(name: str, structure: ModelStructure, length: float,
     terms fitted (LS-SVM, γ = 1e4) on the reference's noise-free 10°/10° and 20°/20° zig-zags
     and 35° turns to both sides, carried to ``length`` at equal Froude number
     (``shipid.dynamics.prime.froude_scaled``), the rudder in the ship's convention
-    (``rudder_positive``; None: the reference's).
+    (``rudder_positive``; None, not known: the terms that change sign with the rudder's get no
+    prior, as the Clarke prior's rudder without it).
 
     Only the terms the reference can give and whose prime coefficient does not depend on the
     speed it is taken at get a prior: those of u, v, r and δ alone (no propeller speed, wind or
@@ -186,7 +187,13 @@ def reference_prior(name: str, structure: ModelStructure, length: float,
     if not (math.isfinite(length) and length > 0):
         raise ShipidError(f"a reference prior needs the ship's length (> 0), got {length!r}")
     logs, ship = _reference_trials(name)
-    if rudder_positive is not None and rudder_positive != ship.rudder_positive:
+    if rudder_positive is None:
+        # Both conventions; what the rudder's sign changes is left out.
+        one, other = (reference_prior(name, structure, length, side)
+                      for side in ("starboard", "port"))  # fmt: skip
+        return {d: {t: v for t, v in terms.items() if math.isclose(v, other[d][t])}
+                for d, terms in one.items()}  # fmt: skip
+    if rudder_positive != ship.rudder_positive:
         # The same trials in the ship's convention: the rudder's column changes sign.
         logs = tuple(log.assign(delta=-log["delta"]) for log in logs)
         for log in logs:
