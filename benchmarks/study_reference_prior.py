@@ -10,7 +10,9 @@ number, the LS-SVM drawn toward it. Judged on logs the models were not fitted to
    ``study_crossflow.py`` judges; with ``pairs``, every pair of the files too (the cross-flow
    rows at γ 1 and 10, as ``study_crossflow.py pairs`` judges);
 2. the real KVLCC2: identified on MARIN's 20/20 zig-zag (its particulars), judged on the −20/−20
-   run and HSVA's 20/10, the KVLCC2's own MMG model as the reference.
+   run and HSVA's 20/10, the KVLCC2's own MMG model as the reference;
+3. the ``tanker`` as a truth (another VLCC) with the KVLCC2 as the reference, judged on its own
+   turns and zig-zag as ``study_tanker.py`` judges.
 
 Run: .venv/bin/python benchmarks/study_reference_prior.py [pairs]
 """
@@ -81,6 +83,43 @@ def kvlcc2() -> None:
     print(f"\nmeasured overshoots: {'; '.join(measured)}")
 
 
+def tanker(seeds: int = 3) -> None:
+    """The ``tanker`` as the truth (another VLCC, van Berlekom and Goddard's; its logs at the sea
+    sensors' noise as ``study_tanker.py`` makes them, its length given), the KVLCC2 as the
+    reference."""
+    import json
+    from pathlib import Path
+
+    import study_tanker as st
+    from cli_models import model_by_cli, noisy_files
+
+    clean, truth = st.trials(), st.truth_indices()
+    print("\nThe tanker as the truth, the KVLCC2 as the reference (identify --model blanke-speed "
+          f"--crossflow, the tanker's length), {seeds} seeds: 35° TD and steady r |error| median "
+          "(largest), 20° TD error median, 10°/10° worst overshoot error median (largest)\n")
+    print("| trained on | made by | 35° TD | 35° steady r | 20° TD | 10°/10° |")
+    print("|---|---|---|---|---|---|")
+    made = {"blanke-speed --crossflow": [],
+            "  --prior kvlcc2 --gamma 1": ["--prior", "kvlcc2", "--gamma", "1"],
+            "  --prior kvlcc2 --gamma auto": ["--prior", "kvlcc2", "--gamma", "auto"]}
+    rows: dict[tuple[str, str], list[dict]] = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        particulars = Path(tmp) / "tanker.json"
+        particulars.write_text(json.dumps({"length": 304.8}))
+        for seed in range(seeds):
+            paths = noisy_files(clean, st.SEA_SENSORS, seed, tmp)
+            for label in list(st.TRAINING)[:2]:
+                files = [paths[f"{n}_{rpm}"] for n, rpm in st.TRAINING[label]]
+                for how, flags in made.items():
+                    model = model_by_cli(["identify", "--particulars", str(particulars), "--model",
+                                          "blanke-speed", "--crossflow", *flags], files,
+                                         f"{tmp}/model.json")  # fmt: skip
+                    if model is not None:
+                        rows.setdefault((label, how), []).append(st.judged(model, truth))
+    for (label, how), judged in rows.items():
+        print(f"| {label} | {how.rstrip()} | " + " | ".join(st.summary(judged)) + " |")
+
+
 def pairs() -> None:
     print()
     esso(True, {k: ESSO_CONFIGS[k] for k in ("blanke-speed+wind --crossflow",
@@ -90,5 +129,5 @@ def pairs() -> None:
 
 if __name__ == "__main__":
     warnings.simplefilter("ignore")
-    run_with_files(lambda _: esso(False, ESSO_CONFIGS), lambda _: kvlcc2(),
+    run_with_files(lambda _: esso(False, ESSO_CONFIGS), lambda _: kvlcc2(), lambda _: tanker(),
                    *([lambda _: pairs()] if "pairs" in sys.argv[1:] else []))
