@@ -3,7 +3,8 @@ speed, straight-line stability, the automatic prefilter and a bootstrap, against
 the same data in the same process, at 450, 4 500 and 45 000 samples (zig-zags of the paper's ship
 with its sensor noise). The paper's ship is stable, so ``stable`` only checks its rows there; a
 second table fits a straight-line unstable ship, where the constraint holds (SLSQP and the exact
-polish); a third, output error with the sign bounds against the free output-error fit.
+polish); a third, output error with the sign bounds against the free output-error fit; a
+fourth, what a reference ship's prior (``--prior SHIP``) costs.
 
 Run: .venv/bin/python benchmarks/bench_physics.py
 """
@@ -49,6 +50,7 @@ def main() -> None:
         print(f"| {len(log)} | {plain:.3f} | {cells} |")
     unstable_ship()
     bounded_output_error()
+    reference_prior_cost()
 
 
 UNSTABLE = "u: |u|*u, 1; v: u*v, u*r, u^2*delta; r: u*v, u*r, |r|*r, u^2*delta"
@@ -92,6 +94,35 @@ def bounded_output_error() -> None:
         fit = output_error(start, log, bounds=bounds, reasons=reasons)[0]
         at = ", ".join(f"{d}: {t}" for d, t in fit.statistics["at_bound"]) or "none"
         print(f"| {len(log)} | {free:.3f} | {held:.3f} ({held / free:.1f}×) | {at} |")
+
+
+def reference_prior_cost() -> None:
+    """``--prior SHIP``: the reference's trials simulated (once per process) and fitted in the
+    structure, then carried to the ship's length; against the plain fit of a 451-sample zig-zag
+    and the fit with the prior, in the same process. The first call per reference is timed once
+    (its cache cleared), the next ones as the best of three."""
+    import time
+
+    from shipid.dynamics.model import get_structure
+    from shipid.identification.priors import _reference_trials, reference_prior
+
+    log = PAPER_IMU.apply(zigzag(scale_ship(rudder_rate_deg=9.6), 20, 20, duration=90, dt=0.2,
+                                 method="euler").log, seed=1)  # fmt: skip
+    structure = get_structure("blanke-speed").with_crossflow_hull(4.389)
+    plain = best_of(lambda: identify(log, model=structure))
+    print("\n| reference | prior, first call (s) | prior, cached trials (s) | fit with the prior "
+          "(s) | plain fit (s) |")  # fmt: skip
+    print("|---|---|---|---|---|")
+    for name in ("kvlcc2", "mariner", "tanker", "cybership2", "scale-ship"):
+        _reference_trials.cache_clear()
+        t0 = time.perf_counter()
+        reference_prior(name, structure, 4.389, "port")
+        first = time.perf_counter() - t0
+        cached = best_of(lambda n=name: reference_prior(n, structure, 4.389, "port"))
+        physics = PhysicsOptions(prior=reference_prior(name, structure, 4.389, "port"))
+        fit = best_of(lambda ph=physics: identify(log, model=structure, gamma=1.0, physics=ph))
+        print(f"| {name} | {first:.3f} | {cached:.3f} | {fit:.3f} ({fit / plain:.1f}×) | "
+              f"{plain:.3f} |")
 
 
 if __name__ == "__main__":
