@@ -152,3 +152,67 @@ def test_gamma_auto_with_a_reference_prior_searches_where_the_prior_leads(tmp_pa
     assert code == 0, err
     assert "γ chosen by free-run cross-validation (blocks:4): 10\n" in said
     assert json.loads(out.read_text())["identification"]["gamma"] == 10
+
+
+def _froude_log(log, k: float):
+    """``log`` of a geometrically similar ship ``k`` times as long at equal Froude number."""
+    out = log.copy()
+    root = k**0.5
+    out["t"] = log["t"] * root
+    for c in ("u", "v"):
+        out[c] = log[c] * root
+    out["r"] = log["r"] / root
+    for c in ("x", "y"):
+        out[c] = log[c] * k
+    out.attrs = dict(log.attrs)
+    return out
+
+
+def test_a_model_file_as_the_prior_is_carried_to_the_logs_length_and_rudder(tmp_path, capsys):
+    """``--prior MODEL.json`` took the file's coefficients as they were: a model of the ship at
+    another length (a sister ship, a basin model) drew the fit toward coefficients of the wrong
+    size, and one fitted on logs of the other rudder convention toward a rudder of the wrong
+    sign, silently. Now the file's model is carried to the logs' length at equal Froude number
+    and to their rudder convention: the fit with it is the same fit at either length or
+    convention."""
+    from shipid.data.io import write_log
+    from shipid.dynamics.prime import froude_scaled
+    from shipid.reporting.modelfile import load_model
+    from shipid.trials.manoeuvres import zigzag
+
+    ship = get_vessel("scale-ship")
+    log = zigzag(ship, 20, 20, duration=90, dt=0.2, method="euler").log
+    length = ship.length
+    (tmp_path / "p.json").write_text(json.dumps({"length": length}))
+    write_log(log, tmp_path / "zz.csv")
+    base = ["identify", "--model", "blanke", "--filter", "none", "--no-output-error"]
+    assert run([*base, tmp_path / "zz.csv", "--particulars", tmp_path / "p.json", "-o",
+                tmp_path / "prior.json"], capsys)[0] == 0  # fmt: skip
+    # The prior's own ship, noise-free, 10°/10' zig-zag: its fit at γ = 1 with the prior.
+    other = zigzag(ship, 10, 10, duration=90, dt=0.2, method="euler").log
+    cases = {"same": (other, length, "port"), "twice as long": (_froude_log(other, 2.0),
+             2 * length, "port"), "starboard-positive": (other.assign(delta=-other["delta"]),
+             length, "starboard")}  # fmt: skip
+    fits = {}
+    for key, (lg, L, side) in cases.items():
+        lg.attrs["rudder_positive"] = side
+        path = write_log(lg, tmp_path / f"{key}.csv")
+        (tmp_path / f"{key}.p.json").write_text(json.dumps({"length": L}))
+        code, said, err = run([*base, path, "--particulars", tmp_path / f"{key}.p.json",
+                               "--prior", tmp_path / "prior.json", "--gamma", "1", "-o",
+                               tmp_path / f"{key}.json"], capsys)  # fmt: skip
+        assert code == 0, err
+        fits[key] = load_model(tmp_path / f"{key}.json")
+        if key != "same":
+            assert "prior: the model file" in said and (
+                "carried from L = " in said if L != length else "rudder" in said), said
+    want = froude_scaled(fits["same"], 2.0)
+    for dof, terms in want.coefficients.items():
+        for term, value in terms.items():
+            # (to 0.1 %: the regularisation weighs the terms by their size, which the length
+            # changes)
+            assert fits["twice as long"].coefficients[dof][term] == pytest.approx(
+                value, rel=1e-3, abs=1e-9), (dof, term)  # fmt: skip
+            sign = -1.0 if "delta" in term and "delta^2" not in term else 1.0
+            assert fits["starboard-positive"].coefficients[dof][term] == pytest.approx(
+                sign * fits["same"].coefficients[dof][term], rel=1e-6, abs=1e-12), (dof, term)

@@ -288,12 +288,51 @@ def _physics(args, logs, structure, searched: bool = False):
                   "cross-flow drag (10 % against 11 %: benchmarks/study_reference_prior.py)")
     elif args.prior:
         from shipid.identification.priors import prior_from_model
-        from shipid.reporting.modelfile import load_document, model_from_document
 
-        prior = prior_from_model(model_from_document(load_document(args.prior), args.prior))
+        model, source = _model_file_prior(args.prior, logs)
+        prior = prior_from_model(model)
     options = PhysicsOptions(prior=prior, bounds=bounds or None, approach=tuple(steady) or None,
                              prior_source=source, **flags)  # fmt: skip
     return options if options.active else None
+
+
+def _model_file_prior(path: str, logs) -> tuple:
+    """The model of the file ``path`` as a prior for ``logs``: carried to their ship's length at
+    equal Froude number where both lengths are known and differ (a sister ship, a basin model),
+    and to their rudder convention where both are known and differ (as a log is converted); and
+    where it comes from, in words."""
+    from shipid.data.particulars import Particulars, logs_particulars
+    from shipid.dynamics.prime import froude_scaled
+    from shipid.identification.physics import rudder_sign
+    from shipid.identification.priors import mirrored_rudder
+    from shipid.reporting.modelfile import load_document, model_from_document
+
+    doc = load_document(path)
+    model = model_from_document(doc, path)
+    said = []
+    theirs = Particulars.from_mapping(doc["particulars"], f"{path}: particulars").length \
+        if doc.get("particulars") else None  # fmt: skip
+    part = logs_particulars(logs)
+    ours = part.length if part is not None else None
+    if theirs and ours and not math.isclose(theirs, ours, rel_tol=1e-3):
+        model = froude_scaled(model, ours / theirs)
+        said.append(f"carried from L = {theirs:g} m to the logs' {ours:g} m at equal Froude "
+                    "number")  # fmt: skip
+    elif bool(theirs) != bool(ours):
+        _warn(f"--prior {path}: the {'logs' if theirs else 'model file'}' ship length is not "
+              "known, so the prior's coefficients are taken at the size they have (give "
+              "--particulars)")  # fmt: skip
+    prep = ((doc.get("identification") or {}).get("preprocessing") or {})
+    side_then = prep.get("rudder_positive") if isinstance(prep, dict) else None
+    sign = rudder_sign(logs)
+    side_now = None if sign is None else ("starboard" if sign > 0 else "port")
+    if side_then in ("port", "starboard") and side_now and side_then != side_now:
+        model, dropped = mirrored_rudder(model)
+        said.append(f"its rudder from the {side_then}-positive convention it was fitted in to "
+                    f"the logs' {side_now}-positive one" + (
+                        f" (no prior on {', '.join(dropped)}, one side of the rudder)"
+                        if dropped else ""))  # fmt: skip
+    return model, f"the model file {path}" + (f", {'; '.join(said)}" if said else "")
 
 
 def _term_display(text: str) -> str:

@@ -115,6 +115,36 @@ def clarke_prior(p: Particulars, structure: ModelStructure, speed: float,
     return prior
 
 
+def mirrored_rudder(model: ManoeuvringModel) -> tuple[ManoeuvringModel, list[str]]:
+    """``model`` in the other rudder convention (δ → −δ): the coefficients of terms odd in δ
+    negate, of terms even in δ stay; a term neither (``pos(delta)``: one side of the rudder) has
+    no such twin and is dropped, named in the returned list."""
+    from shipid.dynamics.terms import INPUT_SIGNALS, term_matrix
+
+    rng = np.random.default_rng(0)
+    texts = model.structure.all_terms
+    n = 16
+    signals = {s: rng.uniform(0.2, 1.5, n) * rng.choice([-1.0, 1.0], n)
+               for s in ("u", "v", "r", *INPUT_SIGNALS)}  # fmt: skip
+    inputs = {k: v for k, v in signals.items() if k in INPUT_SIGNALS}
+    plus = term_matrix(texts, signals["u"], signals["v"], signals["r"], inputs)
+    minus = term_matrix(texts, signals["u"], signals["v"], signals["r"],
+                        {**inputs, "delta": -inputs["delta"]})  # fmt: skip
+    factor, dropped = {}, []
+    for j, text in enumerate(texts):
+        if np.allclose(minus[:, j], plus[:, j]):
+            factor[text] = 1.0
+        elif np.allclose(minus[:, j], -plus[:, j]):
+            factor[text] = -1.0
+        else:
+            dropped.append(text)
+    keep = {d: tuple(t for t in ts if t in factor) for d, ts in model.structure.terms.items()}
+    coefs = {d: {t: factor[t] * c for t, c in model.coefficients[d].items() if t in factor}
+             for d in keep}  # fmt: skip
+    return ManoeuvringModel(ModelStructure(model.structure.name, keep), coefs,
+                            name=model.name), dropped  # fmt: skip
+
+
 def prior_from_model(model: ManoeuvringModel) -> dict[str, dict[str, float]]:
     """A model's coefficients as a prior (e.g. a fit of other trials of the same ship)."""
     return {d: {parse_term(t).text: float(c) for t, c in model.coefficients[d].items()}
