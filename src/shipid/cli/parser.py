@@ -178,7 +178,8 @@ def _add_physics_options(p) -> None:
                    "and rudder terms from the particulars, Clarke et al. 1983), a reference "
                    "ship (kvlcc2, mariner, tanker, cybership2, scale-ship: its trials fitted in "
                    "the structure and carried to the particulars' length at equal Froude "
-                   "number) or a model file")
+                   "number) or a model file (carried to the logs' length and rudder "
+                   "convention where the two differ)")
     g.add_argument("--constraints", metavar="LIST",
                    help="comma list: signs (damping, resistance, thrust and rudder terms keep "
                    "their physical sign), derivatives (the linearised damping and rudder "
