@@ -319,7 +319,8 @@ def _model_file_prior(path: str, logs) -> tuple:
         said.append(f"carried from L = {theirs:g} m to the logs' {ours:g} m at equal Froude "
                     "number")  # fmt: skip
     elif bool(theirs) != bool(ours):
-        _warn(f"--prior {path}: the {'logs' if theirs else 'model file'}' ship length is not "
+        whose = "logs'" if theirs else "model file's"
+        _warn(f"--prior {path}: the {whose} ship length is not "
               "known, so the prior's coefficients are taken at the size they have (give "
               "--particulars)")  # fmt: skip
     prep = ((doc.get("identification") or {}).get("preprocessing") or {})
