@@ -216,3 +216,21 @@ def test_a_model_file_as_the_prior_is_carried_to_the_logs_length_and_rudder(tmp_
             sign = -1.0 if "delta" in term and "delta^2" not in term else 1.0
             assert fits["starboard-positive"].coefficients[dof][term] == pytest.approx(
                 sign * fits["same"].coefficients[dof][term], rel=1e-6, abs=1e-12), (dof, term)
+
+
+def test_a_model_file_prior_of_unknown_length_is_taken_as_it_is_and_said(tmp_path, capsys):
+    """Where only one of the prior's file and the logs gives the ship's length, nothing says
+    how to carry the prior: it is taken at the size it has, and a warning says so."""
+    from shipid.data.io import write_log
+    from shipid.trials.manoeuvres import zigzag
+
+    log = write_log(zigzag(get_vessel("scale-ship"), 20, 20, duration=60, dt=0.2,
+                           method="euler").log, tmp_path / "zz.csv")  # fmt: skip
+    base = ["identify", log, "--model", "blanke", "--no-output-error", "--filter", "none"]
+    assert run([*base, "-o", tmp_path / "prior.json"], capsys)[0] == 0
+    (tmp_path / "p.json").write_text(json.dumps({"length": 4.389}))
+    code, _, err = run([*base, "--particulars", tmp_path / "p.json", "--prior",
+                        tmp_path / "prior.json", "-o", tmp_path / "m.json"], capsys)  # fmt: skip
+    assert code == 0, err
+    assert "the model file's ship length is not known, so the prior's coefficients are taken " \
+           "at the size they have" in err  # fmt: skip
