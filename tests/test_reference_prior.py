@@ -234,3 +234,33 @@ def test_a_model_file_prior_of_unknown_length_is_taken_as_it_is_and_said(tmp_pat
     assert code == 0, err
     assert "the model file's ship length is not known, so the prior's coefficients are taken " \
            "at the size they have" in err  # fmt: skip
+
+
+def test_a_model_file_prior_written_for_every_rps_holds_the_fit_at_one(tmp_path, capsys):
+    """A model file of logs at one propeller speed is written for every rps (δ as n²δ, δ² as
+    n²δ²); as the prior of a fit at one rps those terms had none and were drawn toward 0 (the
+    Esso's own earlier fit as its prior at γ = 1 put δ² at a tenth of its value). Now each takes
+    the prior's value at the logs' rps: the ship's own fit as the prior gives it back."""
+    from shipid.reporting.modelfile import load_document
+
+    log = _paper_log_at_one_rps(tmp_path)
+    base = ["identify", log, "--model", "blanke", "--no-output-error", "--filter", "none"]
+    assert run([*base, "-o", tmp_path / "own.json"], capsys)[0] == 0
+    code, _, err = run([*base, "--prior", tmp_path / "own.json", "--gamma", "1", "-o",
+                        tmp_path / "again.json"], capsys)  # fmt: skip
+    assert code == 0, err
+    own, again = (load_document(tmp_path / f"{k}.json")["model"]["coefficients"]
+                  for k in ("own", "again"))  # fmt: skip
+    assert "n^2*delta^2" in own["u"] and "n^2*delta" in own["r"]
+    for dof, terms in own.items():
+        for term, value in terms.items():
+            assert again[dof][term] == pytest.approx(value, rel=1e-2, abs=1e-9), (dof, term)
+
+
+def _paper_log_at_one_rps(folder):
+    """The paper's ship's 20°/20° zig-zag with its propeller logged at one 10 rps."""
+    from shipid.data.io import write_log
+    from shipid.trials.manoeuvres import zigzag
+
+    log = zigzag(get_vessel("scale-ship"), 20, 20, duration=90, dt=0.2, method="euler").log
+    return write_log(log.assign(n=10.0), folder / "zz_n.csv")

@@ -193,11 +193,19 @@ def _one_rps(logs, args) -> float | None:
     records it), where it is one and positive and the model is to be carried to the others by
     advance-ratio similarity (``shipid.dynamics.similarity``; not with --no-rps-similarity);
     else None."""
+    if not getattr(args, "rps_similarity", True):
+        return None
+    return _constant_rps(logs)
+
+
+def _constant_rps(logs) -> float | None:
+    """The one positive propeller speed the logs run at (their approaches' median), else None
+    (no rps logged, or one that varies)."""
     import numpy as np
 
     from shipid.identification.identify import varies
 
-    if not getattr(args, "rps_similarity", True) or not all("n" in log.columns for log in logs):
+    if not all("n" in log.columns for log in logs):
         return None
     n = np.concatenate([log["n"].to_numpy(dtype=float) for log in logs])
     # Anchored at the median of the logs' approach rps, which the fit stands for whatever their
@@ -291,6 +299,11 @@ def _physics(args, logs, structure, searched: bool = False):
 
         model, source = _model_file_prior(args.prior, logs)
         prior = prior_from_model(model)
+        rps = _constant_rps(logs)
+        if rps is not None:
+            from shipid.identification.priors import prior_at_rps
+
+            prior = prior_at_rps(prior, structure, rps)
     options = PhysicsOptions(prior=prior, bounds=bounds or None, approach=tuple(steady) or None,
                              prior_source=source, **flags)  # fmt: skip
     return options if options.active else None

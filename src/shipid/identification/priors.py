@@ -145,6 +145,24 @@ def mirrored_rudder(model: ManoeuvringModel) -> tuple[ManoeuvringModel, list[str
                             name=model.name), dropped  # fmt: skip
 
 
+def prior_at_rps(prior: dict[str, dict[str, float]], structure: ModelStructure,
+                 rps: float) -> dict[str, dict[str, float]]:  # fmt: skip
+    """``prior`` with a value for each term of ``structure`` fitted at the one propeller speed
+    ``rps`` that the prior holds in its advance-ratio similar form (a model file written for every
+    rps: δ as n²δ, the constant as |n|n; ``shipid.dynamics.similarity``): that term's value at
+    ``rps``. Without it those terms had no prior, and were drawn toward 0."""
+    from shipid.dynamics.similarity import similar_term
+
+    out = {d: dict(v) for d, v in prior.items()}
+    for dof, terms in structure.terms.items():
+        given = out.get(dof, {})
+        for text in terms:
+            similar, k = similar_term(text)
+            if k and text not in given and similar in given:
+                out.setdefault(dof, {})[text] = given[similar] * rps**k
+    return out
+
+
 def prior_from_model(model: ManoeuvringModel) -> dict[str, dict[str, float]]:
     """A model's coefficients as a prior (e.g. a fit of other trials of the same ship)."""
     return {d: {parse_term(t).text: float(c) for t, c in model.coefficients[d].items()}
