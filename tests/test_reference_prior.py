@@ -1,5 +1,7 @@
-"""A reference ship as the prior (``--prior SHIP``, issue #10 item 2): the reference's trials
-fitted in the structure identified, carried to the ship's length at equal Froude number."""
+"""Priors from other ships and other model files (issue #10 item 2): a reference ship
+(``--prior SHIP``: its trials fitted in the structure identified, carried to the ship's length
+at equal Froude number), and a model file (``--prior MODEL.json``) carried to the logs' length,
+rudder convention and propeller speed."""
 
 import json
 from pathlib import Path
