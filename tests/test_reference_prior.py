@@ -88,6 +88,10 @@ def test_the_cross_flow_terms_are_fitted_on_the_references_hull():
     (["--prior", "kvlcc2", "--model", "blanke"], "needs the ship's length (--particulars FILE)"),
     (["--prior", "kvlcc2"], "is fitted in the structure it is for: give the structure with "
                             "--model NAME"),
+    # Read as a model file before, 'kvlc2: no such model file'.
+    (["--prior", "kvlc2", "--model", "blanke"], "--prior kvlc2: no such model file, and not "
+                                                "'clarke' nor a reference ship (scale-ship"),
+    (["--prior", "KVLCC2", "--model", "blanke"], "--prior kvlcc2 needs the ship's length"),
 ])  # fmt: skip
 def test_bad_reference_priors_are_one_line(tmp_path, capsys, argv, match):
     from shipid.data.io import write_log

@@ -247,7 +247,13 @@ def _physics(args, logs, structure, searched: bool = False):
         steady = similar_steady_speeds(steady, _one_rps(logs, args))
     bounds = _parse_bounds(args.bound)
     prior, source = None, ""
-    if args.prior == "clarke":
+    name = args.prior
+    if name and not Path(name).exists() and name.lower() in ("clarke", *_vessel_names()):
+        name = name.lower()  # --prior KVLCC2, Clarke: a name, not a file
+    if name and name != "clarke" and name not in _vessel_names() and not Path(name).exists():
+        raise ShipidError(f"--prior {name}: no such model file, and not 'clarke' nor a reference "
+                          f"ship ({', '.join(_vessel_names())})")  # fmt: skip
+    if name == "clarke":
         from shipid.data.particulars import logs_particulars
         from shipid.identification.priors import clarke_prior
 
@@ -259,28 +265,28 @@ def _physics(args, logs, structure, searched: bool = False):
         side = None if sign is None else ("starboard" if sign > 0 else "port")
         speed = _approach(logs[0], "u")
         prior = clarke_prior(part, structure, speed or 0.0, side)
-    elif args.prior and args.prior in _vessel_names():
+    elif name and name in _vessel_names():
         from shipid.data.particulars import logs_particulars
 
         if searched:
             # Fitted on the reference jointly, a library's terms would share its forces among
             # them at random: the prior is for the structure fitted.
-            raise ShipidError(f"--prior {args.prior} is fitted in the structure it is for: give "
+            raise ShipidError(f"--prior {name} is fitted in the structure it is for: give "
                               "the structure with --model NAME (identify; not select, nor "
                               "identify's own choice of structure)")
         from shipid.identification.priors import reference_prior
 
         part = logs_particulars(logs)
         if part is None or part.length is None:
-            raise ShipidError(f"--prior {args.prior} needs the ship's length (--particulars FILE)")
+            raise ShipidError(f"--prior {name} needs the ship's length (--particulars FILE)")
         sign = rudder_sign(logs)
         side = None if sign is None else ("starboard" if sign > 0 else "port")
         if side is None:
-            _warn(f"--prior {args.prior}: the logs do not say which way a positive rudder turns "
+            _warn(f"--prior {name}: the logs do not say which way a positive rudder turns "
                   "the ship (rudder_positive), so the rudder's terms get no prior (the "
                   "reference's sign could be the opposite of the logs')")  # fmt: skip
-        prior = reference_prior(args.prior, structure, part.length, side)
-        source = (f"the reference ship {args.prior}'s 10°/10° and 20°/20° zig-zags and 35° turns "
+        prior = reference_prior(name, structure, part.length, side)
+        source = (f"the reference ship {name}'s 10°/10° and 20°/20° zig-zags and 35° turns "
                   f"fitted in this structure, carried to L = {part.length:g} m at equal Froude "
                   "number: " + "; ".join(f"{d}: {', '.join(terms)}" for d, terms in prior.items()))
         split = [t for t in SPLIT_DAMPING
@@ -288,7 +294,7 @@ def _physics(args, logs, structure, searched: bool = False):
         if split:
             from shipid.dynamics.terms import parse_term
 
-            _warn(f"--prior {args.prior}: the structure splits the hull's nonlinear damping over "
+            _warn(f"--prior {name}: the structure splits the hull's nonlinear damping over "
                   f"{', '.join(parse_term(t).display() for t in split)}, which share it "
                   "differently on every hull: the reference's share carries over, not its hull "
                   "(the Esso Osaka's one-file fits from the KVLCC2 at γ = 1: 35° turns 79 % off "
