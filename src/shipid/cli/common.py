@@ -234,7 +234,6 @@ def _physics(args, logs, structure, searched: bool = False):
         PhysicsOptions,
         parse_constraints,
         parse_steady_speeds,
-        rudder_sign,
         similar_steady_speeds,
     )
 
@@ -261,45 +260,10 @@ def _physics(args, logs, structure, searched: bool = False):
         part = logs_particulars(logs)
         if part is None:
             raise ShipidError("--prior clarke needs the ship's particulars (--particulars FILE)")
-        sign = rudder_sign(logs)
-        side = None if sign is None else ("starboard" if sign > 0 else "port")
         speed = _approach(logs[0], "u")
-        prior = clarke_prior(part, structure, speed or 0.0, side)
+        prior = clarke_prior(part, structure, speed or 0.0, _logs_side(logs))
     elif name and name in _vessel_names():
-        from shipid.data.particulars import logs_particulars
-
-        if searched:
-            # Fitted on the reference jointly, a library's terms would share its forces among
-            # them at random: the prior is for the structure fitted.
-            raise ShipidError(f"--prior {name} is fitted in the structure it is for: give "
-                              "the structure with --model NAME (identify; not select, nor "
-                              "identify's own choice of structure)")
-        from shipid.identification.priors import reference_prior
-
-        part = logs_particulars(logs)
-        if part is None or part.length is None:
-            raise ShipidError(f"--prior {name} needs the ship's length (--particulars FILE)")
-        sign = rudder_sign(logs)
-        side = None if sign is None else ("starboard" if sign > 0 else "port")
-        if side is None:
-            _warn(f"--prior {name}: the logs do not say which way a positive rudder turns "
-                  "the ship (rudder_positive), so the rudder's terms get no prior (the "
-                  "reference's sign could be the opposite of the logs')")  # fmt: skip
-        prior = reference_prior(name, structure, part.length, side)
-        source = (f"the reference ship {name}'s 10°/10° and 20°/20° zig-zags and 35° turns "
-                  f"fitted in this structure, carried to L = {part.length:g} m at equal Froude "
-                  "number: " + "; ".join(f"{d}: {', '.join(terms)}" for d, terms in prior.items()))
-        split = [t for t in SPLIT_DAMPING
-                 if any(t in structure.terms.get(d, ()) for d in ("v", "r"))]  # fmt: skip
-        if split:
-            from shipid.dynamics.terms import parse_term
-
-            _warn(f"--prior {name}: the structure splits the hull's nonlinear damping over "
-                  f"{', '.join(parse_term(t).display() for t in split)}, which share it "
-                  "differently on every hull: the reference's share carries over, not its hull "
-                  "(the Esso Osaka's one-file fits from the KVLCC2 at γ = 1: 35° turns 79 % off "
-                  "in the median against 35 % without it); --crossflow makes it one term, the "
-                  "cross-flow drag (10 % against 11 %: benchmarks/study_reference_prior.py)")
+        prior, source = _reference_ship_prior(name, logs, structure, searched)
     elif args.prior:
         from shipid.identification.priors import prior_from_model
 
@@ -315,6 +279,53 @@ def _physics(args, logs, structure, searched: bool = False):
     return options if options.active else None
 
 
+def _reference_ship_prior(name: str, logs, structure, searched: bool) -> tuple[dict, str]:
+    """``--prior SHIP``: the reference ship ``name``'s prior for ``structure`` at the logs'
+    length and rudder convention (``priors.reference_prior``), and where it comes from."""
+    from shipid.data.particulars import logs_particulars
+
+    if searched:
+        # Fitted on the reference jointly, a library's terms would share its forces among
+        # them at random: the prior is for the structure fitted.
+        raise ShipidError(f"--prior {name} is fitted in the structure it is for: give "
+                          "the structure with --model NAME (identify; not select, nor "
+                          "identify's own choice of structure)")
+    from shipid.identification.priors import reference_prior
+
+    part = logs_particulars(logs)
+    if part is None or part.length is None:
+        raise ShipidError(f"--prior {name} needs the ship's length (--particulars FILE)")
+    side = _logs_side(logs)
+    if side is None:
+        _warn(f"--prior {name}: the logs do not say which way a positive rudder turns "
+              "the ship (rudder_positive), so the rudder's terms get no prior (the "
+              "reference's sign could be the opposite of the logs')")  # fmt: skip
+    prior = reference_prior(name, structure, part.length, side)
+    source = (f"the reference ship {name}'s 10°/10° and 20°/20° zig-zags and 35° turns "
+              f"fitted in this structure, carried to L = {part.length:g} m at equal Froude "
+              "number: " + "; ".join(f"{d}: {', '.join(terms)}" for d, terms in prior.items()))
+    split = [t for t in SPLIT_DAMPING
+             if any(t in structure.terms.get(d, ()) for d in ("v", "r"))]  # fmt: skip
+    if split:
+        from shipid.dynamics.terms import parse_term
+
+        _warn(f"--prior {name}: the structure splits the hull's nonlinear damping over "
+              f"{', '.join(parse_term(t).display() for t in split)}, which share it "
+              "differently on every hull: the reference's share carries over, not its hull "
+              "(the Esso Osaka's one-file fits from the KVLCC2 at γ = 1: 35° turns 79 % off "
+              "in the median against 35 % without it); --crossflow makes it one term, the "
+              "cross-flow drag (10 % against 11 %: benchmarks/study_reference_prior.py)")
+    return prior, source
+
+
+def _logs_side(logs) -> str | None:
+    """'port' or 'starboard': where a positive rudder turns the logs' ship; None, not known."""
+    from shipid.identification.physics import rudder_sign
+
+    sign = rudder_sign(logs)
+    return None if sign is None else ("starboard" if sign > 0 else "port")
+
+
 def _model_file_prior(path: str, logs) -> tuple:
     """The model of the file ``path`` as a prior for ``logs``: carried to their ship's length at
     equal Froude number where both lengths are known and differ (a sister ship, a basin model),
@@ -322,7 +333,6 @@ def _model_file_prior(path: str, logs) -> tuple:
     where it comes from, in words."""
     from shipid.data.particulars import Particulars, logs_particulars
     from shipid.dynamics.prime import froude_scaled
-    from shipid.identification.physics import rudder_sign
     from shipid.identification.priors import mirrored_rudder
     from shipid.reporting.modelfile import load_document, model_from_document
 
@@ -344,8 +354,7 @@ def _model_file_prior(path: str, logs) -> tuple:
               "--particulars)")  # fmt: skip
     prep = ((doc.get("identification") or {}).get("preprocessing") or {})
     side_then = prep.get("rudder_positive") if isinstance(prep, dict) else None
-    sign = rudder_sign(logs)
-    side_now = None if sign is None else ("starboard" if sign > 0 else "port")
+    side_now = _logs_side(logs)
     if side_then in ("port", "starboard") and side_now and side_then != side_now:
         model, dropped = mirrored_rudder(model)
         said.append(f"its rudder from the {side_then}-positive convention it was fitted in to "
