@@ -183,7 +183,9 @@ def _read_files(args, *given) -> list:
     files = [g for g in given if g is not None]
     for option in ("particulars", "prior"):
         value = getattr(args, option, None)
-        if isinstance(value, str | Path) and str(value) != "clarke":
+        # 'clarke' and a reference ship are names, not files (unless such a file exists).
+        if isinstance(value, str | Path) and (
+                Path(value).exists() or str(value).lower() not in ("clarke", *_vessel_names())):
             files.append(value)
     return files
 
@@ -215,10 +217,6 @@ def _constant_rps(logs) -> float | None:
     approaches = [a for a in (_approach(log, "n") for log in logs) if a is not None]
     rps = float(np.median(approaches)) if approaches else None
     return rps if rps is not None and rps > 0 and not varies(n) else None
-
-
-# The terms a structure splits the hull's nonlinear sway and yaw damping into.
-SPLIT_DAMPING = ("|v|*v", "|v|*r", "|r|*r", "v*|r|", "|r|*v", "r*|v|")
 
 
 def _vessel_names() -> tuple[str, ...]:
@@ -304,13 +302,15 @@ def _reference_ship_prior(name: str, logs, structure, searched: bool) -> tuple[d
     source = (f"the reference ship {name}'s 10°/10° and 20°/20° zig-zags and 35° turns "
               f"fitted in this structure, carried to L = {part.length:g} m at equal Froude "
               "number: " + "; ".join(f"{d}: {', '.join(terms)}" for d, terms in prior.items()))
-    split = [t for t in SPLIT_DAMPING
-             if any(t in structure.terms.get(d, ()) for d in ("v", "r"))]  # fmt: skip
+    from shipid.dynamics.model import HULL_DRAG
+    from shipid.dynamics.terms import parse_term
+
+    split = [t for t in map(parse_term, HULL_DRAG)
+             if any(t.text in structure.terms.get(d, ()) for d in ("v", "r"))]  # fmt: skip
     if split:
-        from shipid.dynamics.terms import parse_term
 
         _warn(f"--prior {name}: the structure splits the hull's nonlinear damping over "
-              f"{', '.join(parse_term(t).display() for t in split)}, which share it "
+              f"{', '.join(t.display() for t in split)}, which share it "
               "differently on every hull: the reference's share carries over, not its hull "
               "(the Esso Osaka's one-file fits from the KVLCC2 at γ = 1: 35° turns 79 % off "
               "in the median against 35 % without it); --crossflow makes it one term, the "
@@ -688,6 +688,15 @@ def _check_scale(name: str, cond: dict, scale: float | None, source: str) -> Non
                       "OUT.json)")  # fmt: skip
 
 
+def _steady_window(cond: dict) -> float:
+    """The seconds over which a model's approach is judged steady: ``STEADY_WINDOW`` at the
+    scale it was identified at, √λ times as long for each Froude rescaling by λ since
+    (``modelfile.time_scale``), that a rescaled model start its manoeuvres as its original."""
+    from shipid.data.log import STEADY_WINDOW
+
+    return STEADY_WINDOW * cond.get("time_scale", 1.0)
+
+
 def _run_approach(target, cond: dict, speed: float | None, rps: float | None):
     """Approach speed and rps of a run on ``target``: a reference ship's own trim, or a model's
     steady straight approach (``shipid.dynamics.equilibrium.steady_approach``), printed, with a
@@ -700,10 +709,8 @@ def _run_approach(target, cond: dict, speed: float | None, rps: float | None):
         return speed, rps, None
     if speed is None and not cond["speed"]:
         return None, rps if rps is not None else cond["rps"], None  # the run names what is missing
-    from shipid.data.log import STEADY_WINDOW
-
     app = steady_approach(target, cond["speed"], cond["rps"], speed, rps,
-                          window=STEADY_WINDOW * cond.get("time_scale", 1.0))  # fmt: skip
+                          window=_steady_window(cond))  # fmt: skip
     print(app.describe())
     return app.speed, app.rps, app.warning
 

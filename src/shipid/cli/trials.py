@@ -18,6 +18,7 @@ from shipid.cli.common import (
     _run_approach,
     _ship_or_model,
     _simulated_metadata,
+    _steady_window,
     _steering,
     _step_note,
     _unused_inputs,
@@ -85,11 +86,9 @@ def cmd_criteria(args) -> int:
     rate_note = None
     if args.rudder_rate is None and getattr(target, "steering", None) is None:
         steering, rate_note = _gear_beyond_ships(steering, scale)
-    from shipid.data.log import STEADY_WINDOW
-
     run = partial(imo_criteria, particulars=particulars, length=args.length, speed=speed,
                   scale=scale, rps=rps, steering=steering, astern_rps=args.astern_rps,
-                  dt=args.dt, steady_window=STEADY_WINDOW * cond.get("time_scale", 1.0))  # fmt: skip
+                  dt=args.dt, steady_window=_steady_window(cond))  # fmt: skip
     crit = run(target)
     crit.notes += [rate_note] if rate_note else []
     crit.notes += _unused_inputs(target, args)

@@ -115,14 +115,13 @@ def clarke_prior(p: Particulars, structure: ModelStructure, speed: float,
     return prior
 
 
-def mirrored_rudder(model: ManoeuvringModel) -> tuple[ManoeuvringModel, list[str]]:
-    """``model`` in the other rudder convention (δ → −δ): the coefficients of terms odd in δ
-    negate, of terms even in δ stay; a term neither (``pos(delta)``: one side of the rudder) has
-    no such twin and is dropped, named in the returned list."""
+def rudder_parity(texts) -> dict[str, int]:
+    """Per term, how it answers the rudder's sign (δ → −δ): +1 even (unchanged), −1 odd
+    (negated), 0 neither (``pos(delta)``: one side of the rudder)."""
     from shipid.dynamics.terms import INPUT_SIGNALS, term_matrix
 
+    texts = list(texts)
     rng = np.random.default_rng(0)
-    texts = model.structure.all_terms
     n = 16
     signals = {s: rng.uniform(0.2, 1.5, n) * rng.choice([-1.0, 1.0], n)
                for s in ("u", "v", "r", *INPUT_SIGNALS)}  # fmt: skip
@@ -130,16 +129,19 @@ def mirrored_rudder(model: ManoeuvringModel) -> tuple[ManoeuvringModel, list[str
     plus = term_matrix(texts, signals["u"], signals["v"], signals["r"], inputs)
     minus = term_matrix(texts, signals["u"], signals["v"], signals["r"],
                         {**inputs, "delta": -inputs["delta"]})  # fmt: skip
-    factor, dropped = {}, []
-    for j, text in enumerate(texts):
-        if np.allclose(minus[:, j], plus[:, j]):
-            factor[text] = 1.0
-        elif np.allclose(minus[:, j], -plus[:, j]):
-            factor[text] = -1.0
-        else:
-            dropped.append(text)
-    keep = {d: tuple(t for t in ts if t in factor) for d, ts in model.structure.terms.items()}
-    coefs = {d: {t: factor[t] * c for t, c in model.coefficients[d].items() if t in factor}
+    return {t: 1 if np.allclose(minus[:, j], plus[:, j])
+            else -1 if np.allclose(minus[:, j], -plus[:, j]) else 0
+            for j, t in enumerate(texts)}  # fmt: skip
+
+
+def mirrored_rudder(model: ManoeuvringModel) -> tuple[ManoeuvringModel, list[str]]:
+    """``model`` in the other rudder convention (δ → −δ): the coefficients of terms odd in δ
+    negate, of terms even in δ stay; a term neither (``rudder_parity`` 0) has no such twin and
+    is dropped, named in the returned list."""
+    parity = rudder_parity(model.structure.all_terms)
+    dropped = [t for t, p in parity.items() if not p]
+    keep = {d: tuple(t for t in ts if parity[t]) for d, ts in model.structure.terms.items()}
+    coefs = {d: {t: parity[t] * c for t, c in model.coefficients[d].items() if parity[t]}
              for d in keep}  # fmt: skip
     return ManoeuvringModel(ModelStructure(model.structure.name, keep), coefs,
                             name=model.name), dropped  # fmt: skip
@@ -235,17 +237,6 @@ def reference_prior(name: str, structure: ModelStructure, length: float,
     if not (math.isfinite(length) and length > 0):
         raise ShipidError(f"a reference prior needs the ship's length (> 0), got {length!r}")
     logs, ship = _reference_trials(name)
-    if rudder_positive is None:
-        # Both conventions; what the rudder's sign changes is left out.
-        one, other = (reference_prior(name, structure, length, side)
-                      for side in ("starboard", "port"))  # fmt: skip
-        return {d: {t: v for t, v in terms.items() if math.isclose(v, other[d][t])}
-                for d, terms in one.items()}  # fmt: skip
-    if rudder_positive != ship.rudder_positive:
-        # The same trials in the ship's convention: the rudder's column changes sign.
-        logs = tuple(log.assign(delta=-log["delta"]) for log in logs)
-        for log in logs:
-            log.attrs["rudder_positive"] = rudder_positive
     factor = length / ship.length
     # The structure's cross-flow terms on the reference's hull, and back.
     to_reference = lengthened_terms(structure.all_terms, 1 / factor)
@@ -268,10 +259,16 @@ def reference_prior(name: str, structure: ModelStructure, length: float,
     fit = identify(list(logs), model=ModelStructure(f"{name} reference", terms), gamma=1e4,
                    force=True).model  # fmt: skip
     scaled = froude_scaled(fit, factor)
+    # In the ship's rudder convention, as a log of the other is converted; not known: only the
+    # terms the rudder's sign leaves alone.
+    if rudder_positive is not None and rudder_positive != ship.rudder_positive:
+        scaled = mirrored_rudder(scaled)[0]
+    parity = rudder_parity(scaled.structure.all_terms)
     prior: dict[str, dict[str, float]] = {}
     for dof, coefs in scaled.coefficients.items():
         for text, value in coefs.items():
             original = back.get(text, text)
-            if original in structure.terms.get(dof, ()) and transferable(original):
+            if original in structure.terms.get(dof, ()) and transferable(original) and (
+                    rudder_positive is not None or parity[text] == 1):
                 prior.setdefault(dof, {})[original] = float(value)
     return prior
