@@ -54,6 +54,35 @@ def test_log_round_trip_keeps_times_exactly_and_metadata(tmp_path, ext):
         assert back.attrs[k] == log.attrs[k]
 
 
+
+@pytest.mark.parametrize("ext", [".csv", ".parquet"])
+def test_nested_metadata_is_shared_read_only_and_survives_files_and_pickles(tmp_path, ext):
+    """The particulars (and the sensors' noise) are handed to every column pandas cuts from a
+    log: by reference, as a mapping nobody can change, and as plain JSON in files."""
+    import copy
+    import pickle
+
+    from shipid.data.log import FrozenMapping, make_log
+
+    particulars = {"length": 3.0, "beam": 0.489, "draught": 0.201}
+    log = make_log({"t": np.arange(5.0), "delta": np.zeros(5), "u": np.ones(5),
+                    "v": np.zeros(5), "r": np.zeros(5)}, particulars=particulars,
+                   rudder_positive="starboard")  # fmt: skip
+    shared = log.attrs["particulars"]
+    assert isinstance(shared, FrozenMapping) and shared == particulars
+    assert log["u"].attrs["particulars"] is shared and log.iloc[2:].attrs["particulars"] is shared
+    assert copy.deepcopy(log).attrs["particulars"] is shared
+    with pytest.raises(TypeError, match="read-only"):
+        shared["length"] = 4.0
+    with pytest.raises(TypeError, match="read-only"):
+        shared.update(length=4.0)
+    assert shared == particulars  # the log's own copy is untouched
+    unpickled = pickle.loads(pickle.dumps(log))
+    assert unpickled.attrs["particulars"] == particulars
+    back = read_log(write_log(log, tmp_path / f"log{ext}"))
+    assert {k: back.attrs["particulars"][k] for k in particulars} == particulars
+    assert isinstance(back.attrs["particulars"], FrozenMapping)
+
 @needs_data
 def test_imported_marin_file_identifies_as_is(tmp_path, capsys):
     csv = tmp_path / "zz20.csv"

@@ -42,6 +42,7 @@ def _read_logs(args, paths=None, cut_from_rest: bool = False) -> list:
     given (zig-zags and turns from rest to their manoeuvre, other runs before a propulsion
     dropout: ``shipid.trials.reading.read_trial_log``)."""
     from shipid.data.io import read_log
+    from shipid.data.log import frozen
 
     options = _read_options(args)
     paths = paths or args.logs
@@ -56,7 +57,7 @@ def _read_logs(args, paths=None, cut_from_rest: bool = False) -> list:
     particulars = _particulars(args)
     if particulars is not None:
         for log in logs:
-            log.attrs["particulars"] = particulars.to_dict()
+            log.attrs["particulars"] = frozen(particulars.to_dict())
     return logs
 
 

@@ -30,7 +30,14 @@ from shipid.data.checks import (
 from shipid.data.formats import FORMATS, detect_format, read_format
 from shipid.data.geodetic import GEODETIC_COLUMNS, check_geodetic, local_track
 from shipid.data.header_units import si_factors, split_units
-from shipid.data.log import COLUMNS, REQUIRED, csv_metadata_line, metadata, parse_csv_metadata
+from shipid.data.log import (
+    COLUMNS,
+    REQUIRED,
+    csv_metadata_line,
+    frozen,
+    metadata,
+    parse_csv_metadata,
+)
 from shipid.data.preprocess import resample
 from shipid.data.track_velocities import (
     GROUND_VELOCITY_COLUMNS,
@@ -298,7 +305,7 @@ def read_log(path: str | Path, options: ReadOptions | None = None, **overrides) 
             lat, lon = (df[c].to_numpy(dtype=float) for c in GEODETIC_COLUMNS)
             check_geodetic(lat, lon, name)
             df["x"], df["y"] = local_track(lat, lon)
-            meta = {**meta, "track_origin": {"lat": float(lat[0]), "lon": float(lon[0])}}
+            meta = {**meta, "track_origin": frozen({"lat": float(lat[0]), "lon": float(lon[0])})}
         if ground:
             df = _read_off_ground_velocity(df, options, name)
             meta = {**meta, "velocities": df.attrs["velocities"]}

@@ -37,13 +37,47 @@ METADATA_KEYS = ("ship", "source", "rudder_positive", "scale", "manoeuvre", "tim
 CSV_METADATA_PREFIX = "# shipid-log: "
 
 
+class FrozenMapping(dict):
+    """A read-only mapping of log metadata (the particulars, the sensor noise, ...), which pandas
+    hands on by reference. pandas deep-copies a frame's ``attrs`` into every column it hands out
+    (``log["u"]``): with the particulars' nested dict that took 22 µs a column instead of 11, 5 %
+    of the test suite's time. A mapping that cannot change is its own copy. Replace the whole
+    value to change it (``log.attrs["particulars"] = frozen({...})``)."""
+
+    __slots__ = ()
+
+    def __deepcopy__(self, memo) -> FrozenMapping:
+        return self
+
+    def __reduce__(self):
+        return FrozenMapping, (dict(self),)
+
+    def _read_only(self, *args, **kwargs):
+        """Refused: log metadata is read-only (replace the whole value)."""
+        raise TypeError("log metadata is read-only: replace the whole value instead")
+
+    __setitem__ = __delitem__ = __ior__ = _read_only
+    clear = pop = popitem = setdefault = update = _read_only
+
+
+def frozen(value: object) -> object:
+    """``value`` with its mappings made ``FrozenMapping`` and its lists tuples, all the way
+    down: metadata that logs share by reference."""
+    if isinstance(value, Mapping):
+        return value if isinstance(value, FrozenMapping) else \
+            FrozenMapping({k: frozen(v) for k, v in value.items()})  # fmt: skip
+    if isinstance(value, list | tuple):
+        return tuple(frozen(v) for v in value)
+    return value
+
+
 def make_log(columns: Mapping[str, np.ndarray], **meta: object) -> pd.DataFrame:
     """A canonical log from column arrays (canonical names only) and metadata."""
     unknown = set(columns) - set(COLUMNS)
     if unknown:
         raise ValueError(f"not canonical log columns: {sorted(unknown)}; use {COLUMNS}")
     df = pd.DataFrame({c: np.asarray(columns[c], dtype=float) for c in COLUMNS if c in columns})
-    df.attrs.update({k: v for k, v in meta.items() if v is not None})
+    df.attrs.update({k: frozen(v) for k, v in meta.items() if v is not None})
     return df
 
 
@@ -303,7 +337,7 @@ def check_metadata(meta: Mapping, name: str) -> dict:
             from shipid.data.particulars import Particulars
 
             v = Particulars.from_mapping(v, f"{name} metadata").to_dict()
-        out[k] = v
+        out[k] = frozen(v)
     return out
 
 

@@ -32,6 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from shipid.data.log import frozen
 from shipid.errors import ShipidError
 
 # A GNSS's speed [m/s] and course [rad, clockwise from north] over ground, read instead of a track.
@@ -253,9 +254,9 @@ def _body_velocities(log: pd.DataFrame, t: np.ndarray, psi: np.ndarray, xdot: np
     if {"x", "y"} <= set(out.columns):
         out["x"] = out["x"].to_numpy(dtype=float) - (fore * c - starboard * s)
         out["y"] = out["y"].to_numpy(dtype=float) - (fore * s + starboard * c)
-    out.attrs["velocities"] = {**how, "antenna": list(options.antenna),
-                               "r_from_heading": heading_window is not None,
-                               "heading_window_s": heading_window}  # fmt: skip
+    out.attrs["velocities"] = frozen({**how, "antenna": list(options.antenna),
+                                      "r_from_heading": heading_window is not None,
+                                      "heading_window_s": heading_window})  # fmt: skip
     return out
 
 

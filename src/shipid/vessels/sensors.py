@@ -21,6 +21,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
+from shipid.data.log import frozen
+
 CHANNELS = ("u", "v", "r", "psi", "x", "y", "delta")
 
 
@@ -70,8 +72,8 @@ class SensorModel:
             if self.bias.get(ch, 0.0) > 0:
                 noise += gauss_markov(t, self.bias[ch], self.bias_tau, rng)
             out[ch] = out[ch].to_numpy() + noise
-        out.attrs["noise"] = {"white": dict(self.white), "bias": dict(self.bias),
-                              "bias_tau": self.bias_tau, "seed": seed}  # fmt: skip
+        out.attrs["noise"] = frozen({"white": dict(self.white), "bias": dict(self.bias),
+                                     "bias_tau": self.bias_tau, "seed": seed})  # fmt: skip
         return out
 
 
