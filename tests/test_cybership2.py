@@ -159,7 +159,9 @@ def test_a_speed_that_falls_by_a_third_compares_the_inflow_and_the_papers_fit_st
     """CyberShip II's 10°/10° zig-zags (their speed varies by about 50 %): the paper's blanke
     passed the plausibility checks, and its 35° turns came 75–87 % short (yaw rate 4–5 times
     the ship's); the compared structure's 34–37 % (benchmarks/study_cybership2.py). It now
-    fails one: it all but stops in the turn (``plausibility.STALL_SHARE``)."""
+    fails one: it all but stops in the turn (``plausibility.STALL_SHARE``). (Written in its
+    ahead forms, ``shipid.dynamics.astern``, the paper's fit is 47 % short: crawling through
+    the turn it reaches the speeds where the forms part; the compared structure 34 %.)"""
     from shipid.identification.identify import identify
     from shipid.identification.plausibility import disqualifying, plausibility_at_approach
 
@@ -185,4 +187,5 @@ def test_a_speed_that_falls_by_a_third_compares_the_inflow_and_the_papers_fit_st
                              steering=ship.steering).indices["tactical_diameter"]  # fmt: skip
         return abs(got / truth - 1.0)
 
-    assert error(tmp_path / "p.json") > 0.6 and error(tmp_path / "m.json") < 0.45
+    paper_error, compared_error = error(tmp_path / "p.json"), error(tmp_path / "m.json")
+    assert paper_error > 0.4 and compared_error < 0.45 and compared_error < paper_error

@@ -257,7 +257,8 @@ def model_doc(tmp_path, trial_csv, identified):
      "approach_speed"),
     (lambda d: d["model"]["structure"]["terms"]["u"].append("w^2"), "unknown signal 'w'"),
     # Read as 0 before: a ship without its yaw coefficients never turned, and nothing said so.
-    (lambda d: d["model"]["coefficients"].pop("r"), r"model\.coefficients\.r has no value for 'u\*r'"),
+    (lambda d: d["model"]["coefficients"].pop("r"),
+     r"model\.coefficients\.r has no value for '\|u\|\*r'"),
     (lambda d: d["model"]["coefficients"]["v"].pop("u*r"), r"coefficients\.v has no value for 'u\*r',"),
 ])  # fmt: skip
 @pytest.mark.parametrize("command", ["validate", "simulate", "manoeuvre"])

@@ -232,8 +232,9 @@ def test_cli_prior_constraints_and_bounds(tmp_path, capsys, short_zigzag):
     doc = json.loads(out.read_text())
     physics = doc["identification"]["physics"]
     assert physics["signs"] and physics["steady_speed"]
-    assert physics["bounds"]["r"]["u*r"] == [-3.0, math.inf] or physics["bounds"]["r"]["u*r"][0] == -3
-    assert set(physics["prior"]["v"]) == {"u*v", "u*r", "u^2*delta"}
+    # In the model's terms: written |u|·r, |u|·v, |u|·u·δ (the log runs ahead).
+    assert physics["bounds"]["r"]["|u|*r"][0] == -3
+    assert set(physics["prior"]["v"]) == {"|u|*v", "u*r", "|u|*u*delta"}
     for argv, message in [
         (["--bound", "r: u*r < 0"], "--bound expects"),
         (["--prior", "clarke"], "needs the ship's particulars"),

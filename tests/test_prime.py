@@ -147,7 +147,7 @@ def test_identify_prints_and_stores_the_prime_form(model_files, capsys):
     c = doc["model"]["coefficients"]
     # u̇ = c|u|u → c′ = cL; ṙ = c u r → c′ = cL; u̇ = c → c′ = cL/U²
     assert prime["coefficients"]["u"]["|u|*u"] == pytest.approx(c["u"]["|u|*u"] * 4.5)
-    assert prime["coefficients"]["r"]["u*r"] == pytest.approx(c["r"]["u*r"] * 4.5)
+    assert prime["coefficients"]["r"]["|u|*r"] == pytest.approx(c["r"]["|u|*r"] * 4.5)
     assert prime["coefficients"]["u"]["1"] == pytest.approx(c["u"]["1"] * 4.5 / speed**2)
 
 
@@ -164,8 +164,8 @@ def test_a_rescaled_model_turns_the_similar_circle(model_files, capsys):
     doc = json.loads((model_files / "full.json").read_text(encoding="utf-8"))
     small = json.loads((model_files / "m.json").read_text(encoding="utf-8"))
     assert doc["particulars"]["length"] == pytest.approx(4.5 * f)
-    assert doc["prime"]["coefficients"]["r"]["u*r"] == pytest.approx(
-        small["prime"]["coefficients"]["r"]["u*r"], rel=1e-12)
+    assert doc["prime"]["coefficients"]["r"]["|u|*r"] == pytest.approx(
+        small["prime"]["coefficients"]["r"]["|u|*r"], rel=1e-12)
     k = math.sqrt(f)
     prep, prep0 = (x["identification"]["preprocessing"] for x in (doc, small))
     assert prep["approach_speed"] == pytest.approx(prep0["approach_speed"] * k)
@@ -175,7 +175,7 @@ def test_a_rescaled_model_turns_the_similar_circle(model_files, capsys):
     assert env["delta"] == env0["delta"]
     # every bootstrap replicate scaled like the point estimate
     t0, t1 = (np.asarray(x["uncertainty"]["thetas"]) for x in (small, doc))
-    j = small["uncertainty"]["terms"].index("u*r")
+    j = small["uncertainty"]["terms"].index("|u|*r")
     np.testing.assert_allclose(t1[:, 2, j] / t0[:, 2, j], t1[0, 2, j] / t0[0, 2, j], rtol=1e-12)
 
     def turn(path, dt, duration):

@@ -150,8 +150,8 @@ def test_identify_writes_the_one_rps_fit_to_scale_with_the_propeller(one_rps):
         assert c["n^2*delta"] == pytest.approx(c0["delta"] / N0**2, rel=1e-12)
         assert se["std_errors"]["n^2*delta"] / c["n^2*delta"] == pytest.approx(
             se0["std_errors"]["delta"] / c0["delta"], rel=1e-12)
-    assert set(doc["uncertainty"]["terms"]) == set(doc["model"]["structure"]["terms"]["u"]
-                                                   + doc["model"]["structure"]["terms"]["v"])
+    assert set(doc["uncertainty"]["terms"]) == {
+        t for ts in doc["model"]["structure"]["terms"].values() for t in ts}
     assert doc["identification"]["discrete"] == plain["identification"]["discrete"]
 
 
@@ -342,15 +342,21 @@ def test_bounds_with_an_open_side_are_carried(one_rps, tmp_path, capsys):
 def test_select_checks_its_one_rps_model_as_the_file_has_it_crash_stop_too(one_rps, tmp_path,
                                                                             capsys):  # fmt: skip
     """select re-checks the model it writes from logs at one rps as similarity carries it; that
-    report lost the crash stop its own check of the fit had (identify's kept it)."""
+    report lost the crash stop its own check of the fit had (identify's kept it). The check is
+    of the model as written: in its ahead forms (``shipid.dynamics.astern``) this fit stops
+    going astern; in the fitted forms (--no-ahead-forms) its yaw damping u·r turns to a drive
+    once u < 0, the crash stop diverges, and it says so."""
     log = one_rps["similar"].parent / "zz.csv"
-    out = tmp_path / "sel.json"
-    code, _, err = run(["select", log, "--library", "blanke", "--cv", "blocks:3", "--quiet", "-o",
-                        out], capsys)  # fmt: skip
-    assert code == 0, err
-    doc = json.loads(out.read_text())
-    assert doc["model"]["similar_at_rps"] == pytest.approx(N0)
-    astern = doc["identification"]["plausibility"]["astern"]
-    # This fit diverges going astern (its logs never do), and says so.
-    assert astern["diverged"] is True
-    assert "(a crash stop)" in err and "the model is not for going astern" in err
+    for extra, diverges in (([], False), (["--no-ahead-forms"], True)):
+        out = tmp_path / "sel.json"
+        code, said, err = run(["select", log, "--library", "blanke", "--cv", "blocks:3",
+                               "--quiet", *extra, "-o", out], capsys)  # fmt: skip
+        assert code == 0, err
+        doc = json.loads(out.read_text())
+        assert doc["model"]["similar_at_rps"] == pytest.approx(N0)
+        astern = doc["identification"]["plausibility"]["astern"]
+        assert astern["diverged"] is diverges, astern
+        assert ("(a crash stop)" in err and "the model is not for going astern" in err) \
+            is diverges  # fmt: skip
+        assert ("ahead_forms" in doc["identification"]) is not diverges
+        assert ("going astern: the logs never do" in said) is not diverges

@@ -201,6 +201,14 @@ def _one_rps(logs, args) -> float | None:
     return _constant_rps(logs)
 
 
+def _ahead(logs, args) -> bool:
+    """Whether the model of ``logs`` is written in its ahead forms (``shipid.dynamics.astern``):
+    every log runs ahead throughout, and not --no-ahead-forms."""
+    from shipid.dynamics.astern import logs_ahead
+
+    return getattr(args, "ahead_forms", True) and logs_ahead(logs)
+
+
 def _constant_rps(logs) -> float | None:
     """The one positive propeller speed the logs run at (their approaches' median), else None
     (no rps logged, or one that varies)."""
@@ -264,10 +272,10 @@ def _physics(args, logs, structure, searched: bool = False):
     elif name and name in _vessel_names():
         prior, source = _reference_ship_prior(name, logs, structure, searched)
     elif args.prior:
-        from shipid.identification.priors import prior_from_model
+        from shipid.identification.priors import prior_from_model, prior_in_forms
 
         model, source = _model_file_prior(args.prior, logs)
-        prior = prior_from_model(model)
+        prior = prior_in_forms(prior_from_model(model), structure)
         rps = _constant_rps(logs)
         if rps is not None:
             from shipid.identification.priors import prior_at_rps

@@ -8,6 +8,7 @@ import sys
 from types import SimpleNamespace
 
 from shipid.cli.common import (
+    _ahead,
     _approach,
     _fmt_speed,
     _json_text,
@@ -271,10 +272,13 @@ def cmd_identify(args) -> int:
     if residual is not None:
         one_rps = None  # its kernel residual is the fit's at that one rps
 
+    ahead = residual is None and _ahead(logs, args)
+
     def as_written(model):
         """The model as the file will have it: carried to every rps where the logs run at one
-        (checked from the approach its manoeuvres will start from)."""
-        return _similar_or_fitted(model, one_rps)
+        (checked from the approach its manoeuvres will start from), in its ahead forms where
+        they never go astern."""
+        return _as_written(model, one_rps, ahead)
 
     plausibility, notes = plausibility_at_approach(hybrid or as_written(ident.model), speed, rps,
                                                    curvature=curvature, astern=True)  # fmt: skip
@@ -368,10 +372,8 @@ def cmd_identify(args) -> int:
     from shipid.reporting.modelfile import prime_record
 
     prime = prime_record(final, _log_particulars(logs), speed)
-    similar = _rps_similar(text, one_rps, args.output)
-    if similar is not None:
-        text, prime = _json_text(similar), similar.get("prime")
-    _print_prime(prime)
+    text, written_prime = _written_text(text, one_rps, ahead, args.output)
+    _print_prime(written_prime or prime)
     atomic_write_text(args.output, text)
     for w in ident.warnings:
         _warn(w)
@@ -414,14 +416,44 @@ def _report_replicates(ensemble, record: dict, ident) -> None:
         ident.warnings.append(f"bootstrap: {weak}")
 
 
-def _similar_or_fitted(model, rps: float | None):
-    """``model`` carried to every propeller speed from ``rps`` (None: as it is), as the model
-    file will have it; as it is where no term changes or two would merge."""
+def _as_written(model, rps: float | None, ahead: bool = False):
+    """``model`` as the model file will have it: carried to every propeller speed from ``rps``
+    (None: as it is), then in its ahead forms where ``ahead`` (``shipid.dynamics.astern``);
+    ``model`` itself where nothing changes."""
+    from shipid.dynamics.astern import written_ahead
     from shipid.dynamics.similarity import rps_similar, similarity_map
 
-    if rps is None or not similarity_map(model.structure, rps).changes:
-        return model
-    return rps_similar(model, rps)
+    if rps is not None and similarity_map(model.structure, rps).changes:
+        model = rps_similar(model, rps)
+    return written_ahead(model) if ahead else model
+
+
+def _written_text(text: str, rps: float | None, ahead: bool, path) -> tuple[str, dict | None]:
+    """The model file ``text`` as it is written (``_rps_similar``, then ``_ahead_forms``), and
+    its prime record where either changed it (else None)."""
+    prime = None
+    for step in (lambda t: _rps_similar(t, rps, path), lambda t: _ahead_forms(t, ahead, path)):
+        doc = step(text)
+        if doc is not None:
+            text, prime = _json_text(doc), doc.get("prime")
+    return text, prime
+
+
+def _ahead_forms(text: str, ahead: bool, path) -> dict | None:
+    """The model file ``text`` with its terms in their ahead forms where ``ahead``, said on the
+    command line; None where not, or no term changes."""
+    from shipid.reporting.modelfile import ahead_forms_document
+
+    if not ahead:
+        return None
+    doc = ahead_forms_document(json.loads(text), path)
+    if doc is not None:
+        print(f"going astern: the logs never do, and cannot tell these forms from the fitted "
+              f"ones; written as the physics carries them astern "
+              f"({doc['identification']['ahead_forms']['terms']}): the same fit ahead, its "
+              "damping damps and its rudder reverses astern (--no-ahead-forms keeps the "
+              "fit's)")  # fmt: skip
+    return doc
 
 
 def _rps_similar(text: str, rps: float | None, path) -> dict | None:

@@ -154,6 +154,10 @@ def _add_similarity_option(p) -> None:
                    "other rps as that one (default: each term that does not grow with the "
                    "speeds gains the power of n it needs to scale as advance-ratio similarity "
                    "has it; the model at the logs' rps is the fit)")
+    p.add_argument("--no-ahead-forms", dest="ahead_forms", action="store_false",
+                   help="logs that never go astern: keep the fit's u·v, u·r, u²δ, u²δ² (default: "
+                   "written |u|·v in the sway, |u|·r in the yaw, |u|·u·δ, |u|·u·δ², the same fit "
+                   "ahead, whose damping damps and whose rudder reverses astern)")
 
 
 def _add_block_option(p: argparse.ArgumentParser) -> None:

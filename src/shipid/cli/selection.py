@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 from shipid.cli.common import (
+    _ahead,
     _approach,
     _json_text,
     _log_particulars,
@@ -23,15 +24,16 @@ from shipid.cli.common import (
     _warn_approach,
 )
 from shipid.cli.identify import (
+    _as_written,
     _replicates_checked,
     _report_replicates,
-    _rps_similar,
-    _similar_or_fitted,
+    _written_text,
 )
 from shipid.errors import ShipidError
 
 
-def _check_replicates(ensemble, report: dict, model, one_rps, logs, args, ident) -> None:
+def _check_replicates(ensemble, report: dict, model, one_rps, ahead, logs, args, ident
+                      ) -> None:  # fmt: skip
     """``_report_replicates`` of select's ensemble, each replicate checked from the approach
     its model was (``report``), as the model file will have it."""
     from shipid.identification.plausibility import sharpest_curvature
@@ -42,14 +44,13 @@ def _check_replicates(ensemble, report: dict, model, one_rps, logs, args, ident)
         return
     curvature = sharpest_curvature(logs, speed)
     _report_replicates(ensemble, _replicates_checked(
-        ensemble, report, model, lambda member: _similar_or_fitted(member, one_rps), speed, rps,
+        ensemble, report, model, lambda member: _as_written(member, one_rps, ahead), speed, rps,
         curvature, (args.speed, args.rps)), ident)  # fmt: skip
 
 
 def cmd_select(args) -> int:
     """``shipid select``: structure and γ by cross-validated free-run error."""
     from shipid.dynamics.model import get_structure
-    from shipid.dynamics.similarity import rps_similar, similarity_map
     from shipid.identification.cross_validation import parse_cv
     from shipid.identification.select import RESAMPLES, SelectOptions, default_library, select
     from shipid.outputs import OutputSet, check_outputs
@@ -122,8 +123,9 @@ def cmd_select(args) -> int:
     _warn_approach(logs, names)
     plausibility, notes = sel.plausibility, sel.plausibility_notes
     one_rps = _one_rps(logs, args)
-    if one_rps is not None and args.speed is None and args.rps is None \
-            and similarity_map(sel.model.structure, one_rps).changes:  # fmt: skip
+    ahead = _ahead(logs, args)
+    written = _as_written(sel.model, one_rps, ahead)
+    if written is not sel.model and args.speed is None and args.rps is None:
         # Checked as the file will have it: at the logs' rps from their approach, as identify's.
         from shipid.identification.plausibility import (
             plausibility_at_approach,
@@ -133,13 +135,13 @@ def cmd_select(args) -> int:
         speed = _approach(logs[0], "u")
         # With the crash stop, as select's own report of the fit has it.
         plausibility, notes = plausibility_at_approach(
-            rps_similar(sel.model, one_rps), speed, one_rps,
+            written, speed, one_rps or _approach(logs[0], "n"),
             curvature=sharpest_curvature(logs, speed), astern=True)  # fmt: skip
     ident.warnings.extend(f"plausibility: {n}" for n in notes)
     from shipid.identification.plausibility import given_steady_speeds, missed_steady_speed
 
     for u, n in given_steady_speeds(physics):
-        missed = missed_steady_speed(_similar_or_fitted(sel.model, one_rps), u, n)
+        missed = missed_steady_speed(written, u, n)
         if missed:
             ident.warnings.append(missed)
     prep = _log_record(args, logs)
@@ -159,13 +161,11 @@ def cmd_select(args) -> int:
               f"{ensemble.resampling}; a term outside the model "
               "has value 0, inclusion the share of replicates that hold it):")  # fmt: skip
         print(table.to_markdown(index=False, floatfmt=".4g"))
-        _check_replicates(ensemble, plausibility, sel.model, one_rps, logs, args, ident)
+        _check_replicates(ensemble, plausibility, sel.model, one_rps, ahead, logs, args, ident)
     text = model_text(ident, args.logs, preprocessing=prep, plausibility=plausibility,
                       model=sel.model, selection=sel.to_dict(), particulars=_log_particulars(logs),
                       uncertainty=ensemble.to_dict() if ensemble else None)  # fmt: skip
-    similar = _rps_similar(text, one_rps, args.output)
-    if similar is not None:
-        text = _json_text(similar)
+    text = _written_text(text, one_rps, ahead, args.output)[0]
     with OutputSet() as out:
         out.write(args.output, lambda p: p.write_text(text, encoding="utf-8"))
         if args.table:

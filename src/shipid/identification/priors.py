@@ -165,6 +165,27 @@ def prior_at_rps(prior: dict[str, dict[str, float]], structure: ModelStructure,
     return out
 
 
+def prior_in_forms(prior: dict[str, dict[str, float]], structure: ModelStructure
+                   ) -> dict[str, dict[str, float]]:  # fmt: skip
+    """``prior`` with a value for each term of ``structure`` that the prior holds in another of
+    its ahead forms (``shipid.dynamics.astern``: u·v and |u|·v in v̇, ...), which are the same
+    term on logs that run ahead. A model file of such logs is written in the one form; a fit in
+    the other had no prior on those terms, and drew them toward 0."""
+    from shipid.dynamics.astern import astern_form
+
+    out = {d: dict(v) for d, v in prior.items()}
+    for dof, terms in structure.terms.items():
+        given = out.get(dof, {})
+        for text in terms:
+            if text in given:
+                continue
+            same = [t for t in given if t != text and astern_form(dof, t) == astern_form(dof, text)
+                    and t not in terms]  # fmt: skip
+            if same:
+                out.setdefault(dof, {})[text] = given[same[0]]
+    return out
+
+
 def prior_from_model(model: ManoeuvringModel) -> dict[str, dict[str, float]]:
     """A model's coefficients as a prior (e.g. a fit of other trials of the same ship)."""
     return {d: {parse_term(t).text: float(c) for t, c in model.coefficients[d].items()}

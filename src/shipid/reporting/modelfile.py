@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING
 
 from shipid import __version__
 from shipid.dynamics.hybrid import HybridModel, KernelResidual
-from shipid.dynamics.model import ManoeuvringModel
+from shipid.dynamics.model import ManoeuvringModel, ModelStructure
 from shipid.dynamics.terms import CROSSFLOW, parse_term
 from shipid.errors import ShipidError
 from shipid.outputs import atomic_write_text
@@ -573,31 +573,65 @@ def rps_similar_document(doc: Mapping, rps: float, path: str | Path = "model fil
     scaled as one. The LS-SVM's own record (``identification.discrete``) stays the fit's;
     ``identification.rps_similarity`` says what was done. None where no term gains a factor of
     n, or the bootstrap replicates' terms would merge."""
+    from shipid.dynamics.similarity import rps_similar, similar_term, similarity_map
+
+    found = similarity_map(model_from_document(dict(doc), path).structure, rps)
+
+    def alone(dof: str, term: str) -> tuple[str, float]:
+        new, k = similar_term(term)
+        return new, rps**-k
+
+    return _renamed_document(doc, path, found, alone, lambda m: rps_similar(m, rps), (
+        "rps_similarity", {
+            "rps": float(rps), "terms": found.describe(),
+            "note": "logs at one propeller speed cannot show how a force depends on it; each "
+                    "term is written to scale with it as advance-ratio similarity has it, so "
+                    "the model is the fit at this rps and scales to others; "
+                    "identification.discrete is the fit's"}))  # fmt: skip
+
+
+def ahead_forms_document(doc: Mapping, path: str | Path = "model file") -> dict | None:
+    """The model file of a fit to logs that never go astern with its terms written in the form
+    that carries them astern (``shipid.dynamics.astern``: u·v → |u|·v in v̇, ...), renamed
+    throughout as ``rps_similar_document`` renames; ``identification.ahead_forms`` says what
+    was done. None where no term changes, or the bootstrap replicates' terms would merge."""
+    from shipid.dynamics.astern import ahead_forms, astern_form, written_ahead
+
+    found = ahead_forms(model_from_document(dict(doc), path).structure)
+    return _renamed_document(doc, path, found, lambda dof, term: (astern_form(dof, term), 1.0),
+                             written_ahead, (
+        "ahead_forms", {
+            "terms": found.describe(),
+            "note": "the logs never go astern, where these forms and the fitted ones agree; "
+                    "written in the forms whose astern extension is the physics (damping "
+                    "damps, the rudder's lift reverses with the flow): the same fit ahead"}))
+
+
+def _renamed_document(doc: Mapping, path, found, alone, carried, record: tuple[str, dict]
+                      ) -> dict | None:  # fmt: skip
+    """``doc`` with every model and statistic of it renamed by ``found`` (its ``renamed``
+    {dof: {term: (new term, ratio)}} and ``changes``; ``alone(dof, term)`` for terms of other
+    structures, ``carried(model)`` the model so renamed), ``record`` = (key, value) added to
+    its identification; None where nothing changes or replicates' terms would merge."""
     import copy
 
     import numpy as np
 
     from shipid.dynamics.model import DOFS
-    from shipid.dynamics.similarity import rps_similar, similar_term, similarity_map
     from shipid.dynamics.terms import parse_term
 
-    model = model_from_document(dict(doc), path)
-    found = similarity_map(model.structure, rps)
     if not found.changes:
         return None
     out = copy.deepcopy(dict(doc))
 
     def convert(data: Mapping) -> dict:
-        return rps_similar(model_from_document({"model": data}, path), rps).to_dict()
+        return carried(model_from_document({"model": data}, path)).to_dict()
 
     def rename(dof: str, term: str) -> tuple[str, float]:
-        """(similar term, ratio) of a term of the model's ``dof`` equation (of another
-        structure's: as similarity writes it alone)."""
+        """(new term, ratio) of a term of the model's ``dof`` equation (of another
+        structure's: as it is renamed alone)."""
         given = found.renamed.get(dof, {}).get(parse_term(term).text)
-        if given is not None:
-            return given
-        new, k = similar_term(term)
-        return new, rps**-k
+        return given if given is not None else alone(dof, term)
 
     def mapped(values: Mapping, dof: str) -> dict:
         """{term: value} of equation ``dof`` renamed, each value (or pair) times its ratio;
@@ -626,6 +660,21 @@ def rps_similar_document(doc: Mapping, rps: float, path: str | Path = "model fil
                 return None  # two of a replicate's terms would become one
             for j in live:
                 moved[:, i, targets[j]] = thetas[:, i, j] * row[j][1]
+        out["model"] = convert(doc["model"])
+        if unc.get("structure"):
+            unc["structure"] = {d: [rename(d, t)[0] for t in ts]
+                                for d, ts in unc["structure"].items()}  # fmt: skip
+        # In the order the ensemble's structure (else the model's) lists its terms, as a model
+        # file has it.
+        owner = unc.get("structure") or out["model"]["structure"]["terms"]
+        order = list(ModelStructure("ensemble", {d: tuple(ts) for d, ts in owner.items()}
+                                    ).all_terms)  # fmt: skip
+        # (A term renamed in one equation is still named as it was in the others, where it
+        # is 0 in every replicate: such a column goes.)
+        spare = [c for c in columns if c not in order and not np.any(moved[:, :, columns.index(c)])]
+        if set(order) == set(columns) - set(spare):
+            moved = moved[:, :, [columns.index(t) for t in order]]
+            columns = order
         unc["thetas"], unc["terms"] = moved.tolist(), columns
     out["model"] = convert(doc["model"])
     ident = out.get("identification") or {}
@@ -669,12 +718,9 @@ def rps_similar_document(doc: Mapping, rps: float, path: str | Path = "model fil
     model_out = model_from_document(out, path)
     out["prime"] = prime_record(model_out, out.get("particulars"),
                                 (ident.get("preprocessing") or {}).get("approach_speed"))
-    ident["rps_similarity"] = {
-        "rps": float(rps), "terms": found.describe(),
-        "note": "logs at one propeller speed cannot show how a force depends on it; each term "
-                "is written to scale with it as advance-ratio similarity has it, so the model "
-                "is the fit at this rps and scales to others; identification.discrete is the "
-                "fit's"}  # fmt: skip
+    if out.get("identification") is None:
+        out["identification"] = ident
+    ident[record[0]] = record[1]
     return _fingerprinted(out)
 
 
