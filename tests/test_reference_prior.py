@@ -243,8 +243,8 @@ def test_a_model_file_prior_of_unknown_length_is_taken_as_it_is_and_said(tmp_pat
 
 
 def test_a_model_file_prior_written_for_every_rps_holds_the_fit_at_one(tmp_path, capsys):
-    """A model file of logs at one propeller speed is written for every rps (δ as n²δ, δ² as
-    n²δ²); as the prior of a fit at one rps those terms had none and were drawn toward 0 (the
+    """A model file of logs at one propeller speed is written for every rps (δ as n⁺²δ, δ² as
+    n⁺²δ²); as the prior of a fit at one rps those terms had none and were drawn toward 0 (the
     Esso's own earlier fit as its prior at γ = 1 put δ² at a tenth of its value). Now each takes
     the prior's value at the logs' rps: the ship's own fit as the prior gives it back."""
     from shipid.reporting.modelfile import load_document
@@ -257,7 +257,7 @@ def test_a_model_file_prior_written_for_every_rps_holds_the_fit_at_one(tmp_path,
     assert code == 0, err
     own, again = (load_document(tmp_path / f"{k}.json")["model"]["coefficients"]
                   for k in ("own", "again"))  # fmt: skip
-    assert "n^2*delta^2" in own["u"] and "n^2*delta" in own["r"]
+    assert "pos(n)^2*delta^2" in own["u"] and "pos(n)^2*delta" in own["r"]
     for dof, terms in own.items():
         for term, value in terms.items():
             assert again[dof][term] == pytest.approx(value, rel=1e-2, abs=1e-9), (dof, term)

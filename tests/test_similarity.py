@@ -88,7 +88,7 @@ def test_terms_keep_their_form_where_similarity_cannot_write_them():
     assert speed_degree("wind_speed^2*sin(wind_angle)") is None
     assert speed_degree("thrust") == 2 and speed_degree("|u|*u*delta") == 2
     assert similar_term("1") == ("|n|*n", 2)
-    assert similar_term("u*delta") == ("u*|n|*delta", 1)
+    assert similar_term("u*delta") == ("u*pos(n)*delta", 1)  # the race: ahead only
     assert similar_term("u^3") == ("u^3", 0)
     # blanke-rps has its own |n|n beside the constant: the constant stays as fitted.
     found = similarity_map(ManoeuvringModel("blanke-rps", {}).structure, 10.0)
@@ -138,17 +138,17 @@ def test_identify_writes_the_one_rps_fit_to_scale_with_the_propeller(one_rps):
     assert "propeller speed: the logs run at one 12 rps" in one_rps["similar_said"]
     assert "propeller speed" not in one_rps["plain_said"]
     rec = doc["identification"]["rps_similarity"]
-    assert rec["rps"] == pytest.approx(N0) and "δ → n² δ" in rec["terms"]
+    assert rec["rps"] == pytest.approx(N0) and "δ → pos(n)² δ" in rec["terms"]
     assert doc["model"]["similar_at_rps"] == pytest.approx(N0)
     assert "|n|*n" in doc["model"]["structure"]["terms"]["v"]
-    assert "n^2*delta" in doc["model"]["structure"]["terms"]["r"]
+    assert "pos(n)^2*delta" in doc["model"]["structure"]["terms"]["r"]
     # Every record keyed by term follows the model: coefficients and standard errors scaled as
     # one (their ratio is the fit's), the bootstrap's columns renamed.
     for dof in ("v", "r"):
         c, se = doc["model"]["coefficients"][dof], doc["identification"]["diagnostics"][dof]
         c0, se0 = plain["model"]["coefficients"][dof], plain["identification"]["diagnostics"][dof]
-        assert c["n^2*delta"] == pytest.approx(c0["delta"] / N0**2, rel=1e-12)
-        assert se["std_errors"]["n^2*delta"] / c["n^2*delta"] == pytest.approx(
+        assert c["pos(n)^2*delta"] == pytest.approx(c0["delta"] / N0**2, rel=1e-12)
+        assert se["std_errors"]["pos(n)^2*delta"] / c["pos(n)^2*delta"] == pytest.approx(
             se0["std_errors"]["delta"] / c0["delta"], rel=1e-12)
     assert set(doc["uncertainty"]["terms"]) == {
         t for ts in doc["model"]["structure"]["terms"].values() for t in ts}
@@ -280,7 +280,7 @@ def test_an_output_error_fit_is_carried_with_its_statistics(one_rps, tmp_path, c
     for dof, errors in stats["standard_errors"].items():
         assert set(errors) <= set(terms[dof])
     labels = [tuple(x) for x in stats["covariance"]["terms"]]
-    i, i0 = labels.index(("r", "n^2*delta")), [tuple(x) for x in
+    i, i0 = labels.index(("r", "pos(n)^2*delta")), [tuple(x) for x in
                                                 stats0["covariance"]["terms"]].index(("r", "delta"))
     assert stats["covariance"]["matrix"][i][i] == pytest.approx(
         stats0["covariance"]["matrix"][i0][i0] / N0**4, rel=1e-12)
@@ -335,8 +335,8 @@ def test_bounds_with_an_open_side_are_carried(one_rps, tmp_path, capsys):
     assert code == 0, err
     bounds = json.loads(out.read_text())["identification"]["physics"]["bounds"]
     assert bounds["u"] == {"v*r": [0.5, None]}
-    assert bounds["v"]["n^2*delta"] == [pytest.approx(0.01 / N0**2, rel=1e-12), None]
-    assert bounds["r"] == {"n^2*delta": [None, 0.0]}
+    assert bounds["v"]["pos(n)^2*delta"] == [pytest.approx(0.01 / N0**2, rel=1e-12), None]
+    assert bounds["r"] == {"pos(n)^2*delta": [None, 0.0]}
 
 
 def test_select_checks_its_one_rps_model_as_the_file_has_it_crash_stop_too(one_rps, tmp_path,

@@ -13,9 +13,13 @@ other propeller speed as at n₀; the paper's ``blanke`` gives a rudder force an
 do not change with n, so a model of the Esso's 16.7 rps zig-zag turned at 10 rps with the
 thrust of 16.7. ``rps_similar`` writes each term of degree d < 2 with the factor (n/n₀)^(2−d)
 it needs to scale as the rest: the constant c as c·n|n|/n₀² (thrust and side force reverse
-astern), δ as δ·n²/n₀², u·δ as u·δ·|n|/n₀. At n₀ the model is the fit itself, bit for bit up
-to rounding. Terms of degree above 2 (Abkowitz's u³, v³) cannot be so written (n⁻¹ is no
-factor of the term algebra) and terms of the wind (an external speed) keep their form.
+astern), δ as δ·n⁺²/n₀², u·δ as u·δ·n⁺/n₀ (n⁺ = max(n, 0): a rudder term that does not fall
+with the ship's speed is the propeller's race over it, which an astern propeller does not throw
+there; as n² the rudder kept its full force at −10 rps with the ship at rest, and the Esso's
+one-file models' random runs went 1.47 of their spread off instead of 1.18;
+``benchmarks/study_ahead_forms.py``), v as v·|n|/n₀. At n₀ the model is the fit itself, bit
+for bit up to rounding. Terms of degree above 2 (Abkowitz's u³, v³) cannot be so written (n⁻¹
+is no factor of the term algebra) and terms of the wind (an external speed) keep their form.
 
 Measured on the Esso Osaka (``benchmarks/study_esso_single_logs.py``): the default model of one
 zig-zag file predicts the held-out logs at another propeller speed with a yaw rate error of
@@ -57,6 +61,8 @@ def similar_term(term: str) -> tuple[str, int]:
     k = 2 - degree
     if text == "1":
         return parse_term("n*|n|").text, 2
+    if "delta" in parse_term(text).signals:  # the rudder's force: in the race of n ahead only
+        return parse_term(f"{text}*{'pos(n)' if k == 1 else 'pos(n)^2'}").text, k
     return parse_term(f"{text}*{'|n|' if k == 1 else 'n^2'}").text, k
 
 
@@ -104,7 +110,7 @@ class SimilarityMap:
 
 def similarity_map(structure: ModelStructure, rps: float) -> SimilarityMap:
     """The ``SimilarityMap`` of ``structure`` at ``rps`` (> 0). A term whose similar form the
-    equation already has (its constant beside ``|n|*n``, ``delta`` beside ``n^2*delta``) keeps
+    equation already has (its constant beside ``|n|*n``, ``delta`` beside ``pos(n)^2*delta``) keeps
     its fitted form: the structure's own term carries the dependence on n, and two terms made
     one would lose the fit's standard errors and replicates."""
     if not (np.isfinite(rps) and rps > 0):

@@ -151,7 +151,7 @@ def prior_at_rps(prior: dict[str, dict[str, float]], structure: ModelStructure,
                  rps: float) -> dict[str, dict[str, float]]:  # fmt: skip
     """``prior`` with a value for each term of ``structure`` fitted at the one propeller speed
     ``rps`` that the prior holds in its advance-ratio similar form (a model file written for every
-    rps: δ as n²δ, the constant as |n|n; ``shipid.dynamics.similarity``): that term's value at
+    rps: δ as n⁺²δ, the constant as |n|n; ``shipid.dynamics.similarity``): that term's value at
     ``rps``. Without it those terms had no prior, and were drawn toward 0."""
     from shipid.dynamics.similarity import similar_term
 
