@@ -84,6 +84,22 @@ def test_the_similar_model_runs_the_same_path_at_another_rps(c):
     assert np.max(np.abs(plain["y"] - slow["y"])) > 1.0  # metres apart: not similar
 
 
+def test_astern_the_propeller_throws_no_race_on_the_rudder():
+    """The fit's rudder terms that do not fall with the ship's speed (δ, u·δ) are the race's:
+    the similar model at −N0 rps, the ship at rest, has no rudder force from them (as n² it had
+    its whole force there), while its |u|-free terms of the hull answer as before."""
+    model = ManoeuvringModel("v: u*v, delta, u*delta; r: u*r, delta, u*delta",
+                             {"v": {"u*v": -0.5, "delta": 0.05, "u*delta": 0.02},
+                              "r": {"u*r": -0.8, "delta": -0.1, "u*delta": -0.04}})  # fmt: skip
+    similar = rps_similar(model, N0)
+    for n in (-N0, -2.0):
+        with_rudder = similar.accelerations(0.0, 0.1, 0.05, 0.3, rps=n)[0]
+        without = similar.accelerations(0.0, 0.1, 0.05, 0.0, rps=n)[0]
+        np.testing.assert_allclose(with_rudder, without, atol=1e-15)
+    ahead = similar.accelerations(0.3, 0.1, 0.05, 0.3, rps=N0)[0]
+    np.testing.assert_allclose(ahead, model.accelerations(0.3, 0.1, 0.05, 0.3)[0], rtol=1e-12)
+
+
 def test_terms_keep_their_form_where_similarity_cannot_write_them():
     assert speed_degree("wind_speed^2*sin(wind_angle)") is None
     assert speed_degree("thrust") == 2 and speed_degree("|u|*u*delta") == 2
