@@ -646,6 +646,7 @@ def _renamed_document(doc: Mapping, path, found, alone, carried, record: tuple[s
             res[new] = [times(b, ratio) for b in v] if isinstance(v, list) else times(v, ratio)
         return res
 
+    out["model"] = convert(doc["model"])
     unc = out.get("uncertainty")
     if unc:
         # Each replicate's row of each equation, renamed as that equation's terms are.
@@ -660,7 +661,6 @@ def _renamed_document(doc: Mapping, path, found, alone, carried, record: tuple[s
                 return None  # two of a replicate's terms would become one
             for j in live:
                 moved[:, i, targets[j]] = thetas[:, i, j] * row[j][1]
-        out["model"] = convert(doc["model"])
         if unc.get("structure"):
             unc["structure"] = {d: [rename(d, t)[0] for t in ts]
                                 for d, ts in unc["structure"].items()}  # fmt: skip
@@ -672,11 +672,10 @@ def _renamed_document(doc: Mapping, path, found, alone, carried, record: tuple[s
         # (A term renamed in one equation is still named as it was in the others, where it
         # is 0 in every replicate: such a column goes.)
         spare = [c for c in columns if c not in order and not np.any(moved[:, :, columns.index(c)])]
-        if set(order) == set(columns) - set(spare):
-            moved = moved[:, :, [columns.index(t) for t in order]]
-            columns = order
-        unc["thetas"], unc["terms"] = moved.tolist(), columns
-    out["model"] = convert(doc["model"])
+        if set(order) != set(columns) - set(spare):
+            return None  # the replicates would not fit the structure: the file as fitted
+        unc["thetas"] = moved[:, :, [columns.index(t) for t in order]].tolist()
+        unc["terms"] = order
     ident = out.get("identification") or {}
     refinement = ident.get("refinement")
     if refinement:
