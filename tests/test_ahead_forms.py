@@ -212,3 +212,17 @@ def test_one_esso_zigzag_file_no_longer_diverges_in_a_random_run():
             sim = validate(load_model(out), held, start_draws=False)[0].simulation
             diverged[key] = sim is None or sim.diverged
     assert diverged == {"ahead": False, "fitted": True}
+
+
+def test_select_checks_the_model_as_written_from_a_given_approach_too(fitted_files, tmp_path):
+    """select's report of its model is of the file's model: in its ahead forms, also where
+    --speed and --rps set the approach (its own check of the fit, in the fitted forms, was
+    kept there: a crash stop that diverged for a model that does not)."""
+    for extra, diverges in (([], False), (["--no-ahead-forms"], True)):
+        out = tmp_path / "sel.json"
+        code, _, err = run(["select", fitted_files["log"], "--library", "blanke", "--cv",
+                            "blocks:3", "--quiet", "--speed", "2.0", "--rps", str(N0), *extra,
+                            "-o", out])  # fmt: skip
+        assert code == 0, err
+        report = json.loads(out.read_text())["identification"]["plausibility"]
+        assert report["astern"]["diverged"] is diverges, report["astern"]

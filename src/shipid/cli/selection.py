@@ -125,17 +125,18 @@ def cmd_select(args) -> int:
     one_rps = _one_rps(logs, args)
     ahead = _ahead(logs, args)
     written = _as_written(sel.model, one_rps, ahead)
-    if written is not sel.model and args.speed is None and args.rps is None:
-        # Checked as the file will have it: at the logs' rps from their approach, as identify's.
+    if written is not sel.model:
+        # Checked as the file will have it, from the approach select's own check of the fit
+        # took (the logs' first, or --speed and --rps), with the crash stop it had.
         from shipid.identification.plausibility import (
             plausibility_at_approach,
             sharpest_curvature,
         )
 
-        speed = _approach(logs[0], "u")
-        # With the crash stop, as select's own report of the fit has it.
+        speed = args.speed if args.speed is not None else _approach(logs[0], "u")
+        rps = args.rps if args.rps is not None else (one_rps or _approach(logs[0], "n"))
         plausibility, notes = plausibility_at_approach(
-            written, speed, one_rps or _approach(logs[0], "n"),
+            written, speed, rps, args.speed, args.rps,
             curvature=sharpest_curvature(logs, speed), astern=True)  # fmt: skip
     ident.warnings.extend(f"plausibility: {n}" for n in notes)
     from shipid.identification.plausibility import given_steady_speeds, missed_steady_speed
