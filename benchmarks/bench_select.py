@@ -7,6 +7,10 @@ search (stepwise along the FROLS ranking, γ pre-screened by exact LOO, one-SE r
 in the same run is one plain ``identify`` of the full library on the same logs: the ratio says
 how many identifications' worth the whole cross-validated search costs.
 
+Then the search's fits summing each fold's Gram and cross blocks once (``_Data.fold_sums``)
+against summing them log by log in every candidate's fit (the code before, patched back in), in
+the same process, alternated, the chosen candidates compared.
+
 Run: .venv/bin/python benchmarks/bench_select.py
 """
 
@@ -73,6 +77,44 @@ def main() -> None:
             ti = time.perf_counter() - t0
             print(f"| {n_terms} | {total} | {n_logs} | {len(sel.candidates)} | {ts:.2f} | "
                   f"{ti:.3f} | {ts / ti:.0f}× |")
+    fold_sum_cost(logs)
+
+
+def fold_sum_cost(logs, repeats: int = 3) -> None:
+    """select on 10 logs and the 30-term library with the fold sums cached and summed per fit."""
+    import numpy as np
+
+    from shipid.dynamics.model import DOFS
+    from shipid.identification import select as select_module
+
+    cached = select_module._Data.fold_sums
+
+    def per_fit(self, train):  # every fit sums its fold's blocks anew, as the code before did
+        key = tuple(train)
+        return (sum(self.gram[j] for j in key),
+                {d: sum(self.cross[j][d] for j in key) for d in DOFS})
+
+    lib, train = library(30), logs[:10]
+    times: dict[str, list[float]] = {"cached once per fold": [], "summed per fit": []}
+    chosen = {}
+    for _ in range(repeats):
+        for label, method in (("cached once per fold", cached), ("summed per fit", per_fit)):
+            select_module._Data.fold_sums = method
+            try:
+                t0 = time.perf_counter()
+                sel = select(train, library=lib)
+                times[label].append(time.perf_counter() - t0)
+            finally:
+                select_module._Data.fold_sums = cached
+            chosen[label] = np.asarray(sel.model.theta)
+    same = np.array_equal(chosen["cached once per fold"], chosen["summed per fit"])
+    base = min(times["summed per fit"])
+    print(f"\nselect, 30 lateral terms, 10 logs ({repeats} runs each, alternated; the same model: "
+          f"{same})\n")
+    print("| fits' Gram blocks | select (s), best | mean | against per fit |")
+    print("|---|---|---|---|")
+    for label, ts in times.items():
+        print(f"| {label} | {min(ts):.2f} | {np.mean(ts):.2f} | {base / min(ts):.2f}× |")
 
 
 if __name__ == "__main__":

@@ -148,7 +148,8 @@ def _block(text: str) -> float | str:
     return value
 
 
-def _add_similarity_option(p) -> None:
+def _add_written_forms_options(p) -> None:
+    """The forms a fit's model is written in: carried to every rps, and astern."""
     p.add_argument("--no-rps-similarity", dest="rps_similarity", action="store_false",
                    help="logs at one propeller speed: keep the fit's terms, which answer every "
                    "other rps as that one (default: each term that does not grow with the "
@@ -286,7 +287,7 @@ def build_parser() -> argparse.ArgumentParser:
                    "one-step acceleration residual, γ and σ (or none) chosen by the free-run "
                    "error of the hybrid on each log left out (--cv); it fades out beyond the "
                    "training logs' envelope. Validate, simulate, manoeuvre and criteria run it")
-    _add_similarity_option(p)
+    _add_written_forms_options(p)
     # --out spelled out: since --output-error, argparse no longer takes it for --output.
     p.add_argument("-o", "--output", "--out", required=True, metavar="MODEL.json")
     _add_physics_options(p)
@@ -337,7 +338,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--table", metavar="OUT.csv", help="write every candidate with its scores")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     _add_crossflow_option(p)
-    _add_similarity_option(p)
+    _add_written_forms_options(p)
     p.add_argument("-o", "--output", required=True, metavar="MODEL.json")
     _add_physics_options(p)
     _add_log_options(p)

@@ -28,12 +28,12 @@ as fitted.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
 
 from shipid.dynamics.model import ManoeuvringModel, ModelStructure
+from shipid.dynamics.renaming import TermRenaming, renamed_model, renamed_terms
 from shipid.dynamics.terms import parse_term
 
 # (equation or None for any, the fitted term) → the form written, in canonical texts.
@@ -56,55 +56,15 @@ def logs_ahead(logs: Sequence[pd.DataFrame]) -> bool:
     return bool(logs) and all(float(np.min(log["u"].to_numpy(dtype=float))) > 0 for log in logs)
 
 
-@dataclass(frozen=True)
-class AheadForms:
-    """The terms of a structure written in their ``AHEAD_FORMS``: ``renamed`` {dof: {fitted
-    term: (written term, 1.0)}} (a term left as it is maps to itself), as
-    ``shipid.dynamics.similarity.SimilarityMap`` renames."""
-
-    renamed: Mapping[str, Mapping[str, tuple[str, float]]]
-
-    @property
-    def changes(self) -> bool:
-        """Whether any term is written in another form."""
-        return any(new != old for eq in self.renamed.values() for old, (new, _) in eq.items())
-
-    def structure(self, structure: ModelStructure) -> ModelStructure:
-        """The structure with its terms renamed (its name kept: the same fit)."""
-        terms = {d: tuple(self.renamed[d][t][0] for t in ts) for d, ts in structure.terms.items()}
-        return ModelStructure(structure.name, terms)
-
-    def describe(self) -> str:
-        """Which terms were written in which form, in words."""
-        return ", ".join(sorted({f"{parse_term(old).display()} → {parse_term(new).display()}"
-                                 for eq in self.renamed.values()
-                                 for old, (new, _) in eq.items() if new != old}))  # fmt: skip
-
-
-def ahead_forms(structure: ModelStructure) -> AheadForms:
-    """The ``AheadForms`` of ``structure``; a term whose form the equation already has (u·v
-    beside |u|·v) keeps its fitted one, as the two are the fit's separate terms."""
-    renamed: dict[str, dict[str, tuple[str, float]]] = {}
-    for dof, terms in structure.terms.items():
-        taken = set(terms)
-        eq: dict[str, tuple[str, float]] = {}
-        for t in terms:
-            new = astern_form(dof, t)
-            if new != t and new in taken:
-                new = t
-            taken.add(new)
-            eq[t] = (new, 1.0)
-        renamed[dof] = eq
-    return AheadForms(renamed)
+def ahead_forms(structure: ModelStructure) -> TermRenaming:
+    """The ``AHEAD_FORMS`` of ``structure``'s terms (``shipid.dynamics.renaming``, ratio 1); a
+    term whose form the equation already has (u·v beside |u|·v) keeps its fitted one, as the
+    two are the fit's separate terms."""
+    return TermRenaming(renamed_terms(structure, lambda dof, t: (astern_form(dof, t), 1.0)))
 
 
 def written_ahead(model: ManoeuvringModel) -> ManoeuvringModel:
     """``model`` with its terms in their ``AHEAD_FORMS``: the same accelerations wherever
     u ≥ 0."""
     found = ahead_forms(model.structure)
-    if not found.changes:
-        return model
-    coefficients = {d: {found.renamed[d][t][0]: float(c) for t, c in values.items()}
-                    for d, values in model.coefficients.items()}  # fmt: skip
-    return ManoeuvringModel(found.structure(model.structure), coefficients, name=model.name,
-                            similar_at_rps=model.similar_at_rps)  # fmt: skip
+    return renamed_model(model, found) if found.changes else model

@@ -29,11 +29,12 @@ zig-zag file predicts the held-out logs at another propeller speed with a yaw ra
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from shipid.dynamics.model import ManoeuvringModel, ModelStructure
+from shipid.dynamics.renaming import TermRenaming, renamed_model, renamed_terms
 from shipid.dynamics.terms import Term, parse_term
 
 # Signals that scale with the propeller speed under advance-ratio similarity (each degree 1);
@@ -67,40 +68,22 @@ def similar_term(term: str) -> tuple[str, int]:
 
 
 @dataclass(frozen=True)
-class SimilarityMap:
-    """The terms of a structure carried to advance-ratio similarity at ``rps``: ``renamed``
-    {dof: {fitted term: (similar term, ratio of coefficients)}} (a term left as it is maps to
-    itself with ratio 1), ``kept`` the terms of degree above 2 left as fitted, {dof: [term]}."""
+class SimilarityMap(TermRenaming):
+    """The terms of a structure carried to advance-ratio similarity at ``rps``
+    (``TermRenaming``: a term's ratio is n₀ to the power it gained, negated), ``kept`` the terms
+    of degree above 2 left as fitted, {dof: [term]}."""
 
-    rps: float
-    renamed: Mapping[str, Mapping[str, tuple[str, float]]]
-    kept: Mapping[str, tuple[str, ...]]
+    rps: float = 0.0
+    kept: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
 
-    @property
-    def changes(self) -> bool:
-        """Whether any term gains a factor of n."""
-        return any(new != old for eq in self.renamed.values() for old, (new, _) in eq.items())
-
-    def structure(self, structure: ModelStructure) -> ModelStructure:
-        """The structure with its terms renamed."""
-        terms = {d: tuple(self.renamed[d][t][0] for t in ts) for d, ts in structure.terms.items()}
-        return ModelStructure(f"{structure.name} (rps-similar at {self.rps:.4g})", terms)
-
-    def coefficients(self, coefficients: Mapping[str, Mapping[str, float]]) -> dict:
-        """{dof: {similar term: coefficient}} of fitted ones."""
-        return {d: {self.renamed[d][t][0]: float(c) * self.renamed[d][t][1]
-                    for t, c in values.items()} for d, values in coefficients.items()}  # fmt: skip
-
-    def term(self, dof: str, term: str) -> tuple[str, float]:
-        """(similar term, ratio) of a fitted term of equation ``dof``."""
-        return self.renamed[dof][parse_term(term).text]
+    def structure(self, structure: ModelStructure, name: str | None = None) -> ModelStructure:
+        """The structure with its terms renamed, named for the similarity."""
+        return super().structure(structure, name or
+                                 f"{structure.name} (rps-similar at {self.rps:.4g})")  # fmt: skip
 
     def describe(self) -> str:
         """Which terms gained which factor, in words."""
-        done = sorted({f"{parse_term(old).display() or '1'} → {parse_term(new).display()}"
-                       for eq in self.renamed.values() for old, (new, _) in eq.items()
-                       if new != old})  # fmt: skip
-        out = ", ".join(done)
+        out = super().describe()
         kept = sorted({parse_term(t).display() for ts in self.kept.values() for t in ts})
         if kept:
             out += f"; kept as fitted (degree above 2, no factor of n makes them scale): " \
@@ -110,25 +93,18 @@ class SimilarityMap:
 
 def similarity_map(structure: ModelStructure, rps: float) -> SimilarityMap:
     """The ``SimilarityMap`` of ``structure`` at ``rps`` (> 0). A term whose similar form the
-    equation already has (its constant beside ``|n|*n``, ``delta`` beside ``pos(n)^2*delta``) keeps
-    its fitted form: the structure's own term carries the dependence on n, and two terms made
-    one would lose the fit's standard errors and replicates."""
+    equation already has (its constant beside ``|n|*n``, ``delta`` beside ``pos(n)^2*delta``)
+    keeps its fitted form (``shipid.dynamics.renaming.renamed_terms``)."""
     if not (np.isfinite(rps) and rps > 0):
         raise ValueError(f"the propeller speed must be positive, got {rps!r}")
-    renamed: dict[str, dict[str, tuple[str, float]]] = {}
-    kept: dict[str, tuple[str, ...]] = {}
-    for dof, terms in structure.terms.items():
-        eq: dict[str, tuple[str, float]] = {}
-        taken = set(terms)
-        for t in terms:
-            new, k = similar_term(t)
-            if new != t and new in taken:
-                new, k = t, 0
-            taken.add(new)
-            eq[t] = (new, float(rps) ** -k)
-        renamed[dof] = eq
-        kept[dof] = tuple(t for t in terms if (speed_degree(t) or 0) > 2)
-    return SimilarityMap(float(rps), renamed, kept)
+
+    def similar(dof: str, term: str) -> tuple[str, float]:
+        new, k = similar_term(term)
+        return new, float(rps) ** -k
+
+    kept = {dof: tuple(t for t in terms if (speed_degree(t) or 0) > 2)
+            for dof, terms in structure.terms.items()}  # fmt: skip
+    return SimilarityMap(renamed_terms(structure, similar), rps=float(rps), kept=kept)
 
 
 def rps_similar(model: ManoeuvringModel, rps: float) -> ManoeuvringModel:
@@ -137,6 +113,4 @@ def rps_similar(model: ManoeuvringModel, rps: float) -> ManoeuvringModel:
     ``model`` at ``rps``, and anchored there (``similar_at_rps``): its manoeuvres start from the
     training logs' approach speed times n/``rps``."""
     found = similarity_map(model.structure, rps)
-    return ManoeuvringModel(found.structure(model.structure),
-                            found.coefficients(model.coefficients), name=model.name,
-                            similar_at_rps=found.rps)  # fmt: skip
+    return renamed_model(model, found, similar_at_rps=found.rps)

@@ -155,34 +155,43 @@ def prior_at_rps(prior: dict[str, dict[str, float]], structure: ModelStructure,
     ``rps``. Without it those terms had no prior, and were drawn toward 0."""
     from shipid.dynamics.similarity import similar_term
 
-    out = {d: dict(v) for d, v in prior.items()}
-    for dof, terms in structure.terms.items():
-        given = out.get(dof, {})
-        for text in terms:
-            similar, k = similar_term(text)
-            if k and text not in given and similar in given:
-                out.setdefault(dof, {})[text] = given[similar] * rps**k
-    return out
+    def similar(dof: str, text: str) -> list[tuple[str, float]]:
+        form, k = similar_term(text)
+        return [(form, rps**k)] if k else []
+
+    return _from_twins(prior, structure, similar)
 
 
 def prior_in_forms(prior: dict[str, dict[str, float]], structure: ModelStructure
                    ) -> dict[str, dict[str, float]]:  # fmt: skip
-    """``prior`` with a value for each term of ``structure`` that the prior holds in another of
-    its ahead forms (``shipid.dynamics.astern``: u·v and |u|·v in v̇, ...), which are the same
-    term on logs that run ahead. A model file of such logs is written in the one form; a fit in
-    the other had no prior on those terms, and drew them toward 0."""
-    from shipid.dynamics.astern import astern_form
+    """``prior`` with a value for each term of ``structure`` that the prior holds in its other
+    ahead form (``shipid.dynamics.astern``: u·v and |u|·v in v̇, ...), the same term on logs
+    that run ahead. A model file of such logs is written in the one form; a fit in the other
+    had no prior on those terms, and drew them toward 0."""
+    from shipid.dynamics.astern import AHEAD_FORMS, astern_form
 
+    def other_form(dof: str, text: str) -> list[tuple[str, float]]:
+        fitted = [f for (d, f), w in AHEAD_FORMS.items() if w == text and d in (dof, None)]
+        return [(t, 1.0) for t in (astern_form(dof, text), *fitted) if t != text]
+
+    return _from_twins(prior, structure, other_form)
+
+
+def _from_twins(prior: dict[str, dict[str, float]], structure: ModelStructure, twins
+                ) -> dict[str, dict[str, float]]:  # fmt: skip
+    """``prior`` with, for each term of ``structure`` it lacks, the value of its first twin
+    (``twins(dof, term)``: [(another form, factor)]) that the prior holds and the equation does
+    not, times the factor."""
     out = {d: dict(v) for d, v in prior.items()}
     for dof, terms in structure.terms.items():
         given = out.get(dof, {})
         for text in terms:
             if text in given:
                 continue
-            same = [t for t in given if t != text and astern_form(dof, t) == astern_form(dof, text)
-                    and t not in terms]  # fmt: skip
-            if same:
-                out.setdefault(dof, {})[text] = given[same[0]]
+            found = next(((t, f) for t, f in twins(dof, text) if t in given and t not in terms),
+                         None)  # fmt: skip
+            if found is not None:
+                out.setdefault(dof, {})[text] = given[found[0]] * found[1]
     return out
 
 

@@ -245,7 +245,7 @@ class _Data:
     s0: np.ndarray  # (L, 6)
     logs: list[pd.DataFrame] = field(default_factory=list)  # for the physics (rudder sign, approach)
     library_note: str = ""  # the default library's terms left out for the logs' columns
-    _fold_sums: dict = field(default_factory=dict, repr=False)
+    _fold_sums: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def fold_sums(self, train: Sequence[int]) -> tuple[np.ndarray, dict[str, np.ndarray]]:
         """[Φ 1]ᵀ[Φ 1] and, per DOF, [Φ 1]ᵀy summed over the logs ``train``: once per fold for
