@@ -120,6 +120,31 @@ def test_sign_constraints_hold_and_are_reported(short_zigzag):
     assert fit.physics["signs"] is True
 
 
+def test_the_thrust_falls_with_the_advance_under_the_sign_table():
+    """u|n| ≥ 0 in the surge is a speed that feeds itself (astern too): the sign table holds it
+    at ≤ 0. The truth here has it positive, so the free fit finds it so and the rule binds."""
+    from shipid.dynamics.model import ManoeuvringModel
+    from shipid.dynamics.simulate import simulate
+
+    truth = ManoeuvringModel("u: |u|*u, pos(n)^2, u*|n|; v: u*v, u*r, delta; r: u*v, u*r, delta",
+                             {"u": {"|u|*u": -0.05, "pos(n)^2": 1e-4, "u*|n|": 0.002},
+                              "v": {"u*v": -0.4, "u*r": -0.3, "delta": 0.02},
+                              "r": {"u*v": -0.2, "u*r": -0.5, "delta": -0.05}})  # fmt: skip
+    t = np.arange(0.0, 400.0, 0.2)
+    rps = np.select([t < 100, t < 200, t < 300], [10.0, 6.0, 12.0], 8.0)
+    delta = np.radians(10.0) * np.sign(np.sin(2 * np.pi * t / 60.0))
+    log = simulate(truth, t, delta, {"u": 0.69}, rps=rps).log
+    log = SensorModel(white={"u": 0.002, "v": 0.002, "r": 0.001}).apply(log, seed=1)
+    structure = truth.structure
+    free = identify(log, structure, gamma=1e6)
+    held = identify(log, structure, gamma=1e6, physics=PhysicsOptions(signs=True))
+    assert 0.001 < free.model.coefficients["u"]["u*|n|"] < 0.004  # the truth 0.002, noisy
+    assert held.model.coefficients["u"]["u*|n|"] == 0.0
+    assert "u*|n|" in held.diagnostics["u"]["at_bound"]
+    assert any(w.startswith("u: u |n| held at its bound 0 (thrust falls with the advance)")
+               for w in held.warnings)  # fmt: skip
+
+
 def test_steady_speed_holds_on_every_approach(short_zigzag):
     fit = identify(short_zigzag, "blanke", physics=PhysicsOptions(steady_speed=True))
     u0 = float(short_zigzag["u"].iloc[0])

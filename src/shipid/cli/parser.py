@@ -186,9 +186,10 @@ def _add_physics_options(p) -> None:
                    "number) or a model file (carried to the logs' length and rudder "
                    "convention where the two differ)")
     g.add_argument("--constraints", metavar="LIST",
-                   help="comma list: signs (damping, resistance, thrust and rudder terms keep "
-                   "their physical sign), derivatives (the linearised damping and rudder "
-                   "derivatives keep theirs, whatever terms carry them), steady-speed (u̇ = 0 on "
+                   help="comma list: signs (damping, resistance, thrust, its fall with the "
+                   "advance and rudder terms keep their physical sign), derivatives (the "
+                   "linearised damping and rudder derivatives keep theirs, whatever terms carry "
+                   "them), steady-speed (u̇ = 0 on "
                    "the approach), stable (straight-line stability at the approach: the yaw "
                    "equation given the sway one)")
     g.add_argument("--bound", action="append", metavar="'DOF: TERM <= X'",

@@ -21,7 +21,11 @@ Sign table (``SIGN_RULES``; accelerations in the body frame, forward speed u > 0
 s = +1 when a positive rudder angle turns the ship to starboard, −1 when to port):
 
 * u̇: |u|u ≤ 0 (hull resistance grows with speed); δ², u²δ² ≤ 0 (rudder drag); |n|n, pos(n)²,
-  thrust ≥ 0 (propeller thrust ahead); neg(n)² ≤ 0 (propeller astern pulls back).
+  thrust ≥ 0 (propeller thrust ahead); neg(n)² ≤ 0 (propeller astern pulls back); u|n|,
+  u·pos(n) ≤ 0 (thrust falls with the advance: K_T(J) falls with J ahead, and astern the inflow
+  brakes the reversed propeller harder; of the other sign the surge feeds on its own speed,
+  astern as ahead: the default model of two Esso Osaka zig-zag files, 13_29_19 and 13_42_53,
+  has it at +0.0044 and, with its sway's |u|·v > 0, ran away astern in two random runs).
 * v̇: uv, |u|v, Uv, |v|v, v|n|, v ≤ 0 (sway damping).
 * ṙ: ur, |u|r, Ur, |r|r, r|n|, r ≤ 0 (yaw damping).
 * v̇: crossflow_sway(L) ≤ 0, ṙ: crossflow_yaw(L) ≤ 0 (cross-flow drag opposes the hull's lateral
@@ -62,6 +66,7 @@ SIGN_RULES: tuple[tuple[str, frozenset[str], object, str], ...] = (
     ("u", _canonical("delta^2", "u^2*delta^2"), -1, "rudder drag"),
     ("u", _canonical("|n|*n", "pos(n)^2", "thrust"), 1, "propeller thrust ahead"),
     ("u", _canonical("neg(n)^2"), -1, "propeller astern pulls back"),
+    ("u", _canonical("u*|n|", "u*pos(n)"), -1, "thrust falls with the advance"),
     ("v", _canonical("u*v", "|u|*v", "U*v", "|v|*v", "v*|n|", "v"), -1, "sway damping"),
     ("r", _canonical("u*r", "|u|*r", "U*r", "|r|*r", "r*|n|", "r"), -1, "yaw damping"),
     ("r", _RUDDER_TERMS, RUDDER, "the rudder turns the ship its way"),
