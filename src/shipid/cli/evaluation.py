@@ -115,11 +115,8 @@ def cmd_validate(args) -> int:
         print(metrics_frame(good).to_markdown(index=False, floatfmt=".4g"))
         table = indices_frame(good)
         if len(table):
-            # Mixed columns (numbers and blanks) are objects, which floatfmt leaves alone.
-            table = table.map(lambda x: f"{x:.4g}" if isinstance(x, float) and x == x else x)
-            table = table.astype(object).where(table.notna(), "–")
             print()
-            print(table.to_markdown(index=False, floatfmt=".4g"))
+            print(_markdown_dashed(table, ".4g"))
             note = switch_heading_note(good)
             if note:
                 print(note)
@@ -127,7 +124,7 @@ def cmd_validate(args) -> int:
             if spread:
                 print(spread)
     if args.horizon and good:
-        _print_horizons(model, vals, logs, args)
+        _print_horizons(model, vals, logs, args, env)
     tied, tied_table, tied_runs = ({}, None, {}) if args.lssvm or not good else \
         _tied_validations(doc, args, vals, logs)  # fmt: skip
     residuals = {}
@@ -276,9 +273,10 @@ def _tied_validations(doc, args, vals, logs) -> tuple[dict, object, dict]:
     return out, table, runs
 
 
-def _print_horizons(model, vals, logs, args) -> None:
+def _print_horizons(model, vals, logs, args, envelope) -> None:
     """``validate --horizon``: each log's free runs restarted every H seconds (kept with its
-    validation: ``--json``, the report), and a table of their errors over the log's spread."""
+    validation: ``--json``, the report), and a table of their errors over the log's spread,
+    also within the model's training ``envelope`` and beyond it."""
     from shipid.evaluation.horizon import horizon_errors
     from shipid.reporting.report import horizons_frame
 
@@ -287,14 +285,25 @@ def _print_horizons(model, vals, logs, args) -> None:
             continue
         for h in args.horizon:
             try:
-                v.horizons.append(horizon_errors(model, log, h, args.method, v.name).to_dict())
+                v.horizons.append(horizon_errors(model, log, h, args.method, v.name,
+                                                 envelope).to_dict())
             except ShipidError as exc:  # printed after the log's name, which it starts with
                 v.warnings.append(str(exc).removeprefix(f"{v.name}: "))
     table = horizons_frame(vals)
     if len(table):
         print("\nPredictions over a horizon: free runs restarted from the measured state every "
-              "H s, their rms error over the log's spread (1 ≈ predicting its mean):")
-        print(table.to_markdown(index=False, floatfmt=".3g"))
+              "H s, their rms error over the log's spread (1 ≈ predicting its mean)"
+              + ("; the windows whose every signal stays within the training logs' envelope, "
+                 "and the yaw rate's error over them and over the rest (extrapolation)"
+                 if "in envelope" in table.columns else "") + ":")
+        print(_markdown_dashed(table, ".3g"))
+
+
+def _markdown_dashed(table, fmt: str) -> str:
+    """``table`` as markdown, its numbers to ``fmt`` and its blanks (NaN, None) as '–'."""
+    # Mixed columns (numbers and blanks) are objects, which floatfmt leaves alone.
+    table = table.map(lambda x: f"{x:{fmt}}" if isinstance(x, float) and x == x else x)
+    return table.astype(object).where(table.notna(), "–").to_markdown(index=False, floatfmt=fmt)
 
 
 def _coefficient_errors(doc, model, lssvm: bool) -> tuple[dict | None, str]:

@@ -41,14 +41,26 @@ def envelope(logs: Sequence[pd.DataFrame]) -> dict[str, list[float]]:
     return out
 
 
-def outside_envelope(env: Mapping[str, Sequence[float]], log: pd.DataFrame) -> list[str]:
-    """One message per signal of ``log`` that leaves the envelope by more than ``MARGIN``."""
-    notes = []
+def allowed_ranges(env: Mapping[str, Sequence[float]]) -> dict[str, tuple[float, float, float]]:
+    """{signal: (low, high, margin)}: the training range and how far beyond it, either side, a
+    run's signal may go before it leaves the envelope (``MARGIN`` of the range's span, and at
+    least ``MAGNITUDE_MARGIN`` of its magnitude)."""
+    out = {}
     for s, bounds in (env or {}).items():
-        if s not in log.columns or len(bounds) != 2:
+        if len(bounds) != 2:
             continue
         lo, hi = (float(b) for b in bounds)
         margin = max(MARGIN * (hi - lo), MAGNITUDE_MARGIN * max(abs(lo), abs(hi)), 1e-12)
+        out[s] = (lo, hi, margin)
+    return out
+
+
+def outside_envelope(env: Mapping[str, Sequence[float]], log: pd.DataFrame) -> list[str]:
+    """One message per signal of ``log`` that leaves the envelope by more than ``MARGIN``."""
+    notes = []
+    for s, (lo, hi, margin) in allowed_ranges(env).items():
+        if s not in log.columns:
+            continue
         x = log[s].to_numpy()
         if x.size == 0:
             continue

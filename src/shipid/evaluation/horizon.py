@@ -7,6 +7,11 @@ controller asks of it. Here the log is cut into consecutive windows of H seconds
 simulated from the measured u, v, r at its start, driven by the measured rudder (and propeller,
 wind), and its error kept over the window. Reported per state as the root-mean-square error over
 all windows' samples, and over the state's spread in the log (1 ≈ predicting the log's mean).
+
+Given the model's training envelope (``shipid.evaluation.envelope``), the windows are also split
+by whether every signal stays within it: a model is only known where its trials went, and a
+run that leaves them (a random run astern, from zig-zags ahead) mixes what it was trained for
+with extrapolation. The two parts' errors say which of them the run's error is.
 """
 
 from __future__ import annotations
@@ -19,6 +24,7 @@ import pandas as pd
 
 from shipid.dynamics.simulate import model_inputs, simulate_batch
 from shipid.errors import ShipidError
+from shipid.evaluation.envelope import allowed_ranges
 
 STATES = ("u", "v", "r")
 
@@ -32,18 +38,43 @@ class HorizonErrors:
     diverged: int
     rmse: dict[str, float] = field(default_factory=dict)
     over_spread: dict[str, float] = field(default_factory=dict)
+    # Given the training envelope: how many windows stay within it, and the error over the
+    # log's spread of those windows and of the rest (NaN where there are none).
+    inside: int | None = None
+    over_spread_inside: dict[str, float] = field(default_factory=dict)
+    over_spread_outside: dict[str, float] = field(default_factory=dict)
 
     def to_dict(self) -> dict:
         """The errors as JSON-ready data (``validate --json``, each log's ``horizons``)."""
-        return {"horizon_s": self.horizon_s, "windows": self.windows, "diverged": self.diverged,
-                "rmse": dict(self.rmse), "over_spread": dict(self.over_spread)}  # fmt: skip
+        out = {"horizon_s": self.horizon_s, "windows": self.windows, "diverged": self.diverged,
+               "rmse": dict(self.rmse), "over_spread": dict(self.over_spread)}  # fmt: skip
+        if self.inside is not None:
+            out.update(inside_envelope=self.inside,
+                       over_spread_inside=dict(self.over_spread_inside),
+                       over_spread_outside=dict(self.over_spread_outside))  # fmt: skip
+        return out
+
+
+def windows_inside(env, log: pd.DataFrame, index: np.ndarray, real: np.ndarray) -> np.ndarray:
+    """(B,) whether each window (rows of ``index`` into ``log``, ``real`` its samples) keeps
+    every signal of ``log`` the envelope ``env`` has within its allowed range."""
+    inside = np.ones(index.shape[0], dtype=bool)
+    for s, (lo, hi, margin) in allowed_ranges(env).items():
+        if s not in log.columns:
+            continue
+        x = log[s].to_numpy(dtype=float)[index]
+        within = (x >= lo - margin) & (x <= hi + margin)
+        inside &= np.all(within | ~real, axis=1)
+    return inside
 
 
 def horizon_errors(model, log: pd.DataFrame, horizon_s: float, method: str = "euler",
-                   name: str | None = None) -> HorizonErrors:  # fmt: skip
+                   name: str | None = None, envelope=None) -> HorizonErrors:  # fmt: skip
     """Free runs of ``model`` over consecutive windows of ``horizon_s`` seconds of ``log``, each
     from the log's measured state at its start (``HorizonErrors``). A window whose run diverges
-    counts in ``diverged`` and its samples from there on as missing."""
+    counts in ``diverged`` and its samples from there on as missing. With ``envelope`` (the
+    model's training envelope, {signal: [min, max]}), the windows within it and the rest are
+    also reported apart."""
     name = name or log.attrs.get("name", "log")
     if not (isinstance(horizon_s, int | float) and math.isfinite(horizon_s) and horizon_s > 0):
         raise ShipidError(f"--horizon must be seconds > 0, got {horizon_s!r}")
@@ -71,11 +102,21 @@ def horizon_errors(model, log: pd.DataFrame, horizon_s: float, method: str = "eu
     keep = real & alive
     keep[:, 0] = False  # the measured start itself
     out = HorizonErrors(steps * dt, len(starts), int(batch.diverged.sum()))
+    inside = windows_inside(envelope, log, index, real) if envelope else None
+    if inside is not None:
+        out.inside = int(inside.sum())
     for j, s in enumerate(STATES):
         measured = log[s].to_numpy(dtype=float)
-        err = (batch.states[:, :, j] - measured[index])[keep]
-        rmse = float(np.sqrt(np.mean(err**2))) if err.size else math.nan
         spread = float(np.std(measured))
-        out.rmse[s] = rmse
-        out.over_spread[s] = rmse / spread if spread > 0 else math.nan
+        error = batch.states[:, :, j] - measured[index]
+        out.rmse[s] = _rms(error[keep])
+        out.over_spread[s] = out.rmse[s] / spread if spread > 0 else math.nan
+        if inside is not None:
+            for part, windows in ((out.over_spread_inside, inside),
+                                  (out.over_spread_outside, ~inside)):  # fmt: skip
+                part[s] = _rms(error[keep & windows[:, None]]) / spread if spread > 0 else math.nan
     return out
+
+
+def _rms(err: np.ndarray) -> float:
+    return float(np.sqrt(np.mean(err**2))) if err.size else math.nan

@@ -87,7 +87,11 @@ def validation_report(
     if len(horizons):
         parts += ["<h2>Predictions over a horizon</h2>",
                   "<p>Free runs restarted from the measured state every H s; rms error over "
-                  "the log's spread (1 ≈ predicting its mean).</p>", _table(horizons)]
+                  "the log's spread (1 ≈ predicting its mean)"
+                  + ("; the windows whose every signal stays within the training logs' "
+                     "envelope, and the yaw rate's error over them and over the rest "
+                     "(extrapolation)" if "in envelope" in horizons.columns else "")
+                  + ".</p>", _table(horizons)]
     failed = [v for v in validations if v.error is not None]
     if failed:
         parts.append("<ul>" + "".join(f"<li class='warn'>{html.escape(v.error)}</li>"

@@ -59,11 +59,21 @@ UNITS = {"u": "m/s", "v": "m/s", "r": "rad/s"}
 
 def horizons_frame(validations: Sequence[Validation]) -> pd.DataFrame:
     """One row per log and horizon (``validate --horizon``): windows, diverged, and the rms
-    error of u, v, r over the log's spread."""
-    rows = [{"log": Path(v.name).name, "horizon [s]": h["horizon_s"], "windows": h["windows"],
-             "diverged": h["diverged"],
-             **{f"{s} error / spread": h["over_spread"][s] for s in ("u", "v", "r")}}
-            for v in validations if v.error is None for h in v.horizons]  # fmt: skip
+    error of u, v, r over the log's spread; where the model keeps its training envelope, the
+    windows within it and the yaw rate's error over them and over the rest."""
+    rows = []
+    for v in validations:
+        if v.error is not None:
+            continue
+        for h in v.horizons:
+            row = {"log": Path(v.name).name, "horizon [s]": h["horizon_s"],
+                   "windows": h["windows"], "diverged": h["diverged"],
+                   **{f"{s} error / spread": h["over_spread"][s] for s in ("u", "v", "r")}}
+            if h.get("inside_envelope") is not None:
+                row.update({"in envelope": h["inside_envelope"],
+                            "r error / spread in it": h["over_spread_inside"]["r"],
+                            "beyond it": h["over_spread_outside"]["r"]})  # fmt: skip
+            rows.append(row)
     return pd.DataFrame(rows)
 
 
