@@ -86,13 +86,13 @@ def main() -> None:
 
 def random_runs_inside_and_outside(horizon_s: float = 10.0) -> None:
     """Why zig-zags alone predict the random runs poorly: the held-out random runs cut into
-    windows of ``horizon_s``, each free-run from its measured state (``validate --horizon``),
-    split by whether the window stays inside the training logs' envelope (every signal,
-    ``shipid.evaluation.envelope``); the r error over the run's spread in each part. The
-    README's recipe (stepwise, ``--average``), trained on the zig-zags alone and on the
-    README's fold."""
-    from shipid.dynamics.simulate import simulate_log
-    from shipid.evaluation.envelope import envelope, outside_envelope
+    windows of ``horizon_s``, each free-run from its measured state, split by whether the window
+    stays inside the training logs' envelope (every signal): ``validate --horizon``'s columns,
+    ``shipid.evaluation.horizon`` with the envelope; the r error over the run's spread in each
+    part. The README's recipe (stepwise, ``--average``), trained on the zig-zags alone and on
+    the README's fold."""
+    from shipid.evaluation.envelope import envelope
+    from shipid.evaluation.horizon import horizon_errors
 
     data = esso_logs()
     if data is None:
@@ -109,20 +109,11 @@ def random_runs_inside_and_outside(horizon_s: float = 10.0) -> None:
         model = select(train, library=LIBRARY, cv="logo", search="stepwise", average=True).model
         env = envelope(train)
         for key in rnd_held:
-            log = rnd[key]
-            steps = int(round(horizon_s / float(np.median(np.diff(log["t"])))))
-            errors: dict[bool, list[np.ndarray]] = {True: [], False: []}
-            for a in range(0, len(log) - 1, steps):
-                window = log.iloc[a : a + steps + 1].reset_index(drop=True)
-                window = window.assign(t=window["t"] - window["t"].iloc[0])
-                sim = simulate_log(model, window).log
-                err = (sim["r"].to_numpy() - window["r"].to_numpy()[: len(sim)])[1:]
-                errors[not outside_envelope(env, window)].append(err)
-            spread = float(np.std(log["r"]))
-            cells = [f"{np.sqrt(np.mean(np.concatenate(e) ** 2)) / spread:.2f}" if e else "–"
-                     for e in (errors[True], errors[False])]  # fmt: skip
-            n_in, n_all = len(errors[True]), len(errors[True]) + len(errors[False])
-            print(f"| {fold} | {key} | {n_in} of {n_all} | {cells[0]} | {cells[1]} |")
+            found = horizon_errors(model, rnd[key], horizon_s, envelope=env)
+            cells = [f"{x:.2f}" if x == x else "–" for x in
+                     (found.over_spread_inside["r"], found.over_spread_outside["r"])]  # fmt: skip
+            print(f"| {fold} | {key} | {found.inside} of {found.windows} | {cells[0]} | "
+                  f"{cells[1]} |")
 
 
 if __name__ == "__main__":
