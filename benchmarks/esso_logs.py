@@ -41,6 +41,20 @@ def esso_logs(dt: float | None = 0.5):
     return zz, rnd, turns
 
 
+def trial_files():
+    """(the zig-zag files, {path: log} of every trial file, zig-zags first, as the commands read
+    it with ``--format osaka-frt``: cut to the manoeuvre, or to a propulsion dropout), or None
+    (and a line saying so) when ``../shared/data`` is absent."""
+    from shipid.trials.reading import read_trial_log
+
+    if not DATA.is_dir():
+        print("../shared/data is absent")
+        return None
+    zigzags = sorted((DATA / "zigzag").glob("*.csv"))
+    others = sorted((DATA / "turning").glob("*.csv")) + sorted((DATA / "random").glob("*.csv"))
+    return zigzags, {p: read_trial_log(p, fmt="osaka-frt") for p in zigzags + others}
+
+
 def condition_folds(rnd) -> dict[str, tuple[list[str], list[str], list[str], list[str]]]:
     """Per fold: (training zig-zags, training random runs, held-out zig-zags, held-out random
     runs); the turns are held out in every fold. Three folds reach beyond the training

@@ -28,13 +28,12 @@ import time
 import warnings
 
 import numpy as np
-from esso_logs import DATA
+from esso_logs import trial_files
 
 from shipid.cli import main as shipid
 from shipid.evaluation.validate import validate
 from shipid.identification.plausibility import crash_stop
 from shipid.reporting.modelfile import load_document, load_model
-from shipid.trials.reading import read_trial_log
 
 VARIANTS = {"ahead forms (default)": [], "fitted forms (--no-ahead-forms)": ["--no-ahead-forms"]}
 
@@ -84,13 +83,11 @@ def _table(title: str, cases: list[list], held: dict) -> None:
 
 
 def main(pairs: bool) -> None:
-    if not DATA.is_dir():
-        print("../shared/data is absent")
-        return
     warnings.simplefilter("ignore")
-    zigzags = sorted((DATA / "zigzag").glob("*.csv"))
-    others = sorted((DATA / "turning").glob("*.csv")) + sorted((DATA / "random").glob("*.csv"))
-    held = {p: read_trial_log(p, fmt="osaka-frt") for p in zigzags + others}
+    files = trial_files()
+    if files is None:
+        return
+    zigzags, held = files
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores")
     _table("Each zig-zag file alone", [[z] for z in zigzags], held)
     _table("The nine zig-zag files together", [zigzags], held)

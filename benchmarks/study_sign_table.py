@@ -20,12 +20,11 @@ import time
 import warnings
 
 import numpy as np
-from esso_logs import DATA
+from esso_logs import trial_files
 
 from shipid.cli import main as shipid
 from shipid.evaluation.validate import validate
 from shipid.reporting.modelfile import load_document, load_model
-from shipid.trials.reading import read_trial_log
 
 VARIANTS = {"default": [], "--constraints signs": ["--constraints", "signs"]}
 
@@ -57,13 +56,11 @@ def _judge(paths: list, extra: list[str], held: dict, out: str) -> dict | None:
 
 
 def main() -> None:
-    if not DATA.is_dir():
-        print("../shared/data is absent")
-        return
     warnings.simplefilter("ignore")
-    zigzags = sorted((DATA / "zigzag").glob("*.csv"))
-    others = sorted((DATA / "turning").glob("*.csv")) + sorted((DATA / "random").glob("*.csv"))
-    held = {p: read_trial_log(p, fmt="osaka-frt") for p in zigzags + others}
+    files = trial_files()
+    if files is None:
+        return
+    zigzags, held = files
     pairs = [list(p) for p in itertools.combinations(zigzags, 2)]
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores\n")
     print(f"Each pair of zig-zag files ({len(pairs)} models); every figure on logs the model was "
