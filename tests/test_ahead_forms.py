@@ -151,7 +151,7 @@ def test_a_crash_stop_of_the_ahead_forms_comes_to_rest(fitted_files):
     speed = json.loads(fitted_files["ahead"].read_text())["identification"]["preprocessing"][
         "approach_speed"]  # fmt: skip
     checks = {k: crash_stop(load_model(fitted_files[k]), speed, N0) for k in ("ahead", "fitted")}
-    assert checks == {"ahead": {"diverged": False, "reason": "", "at": None},
+    assert checks == {"ahead": {"diverged": False, "reason": "", "at": None, "coasting": None},
                       "fitted": {**checks["fitted"], "diverged": True}}  # fmt: skip
     run_ = stopping(load_model(fitted_files["ahead"]), N0, duration=600.0, dt=0.1, speed=speed)
     tail = run_.log.iloc[-500:]

@@ -89,6 +89,59 @@ def test_stopping_of_a_model_with_propeller_terms():
         stopping(kvlcc2(), 10.0)
 
 
+def _propelled(surge: dict):
+    from shipid.dynamics.model import ManoeuvringModel
+
+    return ManoeuvringModel("u: " + ", ".join(surge) + "; v: u*v, delta; r: u*r, delta",
+                            {"u": surge, "v": {"u*v": -1.0, "delta": 0.1},
+                             "r": {"u*r": -1.0, "delta": -0.2}})  # fmt: skip
+
+
+@pytest.mark.parametrize(("surge", "braking"), [
+    ({"|u|u": -0.25, "pos(n)^2": 0.01}, 0.0),  # thrust ahead only: reversed, nothing
+    ({"|u|u": -0.25, "|n|n": 0.01}, -1.0),  # the same thrust astern: −a n²
+    ({"|u|u": -0.25, "pos(n)^2": 0.01, "neg(n)^2": -0.004}, -0.4),  # 40 % of it astern
+    ({"|u|u": -0.25, "pos(n)^2": 0.01, "u*|n|": -0.02}, -0.4),  # the advance term: c u |n|
+])  # fmt: skip
+def test_the_reversed_propellers_braking_by_hand(surge, braking):
+    """u̇(2 m/s, n = −10) − u̇(2 m/s, n = 0) of each surge, by hand; none where it is 0."""
+    from shipid.dynamics.equilibrium import astern_braking
+
+    found = astern_braking(_propelled(surge), 2.0, 10.0)
+    assert found["braking"] == pytest.approx(braking, abs=1e-12)
+    assert found["none"] is (braking == 0.0)
+
+
+@pytest.mark.parametrize("thrust", ["pos(n)^2", "|n|n"])
+def test_a_model_whose_propeller_does_nothing_astern_coasts_and_says_so(tmp_path, capsys, thrust):
+    """A propeller term that is zero for n < 0 (what a selection keeps from logs that never
+    reverse the propeller) makes the full astern a coast on the resistance: longer than with
+    the propeller braking, so the criteria keep a pass and judge no fail, and the crash stop
+    identify runs and ``manoeuvre stopping`` say so. The same thrust as |n|n brakes."""
+    from shipid.identification.plausibility import check_plausibility
+
+    # u̇ = a pos(n)² − c − k u|u|, steady at 1 m/s at 10 rps; coasting from 1 m/s stops within
+    # ln(1 + k/c)/2k = 9.7 m, over 15 L of a 0.5 m ship.
+    c, k = 2e-3, 0.25
+    model = _propelled({"1": -c, "|u|u": -k, thrust: (c + k) / 100.0})
+    coasts = thrust == "pos(n)^2"
+    crit = imo_criteria(model, length=0.5, speed=1.0, scale=1.0, rps=10.0, dt=0.1)
+    row = crit.table.set_index("criterion").loc["stopping track reach"]
+    noted = [n for n in crit.notes if "does not brake astern" in n]
+    if coasts:
+        assert row["value"] > 15.0 and row["passed"] is None and math.isnan(row["margin"])
+        assert len(noted) == 1 and "a pass holds, a fail is not judged" in noted[0]
+    else:
+        assert row["value"] < 15.0 and bool(row["passed"]) and not noted
+    _, warnings = check_plausibility(model, 1.0, 10.0, astern=True)
+    assert any("does not brake astern" in w for w in warnings) is coasts
+    path = tmp_path / "m.json"
+    model.save(path)
+    code, _, err = run(["manoeuvre", path, "stopping", "--rps", "10", "--speed", "1"], capsys)
+    assert code == 0, err
+    assert ("does not brake astern" in err) is coasts
+
+
 def test_measured_criteria_pick_the_standard_manoeuvres():
     turn = {"kind": "turning", "advance": 30.0, "tactical_diameter": 40.0}
     rows = measured_criteria(turn, 35.0, None, 10.0, 1.0)

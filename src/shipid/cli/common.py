@@ -398,6 +398,13 @@ def _parse_drop(spec: str | None) -> dict[str, list[str]]:
     return out
 
 
+def _markdown_dashed(table, fmt: str) -> str:
+    """``table`` as markdown, its numbers to ``fmt`` and its blanks (NaN, None) as '–'."""
+    # Mixed columns (numbers and blanks) are objects, which floatfmt leaves alone.
+    table = table.map(lambda x: f"{x:{fmt}}" if isinstance(x, float) and x == x else x)
+    return table.astype(object).where(table.notna(), "–").to_markdown(index=False, floatfmt=fmt)
+
+
 def _warn(message: str) -> None:
     warnings.warn(message, ShipidWarning, stacklevel=2)
 

@@ -12,6 +12,7 @@ from shipid.cli.common import (
     _check_length,
     _check_scale,
     _json_text,
+    _markdown_dashed,
     _particulars,
     _pd,
     _print_yaw_rate_offsets,
@@ -297,13 +298,6 @@ def _print_horizons(model, vals, logs, args, envelope) -> None:
                  "and the yaw rate's error over them and over the rest (extrapolation)"
                  if "in envelope" in table.columns else "") + ":")
         print(_markdown_dashed(table, ".3g"))
-
-
-def _markdown_dashed(table, fmt: str) -> str:
-    """``table`` as markdown, its numbers to ``fmt`` and its blanks (NaN, None) as '–'."""
-    # Mixed columns (numbers and blanks) are objects, which floatfmt leaves alone.
-    table = table.map(lambda x: f"{x:{fmt}}" if isinstance(x, float) and x == x else x)
-    return table.astype(object).where(table.notna(), "–").to_markdown(index=False, floatfmt=fmt)
 
 
 def _coefficient_errors(doc, model, lssvm: bool) -> tuple[dict | None, str]:

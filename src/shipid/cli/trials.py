@@ -13,6 +13,7 @@ from shipid.cli.common import (
     _check_length,
     _check_scale,
     _json_text,
+    _markdown_dashed,
     _pd,
     _read_files,
     _run_approach,
@@ -142,7 +143,7 @@ def cmd_criteria(args) -> int:
     record = {**crit.to_dict(), "criteria": table.to_dict(orient="records"),
               "tied_structures": tied or None, "verdict": verdict}  # fmt: skip
     table["passed"] = table["passed"].map({True: "pass", False: "FAIL", None: "–"})
-    print(table.to_markdown(index=False, floatfmt=".3g"))
+    print(_markdown_dashed(table, ".3g"))
     if "pass_share" in table:
         print(f"lower, upper: 95 % interval of the value, pass_share: the share of passes, "
               f"no_value: how many have none, over the model's {ensemble.replicates} "
@@ -251,6 +252,7 @@ def cmd_manoeuvre(args) -> int:
     from shipid.evaluation.validate import faded_residual_notes
     from shipid.outputs import OutputSet, check_outputs
     from shipid.trials.manoeuvres import (
+        coasting_note,
         pull_out,
         spiral,
         stopping,
@@ -319,6 +321,8 @@ def cmd_manoeuvre(args) -> int:
     if res.diverged:
         print(res.reason, file=sys.stderr)
     notes = ([unsteady] if unsteady else []) + _unused_inputs(target, args)
+    if args.kind == "stopping":
+        notes += [n for n in [coasting_note(target, speed, rps, args.astern_rps)] if n]
     notes += outside_envelope(cond["envelope"], res.log)
     notes += faded_residual_notes(target, res.log)
     if res.incomplete and not res.diverged:

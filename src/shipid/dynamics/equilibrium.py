@@ -42,6 +42,26 @@ def still_air_accelerations(model: ManoeuvringModel, u, v, r, delta, rps,
     return model.accelerations(u, v, r, delta, None, n, **air)
 
 
+# The reversed propeller's braking counts as none below this share of the ahead thrust's push at
+# the same speed: a model whose thrust terms are zero for n < 0 (pos(n)², the only propeller term
+# a selection keeps from logs that never reverse it) gives exactly 0.
+NO_BRAKING_SHARE = 1e-3
+
+
+def astern_braking(model, speed: float, rps: float, astern_rps: float | None = None) -> dict:
+    """What the propeller reversed to ``astern_rps`` (default −``rps``) does to the surge at
+    ``speed`` ahead, the rudder amidships, still air: {"braking": u̇(astern) − u̇(0) [m/s²] (< 0:
+    it brakes), "ahead": u̇(rps) − u̇(0), "none": True where the braking is under
+    ``NO_BRAKING_SHARE`` of the ahead push (or pushes ahead)}. A crash stop of a model without
+    it is the ship coasting."""
+    astern = -rps if astern_rps is None else astern_rps
+    u̇ = [float(still_air_accelerations(model, speed, 0.0, 0.0, 0.0, n)[0, 0])
+         for n in (astern, 0.0, rps)]  # fmt: skip
+    braking, ahead = u̇[0] - u̇[1], u̇[2] - u̇[1]
+    return {"braking": braking, "ahead": ahead,
+            "none": bool(braking > -NO_BRAKING_SHARE * abs(ahead))}  # fmt: skip
+
+
 def surge_equilibrium(model: ManoeuvringModel, speed: float, rps: float | None = None,
                       span: float = 3.0, wind: tuple[float, float] | None = None,
                       psi: float = 0.0) -> float | None:  # fmt: skip

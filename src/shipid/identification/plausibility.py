@@ -19,6 +19,8 @@ approach condition (speed u0, propeller speed n):
 * crash stop (``astern``, for the model a command hands out): the propeller reversed from the
   approach must not make the model diverge; a warning, since logs run ahead only leave going
   astern to extrapolation, and ruling models out for it made the Esso's pairs predict worse.
+  Nor should the reversed propeller do nothing: a model none of whose propeller terms acts with
+  n < 0 coasts to a stop (``coasting_note``), which a warning says too.
 """
 
 from __future__ import annotations
@@ -31,7 +33,7 @@ import numpy as np
 from shipid.dynamics.equilibrium import still_air_accelerations, surge_equilibrium
 from shipid.dynamics.model import ManoeuvringModel
 from shipid.errors import ShipidError
-from shipid.trials.manoeuvres import doubling, stopping, turning_circle
+from shipid.trials.manoeuvres import coasting_note, doubling, stopping, turning_circle
 
 SETTLED_FRACTION = 0.02  # of the steady value, over the last 10 % of the run
 # A ship whose propeller keeps turning keeps a share of its approach speed in a steady turn with
@@ -174,7 +176,8 @@ def crash_stop(model, speed: float, rps: float | None, duration: float | None = 
         res = stopping(model, rps, duration=length, dt=dt, speed=speed)
     except ShipidError:
         return None
-    return {"diverged": bool(res.diverged), "reason": res.reason, "at": res.diverged_at}
+    return {"diverged": bool(res.diverged), "reason": res.reason, "at": res.diverged_at,
+            "coasting": coasting_note(model, speed, rps)}  # fmt: skip
 
 
 def _runaway_from_drift(model, speed, rps, rudder_deg, side, duration, dt,
@@ -385,6 +388,9 @@ def failed_checks(report: dict, model: ManoeuvringModel) -> dict[str, tuple[int,
         out["astern"] = (1, f"propeller reversed to −{report['rps']:.4g} rps from the approach "
                          f"(a crash stop): {astern['reason']}: the model is not for going "
                          "astern; logs that go astern give it the terms for it")  # fmt: skip
+    elif astern and astern.get("coasting"):
+        out["astern"] = (1, f"propeller reversed to −{report['rps']:.4g} rps from the approach "
+                         f"(a crash stop): {astern['coasting']}")  # fmt: skip
     for side, entry in (report.get("held_rudder") or {}).items():
         where, key = f"{rudder_deg:g}° rudder held to {side}", f"held_rudder_{side}"
         if entry["diverged"]:

@@ -30,7 +30,7 @@ from shipid.dynamics.hybrid import HybridModel
 from shipid.dynamics.model import ManoeuvringModel
 from shipid.dynamics.steering import SteeringMachine
 from shipid.errors import ShipidError
-from shipid.trials.manoeuvres import stopping, turning_circle, without_value, zigzag
+from shipid.trials.manoeuvres import coasting_note, stopping, turning_circle, without_value, zigzag
 from shipid.trials.trial import TURN_KINDS
 from shipid.vessels.vessel import Vessel
 
@@ -191,8 +191,17 @@ def imo_criteria(
         res = stopping(ship, rps, astern_rps, reversal_time=10.0 / math.sqrt(lam),
                        duration=3 * duration, dt=dt, speed=V, method=method)  # fmt: skip
         runs["full astern"] = res  # keyed as its row's manoeuvre
-        rows.append(_row("stopping track reach", "full astern", _in_l(res.indices["track_reach"], L),
-                         15.0, "L"))  # fmt: skip
+        row = _row("stopping track reach", "full astern", _in_l(res.indices["track_reach"], L),
+                   15.0, "L")
+        coasting = coasting_note(ship, V, rps, astern_rps)
+        if coasting:
+            # Coasting reaches further than braking: a pass holds for the ship, a fail decides
+            # nothing.
+            if row["passed"] is False:
+                row["passed"] = row["margin"] = None
+            notes.append(f"stopping ability: {coasting}; its track reach is an upper bound: a "
+                         "pass holds, a fail is not judged")  # fmt: skip
+        rows.append(row)
     else:
         # A reference ship's own physics may run a propeller, at the one speed it was set to
         # (the KVLCC2's MMG model): it takes no order to reverse it.

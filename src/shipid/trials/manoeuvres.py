@@ -25,6 +25,7 @@ import pandas as pd
 
 from shipid.data.log import make_log, relative_wind, starboard_sign
 from shipid.dynamics import codegen, kernel
+from shipid.dynamics.equilibrium import astern_braking
 from shipid.dynamics.hybrid import HybridModel
 from shipid.dynamics.model import ManoeuvringModel
 from shipid.dynamics.simulate import (
@@ -487,6 +488,24 @@ def pull_out(
     if given_hold is not None and given_release is not None:
         return run(given_hold)
     return _extended(run, PULL_OUT_PHASE)
+
+
+def coasting_note(ship, speed: float, rps: float, astern_rps: float | None = None) -> str | None:
+    """A note where a model's propeller does not brake when reversed
+    (``shipid.dynamics.equilibrium.astern_braking``): its stopping test is the ship coasting on
+    its resistance, a longer reach than the ship's own. None for a vessel (its physics) or a
+    model whose propeller brakes."""
+    if not isinstance(ship, ManoeuvringModel | HybridModel) or not ship.uses_rps:
+        return None
+    found = astern_braking(ship, speed, rps, astern_rps)
+    if not found["none"]:
+        return None
+    return ("the model's propeller does not brake astern: reversed, it changes u̇ by "
+            f"{found['braking']:+.3g} m/s² where ahead it gives {found['ahead']:+.3g} (none of its "
+            "propeller terms acts with n < 0; a selection keeps only the terms its logs excite, "
+            "and logs that never reverse the propeller leave the astern thrust out), so a full "
+            "astern is the ship coasting to a stop on its resistance, a longer reach than the "
+            "ship's own; logs with the propeller astern give it the terms")
 
 
 def stopping(
