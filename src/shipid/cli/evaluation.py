@@ -278,7 +278,7 @@ def _print_horizons(model, vals, logs, args, envelope) -> None:
     """``validate --horizon``: each log's free runs restarted every H seconds (kept with its
     validation: ``--json``, the report), and a table of their errors over the log's spread,
     also within the model's training ``envelope`` and beyond it."""
-    from shipid.evaluation.horizon import horizon_errors
+    from shipid.evaluation.horizon import ENVELOPE_COLUMNS_NOTE, horizon_errors
     from shipid.reporting.report import horizons_frame
 
     for v, log in zip(vals, logs, strict=True):
@@ -294,9 +294,7 @@ def _print_horizons(model, vals, logs, args, envelope) -> None:
     if len(table):
         print("\nPredictions over a horizon: free runs restarted from the measured state every "
               "H s, their rms error over the log's spread (1 ≈ predicting its mean)"
-              + ("; the windows whose every signal stays within the training logs' envelope, "
-                 "and the yaw rate's error over them and over the rest (extrapolation)"
-                 if "in envelope" in table.columns else "") + ":")
+              + (f"; {ENVELOPE_COLUMNS_NOTE}" if "in envelope" in table.columns else "") + ":")
         print(_markdown_dashed(table, ".3g"))
 
 

@@ -17,6 +17,7 @@ with extrapolation. The two parts' errors say which of them the run's error is.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -27,6 +28,10 @@ from shipid.errors import ShipidError
 from shipid.evaluation.envelope import allowed_ranges
 
 STATES = ("u", "v", "r")
+# The caption of the columns the envelope adds (``validate --horizon``, its report).
+ENVELOPE_COLUMNS_NOTE = ("the windows whose every signal stays within the training logs' "
+                         "envelope, and the yaw rate's error over them and over the rest "
+                         "(extrapolation)")  # fmt: skip
 
 
 @dataclass
@@ -55,16 +60,17 @@ class HorizonErrors:
         return out
 
 
-def windows_inside(env, log: pd.DataFrame, index: np.ndarray, real: np.ndarray) -> np.ndarray:
+def windows_inside(env: Mapping[str, Sequence[float]], log: pd.DataFrame, index: np.ndarray,
+                   real: np.ndarray) -> np.ndarray:  # fmt: skip
     """(B,) whether each window (rows of ``index`` into ``log``, ``real`` its samples) keeps
-    every signal of ``log`` the envelope ``env`` has within its allowed range."""
+    every signal of ``log`` the envelope ``env`` has within its allowed range (as
+    ``outside_envelope`` judges a whole log)."""
     inside = np.ones(index.shape[0], dtype=bool)
     for s, (lo, hi, margin) in allowed_ranges(env).items():
         if s not in log.columns:
             continue
         x = log[s].to_numpy(dtype=float)[index]
-        within = (x >= lo - margin) & (x <= hi + margin)
-        inside &= np.all(within | ~real, axis=1)
+        inside &= ~np.any(((x < lo - margin) | (x > hi + margin)) & real, axis=1)
     return inside
 
 

@@ -59,6 +59,7 @@ def validation_report(
     ``tied``: the table of the structures ``identify`` could not tell apart from the model's,
     run on the same logs (``shipid validate``), and ``tied_runs`` their free runs per log
     ({log: {structure: simulated log}}), drawn in the figures."""
+    from shipid.evaluation.horizon import ENVELOPE_COLUMNS_NOTE
     from shipid.reporting import plots
     from shipid.reporting.report import (
         horizons_frame,
@@ -88,9 +89,7 @@ def validation_report(
         parts += ["<h2>Predictions over a horizon</h2>",
                   "<p>Free runs restarted from the measured state every H s; rms error over "
                   "the log's spread (1 ≈ predicting its mean)"
-                  + ("; the windows whose every signal stays within the training logs' "
-                     "envelope, and the yaw rate's error over them and over the rest "
-                     "(extrapolation)" if "in envelope" in horizons.columns else "")
+                  + (f"; {ENVELOPE_COLUMNS_NOTE}" if "in envelope" in horizons.columns else "")
                   + ".</p>", _table(horizons)]
     failed = [v for v in validations if v.error is not None]
     if failed:
