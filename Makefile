@@ -10,6 +10,7 @@ $(STAMP): pyproject.toml
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e ".[dev]"
 	$(BIN)/python -m shipid.precompile  # the numba kernels into their cache, once
+	$(BIN)/python -m compileall -q src  # bytecode once, not in every process where none is written
 	touch $(STAMP)
 
 install: $(STAMP)
