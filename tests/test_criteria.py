@@ -140,6 +140,16 @@ def test_a_model_whose_propeller_does_nothing_astern_coasts_and_says_so(tmp_path
     code, _, err = run(["manoeuvre", path, "stopping", "--rps", "10", "--speed", "1"], capsys)
     assert code == 0, err
     assert ("does not brake astern" in err) is coasts
+    # validate names it for a log that reverses the propeller (half its samples here).
+    import pandas as pd
+
+    from shipid.cli.evaluation import _reversed_propeller_notes
+
+    notes = _reversed_propeller_notes(model, {"speed": 1.0, "rps": 10.0},
+                                      pd.DataFrame({"n": [10.0, -10.0, -10.0, 10.0]}))
+    assert bool(notes) is coasts and all("reverses the propeller for 50 %" in n for n in notes)
+    assert not _reversed_propeller_notes(model, {"speed": 1.0, "rps": 10.0},
+                                         pd.DataFrame({"n": [10.0, 8.0]}))
 
 
 def test_measured_criteria_pick_the_standard_manoeuvres():

@@ -106,7 +106,8 @@ def cmd_validate(args) -> int:
                                   disable=args.quiet or len(logs) < 3)]  # fmt: skip
     for v, log in zip(vals, logs, strict=True):
         if v.error is None:
-            v.warnings.extend(outside_envelope(env, log))
+            v.warnings.extend(outside_envelope(env, log) + _reversed_propeller_notes(model, cond,
+                                                                                    log))
     _mark_training_logs(doc, vals)
     good = [v for v in vals if v.error is None]
     if good:
@@ -272,6 +273,22 @@ def _tied_validations(doc, args, vals, logs) -> tuple[dict, object, dict]:
           f"logs ({alternatives_fit(doc)}; judge them on logs none was fitted to):")
     print(table.to_markdown(index=False, floatfmt=".4g"))
     return out, table, runs
+
+
+def _reversed_propeller_notes(model, cond: dict, log) -> list[str]:
+    """A note where ``log`` reverses the propeller and the model's does nothing reversed
+    (``shipid.trials.manoeuvres.coasting_note``, at the training approach): the log's spans
+    astern are the model coasting."""
+    from shipid.trials.manoeuvres import coasting_note
+
+    if "n" not in log.columns or not cond.get("speed") or not cond.get("rps"):
+        return []
+    share = float((log["n"].to_numpy() < 0).mean())
+    if share == 0:
+        return []
+    note = coasting_note(model, cond["speed"], cond["rps"])
+    return [f"the log reverses the propeller for {100 * share:.0f} % of its samples and {note}"
+            ] if note else []  # fmt: skip
 
 
 def _print_horizons(model, vals, logs, args, envelope) -> None:
