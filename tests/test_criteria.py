@@ -152,6 +152,29 @@ def test_a_model_whose_propeller_does_nothing_astern_coasts_and_says_so(tmp_path
                                          pd.DataFrame({"n": [10.0, 8.0]}))
 
 
+@pytest.mark.parametrize("carried", [True, False])
+def test_a_thrust_mirrored_astern_by_similarity_is_named_where_it_stops_the_ship(carried):
+    """A model carried from logs at one rps (``similar_at_rps``) brakes astern with its ahead
+    thrust mirrored (|n|n), an assumption those logs never tested: the stopping verdict says it
+    rests on it. The same terms fitted on logs at several rps say nothing of the kind."""
+    from shipid.dynamics.model import ManoeuvringModel
+    from shipid.trials.manoeuvres import mirrored_thrust_note
+
+    c, k = 2e-3, 0.25
+    plain = _propelled({"1": -c, "|u|u": -k, "|n|n": (c + k) / 100.0})
+    model = ManoeuvringModel(plain.structure, plain.coefficients,
+                             similar_at_rps=10.0 if carried else None)  # fmt: skip
+    crit = imo_criteria(model, length=0.5, speed=1.0, scale=1.0, rps=10.0, dt=0.1)
+    noted = [n for n in crit.notes if "brakes astern at 100 % of its ahead push" in n]
+    assert len(noted) == int(carried)
+    # Half the thrust astern: named at 50 %, from u̇(−n) − u̇(0) over u̇(n) − u̇(0).
+    half = ManoeuvringModel("u: 1, |u|u, pos(n)^2, neg(n)^2; v: u*v, delta; r: u*r, delta",
+                            {"u": {"1": -c, "|u|u": -k, "pos(n)^2": 0.01, "neg(n)^2": -0.005},
+                             "v": {"u*v": -1.0, "delta": 0.1}, "r": {"u*r": -1.0, "delta": -0.2}},
+                            similar_at_rps=10.0)  # fmt: skip
+    assert "at 50 % of its ahead push" in mirrored_thrust_note(half, 1.0, 10.0)
+
+
 def test_measured_criteria_pick_the_standard_manoeuvres():
     turn = {"kind": "turning", "advance": 30.0, "tactical_diameter": 40.0}
     rows = measured_criteria(turn, 35.0, None, 10.0, 1.0)

@@ -30,7 +30,14 @@ from shipid.dynamics.hybrid import HybridModel
 from shipid.dynamics.model import ManoeuvringModel
 from shipid.dynamics.steering import SteeringMachine
 from shipid.errors import ShipidError
-from shipid.trials.manoeuvres import coasting_note, stopping, turning_circle, without_value, zigzag
+from shipid.trials.manoeuvres import (
+    coasting_note,
+    mirrored_thrust_note,
+    stopping,
+    turning_circle,
+    without_value,
+    zigzag,
+)
 from shipid.trials.trial import TURN_KINDS
 from shipid.vessels.vessel import Vessel
 
@@ -201,6 +208,9 @@ def imo_criteria(
                 row["passed"] = row["margin"] = None
             notes.append(f"stopping ability: {coasting}; its track reach is an upper bound: a "
                          "pass holds, a fail is not judged")  # fmt: skip
+        mirrored = mirrored_thrust_note(ship, V, rps, astern_rps)
+        if mirrored:
+            notes.append(f"stopping ability: {mirrored}")
         rows.append(row)
     else:
         # A reference ship's own physics may run a propeller, at the one speed it was set to

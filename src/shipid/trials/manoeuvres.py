@@ -508,6 +508,26 @@ def coasting_note(ship, speed: float, rps: float, astern_rps: float | None = Non
             "ship's own; logs with the propeller astern give it the terms")
 
 
+def mirrored_thrust_note(ship, speed: float, rps: float,
+                         astern_rps: float | None = None) -> str | None:  # fmt: skip
+    """A note where a model carried from logs at one propeller speed (advance-ratio
+    similarity, ``shipid.dynamics.similarity``) brakes astern with its ahead thrust mirrored, an
+    assumption its logs could not test: its stopping test rests on it. None otherwise."""
+    physical = getattr(ship, "physical", ship)
+    if not isinstance(physical, ManoeuvringModel) or physical.similar_at_rps is None \
+            or not ship.uses_rps:  # fmt: skip
+        return None
+    found = astern_braking(ship, speed, rps, astern_rps)
+    if found["none"] or not found["ahead"] > 0:
+        return None
+    return (f"the model brakes astern at {-100 * found['braking'] / found['ahead']:.0f} % of "
+            "its ahead push: its logs ran the propeller at one speed ahead, and advance-ratio "
+            "similarity carries the fit to every propeller speed with its thrust mirrored "
+            "astern, which they could not test; a propeller astern may give less than ahead, so "
+            "its reach may be short of the ship's; logs with the propeller astern give it the "
+            "terms")
+
+
 def stopping(
     ship: Vessel | ManoeuvringModel | HybridModel,
     rps: float,
