@@ -157,6 +157,8 @@ def test_a_thrust_mirrored_astern_by_similarity_is_named_where_it_stops_the_ship
     """A model carried from logs at one rps (``similar_at_rps``) brakes astern with its ahead
     thrust mirrored (|n|n), an assumption those logs never tested: the stopping verdict says it
     rests on it. The same terms fitted on logs at several rps say nothing of the kind."""
+    import pandas as pd
+
     from shipid.dynamics.model import ManoeuvringModel
     from shipid.trials.manoeuvres import mirrored_thrust_note
 
@@ -167,6 +169,11 @@ def test_a_thrust_mirrored_astern_by_similarity_is_named_where_it_stops_the_ship
     crit = imo_criteria(model, length=0.5, speed=1.0, scale=1.0, rps=10.0, dt=0.1)
     noted = [n for n in crit.notes if "brakes astern at 100 % of its ahead push" in n]
     assert len(noted) == int(carried)
+    from shipid.cli.evaluation import _reversed_propeller_notes
+
+    said = _reversed_propeller_notes(model, {"speed": 1.0, "rps": 10.0},
+                                     pd.DataFrame({"n": [10.0, -10.0, -10.0, -10.0]}))
+    assert len(said) == int(carried) and all("for 75 % of its samples" in n for n in said)
     # Half the thrust astern: named at 50 %, from u̇(−n) − u̇(0) over u̇(n) − u̇(0).
     half = ManoeuvringModel("u: 1, |u|u, pos(n)^2, neg(n)^2; v: u*v, delta; r: u*r, delta",
                             {"u": {"1": -c, "|u|u": -k, "pos(n)^2": 0.01, "neg(n)^2": -0.005},

@@ -276,19 +276,20 @@ def _tied_validations(doc, args, vals, logs) -> tuple[dict, object, dict]:
 
 
 def _reversed_propeller_notes(model, cond: dict, log) -> list[str]:
-    """A note where ``log`` reverses the propeller and the model's does nothing reversed
-    (``shipid.trials.manoeuvres.coasting_note``, at the training approach): the log's spans
-    astern are the model coasting."""
-    from shipid.trials.manoeuvres import coasting_note
+    """A note where ``log`` reverses the propeller and the model's does nothing reversed, or
+    brakes with its ahead thrust mirrored by similarity (``shipid.trials.manoeuvres``'s
+    ``coasting_note``, ``mirrored_thrust_note``, at the training approach): what the log's spans
+    astern are predicted with."""
+    from shipid.trials.manoeuvres import coasting_note, mirrored_thrust_note
 
     if "n" not in log.columns or not cond.get("speed") or not cond.get("rps"):
         return []
     share = float((log["n"].to_numpy() < 0).mean())
     if share == 0:
         return []
-    note = coasting_note(model, cond["speed"], cond["rps"])
     return [f"the log reverses the propeller for {100 * share:.0f} % of its samples and {note}"
-            ] if note else []  # fmt: skip
+            for note in (coasting_note(model, cond["speed"], cond["rps"]),
+                         mirrored_thrust_note(model, cond["speed"], cond["rps"])) if note]
 
 
 def _print_horizons(model, vals, logs, args, envelope) -> None:
