@@ -160,7 +160,7 @@ def test_a_thrust_mirrored_astern_by_similarity_is_named_where_it_stops_the_ship
     import pandas as pd
 
     from shipid.dynamics.model import ManoeuvringModel
-    from shipid.trials.manoeuvres import mirrored_thrust_note
+    from shipid.trials.manoeuvres import astern_thrust_note
 
     c, k = 2e-3, 0.25
     plain = _propelled({"1": -c, "|u|u": -k, "|n|n": (c + k) / 100.0})
@@ -179,7 +179,8 @@ def test_a_thrust_mirrored_astern_by_similarity_is_named_where_it_stops_the_ship
                             {"u": {"1": -c, "|u|u": -k, "pos(n)^2": 0.01, "neg(n)^2": -0.005},
                              "v": {"u*v": -1.0, "delta": 0.1}, "r": {"u*r": -1.0, "delta": -0.2}},
                             similar_at_rps=10.0)  # fmt: skip
-    assert "at 50 % of its ahead push" in mirrored_thrust_note(half, 1.0, 10.0)
+    found = astern_thrust_note(half, 1.0, 10.0)
+    assert found.kind == "mirrored" and "at 50 % of its ahead push" in found.note
 
 
 def test_measured_criteria_pick_the_standard_manoeuvres():

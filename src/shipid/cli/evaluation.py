@@ -276,20 +276,17 @@ def _tied_validations(doc, args, vals, logs) -> tuple[dict, object, dict]:
 
 
 def _reversed_propeller_notes(model, cond: dict, log) -> list[str]:
-    """A note where ``log`` reverses the propeller and the model's does nothing reversed, or
-    brakes with its ahead thrust mirrored by similarity (``shipid.trials.manoeuvres``'s
-    ``coasting_note``, ``mirrored_thrust_note``, at the training approach): what the log's spans
-    astern are predicted with."""
-    from shipid.trials.manoeuvres import coasting_note, mirrored_thrust_note
+    """A note where ``log`` reverses the propeller and the model's astern thrust is not what
+    logs showed (``shipid.trials.manoeuvres.astern_thrust_note``, at the training approach):
+    what the log's spans astern are predicted with."""
+    from shipid.trials.manoeuvres import astern_thrust_note
 
     if "n" not in log.columns or not cond.get("speed") or not cond.get("rps"):
         return []
     share = float((log["n"].to_numpy() < 0).mean())
-    if share == 0:
-        return []
-    return [f"the log reverses the propeller for {100 * share:.0f} % of its samples and {note}"
-            for note in (coasting_note(model, cond["speed"], cond["rps"]),
-                         mirrored_thrust_note(model, cond["speed"], cond["rps"])) if note]
+    astern = astern_thrust_note(model, cond["speed"], cond["rps"]) if share > 0 else None
+    return [f"the log reverses the propeller for {100 * share:.0f} % of its samples and "
+            f"{astern.note}"] if astern else []  # fmt: skip
 
 
 def _print_horizons(model, vals, logs, args, envelope) -> None:

@@ -252,8 +252,7 @@ def cmd_manoeuvre(args) -> int:
     from shipid.evaluation.validate import faded_residual_notes
     from shipid.outputs import OutputSet, check_outputs
     from shipid.trials.manoeuvres import (
-        coasting_note,
-        mirrored_thrust_note,
+        astern_thrust_note,
         pull_out,
         spiral,
         stopping,
@@ -323,8 +322,8 @@ def cmd_manoeuvre(args) -> int:
         print(res.reason, file=sys.stderr)
     notes = ([unsteady] if unsteady else []) + _unused_inputs(target, args)
     if args.kind == "stopping":
-        notes += [n for n in (coasting_note(target, speed, rps, args.astern_rps),
-                              mirrored_thrust_note(target, speed, rps, args.astern_rps)) if n]
+        astern = astern_thrust_note(target, speed, rps, args.astern_rps)
+        notes += [astern.note] if astern else []
     notes += outside_envelope(cond["envelope"], res.log)
     notes += faded_residual_notes(target, res.log)
     if res.incomplete and not res.diverged:

@@ -41,7 +41,7 @@ class FrozenMapping(dict):
     """A read-only mapping of log metadata (the particulars, the sensor noise, ...), which pandas
     hands on by reference. pandas deep-copies a frame's ``attrs`` into every column it hands out
     (``log["u"]``): with the particulars as a dict that took 22 µs a column, 17 µs with them
-    shared (11 µs without metadata); 4–5 % of the CPU time of five test files, measured with the
+    shared (11 µs without metadata); 4–5 % of the CPU time of three test files, measured with the
     copy made shallow. A mapping that cannot change is its own copy. Replace the whole
     value to change it (``log.attrs["particulars"] = frozen({...})``)."""
 

@@ -20,7 +20,7 @@ approach condition (speed u0, propeller speed n):
   approach must not make the model diverge; a warning, since logs run ahead only leave going
   astern to extrapolation, and ruling models out for it made the Esso's pairs predict worse.
   Nor should the reversed propeller do nothing: a model none of whose propeller terms acts with
-  n < 0 coasts to a stop (``coasting_note``), which a warning says too.
+  n < 0 coasts to a stop (``astern_thrust_note``), which a warning says too.
 """
 
 from __future__ import annotations
@@ -33,7 +33,7 @@ import numpy as np
 from shipid.dynamics.equilibrium import still_air_accelerations, surge_equilibrium
 from shipid.dynamics.model import ManoeuvringModel
 from shipid.errors import ShipidError
-from shipid.trials.manoeuvres import coasting_note, doubling, stopping, turning_circle
+from shipid.trials.manoeuvres import astern_thrust_note, doubling, stopping, turning_circle
 
 SETTLED_FRACTION = 0.02  # of the steady value, over the last 10 % of the run
 # A ship whose propeller keeps turning keeps a share of its approach speed in a steady turn with
@@ -167,7 +167,8 @@ def _worth_entering_drifting(entry: dict, side: str, speed: float) -> bool:
 def crash_stop(model, speed: float, rps: float | None, duration: float | None = None,
                dt: float = 0.1) -> dict | None:  # fmt: skip
     """The propeller reversed to −``rps`` from the approach, the rudder amidships (the IMO
-    stopping test): bounded? {"diverged", "reason", "at"}; None for a model without propeller
+    stopping test): bounded? {"diverged", "reason", "at", "coasting": the note of a propeller
+    that does nothing reversed}; None for a model without propeller
     terms or without an approach rps, or one the stopping test refuses."""
     if not getattr(model, "uses_rps", False) or not rps or not rps > 0 or not speed > 0:
         return None
@@ -176,8 +177,9 @@ def crash_stop(model, speed: float, rps: float | None, duration: float | None = 
         res = stopping(model, rps, duration=length, dt=dt, speed=speed)
     except ShipidError:
         return None
+    astern = astern_thrust_note(model, speed, rps)
     return {"diverged": bool(res.diverged), "reason": res.reason, "at": res.diverged_at,
-            "coasting": coasting_note(model, speed, rps)}  # fmt: skip
+            "coasting": astern.note if astern and astern.kind == "coasting" else None}
 
 
 def _runaway_from_drift(model, speed, rps, rudder_deg, side, duration, dt,

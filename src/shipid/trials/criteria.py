@@ -31,8 +31,7 @@ from shipid.dynamics.model import ManoeuvringModel
 from shipid.dynamics.steering import SteeringMachine
 from shipid.errors import ShipidError
 from shipid.trials.manoeuvres import (
-    coasting_note,
-    mirrored_thrust_note,
+    astern_thrust_note,
     stopping,
     turning_circle,
     without_value,
@@ -200,17 +199,16 @@ def imo_criteria(
         runs["full astern"] = res  # keyed as its row's manoeuvre
         row = _row("stopping track reach", "full astern", _in_l(res.indices["track_reach"], L),
                    15.0, "L")
-        coasting = coasting_note(ship, V, rps, astern_rps)
-        if coasting:
+        astern = astern_thrust_note(ship, V, rps, astern_rps)
+        if astern and astern.kind == "coasting":
             # Coasting reaches further than braking: a pass holds for the ship, a fail decides
             # nothing.
             if row["passed"] is False:
                 row["passed"] = row["margin"] = None
-            notes.append(f"stopping ability: {coasting}; its track reach is an upper bound: a "
-                         "pass holds, a fail is not judged")  # fmt: skip
-        mirrored = mirrored_thrust_note(ship, V, rps, astern_rps)
-        if mirrored:
-            notes.append(f"stopping ability: {mirrored}")
+            notes.append(f"stopping ability: {astern.note}; its track reach is an upper bound: "
+                         "a pass holds, a fail is not judged")  # fmt: skip
+        elif astern:
+            notes.append(f"stopping ability: {astern.note}")
         rows.append(row)
     else:
         # A reference ship's own physics may run a propeller, at the one speed it was set to

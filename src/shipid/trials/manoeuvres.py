@@ -490,42 +490,43 @@ def pull_out(
     return _extended(run, PULL_OUT_PHASE)
 
 
-def coasting_note(ship, speed: float, rps: float, astern_rps: float | None = None) -> str | None:
-    """A note where a model's propeller does not brake when reversed
-    (``shipid.dynamics.equilibrium.astern_braking``): its stopping test is the ship coasting on
-    its resistance, a longer reach than the ship's own. None for a vessel (its physics) or a
-    model whose propeller brakes."""
+@dataclass(frozen=True)
+class AsternThrust:
+    """What a model's stopping test rests on (``astern_thrust_note``): ``kind`` "coasting" (its
+    propeller does nothing reversed) or "mirrored" (its ahead thrust mirrored astern by
+    similarity), and the note that says so."""
+
+    kind: str
+    note: str
+
+
+def astern_thrust_note(ship, speed: float, rps: float,
+                       astern_rps: float | None = None) -> AsternThrust | None:  # fmt: skip
+    """Where a model's astern thrust is not what its logs showed
+    (``shipid.dynamics.equilibrium.astern_braking``): a propeller that does not brake when
+    reversed, so a full astern is the ship coasting on its resistance, a longer reach than the
+    ship's own; or, for a model carried from logs at one propeller speed (advance-ratio
+    similarity), its ahead thrust mirrored astern, an assumption those logs could not test. None
+    for a vessel (its physics) or a model fitted on logs that reverse the propeller."""
     if not isinstance(ship, ManoeuvringModel | HybridModel) or not ship.uses_rps:
         return None
     found = astern_braking(ship, speed, rps, astern_rps)
-    if not found["none"]:
+    if found["none"]:
+        return AsternThrust("coasting", (
+            "the model's propeller does not brake astern: reversed, it changes u̇ by "
+            f"{found['braking']:+.3g} m/s² where ahead it gives {found['ahead']:+.3g} (none of "
+            "its propeller terms acts with n < 0; a selection keeps only the terms its logs "
+            "excite, and logs that never reverse the propeller leave the astern thrust out), so "
+            "a full astern is the ship coasting to a stop on its resistance, a longer reach than "
+            "the ship's own; logs with the propeller astern give it the terms"))
+    if getattr(ship, "physical", ship).similar_at_rps is None or not found["ahead"] > 0:
         return None
-    return ("the model's propeller does not brake astern: reversed, it changes u̇ by "
-            f"{found['braking']:+.3g} m/s² where ahead it gives {found['ahead']:+.3g} (none of its "
-            "propeller terms acts with n < 0; a selection keeps only the terms its logs excite, "
-            "and logs that never reverse the propeller leave the astern thrust out), so a full "
-            "astern is the ship coasting to a stop on its resistance, a longer reach than the "
-            "ship's own; logs with the propeller astern give it the terms")
-
-
-def mirrored_thrust_note(ship, speed: float, rps: float,
-                         astern_rps: float | None = None) -> str | None:  # fmt: skip
-    """A note where a model carried from logs at one propeller speed (advance-ratio
-    similarity, ``shipid.dynamics.similarity``) brakes astern with its ahead thrust mirrored, an
-    assumption its logs could not test: its stopping test rests on it. None otherwise."""
-    physical = getattr(ship, "physical", ship)
-    if not isinstance(physical, ManoeuvringModel) or physical.similar_at_rps is None \
-            or not ship.uses_rps:  # fmt: skip
-        return None
-    found = astern_braking(ship, speed, rps, astern_rps)
-    if found["none"] or not found["ahead"] > 0:
-        return None
-    return (f"the model brakes astern at {-100 * found['braking'] / found['ahead']:.0f} % of "
-            "its ahead push: its logs ran the propeller at one speed ahead, and advance-ratio "
-            "similarity carries the fit to every propeller speed with its thrust mirrored "
-            "astern, which they could not test; a propeller astern may give less than ahead, so "
-            "its reach may be short of the ship's; logs with the propeller astern give it the "
-            "terms")
+    return AsternThrust("mirrored", (
+        f"the model brakes astern at {-100 * found['braking'] / found['ahead']:.0f} % of its "
+        "ahead push: its logs ran the propeller at one speed ahead, and advance-ratio similarity "
+        "carries the fit to every propeller speed with its thrust mirrored astern, which they "
+        "could not test; a propeller astern may give less than ahead, so a full astern may stop "
+        "the model short of the ship; logs with the propeller astern give it the terms"))
 
 
 def stopping(
