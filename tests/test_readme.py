@@ -1,4 +1,5 @@
-"""Every code block of the README runs as written (issue #11 item 15).
+"""Every code block of the README and of its guides (``docs/*.md``, in ``GUIDES``' order)
+runs as written (issue #11 item 15).
 
 ```python blocks run in order in one namespace; ```sh blocks run line by line (``make`` lines
 excepted: they are this suite's own entry point), in a scratch folder beside a link to the shared
@@ -18,11 +19,23 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-README = (ROOT / "README.md").read_text(encoding="utf-8")
 DATA = ROOT.parent / "shared" / "data"
-BLOCKS = re.findall(r"^```(\w+)\n(.*?)^```", README, flags=re.S | re.M)
+# The README's blocks first, then each guide's: a guide's commands use the README's files (the
+# Esso logs it imports) and an earlier guide's (docs/evaluation.md exports docs/kvlcc2.md's model).
+GUIDES = ("esso", "kvlcc2", "structures", "physics-and-uncertainty", "studies", "evaluation",
+          "logs-and-files")
+PAGES = [ROOT / "README.md", *(ROOT / "docs" / f"{g}.md" for g in GUIDES)]
+FENCED = [(page.relative_to(ROOT).as_posix(), kind, code) for page in PAGES
+          for kind, code in re.findall(r"^```(\w+)\n(.*?)^```", page.read_text(encoding="utf-8"),
+                                       flags=re.S | re.M)]  # fmt: skip
+BLOCKS = [(kind, code) for _, kind, code in FENCED]
 # The blocks build on each other's files (import, then select, then validate) in one folder: under
 # pytest-xdist they must run on one worker, in order: make test passes --dist loadfile.
+
+
+def test_every_guide_is_run():
+    """A guide added to docs/ without a place in ``GUIDES`` would go untested."""
+    assert sorted(GUIDES) == sorted(p.stem for p in (ROOT / "docs").glob("*.md"))
 
 
 def test_the_readme_has_runnable_blocks():
@@ -70,6 +83,7 @@ def _commands(block: str) -> list[str]:
 
 
 SH = [c for k, c in BLOCKS if k == "sh"]
+SH_PAGES = [page for page, k, _ in FENCED if k == "sh"]
 
 
 SHIPID = ".venv/bin/shipid "
@@ -100,7 +114,7 @@ def test_shell_blocks_run(scratch, index, monkeypatch, capsys):
         if pending:
             res = _bash("\n".join(assignments + pending), scratch)
             assert res.returncode == 0, (
-                f"README shell block {index} failed:\n{block}\n{res.stderr[-2000:]}")
+                f"{SH_PAGES[index]}: shell block {index} failed:\n{block}\n{res.stderr[-2000:]}")
             pending.clear()
 
     for line in commands:
@@ -113,7 +127,8 @@ def test_shell_blocks_run(scratch, index, monkeypatch, capsys):
             argv = res.stdout.split("\0")[:-1]
             code = main(argv)
             err = capsys.readouterr().err
-            assert code == 0, f"README shell block {index}: shipid {' '.join(argv)}\n{err[-2000:]}"
+            assert code == 0, (f"{SH_PAGES[index]}: shell block {index}: shipid "
+                               f"{' '.join(argv)}\n{err[-2000:]}")  # fmt: skip
         else:
             pending.append(line)
     flush()

@@ -226,9 +226,10 @@ def test_race_damping_predicts_every_held_out_kvlcc2_log_better_in_sway_and_yaw(
 
 @needs_data
 def test_the_kernel_residual_on_the_kvlcc2_is_the_readmes():
-    """README, *A kernel residual*: blanke-speed from MARIN zz 20° (1.25 Hz prefilter), γ and σ
-    by free-run CV over four blocks (0.1, 4), and the unseen zz −20° run's free-run errors
-    0.0152 / 0.0123 / 0.0038 → 0.0091 / 0.0101 / 0.0031; the folds' gain within its noise."""
+    """docs/physics-and-uncertainty.md, *A kernel residual*: blanke-speed from MARIN zz 20°
+    (1.25 Hz prefilter), γ and σ by free-run CV over four blocks (0.1, 4), and the unseen zz −20°
+    run's free-run errors 0.0152 / 0.0123 / 0.0038 → 0.0091 / 0.0101 / 0.0031; the folds' gain
+    within its noise."""
     from shipid.data.preprocess import lowpass
     from shipid.dynamics.hybrid import HybridModel
     from shipid.dynamics.simulate import simulate_log

@@ -34,7 +34,7 @@ from the logs:
 
 A fixed richer structure is not the remedy: on the Esso logs ``blanke-rps+wind`` puts the turns
 3–44 % long and diverges in a held-out random run in three of six folds, where the chosen terms
-do in one (README, *The default structure*).
+do in one (docs/structures.md, *The default structure*).
 """
 
 from __future__ import annotations
@@ -324,7 +324,7 @@ def widened_selection(sel, logs, names, options, drop=None, announce=_quiet):
     m/s at 10 rps the widened choice scored the held-out zig-zags better (0.370 against 0.424)
     and turned the 35° turns +92 % and +85 % wide (closed loop), the default library's +33 %
     and +5 %; the rudder's drift terms chosen from the Esso's zig-zags put its turns 30–47 %
-    long before (README). No other of the Esso's training sets measured (nine files, 36 pairs)
+    long before (docs/esso.md). No other of the Esso's training sets measured (nine files, 36 pairs)
     meets the case; on the tanker, whose default choice fails the checks, the widening brought
     the turns from 37–41 % short to within 5 % (``study_tanker.py``). ``identify``'s default
     and ``shipid select`` without ``--library`` widen so."""
