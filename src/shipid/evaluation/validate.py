@@ -244,7 +244,7 @@ def _read_as_logged(run: pd.DataFrame, trial: Trial, t_exec: float) -> dict:
     """The indices of a simulated ``run`` read as the log's are: its kind and switch heading,
     from the execute at ``t_exec`` (the log's, on the run's time axis)."""
     return manoeuvre_indices(run, trial=describe_trial(run, trial.kind, trial.switch_heading_deg,
-                                                       t_exec))  # fmt: skip
+                                                       t_exec, indices_only=True))  # fmt: skip
 
 
 def _replay_indices(sim: SimulationResult, trial: Trial) -> dict:

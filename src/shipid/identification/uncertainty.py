@@ -235,6 +235,10 @@ def implausible_members_note(record: Mapping, label: str = "bootstrap replicates
             "manoeuvres you need, pin it down")
 
 
+# Values per block of ``conservative_percentiles``: its temporaries stay within the CPU's cache.
+_CHUNK = 1 << 16
+
+
 def conservative_percentiles(values: np.ndarray, level: float = LEVEL, axis: int = 0
                              ) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
     """Central percentile bounds of ``values`` along ``axis`` where a replicate without a value
@@ -244,6 +248,14 @@ def conservative_percentiles(values: np.ndarray, level: float = LEVEL, axis: int
     than the tail (1 − level) / 2 makes the bounds −∞ and +∞: not bounded. NaN where no
     replicate has a value."""
     v = np.moveaxis(np.asarray(values, dtype=float), axis, 0)
+    if v.ndim > 1 and v.size > _CHUNK:
+        # Column blocks: a 200-replicate band over a 45 000-sample log made four 216 MB
+        # temporaries at once, and most of its time was the memory's first touch.
+        flat = v.reshape(v.shape[0], -1)
+        step = max(1, _CHUNK // v.shape[0])
+        parts = [conservative_percentiles(flat[:, j : j + step], level)
+                 for j in range(0, flat.shape[1], step)]  # fmt: skip
+        return tuple(np.concatenate([b[k] for b in parts]).reshape(v.shape[1:]) for k in (0, 1))
     n = v.shape[0]
     missing = ~np.isfinite(v)
     lower_sorted = np.sort(np.where(missing, -np.inf, v), axis=0)

@@ -184,7 +184,7 @@ def zigzag_indices(
     rudder orders. ``smooth_s`` is a moving-average window on the heading (noisy logs).
     """
     if trial is None:
-        trial = describe_trial(log, "zigzag", heading_deg, t_order)
+        trial = describe_trial(log, "zigzag", heading_deg, t_order, indices_only=True)
     t = log["t"].to_numpy()
     i0 = trial.execute_index
     dpsi = smooth_heading(unwrapped_heading(log) - trial.psi0, t, smooth_s)
@@ -205,7 +205,9 @@ def zigzag_indices(
     # First turning direction: the side on which the heading first reaches the switch angle.
     side = 1.0 if down.size == 0 or (up.size and up[0] <= down[0]) else -1.0
     executes = [(float(t[i0]), i0, side)]
-    while True:
+    # The indices need the first four executes (the second overshoot ends at the fourth); a
+    # long log's hundreds of reversals after them cost a Python step each.
+    while len(executes) < 4:
         _, k_prev, s = executes[-1]
         ks = up if s > 0 else down
         j = int(np.searchsorted(ks, k_prev))
@@ -245,7 +247,7 @@ def turning_indices(
     """Advance, transfer, tactical diameter, times to 90° and 180°, and the steady turn
     (diameter, speed and yaw rate over the span with the rudder held and r settled)."""
     if trial is None:
-        trial = describe_trial(log, "turning", t_order=t_order)
+        trial = describe_trial(log, "turning", t_order=t_order, indices_only=True)
     t = log["t"].to_numpy()
     i0 = trial.execute_index
     psi, x, y = track(log)
@@ -355,7 +357,7 @@ def pull_out_indices(
 ) -> dict:
     """A pull-out's held turn (``turning_indices``) and its release (``pull_out_yaw_rates``)."""
     if trial is None:
-        trial = describe_trial(log, "pull-out")
+        trial = describe_trial(log, "pull-out", indices_only=True)
     out = turning_indices(log, length=length, trial=trial)
     if trial.release_time is not None:
         out["release_time"] = trial.release_time

@@ -352,9 +352,16 @@ def describe_trial(
     kind: str | None = None,
     heading_deg: float | None = None,
     t_order: float | None = None,
+    indices_only: bool = False,
 ) -> Trial:
     """The trial facts of ``log``; ``kind`` forces the kind, ``heading_deg`` the zig-zag switch
-    heading, ``t_order`` the execute time (a simulated manoeuvre knows it)."""
+    heading, ``t_order`` the execute time (a simulated manoeuvre knows it).
+
+    ``indices_only`` with ``kind`` given: the facts the indices read, for a run read for its
+    indices only (a replicate's replica in ``validate``): no rudder rate (None) and, unless the
+    switch heading is to be inferred from them, no heading at the rudder reversals
+    (``reversal_headings_deg`` empty, ``reversal_step_deg`` 0). A long zig-zag's hundreds of
+    swings cost a Python step each for both."""
     if kind is not None and kind not in KINDS:
         raise ShipidError(f"manoeuvre kind must be one of {', '.join(KINDS)}, got {kind!r}")
     t = log["t"].to_numpy()
@@ -388,19 +395,14 @@ def describe_trial(
     big = np.flatnonzero(side[i0:]) + i0
     # A noisy rudder's event signal creeps up to the highest noise on a plateau: the level is
     # the median of the measured rudder on it.
-    measured_dev = raw - neutral
-    amplitudes = []
-    for a, b, s in runs_of(side[i0:]):
-        if s != 0:
-            run = slice(i0 + a, i0 + b + 1)
-            top = float(np.max(s * dev[run]))
-            if rudder_noise:
-                on_plateau = s * dev[run] >= top - PLATEAU_TOLERANCE
-                top = float(np.median(s * measured_dev[run][on_plateau]))
-            amplitudes.append(top)
+    amplitudes = _plateau_levels(side[i0:], dev[i0:], (raw - neutral)[i0:] if rudder_noise
+                                 else None)  # fmt: skip
     amplitude = float(np.median(amplitudes)) if amplitudes else 0.0
     first_rudder = float(side[big[0]] * amplitudes[0]) if amplitudes else 0.0
-    orders = _plateau_orders(delta, side, i0, *((t, raw) if rudder_noise else ()))
+    quick = indices_only and kind is not None
+    skip = quick and (heading_deg is not None or kind != "zigzag")
+    orders = [] if skip else _plateau_orders(delta, side, i0,
+                                             *((t, raw) if rudder_noise else ()))  # fmt: skip
     switch, reversals, step = None, (), 0.0
     if orders:
         k = np.array([o for o, _, _ in orders])
@@ -427,7 +429,8 @@ def describe_trial(
     facts = dict(execute_index=i0, execute_time=float(t[i0]), psi0=psi0, neutral=neutral,
                  amplitude=amplitude, plateau_angle=plateau_angle, first_rudder=first_rudder,
                  switch_heading_deg=switch,
-                 rudder_rate=rise_rate(t, delta) if rudder_noise else _rudder_rate(t, delta),
+                 rudder_rate=None if quick else rise_rate(t, delta) if rudder_noise
+                 else _rudder_rate(t, delta),
                  held_end_index=held_end, reversal_headings_deg=reversals,
                  reversal_step_deg=step,
                  release_time=release_time)  # fmt: skip
@@ -436,6 +439,28 @@ def describe_trial(
     found, reason = _classify(log, dpsi, dev, side, i0, held_end, amplitudes, orders,
                               release_time)  # fmt: skip
     return Trial(kind=found, reason=reason, **facts)
+
+
+def _plateau_levels(side: np.ndarray, dev: np.ndarray, measured_dev: np.ndarray | None
+                    ) -> list[float]:  # fmt: skip
+    """The level of each rudder plateau (each run of ``side`` ≠ 0), in order: the largest
+    deflection ``dev`` to its side, or with a noisy rudder (``measured_dev``, the measured
+    rudder's deflection) the median of the measured rudder within ``PLATEAU_TOLERANCE`` of it.
+    One reduction over all runs: a long zig-zag has hundreds of them."""
+    if side.size == 0:
+        return []
+    starts = np.concatenate([[0], np.flatnonzero(side[1:] != side[:-1]) + 1])
+    tops = np.maximum.reduceat(side * dev, starts)
+    ends = np.append(starts[1:], side.size)
+    levels = []
+    for a, b, s, top in zip(starts, ends, side[starts], tops, strict=True):
+        if s == 0:
+            continue
+        if measured_dev is not None:
+            on_plateau = s * dev[a:b] >= top - PLATEAU_TOLERANCE
+            top = np.median(s * measured_dev[a:b][on_plateau])
+        levels.append(float(top))
+    return levels
 
 
 def _held_end(t: np.ndarray, delta: np.ndarray, i0: int, stand_s: float = 1.0) -> int:
