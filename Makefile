@@ -60,6 +60,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/study_ahead_forms.py
 	$(BIN)/python benchmarks/study_sign_table.py
 	$(BIN)/python benchmarks/study_esso_turn_in_training.py
+	$(BIN)/python benchmarks/study_esso_rps_range.py
 	$(BIN)/python benchmarks/bench_blas_threads.py
 
 clean:

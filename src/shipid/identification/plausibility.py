@@ -26,7 +26,7 @@ approach condition (speed u0, propeller speed n):
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 import numpy as np
 
@@ -133,11 +133,12 @@ def straight_line_stability(model: ManoeuvringModel, speed: float, rps: float | 
 
 def held_rudder(model: ManoeuvringModel, speed: float, rps: float | None = None,
                 rudder_deg: float = 35.0, duration: float | None = None,
-                dt: float = 0.1, drift_speed: float | None = None) -> dict:  # fmt: skip
+                dt: float = 0.1, drift_speed: float | None = None,
+                drifting: bool = True) -> dict:  # fmt: skip
     """The largest rudder held to each side: bounded? settled? steady yaw rate and speed, and
-    the ``duration`` run (see the module's note); and entered drifting from ``drift_speed``
-    (default ``speed``; ``check_plausibility`` gives the faster of the approach and the model's
-    own straight speed, where a ship runs before its helm goes over)."""
+    the ``duration`` run (see the module's note); and (``drifting``) entered drifting from
+    ``drift_speed`` (default ``speed``; ``check_plausibility`` gives the faster of the approach
+    and the model's own straight speed, where a ship runs before its helm goes over)."""
     out = {}
     for side in ("starboard", "port"):
         out[side], _ = doubling(
@@ -145,7 +146,7 @@ def held_rudder(model: ManoeuvringModel, speed: float, rps: float | None = None,
             duration or HELD_DURATION,
             lambda entry: duration is not None or entry["diverged"] or entry["settled"],
             2**HELD_MAX_DOUBLINGS)  # fmt: skip
-        if _worth_entering_drifting(out[side], side, speed):
+        if drifting and _worth_entering_drifting(out[side], side, speed):
             start = drift_speed or speed
             reference = max(start, out[side].get("steady_speed") or 0.0)
             runaway = _runaway_from_drift(model, start, rps, rudder_deg, side,
@@ -489,6 +490,54 @@ def new_failures(reference: dict, candidate: dict, model: ManoeuvringModel) -> l
     before = failed_checks(reference, model)
     return [note for check, (severity, note) in failed_checks(candidate, model).items()
             if severity > before.get(check, (0, ""))[0]]  # fmt: skip
+
+
+# Training logs whose approach propeller speeds lie within this share of one another are at one.
+SAME_RPS = 0.05
+
+
+def other_propeller_speeds(logs, first_rps: float | None) -> list[float]:
+    """The training logs' ahead propeller speeds at their approach (``approach``) other than
+    ``first_rps``, the one the checks run at (more than ``SAME_RPS`` apart), ascending."""
+    from shipid.data.log import approach
+
+    if first_rps is None or not first_rps > 0:
+        return []
+    found = sorted(n for n in (approach(log, "n") for log in logs) if n is not None and n > 0)
+    out: list[float] = []
+    for n in found:
+        if all(abs(n / m - 1) > SAME_RPS for m in (first_rps, *out)):
+            out.append(float(n))
+    return out
+
+
+def gross_at_other_rps(model: ManoeuvringModel, speed: float, rps: float | None,
+                       others: Sequence[float]) -> dict[str, tuple[int, str]]:  # fmt: skip
+    """The rudder held to either side at each of ``others`` (training logs' propeller speeds,
+    from the model's own steady straight run there, ``steady_approach``), keyed by check and
+    rps with (severity, reason) as ``disqualifying_checks`` gives them: where the turn diverges,
+    turns the ship the other way or ends going astern, which no ship does at a propeller speed
+    its own logs ran at. ``select`` checked its candidates at the first log's rps alone: from
+    two Esso zig-zag files at 15 and 12 rps, the model it handed out ended its 35° turns going
+    astern at 12 rps (``benchmarks/study_esso_rps_range.py``). The held turns alone, not
+    entered drifting: what is judged here is gross."""
+    from shipid.dynamics.equilibrium import steady_approach
+
+    if not others or not getattr(model, "uses_rps", False):
+        return {}
+    out = {}
+    for n in others:
+        app = steady_approach(model, speed, rps, rps=n)
+        at = f"at {n:.4g} rps"
+        for side, entry in held_rudder(model, app.speed, app.rps, drifting=False).items():
+            key = f"held_rudder_{side} {at}"
+            if entry["diverged"]:
+                out[key] = (DIVERGED, f"diverges with the rudder held to {side} {at}")
+            elif _turns_wrong_way(entry, side):
+                out[key] = (WRONG_WAY, f"turns the wrong way with the rudder to {side} {at}")
+            elif _goes_astern(entry, app.speed):
+                out[key] = (WRONG_WAY, f"ends going astern with the rudder held to {side} {at}")
+    return out
 
 
 def disqualifying(report: dict, model: ManoeuvringModel) -> list[str]:

@@ -24,8 +24,10 @@ grid pre-screens; the free-run CV decides among the values within 1.5× of the b
 the full library and again for the chosen structure.
 
 Candidates must be plausible (``plausibility.disqualifying``): the chosen one, fitted on all logs,
-has a steady speed and turns the right way, bounded, with the rudder held; implausible candidates
-stay in the table, marked, and are not chosen.
+has a steady speed and turns the right way, bounded, with the rudder held, at the first log's
+propeller speed and, held alone, at every other its logs ran at
+(``plausibility.gross_at_other_rps``); implausible candidates stay in the table, marked, and are
+not chosen.
 
 How firm the choice is: the choice rule (the best plausible score, then the one-standard-error
 rule) is repeated on ``RESAMPLES`` bootstrap resamples of the held-out logs, among the candidates
@@ -612,6 +614,8 @@ def select(
         disqualifying_checks,
         failed_checks,
         given_steady_speeds,
+        gross_at_other_rps,
+        other_propeller_speeds,
         plausibility_at_approach,
         sharpest_curvature,
     )
@@ -634,6 +638,7 @@ def select(
         raise ShipidError(f"{names[0]}: starts without headway; give the plausibility condition "
                           "(speed=..., --speed)")  # fmt: skip
     curvature = sharpest_curvature(logs, speed)
+    other_rps = other_propeller_speeds(logs, rps) if options.plausibility else []
     bar = _progress(options)
 
     def evaluate(terms, gamma, stage) -> Candidate:
@@ -665,6 +670,9 @@ def select(
                     at = plausibility_at_approach(model, u, n, u, n)[0]
                     reasons += [f"{r} at {u:.3g} m/s, {n:.3g} rps"
                                 for r in disqualifying(at, model)]  # fmt: skip
+                if not reasons:  # no ship fails so at a propeller speed its logs ran at
+                    reasons = [why for _, why in
+                               gross_at_other_rps(model, speed, rps, other_rps).values()]
                 plausibility_cache[cand.key] = (not reasons, "; ".join(reasons))
         ok, why = plausibility_cache[cand.key]
         cand.plausible = ok
@@ -732,11 +740,14 @@ def select(
                                    f"average of {len(shared)} candidates from {library.name}")
         checked = plausibility_at_approach(averaged, speed, rps, options.speed, options.rps,
                                            curvature)  # fmt: skip
-        failing = disqualifying_checks(checked[0], averaged) if options.plausibility else {}
+        failing = ({**disqualifying_checks(checked[0], averaged),
+                    **gross_at_other_rps(averaged, speed, rps, other_rps)}
+                   if options.plausibility else {})  # fmt: skip
         if failing:
             # Check by check: the chosen candidate only where it fails them less badly.
-            own = disqualifying_checks(plausibility_at_approach(
-                model, speed, rps, options.speed, options.rps, curvature)[0], model)
+            own = {**disqualifying_checks(plausibility_at_approach(
+                model, speed, rps, options.speed, options.rps, curvature)[0], model),
+                **gross_at_other_rps(model, speed, rps, other_rps)}  # fmt: skip
             failing = {k: f for k, f in failing.items() if f[0] > own.get(k, (0, ""))[0]}
         if failing:
             notes.append(f"the average of the candidates is implausible "

@@ -1,0 +1,113 @@
+"""Issue #10's acceptance on the Esso Osaka: with constraints, no identified model turns the wrong
+way or loses its steady speed under 35° rudder at 8–16.7 rps.
+
+Models made by the command line on the raw files (``--format osaka-frt --dt 0.5``), each with
+and without ``--constraints signs``: a plain ``shipid identify`` of every zig-zag file alone,
+of every pair of them, of the nine zig-zags with three random runs (the README's fold) and of
+all fifteen logs, and the README's recipe (``select --library
+low-speed+wind+propeller-asymmetry --average``) on the README's fold. Each model's 35° rudder
+is held to either side at 8, 10, 12, 15 and 16.7 rps, from its own steady straight speed there
+(``plausibility_at_approach``, the checks ``identify`` runs at the logs' rps): a turn that
+diverges, turns the other way, ends going astern, all but stops, runs away when entered
+drifting, or runs on a path far wider or tighter than the logs' is counted, by what it does.
+Run as a script: ``python benchmarks/study_esso_rps_range.py [--no-pairs]``.
+"""
+
+from __future__ import annotations
+
+import itertools
+import os
+import sys
+import tempfile
+import time
+from collections import Counter
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from cli_models import model_by_cli  # noqa: E402
+from esso_logs import DATA, README_HELD  # noqa: E402
+
+from shipid.identification.plausibility import (  # noqa: E402
+    WRONG_WAY,
+    failed_checks,
+    plausibility_at_approach,
+)
+from shipid.reporting.modelfile import load_document, training_conditions  # noqa: E402
+
+RPS = (8.0, 10.0, 12.0, 15.0, 16.67)
+FORMAT = ["--format", "osaka-frt", "--dt", "0.5"]
+RECIPE = ["--library", "low-speed+wind+propeller-asymmetry", "--quiet", "--average"]
+# What a held turn that fails does, read off its warning.
+KINDS = (("diverge", "diverges"), ("other way", "turns the other way"),
+         ("astern", "ends going astern"), ("all but stops", "all but stops"),
+         ("runs away", "runs away"), ("path", "path far wider or tighter"))  # fmt: skip
+
+
+def what_it_does(note: str) -> str:
+    return next((label for key, label in KINDS if key in note), "diverges")
+
+
+def judged(path: str) -> tuple[int, Counter]:
+    """(held turns judged, Counter of what the failing ones do) over ``RPS`` × both sides."""
+    from shipid.reporting.modelfile import model_from_document
+
+    doc = load_document(path)
+    model = model_from_document(doc, path, "model")
+    cond = training_conditions(doc)
+    speed, rps0 = cond.get("speed"), cond.get("rps")
+    failures: Counter = Counter()
+    for rps in RPS:
+        report, _ = plausibility_at_approach(model, speed, rps0, rps=rps)
+        for key, (severity, note) in failed_checks(report, model).items():
+            if key.startswith("held_rudder") and severity >= WRONG_WAY:
+                failures[what_it_does(note)] += 1
+    return 2 * len(RPS), failures
+
+
+def main() -> None:
+    if not DATA.is_dir():
+        print("../shared/data is absent")
+        return
+    zigzags = sorted((DATA / "zigzag").glob("*.csv"))
+    randoms = sorted((DATA / "random").glob("*.csv"))
+    turns = sorted((DATA / "turning").glob("*.csv"))
+    readme = [*zigzags, *(r for r in randoms if README_HELD not in r.name)]
+    sets = [("each zig-zag file alone", "identify", [[z] for z in zigzags])]
+    if "--no-pairs" not in sys.argv:
+        sets.append(("every pair of zig-zag files", "identify",
+                     [list(p) for p in itertools.combinations(zigzags, 2)]))  # fmt: skip
+    sets += [("nine zig-zags and three random runs", "identify", [readme]),
+             ("nine zig-zags and three random runs", "select (README)", [readme]),
+             ("all fifteen logs", "identify", [[*zigzags, *randoms, *turns]])]
+    print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores\n")
+    print(f"35° rudder held to either side at {', '.join(f'{r:g}' for r in RPS)} rps, from each "
+          "model's own steady straight speed there: the held turns that fail, by what they do\n")
+    print("| trained on | made by | constraints | models | held turns | failing | models with "
+          "one | what the failing turns do |")  # fmt: skip
+    print("|---|---|---|---|---|---|---|---|")
+    t0 = time.perf_counter()
+    with tempfile.TemporaryDirectory() as scratch:
+        for label, maker, trainings in sets:
+            for constraints in ([], ["--constraints", "signs"]):
+                argv = (["identify", *FORMAT] if maker == "identify"
+                        else ["select", *FORMAT, *RECIPE]) + constraints  # fmt: skip
+                turns_judged, failing, models, with_one, made = 0, Counter(), 0, 0, 0
+                for train in trainings:
+                    out = f"{scratch}/m.json"
+                    if model_by_cli(argv, [str(p) for p in train], out) is None:
+                        continue
+                    made += 1
+                    n, fails = judged(out)
+                    turns_judged += n
+                    failing += fails
+                    with_one += bool(fails)
+                models = f"{made}" + (f" of {len(trainings)}" if made < len(trainings) else "")
+                does = ", ".join(f"{k} {v}" for k, v in failing.most_common()) or "–"
+                print(f"| {label} | {maker} | {'signs' if constraints else 'none'} | {models} | "
+                      f"{turns_judged} | {sum(failing.values())} | {with_one} | {does} |")
+                sys.stdout.flush()
+    print(f"\n{time.perf_counter() - t0:.0f} s")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,53 @@
+"""A candidate is checked at every propeller speed its training logs ran at, not the first log's
+alone: no ship ends a held turn going astern, turns the other way or diverges at a speed its own
+logs ran at (issue #10: from two Esso Osaka zig-zag files at 15 and 12 rps, the model handed out
+ended its 35° turns going astern at 12 rps)."""
+
+import contextlib
+import io
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from shipid.cli import main
+from shipid.identification.plausibility import gross_at_other_rps, other_propeller_speeds
+from shipid.reporting.modelfile import load_document, model_from_document, training_conditions
+
+DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
+ZIGZAG = DATA / "esso-osaka" / "zigzag"
+needs_data = pytest.mark.skipif(not DATA.is_dir(), reason="../shared/data is not present")
+
+
+def _log(n: float | None) -> pd.DataFrame:
+    t = np.arange(0.0, 60.0, 0.5)
+    log = pd.DataFrame({"t": t, "delta": 0.0, "u": 0.4, "v": 0.0, "r": 0.0})
+    if n is not None:
+        log["n"] = n
+    return log
+
+
+def test_the_other_propeller_speeds_are_the_logs_apart_from_the_first():
+    logs = [_log(n) for n in (10.0, 16.7, 12.0, 12.3, 10.2, -5.0, 0.0, None)]
+    # 12.3 and 10.2 are within 5 % of 12 and 10; astern, stopped and unlogged are no approach.
+    assert other_propeller_speeds(logs, 10.0) == [12.0, 16.7]
+    assert other_propeller_speeds(logs, None) == []
+    assert other_propeller_speeds([_log(10.0)], 10.0) == []
+
+
+@needs_data
+def test_a_pair_of_zigzags_at_two_rps_gives_a_model_that_turns_at_both(tmp_path):
+    """Checked at the first log's 15 rps alone, the model handed out ended its held turns going
+    astern at the second log's 12 rps."""
+    files = [str(ZIGZAG / "zigzag_31-Jul-2020_13_57_45.csv"),  # 15 rps, read first
+             str(ZIGZAG / "zigzag_31-Jul-2020_14_03_39.csv")]  # 12 rps  # fmt: skip
+    out = tmp_path / "pair.json"
+    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+        assert main(["identify", "--format", "osaka-frt", "--dt", "0.5", *files,
+                     "-o", str(out)]) == 0  # fmt: skip
+    doc = load_document(out)
+    cond = training_conditions(doc)
+    model = model_from_document(doc, str(out), "model")
+    assert round(cond["rps"]) == 15
+    assert gross_at_other_rps(model, cond["speed"], cond["rps"], [12.0]) == {}
