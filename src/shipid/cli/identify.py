@@ -342,6 +342,7 @@ def cmd_identify(args) -> int:
     ident.warnings.extend(f"plausibility: {n}" for n in notes)
     from shipid.identification.plausibility import (
         approach_beyond_logs,
+        at_the_logs_other_rps,
         below_the_logs_rps,
         given_steady_speeds,
         missed_steady_speed,
@@ -353,6 +354,7 @@ def cmd_identify(args) -> int:
     below = below_the_logs_rps(hybrid or as_written(final), plausibility, logs)
     if below:
         ident.warnings.append(below)
+    ident.warnings.extend(at_the_logs_other_rps(hybrid or as_written(final), plausibility, logs))
 
     for u, n in given_steady_speeds(physics):  # where the user says the ship runs steady
         at = plausibility_at_approach(hybrid or as_written(final), u, n, u, n)[1]

@@ -330,6 +330,24 @@ def below_the_logs_rps(model: ManoeuvringModel, report: dict, logs) -> str | Non
             "validate it on a log at the propeller speed you need before using it there")
 
 
+def at_the_logs_other_rps(model: ManoeuvringModel, report: dict, logs) -> list[str]:
+    """Warnings where ``model`` (checked at the logs' approach in ``report``) holds its rudder
+    at another propeller speed its logs ran at and the turn diverges, turns the other way or
+    ends going astern (``gross_at_other_rps``): ``select`` rules such candidates out, a
+    structure given with ``--model`` is fitted as it is."""
+    speed, rps = report.get("approach_speed"), report.get("rps")
+    if not speed or not rps:
+        return []
+    others = other_propeller_speeds(logs, rps)
+    try:
+        failing = gross_at_other_rps(model, speed, rps, others)
+    except (ShipidError, ValueError):
+        return []
+    return [f"at a propeller speed its logs ran at, the model {why}: no ship does, and its "
+            "logs there are not represented (another --model, or none: the default's selection "
+            "rules such fits out)" for _, why in failing.values()]
+
+
 def given_steady_speeds(physics) -> list[tuple[float, float]]:
     """(u, n) of the steady speeds a user gave (``--steady-speed``): the model is checked there
     too, where its manoeuvres will be asked for, not only from the first log's approach."""
