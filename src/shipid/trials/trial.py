@@ -358,10 +358,11 @@ def describe_trial(
     heading, ``t_order`` the execute time (a simulated manoeuvre knows it).
 
     ``indices_only`` with ``kind`` given: the facts the indices read, for a run read for its
-    indices only (a replicate's replica in ``validate``): no rudder rate (None) and, unless the
-    switch heading is to be inferred from them, no heading at the rudder reversals
-    (``reversal_headings_deg`` empty, ``reversal_step_deg`` 0). A long zig-zag's hundreds of
-    swings cost a Python step each for both."""
+    indices only (a replicate's replica in ``validate``): no rudder rate (None) and, unless a
+    zig-zag's switch heading is to be inferred from them, no rudder reversals
+    (``reversal_headings_deg`` empty, ``reversal_step_deg`` 0, and a turn's or pull-out's
+    ``switch_heading_deg`` None). A long zig-zag's hundreds of swings cost a Python step each
+    for both."""
     if kind is not None and kind not in KINDS:
         raise ShipidError(f"manoeuvre kind must be one of {', '.join(KINDS)}, got {kind!r}")
     t = log["t"].to_numpy()
