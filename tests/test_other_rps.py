@@ -38,10 +38,10 @@ def test_the_other_propeller_speeds_are_the_logs_apart_from_the_first():
 
 @needs_data
 def test_a_pair_of_zigzags_at_two_rps_gives_a_model_that_turns_at_both(tmp_path):
-    """Checked at the first log's 15 rps alone, the model handed out ended its held turns going
-    astern at the second log's 12 rps."""
-    files = [str(ZIGZAG / "zigzag_31-Jul-2020_13_57_45.csv"),  # 15 rps, read first
-             str(ZIGZAG / "zigzag_31-Jul-2020_14_03_39.csv")]  # 12 rps  # fmt: skip
+    """Checked at the first log's 10 rps alone, the model handed out ended its turn to port
+    going astern at the second log's 12 rps (as the pair at 15 and 12 rps did to both sides)."""
+    files = [str(ZIGZAG / "zigzag_31-Jul-2020_13_22_52.csv"),  # 10 rps, read first
+             str(ZIGZAG / "zigzag_31-Jul-2020_14_10_05.csv")]  # 12 rps  # fmt: skip
     out = tmp_path / "pair.json"
     with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
         assert main(["identify", "--format", "osaka-frt", "--dt", "0.5", *files,
@@ -49,7 +49,7 @@ def test_a_pair_of_zigzags_at_two_rps_gives_a_model_that_turns_at_both(tmp_path)
     doc = load_document(out)
     cond = training_conditions(doc)
     model = model_from_document(doc, str(out), "model")
-    assert round(cond["rps"]) == 15
+    assert round(cond["rps"]) == 10
     assert gross_at_other_rps(model, cond["speed"], cond["rps"], [12.0]) == {}
 
 
