@@ -29,7 +29,9 @@ def _log(n: float | None) -> pd.DataFrame:
 
 
 def test_the_other_propeller_speeds_are_the_logs_apart_from_the_first():
-    logs = [_log(n) for n in (10.0, 16.7, 12.0, 12.3, 10.2, -5.0, 0.0, None)]
+    varying = _log(8.0)
+    varying["n"] = np.linspace(-10.0, 10.0, len(varying))  # a random run: no one rps
+    logs = [_log(n) for n in (10.0, 16.7, 12.0, 12.3, 10.2, -5.0, 0.0, None)] + [varying]
     # 12.3 and 10.2 are within 5 % of 12 and 10; astern, stopped and unlogged are no approach.
     assert other_propeller_speeds(logs, 10.0) == [12.0, 16.7]
     assert other_propeller_speeds(logs, None) == []

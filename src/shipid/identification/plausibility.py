@@ -515,13 +515,17 @@ SAME_RPS = 0.05
 
 
 def other_propeller_speeds(logs, first_rps: float | None) -> list[float]:
-    """The training logs' ahead propeller speeds at their approach (``approach``) other than
-    ``first_rps``, the one the checks run at (more than ``SAME_RPS`` apart), ascending."""
+    """The ahead propeller speeds the training logs ran at, each log at one (its ``approach``;
+    a log whose rps varies, a random run, holds none), other than ``first_rps``, the one the
+    checks run at (more than ``SAME_RPS`` apart), ascending."""
     from shipid.data.log import approach
+    from shipid.identification.identify import varies
 
     if first_rps is None or not first_rps > 0:
         return []
-    found = sorted(n for n in (approach(log, "n") for log in logs) if n is not None and n > 0)
+    held = [approach(log, "n") for log in logs
+            if "n" in log.columns and not varies(log["n"].to_numpy(dtype=float))]  # fmt: skip
+    found = sorted(n for n in held if n is not None and n > 0)
     out: list[float] = []
     for n in found:
         if all(abs(n / m - 1) > SAME_RPS for m in (first_rps, *out)):
