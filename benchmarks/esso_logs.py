@@ -41,6 +41,15 @@ def esso_logs(dt: float | None = 0.5):
     return zz, rnd, turns
 
 
+def raw_files():
+    """(zig-zag, turning, random-run files), each sorted, as ``../shared/data`` holds them, or
+    None (and a line saying so) when it is absent."""
+    if not DATA.is_dir():
+        print("../shared/data is absent")
+        return None
+    return tuple(sorted((DATA / kind).glob("*.csv")) for kind in ("zigzag", "turning", "random"))
+
+
 def trial_files():
     """(the zig-zag files, {path: log} of every trial file, zig-zags first, as the commands read
     it with ``--format osaka-frt``: cut to the manoeuvre, or to a propulsion dropout), or None

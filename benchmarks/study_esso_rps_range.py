@@ -25,7 +25,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from cli_models import model_by_cli  # noqa: E402
-from esso_logs import DATA, README_HELD  # noqa: E402
+from esso_logs import README_HELD, raw_files  # noqa: E402
 
 from shipid.identification.plausibility import (  # noqa: E402
     WRONG_WAY,
@@ -65,12 +65,10 @@ def judged(path: str) -> tuple[int, Counter]:
 
 
 def main() -> None:
-    if not DATA.is_dir():
-        print("../shared/data is absent")
+    files = raw_files()
+    if files is None:
         return
-    zigzags = sorted((DATA / "zigzag").glob("*.csv"))
-    randoms = sorted((DATA / "random").glob("*.csv"))
-    turns = sorted((DATA / "turning").glob("*.csv"))
+    zigzags, turns, randoms = files
     readme = [*zigzags, *(r for r in randoms if README_HELD not in r.name)]
     sets = [("each zig-zag file alone", "identify", [[z] for z in zigzags])]
     if "--no-pairs" not in sys.argv:

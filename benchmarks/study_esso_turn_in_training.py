@@ -23,7 +23,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from cli_models import model_by_cli  # noqa: E402
-from esso_logs import DATA, read  # noqa: E402
+from esso_logs import raw_files, read  # noqa: E402
 
 from shipid.evaluation.validate import validate_log  # noqa: E402
 
@@ -35,12 +35,10 @@ KEYS = ("tactical_diameter", "advance", "steady_yaw_rate")
 
 
 def main() -> None:
-    if not DATA.is_dir():
-        print("../shared/data is absent")
+    files = raw_files()
+    if files is None:
         return
-    zigzags = sorted((DATA / "zigzag").glob("*.csv"))
-    turns = sorted((DATA / "turning").glob("*.csv"))
-    randoms = sorted((DATA / "random").glob("*.csv"))
+    zigzags, turns, randoms = files
     logs = {p: read(p, trim=p not in randoms) for p in turns + randoms}
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores\n")
     print("Trained on the nine zig-zags, one 35° turn and three random runs; judged on the other "
