@@ -55,22 +55,49 @@ def test_a_pair_of_zigzags_at_two_rps_gives_a_model_that_turns_at_both(tmp_path)
     assert gross_at_other_rps(model, cond["speed"], cond["rps"], [12.0]) == {}
 
 
-def test_identify_warns_where_a_given_structure_fails_at_another_logs_rps():
-    """A structure given with ``--model`` is fitted as it is: ``identify`` says where its held
-    turn fails at a propeller speed its logs ran at. Here the rudder's drag grows as n⁴δ² and
-    the thrust as n²: at 10 rps the 35° turn keeps half its speed, at 15 rps the drag wins and
-    the turn runs astern, where this hull's terms make it diverge."""
+def _drag_model():
+    """The rudder's drag grows as n⁴δ² and the thrust as n²: at 10 rps the 35° turn keeps half
+    its speed, from 11.6 rps on (n² = 5e-4 / (1e-5 δ²)) the drag wins and the turn runs
+    astern, where this hull's terms make it diverge."""
     from shipid.dynamics.model import ManoeuvringModel, get_structure
-    from shipid.identification.plausibility import at_the_logs_other_rps, plausibility_at_approach
 
     structure = get_structure("u: |u|u, pos(n)^2, pos(n)^4*delta^2; v: u*v, u*r, u*delta; "
                               "r: u*v, u*r, u*delta")  # fmt: skip
-    model = ManoeuvringModel(structure, {
+    return ManoeuvringModel(structure, {
         "u": {"|u|*u": -1.0, "pos(n)^2": 5e-4, "pos(n)^4*delta^2": -1e-5},
         "v": {"u*v": -1.5, "u*r": -0.3, "u*delta": 0.05},
         "r": {"u*v": -0.5, "u*r": -1.2, "u*delta": -0.4}})  # fmt: skip
+
+
+def test_identify_warns_where_a_given_structure_fails_at_another_logs_rps():
+    """A structure given with ``--model`` is fitted as it is: ``identify`` says where its held
+    turn fails at a propeller speed its logs ran at."""
+    from shipid.identification.plausibility import at_the_logs_other_rps, plausibility_at_approach
+
+    model = _drag_model()
     report = plausibility_at_approach(model, 0.22, 10.0)[0]
     assert not [k for k in report["held_rudder"] if report["held_rudder"][k]["diverged"]]
     assert at_the_logs_other_rps(model, report, [_log(10.0)]) == []
     notes = at_the_logs_other_rps(model, report, [_log(10.0), _log(15.0)])
     assert notes and all("at 15 rps" in n and ("astern" in n or "diverges" in n) for n in notes)
+
+
+@pytest.mark.parametrize(("rps", "warned"), [(10.0, True), (8.0, False)])
+def test_a_model_that_fails_above_the_logs_rps_is_named(rps, warned):
+    """At 1.4 times the logs' highest rps: 14 rps fails (the drag wins from 11.6), 11.2 not."""
+    from shipid.identification.plausibility import (
+        above_the_logs_rps,
+        below_the_logs_rps,
+        plausibility_at_approach,
+    )
+
+    model = _drag_model()
+    report = plausibility_at_approach(model, 0.0224 * rps, rps)[0]
+    found = above_the_logs_rps(model, report, [_log(rps)])
+    if warned:
+        assert found is not None and found.startswith(
+            "above the logs' propeller speeds the model extrapolates: at 14 rps (1.4 times the "
+            "highest, 10) it ")  # fmt: skip
+    else:
+        assert found is None
+    assert below_the_logs_rps(model, report, [_log(rps)]) is None

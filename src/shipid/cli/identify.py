@@ -341,6 +341,7 @@ def cmd_identify(args) -> int:
               + (", with its kernel residual" if hybrid else ""))  # fmt: skip
     ident.warnings.extend(f"plausibility: {n}" for n in notes)
     from shipid.identification.plausibility import (
+        above_the_logs_rps,
         approach_beyond_logs,
         at_the_logs_other_rps,
         below_the_logs_rps,
@@ -351,9 +352,10 @@ def cmd_identify(args) -> int:
     beyond = approach_beyond_logs(plausibility, ident.envelope)
     if beyond and not given_steady_speeds(physics):  # a speed given is no extrapolation
         ident.warnings.append(beyond)
-    below = below_the_logs_rps(hybrid or as_written(final), plausibility, logs)
-    if below:
-        ident.warnings.append(below)
+    for beyond_rps in (below_the_logs_rps, above_the_logs_rps):
+        said = beyond_rps(hybrid or as_written(final), plausibility, logs)
+        if said:
+            ident.warnings.append(said)
     ident.warnings.extend(at_the_logs_other_rps(hybrid or as_written(final), plausibility, logs))
 
     for u, n in given_steady_speeds(physics):  # where the user says the ship runs steady

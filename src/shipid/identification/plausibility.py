@@ -297,6 +297,10 @@ def approach_beyond_logs(report: dict, env: dict) -> str | None:
 # of the lowest training rps, 7.2 rps, its held turns diverge too). Said where the model is
 # made, as `validate` says the same of a log beyond the training range.
 LOWER_RPS_SHARE = 0.6
+# And above them: over the Esso's 36 pairs of zig-zag files (at 10–16.7 rps), the two models
+# whose held turns end astern above their logs' rps in 8–16.7 fail a check at 1.4 times their
+# highest and no other pair's does (``benchmarks/study_esso_rps_range.py``).
+UPPER_RPS_SHARE = 1.4
 
 
 def below_the_logs_rps(model: ManoeuvringModel, report: dict, logs) -> str | None:
@@ -304,6 +308,16 @@ def below_the_logs_rps(model: ManoeuvringModel, report: dict, logs) -> str | Non
     ``report``) fails a disqualifying check with the rudder held at ``LOWER_RPS_SHARE`` of the
     lowest rps of ``logs``, each run at a constant rps, from its own steady speed there; else
     None (also for logs whose rps varies within them: random runs cover the low rps)."""
+    return _beyond_the_logs_rps(model, report, logs, LOWER_RPS_SHARE)
+
+
+def above_the_logs_rps(model: ManoeuvringModel, report: dict, logs) -> str | None:
+    """As ``below_the_logs_rps``, at ``UPPER_RPS_SHARE`` times the highest rps of ``logs``."""
+    return _beyond_the_logs_rps(model, report, logs, UPPER_RPS_SHARE)
+
+
+def _beyond_the_logs_rps(model: ManoeuvringModel, report: dict, logs, share: float
+                         ) -> str | None:  # fmt: skip
     from shipid.data.log import approach
     from shipid.identification.identify import varies
 
@@ -315,19 +329,23 @@ def below_the_logs_rps(model: ManoeuvringModel, report: dict, logs) -> str | Non
     found = [float(n) for n in found if n is not None and n > 0]
     if not found or not report.get("rps"):
         return None
-    lowest = min(found)
-    rps = LOWER_RPS_SHARE * lowest
+    below = share < 1
+    edge = min(found) if below else max(found)
+    rps = share * edge
     near = report["approach_speed"] * rps / float(report["rps"])
     try:
-        low = plausibility_at_approach(model, near, rps, None, rps)[0]
+        there = plausibility_at_approach(model, near, rps, None, rps)[0]
     except (ShipidError, ValueError):
         return None
-    reasons = [("has " + r if r.startswith("no ") else r) for r in disqualifying(low, model)]
+    reasons = [("has " + r if r.startswith("no ") else r) for r in disqualifying(there, model)]
     if not reasons:
         return None
-    return (f"below the logs' propeller speeds the model extrapolates: at {rps:.3g} rps "
-            f"({LOWER_RPS_SHARE:g} of the lowest, {lowest:.4g}) it {' and '.join(reasons[:2])}; "
-            "validate it on a log at the propeller speed you need before using it there")
+    where = (f"below the logs' propeller speeds the model extrapolates: at {rps:.3g} rps "
+             f"({share:g} of the lowest, {edge:.4g})" if below else
+             f"above the logs' propeller speeds the model extrapolates: at {rps:.3g} rps "
+             f"({share:g} times the highest, {edge:.4g})")  # fmt: skip
+    return (f"{where} it {' and '.join(reasons[:2])}; validate it on a log at the propeller "
+            "speed you need before using it there")
 
 
 def at_the_logs_other_rps(model: ManoeuvringModel, report: dict, logs) -> list[str]:
