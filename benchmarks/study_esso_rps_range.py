@@ -25,7 +25,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from cli_models import model_by_cli  # noqa: E402
-from esso_logs import README_HELD, raw_files  # noqa: E402
+from esso_logs import README_HELD, ZIGZAGS, raw_files  # noqa: E402
 
 from shipid.identification.plausibility import (  # noqa: E402
     WRONG_WAY,
@@ -47,8 +47,9 @@ def what_it_does(note: str) -> str:
     return next((label for key, label in KINDS if key in note), "diverges")
 
 
-def judged(path: str) -> tuple[int, Counter]:
-    """(held turns judged, Counter of what the failing ones do) over ``RPS`` × both sides."""
+def judged(path: str) -> tuple[int, Counter, set[float]]:
+    """(held turns judged, Counter of what the failing ones do, the rps they fail at) over
+    ``RPS`` × both sides."""
     from shipid.reporting.modelfile import model_from_document
 
     doc = load_document(path)
@@ -56,12 +57,30 @@ def judged(path: str) -> tuple[int, Counter]:
     cond = training_conditions(doc)
     speed, rps0 = cond.get("speed"), cond.get("rps")
     failures: Counter = Counter()
+    at: set[float] = set()
     for rps in RPS:
         report, _ = plausibility_at_approach(model, speed, rps0, rps=rps)
         for key, (severity, note) in failed_checks(report, model).items():
             if key.startswith("held_rudder") and severity >= WRONG_WAY:
                 failures[what_it_does(note)] += 1
-    return 2 * len(RPS), failures
+                at.add(rps)
+    return 2 * len(RPS), failures, at
+
+
+def warned(path: str, train: list[Path]) -> dict[str, bool]:
+    """Whether ``identify``'s warnings below and above the logs' propeller speeds fire on the
+    model of ``path`` (trained on ``train``)."""
+    from shipid.identification.plausibility import above_the_logs_rps, below_the_logs_rps
+    from shipid.reporting.modelfile import model_from_document
+    from shipid.trials.reading import read_trial_log
+
+    doc = load_document(path)
+    model = model_from_document(doc, path, "model")
+    cond = training_conditions(doc)
+    report, _ = plausibility_at_approach(model, cond.get("speed"), cond.get("rps"))
+    logs = [read_trial_log(p, fmt="osaka-frt") for p in train]
+    return {"below": below_the_logs_rps(model, report, logs) is not None,
+            "above": above_the_logs_rps(model, report, logs) is not None}  # fmt: skip
 
 
 def main() -> None:
@@ -84,6 +103,7 @@ def main() -> None:
           "one | what the failing turns do |")  # fmt: skip
     print("|---|---|---|---|---|---|---|---|")
     t0 = time.perf_counter()
+    beyond = Counter()  # the pairs: failing beyond their logs' rps, against the warnings
     with tempfile.TemporaryDirectory() as scratch:
         for label, maker, trainings in sets:
             for constraints in ([], ["--constraints", "signs"]):
@@ -95,15 +115,32 @@ def main() -> None:
                     if model_by_cli(argv, [str(p) for p in train], out) is None:
                         continue
                     made += 1
-                    n, fails = judged(out)
+                    n, fails, at = judged(out)
                     turns_judged += n
                     failing += fails
                     with_one += bool(fails)
+                    if len(train) == 2 and not constraints:
+                        rps = [ZIGZAGS[p.stem[-8:]][1] for p in train]
+                        side = {"below": any(n < 0.95 * min(rps) for n in at),
+                                "above": any(n > 1.05 * max(rps) for n in at)}  # fmt: skip
+                        said = warned(out, train)
+                        for k in ("below", "above"):
+                            beyond[(k, side[k], said[k])] += 1
                 models = f"{made}" + (f" of {len(trainings)}" if made < len(trainings) else "")
                 does = ", ".join(f"{k} {v}" for k, v in failing.most_common()) or "–"
                 print(f"| {label} | {maker} | {'signs' if constraints else 'none'} | {models} | "
                       f"{turns_judged} | {sum(failing.values())} | {with_one} | {does} |")
                 sys.stdout.flush()
+    if beyond:
+        print("\nThe pairs (no constraints): models whose held turns fail beyond their logs' "
+              "propeller speeds, and identify's warnings below (0.6 of the lowest) and above "
+              "(1.4 times the highest) them\n")  # fmt: skip
+        print("| beyond the logs' rps | fails there, warned | fails there, not warned | "
+              "does not fail there, warned |")  # fmt: skip
+        print("|---|---|---|---|")
+        for k in ("below", "above"):
+            print(f"| {k} | {beyond[(k, True, True)]} | {beyond[(k, True, False)]} | "
+                  f"{beyond[(k, False, True)]} |")
     print(f"\n{time.perf_counter() - t0:.0f} s")
 
 
