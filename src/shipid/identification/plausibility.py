@@ -316,18 +316,25 @@ def above_the_logs_rps(model: ManoeuvringModel, report: dict, logs) -> str | Non
     return _beyond_the_logs_rps(model, report, logs, UPPER_RPS_SHARE)
 
 
-def _beyond_the_logs_rps(model: ManoeuvringModel, report: dict, logs, share: float
-                         ) -> str | None:  # fmt: skip
+def held_propeller_speeds(logs) -> tuple[list[float], bool]:
+    """(the ahead propeller speeds of the logs that run at one, each log's ``approach``, sorted;
+    whether every log does: a log whose rps varies, a random run, holds none)."""
     from shipid.data.log import approach
     from shipid.identification.identify import varies
 
+    held = [log for log in logs
+            if "n" in log.columns and not varies(log["n"].to_numpy(dtype=float))]  # fmt: skip
+    found = sorted(float(n) for n in (approach(log, "n") for log in held)
+                   if n is not None and n > 0)  # fmt: skip
+    return found, len(held) == len(logs)
+
+
+def _beyond_the_logs_rps(model: ManoeuvringModel, report: dict, logs, share: float
+                         ) -> str | None:  # fmt: skip
     if not getattr(model, "uses_rps", False) or not report.get("approach_speed"):
         return None
-    if any("n" not in log.columns or varies(log["n"].to_numpy(dtype=float)) for log in logs):
-        return None
-    found = [approach(log, "n") for log in logs]
-    found = [float(n) for n in found if n is not None and n > 0]
-    if not found or not report.get("rps"):
+    found, every_log = held_propeller_speeds(logs)
+    if not every_log or not found or not report.get("rps"):
         return None
     below = share < 1
     edge = min(found) if below else max(found)
@@ -536,16 +543,10 @@ def other_propeller_speeds(logs, first_rps: float | None) -> list[float]:
     """The ahead propeller speeds the training logs ran at, each log at one (its ``approach``;
     a log whose rps varies, a random run, holds none), other than ``first_rps``, the one the
     checks run at (more than ``SAME_RPS`` apart), ascending."""
-    from shipid.data.log import approach
-    from shipid.identification.identify import varies
-
     if first_rps is None or not first_rps > 0:
         return []
-    held = [approach(log, "n") for log in logs
-            if "n" in log.columns and not varies(log["n"].to_numpy(dtype=float))]  # fmt: skip
-    found = sorted(n for n in held if n is not None and n > 0)
     out: list[float] = []
-    for n in found:
+    for n in held_propeller_speeds(logs)[0]:
         if all(abs(n / m - 1) > SAME_RPS for m in (first_rps, *out)):
             out.append(float(n))
     return out
