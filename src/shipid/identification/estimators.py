@@ -44,8 +44,11 @@ def fit_linear(X: np.ndarray, y: np.ndarray, estimator="lssvm", gamma: float = 1
     """Coefficients and bias of one DOF's regression y ≈ X w + b with ``estimator``.
 
     ``physics``: a ``shipid.identification.physics.DofPhysics`` (prior, bounds, tied bias),
-    for the ``lssvm`` and ``ols`` estimators; the bounds held are in ``physics.active``."""
-    if physics is not None and _changes_fit(physics):
+    for the ``lssvm`` and ``ols`` estimators; the bounds held are in ``physics.active``. An
+    equation without a constant term (``physics.no_constant``) is fitted with b = 0 by those
+    two; the other estimators fit a bias, which the model then leaves out."""
+    if physics is not None and (_changes_fit(physics) or physics.no_constant
+                                and estimator in ("lssvm", "ols")):
         if estimator not in ("lssvm", "ols"):
             raise ShipidError(f"priors and constraints need the lssvm or ols estimator, not "
                               f"{estimator if isinstance(estimator, str) else type(estimator).__name__}")
@@ -55,8 +58,8 @@ def fit_linear(X: np.ndarray, y: np.ndarray, estimator="lssvm", gamma: float = 1
         A, B = accumulate_normal_equations([(X, y[:, None], w)], X.shape[1], 1)
         coef, bias, physics.active = solve_primal_constrained(
             A, B[:, 0], gamma if estimator == "lssvm" else math.inf, physics.prior,
-            physics.lower, physics.upper, physics.equalities, physics.inequalities)
-        return coef, bias
+            physics.lower, physics.upper, physics.solver_equalities(), physics.inequalities)
+        return coef, 0.0 if physics.no_constant else bias
     fit_kw = {} if sample_weight is None else {"sample_weight": sample_weight}
     if not isinstance(estimator, str):
         from sklearn.base import clone

@@ -210,6 +210,21 @@ class DofPhysics:
     reasons: dict[str, str] = field(default_factory=dict)  # term → why it is bounded
     notes: list[str] = field(default_factory=list)
     active: np.ndarray | None = None  # after the fit: which coefficients sit on a bound
+    # The equation has no constant term "1": the LS-SVM's bias is held at 0 in the fit (the
+    # lssvm and ols estimators), not fitted and then dropped from the model.
+    no_constant: bool = False
+
+    def solver_equalities(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """The equality rows over [ω; b] the solver holds: ``equalities``, and b = 0 for an
+        equation without a constant."""
+        if not self.no_constant:
+            return self.equalities
+        p = len(self.lower)
+        row, zero = np.eye(1, p + 1, p), np.zeros(1)
+        if self.equalities is None:
+            return row, zero
+        E, f = self.equalities
+        return np.vstack([E, row]), np.concatenate([f, zero])
 
 
 def rudder_sign(logs: Sequence[pd.DataFrame], given: str | None = None) -> float | None:
@@ -445,7 +460,8 @@ def dof_physics(options: PhysicsOptions | None, dof: str, names: Sequence[str], 
     """Prior, bounds and the steady-speed tie of one equation whose free regressors are
     ``names`` (canonical term texts, the constant excluded)."""
     p = len(names)
-    out = DofPhysics(None, np.full(p, -math.inf), np.full(p, math.inf))
+    out = DofPhysics(None, np.full(p, -math.inf), np.full(p, math.inf),
+                     no_constant=not has_constant)
     if options is None or not options.active:
         return out
     if options.prior and options.prior.get(dof):

@@ -314,7 +314,7 @@ def _fit_theta(data: _Data, terms: Mapping[str, Sequence[str]], gamma: float, tr
             A, b = gram[np.ix_(sel, sel)], cross[dof][sel]
             w, bias, _ = solve_primal_constrained(
                 A, b, gamma if estimator == "lssvm" else math.inf, extra.prior, extra.lower,
-                extra.upper, extra.equalities, extra.inequalities)
+                extra.upper, extra.solver_equalities(), extra.inequalities)
         else:
             X = np.vstack([data.phi[j][:, cols] for j in train])
             y = np.concatenate([data.targets[j][dof] for j in train])
@@ -403,11 +403,14 @@ class _Scorer:
 
 
 # ---------------------------------------------------------------------------- rankings
-def frols_ranking(X: np.ndarray, y: np.ndarray, names: Sequence[str]) -> list[tuple[str, float]]:
+def frols_ranking(X: np.ndarray, y: np.ndarray, names: Sequence[str], centred: bool = True
+                  ) -> list[tuple[str, float]]:  # fmt: skip
     """Terms in the order of forward orthogonal least squares, with their error-reduction ratio
-    (share of the centred target variance each term explains, orthogonally to the ones before)."""
-    Xc = X - X.mean(axis=0)
-    yc = y - y.mean()
+    (share of the centred target variance each term explains, orthogonally to the ones before).
+    ``centred=False`` for an equation without a constant: its terms then explain the target's
+    mean too (its sum of squares about 0), which a constant would take first."""
+    Xc = X - X.mean(axis=0) if centred else X
+    yc = y - y.mean() if centred else y
     yy = float(yc @ yc)
     if yy <= 0:
         return [(n, 0.0) for n in names]
@@ -868,7 +871,7 @@ def _rankings(data: _Data, full, kept: Mapping[str, Sequence[str]] | None = None
     out = {}
     for dof, terms in full.items():
         names, X, y = _stacked(data, dof, terms)
-        ranked = frols_ranking(X, y, names)
+        ranked = frols_ranking(X, y, names, centred="1" in terms)
         propelled = any("n" in parse_term(t).inputs for t in terms)
         if dof == "u" and propelled and any(t == HULL_RESISTANCE for t, _ in ranked):
             ranked = sorted(ranked, key=lambda item: item[0] != HULL_RESISTANCE)

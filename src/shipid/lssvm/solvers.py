@@ -346,6 +346,8 @@ def _solve_boxed(A, b, gamma, prior, lower, upper, equalities):
         exact = linalg.lstsq(K, np.concatenate([cs, g]), check_finite=False)[0][: p + 1]
         if not bounded or np.all((exact >= lo / d - 1e-9) & (exact <= hi / d + 1e-9)):
             z = exact
+            if held.size:  # on the bound itself, not within the KKT solve's rounding of it
+                z[held] = rhs_eq[-1]
     else:
         try:
             z = linalg.solve(Ms, cs, assume_a="pos", check_finite=False)
