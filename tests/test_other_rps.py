@@ -55,6 +55,25 @@ def test_a_pair_of_zigzags_at_two_rps_gives_a_model_that_turns_at_both(tmp_path)
     assert gross_at_other_rps(model, cond["speed"], cond["rps"], [12.0]) == {}
 
 
+@needs_data
+def test_a_pair_of_zigzags_gives_a_model_that_turns_beyond_their_rps(tmp_path):
+    """From the files at 12 and 10 rps the default model held a constant force, the same at
+    every rps, and ended its 35° turns going astern at 8 rps, where the thrust had fallen by a
+    third and the constant had not. The library's constant and δ² are now written as
+    advance-ratio similarity has them (n|n|, n⁺²δ²): its turns hold at 8, 15 and 16.7 rps."""
+    files = [str(ZIGZAG / "zigzag_31-Jul-2020_13_29_19.csv"),  # 12 rps
+             str(ZIGZAG / "zigzag_31-Jul-2020_13_42_53.csv")]  # 10 rps  # fmt: skip
+    out = tmp_path / "pair.json"
+    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+        assert main(["identify", "--format", "osaka-frt", "--dt", "0.5", *files,
+                     "-o", str(out)]) == 0  # fmt: skip
+    doc = load_document(out)
+    cond = training_conditions(doc)
+    model = model_from_document(doc, str(out), "model")
+    assert "1" not in model.structure.all_terms and "delta^2" not in model.structure.all_terms
+    assert gross_at_other_rps(model, cond["speed"], cond["rps"], [8.0, 15.0, 16.67]) == {}
+
+
 def _drag_model():
     """The rudder's drag grows as n⁴δ² and the thrust as n²: at 10 rps the 35° turn keeps half
     its speed, from 11.6 rps on (n² = 5e-4 / (1e-5 δ²)) the drag wins and the turn runs

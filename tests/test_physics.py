@@ -100,6 +100,17 @@ def short_zigzag():
     return SensorModel(white={"u": 0.01, "v": 0.01, "r": 0.005}).apply(log, seed=0)
 
 
+@pytest.mark.parametrize("term", ["delta^2", "u^2*delta^2", "|u|*u*delta^2", "pos(n)^2*delta^2"])
+def test_the_rudders_drag_is_a_drag_in_the_free_stream_and_in_the_race(term):
+    """The sign table held δ² and u²δ² ≤ 0, not the ahead form |u|uδ² nor the race's n⁺²δ²: the
+    best candidate of the Esso's nine zig-zag files had n⁺²δ² at +3.5e-4, a rudder that pushes
+    the ship ahead the harder it is put over."""
+    from shipid.dynamics.terms import parse_term
+    from shipid.identification.physics import _sign_bounds
+
+    assert _sign_bounds("u", parse_term(term).text, None) == (-math.inf, 0.0, "rudder drag")
+
+
 def test_sign_constraints_hold_and_are_reported(short_zigzag):
     free = identify(short_zigzag, "blanke-speed")
     fit = identify(short_zigzag, "blanke-speed", physics=PhysicsOptions(signs=True))

@@ -290,6 +290,7 @@ def test_the_default_library_leaves_out_what_the_logs_cannot_give(tmp_path, caps
     from generated_logs import noisy_zigzags
 
     from shipid.dynamics.model import get_structure
+    from shipid.dynamics.similarity import similar_library
     from shipid.identification.select import DEFAULT_LIBRARY, default_library
 
     logs = noisy_zigzags(5)
@@ -298,13 +299,15 @@ def test_the_default_library_leaves_out_what_the_logs_cannot_give(tmp_path, caps
         # A moment astern, propeller and ship: the astern terms are excited.
         log.loc[log.index[-5:], ["n", "u"]] = [-4.0, -0.05]
     library, note = default_library(logs)
-    full = get_structure(DEFAULT_LIBRARY)
+    # Each log at one rps: the constant and δ² as similarity has them (test_similarity).
+    full = similar_library(get_structure(DEFAULT_LIBRARY))[0]
     dropped = {t for d in full.terms for t in full.terms[d]} - set(library.all_terms)
     assert dropped and all("wind" in t for t in dropped)
     assert "wind_angle, wind_speed" in note
     windy = [log.assign(wind_speed=1.0, wind_angle=0.3) for log in logs]
     kept, note = default_library(windy)
-    assert note == "" and kept.all_terms == full.all_terms
+    assert note.startswith("1, delta^2 are written as advance-ratio similarity has them")
+    assert kept.all_terms == full.all_terms
     # Never astern: the astern propeller's terms are zero along every log, and left out.
     ahead = [log.assign(n=12.0) for log in windy]
     trimmed, note = default_library(ahead)

@@ -116,6 +116,40 @@ def test_terms_keep_their_form_where_similarity_cannot_write_them():
         similarity_map(_fitted().structure, 0.0)
 
 
+def test_a_library_at_several_rps_holds_no_force_the_same_at_every_rps():
+    """The default library's constant and δ² do not grow with the propeller speed: fitted on
+    logs at two rps, they go astern or turn the other way at a third (the Esso Osaka's pairs of
+    zig-zag files, test_other_rps). Where each log runs at one rps their similar forms replace
+    them, left out where the equation holds them already (|n|n = n⁺² − n⁻²)."""
+    from shipid.dynamics.model import get_structure
+    from shipid.dynamics.similarity import similar_library
+    from shipid.identification.select import DEFAULT_LIBRARY, default_library
+
+    full = get_structure(DEFAULT_LIBRARY)
+    similar, replaced = similar_library(full)
+    assert replaced == ("1", "delta^2")
+    assert {d: set(full.terms[d]) - set(similar.terms[d]) for d in full.terms} == {
+        "u": {"1", "delta^2"}, "v": {"1"}, "r": {"1"}}
+    assert set(similar.all_terms) <= set(full.all_terms)
+    assert all(speed_degree(t) in (2, None) for t in similar.all_terms)
+    # The lateral equations of low-speed alone have n⁻² but not n⁺²: the constant becomes |n|n.
+    low, _ = similar_library(get_structure("low-speed"))
+    assert "|n|*n" in low.terms["v"] and "1" not in low.terms["v"]
+    assert "|n|*n" not in low.terms["u"]  # its surge has both
+    # Without n a library is as it was, and the default keeps the constant for logs without n.
+    assert similar_library(get_structure("blanke")) == (get_structure("blanke"), ())
+    log = pd.DataFrame({"t": np.arange(0, 10.0, 0.5), "u": 0.5, "v": 0.01, "r": 0.01,
+                        "delta": 0.1, "wind_speed": 1.0, "wind_angle": 0.3})  # fmt: skip
+    library, note = default_library([log])
+    assert "1" in library.terms["u"] and "advance-ratio" not in note
+    library, note = default_library([log.assign(n=10.0), log.assign(n=12.0)])
+    assert "1" not in library.all_terms and note.startswith("1, delta^2 are written as")
+    # A log whose rps varies (a random run) shows how the forces go with n: the constant stays.
+    random_run = log.assign(n=np.linspace(-8.0, 10.0, len(log)))
+    library, note = default_library([log.assign(n=10.0), random_run])
+    assert "1" in library.all_terms and "advance-ratio" not in note
+
+
 def test_froude_scaling_carries_the_anchor():
     similar = rps_similar(_fitted(), N0)
     assert froude_scaled(similar, 4.0).similar_at_rps == pytest.approx(N0 / 2)

@@ -114,3 +114,37 @@ def rps_similar(model: ManoeuvringModel, rps: float) -> ManoeuvringModel:
     training logs' approach speed times n/``rps``."""
     found = similarity_map(model.structure, rps)
     return renamed_model(model, found, similar_at_rps=found.rps)
+
+
+# |n|n = n⁺² − n⁻²: an equation that holds both has the constant's similar form in its span.
+_SIGNED_THRUST = ("pos(n)^2", "neg(n)^2")
+
+
+def similar_library(library: ModelStructure) -> tuple[ModelStructure, tuple[str, ...]]:
+    """A candidate library for logs with a propeller speed, written as advance-ratio similarity
+    has a ship's forces: each term of degree below 2 (the constant, δ²) replaced by its similar
+    form (``similar_term``: n|n|, n⁺²δ²), left out where the equation already holds that form;
+    and the terms so replaced. A library without n is returned as it is.
+
+    Fitted at several propeller speeds, a constant force stays the same at every rps while the
+    thrust and the rudder's race go as n²: the Esso Osaka's pairs of zig-zag files at 10–16.7 rps
+    kept a constant in every candidate, and 8 of their 28 models at two rps went astern, the
+    other way or diverged with the rudder held at 8–16.7 rps (``benchmarks/study_esso_rps_range.py``).
+    """
+    if "n" not in library.inputs:
+        return library, ()
+    terms: dict[str, tuple[str, ...]] = {}
+    replaced: set[str] = set()
+    for dof, names in library.terms.items():
+        out: list[str] = []
+        for term in names:
+            new, k = similar_term(term)
+            if k == 0:
+                out.append(term)
+                continue
+            replaced.add(term)
+            spanned = new == parse_term("|n|*n").text and all(t in names for t in _SIGNED_THRUST)
+            if new not in names and new not in out and not spanned:
+                out.append(new)
+        terms[dof] = tuple(out)
+    return ModelStructure(library.name, terms), tuple(sorted(replaced))

@@ -193,49 +193,34 @@ def _auto_structure(logs, names, physics, cv, estimator, drop, announce) -> Stru
                                    alternatives=choice.alternatives)  # fmt: skip
         choice.reasons = reasons + choice.reasons
         return choice
-    from shipid.identification.select import (
-        DEFAULT_LIBRARY,
-        SelectOptions,
-        default_library,
-        select,
-    )
+    from shipid.identification.select import DEFAULT_LIBRARY, SelectOptions
 
-    library, note = default_library(logs)
-    library_name = DEFAULT_LIBRARY + (" (less what the logs lack)" if note else "")
     cv = cv or choice_cv(logs)
     fallback = "blanke-rps" + ("+wind" if wind else "")
+    options = SelectOptions(cv=cv, physics=physics, estimator=estimator)
     try:
-        # The default library is passed as None (select trims it and says so) unless terms
-        # are dropped from it.
-        given = _without(library, drop) if drop else None
-        announce(f"choosing the terms from {library_name} by free-run cross-validation ({cv})…")
-        sel = select(logs, SelectOptions(library=given, cv=cv, physics=physics,
-                                         estimator=estimator), names=names)  # fmt: skip
+        found = _searched(logs, names, options, drop, announce)
+        if found.why and found.similar:
+            # The similar forms leave the logs nothing plausible: the library with the constant.
+            announce(f"{found.why}; choosing again from {DEFAULT_LIBRARY} with its constant "
+                     f"and δ² ({cv})…")  # fmt: skip
+            constant = _searched(logs, names, options, drop, announce, similar=False)
+            if not constant.why:
+                constant.widening = [*found.widening, (
+                    f"{found.why} with its constant and δ² written as advance-ratio similarity "
+                    "has them (n|n|, n⁺²δ²), so the library with them as they are was searched "
+                    "instead: its model holds a force that stays the same at every propeller "
+                    "speed")]  # fmt: skip
+                found = constant
     except ShipidError as exc:  # too little data to hold logs out, say
         return StructureChoice(get_structure(fallback), "named", reasons,
                                notes=[f"select found no structure ({exc}); {fallback} instead"])
-    widening, apart = [], None
-    if sel.best_ruled_out:
-        wider, widening, apart = widened_selection(
-            sel, logs, names, SelectOptions(cv=cv, physics=physics, estimator=estimator), drop,
-            announce)  # fmt: skip
-        if wider is not None:
-            sel, library_name, note = wider
-    crossflow = _crossflow_selection(sel, logs, names, library, drop, SelectOptions(
-        cv=cv, physics=physics, estimator=estimator), announce)  # fmt: skip
-    if crossflow is not None:
-        sel, library_name = crossflow, f"{library_name} with the hull's cross-flow drag"
-    why = None
-    if not _chosen_passes(sel):
-        why = (f"none of select's {len(sel.candidates)} candidates from its default library is "
-               "plausible")  # fmt: skip
-    elif not sel.score < 1.0:
-        why = (f"the best of select's {len(sel.candidates)} candidates predicts the held-out "
-               f"logs no better than their mean (score {sel.score:.3g})")  # fmt: skip
-    if why:
+    sel, library_name, note, widening, apart = (found.selection, found.library_name, found.note,
+                                                found.widening, found.apart)  # fmt: skip
+    if found.why:
         # The simplest structure that holds the inputs, checked as any fit is.
         return StructureChoice(get_structure(fallback), "named", reasons,
-                               notes=[*widening, f"{why}; {fallback} instead"])  # fmt: skip
+                               notes=[*widening, f"{found.why}; {fallback} instead"])  # fmt: skip
     chosen = sel.chosen_model.structure
     # The chosen fit's own notes per equation (a constraint held, a prior) the fit of the chosen
     # structure repeats; the search's (few folds, the library trimmed) are passed on.
@@ -250,6 +235,59 @@ def _auto_structure(logs, names, physics, cv, estimator, drop, announce) -> Stru
                            warnings=[w for w in sel.warnings
                                      if not w.startswith(("u: ", "v: ", "r: "))]
                            + ([apart] if apart else []))  # fmt: skip
+
+
+@dataclass
+class _Search:
+    """What the default library's search found (``_searched``): the selection, the library's
+    name and note, the widening's notes and warning, why the choice cannot be used (None where
+    it can), and whether the library was written as advance-ratio similarity has it."""
+
+    selection: object
+    library_name: str
+    note: str
+    widening: list[str]
+    apart: str | None
+    why: str | None
+    similar: bool
+
+
+def _searched(logs, names, options, drop, announce, similar: bool = True) -> _Search:
+    """``select`` on the default library (``similar``: its constant and δ² written as
+    advance-ratio similarity has them), widened where its best candidate is ruled out, with the
+    hull's cross-flow drag where the logs give the length."""
+    import dataclasses
+
+    from shipid.identification.select import DEFAULT_LIBRARY, default_library, select
+
+    library, note = default_library(logs, similar=similar)
+    library_name = DEFAULT_LIBRARY + ("" if similar else " with its constant and δ²") + (
+        " (less what the logs lack)" if note else "")
+    # The default library is passed as None (select trims it and says so) unless terms are
+    # dropped from it or its constant kept.
+    given = _without(library, drop) if drop or not similar else None
+    if similar:
+        announce(f"choosing the terms from {library_name} by free-run cross-validation "
+                 f"({options.cv})…")  # fmt: skip
+    sel = select(logs, dataclasses.replace(options, library=given), names=names)
+    widening, apart = [], None
+    if sel.best_ruled_out:
+        wider, widening, apart = widened_selection(sel, logs, names, options, drop, announce,
+                                                   similar)  # fmt: skip
+        if wider is not None:
+            sel, library_name, note = wider
+    crossflow = _crossflow_selection(sel, logs, names, library, drop, options, announce)
+    if crossflow is not None:
+        sel, library_name = crossflow, f"{library_name} with the hull's cross-flow drag"
+    why = None
+    if not _chosen_passes(sel):
+        why = (f"none of select's {len(sel.candidates)} candidates from its default library is "
+               "plausible")  # fmt: skip
+    elif not sel.score < 1.0:
+        why = (f"the best of select's {len(sel.candidates)} candidates predicts the held-out "
+               f"logs no better than their mean (score {sel.score:.3g})")  # fmt: skip
+    # The default library loses its constant only to similarity.
+    return _Search(sel, library_name, note, widening, apart, why, "1" not in library.all_terms)
 
 
 # The most logs the default's ``select`` path also searches the library with the hull's
@@ -308,7 +346,7 @@ def _crossflow_selection(sel, logs, names, library, drop, options, announce):
 WIDENING = "rudder-drift"
 
 
-def widened_selection(sel, logs, names, options, drop=None, announce=_quiet):
+def widened_selection(sel, logs, names, options, drop=None, announce=_quiet, similar=True):
     """``select`` (with ``options``, a ``SelectOptions``) on the default library widened by
     ``WIDENING``, for logs whose best-scoring candidate from the default library the
     plausibility checks rule out (``sel.best_ruled_out``): the logs then prefer what physics
@@ -335,7 +373,7 @@ def widened_selection(sel, logs, names, options, drop=None, announce=_quiet):
     name = f"{DEFAULT_LIBRARY}+{WIDENING}"
     why = (f"the best-scoring candidate of {DEFAULT_LIBRARY} is ruled out ({sel.best_ruled_out}"
            f"): the logs prefer what physics rejects")  # fmt: skip
-    library, note = default_library(logs, name)
+    library, note = default_library(logs, name, similar)
     added = set(get_structure(WIDENING).all_terms)
     if not added & set(_without(library, drop).all_terms):
         return None, [], None  # its terms need what the logs lack (the propeller speed)

@@ -20,7 +20,8 @@ model) can be slightly unstable.
 Sign table (``SIGN_RULES``; accelerations in the body frame, forward speed u > 0, "rudder sign"
 s = +1 when a positive rudder angle turns the ship to starboard, −1 when to port):
 
-* u̇: |u|u ≤ 0 (hull resistance grows with speed); δ², u²δ² ≤ 0 (rudder drag); |n|n, pos(n)²,
+* u̇: |u|u ≤ 0 (hull resistance grows with speed); δ², u²δ², |u|uδ², n⁺²δ² ≤ 0 (rudder drag, in
+  the free stream and in the propeller's race); |n|n, pos(n)²,
   thrust ≥ 0 (propeller thrust ahead); neg(n)² ≤ 0 (propeller astern pulls back); u|n|,
   u·pos(n) ≤ 0 (thrust falls with the advance: K_T(J) falls with J ahead, and astern the inflow
   brakes the reversed propeller harder; of the other sign the surge feeds on its own speed,
@@ -63,7 +64,8 @@ _RUDDER_TERMS = _canonical("delta", "u*delta", "|u|*delta", "U*delta", "u^2*delt
 # (equation, terms, sign, why): sign −1 (≤ 0), +1 (≥ 0), or RUDDER / "-" + RUDDER (s, −s).
 SIGN_RULES: tuple[tuple[str, frozenset[str], object, str], ...] = (
     ("u", _canonical("|u|*u"), -1, "hull resistance grows with speed"),
-    ("u", _canonical("delta^2", "u^2*delta^2"), -1, "rudder drag"),
+    ("u", _canonical("delta^2", "u^2*delta^2", "|u|*u*delta^2", "pos(n)^2*delta^2"), -1,
+     "rudder drag"),
     ("u", _canonical("|n|*n", "pos(n)^2", "thrust"), 1, "propeller thrust ahead"),
     ("u", _canonical("neg(n)^2"), -1, "propeller astern pulls back"),
     ("u", _canonical("u*|n|", "u*pos(n)"), -1, "thrust falls with the advance"),
