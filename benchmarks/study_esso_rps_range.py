@@ -10,6 +10,10 @@ is held to either side at 8, 10, 12, 15 and 16.7 rps, from its own steady straig
 (``plausibility_at_approach``, the checks ``identify`` runs at the logs' rps): a turn that
 diverges, turns the other way, ends going astern, all but stops, runs away when entered
 drifting, or runs on a path far wider or tighter than the logs' is counted, by what it does.
+The pairs (no constraints) are also judged on the logs they were not fitted to, as
+``study_esso_single_logs.py`` judges them: the other seven zig-zags and the two turns (yaw rate
+error over the spread), the four random runs read whole, the turns' tactical diameters at 10 rps
+(closed loop).
 Run as a script: ``python benchmarks/study_esso_rps_range.py [--no-pairs]``.
 """
 
@@ -23,9 +27,12 @@ import time
 from collections import Counter
 from pathlib import Path
 
+import numpy as np
+
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from cli_models import model_by_cli  # noqa: E402
 from esso_logs import README_HELD, ZIGZAGS, raw_files  # noqa: E402
+from study_esso_single_logs import _errors, _turn_cell, _turn_errors, _validations  # noqa: E402
 
 from shipid.identification.plausibility import (  # noqa: E402
     WRONG_WAY,
@@ -104,6 +111,8 @@ def main() -> None:
     print("|---|---|---|---|---|---|---|---|")
     t0 = time.perf_counter()
     beyond = Counter()  # the pairs: failing beyond their logs' rps, against the warnings
+    judged_on = _held_out_logs(zigzags, turns, randoms) if "--no-pairs" not in sys.argv else None
+    predictions = []  # the pairs': (held-out logs' median, random runs' median, turns, diverged)
     with tempfile.TemporaryDirectory() as scratch:
         for label, maker, trainings in sets:
             for constraints in ([], ["--constraints", "signs"]):
@@ -126,6 +135,7 @@ def main() -> None:
                         said = warned(out, train)
                         for k in ("below", "above"):
                             beyond[(k, side[k], said[k])] += 1
+                        predictions.append(_predictions(out, train, *judged_on))
                 models = f"{made}" + (f" of {len(trainings)}" if made < len(trainings) else "")
                 does = ", ".join(f"{k} {v}" for k, v in failing.most_common()) or "–"
                 print(f"| {label} | {maker} | {'signs' if constraints else 'none'} | {models} | "
@@ -141,7 +151,38 @@ def main() -> None:
         for k in ("below", "above"):
             print(f"| {k} | {beyond[(k, True, True)]} | {beyond[(k, True, False)]} | "
                   f"{beyond[(k, False, True)]} |")
+    if predictions:
+        held = [p[0] for p in predictions]
+        turns_off = np.abs(np.concatenate([p[2] for p in predictions]))
+        finite = turns_off[np.isfinite(turns_off)]
+        print(f"\nThe pairs (no constraints) on the logs they were not fitted to: held-out "
+              f"zig-zags and turns r error / spread {np.median(held):.3f} (median of the pairs' "
+              f"medians); the random runs' {np.median([p[1] for p in predictions]):.2f}; the 35° "
+              f"turns' tactical diameter {_turn_cell(turns_off)}, mean {np.mean(finite):.0f} %; "
+              f"runs diverged {sum(p[3] for p in predictions)}")  # fmt: skip
     print(f"\n{time.perf_counter() - t0:.0f} s")
+
+
+def _held_out_logs(zigzags, turns, randoms):
+    """({path: log} of the zig-zags and turns, of the random runs), as the commands read them."""
+    from shipid.trials.reading import read_trial_log
+
+    held = {f: read_trial_log(f, fmt="osaka-frt") for f in [*zigzags, *turns]}
+    return held, {f: read_trial_log(f, fmt="osaka-frt") for f in randoms}
+
+
+def _predictions(path: str, train, held, randoms):
+    """(held-out zig-zags' and turns' median r error / spread, the random runs' median, the
+    turns' tactical diameter errors [%], runs diverged) of the model of ``path``."""
+    from shipid.reporting.modelfile import load_model
+
+    model = load_model(path)
+    others = {g: log for g, log in held.items() if g not in train}
+    runs = _validations(model, others)
+    errors, rnd = _errors(runs, others), _errors(_validations(model, randoms), randoms)
+    turns = _turn_errors([v for g, v in zip(others, runs, strict=True) if "turn" in g.stem])
+    return (float(np.median(errors)), float(np.median(rnd)), turns,
+            int(np.isinf(errors).sum() + np.isinf(rnd).sum()))  # fmt: skip
 
 
 if __name__ == "__main__":
