@@ -38,19 +38,22 @@ def test_the_other_propeller_speeds_are_the_logs_apart_from_the_first():
     assert other_propeller_speeds([_log(10.0)], 10.0) == []
 
 
-@needs_data
-def test_a_pair_of_zigzags_at_two_rps_gives_a_model_that_turns_at_both(tmp_path):
-    """Checked at the first log's 10 rps alone, the model handed out ended its turn to port
-    going astern at the second log's 12 rps (as the pair at 15 and 12 rps did to both sides)."""
-    files = [str(ZIGZAG / "zigzag_31-Jul-2020_13_22_52.csv"),  # 10 rps, read first
-             str(ZIGZAG / "zigzag_31-Jul-2020_14_10_05.csv")]  # 12 rps  # fmt: skip
+def _pair_model(tmp_path, first: str, second: str):
+    """(model, training conditions) of a plain ``identify`` of two Esso zig-zag files at Δk 0.5 s."""
+    files = [str(ZIGZAG / f"zigzag_31-Jul-2020_{t}.csv") for t in (first, second)]
     out = tmp_path / "pair.json"
     with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
         assert main(["identify", "--format", "osaka-frt", "--dt", "0.5", *files,
                      "-o", str(out)]) == 0  # fmt: skip
     doc = load_document(out)
-    cond = training_conditions(doc)
-    model = model_from_document(doc, str(out), "model")
+    return model_from_document(doc, str(out), "model"), training_conditions(doc)
+
+
+@needs_data
+def test_a_pair_of_zigzags_at_two_rps_gives_a_model_that_turns_at_both(tmp_path):
+    """Checked at the first log's 10 rps alone, the model handed out ended its turn to port
+    going astern at the second log's 12 rps (as the pair at 15 and 12 rps did to both sides)."""
+    model, cond = _pair_model(tmp_path, "13_22_52", "14_10_05")  # 10 rps read first, 12 rps
     assert round(cond["rps"]) == 10
     assert gross_at_other_rps(model, cond["speed"], cond["rps"], [12.0]) == {}
 
@@ -61,15 +64,7 @@ def test_a_pair_of_zigzags_gives_a_model_that_turns_beyond_their_rps(tmp_path):
     every rps, and ended its 35° turns going astern at 8 rps, where the thrust had fallen by a
     third and the constant had not. The library's constant and δ² are now written as
     advance-ratio similarity has them (n|n|, n⁺²δ²): its turns hold at 8, 15 and 16.7 rps."""
-    files = [str(ZIGZAG / "zigzag_31-Jul-2020_13_29_19.csv"),  # 12 rps
-             str(ZIGZAG / "zigzag_31-Jul-2020_13_42_53.csv")]  # 10 rps  # fmt: skip
-    out = tmp_path / "pair.json"
-    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
-        assert main(["identify", "--format", "osaka-frt", "--dt", "0.5", *files,
-                     "-o", str(out)]) == 0  # fmt: skip
-    doc = load_document(out)
-    cond = training_conditions(doc)
-    model = model_from_document(doc, str(out), "model")
+    model, cond = _pair_model(tmp_path, "13_29_19", "13_42_53")  # 12 and 10 rps
     assert "1" not in model.structure.all_terms and "delta^2" not in model.structure.all_terms
     assert gross_at_other_rps(model, cond["speed"], cond["rps"], [8.0, 15.0, 16.67]) == {}
 
