@@ -3,6 +3,7 @@ free-run errors on logs left out."""
 
 from __future__ import annotations
 
+import functools
 import sys
 from pathlib import Path
 
@@ -46,6 +47,35 @@ def _check_replicates(ensemble, report: dict, model, one_rps, ahead, logs, args,
     _report_replicates(ensemble, _replicates_checked(
         ensemble, report, model, lambda member: _as_written(member, one_rps, ahead), speed, rps,
         curvature, (args.speed, args.rps)), ident)  # fmt: skip
+
+
+def _with_the_constant(sel, logs, names, options, edit):
+    """``sel``, or, where none of the default library's candidates is plausible with its
+    constant and δ² written as advance-ratio similarity has them, the search of the library with
+    them as they are where its choice is (as identify's default; docs/structures.md, *Logs at
+    several propeller speeds*)."""
+    import dataclasses
+
+    from shipid.identification.auto_structure import chosen_passes, widened_selection
+    from shipid.identification.select import DEFAULT_LIBRARY, default_library, select
+
+    if chosen_passes(sel):
+        return sel
+    say = functools.partial(print, file=sys.stderr)
+    say(f"none of the candidates is plausible; choosing again from {DEFAULT_LIBRARY} with its "
+        f"constant and δ² ({options.cv})…")  # fmt: skip
+    library = edit.apply(default_library(logs, similar=False)[0])
+    constant = select(logs, dataclasses.replace(options, library=library), names=names)
+    if constant.best_ruled_out:
+        wider, _, _ = widened_selection(constant, logs, names, options, edit, say, similar=False)
+        constant = wider[0] if wider is not None else constant
+    if not chosen_passes(constant):
+        return sel
+    print(f"library: none of the candidates of {DEFAULT_LIBRARY} is plausible with its constant "
+          "and δ² written as advance-ratio similarity has them (n|n|, n⁺²δ²); the library with "
+          "them as they are was searched instead: its model holds a force that stays the same "
+          "at every propeller speed")  # fmt: skip
+    return constant
 
 
 def cmd_select(args) -> int:
@@ -99,6 +129,8 @@ def cmd_select(args) -> int:
             sel.identification.warnings.append(f"library: {apart}")
         for note in said:  # the model file's selection record names the library searched
             print(f"library: {note}")
+    if args.library is None and "1" not in library.all_terms:
+        sel = _with_the_constant(sel, logs, names, options, edit)
     ident = sel.identification
     if sel.model is not sel.chosen_model:
         print(f"The chosen candidate:\n{sel.chosen_model.equations()}\n\nThe model written, "

@@ -280,7 +280,7 @@ def _searched(logs, names, options, drop, announce, similar: bool = True) -> _Se
     if crossflow is not None:
         sel, library_name = crossflow, f"{library_name} with the hull's cross-flow drag"
     why = None
-    if not _chosen_passes(sel):
+    if not chosen_passes(sel):
         why = (f"none of select's {len(sel.candidates)} candidates from its default library is "
                "plausible")  # fmt: skip
     elif not sel.score < 1.0:
@@ -320,7 +320,7 @@ def _crossflow_selection(sel, logs, names, library, drop, options, announce):
         return None
     chosen = sel.candidates[sel.candidates["chosen"]]
     limit = sel.score + (float(chosen["score_se"].iloc[0]) if len(chosen) else 0.0)
-    if _chosen_passes(wide) and (not _chosen_passes(sel) or wide.score <= limit):
+    if chosen_passes(wide) and (not chosen_passes(sel) or wide.score <= limit):
         return wide
     return None
 
@@ -385,10 +385,10 @@ def widened_selection(sel, logs, names, options, drop=None, announce=_quiet, sim
         return None, [f"{why}; {name} found no structure ({exc})"], None
     if not added & set(wide.chosen_model.structure.all_terms):
         return None, [f"{why}; {name}, tried, chooses none of the {WIDENING} terms"], None
-    if not _chosen_passes(wide) or (_chosen_passes(sel) and not wide.score < sel.score):
+    if not chosen_passes(wide) or (chosen_passes(sel) and not wide.score < sel.score):
         return None, [f"{why}; {name}, tried, predicts the held-out logs no better (score "
                       f"{wide.score:.4f} against {sel.score:.4f}) and is not kept"], None
-    apart = _held_turns_apart(sel, wide) if _chosen_passes(sel) else None
+    apart = _held_turns_apart(sel, wide) if chosen_passes(sel) else None
     if apart and not _logs_hold_a_turn(logs):
         rudder = (sel.plausibility or {}).get("rudder_deg", 35.0)
         said = (f"{why}; {name}, tried, predicts the held-out logs better (score "
@@ -400,7 +400,7 @@ def widened_selection(sel, logs, names, options, drop=None, announce=_quiet, sim
             "library's choice is kept; validate on a turning log, or train on one")
     label = name + (" (less what the logs lack)" if note else "")
     better = (f"predicts the held-out logs better (score {wide.score:.4f} against "
-              f"{sel.score:.4f})" if _chosen_passes(sel) else "passes the checks, where the "
+              f"{sel.score:.4f})" if chosen_passes(sel) else "passes the checks, where the "
               "default library's chosen candidate does not")  # fmt: skip
     return (wide, label, note), [
         f"{why}, so the library is widened by {WIDENING} (the rudder's lift in the propeller's "
@@ -439,7 +439,7 @@ def _held_turns_apart(narrow, wide) -> str | None:
     return ", ".join(sides) or None
 
 
-def _chosen_passes(selection) -> bool:
+def chosen_passes(selection) -> bool:
     """Whether a selection's chosen candidate passes the plausibility checks."""
     chosen = selection.candidates[selection.candidates["chosen"]]
     return bool(len(chosen) and chosen["plausible"].all())
