@@ -20,9 +20,10 @@ if os.environ.get("PYTEST_XDIST_WORKER"):
 # time: its blocks run in order on one worker) started late and ran alone at the end; the longest
 # files first balance the two workers (by their seconds in a --durations run: with the four
 # longest alone first, one worker ran 98 s of tests and the other 90 s).
-LONGEST_FIRST = ("test_readme.py", "test_real_data.py", "test_auto_structure.py",
-                 "test_select.py", "test_tanker.py", "test_output_error.py", "test_cli.py",
-                 "test_files.py", "test_study.py")
+LONGEST_FIRST = ("test_readme.py", "test_other_rps.py", "test_real_data.py",
+                 "test_auto_structure.py", "test_select.py", "test_tanker.py",
+                 "test_output_error.py", "test_files.py", "test_cli.py", "test_steady_speed.py",
+                 "test_study.py")
 
 
 def pytest_collection_modifyitems(session, config, items):

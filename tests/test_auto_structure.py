@@ -174,34 +174,6 @@ KVLCC2 = DATA.parent / "kvlcc2-marin" / "MARIN_FREE_KVLCC2_zz_20_m.dat"
 
 
 @needs_data
-@pytest.mark.parametrize("command", ["identify", "select"])
-def test_where_nothing_similar_is_plausible_the_library_keeps_its_constant(tmp_path, capsys,
-                                                                           command):
-    """The nine Esso zig-zag files: every candidate of the default library with its constant and
-    δ² written as advance-ratio similarity has them ends its held 35° turns astern (its thrust
-    rides on u|n| against a negative n⁺², one column along runs whose speed goes with n).
-    identify and select (without --library) then search the library with them as they are, say
-    so, and hand out a plausible model, the one they gave before the similar forms."""
-    from shipid.identification.plausibility import disqualifying, plausibility_at_approach
-    from shipid.reporting.modelfile import load_document, model_from_document, training_conditions
-
-    files = sorted((DATA / "zigzag").glob("*.csv"))
-    out = tmp_path / "nine.json"
-    quiet = ["--quiet"] if command == "select" else []
-    code, said, err = run([command, "--format", "osaka-frt", "--dt", "0.5", *quiet, *files,
-                           "-o", out], capsys)  # fmt: skip
-    assert code == 0, err
-    assert "with its constant and δ² (logo)…" in err
-    assert "the library with them as they are was searched instead" in said + err
-    doc = load_document(out)
-    model = model_from_document(doc, str(out), "model")
-    assert "1" in model.structure.terms["u"]
-    cond = training_conditions(doc)
-    report, _ = plausibility_at_approach(model, cond["speed"], cond["rps"])
-    assert disqualifying(report, model) == []
-
-
-@needs_data
 def test_a_speed_that_varies_at_constant_rps_compares_the_rudders_inflow(paper_log):
     """The KVLCC2's MARIN zig-zag loses 30 % of its speed at a constant 10.3 rps: the paper's
     rudder force in δ assumes one speed. Plain `identify` fitted blanke to it; blanke-speed

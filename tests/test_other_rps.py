@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+from cli_helpers import run
 
 from shipid.cli import main
 from shipid.identification.plausibility import gross_at_other_rps, other_propeller_speeds
@@ -50,23 +51,18 @@ def _pair_model(tmp_path, first: str, second: str):
 
 
 @needs_data
-def test_a_pair_of_zigzags_at_two_rps_gives_a_model_that_turns_at_both(tmp_path):
+def test_a_pair_of_zigzags_at_two_rps_gives_a_model_that_turns_at_both_and_beyond(tmp_path):
     """Checked at the first log's 10 rps alone, the model handed out ended its turn to port
-    going astern at the second log's 12 rps (as the pair at 15 and 12 rps did to both sides)."""
+    going astern at the second log's 12 rps (as the pair at 15 and 12 rps did to both sides).
+    Then, checked at both, its library's constant, the same force at every rps, ended its 35°
+    turns going astern at 15 and 16.7 rps, where the thrust had grown and the constant had not
+    (the pair at 12 and 10 rps at 8 rps, where the thrust had fallen). The library's constant
+    and δ² are now written as advance-ratio similarity has them (n|n|, n⁺²δ²): its turns hold
+    from 8 to 16.7 rps."""
     model, cond = _pair_model(tmp_path, "13_22_52", "14_10_05")  # 10 rps read first, 12 rps
     assert round(cond["rps"]) == 10
-    assert gross_at_other_rps(model, cond["speed"], cond["rps"], [12.0]) == {}
-
-
-@needs_data
-def test_a_pair_of_zigzags_gives_a_model_that_turns_beyond_their_rps(tmp_path):
-    """From the files at 12 and 10 rps the default model held a constant force, the same at
-    every rps, and ended its 35° turns going astern at 8 rps, where the thrust had fallen by a
-    third and the constant had not. The library's constant and δ² are now written as
-    advance-ratio similarity has them (n|n|, n⁺²δ²): its turns hold at 8, 15 and 16.7 rps."""
-    model, cond = _pair_model(tmp_path, "13_29_19", "13_42_53")  # 12 and 10 rps
     assert "1" not in model.structure.all_terms and "delta^2" not in model.structure.all_terms
-    assert gross_at_other_rps(model, cond["speed"], cond["rps"], [8.0, 15.0, 16.67]) == {}
+    assert gross_at_other_rps(model, cond["speed"], cond["rps"], [8.0, 12.0, 15.0, 16.67]) == {}
 
 
 def _drag_model():
@@ -112,3 +108,30 @@ def test_a_model_that_fails_above_the_logs_rps_is_named(rps, warned):
               "highest, 10) it ")  # fmt: skip
     assert found.startswith(prefix) if warned else found == ""
     assert below_the_logs_rps(model, report, [_log(rps)]) is None
+
+
+@needs_data
+@pytest.mark.parametrize("command", ["identify", "select"])
+def test_where_nothing_similar_is_plausible_the_library_keeps_its_constant(tmp_path, capsys,
+                                                                           command):
+    """The nine Esso zig-zag files: every candidate of the default library with its constant and
+    δ² written as advance-ratio similarity has them ends its held 35° turns astern (its thrust
+    rides on u|n| against a negative n⁺², one column along runs whose speed goes with n).
+    identify and select (without --library) then search the library with them as they are, say
+    so, and hand out a plausible model, the one they gave before the similar forms."""
+    from shipid.identification.plausibility import disqualifying, plausibility_at_approach
+
+    files = sorted(ZIGZAG.glob("*.csv"))
+    out = tmp_path / "nine.json"
+    quiet = ["--quiet"] if command == "select" else []
+    code, said, err = run([command, "--format", "osaka-frt", "--dt", "0.5", *quiet, *files,
+                           "-o", out], capsys)  # fmt: skip
+    assert code == 0, err
+    assert "with its constant and δ² (logo)…" in err
+    assert "the library with them as they are was searched instead" in said + err
+    doc = load_document(out)
+    model = model_from_document(doc, str(out), "model")
+    assert "1" in model.structure.terms["u"]
+    cond = training_conditions(doc)
+    report, _ = plausibility_at_approach(model, cond["speed"], cond["rps"])
+    assert disqualifying(report, model) == []
