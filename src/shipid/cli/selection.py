@@ -49,35 +49,6 @@ def _check_replicates(ensemble, report: dict, model, one_rps, ahead, logs, args,
         curvature, (args.speed, args.rps)), ident)  # fmt: skip
 
 
-def _with_the_constant(sel, logs, names, options, edit):
-    """``sel``, or, where none of the default library's candidates is plausible with its
-    constant and δ² written as advance-ratio similarity has them, the search of the library with
-    them as they are where its choice is (as identify's default; docs/structures.md, *Logs at
-    several propeller speeds*)."""
-    import dataclasses
-
-    from shipid.identification.auto_structure import chosen_passes, widened_selection
-    from shipid.identification.select import DEFAULT_LIBRARY, default_library, select
-
-    if chosen_passes(sel):
-        return sel
-    say = functools.partial(print, file=sys.stderr)
-    say(f"none of the candidates is plausible; choosing again from {DEFAULT_LIBRARY} with its "
-        f"constant and δ² ({options.cv})…")  # fmt: skip
-    library = edit.apply(default_library(logs, similar=False)[0])
-    constant = select(logs, dataclasses.replace(options, library=library), names=names)
-    if constant.best_ruled_out:
-        wider, _, _ = widened_selection(constant, logs, names, options, edit, say, similar=False)
-        constant = wider[0] if wider is not None else constant
-    if not chosen_passes(constant):
-        return sel
-    print(f"library: none of the candidates of {DEFAULT_LIBRARY} is plausible with its constant "
-          "and δ² written as advance-ratio similarity has them (n|n|, n⁺²δ²); the library with "
-          "them as they are was searched instead: its model holds a force that stays the same "
-          "at every propeller speed")  # fmt: skip
-    return constant
-
-
 def cmd_select(args) -> int:
     """``shipid select``: structure and γ by cross-validated free-run error."""
     from shipid.dynamics.model import get_structure
@@ -116,21 +87,29 @@ def cmd_select(args) -> int:
                             average=args.average, keep=args.keep,
                             **({"gammas": gammas} if gammas else {}))
     sel = select(logs, options, names=names)
-    if args.library is None and sel.best_ruled_out:
-        from shipid.identification.auto_structure import widened_selection
+    from shipid.identification.auto_structure import unusable, widened_selection
 
+    say = functools.partial(print, file=sys.stderr)
+    if args.library is None and sel.best_ruled_out:
         # As identify's default: where the logs' best fit from the default library is ruled out
         # by the checks, the search again with the rudder's lift at the hull's drift.
-        wider, said, apart = widened_selection(sel, logs, names, options, edit,
-                                               announce=lambda m: print(m, file=sys.stderr))
+        wider, said, apart = widened_selection(sel, logs, names, options, edit, announce=say)
         if wider is not None:
             sel = wider[0]
         if apart:
             sel.identification.warnings.append(f"library: {apart}")
         for note in said:  # the model file's selection record names the library searched
             print(f"library: {note}")
-    if args.library is None and "1" not in library.all_terms:
-        sel = _with_the_constant(sel, logs, names, options, edit)
+    why = unusable(sel) if args.library is None and "1" not in library.all_terms else None
+    if why:  # as identify's default: the library with its constant where nothing similar is
+        from shipid.identification.auto_structure import searched_with_the_constant
+
+        constant = searched_with_the_constant(logs, names, options, edit, say, why,
+                                              crossflow=False)  # fmt: skip
+        if constant is not None:
+            sel = constant.selection
+            for note in constant.widening:
+                print(f"library: {note}")
     ident = sel.identification
     if sel.model is not sel.chosen_model:
         print(f"The chosen candidate:\n{sel.chosen_model.equations()}\n\nThe model written, "

@@ -193,7 +193,7 @@ def _auto_structure(logs, names, physics, cv, estimator, drop, announce) -> Stru
                                    alternatives=choice.alternatives)  # fmt: skip
         choice.reasons = reasons + choice.reasons
         return choice
-    from shipid.identification.select import DEFAULT_LIBRARY, SelectOptions
+    from shipid.identification.select import SelectOptions
 
     cv = cv or choice_cv(logs)
     fallback = "blanke-rps" + ("+wind" if wind else "")
@@ -201,16 +201,10 @@ def _auto_structure(logs, names, physics, cv, estimator, drop, announce) -> Stru
     try:
         found = _searched(logs, names, options, drop, announce)
         if found.why and found.similar:
-            # The similar forms leave the logs nothing plausible: the library with the constant.
-            announce(f"{found.why}; choosing again from {DEFAULT_LIBRARY} with its constant "
-                     f"and δ² ({cv})…")  # fmt: skip
-            constant = _searched(logs, names, options, drop, announce, similar=False)
-            if not constant.why:
-                constant.widening = [*found.widening, (
-                    f"{found.why} with its constant and δ² written as advance-ratio similarity "
-                    "has them (n|n|, n⁺²δ²), so the library with them as they are was searched "
-                    "instead: its model holds a force that stays the same at every propeller "
-                    "speed")]  # fmt: skip
+            constant = searched_with_the_constant(logs, names, options, drop, announce,
+                                                  found.why)  # fmt: skip
+            if constant is not None:
+                constant.widening = [*found.widening, *constant.widening]
                 found = constant
     except ShipidError as exc:  # too little data to hold logs out, say
         return StructureChoice(get_structure(fallback), "named", reasons,
@@ -252,10 +246,12 @@ class _Search:
     similar: bool
 
 
-def _searched(logs, names, options, drop, announce, similar: bool = True) -> _Search:
+def _searched(logs, names, options, drop, announce, similar: bool = True,
+              crossflow: bool = True) -> _Search:
     """``select`` on the default library (``similar``: its constant and δ² written as
     advance-ratio similarity has them), widened where its best candidate is ruled out, with the
-    hull's cross-flow drag where the logs give the length."""
+    hull's cross-flow drag where the logs give the length (``crossflow``: ``identify``'s
+    default; ``select`` takes it with ``--crossflow`` alone)."""
     import dataclasses
 
     from shipid.identification.select import DEFAULT_LIBRARY, default_library, select
@@ -276,18 +272,46 @@ def _searched(logs, names, options, drop, announce, similar: bool = True) -> _Se
                                                    similar)  # fmt: skip
         if wider is not None:
             sel, library_name, note = wider
-    crossflow = _crossflow_selection(sel, logs, names, library, drop, options, announce)
-    if crossflow is not None:
-        sel, library_name = crossflow, f"{library_name} with the hull's cross-flow drag"
-    why = None
-    if not chosen_passes(sel):
-        why = (f"none of select's {len(sel.candidates)} candidates from its default library is "
-               "plausible")  # fmt: skip
-    elif not sel.score < 1.0:
-        why = (f"the best of select's {len(sel.candidates)} candidates predicts the held-out "
-               f"logs no better than their mean (score {sel.score:.3g})")  # fmt: skip
+    found = _crossflow_selection(sel, logs, names, library, drop, options, announce) \
+        if crossflow else None  # fmt: skip
+    if found is not None:
+        sel, library_name = found, f"{library_name} with the hull's cross-flow drag"
     # The default library loses its constant only to similarity.
-    return _Search(sel, library_name, note, widening, apart, why, "1" not in library.all_terms)
+    return _Search(sel, library_name, note, widening, apart, unusable(sel),
+                   "1" not in library.all_terms)  # fmt: skip
+
+
+def unusable(selection) -> str | None:
+    """Why the default library's selection cannot be used (its chosen candidate implausible, or
+    no better than predicting the held-out logs' mean), or None."""
+    n = len(selection.candidates)
+    if not _chosen_passes(selection):
+        return f"none of select's {n} candidates from its default library is plausible"
+    if not selection.score < 1.0:
+        return (f"the best of select's {n} candidates predicts the held-out logs no better than "
+                f"their mean (score {selection.score:.3g})")  # fmt: skip
+    return None
+
+
+def searched_with_the_constant(logs, names, options, drop, announce, why: str,
+                               crossflow: bool = True) -> _Search | None:
+    """The default library searched again with its constant and δ² as they are, where the
+    search with them written as advance-ratio similarity has them found nothing usable
+    (``why``): ``identify``'s default and ``select`` without ``--library`` (on the Esso's nine
+    zig-zag files every similar candidate ends its held turns astern). None where this search
+    finds nothing usable either; its notes begin with why it was made."""
+    from shipid.identification.select import DEFAULT_LIBRARY
+
+    announce(f"{why}; choosing again from {DEFAULT_LIBRARY} with its constant and δ² "
+             f"({options.cv})…")  # fmt: skip
+    found = _searched(logs, names, options, drop, announce, similar=False, crossflow=crossflow)
+    if found.why:
+        return None
+    found.widening = [f"{why} with its constant and δ² written as advance-ratio similarity has "
+                      "them (n|n|, n⁺²δ²), so the library with them as they are was searched "
+                      "instead: its model holds a force that stays the same at every propeller "
+                      "speed", *found.widening]  # fmt: skip
+    return found
 
 
 # The most logs the default's ``select`` path also searches the library with the hull's
@@ -320,7 +344,7 @@ def _crossflow_selection(sel, logs, names, library, drop, options, announce):
         return None
     chosen = sel.candidates[sel.candidates["chosen"]]
     limit = sel.score + (float(chosen["score_se"].iloc[0]) if len(chosen) else 0.0)
-    if chosen_passes(wide) and (not chosen_passes(sel) or wide.score <= limit):
+    if _chosen_passes(wide) and (not _chosen_passes(sel) or wide.score <= limit):
         return wide
     return None
 
@@ -385,10 +409,10 @@ def widened_selection(sel, logs, names, options, drop=None, announce=_quiet, sim
         return None, [f"{why}; {name} found no structure ({exc})"], None
     if not added & set(wide.chosen_model.structure.all_terms):
         return None, [f"{why}; {name}, tried, chooses none of the {WIDENING} terms"], None
-    if not chosen_passes(wide) or (chosen_passes(sel) and not wide.score < sel.score):
+    if not _chosen_passes(wide) or (_chosen_passes(sel) and not wide.score < sel.score):
         return None, [f"{why}; {name}, tried, predicts the held-out logs no better (score "
                       f"{wide.score:.4f} against {sel.score:.4f}) and is not kept"], None
-    apart = _held_turns_apart(sel, wide) if chosen_passes(sel) else None
+    apart = _held_turns_apart(sel, wide) if _chosen_passes(sel) else None
     if apart and not _logs_hold_a_turn(logs):
         rudder = (sel.plausibility or {}).get("rudder_deg", 35.0)
         said = (f"{why}; {name}, tried, predicts the held-out logs better (score "
@@ -400,7 +424,7 @@ def widened_selection(sel, logs, names, options, drop=None, announce=_quiet, sim
             "library's choice is kept; validate on a turning log, or train on one")
     label = name + (" (less what the logs lack)" if note else "")
     better = (f"predicts the held-out logs better (score {wide.score:.4f} against "
-              f"{sel.score:.4f})" if chosen_passes(sel) else "passes the checks, where the "
+              f"{sel.score:.4f})" if _chosen_passes(sel) else "passes the checks, where the "
               "default library's chosen candidate does not")  # fmt: skip
     return (wide, label, note), [
         f"{why}, so the library is widened by {WIDENING} (the rudder's lift in the propeller's "
@@ -439,7 +463,7 @@ def _held_turns_apart(narrow, wide) -> str | None:
     return ", ".join(sides) or None
 
 
-def chosen_passes(selection) -> bool:
+def _chosen_passes(selection) -> bool:
     """Whether a selection's chosen candidate passes the plausibility checks."""
     chosen = selection.candidates[selection.candidates["chosen"]]
     return bool(len(chosen) and chosen["plausible"].all())
