@@ -376,3 +376,26 @@ def test_the_average_of_candidates_and_its_bootstrap_refit():
     assert refit(weights).term_texts == model.term_texts
     with pytest.raises(ShipidError, match="weights"):
         averaged_model(train, [(get_structure("blanke"), 1e4, 0.0)])
+
+
+def test_the_candidates_of_an_average_share_each_logs_term_columns(clean_zigzag, monkeypatch):
+    """Inside ``shared_term_columns`` a term's values along a log are computed once, equal to
+    the bit to those computed alone, and forgotten at its end (nested uses share the outer)."""
+    import shipid.identification.regression as regression
+
+    names = ["u*v", "|v|*v", "u*delta", "1"]
+    alone = regression.log_terms(clean_zigzag, names)
+    computed = []
+    compute = regression._log_terms
+    monkeypatch.setattr(regression, "_log_terms", lambda log, terms, name: (
+        computed.extend(terms), compute(log, terms, name))[1])  # fmt: skip
+    other = clean_zigzag.copy()
+    with regression.shared_term_columns():
+        np.testing.assert_array_equal(regression.log_terms(clean_zigzag, names), alone)
+        with regression.shared_term_columns():
+            again = regression.log_terms(clean_zigzag, ["u*delta", "u*r", "u*v"])
+        np.testing.assert_array_equal(again[:, [0, 2]], alone[:, [2, 0]])
+        regression.log_terms(other, ["u*v"])  # another log: its own columns
+    assert computed == [*names, "u*r", "u*v"]
+    regression.log_terms(clean_zigzag, ["u*v"])
+    assert computed[-1:] == ["u*v"] and len(computed) == 7

@@ -29,7 +29,12 @@ from shipid.identification.physics import (
     still_air,
     with_stability,
 )
-from shipid.identification.regression import FORMS, RegressionProblem, regression_problem
+from shipid.identification.regression import (
+    FORMS,
+    RegressionProblem,
+    regression_problem,
+    shared_term_columns,
+)
 from shipid.lssvm.solvers import NumericalWarning
 
 COLLINEAR_CORRELATION = 0.999
@@ -533,8 +538,9 @@ def averaged_model(
     total = float(sum(w for _, _, w in members))
     if not total > 0:
         raise ShipidError("the candidates' weights must add up to more than 0")
-    fits = [(identify(logs, model=s, gamma=g, force=True, **options).model, w / total)
-            for s, g, w in members]  # fmt: skip
+    with shared_term_columns():
+        fits = [(identify(logs, model=s, gamma=g, force=True, **options).model, w / total)
+                for s, g, w in members]  # fmt: skip
     return average_models(fits, first, name)
 
 
