@@ -46,6 +46,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/study_selection_uncertainty.py
 	$(BIN)/python benchmarks/study_kvlcc2_average.py
 	$(BIN)/python benchmarks/study_kvlcc2_sampling.py
+	$(BIN)/python benchmarks/study_kvlcc2_turn.py
 	$(BIN)/python benchmarks/study_auto_structure.py
 	$(BIN)/python benchmarks/study_sampling.py
 	$(BIN)/python benchmarks/study_auto_inflow.py
