@@ -83,7 +83,8 @@ _SHARED: ContextVar[dict[int, tuple[pd.DataFrame, dict[str, np.ndarray]]] | None
 def shared_term_columns() -> Iterator[None]:
     """Within it, a term's values along a log are computed once and shared by every fit of that
     log: the candidates of an average share most of their terms, and each fit built every
-    column anew (a tenth of ``identify``'s time on nine Esso zig-zag files). The logs must not
+    column anew (5–9 % of ``identify``'s time on nine Esso zig-zag files, 6–15 % on a pair of
+    them; benchmarks/README.md, *Start-up and end to end*). The logs must not
     change in place inside it; each cached log is held, so its id names it alone. Nested uses
     share the outermost cache."""
     if _SHARED.get() is not None:
