@@ -210,3 +210,45 @@ def test_an_unsettled_turn_is_read_as_the_selection_reads_it():
     report["held_rudder"]["port"]["steady_yaw_rate"] = -0.0004
     assert failed_checks(report, model)["held_rudder_port"][0] == UNSETTLED
     assert disqualifying(report, model) == ["ends going astern with the rudder held to starboard"]
+
+
+def _linear(scale: float) -> ManoeuvringModel:
+    from shipid.dynamics.model import get_structure
+
+    structure = get_structure("u: u, 1; v: v, r, delta; r: v, r, delta")
+    return ManoeuvringModel(structure, {
+        "u": {"u": -0.05 * scale, "1": 0.1 * scale},
+        "v": {"v": -0.8 * scale, "r": 0.3 * scale, "delta": 0.05},
+        "r": {"v": -0.2 * scale, "r": -0.6 * scale, "delta": -0.1}})  # fmt: skip
+
+
+@pytest.mark.parametrize(("scale", "step"), [(1.0, 0.2), (2.0, "between"), (30.0, 0.1)])
+def test_the_held_turns_step_follows_the_models_fastest_mode(scale, step):
+    """A linear model's Jacobian is its coefficients: its fastest mode is their largest |λ|, and
+    the held turns' RK4 step keeps |λ| dt at 0.2 within 0.1–0.2 s."""
+    from shipid.identification.plausibility import fastest_mode, held_step
+
+    model = _linear(scale)
+    A = scale * np.array([[-0.05, 0.0, 0.0], [0.0, -0.8, 0.3], [0.0, -0.2, -0.6]])
+    fastest = float(np.max(np.abs(np.linalg.eigvals(A))))
+    assert fastest_mode(model, 2.0) == pytest.approx(fastest, rel=1e-6)
+    expected = 0.2 / fastest if step == "between" else step
+    assert 0.1 < expected < 0.2 or step != "between"
+    assert held_step(model, 2.0) == pytest.approx(expected, rel=1e-6)
+
+
+def test_the_held_turns_at_their_step_are_the_turns_at_a_tenth_of_a_second():
+    """A slow model's held 35° turns at the step ``held_step`` chooses (0.2 s) settle where
+    those at 0.1 s do, to 1e-6, with the same verdicts; the paper's scale ship, whose fastest
+    mode is 3 1/s at 2 m/s, keeps 0.1 s."""
+    from shipid.identification.plausibility import held_rudder, held_step
+
+    assert held_step(scale_ship_model(), 2.0) == 0.1
+    model = _linear(1.0)
+    assert held_step(model, 2.0) == 0.2
+    chosen, fine = held_rudder(model, 2.0), held_rudder(model, 2.0, dt=0.1)
+    for side in ("starboard", "port"):
+        for key in ("steady_yaw_rate", "steady_speed"):
+            assert chosen[side][key] == pytest.approx(fine[side][key], rel=1e-6)
+        assert {k: chosen[side][k] for k in ("diverged", "settled", "duration")} == \
+            {k: fine[side][k] for k in ("diverged", "settled", "duration")}  # fmt: skip
