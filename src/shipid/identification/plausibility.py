@@ -71,8 +71,8 @@ HELD_DURATION, HELD_MAX_DOUBLINGS = 300.0, 4
 # 0.2 s instead of the 0.1 s every model ran at before: over the 45 default models of one or two
 # Esso zig-zag files the held turns' steady values moved by 3e-8 at most (relative), no verdict
 # and no model changed, and `identify` took 5–15 % less time. A fixed 0.5 s flipped a verdict in
-# the test suite; a stiff model (the paper's scale ship: 3 1/s) keeps 0.1 s (benchmarks/README.md,
-# *Start-up and end to end*).
+# the test suite, the same rule up to 1.0 s the Esso's runaway check; a stiff model (the paper's
+# scale ship: 3 1/s) keeps 0.1 s (benchmarks/README.md, *Start-up and end to end*).
 HELD_STEP, HELD_STEP_MIN, HELD_STEP_MODE = 0.2, 0.1, 0.2
 # A held turn entered drifting that ends more than this factor faster than the same turn entered
 # straight, and than the straight run, has found a second, runaway turn. (Faster than the straight
