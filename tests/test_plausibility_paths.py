@@ -252,3 +252,4 @@ def test_the_held_turns_at_their_step_are_the_turns_at_a_tenth_of_a_second():
             assert chosen[side][key] == pytest.approx(fine[side][key], rel=1e-6)
         assert {k: chosen[side][k] for k in ("diverged", "settled", "duration")} == \
             {k: fine[side][k] for k in ("diverged", "settled", "duration")}  # fmt: skip
+        assert (chosen[side]["step"], fine[side]["step"]) == (0.2, 0.1)

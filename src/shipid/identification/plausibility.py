@@ -247,7 +247,7 @@ def _runaway_from_drift(model, speed, rps, rudder_deg, side, duration, dt,
 def _held(model, speed, rps, rudder_deg, side, duration, dt) -> dict:
     res = turning_circle(model, rudder_deg, side=side, duration=duration, dt=dt, speed=speed,
                          rps=rps, indices=False)  # fmt: skip
-    entry = {"diverged": res.diverged, "reason": res.reason, "duration": duration,
+    entry = {"diverged": res.diverged, "reason": res.reason, "duration": duration, "step": dt,
              "settled": False}  # fmt: skip
     if not res.diverged:
         tail = res.log.iloc[int(0.9 * len(res.log)) :]
