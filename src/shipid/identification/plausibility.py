@@ -124,25 +124,10 @@ def _too_tight(entry: dict, curvature: float | None) -> bool:
     return ratio is not None and ratio > TIGHT_FACTOR
 
 
-def straight_line_stability(model: ManoeuvringModel, speed: float, rps: float | None = None) -> dict:
-    """Eigenvalues [1/s] of ∂(v̇, ṙ)/∂(v, r) at (u0, 0, 0, δ = 0), by central differences."""
-    if not {"v", "r"} <= set(model.structure.dofs):
-        return {}
-    h = 1e-7 * max(speed, 1.0)
-    A = np.zeros((2, 2))
-    for j, (dv, dr) in enumerate(((h, 0.0), (0.0, h))):
-        plus = still_air_accelerations(model, speed, dv, dr, 0.0, rps)[0]
-        minus = still_air_accelerations(model, speed, -dv, -dr, 0.0, rps)[0]
-        A[:, j] = (plus[1:] - minus[1:]) / (2 * h)
-    eig = np.linalg.eigvals(A)
-    return {"eigenvalues": [complex(e).real if abs(complex(e).imag) < 1e-12 else str(complex(e))
-                            for e in eig],  # fmt: skip
-            "stable": bool(np.all(eig.real < 0)), "max_real_part": float(np.max(eig.real))}
-
-
-def fastest_mode(model: ManoeuvringModel, speed: float, rps: float | None = None) -> float:
-    """The largest |λ| [1/s] of ∂(u̇, v̇, ṙ)/∂(u, v, r) at the straight approach (u0, 0, 0,
-    δ = 0), by central differences: the model's fastest mode there (inf where not finite)."""
+def approach_jacobian(model: ManoeuvringModel, speed: float, rps: float | None = None
+                      ) -> np.ndarray:  # fmt: skip
+    """∂(u̇, v̇, ṙ)/∂(u, v, r) [1/s] at the straight approach (u0, 0, 0, δ = 0), by central
+    differences."""
     h = 1e-7 * max(speed, 1.0)
     J = np.zeros((3, 3))
     for j in range(3):
@@ -150,6 +135,23 @@ def fastest_mode(model: ManoeuvringModel, speed: float, rps: float | None = None
         plus = still_air_accelerations(model, speed + d[0], d[1], d[2], 0.0, rps)[0]
         minus = still_air_accelerations(model, speed - d[0], -d[1], -d[2], 0.0, rps)[0]
         J[:, j] = (plus - minus) / (2 * h)
+    return J
+
+
+def straight_line_stability(model: ManoeuvringModel, speed: float, rps: float | None = None) -> dict:
+    """Eigenvalues [1/s] of ∂(v̇, ṙ)/∂(v, r) at (u0, 0, 0, δ = 0) (``approach_jacobian``)."""
+    if not {"v", "r"} <= set(model.structure.dofs):
+        return {}
+    eig = np.linalg.eigvals(approach_jacobian(model, speed, rps)[1:, 1:])
+    return {"eigenvalues": [complex(e).real if abs(complex(e).imag) < 1e-12 else str(complex(e))
+                            for e in eig],  # fmt: skip
+            "stable": bool(np.all(eig.real < 0)), "max_real_part": float(np.max(eig.real))}
+
+
+def fastest_mode(model: ManoeuvringModel, speed: float, rps: float | None = None) -> float:
+    """The largest |λ| [1/s] of ``approach_jacobian``: the model's fastest mode at its straight
+    approach (inf where not finite)."""
+    J = approach_jacobian(model, speed, rps)
     if not np.all(np.isfinite(J)):
         return math.inf
     return float(np.max(np.abs(np.linalg.eigvals(J))))
