@@ -81,6 +81,25 @@ def test_the_warning_names_both_paths():
                     f"({1 / curvature:.3g} m): it has all but lost the rudder")
 
 
+def test_a_model_without_a_rudder_goes_straight_not_on_a_radius():
+    """A structure without rudder terms holds its course under any rudder: its held turns' yaw
+    rate is 0, and the warning said its radius by dividing by it (an internal error)."""
+    from shipid.identification.plausibility import failed_checks
+
+    logs = [zigzag(SHIP, 20, 20, duration=60, dt=0.1, method="euler").log]
+    curvature = sharpest_curvature(logs, SHIP.approach_speed)
+    coefficients = {d: dict(c) for d, c in _with_rudder(0.0).coefficients.items()}
+    for dof in ("v", "r"):
+        coefficients[dof]["1"] = 0.0  # and no rudder offset: it goes straight
+    blind = ManoeuvringModel(SHIP.dynamics.structure, coefficients)
+    report = plausibility_at_approach(blind, SHIP.approach_speed, None, curvature=curvature)[0]
+    assert report["held_rudder"]["starboard"]["steady_yaw_rate"] == 0.0
+    (note,) = [n for k, (_, n) in failed_checks(report, blind).items() if k.endswith("starboard")]
+    assert note == ("35° rudder held to starboard: the model turns on a straight path, wider "
+                    f"than 2.5 times the tightest the training logs run ({1 / curvature:.3g} m):"
+                    " it has all but lost the rudder")
+
+
 def test_the_reference_ships_turn_far_tighter_than_the_rule():
     """The figures of ``WIDE_SHARE``'s comment and the README: the reference ships' 35° turns are
     0.62–3.2 times as curved as their own 10°/10°, 20°/20°, 30°/30° zig-zags and 20° turns, so

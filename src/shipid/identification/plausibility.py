@@ -512,11 +512,14 @@ def failed_checks(report: dict, model: ManoeuvringModel) -> dict[str, tuple[int,
         curvature = report.get("logs_curvature")
         wide, tight = _too_wide(entry, curvature), _too_tight(entry, curvature)
         if out.get(key, (0, ''))[0] < WRONG_WAY and (wide or tight):  # unsettled too
-            radius = entry["steady_speed"] / abs(entry["steady_yaw_rate"])
+            rate = abs(entry["steady_yaw_rate"])
+            # No yaw at all (a model without rudder terms): a straight path, not a radius.
+            path = (f"a path {entry['steady_speed'] / rate:.3g} m in radius" if rate > 0
+                    else "a straight path")  # fmt: skip
             how = (f"wider than {1 / WIDE_SHARE:g} times" if wide
                    else f"{TIGHT_FACTOR:g} times tighter than")  # fmt: skip
-            out[key] = (WRONG_WAY, f"{where}: the model turns on a path {radius:.3g} m in "
-                                   f"radius, {how} the tightest the training logs run "
+            out[key] = (WRONG_WAY, f"{where}: the model turns on {path}, "
+                                   f"{how} the tightest the training logs run "
                                    f"({1 / curvature:.3g} m){'' if wide else ' or more'}: "
                                    f"{'it has all but lost the rudder' if wide else 'it spins'}")
     return out
