@@ -102,6 +102,8 @@ def _factor_expr(f) -> str:
     op = OPS[f.op]
     if f.crossflow:  # the module's own copy of shipid.dynamics.terms.crossflow
         return f"crossflow(v, r, {f.k!r})[{0 if op == 'crossflow_sway' else 1}]"
+    if f.rudder:  # and of shipid.dynamics.terms.rudder_normal
+        return f"rudder_normal(u, v, r, delta, n, {', '.join(repr(p) for p in f.params)})"
     if op == "pow":
         base = x
     elif op == "abs":
@@ -115,15 +117,20 @@ def _factor_expr(f) -> str:
     return base if f.power == 1 else f"{base} ** {f.power}"
 
 
-def _crossflow_source(model: ManoeuvringModel) -> list[str]:
-    """The cross-flow factors' function, where the model has them (its source, as shipid runs it)."""
-    if not any(parse_term(t).crossflow for terms in model.coefficients.values() for t in terms):
-        return []
+def _factor_sources(model: ManoeuvringModel) -> list[str]:
+    """The cross-flow factors' and the rudder's normal force's functions, where the model has
+    them (their source, as shipid runs it)."""
     import inspect
 
-    from shipid.dynamics.terms import TINY, crossflow
+    from shipid.dynamics.terms import TINY, crossflow, rudder_normal
 
-    return [f"TINY = {TINY!r}", "", "", *inspect.getsource(crossflow).splitlines(), "", ""]
+    terms = [parse_term(t) for coefs in model.coefficients.values() for t in coefs]
+    out = []
+    if any(t.crossflow for t in terms):
+        out += [f"TINY = {TINY!r}", "", "", *inspect.getsource(crossflow).splitlines(), "", ""]
+    if any(t.rudder for t in terms):
+        out += [*inspect.getsource(rudder_normal).splitlines(), "", ""]
+    return out
 
 
 def _array_literal(a: np.ndarray) -> str:
@@ -209,7 +216,7 @@ def numpy_source(model: ManoeuvringModel | HybridModel, rudder_positive: str | N
         f"RUDDER_POSITIVE = {rudder_positive!r}  # which way positive delta turns the ship",
         "",
         "",
-        *_crossflow_source(model),
+        *_factor_sources(model),
         f"def accelerations(u, v, r, delta{''.join(f', {s}=0.0' for s in inputs)}):",
         '    """(u̇, v̇, ṙ) at arrays of states and inputs."""',
         "    u, v, r, delta = (np.asarray(a, dtype=float) for a in (u, v, r, delta))",

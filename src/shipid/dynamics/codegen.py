@@ -35,7 +35,7 @@ from types import ModuleType
 import numpy as np
 
 from shipid import __version__
-from shipid.dynamics.terms import CROSSFLOW, CROSSFLOW_SLOTS, SIGNALS, TermCode
+from shipid.dynamics.terms import CROSSFLOW, CROSSFLOW_SLOTS, RUDDER, RUDDER_SLOT, SIGNALS, TermCode
 
 ENGINES = ("auto", "generated", "interpreted")
 # Below this many state-steps a run takes well under a second on the interpreter: not worth
@@ -70,7 +70,7 @@ def _factor_expr(signal: int, op: int, k: float, power: int, name: str) -> list[
 
 
 def _signal_name(index: int) -> str:
-    return SIGNALS[index] if index < len(SIGNALS) else CROSSFLOW[index - len(SIGNALS)]
+    return SIGNALS[index] if index < len(SIGNALS) else (*CROSSFLOW, RUDDER)[index - len(SIGNALS)]
 
 
 def source(code: TermCode, pairs: np.ndarray | None = None) -> str:
@@ -90,6 +90,10 @@ def source(code: TermCode, pairs: np.ndarray | None = None) -> str:
                       if code.signal[f] in CROSSFLOW_SLOTS)  # fmt: skip
         sway, yaw = CROSSFLOW_SLOTS
         body.append(f"s{sway}, s{yaw} = _kernel.crossflow(v, r, {length!r})")
+    if RUDDER_SLOT in used:  # the rudder's normal force, its inflow's parameters the table's
+        a, c, g, x = (float(p) for p in code.rudder)
+        body.append(f"s{RUDDER_SLOT} = _kernel.rudder_normal(u, v, r, inp[0], inp[1], {a!r}, "
+                    f"{c!r}, {g!r}, {x!r})")
     for i in (5, 6, 7):
         if i in used:
             body.append(f"s{i} = inp[{i - 5}]")

@@ -31,16 +31,17 @@ import numpy as np
 # numba caches a function that hands ``terms_rhs`` on only when it reaches it as a module
 # attribute, not as a bare global.
 import shipid.dynamics.kernel as _kernel  # noqa: E402  (this module)
-from shipid.dynamics.terms import CROSSFLOW_SLOTS, TINY
+from shipid.dynamics.terms import CROSSFLOW_SLOTS, RUDDER_SLOT, TINY
 
 SWAY_SLOT, YAW_SLOT = CROSSFLOW_SLOTS
 
 N_INPUTS = 5
-# The signal buffer: ``SIGNALS``, then the cross-flow factors' values (``terms.CROSSFLOW_SLOTS``),
-# filled once per evaluation by ``terms_rhs_crossflow`` for a term set that has them; the factor
-# loop itself keeps the six operations (a branch for the drag in it, or in ``terms_rhs``, made
-# every model's interpreted runs 1.15–1.6 times slower, taken or not).
-N_SIGNALS = YAW_SLOT + 1
+# The signal buffer: ``SIGNALS``, then the cross-flow factors' values (``terms.CROSSFLOW_SLOTS``)
+# and the rudder's normal force (``terms.RUDDER_SLOT``), filled once per evaluation by
+# ``terms_rhs_slots`` for a term set that has them; the factor loop itself keeps the six
+# operations (a branch for the drag in it, or in ``terms_rhs``, made every model's interpreted
+# runs 1.15–1.6 times slower, taken or not).
+N_SIGNALS = RUDDER_SLOT + 1
 # Closed-loop parameters, one row per trajectory.
 P_MODE, P_VALUE, P_SWITCH, P_SIDE, P_STBD, P_APPROACH, P_RELEASE, P_HELD, P_PSI_REF = range(9)
 P_MAX_ANGLE, P_MAX_RATE, P_TIME_CONST, P_RPS, P_THRUST, P_WIND_SPEED, P_WIND_DIR = range(9, 16)
@@ -115,6 +116,16 @@ def crossflow(v, r, length):
             ((s2 * c2 - s1 * c1) / 4.0 - v * (c2 - c1) / 3.0) / (r * r) / (length * length))
 
 
+@numba.njit(cache=True, error_model="numpy")
+def rudder_normal(u, v, r, delta, n, a, c, g, x):
+    """U_R² sin α_R of the rudder's inflow (a, c, g, x): the closed form of
+    ``shipid.dynamics.terms.rudder_normal`` for one state."""
+    ahead = n if n > 0.0 else 0.0
+    u_r = math.sqrt(a * u * u + c * ahead * ahead)
+    v_r = -g * (v + x * r)
+    return (u_r * u_r + v_r * v_r) * math.sin(delta - math.atan2(v_r, u_r))
+
+
 @numba.njit(cache=True, inline="always")
 def _factor(x, op, k, p):
     if op == 0:
@@ -164,8 +175,9 @@ def kinematics(u, v, r, psi):
 @numba.njit(cache=True, inline="always")
 def terms_rhs(ctx, u, v, r, psi):
     """State derivative of a term-set model; ctx = (θ, factor table (5 arrays), derived, signal
-    buffer, inputs, true wind?, wind speed, wind direction)."""
-    th, start, sig, op, kk, pw, derived, s, inp, wind_true, vw, dw, _ = ctx
+    buffer, inputs, true wind?, wind speed, wind direction, hull length, rudder inflow, whether
+    the buffer has slots to fill)."""
+    th, start, sig, op, kk, pw, derived, s, inp, wind_true, vw, dw, _, _, _ = ctx
     _, xd, yd = kinematics(u, v, r, psi)
     s[0], s[1], s[2] = u, v, r
     if derived:
@@ -188,12 +200,19 @@ def terms_rhs(ctx, u, v, r, psi):
 
 
 @numba.njit(cache=True, inline="always")
-def terms_rhs_crossflow(ctx, u, v, r, psi):
-    """``terms_rhs`` of a term set with the hull's cross-flow drag: its factors' values into the
-    signal buffer's slots first (ctx's last item the hull's length). A run picks it before its
-    loop: computed in ``terms_rhs`` behind a flag, even never taken, the drag made every model's
-    interpreted runs 1.15–1.6 times slower."""
-    ctx[7][SWAY_SLOT], ctx[7][YAW_SLOT] = crossflow(v, r, ctx[12])
+def terms_rhs_slots(ctx, u, v, r, psi):
+    """``terms_rhs`` of a term set with the hull's cross-flow drag or the rudder's normal force:
+    their values into the signal buffer's slots first (ctx[12] the hull's length, ctx[13] the
+    rudder's inflow, each 0 where the term set has none). A run picks it before its loop
+    (ctx[14]): computed in ``terms_rhs`` behind a flag, even never taken, the drag made every
+    model's interpreted runs 1.15–1.6 times slower."""
+    if ctx[12] > 0.0:
+        ctx[7][SWAY_SLOT], ctx[7][YAW_SLOT] = crossflow(v, r, ctx[12])
+    rud = ctx[13]
+    if rud[0] > 0.0:
+        inp = ctx[8]
+        ctx[7][RUDDER_SLOT] = rudder_normal(u, v, r, inp[0], inp[1], rud[0], rud[1], rud[2],
+                                            rud[3])  # fmt: skip
     return terms_rhs(ctx, u, v, r, psi)
 
 
@@ -248,24 +267,25 @@ def open_run(rhs, ctx, inp, t, inputs, n_steps, s0, rk4, speed_lim, yaw_lim, out
 
 
 @numba.njit(cache=True)
-def _terms_ctx(th, start, sig, op, kk, pw, derived, wind_true, vw, dw):
+def _terms_ctx(th, start, sig, op, kk, pw, rud, derived, wind_true, vw, dw):
     hull = 0.0
     for f in range(sig.size):  # a cross-flow factor's k is the hull's length
         if sig[f] == SWAY_SLOT or sig[f] == YAW_SLOT:
             hull = kk[f]
     return (th, start, sig, op, kk, pw, derived, np.zeros(N_SIGNALS), np.zeros(N_INPUTS),
-            wind_true, vw, dw, hull)  # hull > 0: the runs take ``terms_rhs_crossflow``
+            wind_true, vw, dw, hull, rud, hull > 0.0 or rud[0] > 0.0)  # the runs then take
+    # ``terms_rhs_slots``
 
 
 @numba.njit(cache=True, parallel=True)
-def integrate_open(theta, start, sig, op, kk, pw, derived, t, inputs, n_steps, s0, rk4,
+def integrate_open(theta, start, sig, op, kk, pw, rud, derived, t, inputs, n_steps, s0, rk4,
                    speed_lim, yaw_lim, out, n_valid):  # fmt: skip
     """Free runs driven by input series: out (B, N, 6), n_valid (B,) valid samples per run
     (a run stops at ``n_steps[b]`` samples or where it diverges)."""
     for b in numba.prange(theta.shape[0]):
-        ctx = _terms_ctx(theta[b], start, sig, op, kk, pw, derived, False, 0.0, 0.0)
-        if ctx[12] > 0.0:
-            n_valid[b] = open_run(_kernel.terms_rhs_crossflow, ctx, ctx[8], t, inputs[b],
+        ctx = _terms_ctx(theta[b], start, sig, op, kk, pw, rud, derived, False, 0.0, 0.0)
+        if ctx[14]:
+            n_valid[b] = open_run(_kernel.terms_rhs_slots, ctx, ctx[8], t, inputs[b],
                                   n_steps[b], s0[b], rk4, speed_lim[b], yaw_lim[b], out[b])
         else:
             n_valid[b] = open_run(_kernel.terms_rhs, ctx, ctx[8], t, inputs[b], n_steps[b],
@@ -399,16 +419,16 @@ def closed_run(rhs, ctx, inp, p, dt, n_steps, s0, rk4, speed_lim, yaw_lim, state
 
 
 @numba.njit(cache=True, parallel=True)
-def integrate_closed(theta, start, sig, op, kk, pw, derived, dt, n_steps, s0, params, rk4,
+def integrate_closed(theta, start, sig, op, kk, pw, rud, derived, dt, n_steps, s0, params, rk4,
                      speed_lim, yaw_lim, states, rudder, n_valid):  # fmt: skip
     """Closed-loop manoeuvres: states (B, N, 6), rudder (B, N), n_valid (B,)."""
     for b in numba.prange(theta.shape[0]):
         p = params[b]
         # Still air is wind too: the apparent wind of the ship's own motion.
-        ctx = _terms_ctx(theta[b], start, sig, op, kk, pw, derived, True, p[P_WIND_SPEED],
+        ctx = _terms_ctx(theta[b], start, sig, op, kk, pw, rud, derived, True, p[P_WIND_SPEED],
                          p[P_WIND_DIR])  # fmt: skip
-        if ctx[12] > 0.0:
-            n_valid[b] = closed_run(_kernel.terms_rhs_crossflow, ctx, ctx[8], p, dt, n_steps,
+        if ctx[14]:
+            n_valid[b] = closed_run(_kernel.terms_rhs_slots, ctx, ctx[8], p, dt, n_steps,
                                     s0[b], rk4, speed_lim[b], yaw_lim[b], states[b], rudder[b])
         else:
             n_valid[b] = closed_run(_kernel.terms_rhs, ctx, ctx[8], p, dt, n_steps, s0[b], rk4,
@@ -416,14 +436,14 @@ def integrate_closed(theta, start, sig, op, kk, pw, derived, dt, n_steps, s0, pa
 
 
 @numba.njit(cache=True)
-def accelerations(theta, start, sig, op, kk, pw, derived, states, inputs, out):
+def accelerations(theta, start, sig, op, kk, pw, rud, derived, states, inputs, out):
     """(M, 3) accelerations of one coefficient set θ (3, T) at states (M, 3) and inputs (M, 5):
     the compiled evaluation, checked against ``term_matrix`` by the tests."""
-    ctx = _terms_ctx(theta, start, sig, op, kk, pw, derived, False, 0.0, 0.0)
+    ctx = _terms_ctx(theta, start, sig, op, kk, pw, rud, derived, False, 0.0, 0.0)
     inp = ctx[8]
     for i in range(states.shape[0]):
         for j in range(N_INPUTS):
             inp[j] = inputs[i, j]
-        a = terms_rhs_crossflow(ctx, states[i, 0], states[i, 1], states[i, 2], 0.0) \
-            if ctx[12] > 0.0 else terms_rhs(ctx, states[i, 0], states[i, 1], states[i, 2], 0.0)
+        a = terms_rhs_slots(ctx, states[i, 0], states[i, 1], states[i, 2], 0.0) \
+            if ctx[14] else terms_rhs(ctx, states[i, 0], states[i, 1], states[i, 2], 0.0)
         out[i, 0], out[i, 1], out[i, 2] = a[0], a[1], a[2]

@@ -22,7 +22,7 @@ import math
 from collections.abc import Mapping
 
 from shipid.dynamics.model import ManoeuvringModel, ModelStructure
-from shipid.dynamics.terms import CROSSFLOW, OPS, Factor, Term, parse_term
+from shipid.dynamics.terms import CROSSFLOW, OPS, RUDDER, Factor, Term, parse_term
 from shipid.errors import ShipidError
 
 SPEEDS = ("u", "v", "U", "wind_speed")
@@ -34,10 +34,10 @@ MIN_FACTOR = 1e-4  # a 4 cm model of a 400 m ship, and back
 
 def _factor_scale(name: str, op: str, power: int, length: float, speed: float,
                   rho: float) -> float:  # fmt: skip
+    if op in (*CROSSFLOW, RUDDER):  # |w|w, w = v + x r, and U_R² sin α_R: a speed squared
+        return speed ** (2 * power)
     if op in ("sin", "cos") or name in ANGLES:
         return 1.0
-    if op in CROSSFLOW:  # |w|w, w = v + x r: a speed squared
-        return speed ** (2 * power)
     if name in SPEEDS:
         base = speed
     elif name in RATES:
@@ -120,14 +120,23 @@ def froude_scaled(model: ManoeuvringModel, factor: float, rho: float = RHO,
 
 def lengthened_terms(terms, factor: float) -> dict[str, str]:
     """{term: the same term on a hull ``factor`` times as long} for the cross-flow terms among
-    ``terms`` (their argument is the hull's length); the others keep their text."""
+    ``terms`` (their argument is the hull's length) and the rudder's normal force (its race's
+    share c goes as the propeller's diameter squared, its position x as the length); the others
+    keep their text."""
+
+    def longer(f: Factor) -> Factor:
+        if f.crossflow:
+            return Factor(f.signal, f.op, f.k * factor, f.power)
+        if f.rudder:
+            a, c, g, x = f.params
+            return Factor(f.signal, f.op, f.k, f.power, (a, c * factor**2, g, x * factor))
+        return f
+
     out = {}
     for text in terms:
         term = parse_term(text)
-        if term.crossflow:
-            factors = [Factor(f.signal, f.op, f.k * factor, f.power) if f.crossflow else f
-                       for f in term.factors]  # fmt: skip
-            out[term.text] = Term(tuple(factors)).text
+        if term.crossflow or term.rudder:
+            out[term.text] = Term(tuple(longer(f) for f in term.factors)).text
     return out
 
 

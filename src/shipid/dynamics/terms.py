@@ -21,6 +21,18 @@ sec. 6.7), one coefficient for what ``|v|v``, ``|v|r`` and ``|r|r`` split among 
 
 in closed form (``crossflow``). Where a zig-zag's small drift leaves the split of |v|v and |v|r
 free, the integral carries the drag to a turn's drift and yaw rate by the hull's geometry.
+The rudder's normal force (``rudder_normal(a c g x)``, four numbers) is a factor of u, v, r, n and δ
+together: one inflow to the rudder, shared by the three equations (the MMG standard method's,
+Yasukawa & Yoshimura 2015, with a quadratic race), whose coefficients the fit leaves free::
+
+    rudder_normal = U_R² sin α_R,   U_R² = u_R² + v_R²,   α_R = δ − atan2(v_R, u_R),
+    u_R² = a u² + c n⁺²,   v_R = −g (v + x r)
+
+a = (1 − w_R)² the wake's, c [m²] the propeller race's share (n⁺ = max(n, 0): an ahead
+propeller's), g the hull's flow straightening γ_R, signed as positive rudder turns (+ to
+starboard, − to port), x [m] the rudder's effective position (aft: < 0). The terms
+``rudder_normal(...)*sin(delta)`` (surge: its drag) and ``rudder_normal(...)*cos(delta)`` (sway,
+yaw) are the MMG rudder forces (``rudder_normal``).
 Factors are joined by ``*`` or written side by side (``vr``, ``|u|u``: the names of the original
 Blanke terms parse unchanged). Like factors merge (``u*u`` is ``u^2``), factors are put in one
 order, so each term has one canonical text (``Term.text``), which model files store.
@@ -34,7 +46,7 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cached_property, lru_cache
 
 import numpy as np
@@ -52,7 +64,8 @@ INPUT_SIGNALS = ("delta", "n", "thrust", "wind_speed", "wind_angle")
 ANGLE_SIGNALS = ("beta", "delta", "wind_angle")
 ALIASES = {"T": "thrust", "U_A": "wind_speed", "gamma_A": "wind_angle"}
 DISPLAY = {"delta": "δ", "beta": "β", "thrust": "T", "wind_speed": "U_A", "wind_angle": "γ_A"}
-OPS = ("pow", "abs", "pos", "neg", "sin", "cos", "crossflow_sway", "crossflow_yaw")
+OPS = ("pow", "abs", "pos", "neg", "sin", "cos", "crossflow_sway", "crossflow_yaw",
+       "rudder_normal")  # fmt: skip
 OP_CODE = {op: i for i, op in enumerate(OPS)}
 FUNCTIONS = ("abs", "pos", "neg", "sin", "cos")
 # Factors of v and r together, with the hull's length [m] as their argument. The compiled kernel
@@ -60,6 +73,12 @@ FUNCTIONS = ("abs", "pos", "neg", "sin", "cos")
 # its factor table they are plain signals there, k the length.
 CROSSFLOW = ("crossflow_sway", "crossflow_yaw")
 CROSSFLOW_SLOTS = (len(SIGNALS), len(SIGNALS) + 1)
+# The rudder's normal force, a factor of u, v, r, n and δ with its inflow's four parameters
+# (``Factor.params``); the kernel evaluates it once per state into the slot after the cross-flow's.
+RUDDER = "rudder_normal"
+RUDDER_SLOT = len(SIGNALS) + 2
+RUDDER_SIGNALS = ("u", "v", "r", "delta", "n")
+RUDDER_PARAMS = ("a", "c", "g", "x")
 # Order of factors in a term's text: states, derived, propulsion, wind, the rudder last (u² δ).
 FACTOR_ORDER = {s: i for i, s in enumerate(("u", "v", "r", "U", "beta", "n", "thrust",
                                             "wind_speed", "wind_angle", "delta"))}  # fmt: skip
@@ -75,12 +94,19 @@ _NAMES = sorted([*SIGNALS, *ALIASES], key=len, reverse=True)
 @dataclass(frozen=True, order=True)
 class Factor:
     """op(k·signal)^power, op one of ``OPS`` (k only for sin/cos); for a cross-flow factor
-    (signal v, r read beside it) k is the hull's length [m]."""
+    (signal v, r read beside it) k is the hull's length [m]; the rudder's normal force (signal
+    δ, u, v, r, n read beside it) has its inflow's parameters (a, c, g, x) in ``params``."""
 
     signal: int  # index into SIGNALS
     op: int  # index into OPS
     k: float = 1
     power: int = 1
+    params: tuple[float, ...] = ()
+
+    @cached_property
+    def rudder(self) -> bool:
+        """Whether this is the rudder's normal force (of u, v, r, n and δ, with ``params``)."""
+        return OPS[self.op] == RUDDER
 
     @cached_property
     def crossflow(self) -> bool:
@@ -98,6 +124,8 @@ class Factor:
         op, name = OPS[self.op], self.name
         if op in CROSSFLOW:
             return f"{op}({self.k:.12g})"
+        if op == RUDDER:
+            return f"{op}({' '.join(f'{p:.12g}' for p in self.params)})"
         if op == "pow":
             base = name
         elif op == "abs":
@@ -113,6 +141,9 @@ class Factor:
         op, name = OPS[self.op], DISPLAY.get(self.name, self.name)
         if op in CROSSFLOW:
             return f"{'Y' if op == 'crossflow_sway' else 'N'}_cf(v, r; {self.k:.12g} m)"
+        if op == RUDDER:
+            a, c, g, x = self.params
+            return f"F_R(a {a:.4g}, c {c:.4g} m², γ {g:.4g}, x {x:.4g} m)"
         sup = str(self.power).translate(SUPERSCRIPT) if self.power != 1 else ""
         if op == "pow":
             return f"{name}{sup}"
@@ -123,13 +154,17 @@ class Factor:
         arg = f"{self.k}{name}" if self.k != 1 else name
         return f"{op}{sup}({arg})" if sup else f"{op}({arg})"
 
-    def values(self, x: np.ndarray, r: np.ndarray | None = None) -> np.ndarray:
+    def values(self, x: np.ndarray, r: np.ndarray | None = None,
+               signals: Mapping[str, np.ndarray] | None = None) -> np.ndarray:  # fmt: skip
         """The factor's values for the signal's values ``x`` (and the yaw rate ``r``, which a
-        cross-flow factor reads beside v)."""
+        cross-flow factor reads beside v; the rudder's normal force reads u, v, r, δ and n
+        from ``signals``)."""
         op = OPS[self.op]
         if op in CROSSFLOW:
             sway, yaw = crossflow(x, r, self.k)
             return sway if op == "crossflow_sway" else yaw
+        if op == RUDDER:
+            return rudder_normal(*(signals[s] for s in RUDDER_SIGNALS), *self.params)
         if op == "pow":
             base = x
         elif op == "abs":
@@ -160,12 +195,19 @@ class Term:
     def signals(self) -> tuple[str, ...]:
         """The signals the term uses, in signal order."""
         names = {f.name for f in self.factors} | ({"v", "r"} if self.crossflow else set())
+        if self.rudder:
+            names |= set(RUDDER_SIGNALS)
         return tuple(sorted(names, key=SIGNAL_INDEX.get))
 
     @cached_property
     def crossflow(self) -> bool:
         """Whether the term has a cross-flow factor (of v and r, with the hull's length)."""
         return any(f.crossflow for f in self.factors)
+
+    @cached_property
+    def rudder(self) -> bool:
+        """Whether the term has the rudder's normal force (``rudder_normal``)."""
+        return any(f.rudder for f in self.factors)
 
     @cached_property
     def inputs(self) -> tuple[str, ...]:
@@ -188,10 +230,12 @@ class Term:
     def degree_in(self, signal: str) -> int:
         """Total power of ``signal`` in the term (abs/pos/neg count; sin/cos do not). A
         cross-flow factor counts 2 in v: |w|w, w = v + x r, is a speed squared (its r comes with
-        a length), which is how it scales (prime form, Froude, advance-ratio similarity)."""
+        a length), which is how it scales (prime form, Froude, advance-ratio similarity). The
+        rudder's normal force, the square of its inflow speed, counts 2 in u."""
         i = SIGNAL_INDEX[signal]
-        return sum(2 * f.power if f.crossflow else f.power for f in self.factors
-                   if f.signal == i and OPS[f.op] not in ("sin", "cos"))
+        rudder = 2 * sum(f.power for f in self.factors if f.rudder) if signal == "u" else 0
+        return rudder + sum(2 * f.power if f.crossflow else f.power for f in self.factors
+                            if f.signal == i and OPS[f.op] not in ("sin", "cos", RUDDER))
 
     def __str__(self) -> str:
         return self.text
@@ -199,7 +243,7 @@ class Term:
 
 # ---------------------------------------------------------------------------- parsing
 _TOKEN = re.compile(r"\s*(?:(?P<num>\d+(?:\.\d+)?(?:[eE][-+]?\d+)?)|(?P<name>[A-Za-z_][A-Za-z_0-9]*)"
-                    r"|(?P<sym>[|*^()]))")
+                    r"|(?P<sym>[|*^()-]))")
 
 
 def _tokens(text: str) -> list[tuple[str, str]]:
@@ -208,11 +252,14 @@ def _tokens(text: str) -> list[tuple[str, str]]:
     while pos < len(text):
         m = _TOKEN.match(text, pos)
         if not m or m.end() == pos:
-            raise ShipidError(f"term {text!r}: unexpected {text[pos:pos + 1]!r} at position {pos + 1}")
+            hint = (f" ({RUDDER}(a c g x) takes its numbers apart by spaces: a structure's text "
+                    "lists terms apart by commas)" if text[pos] == "," and RUDDER in text else "")
+            raise ShipidError(f"term {text!r}: unexpected {text[pos:pos + 1]!r} at position "
+                              f"{pos + 1}{hint}")  # fmt: skip
         pos = m.end()
         kind = m.lastgroup
         value = m.group(kind)
-        if kind == "name" and value not in FUNCTIONS + CROSSFLOW:
+        if kind == "name" and value not in (*FUNCTIONS, *CROSSFLOW, RUDDER):
             out.extend(("name", n) for n in _split_names(value, text))
         else:
             out.append((kind, value))
@@ -274,8 +321,48 @@ class _Parser:
             return p
         return 1
 
+    def number(self) -> float:
+        """A real number, signed."""
+        sign = 1.0
+        if self.peek() == ("sym", "-"):
+            self.i += 1
+            sign = -1.0
+        tok = self.peek()
+        if tok is None or tok[0] != "num":
+            raise self.error(f"expected a number, got {'the end' if tok is None else repr(tok[1])}")
+        self.i += 1
+        return sign * float(tok[1])
+
+    def rudder(self) -> Factor:
+        usage = (f"{RUDDER}(a c g x) takes the inflow's four numbers apart by spaces: a = "
+                 f"(1 − w_R)², c [m²] the race's share, g the flow straightening γ_R, x [m] the "
+                 f"rudder's position")  # fmt: skip
+        self.take("name", RUDDER)
+        self.take("sym", "(")
+        params = []
+        for _ in RUDDER_PARAMS:  # apart by spaces: structures' texts list terms apart by commas
+            try:
+                params.append(self.number())
+            except ShipidError:
+                raise self.error(usage) from None
+        if self.peek() != ("sym", ")"):
+            raise self.error(usage)
+        self.i += 1
+        a, c, g, x = params
+        if not all(math.isfinite(p) for p in params):
+            raise self.error(f"{RUDDER}'s parameters must be finite numbers")
+        if not a > 0:
+            raise self.error(f"{RUDDER}'s a = (1 − w_R)² must be > 0, got {a:g}")
+        if not c >= 0:
+            raise self.error(f"{RUDDER}'s race share c must be ≥ 0 m², got {c:g}")
+        if self.peek() == ("sym", "^"):
+            raise self.error(f"{RUDDER}(a c g x) takes no power")
+        return Factor(SIGNAL_INDEX["delta"], OP_CODE[RUDDER], 1, 1, (a, c, g, x))
+
     def factor(self) -> Factor:
         tok = self.peek()
+        if tok is not None and tok == ("name", RUDDER):
+            return self.rudder()
         if tok is not None and tok[0] == "name" and tok[1] in CROSSFLOW:
             fn = self.take("name")
             self.take("sym", "(")
@@ -328,17 +415,19 @@ class _Parser:
 
 
 def _canonical(factors: list[Factor], parser: _Parser) -> Term:
-    merged: dict[tuple[int, int, int], int] = {}
+    merged: dict[tuple[int, int, float, tuple[float, ...]], int] = {}
     for f in factors:
-        key = (f.signal, f.op, f.k)
+        key = (f.signal, f.op, f.k, f.params)
         merged[key] = merged.get(key, 0) + f.power
+    if sum(1 for key in merged if OPS[key[1]] == RUDDER) > 1:
+        raise parser.error(f"{RUDDER} appears twice: a term has it once")
     out = []
-    for (sig, op, k), p in sorted(merged.items()):
-        if OPS[op] in CROSSFLOW and p > 1:
+    for (sig, op, k, params), p in sorted(merged.items()):
+        if OPS[op] in (*CROSSFLOW, RUDDER) and p > 1:
             raise parser.error(f"{OPS[op]} appears twice: a term has it once")
         if p > MAX_POWER:
             raise parser.error(f"power {p} of {SIGNALS[sig]} out of range 1–{MAX_POWER}")
-        out.append(Factor(sig, op, k, p))
+        out.append(Factor(sig, op, k, p, params))
     # |x| before x: reads as |u|u; otherwise signal order.
     out.sort(key=lambda f: (FACTOR_ORDER[f.name],
                             0 if OPS[f.op] == "abs" else 1 if OPS[f.op] == "pow" else 2, f.op, f.k))
@@ -412,7 +501,8 @@ def term_matrix(terms: Sequence[str | Term], u, v, r, inputs: Mapping[str, np.nd
     for j, term in enumerate(parsed):
         col = np.ones(n)
         for f in term.factors:
-            col = col * f.values(np.atleast_1d(sig[f.name]), np.atleast_1d(sig["r"]))
+            col = col * f.values(np.atleast_1d(sig[f.name]), np.atleast_1d(sig["r"]),
+                                 {k: np.atleast_1d(x) for k, x in sig.items()})
         out[:, j] = col
     return out
 
@@ -443,6 +533,19 @@ def crossflow(v, r, length: float) -> tuple[np.ndarray, np.ndarray]:
     return sway, yaw
 
 
+def rudder_normal(u, v, r, delta, n, a: float, c: float, g: float, x: float) -> np.ndarray:
+    """The rudder's normal force factor U_R² sin α_R (see the module docstring) at arrays of u,
+    v [m/s], r [rad/s], δ [rad], n [rps]: u_R = √(a u² + c n⁺²), v_R = −g (v + x r),
+    α_R = δ − atan2(v_R, u_R). The compiled kernel's ``shipid.dynamics.kernel.rudder_normal`` is
+    the same."""
+    u, v, r, delta, n = np.broadcast_arrays(*(np.asarray(s, dtype=float)
+                                              for s in (u, v, r, delta, n)))  # fmt: skip
+    ahead = np.maximum(n, 0.0)
+    u_r = np.sqrt(a * u * u + c * ahead * ahead)
+    v_r = -g * (v + x * r)
+    return (u_r * u_r + v_r * v_r) * np.sin(delta - np.arctan2(v_r, u_r))
+
+
 @dataclass(frozen=True)
 class TermCode:
     """A term set as the factor table the compiled kernel interprets.
@@ -458,6 +561,8 @@ class TermCode:
     k: np.ndarray  # (n_factors,) float64
     power: np.ndarray  # (n_factors,) int64
     uses_derived: bool  # U or beta appear (computed only when needed)
+    # The rudder's normal force's inflow (a, c, g, x); a = 0: the term set has none.
+    rudder: np.ndarray = field(default_factory=lambda: np.zeros(len(RUDDER_PARAMS)))
 
     @property
     def n_terms(self) -> int:
@@ -465,21 +570,25 @@ class TermCode:
         return len(self.texts)
 
     def arrays(self) -> tuple:
-        """(start, signal, op, k, power): the arrays the compiled kernel takes."""
-        return self.start, self.signal, self.op, self.k, self.power
+        """(start, signal, op, k, power, rudder): the arrays the compiled kernel takes."""
+        return self.start, self.signal, self.op, self.k, self.power, self.rudder
 
 
 def term_code(terms: Sequence[str | Term]) -> TermCode:
     """The factor table (``TermCode``) of a term set, for the compiled kernel."""
     parsed = [parse_term(t) if isinstance(t, str) else t for t in terms]
     start, sig, op, k, power = [0], [], [], [], []
-    lengths = set()
+    lengths, inflows = set(), set()
     for t in parsed:
         for f in t.factors:
             if f.crossflow:  # its value's slot, read as it is (the kernel fills it per state)
                 sig.append(CROSSFLOW_SLOTS[CROSSFLOW.index(OPS[f.op])])
                 op.append(OP_CODE["pow"])
                 lengths.add(f.k)
+            elif f.rudder:  # likewise
+                sig.append(RUDDER_SLOT)
+                op.append(OP_CODE["pow"])
+                inflows.add(f.params)
             else:
                 sig.append(f.signal)
                 op.append(f.op)
@@ -489,7 +598,12 @@ def term_code(terms: Sequence[str | Term]) -> TermCode:
     if len(lengths) > 1:
         raise ShipidError(f"the cross-flow terms of one model take one hull length, got "
                           f"{', '.join(f'{x:g}' for x in sorted(lengths))} m")  # fmt: skip
+    if len(inflows) > 1:
+        raise ShipidError(f"the rudder terms of one model take one inflow, got "
+                          f"{', '.join(RUDDER + str(p) for p in sorted(inflows))}")  # fmt: skip
     derived = any(s < len(SIGNALS) and SIGNALS[s] in DERIVED_SIGNALS for s in sig)
+    rudder = np.array(next(iter(inflows)) if inflows else [0.0] * len(RUDDER_PARAMS))
     return TermCode(tuple(t.text for t in parsed), np.array(start, dtype=np.int64),
                     np.array(sig, dtype=np.int64), np.array(op, dtype=np.int64),
-                    np.array(k, dtype=np.float64), np.array(power, dtype=np.int64), derived)
+                    np.array(k, dtype=np.float64), np.array(power, dtype=np.int64), derived,
+                    rudder)

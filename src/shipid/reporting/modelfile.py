@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING
 from shipid import __version__
 from shipid.dynamics.hybrid import HybridModel, KernelResidual
 from shipid.dynamics.model import ManoeuvringModel, ModelStructure
-from shipid.dynamics.terms import CROSSFLOW, parse_term
+from shipid.dynamics.terms import CROSSFLOW, RUDDER, parse_term
 from shipid.errors import ShipidError
 from shipid.outputs import atomic_write_text
 
@@ -436,18 +436,20 @@ def error_band_from_document(doc: Mapping, path: str | Path):
     return ErrorBand.from_dict(data, f"{path}: {where}")
 
 
-def _crossflow_texts(obj) -> set[str]:
-    """The keys and strings of a model file's data that name a cross-flow term."""
+def _lengthened_texts(obj) -> set[str]:
+    """The keys and strings of a model file's data that name a term with a length in it (the
+    cross-flow drag's, the rudder's normal force's)."""
     if isinstance(obj, Mapping):
-        return set().union(*(_crossflow_texts(k) | _crossflow_texts(v) for k, v in obj.items()))
+        return set().union(*(_lengthened_texts(k) | _lengthened_texts(v) for k, v in obj.items()))
     if isinstance(obj, list):
-        return set().union(*(_crossflow_texts(v) for v in obj))
-    if not (isinstance(obj, str) and any(name in obj for name in CROSSFLOW)):
+        return set().union(*(_lengthened_texts(v) for v in obj))
+    if not (isinstance(obj, str) and any(name in obj for name in (*CROSSFLOW, RUDDER))):
         return set()
     try:
-        return {obj} if parse_term(obj).crossflow else set()
+        term = parse_term(obj)
     except ShipidError:  # a note that names one
         return set()
+    return {obj} if term.crossflow or term.rudder else set()
 
 
 def rescaled_document(doc: Mapping, factor: float, to_rho: float | None = None,
@@ -518,7 +520,8 @@ def rescaled_document(doc: Mapping, factor: float, to_rho: float | None = None,
     if particulars is not None:
         p = dict(out["particulars"])
         for key, power in (("length", 1), ("beam", 1), ("draught", 1), ("propeller_diameter", 1),
-                           ("xg", 1), ("rudder_area", 2), ("design_speed", 0.5)):  # fmt: skip
+                           ("xg", 1), ("rudder_area", 2), ("rudder_height", 1),
+                           ("design_speed", 0.5)):  # fmt: skip
             if p.get(key) is not None:
                 p[key] = p[key] * factor**power
         if p.get("mass") is not None:
@@ -550,8 +553,9 @@ def rescaled_document(doc: Mapping, factor: float, to_rho: float | None = None,
     for signal, bounds in envelope.items():
         scale = signal_scale(signal, factor, rho, to_rho)
         envelope[signal] = [b * scale for b in bounds]
-    # The cross-flow terms' argument is the hull's length: every record of them takes the new.
-    renamed = lengthened_terms(_crossflow_texts(out), factor)
+    # The cross-flow terms' argument is the hull's length, the rudder's normal force's inflow has
+    # the propeller's and the rudder's: every record of them takes the new.
+    renamed = lengthened_terms(_lengthened_texts(out), factor)
     if renamed:
         out = renamed_terms(out, renamed)
     model_out = model_from_document(out, path)
