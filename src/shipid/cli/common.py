@@ -130,19 +130,37 @@ def _particulars(args):
 
 
 def _structure_edit(args, logs):
-    """--drop and --crossflow as one ``StructureEdit`` (the length from the particulars)."""
+    """--drop, --crossflow and --rudder-normal as one ``StructureEdit`` (the length and the
+    rudder's inflow from the particulars)."""
     from shipid.data.particulars import logs_particulars
     from shipid.dynamics.model import StructureEdit
 
-    length = None
+    length = rudder = None
+    wanted = getattr(args, "crossflow", False) or getattr(args, "rudder_normal", False)
+    found = logs_particulars(logs) if wanted else None  # --particulars among them
     if getattr(args, "crossflow", False):
-        found = logs_particulars(logs)  # --particulars among them (``_training_logs``)
         if found is None:
             raise ShipidError("--crossflow needs the hull's length: give --particulars FILE "
                               "(length, or Lpp)")  # fmt: skip
         length = found.length
+    if getattr(args, "rudder_normal", False):
+        from shipid.dynamics.rudder import RudderInflow
+
+        if found is None:
+            raise ShipidError("--rudder-normal needs the ship's particulars: give --particulars "
+                              "FILE (length, propeller_diameter, block_coefficient; "
+                              "rudder_height where known)")  # fmt: skip
+        side = _logs_side(logs)
+        if side is None:
+            raise ShipidError("--rudder-normal needs the logs' rudder convention: give "
+                              "--rudder-positive port|starboard")  # fmt: skip
+        if not any("n" in log.columns for log in logs):
+            raise ShipidError("--rudder-normal needs the propeller speed: the logs have no "
+                              "column n [rps]")  # fmt: skip
+        rudder = RudderInflow.from_particulars(found, side)
     return StructureEdit(_parse_drop(getattr(args, "drop", None)) or None, length,
-                         compare_crossflow=getattr(args, "crossflow", None) is not False)
+                         compare_crossflow=getattr(args, "crossflow", None) is not False,
+                         rudder=rudder)  # fmt: skip
 
 
 def _log_particulars(logs) -> dict | None:

@@ -118,7 +118,7 @@ def cmd_identify(args) -> int:
     one_rps = _one_rps(logs, args)
     names = [str(p) for p in args.logs]
     _refuse_no_headway(logs[0], names[0])  # before the fit: the checks start from it
-    _crossflow_into_model(args, logs)
+    _edit_into_model(args, logs)
     gamma_given = args.gamma is not None
     choice = _choose_structure(args, logs, names)
     physics = _physics(args, logs, _structure(args))
@@ -506,19 +506,23 @@ def _choose_structure(args, logs, names):
     return choice
 
 
-def _crossflow_into_model(args, logs) -> None:
-    """--crossflow with a given structure: the structure (less --drop) with the hull's
-    cross-flow drag, put into ``args.model`` (``auto`` takes it into every candidate)."""
+def _edit_into_model(args, logs) -> None:
+    """--crossflow or --rudder-normal with a given structure: the structure (less --drop) with
+    the hull's cross-flow drag or the rudder's normal force, put into ``args.model`` (``auto``
+    takes them into every candidate)."""
     from shipid.identification.auto_structure import AUTO
 
-    if not args.crossflow or args.model == AUTO:
+    if not (args.crossflow or args.rudder_normal) or args.model == AUTO:
         return
     edit = _structure_edit(args, logs)
     given = _structure(args)
     args.model, args.drop = edit.apply(given), None
-    if args.model is given or args.model == given:
+    if args.crossflow and given.with_crossflow_hull(edit.crossflow_length) == given:
         _warn(f"--crossflow: {given.name} has none of the hull's nonlinear damping terms "
               "(|v|v, |v|r, |r|r, v|r|) in sway or yaw; fitted as it is")  # fmt: skip
+    if args.rudder_normal and given.with_rudder_normal(edit.rudder) == given:
+        _warn(f"--rudder-normal: {given.name} has none of the rudder's force terms (δ, u²δ, "
+              "δ², ...); fitted as it is")  # fmt: skip
 
 
 def _refit_alternatives(choice, args, logs, names, gamma) -> tuple[dict, bool]:

@@ -91,6 +91,16 @@ def _add_crossflow_option(p) -> None:
                    "logs its select searches with it too; --no-crossflow never")
 
 
+def _add_rudder_normal_option(p) -> None:
+    p.add_argument("--rudder-normal", action="store_true",
+                   help="the rudder's force terms (δ, u²δ, uδ, δ², ...) as the normal force of one "
+                   "inflow in the propeller's race and the hull's straightened flow (MMG), one "
+                   "term per equation: F_N sin δ in surge, F_N cos δ in sway and yaw; its inflow "
+                   "from the particulars (--particulars: length, propeller_diameter, "
+                   "block_coefficient, rudder_height) and needs the logs' n [rps]. What a "
+                   "zig-zag's race terms cannot say: the rudder's force in a tight turn")
+
+
 def _number_or_auto(text: str) -> float | str:
     return _time_or_auto(text)
 
@@ -239,6 +249,7 @@ def build_parser() -> argparse.ArgumentParser:
                    "logo from three logs, blocks:4 of one or two; --residual: logo from two)")
     p.add_argument("--drop", help="terms to drop, e.g. u:r^2 (the paper drops r²)")
     _add_crossflow_option(p)
+    _add_rudder_normal_option(p)
     p.add_argument("--filter", type=_number_or_auto_or_none, default="auto", metavar="HZ|auto|none",
                    help="zero-phase low-pass of u, v, r against the errors-in-variables bias: a "
                    "cut-off, 'none', or 'auto' (default): the cut-off whose model has the "
@@ -339,6 +350,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--table", metavar="OUT.csv", help="write every candidate with its scores")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     _add_crossflow_option(p)
+    _add_rudder_normal_option(p)
     _add_written_forms_options(p)
     p.add_argument("-o", "--output", required=True, metavar="MODEL.json")
     _add_physics_options(p)

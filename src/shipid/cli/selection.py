@@ -72,8 +72,9 @@ def cmd_select(args) -> int:
     names = [str(p) for p in args.logs]
     library = given if given is not None else default_library(logs)[0]
     edit = _structure_edit(args, logs)
-    if edit.crossflow_length is not None:
-        # The default library passed as given: the trimmed one, with the hull's cross-flow drag.
+    if edit.crossflow_length is not None or edit.rudder is not None:
+        # The default library passed as given: the trimmed one, with the hull's cross-flow drag
+        # or the rudder's normal force.
         given = library = edit.apply(library)
     # The default library is passed as None: select trims it to the logs and says so.
     physics = _physics(args, logs, library, searched=True)

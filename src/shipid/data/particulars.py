@@ -8,6 +8,7 @@ A small file (YAML or JSON) or options. Keys (SI units; aliases of common files 
     block_coefficient  Cb [-]                     (CB, Cb)
     mass          m [kg]                          (m, displacement_mass)
     rudder_area   A_R [m²]                        (A_R, AR)
+    rudder_height  H_R, the rudder's span [m]     (H_R, HR)
     propeller_diameter  D [m]                     (D, Dp)
     scale         λ = ship length / model length (scale_factor; none: not known, where the
                   criteria read the model's training logs' scale, else full scale)
@@ -38,6 +39,7 @@ ALIASES = {
     "block_coefficient": ("block_coefficient", "CB", "Cb", "cb"),
     "mass": ("mass", "m", "displacement_mass"),
     "rudder_area": ("rudder_area", "A_R", "AR"),
+    "rudder_height": ("rudder_height", "H_R", "HR"),
     "propeller_diameter": ("propeller_diameter", "D", "Dp"),
     "scale": ("scale", "scale_factor"),
     "design_speed": ("design_speed", "U0", "speed"),
@@ -45,7 +47,7 @@ ALIASES = {
     "xg": ("xg", "x_G"),
 }
 POSITIVE = ("length", "beam", "draught", "block_coefficient", "mass", "rudder_area",
-            "propeller_diameter", "scale", "design_speed", "rho")  # fmt: skip
+            "rudder_height", "propeller_diameter", "scale", "design_speed", "rho")  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -58,6 +60,7 @@ class Particulars:
     block_coefficient: float | None = None
     mass: float | None = None
     rudder_area: float | None = None
+    rudder_height: float | None = None
     propeller_diameter: float | None = None
     scale: float | None = None  # unknown: not full scale (λ = 1), which it would claim
     design_speed: float | None = None

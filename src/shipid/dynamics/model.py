@@ -24,6 +24,7 @@ import numpy as np
 from shipid.dynamics import kernel
 from shipid.dynamics.terms import (
     INPUT_SIGNALS,
+    OPS,
     TermCode,
     parse_term,
     parse_terms,
@@ -249,6 +250,26 @@ class ModelStructure:
             return self
         return ModelStructure(f"{self.name}+crossflow({length:.4g} m)", terms)
 
+    def with_rudder_normal(self, inflow) -> ModelStructure:
+        """The structure with its rudder force terms (``rudder_terms``: δ, u²δ, |u|uδ, n⁺²δ,
+        δ², ...) as the rudder's normal force of one inflow (a ``shipid.dynamics.rudder.
+        RudderInflow``), one term per equation, in the first replaced term's place: F_N sin δ
+        in surge, F_N cos δ in sway and yaw. An equation without them is left as it is."""
+        terms = dict(self.terms)
+        for dof, new in (("u", inflow.surge), ("v", inflow.lateral), ("r", inflow.lateral)):
+            have = terms.get(dof)
+            if not have:
+                continue
+            gone = set(rudder_terms(have, odd=dof != "u"))
+            if not gone:
+                continue
+            at = next(i for i, t in enumerate(have) if t in gone)
+            kept = [t for t in have if t not in gone]
+            terms[dof] = tuple(kept[:at] + [parse_term(new).text] + kept[at:])
+        if terms == dict(self.terms):
+            return self
+        return ModelStructure(f"{self.name}+rudder-normal", terms)
+
     def __add__(self, other: ModelStructure) -> ModelStructure:
         terms = {d: tuple(dict.fromkeys(self.terms.get(d, ()) + other.terms.get(d, ())))
                  for d in DOFS if d in self.terms or d in other.terms}  # fmt: skip
@@ -263,20 +284,40 @@ class ModelStructure:
         return cls(str(data["name"]), {d: tuple(t) for d, t in data["terms"].items()})
 
 
+def rudder_terms(terms: Sequence[str], odd: bool) -> list[str]:
+    """The terms among ``terms`` that the rudder's normal force stands for: δ^p (p odd for sway
+    and yaw, ``odd``; even for surge's drag) times the ahead flow's speed (u, |u|, U, n, |n|,
+    n⁺, in any power). Terms of the hull's motion (v, r, β), the astern propeller's race (n⁻)
+    and the rudder's asymmetry (|δ|, δ⁺) are not the normal force's and stay."""
+    ahead = {("u", "pow"), ("u", "abs"), ("U", "pow"), ("n", "pow"), ("n", "abs"), ("n", "pos")}
+    out = []
+    for text in terms:
+        factors = parse_term(text).factors
+        rudder = [f for f in factors if f.name == "delta"]
+        if (len(rudder) == 1 and OPS[rudder[0].op] == "pow" and rudder[0].power % 2 == odd
+                and all((f.name, OPS[f.op]) in ahead for f in factors if f.name != "delta")):
+            out.append(text)
+    return out
+
+
 @dataclass(frozen=True)
 class StructureEdit:
     """What a user changes in whichever structure is fitted or chosen: terms dropped (``drop``,
     {dof: [term]}, passed over where a structure lacks them) and the hull's nonlinear damping as
     the cross-flow drag of a hull ``crossflow_length`` m long (``with_crossflow_hull``);
     ``compare_crossflow`` False keeps the drag out of the default's comparison, which otherwise
-    offers it beside the terms where the logs' particulars give the length."""
+    offers it beside the terms where the logs' particulars give the length; the rudder's force
+    terms as its normal force of one inflow, ``rudder`` (a ``shipid.dynamics.rudder.
+    RudderInflow``, ``with_rudder_normal``)."""
 
     drop: Mapping[str, Sequence[str]] | None = None
     crossflow_length: float | None = None
     compare_crossflow: bool = True
+    rudder: object | None = None
 
     def __bool__(self) -> bool:
-        return bool(self.drop) or self.crossflow_length is not None or not self.compare_crossflow
+        return (bool(self.drop) or self.crossflow_length is not None or not self.compare_crossflow
+                or self.rudder is not None)  # fmt: skip
 
     def apply(self, structure: ModelStructure) -> ModelStructure:
         """``structure`` so edited."""
@@ -284,6 +325,8 @@ class StructureEdit:
             structure = structure.without(self.drop, missing_ok=True)
         if self.crossflow_length is not None:
             structure = structure.with_crossflow_hull(self.crossflow_length)
+        if self.rudder is not None:
+            structure = structure.with_rudder_normal(self.rudder)
         return structure
 
 

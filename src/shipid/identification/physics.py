@@ -33,6 +33,8 @@ s = +1 when a positive rudder angle turns the ship to starboard, −1 when to po
   motion), whatever the length L.
 * ṙ: δ, uδ, |u|δ, Uδ, u²δ, |u|uδ, U²δ, pos(n)²δ have the sign s (the rudder turns the ship its
   way); in v̇ the same terms have the sign −s (the rudder pushes the stern the other way).
+* The rudder's normal force (``rudder_normal``, whatever its inflow): its drag F_N sin δ ≤ 0 in
+  u̇; its side force F_N cos δ, of δ's sign, as δ in ṙ (s) and v̇ (−s).
 
 The rudder rows need the logs' rudder sign convention (metadata ``rudder_positive``); without it
 they are left out, with a note. Terms not in the table are free.
@@ -246,19 +248,37 @@ def rudder_sign(logs: Sequence[pd.DataFrame], given: str | None = None) -> float
 CROSSFLOW_SIGNS = {"v": "crossflow_sway", "r": "crossflow_yaw"}
 
 
+def _rudder_normal_sign(dof: str, factors) -> tuple[str, object] | None:
+    """The sign rule of the rudder's normal force terms (their inflow's parameters vary): its
+    drag F_N sin δ ≤ 0 in u̇; its side force F_N cos δ, which has δ's sign (the factor's γ_R is
+    signed by the convention), as δ's rudder terms in v̇ and ṙ."""
+    if len(factors) != 2 or not any(f.rudder for f in factors):
+        return None
+    angle = next(f for f in factors if not f.rudder)
+    if angle.name != "delta" or angle.k != 1 or angle.power != 1:
+        return None
+    if dof == "u" and OPS[angle.op] == "sin":
+        return "rudder drag", -1
+    if dof in ("v", "r") and OPS[angle.op] == "cos":
+        return next((why, sign) for eq, terms, sign, why in SIGN_RULES
+                    if eq == dof and terms is _RUDDER_TERMS)  # fmt: skip
+    return None
+
+
 def _sign_bounds(dof: str, term: str, s: float | None) -> tuple[float, float, str] | None:
     factors = parse_term(term).factors
     if len(factors) == 1 and OPS[factors[0].op] == CROSSFLOW_SIGNS.get(dof):
         return (-math.inf, 0.0, "cross-flow drag opposes the hull's lateral motion")
-    for eq, terms, sign, why in SIGN_RULES:
-        if eq != dof or term not in terms:
-            continue
-        if sign in (RUDDER, "-" + RUDDER):
-            if s is None:
-                return None
-            sign = s if sign == RUDDER else -s
-        return (0.0, math.inf, why) if sign > 0 else (-math.inf, 0.0, why)
-    return None
+    rule = _rudder_normal_sign(dof, factors) or next(
+        ((why, sign) for eq, terms, sign, why in SIGN_RULES if eq == dof and term in terms), None)
+    if rule is None:
+        return None
+    why, sign = rule
+    if sign in (RUDDER, "-" + RUDDER):
+        if s is None:
+            return None
+        sign = s if sign == RUDDER else -s
+    return (0.0, math.inf, why) if sign > 0 else (-math.inf, 0.0, why)
 
 
 def approach_states(options: PhysicsOptions, logs: Sequence[pd.DataFrame], what: str
