@@ -47,6 +47,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/study_kvlcc2_average.py
 	$(BIN)/python benchmarks/study_kvlcc2_sampling.py
 	$(BIN)/python benchmarks/study_kvlcc2_turn.py
+	$(BIN)/python benchmarks/study_esso_rudder_normal.py
 	$(BIN)/python benchmarks/study_auto_structure.py
 	$(BIN)/python benchmarks/study_sampling.py
 	$(BIN)/python benchmarks/study_auto_inflow.py

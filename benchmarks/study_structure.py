@@ -58,10 +58,12 @@ def fit_as_identify(logs, structure):
     return fit(logs if cutoff is None else [lowpass(log, cutoff) for log in logs]), cutoff
 
 
-def held_out_errors(model, ship, truth_zz, truth_tc) -> list[float]:
-    """Overshoot errors [deg] of the held-out zig-zags, then tactical diameter and steady yaw rate
-    errors [%] of the 35° turns (nan where the model diverges)."""
-    kw = {"speed": ship.approach_speed, "steering": ship.steering}
+def held_out_errors(model, ship, truth_zz, truth_tc, rps: float | None = None,
+                    turn_keys=("tactical_diameter", "steady_yaw_rate")) -> list[float]:  # fmt: skip
+    """Overshoot errors [deg] of the held-out zig-zags, then the ``turn_keys`` errors [%] of the
+    35° turns (nan where the model diverges); ``rps``: the propeller speed a model with terms
+    in n runs at."""
+    kw = {"speed": ship.approach_speed, "steering": ship.steering, "rps": rps}
     out = []
     for case in HELD_ZIGZAGS:
         ind = _zigzag(model, *case, **kw).indices
@@ -69,7 +71,7 @@ def held_out_errors(model, ship, truth_zz, truth_tc) -> list[float]:
     for side in ("starboard", "port"):
         res = _turn(model, side, **kw)
         ind = {} if res.diverged or not res.indices else res.indices
-        for k in ("tactical_diameter", "steady_yaw_rate"):
+        for k in turn_keys:
             value = ind.get(k)
             out.append(math.nan if value is None else 100 * (value / truth_tc[side][k] - 1))
     return out

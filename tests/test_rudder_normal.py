@@ -254,7 +254,7 @@ def test_cli_rudder_normal_needs_particulars_and_fits_it(tmp_path, capsys):
     bare = write_log(log.drop(columns=["x", "y", "n"]), tmp_path / "bare.csv")
     code, _, err = run(["identify", bare, *flags, "--rudder-normal", "--particulars",
                         particulars, "-o", tmp_path / "b.json"], capsys)  # fmt: skip
-    assert code == 1 and "the logs have no column n [rps]" in err
+    assert code == 1 and "--rudder-normal needs the propeller speed: bare.csv has no column n" in err
     # A structure without rudder force terms is fitted as it is, and said so.
     code, _, err = run(["identify", path, "--filter", "none", "--no-output-error", "--model",
                         "u: |u|u, 1; v: u*v, u*r; r: u*v, u*r", "--rudder-normal",

@@ -154,9 +154,12 @@ def _structure_edit(args, logs):
         if side is None:
             raise ShipidError("--rudder-normal needs the logs' rudder convention: give "
                               "--rudder-positive port|starboard")  # fmt: skip
-        if not any("n" in log.columns for log in logs):
-            raise ShipidError("--rudder-normal needs the propeller speed: the logs have no "
-                              "column n [rps]")  # fmt: skip
+        from shipid.data.log import log_name
+
+        bare = [log_name(log) for log in logs if "n" not in log.columns]
+        if bare:
+            raise ShipidError(f"--rudder-normal needs the propeller speed: {', '.join(bare)} "
+                              "has no column n [rps]")  # fmt: skip
         rudder = RudderInflow.from_particulars(found, side)
     return StructureEdit(_parse_drop(getattr(args, "drop", None)) or None, length,
                          compare_crossflow=getattr(args, "crossflow", None) is not False,

@@ -18,6 +18,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -33,6 +34,9 @@ from shipid.dynamics.terms import (
     term_matrix,
 )
 from shipid.errors import ShipidError
+
+if TYPE_CHECKING:
+    from shipid.dynamics.rudder import RudderInflow
 
 DOFS = ("u", "v", "r")
 DOF_DISPLAY = {"u": "u̇", "v": "v̇", "r": "ṙ"}
@@ -250,7 +254,7 @@ class ModelStructure:
             return self
         return ModelStructure(f"{self.name}+crossflow({length:.4g} m)", terms)
 
-    def with_rudder_normal(self, inflow) -> ModelStructure:
+    def with_rudder_normal(self, inflow: RudderInflow) -> ModelStructure:
         """The structure with its rudder force terms (``rudder_terms``: δ, u²δ, |u|uδ, n⁺²δ,
         δ², ...) as the rudder's normal force of one inflow (a ``shipid.dynamics.rudder.
         RudderInflow``), one term per equation, in the first replaced term's place: F_N sin δ
@@ -313,7 +317,7 @@ class StructureEdit:
     drop: Mapping[str, Sequence[str]] | None = None
     crossflow_length: float | None = None
     compare_crossflow: bool = True
-    rudder: object | None = None
+    rudder: RudderInflow | None = None
 
     def __bool__(self) -> bool:
         return (bool(self.drop) or self.crossflow_length is not None or not self.compare_crossflow
