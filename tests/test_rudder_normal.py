@@ -260,3 +260,35 @@ def test_cli_rudder_normal_needs_particulars_and_fits_it(tmp_path, capsys):
                         "u: |u|u, 1; v: u*v, u*r; r: u*v, u*r", "--rudder-normal",
                         "--particulars", particulars, "-o", tmp_path / "x.json"], capsys)
     assert code == 0 and "--rudder-normal: custom has none of the rudder's force terms" in err
+
+
+def test_a_hybrid_of_it_runs_compiled_as_its_numpy_derivatives():
+    """The hybrid kernel (``hybrid_kernel``) takes the rudder's slot too: a kernel residual on a
+    rudder-normal model, its compiled zig-zag against its NumPy derivatives integrated."""
+    from shipid.dynamics import kernel
+    from shipid.dynamics.hybrid import HybridModel
+    from shipid.dynamics.simulate import initial_states
+    from shipid.identification.residual import fit_residual
+    from shipid.trials.manoeuvres import _generic_closed_loop, as_vessel, manoeuvre_params
+
+    truth = _truth()
+    log = zigzag(truth, 20, 20, duration=60, dt=0.2, speed=1.5, rps=RPS).log
+    physical = ManoeuvringModel(truth.structure, {d: {t: 0.9 * c for t, c in cs.items()}
+                                                  for d, cs in truth.coefficients.items()})
+    model = HybridModel(physical, fit_residual(physical, [log], 10.0, 1.0))
+
+    class NumPyPath:  # the derivatives alone, so the simulator takes its generic path
+        uses_thrust, uses_rps, inputs = False, True, ("delta", "n")
+
+        def derivatives(self, nu, delta, thrust=None, rps=None):
+            return model.derivatives(nu, delta, rps=rps)
+
+    result = zigzag(model, 20, 20, duration=40, dt=0.2, method="rk4", speed=1.5, rps=RPS)
+    params = manoeuvre_params(as_vessel(model, speed=1.5, rps=RPS), kernel.MODE_ZIGZAG,
+                              np.radians(20), 0.0, 0.0, switch=np.radians(20), side=1.0,
+                              rps=RPS)  # fmt: skip
+    states, _, m = _generic_closed_loop(NumPyPath(), params, len(result.log), 0.2,
+                                        initial_states({"u": 1.5}, 1), "rk4", 1e3, 5.0, RPS)
+    assert m == len(result.log)
+    np.testing.assert_allclose(result.log[["u", "v", "r", "psi"]].to_numpy(), states[:, :4],
+                               rtol=1e-9, atol=1e-11)  # fmt: skip

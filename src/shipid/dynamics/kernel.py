@@ -38,10 +38,16 @@ SWAY_SLOT, YAW_SLOT = CROSSFLOW_SLOTS
 N_INPUTS = 5
 # The signal buffer: ``SIGNALS``, then the cross-flow factors' values (``terms.CROSSFLOW_SLOTS``)
 # and the rudder's normal force (``terms.RUDDER_SLOT``), filled once per evaluation by
-# ``terms_rhs_slots`` for a term set that has them; the factor loop itself keeps the six
-# operations (a branch for the drag in it, or in ``terms_rhs``, made every model's interpreted
-# runs 1.15–1.6 times slower, taken or not).
-N_SIGNALS = RUDDER_SLOT + 1
+# ``terms_rhs_crossflow`` or ``terms_rhs_rudder`` for a term set that has them; the factor loop
+# itself keeps the six operations (a branch for the drag in it, or in ``terms_rhs``, made every
+# model's interpreted runs 1.15–1.6 times slower, taken or not).
+# The rudder's inflow (a, c, g, x) rides in the buffer after its slot, set once per run: as a
+# fifth array in the run's context it made the drag's interpreted runs 10 % slower.
+INFLOW_SLOT = RUDDER_SLOT + 1
+N_SIGNALS = INFLOW_SLOT + 4
+# Which state derivative a run takes (ctx[13]): ``terms_rhs``, ``terms_rhs_crossflow`` or
+# ``terms_rhs_rudder`` (the rudder's normal force, and the drag where the hull's length is set).
+SLOTS_NONE, SLOTS_CROSSFLOW, SLOTS_RUDDER = 0, 1, 2
 # Closed-loop parameters, one row per trajectory.
 P_MODE, P_VALUE, P_SWITCH, P_SIDE, P_STBD, P_APPROACH, P_RELEASE, P_HELD, P_PSI_REF = range(9)
 P_MAX_ANGLE, P_MAX_RATE, P_TIME_CONST, P_RPS, P_THRUST, P_WIND_SPEED, P_WIND_DIR = range(9, 16)
@@ -175,9 +181,9 @@ def kinematics(u, v, r, psi):
 @numba.njit(cache=True, inline="always")
 def terms_rhs(ctx, u, v, r, psi):
     """State derivative of a term-set model; ctx = (θ, factor table (5 arrays), derived, signal
-    buffer, inputs, true wind?, wind speed, wind direction, hull length, rudder inflow, whether
-    the buffer has slots to fill)."""
-    th, start, sig, op, kk, pw, derived, s, inp, wind_true, vw, dw, _, _, _ = ctx
+    buffer, inputs, true wind?, wind speed, wind direction, hull length, which slots the buffer
+    has to fill)."""
+    th, start, sig, op, kk, pw, derived, s, inp, wind_true, vw, dw, _, _ = ctx
     _, xd, yd = kinematics(u, v, r, psi)
     s[0], s[1], s[2] = u, v, r
     if derived:
@@ -200,19 +206,26 @@ def terms_rhs(ctx, u, v, r, psi):
 
 
 @numba.njit(cache=True, inline="always")
-def terms_rhs_slots(ctx, u, v, r, psi):
-    """``terms_rhs`` of a term set with the hull's cross-flow drag or the rudder's normal force:
-    their values into the signal buffer's slots first (ctx[12] the hull's length, ctx[13] the
-    rudder's inflow, each 0 where the term set has none). A run picks it before its loop
-    (ctx[14]): computed in ``terms_rhs`` behind a flag, even never taken, the drag made every
+def terms_rhs_crossflow(ctx, u, v, r, psi):
+    """``terms_rhs`` of a term set with the hull's cross-flow drag: its factors' values into the
+    signal buffer's slots first (ctx[12] the hull's length). A run picks it before its loop
+    (ctx[13]): computed in ``terms_rhs`` behind a flag, even never taken, the drag made every
     model's interpreted runs 1.15–1.6 times slower."""
+    ctx[7][SWAY_SLOT], ctx[7][YAW_SLOT] = crossflow(v, r, ctx[12])
+    return terms_rhs(ctx, u, v, r, psi)
+
+
+@numba.njit(cache=True, inline="always")
+def terms_rhs_rudder(ctx, u, v, r, psi):
+    """``terms_rhs`` of a term set with the rudder's normal force (its inflow in the buffer from
+    ``INFLOW_SLOT``), and the cross-flow drag where ctx[12], the hull's length, is set: their
+    values into the signal buffer's slots first. Apart from ``terms_rhs_crossflow``: its branch
+    made the drag's runs 10 % slower."""
+    s, inp = ctx[7], ctx[8]
     if ctx[12] > 0.0:
-        ctx[7][SWAY_SLOT], ctx[7][YAW_SLOT] = crossflow(v, r, ctx[12])
-    rud = ctx[13]
-    if rud[0] > 0.0:
-        inp = ctx[8]
-        ctx[7][RUDDER_SLOT] = rudder_normal(u, v, r, inp[0], inp[1], rud[0], rud[1], rud[2],
-                                            rud[3])  # fmt: skip
+        s[SWAY_SLOT], s[YAW_SLOT] = crossflow(v, r, ctx[12])
+    i = INFLOW_SLOT
+    s[RUDDER_SLOT] = rudder_normal(u, v, r, inp[0], inp[1], s[i], s[i + 1], s[i + 2], s[i + 3])
     return terms_rhs(ctx, u, v, r, psi)
 
 
@@ -272,9 +285,11 @@ def _terms_ctx(th, start, sig, op, kk, pw, rud, derived, wind_true, vw, dw):
     for f in range(sig.size):  # a cross-flow factor's k is the hull's length
         if sig[f] == SWAY_SLOT or sig[f] == YAW_SLOT:
             hull = kk[f]
-    return (th, start, sig, op, kk, pw, derived, np.zeros(N_SIGNALS), np.zeros(N_INPUTS),
-            wind_true, vw, dw, hull, rud, hull > 0.0 or rud[0] > 0.0)  # the runs then take
-    # ``terms_rhs_slots``
+    slots = SLOTS_RUDDER if rud[0] > 0.0 else (SLOTS_CROSSFLOW if hull > 0.0 else SLOTS_NONE)
+    buffer = np.zeros(N_SIGNALS)
+    buffer[INFLOW_SLOT:] = rud
+    return (th, start, sig, op, kk, pw, derived, buffer, np.zeros(N_INPUTS), wind_true, vw, dw,
+            hull, slots)
 
 
 @numba.njit(cache=True, parallel=True)
@@ -284,8 +299,11 @@ def integrate_open(theta, start, sig, op, kk, pw, rud, derived, t, inputs, n_ste
     (a run stops at ``n_steps[b]`` samples or where it diverges)."""
     for b in numba.prange(theta.shape[0]):
         ctx = _terms_ctx(theta[b], start, sig, op, kk, pw, rud, derived, False, 0.0, 0.0)
-        if ctx[14]:
-            n_valid[b] = open_run(_kernel.terms_rhs_slots, ctx, ctx[8], t, inputs[b],
+        if ctx[13] == SLOTS_CROSSFLOW:
+            n_valid[b] = open_run(_kernel.terms_rhs_crossflow, ctx, ctx[8], t, inputs[b],
+                                  n_steps[b], s0[b], rk4, speed_lim[b], yaw_lim[b], out[b])
+        elif ctx[13] == SLOTS_RUDDER:
+            n_valid[b] = open_run(_kernel.terms_rhs_rudder, ctx, ctx[8], t, inputs[b],
                                   n_steps[b], s0[b], rk4, speed_lim[b], yaw_lim[b], out[b])
         else:
             n_valid[b] = open_run(_kernel.terms_rhs, ctx, ctx[8], t, inputs[b], n_steps[b],
@@ -427,8 +445,11 @@ def integrate_closed(theta, start, sig, op, kk, pw, rud, derived, dt, n_steps, s
         # Still air is wind too: the apparent wind of the ship's own motion.
         ctx = _terms_ctx(theta[b], start, sig, op, kk, pw, rud, derived, True, p[P_WIND_SPEED],
                          p[P_WIND_DIR])  # fmt: skip
-        if ctx[14]:
-            n_valid[b] = closed_run(_kernel.terms_rhs_slots, ctx, ctx[8], p, dt, n_steps,
+        if ctx[13] == SLOTS_CROSSFLOW:
+            n_valid[b] = closed_run(_kernel.terms_rhs_crossflow, ctx, ctx[8], p, dt, n_steps,
+                                    s0[b], rk4, speed_lim[b], yaw_lim[b], states[b], rudder[b])
+        elif ctx[13] == SLOTS_RUDDER:
+            n_valid[b] = closed_run(_kernel.terms_rhs_rudder, ctx, ctx[8], p, dt, n_steps,
                                     s0[b], rk4, speed_lim[b], yaw_lim[b], states[b], rudder[b])
         else:
             n_valid[b] = closed_run(_kernel.terms_rhs, ctx, ctx[8], p, dt, n_steps, s0[b], rk4,
@@ -444,6 +465,11 @@ def accelerations(theta, start, sig, op, kk, pw, rud, derived, states, inputs, o
     for i in range(states.shape[0]):
         for j in range(N_INPUTS):
             inp[j] = inputs[i, j]
-        a = terms_rhs_slots(ctx, states[i, 0], states[i, 1], states[i, 2], 0.0) \
-            if ctx[14] else terms_rhs(ctx, states[i, 0], states[i, 1], states[i, 2], 0.0)
+        u, v, r = states[i, 0], states[i, 1], states[i, 2]
+        if ctx[13] == SLOTS_CROSSFLOW:
+            a = terms_rhs_crossflow(ctx, u, v, r, 0.0)
+        elif ctx[13] == SLOTS_RUDDER:
+            a = terms_rhs_rudder(ctx, u, v, r, 0.0)
+        else:
+            a = terms_rhs(ctx, u, v, r, 0.0)
         out[i, 0], out[i, 1], out[i, 2] = a[0], a[1], a[2]
