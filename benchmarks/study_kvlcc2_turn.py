@@ -54,6 +54,9 @@ VARIANTS = {
                                                  PARTICULARS],
     "… --rudder-normal --crossflow": [*RACE, "--rudder-normal", "--crossflow", "--particulars",
                                       PARTICULARS],
+    "… --rudder-normal --prior clarke --gamma auto": [*RACE, "--rudder-normal", "--particulars",
+                                                      PARTICULARS, "--prior", "clarke",
+                                                      "--gamma", "auto"],
 }  # fmt: skip
 # The inflow's parameters halved and doubled one at a time (the race c, the flow straightening
 # g, the rudder's position x), in blanke-race+race-damping --rudder-normal: how much of the turn
@@ -130,7 +133,8 @@ def study(folder: Path) -> None:
 
 # The MMG model's own particulars (reference-ships.md §2), as a user of its basin would give them.
 MMG_PARTICULARS = {"length": 7.0, "beam": 1.27, "draught": 0.46, "block_coefficient": 0.81,
-                   "propeller_diameter": 0.216, "rudder_height": 0.345}  # fmt: skip
+                   "propeller_diameter": 0.216, "rudder_height": 0.345, "rudder_area": 0.0539,
+                   "mass": 3351.75, "xg": 0.25}  # fmt: skip
 
 
 TRUTH_STRUCTURES = ("blanke-speed", "blanke-race+race-damping")
@@ -189,6 +193,8 @@ def mmg_truth(seeds: int = 6, noise: float = 0.25) -> None:
             variants[name] = ["identify", "--model", name]
             variants[f"{name} --rudder-normal"] = ["identify", "--model", name, "--rudder-normal",
                                                    "--particulars", particulars]
+            variants[f"{name} --rudder-normal --prior clarke --gamma auto"] = [
+                *variants[f"{name} --rudder-normal"], "--prior", "clarke", "--gamma", "auto"]
         for n_logs, label in ((1, "20/20 to starboard"), (3, "20/20 both sides, 20/10")):
             files = [[str(write_log(sensor.apply(_zigzag(ship, *case).log, seed=100 * seed + i)
                                     .assign(n=rps), f"{folder}/zz{seed}_{i}.csv"))

@@ -292,3 +292,24 @@ def test_a_hybrid_of_it_runs_compiled_as_its_numpy_derivatives():
     assert m == len(result.log)
     np.testing.assert_allclose(result.log[["u", "v", "r", "psi"]].to_numpy(), states[:, :4],
                                rtol=1e-9, atol=1e-11)  # fmt: skip
+
+
+@pytest.mark.parametrize("side", ["starboard", "port"])
+def test_the_clarke_prior_gives_the_rudders_normal_force(side):
+    """Its side force takes the u²δ coefficients of the Clarke prior (F ≈ U_R² δ per ½ρA_R f_α),
+    its drag −(1 − t_R) ½ρ A_R f_α / m, whichever the rudder convention."""
+    from shipid.identification.priors import T_R, clarke_linear, clarke_prior
+
+    p = Particulars(length=7.0, beam=1.27, draught=0.46, block_coefficient=0.81,
+                    rudder_area=0.0539, propeller_diameter=0.204, mass=3300.0)  # fmt: skip
+    inflow = RudderInflow.from_particulars(p, side)
+    structure = get_structure("blanke-race").with_rudder_normal(inflow)
+    prior = clarke_prior(p, structure, 1.2, side)
+    linear = clarke_linear(p, side)
+    lateral, surge = parse_term(inflow.lateral).text, parse_term(inflow.surge).text
+    assert prior["v"][lateral] == linear["v"]["delta"] and prior["r"][lateral] == linear["r"]["delta"]
+    f_alpha = 6.13 * 1.5 / (1.5 + 2.25)
+    assert prior["u"][surge] == pytest.approx(-(1 - T_R) * 0.5 * 1025 * 0.0539 * f_alpha / 3300)
+    # The side force turns the ship its convention's way; the drag brakes either way.
+    assert np.sign(prior["r"][lateral]) == (1 if side == "starboard" else -1)
+    assert prior["u"][surge] < 0

@@ -533,6 +533,18 @@ def crossflow(v, r, length: float) -> tuple[np.ndarray, np.ndarray]:
     return sway, yaw
 
 
+def rudder_normal_angle(term: str | Term) -> str | None:
+    """'sin' for the rudder's drag F_N sin δ, 'cos' for its side force F_N cos δ (the terms
+    ``--rudder-normal`` writes, of any inflow), None for any other term."""
+    factors = (parse_term(term) if isinstance(term, str) else term).factors
+    if len(factors) != 2 or not any(f.rudder for f in factors):
+        return None
+    angle = next(f for f in factors if not f.rudder)
+    if angle.name != "delta" or angle.k != 1 or angle.power != 1:
+        return None
+    return OPS[angle.op] if OPS[angle.op] in ("sin", "cos") else None
+
+
 def rudder_normal(u, v, r, delta, n, a: float, c: float, g: float, x: float) -> np.ndarray:
     """The rudder's normal force factor U_R² sin α_R (see the module docstring) at arrays of u,
     v [m/s], r [rad/s], δ [rad], n [rps]: u_R = √(a u² + c n⁺²), v_R = −g (v + x r),

@@ -51,7 +51,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from shipid.dynamics.terms import OPS, parse_term, term_matrix
+from shipid.dynamics.terms import OPS, parse_term, rudder_normal_angle, term_matrix
 from shipid.errors import ShipidError
 
 RUDDER = "rudder"
@@ -248,18 +248,14 @@ def rudder_sign(logs: Sequence[pd.DataFrame], given: str | None = None) -> float
 CROSSFLOW_SIGNS = {"v": "crossflow_sway", "r": "crossflow_yaw"}
 
 
-def _rudder_normal_sign(dof: str, factors) -> tuple[str, object] | None:
+def _rudder_normal_sign(dof: str, term: str) -> tuple[str, object] | None:
     """The sign rule of the rudder's normal force terms (their inflow's parameters vary): its
     drag F_N sin δ ≤ 0 in u̇; its side force F_N cos δ, which has δ's sign (the factor's γ_R is
     signed by the convention), as δ's rudder terms in v̇ and ṙ."""
-    if len(factors) != 2 or not any(f.rudder for f in factors):
-        return None
-    angle = next(f for f in factors if not f.rudder)
-    if angle.name != "delta" or angle.k != 1 or angle.power != 1:
-        return None
-    if dof == "u" and OPS[angle.op] == "sin":
+    angle = rudder_normal_angle(term)
+    if dof == "u" and angle == "sin":
         return "rudder drag", -1
-    if dof in ("v", "r") and OPS[angle.op] == "cos":
+    if dof in ("v", "r") and angle == "cos":
         return next((why, sign) for eq, terms, sign, why in SIGN_RULES
                     if eq == dof and terms is _RUDDER_TERMS)  # fmt: skip
     return None
@@ -269,7 +265,7 @@ def _sign_bounds(dof: str, term: str, s: float | None) -> tuple[float, float, st
     factors = parse_term(term).factors
     if len(factors) == 1 and OPS[factors[0].op] == CROSSFLOW_SIGNS.get(dof):
         return (-math.inf, 0.0, "cross-flow drag opposes the hull's lateral motion")
-    rule = _rudder_normal_sign(dof, factors) or next(
+    rule = _rudder_normal_sign(dof, term) or next(
         ((why, sign) for eq, terms, sign, why in SIGN_RULES if eq == dof and term in terms), None)
     if rule is None:
         return None

@@ -21,6 +21,11 @@ The linear model M (v̇, ṙ) = F(v, r, δ) with M = [[m − Yv̇, m x_G − Y�
 and the rigid-body terms −m u r, −m x_G u r, solved for (v̇, ṙ), gives the acceleration-form
 coefficients of u·v, u·r and u²·δ (or v, r, δ at the approach speed) of any structure that has
 them; other terms get no prior (drawn toward 0 as without one). I_z = m (0.25 L)² + m x_G².
+
+The rudder's normal force of one inflow (``rudder_normal``, U_R² sin α_R, ``--rudder-normal``)
+is F/(½ρ A_R f_α): its side force cos δ·F takes the u²·δ coefficients above, and its drag sin δ·F
+in u̇ takes −(1 − t_R) ½ρ A_R f_α / m with t_R = 0.3 (MMG's published values 0.2–0.4; the
+KVLCC2's 0.387) and the surge's added mass left out (2–8 % of m on merchant hulls).
 """
 
 from __future__ import annotations
@@ -32,11 +37,12 @@ import numpy as np
 
 from shipid.data.particulars import Particulars
 from shipid.dynamics.model import ManoeuvringModel, ModelStructure
-from shipid.dynamics.terms import parse_term
+from shipid.dynamics.terms import parse_term, rudder_normal_angle
 from shipid.errors import ShipidError
 
 ASPECT_RATIO = 1.5
 A_H, X_H, X_R = 0.2, -0.45, -0.5  # hull interaction, its position and the rudder's, in L
+T_R = 0.3  # the rudder's drag less its resistance deduction: −(1 − t_R) F sin δ
 # Terms of the acceleration form each linear coefficient maps to, with the power of the approach
 # speed U0 the coefficient is multiplied by (v·U: power 0 on u·v, 1 on v alone, ...).
 SPEED_TERMS = {
@@ -84,6 +90,7 @@ def clarke_linear(p: Particulars, rudder_positive: str | None) -> dict[str, dict
         sign = 1.0 if rudder_positive == "starboard" else -1.0
         rud = np.linalg.solve(M, sign * force * np.array([-(1 + A_H), -(X_R + A_H * X_H) * L]))
         out["v"]["delta"], out["r"]["delta"] = rud[0], rud[1]
+        out["u"] = {"drag": -(1 - T_R) * force / m}  # per U_R² sin α_R sin δ, either convention
     return {k: {kk: float(vv) for kk, vv in v.items()} for k, v in out.items()}
 
 
@@ -95,6 +102,13 @@ def clarke_prior(p: Particulars, structure: ModelStructure, speed: float,
         raise ShipidError("the Clarke prior needs the approach speed (> 0)")
     linear = clarke_linear(p, rudder_positive)
     prior: dict[str, dict[str, float]] = {}
+    for dof, terms in structure.terms.items():  # the rudder's normal force, of any inflow
+        for text in terms:
+            angle = rudder_normal_angle(text)
+            if angle == "cos" and dof in ("v", "r") and "delta" in linear[dof]:
+                prior.setdefault(dof, {})[text] = linear[dof]["delta"]
+            elif angle == "sin" and dof == "u" and "u" in linear:
+                prior.setdefault(dof, {})[text] = linear["u"]["drag"]
     for dof in ("v", "r"):
         if dof not in structure.terms:
             continue
@@ -110,8 +124,9 @@ def clarke_prior(p: Particulars, structure: ModelStructure, speed: float,
                         linear[dof][signal] * speed**power
                     break
     if not prior:
-        raise ShipidError(f"the Clarke prior gives the u·v, u·r and u²·δ terms (or v, r, δ) of "
-                          f"v̇ and ṙ; the structure {structure.name} has none of them")
+        raise ShipidError(f"the Clarke prior gives the u·v, u·r and u²·δ terms (or v, r, δ, or "
+                          f"the rudder's normal force) of v̇ and ṙ; the structure "
+                          f"{structure.name} has none of them")
     return prior
 
 
