@@ -495,14 +495,13 @@ def term_matrix(terms: Sequence[str | Term], u, v, r, inputs: Mapping[str, np.nd
     """(n, len(terms)) matrix of regressor values."""
     parsed = [parse_term(t) if isinstance(t, str) else t for t in terms]
     needed = {s for t in parsed for s in t.signals}
-    sig = signal_values(u, v, r, inputs, needed)
-    n = np.atleast_1d(np.asarray(u)).shape[0]
+    sig = {k: np.atleast_1d(x) for k, x in signal_values(u, v, r, inputs, needed).items()}
+    n = sig["u"].shape[0]
     out = np.empty((n, len(parsed)))
     for j, term in enumerate(parsed):
         col = np.ones(n)
         for f in term.factors:
-            col = col * f.values(np.atleast_1d(sig[f.name]), np.atleast_1d(sig["r"]),
-                                 {k: np.atleast_1d(x) for k, x in sig.items()})
+            col = col * f.values(sig[f.name], sig["r"], sig)
         out[:, j] = col
     return out
 
