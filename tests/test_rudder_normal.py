@@ -250,6 +250,14 @@ def test_cli_rudder_normal_needs_particulars_and_fits_it(tmp_path, capsys):
     code, out, err = run(["manoeuvre", tmp_path / "m.json", "turning", "--rudder", "35",
                           "--duration", "200"], capsys)  # fmt: skip
     assert code == 0 and "tactical_diameter" in out, err
+    # rescale carries the inflow to the larger ship: c with the length squared, x with it.
+    code, _, err = run(["rescale", tmp_path / "m.json", "--factor", "10", "-o",
+                        tmp_path / "big.json"], capsys)  # fmt: skip
+    assert code == 0, err
+    big = json.loads((tmp_path / "big.json").read_text())
+    longer = RudderInflow(inflow.a, inflow.c * 100, inflow.g, inflow.x * 10)
+    assert parse_term(longer.lateral).text in big["model"]["structure"]["terms"]["r"]
+    assert big["particulars"]["length"] == pytest.approx(40.0)
     # Logs without the propeller speed: the race needs it.
     bare = write_log(log.drop(columns=["x", "y", "n"]), tmp_path / "bare.csv")
     code, _, err = run(["identify", bare, *flags, "--rudder-normal", "--particulars",
