@@ -50,6 +50,17 @@ def raw_files():
     return tuple(sorted((DATA / kind).glob("*.csv")) for kind in ("zigzag", "turning", "random"))
 
 
+def held_out_files():
+    """(zig-zag, turning, random-run files, {path: log} of the turns and random runs as the
+    commands read them: the turns cut to the manoeuvre, the random runs to a dropout), or None
+    (and a line saying so) when ``../shared/data`` is absent: what the studies judge on."""
+    files = raw_files()
+    if files is None:
+        return None
+    zigzags, turns, randoms = files
+    return zigzags, turns, randoms, {p: read(p, trim=p not in randoms) for p in turns + randoms}
+
+
 def trial_files():
     """(the zig-zag files, {path: log} of every trial file, zig-zags first, as the commands read
     it with ``--format osaka-frt``: cut to the manoeuvre, or to a propulsion dropout), or None

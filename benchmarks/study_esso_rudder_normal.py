@@ -18,7 +18,7 @@ import warnings
 
 import numpy as np
 from cli_models import model_by_cli
-from esso_logs import raw_files, read
+from esso_logs import held_out_files
 
 from shipid.evaluation.validate import validate_log
 
@@ -46,11 +46,10 @@ def _judged(model, turns, randoms, logs) -> tuple[list[float], list[float], bool
 
 
 def main() -> None:
-    files = raw_files()
+    files = held_out_files()
     if files is None:
         return
-    zigzags, turns, randoms = files
-    logs = {p: read(p, trim=p not in randoms) for p in turns + randoms}
+    zigzags, turns, randoms, logs = files
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores\n")
     trainings = {"nine zig-zags": [list(zigzags)],
                  "two zig-zag files (36 pairs)": [list(p) for p in

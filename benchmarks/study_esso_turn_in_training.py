@@ -23,7 +23,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from cli_models import model_by_cli  # noqa: E402
-from esso_logs import raw_files, read  # noqa: E402
+from esso_logs import held_out_files  # noqa: E402
 
 from shipid.evaluation.validate import validate_log  # noqa: E402
 
@@ -35,11 +35,10 @@ KEYS = ("tactical_diameter", "advance", "steady_yaw_rate")
 
 
 def main() -> None:
-    files = raw_files()
+    files = held_out_files()
     if files is None:
         return
-    zigzags, turns, randoms = files
-    logs = {p: read(p, trim=p not in randoms) for p in turns + randoms}
+    zigzags, turns, randoms, logs = files
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores\n")
     print("Trained on the nine zig-zags, one 35° turn and three random runs; judged on the other "
           "turn (closed loop: errors of the tactical diameter, advance, steady yaw rate) and the "
