@@ -99,8 +99,9 @@ def test_manoeuvre_log_replays_exactly_with_simulate_log():
 
 
 def test_a_turn_without_its_indices_is_the_same_run():
-    """``indices=False``, for checks that read only a held turn's states: the same run to the
-    bit, no indices; without a duration it would not know when to stop, and says so."""
+    """``indices=False``, for checks that read only a held turn's states (and a zig-zag's, for
+    validate's replicas): the same run to the bit, no indices; without a duration it would not
+    know when to stop, and says so."""
     from shipid.errors import ShipidError
 
     ship = scale_ship()
@@ -110,6 +111,13 @@ def test_a_turn_without_its_indices_is_the_same_run():
     np.testing.assert_array_equal(bare.log.to_numpy(), full.log.to_numpy())
     with pytest.raises(ShipidError, match="needs a duration"):
         turning_circle(ship, 35, indices=False)
+    # The zig-zag too (validate's replicas, whose indices are read as the log's).
+    full = zigzag(ship, 20, 20, duration=60, dt=0.1)
+    bare = zigzag(ship, 20, 20, duration=60, dt=0.1, indices=False)
+    assert full.indices["second_overshoot_deg"] > 0 and bare.indices == {}
+    np.testing.assert_array_equal(bare.log.to_numpy(), full.log.to_numpy())
+    with pytest.raises(ShipidError, match="needs a duration"):
+        zigzag(ship, 20, 20, indices=False)
 
 
 def test_a_model_s_manoeuvre_says_no_scale_it_does_not_know():

@@ -277,8 +277,8 @@ def start_spread(model, log: pd.DataFrame, method: str, trial: Trial, point: dic
         len(log) <= START_MAX_SAMPLES else None  # fmt: skip
     if starts is None:
         return {}
-    draws = [_indices_of(trial_replica(model, log, method, trial, start), trial, log)
-             for start in starts]  # fmt: skip
+    draws = [_indices_of(trial_replica(model, log, method, trial, start, indices=False), trial,
+                         log) for start in starts]  # fmt: skip
     out = {}
     for k, x in point.items():
         if k in BOOKKEEPING or k == "approach_speed" or not isinstance(x, float):
@@ -310,7 +310,7 @@ def drawn_starts(model, log: pd.DataFrame, trial: Trial, n: int, seed: int = 0
 
 
 def _replica_indices(model, log: pd.DataFrame, method: str, trial: Trial) -> dict:
-    return _indices_of(trial_replica(model, log, method, trial), trial, log)
+    return _indices_of(trial_replica(model, log, method, trial, indices=False), trial, log)
 
 
 def _indices_of(replica: ManoeuvreResult | None, trial: Trial, log: pd.DataFrame) -> dict:
@@ -475,19 +475,23 @@ def _reversal_notes(trial: Trial) -> list[str]:
 
 
 def trial_replica(model, log: pd.DataFrame, method: str = "euler", trial: Trial | None = None,
-                  start: dict | None = None) -> ManoeuvreResult | None:  # fmt: skip
+                  start: dict | None = None,
+                  indices: bool = True) -> ManoeuvreResult | None:  # fmt: skip
     """The log's manoeuvre run closed loop on ``model`` (``trial_zigzag``, ``trial_turning``);
-    None for other logs. ``start``: states that replace the log's first ones."""
+    None for other logs. ``start``: states that replace the log's first ones. ``indices=False``:
+    without the manoeuvre's own indices, for a caller that reads them as the log's are
+    (``_indices_of``; computed twice, they were half of ``start_spread``'s time)."""
     trial = trial or describe_trial(log)
     if trial.kind == "zigzag":
-        return trial_zigzag(model, log, method, trial, start)
+        return trial_zigzag(model, log, method, trial, start, indices)
     if trial.kind in TURN_KINDS:  # a pull-out's replica is released where the log was
-        return trial_turning(model, log, method, trial, start)
+        return trial_turning(model, log, method, trial, start, indices)
     return None
 
 
 def trial_turning(model, log: pd.DataFrame, method: str = "euler", trial: Trial | None = None,
-                  start: dict | None = None) -> ManoeuvreResult | None:  # fmt: skip
+                  start: dict | None = None,
+                  indices: bool = True) -> ManoeuvreResult | None:  # fmt: skip
     """The turning circle of a measured log run on ``model`` as ``shipid manoeuvre turning``
     runs it: where the log approaches steady and the model's surge answers the propeller, from
     the model's own steady straight speed at the log's propeller speed (straight, the log's
@@ -511,7 +515,7 @@ def trial_turning(model, log: pd.DataFrame, method: str = "euler", trial: Trial 
         trial.release_time - float(log["t"].iloc[0])  # fmt: skip
     return turning_circle(model, math.degrees(trial.plateau_angle),
                           "starboard" if turns > 0 else "port", speed=initial["u"], method=method,
-                          rps=rps, initial=initial, release=release,
+                          rps=rps, initial=initial, release=release, indices=indices,
                           **_replica_run(log, trial, wind))  # fmt: skip
 
 
@@ -565,7 +569,7 @@ def validate(
 
 
 def trial_zigzag(model, log: pd.DataFrame, method: str = "euler", trial: Trial | None = None,
-                 start: dict | None = None) -> ManoeuvreResult | None:  # fmt: skip
+                 start: dict | None = None, indices: bool = True) -> ManoeuvreResult | None:  # fmt: skip
     """The zig-zag of a measured log run closed loop on ``model``: same initial state (u, v, r, ψ)
     and held rudder (or the model's own steady approach, ``_replica_start``), first execute time
     and side, rudder angle (the median plateau), rudder rate (over its swings,
@@ -582,7 +586,7 @@ def trial_zigzag(model, log: pd.DataFrame, method: str = "euler", trial: Trial |
     initial, rps, wind = _replica_start(model, log, trial, start)
     return zigzag(model, math.degrees(trial.plateau_angle), switch,
                   first="starboard" if turns > 0 else "port", speed=initial["u"], method=method,
-                  initial=initial, rps=rps, switches=uneven_reversals(trial),
+                  initial=initial, rps=rps, switches=uneven_reversals(trial), indices=indices,
                   **_replica_run(log, trial, wind))  # fmt: skip
 
 

@@ -357,10 +357,13 @@ def zigzag(
     rps: float | None = None,
     wind: tuple[float, float] | None = None,
     switches: Sequence[float] | None = None,
+    indices: bool = True,
 ) -> ManoeuvreResult:
     """δ/ψ zig-zag: rudder ``first`` at t = ``approach``, reversed whenever the heading change
     reaches ±ψ on the side the ship is turning to; ``switches`` [deg] gives the first reversals
     their own ψ, in turn (a replica of a trial reversed unevenly), ``heading_deg`` the rest.
+    ``indices=False`` (with a ``duration``): the run alone, for a caller that reads its indices
+    its own way (``validate``'s replicas, as the log's are read).
 
     ``initial`` (u, v, r, psi, delta) starts the run from a trial's measured state instead of a
     straight approach; the rudder is held at its initial ``delta`` until ``approach`` and the
@@ -384,6 +387,8 @@ def zigzag(
     def run(length: float) -> ManoeuvreResult:
         res = run_closed_loop(vessel, params, length, dt, method, initial=initial, rps=rps)
         res.log.attrs["manoeuvre"] = f"zigzag {rudder_deg:g}/{heading_deg:g}, first {first}"
+        if not indices:
+            return res
         res.indices = zigzag_indices(res.log, heading_deg, t_order=approach,
                                      length=_finite_or_none(vessel.length))  # fmt: skip
         if res.indices.get("initial_turning_time") is None:
@@ -395,6 +400,8 @@ def zigzag(
             res.incomplete = f"no second overshoot within {length:g} s"
         return res
 
+    if not indices and duration is None:
+        raise ShipidError("a zig-zag without its indices needs a duration")
     return run(duration) if duration is not None else _extended(run, ZIGZAG_DURATION)
 
 
