@@ -258,6 +258,14 @@ def test_cli_rudder_normal_needs_particulars_and_fits_it(tmp_path, capsys):
     longer = RudderInflow(inflow.a, inflow.c * 100, inflow.g, inflow.x * 10)
     assert parse_term(longer.lateral).text in big["model"]["structure"]["terms"]["r"]
     assert big["particulars"]["length"] == pytest.approx(40.0)
+    # identify's own choice of structure takes it into whichever it fits.
+    code, out, err = run(["identify", path, "--filter", "none", "--no-output-error",
+                          "--rudder-normal", "--particulars", particulars, "-o",
+                          tmp_path / "auto.json"], capsys)  # fmt: skip
+    assert code == 0, err
+    auto = json.loads((tmp_path / "auto.json").read_text())["model"]["structure"]
+    assert "+rudder-normal" in auto["name"] and parse_term(inflow.lateral).text in auto[
+        "terms"]["v"]
     # Logs without the propeller speed: the race needs it.
     bare = write_log(log.drop(columns=["x", "y", "n"]), tmp_path / "bare.csv")
     code, _, err = run(["identify", bare, *flags, "--rudder-normal", "--particulars",

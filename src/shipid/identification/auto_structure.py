@@ -547,7 +547,9 @@ def _paper_or_race(logs, names, physics, cv, estimator, drop=None, announce=_qui
                 structures[edited.name] = edited
         candidates = tuple(structures)
     cv = cv or choice_cv(logs)
-    announce(f"comparing {', '.join(candidates)} by free-run cross-validation ({cv})…")
+    rudder = isinstance(drop, StructureEdit) and drop.rudder is not None
+    announce(f"comparing {', '.join(candidates)} by free-run cross-validation ({cv})"
+             + (", each with the rudder's normal force (--rudder-normal)" if rudder else "") + "…")
     inside = _blocks_inside(logs, cv)
     scores, models, failed, faults, ruled_out = {}, {}, [], {}, {}
 
