@@ -78,8 +78,7 @@ def test_the_term_parses_displays_and_scales_as_a_speed_squared():
     # The prime form: a speed squared over U²/L.
     model = _truth()
     prime = prime_coefficients(model, 4.0, 2.0)
-    lateral = INFLOW.lateral.replace("*cos(delta)", "")
-    text = parse_term(f"{lateral}*cos(delta)").text
+    text = parse_term(INFLOW.lateral).text
     assert prime["v"][text] == pytest.approx(model.coefficients["v"][text] * 4.0)
 
 
@@ -95,6 +94,17 @@ def test_bad_rudder_terms_are_named(text, message):
     with pytest.raises(ShipidError) as err:
         parse_term(text)
     assert message in str(err.value) and text in str(err.value)
+
+
+@pytest.mark.parametrize(("params", "message"), [
+    ((0.0, 0.01, 0.5, -3.0), "rudder inflow: a = (1 − w_R)² must be > 0, got 0"),
+    ((0.4, -0.01, 0.5, -3.0), "rudder inflow: race share c must be ≥ 0 m², got -0.01"),
+    ((0.4, 0.01, math.nan, -3.0), "rudder inflow: g must be a finite number, got nan"),
+])  # fmt: skip
+def test_a_bad_inflow_is_named(params, message):
+    with pytest.raises(ShipidError) as err:
+        RudderInflow(*params)
+    assert str(err.value) == message
 
 
 def test_one_model_takes_one_inflow():

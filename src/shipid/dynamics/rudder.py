@@ -19,8 +19,9 @@ is fixed from the particulars (``RudderInflow.from_particulars``):
 
 Why fixed: on one zig-zag the race terms' three coefficients (u²δ, uδ, δ) come out of opposite
 signs and cancel at a turn's low speed; one inflow shared by the three equations keeps the rudder
-force of a turn (``benchmarks/study_kvlcc2_turn.py``, where halving or doubling c, g or x moves the
-35° turn by a few per cent).
+force of a turn. How much the defaults matter: on the real KVLCC2 zig-zag, halving or doubling c,
+g or x moved the 35° turn's tactical diameter by −13 to +4 % and its steady yaw rate by ±5 %
+(``benchmarks/study_kvlcc2_turn.py``).
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from shipid.dynamics.terms import inflow_problem
 from shipid.errors import ShipidError
 
 KAPPA = 0.5
@@ -47,15 +49,9 @@ class RudderInflow:
     x: float  # [m]
 
     def __post_init__(self) -> None:
-        for name in ("a", "c", "g", "x"):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int | float) \
-                    or not math.isfinite(value):
-                raise ShipidError(f"rudder inflow: {name} must be a finite number, got {value!r}")
-        if not self.a > 0:
-            raise ShipidError(f"rudder inflow: a = (1 − w)² must be > 0, got {self.a:g}")
-        if self.c < 0:
-            raise ShipidError(f"rudder inflow: the race's share c must be ≥ 0 m², got {self.c:g}")
+        problem = inflow_problem(self.a, self.c, self.g, self.x)
+        if problem:
+            raise ShipidError(f"rudder inflow: {problem}")
 
     @property
     def factor(self) -> str:
@@ -87,7 +83,7 @@ class RudderInflow:
                               f"'starboard'), got {rudder_positive!r}")  # fmt: skip
         diameter = particulars.propeller_diameter
         wake = 0.5 * particulars.block_coefficient - 0.05
-        height = getattr(particulars, "rudder_height", None)
+        height = particulars.rudder_height
         eta = ETA_DEFAULT if height is None else min(1.0, diameter / height)
         race = eta * KAPPA**2 * 8.0 * KT0 / math.pi * diameter**2
         sign = 1.0 if rudder_positive == "starboard" else -1.0

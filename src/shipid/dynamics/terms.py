@@ -348,16 +348,12 @@ class _Parser:
         if self.peek() != ("sym", ")"):
             raise self.error(usage)
         self.i += 1
-        a, c, g, x = params
-        if not all(math.isfinite(p) for p in params):
-            raise self.error(f"{RUDDER}'s parameters must be finite numbers")
-        if not a > 0:
-            raise self.error(f"{RUDDER}'s a = (1 − w_R)² must be > 0, got {a:g}")
-        if not c >= 0:
-            raise self.error(f"{RUDDER}'s race share c must be ≥ 0 m², got {c:g}")
+        problem = inflow_problem(*params)
+        if problem:
+            raise self.error(f"{RUDDER}'s {problem}")
         if self.peek() == ("sym", "^"):
             raise self.error(f"{RUDDER}(a c g x) takes no power")
-        return Factor(SIGNAL_INDEX["delta"], OP_CODE[RUDDER], 1, 1, (a, c, g, x))
+        return Factor(SIGNAL_INDEX["delta"], OP_CODE[RUDDER], 1, 1, tuple(params))
 
     def factor(self) -> Factor:
         tok = self.peek()
@@ -530,6 +526,19 @@ def crossflow(v, r, length: float) -> tuple[np.ndarray, np.ndarray]:
         sway[~same] = (c2 - c1) / (3.0 * b) / length
         yaw[~same] = ((s2 * c2 - s1 * c1) / 4.0 - a * (c2 - c1) / 3.0) / (b * b) / length**2
     return sway, yaw
+
+
+def inflow_problem(a: float, c: float, g: float, x: float) -> str | None:
+    """What is wrong with a rudder inflow (a, c, g, x) (``rudder_normal``), or None: the one
+    check of a term's text and of ``shipid.dynamics.rudder.RudderInflow``."""
+    for name, value in zip(RUDDER_PARAMS, (a, c, g, x), strict=True):
+        if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+            return f"{name} must be a finite number, got {value!r}"
+    if not a > 0:
+        return f"a = (1 − w_R)² must be > 0, got {a:g}"
+    if not c >= 0:
+        return f"race share c must be ≥ 0 m², got {c:g}"
+    return None
 
 
 def rudder_normal_angle(term: str | Term) -> str | None:
