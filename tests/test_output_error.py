@@ -386,6 +386,33 @@ def test_the_default_output_error_fit_holds_the_sign_constraints(tmp_path, capsy
     assert "r: u r held at its bound -1 (bound [-1, inf])" in err
 
 
+@pytest.mark.parametrize("fit", ["--no-output-error", "--output-error"])
+def test_equal_bounds_give_a_coefficient(tmp_path, capsys, paper_fit, fit):
+    """`--bound` both ways at one value holds the coefficient there, in the LS-SVM fit and in
+    output error (whose trust-region solver, like the LS-SVM's BVLS, refused the empty box with
+    SciPy's own message): given, not fitted, said so, a standard error of 0; the other
+    coefficients fitted with it in every free run."""
+    _, logs = paper_fit
+    train = write_log(logs[TRAINING], tmp_path / "train.csv")
+    out = tmp_path / "g.json"
+    code, _, err = run(["identify", train, fit, "--bound", "r: u*r >= -0.9", "--bound",
+                        "r: u*r <= -0.9", "-o", out], capsys)  # fmt: skip
+    assert code == 0, err
+    doc = json.loads(out.read_text())
+    coefs = doc["model"]["coefficients"]
+    assert coefs["r"]["|u|*r"] == -0.9  # the free fit: about -1.2
+    assert "r: u r held at -0.9 (bound [-0.9, -0.9]): given, not fitted" in err
+    assert "held at its bound" not in err
+    if fit == "--output-error":
+        refinement = doc["identification"]["refinement"]
+        assert "1 coefficient given" in err
+        assert refinement["statistics"]["standard_errors"]["r"]["|u|*r"] == 0.0
+        # The rest fitted around it, from the LS-SVM fit that held it too.
+        assert refinement["cost_final"] < refinement["cost_initial"]
+        for key in ("initial_model", "refined_model"):
+            assert refinement[key]["coefficients"]["r"]["|u|*r"] == -0.9
+
+
 def test_a_bounded_constant_acceleration_is_the_line_with_its_slope_held():
     """A bound past the free slope: the estimate is the bound, the initial state the mean of
     u − c t (the closed form with the slope held), the other equations as without it; its
@@ -413,8 +440,17 @@ def test_a_bounded_constant_acceleration_is_the_line_with_its_slope_held():
     assert ensemble.thetas[:, 0, 0].max() <= 0.005 < free.model.coefficients["u"]["1"]
     with pytest.raises(ShipidError, match=r"bounds: u: \|u\|\*u is not a term"):
         output_error(constant_model(), log, bounds={"u": {"|u|*u": (-1.0, 0.0)}})
-    with pytest.raises(ShipidError, match="lower 1 is not below upper 1"):
-        output_error(constant_model(), log, bounds={"u": {"1": (1.0, 1.0)}})
+    with pytest.raises(ShipidError, match="lower 2 is not below upper 1"):
+        output_error(constant_model(), log, bounds={"u": {"1": (2.0, 1.0)}})
+    # Equal bounds: the slope given, the same closed form for the initial state, draws at it.
+    held, ensemble = output_error(constant_model((0.0, 0.0, 0.0)), log, draws=50,
+                                  bounds={"u": {"1": (0.004, 0.004)}})  # fmt: skip
+    assert held.model.coefficients["u"]["1"] == 0.004
+    assert held.statistics["initial_states"][0]["u"] == pytest.approx(
+        float(np.mean(log["u"] - 0.004 * t)), rel=1e-6)
+    assert held.statistics["standard_errors"]["u"]["1"] == 0.0
+    assert np.all(ensemble.thetas[:, 0, 0] == 0.004)
+    assert any("u: 1 held at 0.004: given, not fitted" in n for n in held.warnings)
 
 
 def test_the_default_keeps_the_lssvm_where_the_two_fits_turn_apart(tmp_path, capsys):

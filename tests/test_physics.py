@@ -37,7 +37,7 @@ def regression():
     return X, y, A, B[:, 0]
 
 
-def _brute(X, y, gamma, prior=None, bounds=None, equalities=None):
+def _brute(X, y, gamma, prior=None, bounds=None, equalities=None, inequalities=None):
     """The same objective minimised over (ω, b) by SciPy's SLSQP, an independent method."""
     p = X.shape[1]
     w0 = np.zeros(p) if prior is None else np.asarray(prior)
@@ -55,6 +55,9 @@ def _brute(X, y, gamma, prior=None, bounds=None, equalities=None):
     if equalities is not None:
         E, rhs = equalities
         cons = [{"type": "eq", "fun": lambda x: E @ x - rhs, "jac": lambda x: E}]
+    if inequalities is not None:
+        G, h = inequalities
+        cons.append({"type": "ineq", "fun": lambda x: G @ x - h, "jac": lambda x: G})
     bnds = list(bounds or [(None, None)] * p) + [(None, None)]
     x0 = np.linalg.lstsq(np.column_stack([X, np.ones(len(y))]), y, rcond=None)[0]
     res = minimize(f, x0, jac=grad, bounds=bnds, constraints=cons, method="SLSQP",
@@ -90,6 +93,35 @@ def test_constrained_solver_equals_an_independent_minimiser(regression, case):
     if "equalities" in kw:
         E, rhs = kw["equalities"]
         np.testing.assert_allclose(E @ np.append(w, bias), rhs, atol=1e-7)
+
+
+@pytest.mark.parametrize("case", ["alone", "with bounds and equalities", "with inequalities"])
+def test_equal_bounds_hold_a_coefficient_at_their_value(regression, case):
+    """lower = upper (``--bound`` both ways at one value): SciPy's bounded solvers refuse an
+    empty box; the coefficient is held there exactly, flagged, and the rest is the minimiser
+    with that value as an equality (SLSQP, independent)."""
+    X, y, A, b = regression
+    gamma = 5.0
+    lower = np.array([-np.inf, -np.inf, -1.5, -np.inf])
+    upper = np.array([np.inf, np.inf, -1.5, np.inf])
+    kw, rows, rhs = {}, [[0.0, 0.0, 1.0, 0.0, 0.0]], [-1.5]
+    if case == "with bounds and equalities":
+        lower[1], upper[0] = -0.3, 0.5
+        kw["equalities"] = (np.array([[1.0, 0.5, 0.0, 2.0, 1.0]]), np.array([-0.3]))
+        rows, rhs = rows + kw["equalities"][0].tolist(), rhs + [-0.3]
+    if case == "with inequalities":  # ω₀ + ω₁ ≥ 0.6, which the fit without it does not meet
+        kw["inequalities"] = (np.array([[1.0, 1.0, 0.0, 0.0, 0.0]]), np.array([0.6]))
+    w, bias, active = solve_primal_constrained(A, b, gamma, lower=lower, upper=upper, **kw)
+    assert w[2] == -1.5 and active[2]
+    bounds = [(None if not math.isfinite(lo) else lo, None if not math.isfinite(hi) else hi)
+              for lo, hi in zip(lower, upper, strict=True)]  # fmt: skip
+    bounds[2] = (None, None)
+    w_ref, b_ref = _brute(X, y, gamma, None, bounds, (np.array(rows), np.array(rhs)),
+                          kw.get("inequalities"))
+    np.testing.assert_allclose(w, w_ref, atol=2e-6)
+    assert bias == pytest.approx(b_ref, abs=2e-6)
+    if "inequalities" in kw:
+        assert w[0] + w[1] == pytest.approx(0.6, abs=1e-7)
 
 
 # ---------------------------------------------------------------------------- on trials

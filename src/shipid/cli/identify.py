@@ -634,9 +634,12 @@ def _output_error(ident, logs, names, args, physics=None):
     from shipid.identification.physics import coefficient_bounds
 
     bounds, reasons, bound_notes = coefficient_bounds(physics, ident.model, logs)
+    pairs = [b for terms in bounds.values() for b in terms.values()]
+    held = sum(lo == hi for lo, hi in pairs)
+    counts = [f"{n} coefficient{'s' * (n != 1)} {what}"
+              for n, what in ((len(pairs) - held, "bounded"), (held, "given")) if n]
     print("fitting by maximum-likelihood output error (unfiltered logs"
-          + (f"; {sum(map(len, bounds.values()))} coefficients bounded" if bounds else "")
-          + ")…", file=sys.stderr)  # fmt: skip
+          + "".join(f"; {c}" for c in counts) + ")…", file=sys.stderr)  # fmt: skip
     fit, ensemble = output_error(ident.model, logs, max_nfev=args.refine_evals, names=names,
                                  seed=args.seed, bounds=bounds, reasons=reasons)  # fmt: skip
     fit.warnings[:0] = [n for n in bound_notes if n not in fit.warnings]

@@ -203,7 +203,8 @@ def _add_physics_options(p) -> None:
                    "the approach), stable (straight-line stability at the approach: the yaw "
                    "equation given the sway one)")
     g.add_argument("--bound", action="append", metavar="'DOF: TERM <= X'",
-                   help="a bound on one coefficient, e.g. 'r: u*r <= 0' (repeatable)")
+                   help="a bound on one coefficient, e.g. 'r: u*r <= 0' (repeatable); "
+                   "both ways at one value holds it there (given, not fitted)")
     g.add_argument("--steady-speed", action="append", metavar="U@N",
                    help="the ship holds U m/s straight ahead at N rps (repeatable; a straight "
                    "run's or sea trials' speed): u̇ = 0 there with the rudder amidships, instead "

@@ -68,6 +68,16 @@ def _display(name: str) -> str:
     return parse_term(name).display() or "1"
 
 
+def _held_note(dof: str, name: str, j: int, coef: np.ndarray, extra) -> str:
+    """The note of the coefficient ``j`` (``name``) the fit holds at a bound: given (its two
+    bounds equal) or where the unconstrained fit would go past it."""
+    why = extra.reasons.get(name, "bound")
+    if extra.lower[j] == extra.upper[j]:
+        return f"{dof}: {_display(name)} held at {coef[j]:.4g} ({why}): given, not fitted"
+    return (f"{dof}: {_display(name)} held at its bound {coef[j]:.4g} ({why}): the "
+            "unconstrained fit goes past it")
+
+
 def _diagnose(p: RegressionProblem, coef: np.ndarray, bias: float, gamma: float
               ) -> tuple[dict, list[str]]:  # fmt: skip
     """Conditioning, collinearity, standard errors and one-step R² of one DOF's regression."""
@@ -488,9 +498,7 @@ def identify(
         held = [] if extra.active is None else [n for n, a in zip(p.names, extra.active,
                                                                    strict=True) if a]  # fmt: skip
         diagnostics[dof]["at_bound"] = held
-        notes += extra.notes + [f"{dof}: {_display(n)} held at its bound {g[p.names.index(n)]:.4g} "
-                                f"({extra.reasons.get(n, 'bound')}): the unconstrained fit goes "
-                                "past it" for n in held]  # fmt: skip
+        notes += extra.notes + [_held_note(dof, n, p.names.index(n), g, extra) for n in held]
         if extra.equalities is not None and sample_weight is None:
             notes += _equality_cost(p, g, b, estimator, gamma, extra)
         cond = diagnostics[dof]["condition_number"]

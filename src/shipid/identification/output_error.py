@@ -166,11 +166,20 @@ def output_error(
     n_states = len(states)
     state_col = [SHOT_STATES.index(s) for s in states]
 
-    rows, cols = coefficient_slots(model)
+    all_rows, all_cols = coefficient_slots(model)
+    # A coefficient whose two bounds are equal is given, not fitted: held in every free run,
+    # outside the parameters (the trust-region fit refuses an empty box).
+    given = _given_coefficients(model, bounds)
+    free = np.array([(DOFS[i], model.term_texts[j]) not in given
+                     for i, j in zip(all_rows, all_cols, strict=True)], dtype=bool)  # fmt: skip
+    rows, cols = all_rows[free], all_cols[free]
+    base_theta = np.zeros_like(model.theta)
+    for (dof, term), value in given.items():
+        base_theta[DOFS.index(dof), model.term_texts.index(term)] = value
     n_coef = len(rows)
     x0 = np.concatenate([model.theta[rows, cols], seg.shot0[:, state_col].ravel()])
     p = x0.size
-    lower, upper = _bound_vectors(model, rows, cols, bounds, p)
+    lower, upper = _bound_vectors(model, rows, cols, bounds, p, skip=given)
     bounded = bool(np.isfinite(lower).any() or np.isfinite(upper).any())
     x0 = np.clip(x0, lower, upper)  # an unconstrained start moved onto the feasible set
     n_obs = int(seg.mask.sum()) * n_states
@@ -186,7 +195,7 @@ def output_error(
     def simulate(X: np.ndarray) -> np.ndarray:
         """States (K, B, L, n_states) of K parameter vectors; diverged samples NaN."""
         K = X.shape[0]
-        theta = np.zeros((K, B, *model.theta.shape))
+        theta = np.broadcast_to(base_theta, (K, B, *model.theta.shape)).copy()
         theta[:, :, rows, cols] = X[:, None, :n_coef]
         s0 = np.broadcast_to(s0_base, (K, B, 6)).copy()
         s0[:, :, state_col] = X[:, n_coef:].reshape(K, B, n_states)
@@ -253,7 +262,9 @@ def output_error(
     cov_coef = cov[:n_coef, :n_coef]
     se = np.where(undetermined[:n_coef], np.inf, np.sqrt(np.clip(np.diag(cov_coef), 0.0, None)))
 
-    fitted = with_coefficients(model, rows, cols, x[:n_coef],
+    values = base_theta[all_rows, all_cols].copy()
+    values[free] = x[:n_coef]
+    fitted = with_coefficients(model, all_rows, all_cols, values,
                                f"output error ({model.structure.name})")  # fmt: skip
     std_errors: dict[str, dict[str, float]] = {dof: {} for dof in model.structure.dofs}
     labels = []
@@ -267,6 +278,11 @@ def output_error(
         notes.append(f"{dof}: {parse_term(term).display() or '1'} held at its bound {x[j]:.4g}"
                      + (f" ({why})" if why else "") + ": the unbounded output-error fit goes "
                      "past it")  # fmt: skip
+    for (dof, term), value in given.items():
+        std_errors[dof][term] = 0.0  # known, not estimated: its interval is the value
+        why = ((reasons or {}).get(dof) or {}).get(term)
+        notes.append(f"{dof}: {parse_term(term).display() or '1'} held at {value:.4g}"
+                     + (f" ({why})" if why else "") + ": given, not fitted")
     if fit.status == 0:
         notes.append(f"output error stopped at the evaluation cap ({max_nfev}) before converging")
     if inflation > INFLATION_WARNING:
@@ -294,16 +310,28 @@ def output_error(
                                      (lower[:n_coef], upper[:n_coef]) if bounded else None)
 
 
+def _given_coefficients(model: ManoeuvringModel,
+                        bounds: Mapping[str, Mapping[str, tuple[float, float]]] | None
+                        ) -> dict[tuple[str, str], float]:  # fmt: skip
+    """{(dof, term): value} of the coefficients whose lower and upper bounds are equal."""
+    return {(dof, term): float(lo) for dof, terms in (bounds or {}).items()
+            for term, (lo, hi) in terms.items()
+            if lo == hi and math.isfinite(lo) and term in model.coefficients.get(dof, {})}
+
+
 def _bound_vectors(model: ManoeuvringModel, rows: np.ndarray, cols: np.ndarray,
-                   bounds: Mapping[str, Mapping[str, tuple[float, float]]] | None, p: int
-                   ) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+                   bounds: Mapping[str, Mapping[str, tuple[float, float]]] | None, p: int,
+                   skip: Mapping[tuple[str, str], float] = ()) -> tuple[np.ndarray, np.ndarray]:
     """Lower and upper bounds of the p parameters (the coefficients at ``rows``, ``cols``, then
-    the initial states, never bounded), refusing a bound on a term the model lacks."""
+    the initial states, never bounded), refusing a bound on a term the model lacks; those in
+    ``skip`` (given, not fitted) are left out."""
     lower, upper = np.full(p, -np.inf), np.full(p, np.inf)
     index = {(DOFS[i], model.term_texts[j]): k for k, (i, j) in enumerate(zip(rows, cols,
                                                                               strict=True))}
     for dof, terms in (bounds or {}).items():
         for term, (lo, hi) in terms.items():
+            if (dof, term) in skip:
+                continue
             k = index.get((dof, term))
             if k is None:
                 raise ShipidError(f"bounds: {dof}: {term} is not a term of the model's {dof} "

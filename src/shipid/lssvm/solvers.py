@@ -178,7 +178,8 @@ def solve_primal_constrained(
 
     Solves ``min ½‖ω − ω₀‖² + ½ Σ γ wᵢ eᵢ²`` (the LS-SVM regularisation drawn toward the prior
     ω₀ instead of 0) subject to ``lower ≤ ω ≤ upper`` and ``E [ω; b] = f`` (e.g. the fitted
-    equation vanishing at approach states: steady speed).
+    equation vanishing at approach states: steady speed). A coefficient whose lower and upper
+    bounds are equal is held at that value (an equality).
 
     Parameters
     ----------
@@ -202,15 +203,41 @@ def solve_primal_constrained(
     ``EQUALITY_PENALTY``), then solved exactly again with the bounds it found active held as
     equalities (kept if it stays within the other bounds).
     """
+    lower, upper, equalities, held = _held_as_equalities(A.shape[0] - 1, lower, upper,
+                                                         equalities)
     x, bias, active = _solve_boxed(A, b, gamma, prior, lower, upper, equalities)
-    if inequalities is None:
-        return x, bias, active
-    G = np.atleast_2d(np.asarray(inequalities[0], dtype=float))
-    h = np.atleast_1d(np.asarray(inequalities[1], dtype=float))
-    if np.all(G @ np.append(x, bias) >= h - INEQUALITY_TOLERANCE * _row_scale(G, x, bias, h)):
-        return x, bias, active
-    return _solve_with_inequalities(A, b, gamma, prior, lower, upper, equalities, G, h,
-                                    np.append(x, bias))
+    if inequalities is not None:
+        G = np.atleast_2d(np.asarray(inequalities[0], dtype=float))
+        h = np.atleast_1d(np.asarray(inequalities[1], dtype=float))
+        if not np.all(G @ np.append(x, bias)
+                      >= h - INEQUALITY_TOLERANCE * _row_scale(G, x, bias, h)):
+            x, bias, active = _solve_with_inequalities(A, b, gamma, prior, lower, upper,
+                                                       equalities, G, h, np.append(x, bias))
+    if held is not None:
+        mask, values = held
+        x[mask], active[mask] = values, True  # on the value itself, not its solve's rounding
+    return x, bias, active
+
+
+def _held_as_equalities(p: int, lower, upper, equalities):
+    """Coefficients whose lower and upper bounds are equal (``--bound`` both ways: a value
+    held) as equality rows: the bounded solvers (SciPy's BVLS, SLSQP) refuse an empty box.
+    Returns the bounds without them, the equalities with them, and (mask, values) or None."""
+    if lower is None or upper is None:
+        return lower, upper, equalities, None
+    lo, hi = np.array(lower, dtype=float), np.array(upper, dtype=float)
+    mask = np.isfinite(lo) & (lo == hi)
+    if not mask.any():
+        return lower, upper, equalities, None
+    values = lo[mask]
+    rows = np.eye(p + 1)[np.flatnonzero(mask)]
+    if equalities is None:
+        E, f = rows, values
+    else:
+        E = np.vstack([np.atleast_2d(np.asarray(equalities[0], dtype=float)), rows])
+        f = np.concatenate([np.atleast_1d(np.asarray(equalities[1], dtype=float)), values])
+    lo[mask], hi[mask] = -np.inf, np.inf
+    return lo, hi, (E, f), (mask, values)
 
 
 def _row_scale(G: np.ndarray, x: np.ndarray, bias: float, h: np.ndarray) -> np.ndarray:
