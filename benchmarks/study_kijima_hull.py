@@ -44,7 +44,15 @@ from cli_models import model_by_cli
 from esso_logs import held_out_files
 from kvlcc2_logs import kvlcc2_logs
 from study_esso_rudder_normal import FORMAT, _judged
-from study_kvlcc2_turn import MMG_PARTICULARS, PARTICULARS, READ, TRAINING, _cell, _turn_and_zigzag
+from study_kvlcc2_turn import (
+    MMG_PARTICULARS,
+    PARTICULARS,
+    READ,
+    TRAINING,
+    _cell,
+    _turn_and_zigzag,
+    unseen_runs,
+)
 from study_structure import HELD_ZIGZAGS, PAPER_IMU, _turn, _zigzag, held_out_errors
 from study_structure import TRAINING as MMG_TRAINING
 
@@ -53,7 +61,6 @@ from shipid.data.io import write_log
 from shipid.data.particulars import Particulars, read_particulars
 from shipid.dynamics.model import ManoeuvringModel, ModelStructure, get_structure
 from shipid.dynamics.terms import parse_term
-from shipid.evaluation.validate import validate
 from shipid.identification.priors import clarke_derivatives
 
 KIJIMA_TERMS = ("U*v", "U*r", "|v|*v", "|r|*r", "U*r*sin(beta)^2", "r^2*sin(beta)")
@@ -268,16 +275,8 @@ def real_kvlcc2(folder: Path) -> None:
         if model is None:
             print(f"| blanke-speed {variant} | failed | | | | | | |")
             continue
-        cells = []
-        for v in validate(model, list(held_out.values())):
-            closed, measured = v.indices["closed_loop"], v.indices["measured"]
-            cells.append(f"{v.metrics['r']['std']:.5f}, " + ", ".join(
-                f"{closed.get(k, math.nan):.1f}°" for k in ("first_overshoot_deg",
-                                                           "second_overshoot_deg"))
-                + " (" + ", ".join(f"{measured[k]:.1f}" for k in ("first_overshoot_deg",
-                                                                   "second_overshoot_deg")) + ")")
-        print(f"| blanke-speed {variant} | " + " | ".join(cells + _turn_and_zigzag(out, folder))
-              + " |")
+        cells = unseen_runs(model, held_out) + _turn_and_zigzag(out, folder)
+        print(f"| blanke-speed {variant} | " + " | ".join(cells) + " |")
 
 
 def esso(folder: Path) -> None:
