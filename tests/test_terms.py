@@ -49,7 +49,9 @@ def test_term_values_against_hand_computation():
 
 
 @pytest.mark.parametrize(("spec", "match"), [
-    ("u: |u|u, w; v: delta; r: delta", "unknown signal 'w'"),
+    ("u: |u|u, w; v: delta; r: delta", "unknown signal 'w' "),
+    # A word whose start reads as a signal: the rest named in the word, not alone.
+    ("u: |u|u, nothing", "unknown signal 'othing' in 'nothing'"),
     ("u: |u|u, u**2", "expected a signal"),
     ("u: sin(u)", "takes an angle signal"),
     ("u: vr, v*r", "are the same term"),

@@ -277,7 +277,10 @@ def _split_names(word: str, text: str) -> list[str]:
                 break
         else:
             known = ", ".join(SIGNALS) + "; aliases " + ", ".join(ALIASES)
-            raise ShipidError(f"term {text!r}: unknown signal {word[i:]!r} (signals: {known})")
+            # The word too where its start read as signals ('nothing': 'othing' after n).
+            where = f" in {word!r}" if i else ""
+            raise ShipidError(f"term {text!r}: unknown signal {word[i:]!r}{where} (signals: "
+                              f"{known})")  # fmt: skip
     return names
 
 
