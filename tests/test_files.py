@@ -319,6 +319,24 @@ def test_a_known_format_read_without_format_names_it(capsys, path, fmt):
     assert code == 0 and out == given
 
 
+def test_an_osaka_file_with_text_in_a_column_names_it(tmp_path, capsys):
+    """A cell that is not a number: the file's own column and the data row, no output file
+    (it said "a column is not numeric")."""
+    from shipid.data.formats import OSAKA_COLUMNS
+
+    t = np.arange(40) * 0.1
+    df = pd.DataFrame({c: t if c.startswith("t ") else 0.1 + 0 * t for c in OSAKA_COLUMNS})
+    df = df.astype(object)
+    df.iloc[17, 2] = "abc"
+    path = tmp_path / "frt.csv"
+    df.to_csv(path, index=False)
+    code, _, err = run(["import", "--format", "osaka-frt", path, "-o", tmp_path / "out.csv"],
+                       capsys)  # fmt: skip
+    column = list(OSAKA_COLUMNS)[2]
+    assert code == 1 and f"column {column!r} is not numeric at data row 18 ('abc'" in err
+    assert len(err.strip().splitlines()) == 1 and not (tmp_path / "out.csv").exists()
+
+
 def test_an_unknown_vessel_lists_the_known_ones(capsys):
     code, _, err = run(["manoeuvre", "titanic", "turning"], capsys)
     assert code == 1 and "scale-ship, mariner, kvlcc2" in err

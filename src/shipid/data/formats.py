@@ -156,10 +156,15 @@ def read_osaka_frt(path: str | Path) -> pd.DataFrame:
         row = int(np.argmax(bad))
         col = df.columns[df.iloc[row].isna().to_numpy()][0]
         raise ShipidError(f"{path}: column {col!r} is empty at data row {row + 1}")
-    try:
-        cols = {c: df[c].to_numpy(dtype=float) for c in df.columns}
-    except (TypeError, ValueError):
-        raise ShipidError(f"{path}: a column is not numeric (--format osaka-frt)") from None
+    source = {v: k for k, v in mapping.items()}
+    cols = {}
+    for c in df.columns:
+        values = pd.to_numeric(df[c], errors="coerce")
+        if values.isna().any():
+            row = int(np.argmax(values.isna().to_numpy()))
+            raise ShipidError(f"{path}: column {source[c]!r} is not numeric at data row "
+                              f"{row + 1} ({df[c].iloc[row]!r}; --format osaka-frt)")  # fmt: skip
+        cols[c] = values.to_numpy(dtype=float)
     cols["psi"] = np.unwrap(cols["psi"])
     if "wind_angle" in cols:
         cols["wind_angle"] = np.angle(np.exp(1j * cols["wind_angle"]))  # (−π, π]
