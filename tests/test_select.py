@@ -193,6 +193,29 @@ def test_identify_with_another_estimator_and_an_unknown_one():
 
 
 # ---------------------------------------------------------------------------- CLI
+def test_a_bound_holds_in_the_candidates_that_have_its_term(paper_trials, tmp_path, capsys):
+    """`select --bound` on a library term: the search's first candidates lack it, and each fit
+    refused the bound ("not a free term"), so select stopped at its first candidate. Now each
+    candidate with the term holds it, and the chosen model does; a term no candidate can hold
+    (not in the library) is one line, exit 1, before the search."""
+    import json
+
+    training, _ = paper_trials
+    paths = [str(write_log(log, tmp_path / f"t{i}.csv")) for i, log in enumerate(training[:3])]
+    out = tmp_path / "b.json"
+    code = main(["select", *paths, "--quiet", "--bound", "r: |u|*r <= -1", "-o", str(out)])
+    _, err = capsys.readouterr()
+    assert code == 0, err
+    r = json.loads(out.read_text())["model"]["coefficients"]["r"]
+    assert r["|u|*r"] == pytest.approx(-1.0, abs=1e-12)  # chosen without the bound: +0.16
+    assert "r: |u| r held at its bound -1" in err
+    code = main(["select", *paths, "--quiet", "--bound", "r: u*r <= -1", "-o",
+                 str(tmp_path / "c.json")])  # fmt: skip
+    _, err = capsys.readouterr()
+    assert code == 1 and "r: u*r is not a term of the library's r equation" in err
+    assert len(err.strip().splitlines()) == 1 and not (tmp_path / "c.json").exists()
+
+
 def test_cli_select_compare_and_gamma_auto(paper_trials, tmp_path, capsys):
     training, predictions = paper_trials
     paths = [write_log(log, tmp_path / f"train{i}.csv") for i, log in enumerate(training[:4])]

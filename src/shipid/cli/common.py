@@ -255,9 +255,11 @@ def _vessel_names() -> tuple[str, ...]:
     return tuple(VESSELS)
 
 
-def _physics(args, logs, structure, searched: bool = False):
+def _physics(args, logs, structure, searched: bool = False, chosen: bool = False):
     """PhysicsOptions of --prior, --constraints, --bound (None when none is given);
-    ``searched``: ``structure`` is a library terms are chosen from, not the structure fitted."""
+    ``searched``: ``structure`` is a library terms are chosen from, not the structure fitted;
+    ``chosen``: the structures fitted are chosen, not given, so a bound on a term one lacks is
+    passed over (and said so)."""
     from shipid.identification.physics import (
         PhysicsOptions,
         parse_constraints,
@@ -303,7 +305,8 @@ def _physics(args, logs, structure, searched: bool = False):
 
             prior = prior_at_rps(prior, structure, rps)
     options = PhysicsOptions(prior=prior, bounds=bounds or None, approach=tuple(steady) or None,
-                             prior_source=source, **flags)  # fmt: skip
+                             prior_source=source, bounds_where_present=chosen,
+                             **flags)  # fmt: skip
     return options if options.active else None
 
 

@@ -121,7 +121,7 @@ def cmd_identify(args) -> int:
     _edit_into_model(args, logs)
     gamma_given = args.gamma is not None
     choice = _choose_structure(args, logs, names)
-    physics = _physics(args, logs, _structure(args))
+    physics = _physics(args, logs, _structure(args), chosen=choice is not None)
     if physics is not None and physics.prior_source:
         print(f"prior: {physics.prior_source}" + (
             "; the bootstrap resamples the logs, not the reference: its intervals do not hold "
@@ -493,13 +493,16 @@ def _choose_structure(args, logs, names):
         from shipid.identification.select import default_library
 
         # The search fits with the same physics, as select does: a prior over its library.
-        physics = _physics(args, logs, default_library(logs)[0], searched=True)
+        physics = _physics(args, logs, default_library(logs)[0], searched=True, chosen=True)
         choice = auto_structure(logs, names, physics, args.cv, args.estimator,
                                 _structure_edit(args, logs),
                                 announce=lambda m: print(m, file=sys.stderr))  # fmt: skip
         print(choice.describe())
+        from shipid.identification.physics import is_unapplied_bound
+
         for w in choice.warnings:
-            _warn(f"structure: {w}")
+            if not is_unapplied_bound(w):  # the chosen structure's own fit says it, below
+                _warn(f"structure: {w}")
         args.model, args.drop = choice.structure, None  # the drop is in the structure
     if args.gamma is None:
         args.gamma = choice.gamma if choice is not None and choice.gamma else 1e4

@@ -105,6 +105,9 @@ class PhysicsOptions:
         ``with_approaches`` resolves them once for fits that repeat, as ``select``'s).
     rudder_positive : 'port' or 'starboard' (default: the logs' metadata).
     prior_source : where the prior comes from, in words (the model file keeps it).
+    bounds_where_present : a bound on a term the fitted structure lacks is passed over (and
+        said so) instead of refused: the structure was chosen (``select``'s candidates, the
+        default's choice), not given.
     """
 
     prior: Mapping[str, Mapping[str, float]] | None = None
@@ -116,6 +119,7 @@ class PhysicsOptions:
     stable: bool = False
     derivatives: bool = False
     prior_source: str = ""
+    bounds_where_present: bool = False
 
     @property
     def active(self) -> bool:
@@ -473,6 +477,15 @@ def _approach_rows(dof_terms: Sequence[str], fixed: Mapping[str, float], has_con
     return E, f, states
 
 
+UNAPPLIED_BOUND = "has no such term"
+
+
+def is_unapplied_bound(note: str) -> bool:
+    """Whether ``note`` says a bound was passed over (``bounds_where_present``), which the fit
+    of the structure says once: the searches and refits before and after it need not."""
+    return note.startswith("bounds: ") and note.endswith(UNAPPLIED_BOUND)
+
+
 def dof_physics(options: PhysicsOptions | None, dof: str, names: Sequence[str], has_constant: bool,
                 fixed: Mapping[str, float], logs: Sequence[pd.DataFrame]) -> DofPhysics:  # fmt: skip
     """Prior, bounds and the steady-speed tie of one equation whose free regressors are
@@ -491,9 +504,12 @@ def dof_physics(options: PhysicsOptions | None, dof: str, names: Sequence[str], 
                          "disagree on) the rudder sign convention (--rudder-positive)")
     user = {parse_term(t).text: b for t, b in ((options.bounds or {}).get(dof) or {}).items()}
     unknown = sorted(set(user) - set(names))
-    if unknown:
+    if unknown and not options.bounds_where_present:
         raise ShipidError(f"bounds: {dof}: {', '.join(unknown)} is not a free term of the "
                           f"{dof} equation ({', '.join(names) or 'none'})")  # fmt: skip
+    if unknown:
+        out.notes.append(f"bounds: {dof}: {', '.join(unknown)} not applied: the chosen "
+                         f"structure's {dof} equation {UNAPPLIED_BOUND}")  # fmt: skip
     for j, name in enumerate(names):
         lo, hi, why = -math.inf, math.inf, []
         rule = _sign_bounds(dof, name, s) if options.signs else None
@@ -564,7 +580,8 @@ def coefficient_bounds(options: PhysicsOptions | None, model, logs: Sequence[pd.
     for dof, terms in model.coefficients.items():
         names = [t for t in terms if t != "1"]
         extra = dof_physics(options, dof, names, "1" in terms, {}, logs)
-        notes += extra.notes
+        # A bound the structure has no term for: its LS-SVM fit, which comes first, said so.
+        notes += [n for n in extra.notes if not is_unapplied_bound(n)]
         for j, name in enumerate(names):
             if math.isfinite(extra.lower[j]) or math.isfinite(extra.upper[j]):
                 bounds.setdefault(dof, {})[name] = (float(extra.lower[j]), float(extra.upper[j]))

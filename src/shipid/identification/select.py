@@ -38,6 +38,7 @@ draws the terms of its replicates from these shares.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import warnings
 from collections.abc import Mapping, Sequence
@@ -290,6 +291,23 @@ def _prepare(logs: Sequence[pd.DataFrame], names: Sequence[str], library: ModelS
         data.s0[i] = [float(first.get(k, 0.0)) if k in log.columns else 0.0
                       for k in ("u", "v", "r", "psi", "x", "y")]  # fmt: skip
     return data
+
+
+def _bounds_in_library(physics: PhysicsOptions | None,
+                       library: ModelStructure) -> PhysicsOptions | None:  # fmt: skip
+    """``physics`` with its bounds held by the candidates that have their terms, after refusing
+    a bound on a term the library lacks (no candidate could hold it). A candidate without the
+    term was refused the bound ("not a free term"), which stopped the search at its first."""
+    if physics is None or not physics.bounds:
+        return physics
+    for dof, terms in physics.bounds.items():
+        have = [t for t in library.terms.get(dof, ()) if t != "1"]
+        missing = sorted({parse_term(t).text for t in terms} - set(have))
+        if missing:
+            raise ShipidError(f"bounds: {dof}: {', '.join(missing)} is not a term of the "
+                              f"library's {dof} equation ({', '.join(have) or 'none'}): no "
+                              "candidate can hold it")  # fmt: skip
+    return dataclasses.replace(physics, bounds_where_present=True)
 
 
 # ---------------------------------------------------------------------------- fits
@@ -595,6 +613,7 @@ def _setup(logs, names, options: SelectOptions):
     data = _prepare(logs, names, library)
     data.library_note = note
     folds = _folds(len(logs), options.cv)
+    options = dataclasses.replace(options, physics=_bounds_in_library(options.physics, library))
     return logs, names, data, folds, _Scorer(data, options, folds)
 
 
@@ -655,6 +674,7 @@ def select(
     logs, notes = common_rudder_convention([logs] if isinstance(logs, pd.DataFrame) else list(logs))
     logs, names, data, folds, scorer = _setup(logs, names, options)
     library = data.library
+    options = dataclasses.replace(options, physics=_bounds_in_library(options.physics, library))
     if data.library_note:
         notes.append(data.library_note)
     # The first log's approach; each candidate is checked from its own steady approach there.
