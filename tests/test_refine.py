@@ -52,6 +52,28 @@ def test_refinement_recovers_the_true_coefficients_from_a_perturbed_start(trial,
     assert res.n_segments == expected_segments
 
 
+def test_refinement_holds_given_and_bounded_coefficients(trial):
+    """Bounds in the refinement (it had none: `identify --refine --constraints signs` wrote the
+    sway |v|v at +0.45 against the table's ≤ 0, silently). Noise-free, from a perturbed start:
+    ṙ's u·r given at its true value, the rest comes back to the truth as without it; v̇'s u·r
+    bounded at half its true value, it is held exactly there, and both are said."""
+    truth = scale_ship_model()
+    start = perturbed(truth)
+    given = truth.coefficients["r"]["u*r"]
+    res = refine(start, trial, gamma=1e12, max_nfev=200, bounds={"r": {"u*r": (given, given)}})
+    assert res.model.coefficients["r"]["u*r"] == given
+    for dof, cs in truth.coefficients.items():
+        for n, c in cs.items():
+            assert res.model.coefficients[dof][n] == pytest.approx(c, rel=1e-4, abs=1e-5)
+    assert any("r: u r held at -1.17: given, not fitted" in w for w in res.warnings)
+    half = truth.coefficients["v"]["u*r"] / 2  # -0.23: the truth, -0.45, lies below it
+    res = refine(start, trial, gamma=1e12, max_nfev=200, bounds={"v": {"u*r": (half, math.inf)}},
+                 reasons={"v": {"u*r": "bound"}})  # fmt: skip
+    assert res.model.coefficients["v"]["u*r"] == half
+    assert any(w.startswith("v: u r held at its bound -0.2266 (bound)") for w in res.warnings)
+    assert res.cost_final > 1e-6 * res.cost_initial  # no longer the truth's fit
+
+
 def test_refinement_lowers_the_training_free_run_error_of_a_noisy_fit(trial):
     noisy = PAPER_IMU.apply(trial, seed=3)
     fit = identify(noisy, gamma=1e4)
@@ -181,7 +203,7 @@ def test_trial_zigzag_of_the_true_model_reproduces_the_trial():
         assert replica.indices[key] == pytest.approx(measured[key], abs=0.05)
 
 
-def test_cli_identify_refine_keeps_both_models(tmp_path, trial):
+def test_cli_identify_refine_keeps_both_models(tmp_path, trial, capsys):
     noisy = PAPER_IMU.apply(trial, seed=5)
     path = tmp_path / "trial.csv"
     noisy.to_csv(path, index=False)
@@ -201,3 +223,25 @@ def test_cli_identify_refine_keeps_both_models(tmp_path, trial):
     assert lssvm.structure.to_dict() == written_ahead(identify(noisy).model).structure.to_dict()
     assert lssvm.structure.name == get_structure("blanke").name
     assert main(["validate", str(out), str(path), "--lssvm"]) == 0
+
+    # The sign table holds in the refinement as in the LS-SVM fit (the demo's training log:
+    # refined without it, the sway |v|v comes out +0.45, the truth's +0.54, the table's ≤ 0);
+    # a prior, which the refinement does not hold, is refused.
+    from shipid.data.io import write_log
+    from shipid.demo import TRAINING, synthesise_trials
+
+    demo = write_log(synthesise_trials(0)[TRAINING], tmp_path / "demo.csv")
+    sway_damping = []
+    for extra in ([], ["--constraints", "signs"]):
+        assert main(["identify", str(demo), "--refine", "--refine-evals", "40", *extra, "-o",
+                     str(out)]) == 0  # fmt: skip
+        doc = json.loads(out.read_text())
+        sway_damping.append(doc["identification"]["refinement"]["refined_model"]["coefficients"]
+                            ["v"]["|v|*v"])  # fmt: skip
+    assert sway_damping[0] > 0.3 and sway_damping[1] == 0.0
+    capsys.readouterr()
+    assert main(["identify", str(path), "--refine", "--prior", str(out), "-o",
+                 str(tmp_path / "p.json")]) == 1  # fmt: skip
+    assert "--refine holds --constraints signs and --bound; it does not hold --prior" in \
+        capsys.readouterr().err
+    assert not (tmp_path / "p.json").exists()

@@ -102,6 +102,9 @@ def cmd_identify(args) -> int:
     if asked and given_physics:
         raise ShipidError(f"--output-error holds --constraints signs and --bound; it does not hold "
                           f"{given_physics[0]} (the LS-SVM fit does: leave out --output-error)")
+    if args.refine and given_physics:  # its free runs went past them without a word
+        raise ShipidError(f"--refine holds --constraints signs and --bound; it does not hold "
+                          f"{given_physics[0]} (the LS-SVM fit does: leave out --refine)")
     explicit_band = args.error_band not in (None, "none")
     if explicit_band and (args.refine or asked):
         raise ShipidError("--error-band describes the LS-SVM fit; it does not go with --refine "
@@ -240,10 +243,14 @@ def cmd_identify(args) -> int:
     if args.refine:
         from shipid.identification.refine import refine  # scipy.optimize: only when asked
 
+        from shipid.identification.physics import coefficient_bounds
+
+        bounds, reasons, _ = coefficient_bounds(physics, ident.model, logs)  # noted by the fit
         how = "whole logs" if args.segment is None else f"{args.segment:g} s segments"
         print(f"refining by output error ({how})…", file=sys.stderr)
         refinement = refine(ident.model, logs, segment_s=args.segment, gamma=gamma,
-                            max_nfev=args.refine_evals, names=names, progress=True)  # fmt: skip
+                            max_nfev=args.refine_evals, names=names, progress=True,
+                            bounds=bounds, reasons=reasons)  # fmt: skip
         print()
         print("refined by output error:")
         print(refinement.model.equations())

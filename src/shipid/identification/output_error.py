@@ -48,9 +48,11 @@ from shipid.identification.refine import (
     DIVERGED_RESIDUAL,
     SHOT_STATES,
     Refinement,
+    bound_vectors,
     coefficient_slots,
     compare_free_runs,
     cut_logs,
+    given_coefficients,
     with_coefficients,
 )
 from shipid.identification.uncertainty import LEVEL, Ensemble
@@ -169,7 +171,7 @@ def output_error(
     all_rows, all_cols = coefficient_slots(model)
     # A coefficient whose two bounds are equal is given, not fitted: held in every free run,
     # outside the parameters (the trust-region fit refuses an empty box).
-    given = _given_coefficients(model, bounds)
+    given = given_coefficients(model, bounds)
     free = np.array([(DOFS[i], model.term_texts[j]) not in given
                      for i, j in zip(all_rows, all_cols, strict=True)], dtype=bool)  # fmt: skip
     rows, cols = all_rows[free], all_cols[free]
@@ -179,7 +181,7 @@ def output_error(
     n_coef = len(rows)
     x0 = np.concatenate([model.theta[rows, cols], seg.shot0[:, state_col].ravel()])
     p = x0.size
-    lower, upper = _bound_vectors(model, rows, cols, bounds, p, skip=given)
+    lower, upper = bound_vectors(model, rows, cols, bounds, p, skip=given)
     bounded = bool(np.isfinite(lower).any() or np.isfinite(upper).any())
     x0 = np.clip(x0, lower, upper)  # an unconstrained start moved onto the feasible set
     n_obs = int(seg.mask.sum()) * n_states
@@ -308,38 +310,6 @@ def output_error(
                         statistics)  # fmt: skip
     return result, gaussian_ensemble(fitted, rows, cols, cov_coef, draws, seed,
                                      (lower[:n_coef], upper[:n_coef]) if bounded else None)
-
-
-def _given_coefficients(model: ManoeuvringModel,
-                        bounds: Mapping[str, Mapping[str, tuple[float, float]]] | None
-                        ) -> dict[tuple[str, str], float]:  # fmt: skip
-    """{(dof, term): value} of the coefficients whose lower and upper bounds are equal."""
-    return {(dof, term): float(lo) for dof, terms in (bounds or {}).items()
-            for term, (lo, hi) in terms.items()
-            if lo == hi and math.isfinite(lo) and term in model.coefficients.get(dof, {})}
-
-
-def _bound_vectors(model: ManoeuvringModel, rows: np.ndarray, cols: np.ndarray,
-                   bounds: Mapping[str, Mapping[str, tuple[float, float]]] | None, p: int,
-                   skip: Mapping[tuple[str, str], float] = ()) -> tuple[np.ndarray, np.ndarray]:
-    """Lower and upper bounds of the p parameters (the coefficients at ``rows``, ``cols``, then
-    the initial states, never bounded), refusing a bound on a term the model lacks; those in
-    ``skip`` (given, not fitted) are left out."""
-    lower, upper = np.full(p, -np.inf), np.full(p, np.inf)
-    index = {(DOFS[i], model.term_texts[j]): k for k, (i, j) in enumerate(zip(rows, cols,
-                                                                              strict=True))}
-    for dof, terms in (bounds or {}).items():
-        for term, (lo, hi) in terms.items():
-            if (dof, term) in skip:
-                continue
-            k = index.get((dof, term))
-            if k is None:
-                raise ShipidError(f"bounds: {dof}: {term} is not a term of the model's {dof} "
-                                  "equation")  # fmt: skip
-            if not lo < hi:
-                raise ShipidError(f"bounds: {dof}: {term}: lower {lo:g} is not below upper {hi:g}")
-            lower[k], upper[k] = lo, hi
-    return lower, upper
 
 
 def _lag1_autocorrelation(raw: np.ndarray, mask: np.ndarray, states: Sequence[str]

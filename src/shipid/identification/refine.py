@@ -24,7 +24,7 @@ segment by fine-tuning where it starts, and then fails any free run (seen on the
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -33,7 +33,7 @@ import pandas as pd
 from shipid.data.log import input_columns
 from shipid.dynamics.model import DOFS, ManoeuvringModel
 from shipid.dynamics.simulate import METHODS, DivergenceBounds, run_kernel
-from shipid.dynamics.terms import INPUT_SIGNALS
+from shipid.dynamics.terms import INPUT_SIGNALS, parse_term
 from shipid.errors import ShipidError
 from shipid.evaluation.validate import free_run
 from shipid.identification.regression import common_sampling_time
@@ -171,6 +171,8 @@ def refine(
     max_nfev: int = 100,
     names: Sequence[str] | None = None,
     progress: bool = False,
+    bounds: Mapping[str, Mapping[str, tuple[float, float]]] | None = None,
+    reasons: Mapping[str, Mapping[str, str]] | None = None,
 ) -> Refinement:
     """Refine ``model`` (e.g. ``identify(...).model``) by output-error fitting to ``logs``.
 
@@ -187,6 +189,10 @@ def refine(
     method : 'euler' (the paper's scheme and ``validate``'s default) or 'rk4'.
     max_nfev : cap on the number of cost evaluations of ``least_squares``.
     progress : a progress bar of the free-run simulations (on a terminal only).
+    bounds : {dof: {term: (lower, upper)}} box bounds on coefficients (sign constraints, user
+        bounds: ``shipid.identification.physics.coefficient_bounds``), held by the trust-region
+        fit; equal bounds give the coefficient (held there, not fitted), as in
+        ``output_error``. ``reasons`` ({dof: {term: why}}) name them in the notes.
     """
     if isinstance(logs, pd.DataFrame):
         logs = [logs]
@@ -210,8 +216,16 @@ def refine(
     seg, dt, seg_len = cut_logs(logs, names, segment_s, states, model)
     B, L = seg.inputs.shape[:2]
 
-    rows, cols = coefficient_slots(model)
-    x0 = model.theta[rows, cols].copy()
+    all_rows, all_cols = coefficient_slots(model)
+    given = given_coefficients(model, bounds)
+    free = np.array([(DOFS[i], model.term_texts[j]) not in given
+                     for i, j in zip(all_rows, all_cols, strict=True)], dtype=bool)  # fmt: skip
+    rows, cols = all_rows[free], all_cols[free]
+    base_theta = np.zeros_like(model.theta)
+    for (dof, term), value in given.items():
+        base_theta[DOFS.index(dof), model.term_texts.index(term)] = value
+    lower, upper = bound_vectors(model, rows, cols, bounds, len(rows), skip=given)
+    x0 = np.clip(model.theta[rows, cols], lower, upper)
     sigma_e = _equation_error_spread(model, logs, dt)
     prior_scale = np.array([1.0 / (math.sqrt(gamma) * sigma_e[DOFS[i]]) for i in rows])
     state_col = [SHOT_STATES.index(s) if s != "psi" else 3 for s in states]
@@ -229,7 +243,7 @@ def refine(
 
     def residuals(x: np.ndarray) -> np.ndarray:
         bar.update()
-        theta = np.zeros_like(model.theta)
+        theta = base_theta.copy()
         theta[rows, cols] = x
         out, n_valid = run_kernel(model.code, theta, seg.t, seg.inputs, s0, method, speed_lim,
                                   yaw_lim)  # fmt: skip
@@ -244,18 +258,66 @@ def refine(
     try:
         from scipy.optimize import least_squares  # 0.37 s of import: only when fitting
 
-        fit = least_squares(residuals, x0, method="trf", x_scale=scale, max_nfev=max_nfev)
+        fit = least_squares(residuals, x0, method="trf", x_scale=scale, max_nfev=max_nfev,
+                            bounds=(lower, upper))  # fmt: skip
     finally:
         bar.close()
-    refined = with_coefficients(model, rows, cols, fit.x, f"refined ({model.structure.name})")
+    # The bounds the trust-region fit holds active, put exactly on them.
+    active = np.asarray(getattr(fit, "active_mask", np.zeros(len(x0))))
+    x = np.where(active < 0, lower, np.where(active > 0, upper, fit.x))
+    values = base_theta[all_rows, all_cols].copy()
+    values[free] = x
+    refined = with_coefficients(model, all_rows, all_cols, values,
+                                f"refined ({model.structure.name})")  # fmt: skip
 
     notes = []
+    for j in np.flatnonzero(active != 0):
+        dof, term = DOFS[rows[j]], model.term_texts[cols[j]]
+        why = ((reasons or {}).get(dof) or {}).get(term)
+        notes.append(f"{dof}: {parse_term(term).display() or '1'} held at its bound {x[j]:.4g}"
+                     + (f" ({why})" if why else "") + ": the unbounded refinement goes past it")
+    for (dof, term), value in given.items():
+        why = ((reasons or {}).get(dof) or {}).get(term)
+        notes.append(f"{dof}: {parse_term(term).display() or '1'} held at {value:.4g}"
+                     + (f" ({why})" if why else "") + ": given, not fitted")
     if fit.status == 0:
         notes.append(f"refinement stopped at the evaluation cap ({max_nfev}) before converging; "
                      "raise max_nfev or shorten the segments")  # fmt: skip
     runs = compare_free_runs(model, refined, logs, names, method, notes)
     return Refinement(refined, model, seg_len, B, states, cost_initial, float(fit.cost),
                       int(fit.nfev), bool(fit.success), str(fit.message), runs, notes)  # fmt: skip
+
+
+def given_coefficients(model: ManoeuvringModel,
+                        bounds: Mapping[str, Mapping[str, tuple[float, float]]] | None
+                        ) -> dict[tuple[str, str], float]:  # fmt: skip
+    """{(dof, term): value} of the coefficients whose lower and upper bounds are equal."""
+    return {(dof, term): float(lo) for dof, terms in (bounds or {}).items()
+            for term, (lo, hi) in terms.items()
+            if lo == hi and math.isfinite(lo) and term in model.coefficients.get(dof, {})}
+
+
+def bound_vectors(model: ManoeuvringModel, rows: np.ndarray, cols: np.ndarray,
+                   bounds: Mapping[str, Mapping[str, tuple[float, float]]] | None, p: int,
+                   skip: Mapping[tuple[str, str], float] = ()) -> tuple[np.ndarray, np.ndarray]:
+    """Lower and upper bounds of the p parameters (the coefficients at ``rows``, ``cols``, then
+    the initial states, never bounded), refusing a bound on a term the model lacks; those in
+    ``skip`` (given, not fitted) are left out."""
+    lower, upper = np.full(p, -np.inf), np.full(p, np.inf)
+    index = {(DOFS[i], model.term_texts[j]): k for k, (i, j) in enumerate(zip(rows, cols,
+                                                                              strict=True))}
+    for dof, terms in (bounds or {}).items():
+        for term, (lo, hi) in terms.items():
+            if (dof, term) in skip:
+                continue
+            k = index.get((dof, term))
+            if k is None:
+                raise ShipidError(f"bounds: {dof}: {term} is not a term of the model's {dof} "
+                                  "equation")  # fmt: skip
+            if not lo < hi:
+                raise ShipidError(f"bounds: {dof}: {term}: lower {lo:g} is not below upper {hi:g}")
+            lower[k], upper[k] = lo, hi
+    return lower, upper
 
 
 def coefficient_slots(model: ManoeuvringModel) -> tuple[np.ndarray, np.ndarray]:
