@@ -176,6 +176,11 @@ def test_a_propeller_speed_or_wind_the_model_cannot_take_is_named(tmp_path, file
     assert a["indices"] == b["indices"]  # as said: the same run
     code, _, err = run(["criteria", model, "--length", "4.5", "--rps", "5", "--no-bands"], capsys)
     assert "--rps 5 changes nothing" in err
+    # The same for the controllers and the linearisation, which said nothing of it.
+    for argv in (["linearise", model], ["autopilot", model, "-o", tmp_path / "a.png"],
+                 ["follow", model, "--waypoints", "0,0;60,0", "-o", tmp_path / "f.png"]):
+        code, _, err = run([*argv, "--rps", "5"], capsys)
+        assert code == 0 and "--rps 5 changes nothing" in err, (argv, err)
 
 
 def test_implausible_turning_indices_are_named():

@@ -16,6 +16,7 @@ from shipid.cli.common import (
     _ship_or_model,
     _steering,
     _step_note,
+    _unused_inputs,
     _warn,
     _warn_beyond_training,
 )
@@ -28,8 +29,8 @@ def _controlled(args):
 
     target, cond = _ship_or_model(args.model)
     speed, rps, unsteady = _run_approach(target, cond, args.speed, args.rps)
-    if unsteady:
-        _warn(unsteady)
+    for note in ([unsteady] if unsteady else []) + _unused_inputs(target, args):
+        _warn(note)
     speed = speed or getattr(target, "approach_speed", None)
     truth = get_vessel(args.truth) if args.truth else None
     if truth is not None and args.truth not in VESSEL_NAMES:
@@ -75,8 +76,8 @@ def cmd_linearise(args) -> int:
     speed = speed or getattr(target, "approach_speed", None)
     if not speed:
         raise ShipidError("give the speed to linearise at (--speed)")
-    if unsteady:
-        _warn(unsteady)
+    for note in ([unsteady] if unsteady else []) + _unused_inputs(target, args):
+        _warn(note)
     nm = nomoto(target, speed, rps)
     pd = _pd()
     trim = nm["trim"]

@@ -241,9 +241,8 @@ def cmd_identify(args) -> int:
               f"{ensemble.resampling}):")
         print(table.to_markdown(index=False, floatfmt=".4g"))
     if args.refine:
-        from shipid.identification.refine import refine  # scipy.optimize: only when asked
-
         from shipid.identification.physics import coefficient_bounds
+        from shipid.identification.refine import refine  # scipy.optimize: only when asked
 
         bounds, reasons, _ = coefficient_bounds(physics, ident.model, logs)  # noted by the fit
         how = "whole logs" if args.segment is None else f"{args.segment:g} s segments"
