@@ -161,6 +161,30 @@ def test_a_signal_constant_in_training_has_a_margin(tmp_path, trial, capsys):
             assert ("n spans" in err) == (name == "far"), (structure, name, err)
 
 
+@pytest.mark.parametrize(("argv", "said"), [
+    (["manoeuvre", "MODEL", "turning", "--wind-from", "90", "--duration", "30"],
+     "--wind-from 90 changes nothing without --wind-speed"),
+    (["validate", "MODEL", "LOG", "--plot-format", "svg"],
+     "--plot-format svg changes nothing without --plots"),
+    (["validate", "MODEL", "LOG", "--max-lag", "20"], "--max-lag 20 changes nothing without --resid"),
+    (["identify", "LOG", "--segment", "20", "--no-output-error", "-o", "OUT"],
+     "--segment 20 changes nothing without --refine"),
+    (["identify", "LOG", "--block", "10", "--no-output-error", "-o", "OUT"],
+     "--block 10 changes nothing without --bootstrap"),
+])  # fmt: skip
+def test_an_option_without_the_one_it_acts_beside_is_named(tmp_path, files, capsys, argv, said):
+    """Given alone, these changed nothing without a word; with their partner, nothing is said."""
+    log, model = files
+    subs = {"MODEL": model, "LOG": log, "OUT": tmp_path / "m.json"}
+    code, _, err = run([subs.get(a, a) for a in argv], capsys)
+    assert code == 0 and said in err, err
+    option, partner = said.split()[0], said.split()[-1]
+    extra = {"--wind-speed": ["3"], "--plots": [str(tmp_path / "plots")], "--resid": [],
+             "--refine": ["--refine-evals", "5"], "--bootstrap": ["10"]}[partner]
+    code, _, err = run([subs.get(a, a) for a in argv] + [partner, *extra], capsys)
+    assert code == 0 and "changes nothing without" not in err, (option, err)
+
+
 def test_a_propeller_speed_or_wind_the_model_cannot_take_is_named(tmp_path, files, capsys):
     """The paper's blanke has no term in n or the wind: a manoeuvre "at 5 rps in a 3 m/s wind"
     ran its training condition without a word."""

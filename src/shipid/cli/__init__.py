@@ -75,8 +75,26 @@ def _quiet_lost_interrupts(hook):
     return unraisable
 
 
+# Options that act only beside another: dest → (the other's dest, option, the other, default).
+# Given alone they changed nothing without a word (`identify --segment 20` without --refine).
+OPTION_NEEDS = {
+    "segment": ("refine", "--segment", "--refine", None),
+    "block": ("bootstrap", "--block", "--bootstrap", "auto"),
+    "plot_format": ("plots", "--plot-format", "--plots", "png"),
+    "wind_from": ("wind_speed", "--wind-from", "--wind-speed", None),
+    "max_lag": ("resid", "--max-lag", "--resid", 50),
+}
+
+
 def check_options(args) -> None:
-    """Range checks of the numeric options (``OPTION_RULES``) before any work."""
+    """Range checks of the numeric options (``OPTION_RULES``) before any work, and a warning
+    for an option given without the one it acts beside (``OPTION_NEEDS``)."""
+    for dest, (other, option, needed, default) in OPTION_NEEDS.items():
+        value = getattr(args, dest, None)
+        if value is not None and value != default and not getattr(args, other, None):
+            shown = f"{value:g}" if isinstance(value, float) else value
+            warnings.warn(f"{option} {shown} changes nothing without {needed}", ShipidWarning,
+                          stacklevel=2)  # fmt: skip
     for dest, (rule, option) in OPTION_RULES.items():
         value = getattr(args, dest, None)
         if value is None or isinstance(value, str):
