@@ -419,6 +419,12 @@ def test_one_file_imported_into_an_existing_folder_keeps_its_name(tmp_path, file
     assert written.exists() and str(written) in out
     code, _, _ = run(["import", log, "-o", tmp_path / "direct.csv"], capsys)
     assert code == 0 and written.read_text() == (tmp_path / "direct.csv").read_text()
+    # Several inputs to a file's name made a folder of that name, the logs inside it.
+    code, _, err = run(["import", log, tmp_path / "direct.csv", "-o", tmp_path / "both.csv"],
+                       capsys)  # fmt: skip
+    assert code == 1 and "-o" in err and "give -o DIR" in err and len(err.splitlines()) == 1
+    assert not (tmp_path / "both.csv").exists()
+
 
 def test_sigterm_gives_one_line_exit_130_and_no_temporaries(tmp_path):
     exe = Path(sys.executable).parent / "shipid"

@@ -70,6 +70,10 @@ def cmd_import(args) -> int:
     # Several files, or one into an existing folder (as cp does): -o is a folder; each file
     # keeps its name with the extension of --ext.
     several = len(args.logs) > 1 or Path(args.output).is_dir()
+    if len(args.logs) > 1 and Path(args.output).suffix.lower() in (".csv", ".parquet"):
+        # It made a folder of that name, the logs inside it.
+        raise ShipidError(f"-o {args.output}: {len(args.logs)} inputs are written to a folder, "
+                          f"one log each: give -o DIR (a file takes one input)")  # fmt: skip
     if several:
         check_outputs({"-o": (args.output, "dir")}, [*args.logs, *_read_files(args)])
         targets = [Path(args.output) / (Path(p).stem + args.ext) for p in args.logs]
