@@ -352,6 +352,19 @@ def _write(tmp_path, df, name="log.parquet"):
     return path
 
 
+def test_a_column_named_twice_is_refused(tmp_path, trial, capsys):
+    """Two columns named u: pandas read the second as 'u.1' and the log's u was the first,
+    without a word. A name with a dot that is no repeat is read as before."""
+    df = trial.copy()
+    df.insert(3, "u_twice", 2 * df["u"])
+    df.columns = ["u" if c == "u_twice" else c for c in df.columns]
+    path = _write(tmp_path, df, "twice.csv")
+    code, _, err = run(["identify", path, "-o", tmp_path / "m.json"], capsys)
+    assert code == 1 and "column 'u' appears more than once in the header (columns 3, 4)" in err
+    dotted = _write(tmp_path, trial.assign(**{"depth.m": 10.0}), "dotted.csv")
+    assert len(read_log(dotted)) == len(trial)
+
+
 def test_datetime_time_becomes_seconds(tmp_path, trial):
     df = trial.copy()
     df["t"] = pd.Timestamp("2020-07-31 13:04:24") + pd.to_timedelta(df["t"], unit="s")

@@ -198,7 +198,23 @@ def _read_table(path: Path) -> tuple[pd.DataFrame, dict]:
         raise ShipidError(f"{path}: the file has no header and no rows") from None
     except pd.errors.ParserError as exc:
         raise ShipidError(f"{path}: not a valid CSV file ({str(exc).splitlines()[0]})") from None
+    _refuse_repeated_columns(path, sep, decimal, df)
     return df, meta
+
+
+def _refuse_repeated_columns(path: Path, sep: str, decimal: str, df: pd.DataFrame) -> None:
+    """One line where the header names a column twice: pandas reads the second 'u' as 'u.1',
+    and the log's u was then the first of two without a word."""
+    if not any("." in str(c) for c in df.columns):  # pandas marks a repeat 'name.k'
+        return
+    header = pd.read_csv(path, skip_blank_lines=True, comment="#", sep=sep, decimal=decimal,
+                         header=None, nrows=1, dtype=str).iloc[0]  # fmt: skip
+    names = [str(c).strip() for c in header]
+    repeated = next((c for c in names if names.count(c) > 1), None)
+    if repeated is not None:
+        where = ", ".join(str(i + 1) for i, c in enumerate(names) if c == repeated)
+        raise ShipidError(f"{path}: column {repeated!r} appears more than once in the header "
+                          f"(columns {where}): which is the log's is not known")  # fmt: skip
 
 
 def _hint_format(path: Path, exc: ShipidError) -> ShipidError:
