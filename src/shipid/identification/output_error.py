@@ -42,17 +42,15 @@ from threadpoolctl import threadpool_limits
 
 from shipid.dynamics.model import DOFS, ManoeuvringModel
 from shipid.dynamics.simulate import METHODS, DivergenceBounds, run_kernel
-from shipid.dynamics.terms import parse_term
 from shipid.errors import ShipidError
 from shipid.identification.refine import (
     DIVERGED_RESIDUAL,
     SHOT_STATES,
+    FreeCoefficients,
     Refinement,
     bound_vectors,
-    coefficient_slots,
     compare_free_runs,
     cut_logs,
-    given_coefficients,
     with_coefficients,
 )
 from shipid.identification.uncertainty import LEVEL, Ensemble
@@ -168,20 +166,12 @@ def output_error(
     n_states = len(states)
     state_col = [SHOT_STATES.index(s) for s in states]
 
-    all_rows, all_cols = coefficient_slots(model)
-    # A coefficient whose two bounds are equal is given, not fitted: held in every free run,
-    # outside the parameters (the trust-region fit refuses an empty box).
-    given = given_coefficients(model, bounds)
-    free = np.array([(DOFS[i], model.term_texts[j]) not in given
-                     for i, j in zip(all_rows, all_cols, strict=True)], dtype=bool)  # fmt: skip
-    rows, cols = all_rows[free], all_cols[free]
-    base_theta = np.zeros_like(model.theta)
-    for (dof, term), value in given.items():
-        base_theta[DOFS.index(dof), model.term_texts.index(term)] = value
+    slots = FreeCoefficients.of(model, bounds)
+    rows, cols = slots.rows, slots.cols
     n_coef = len(rows)
     x0 = np.concatenate([model.theta[rows, cols], seg.shot0[:, state_col].ravel()])
     p = x0.size
-    lower, upper = bound_vectors(model, rows, cols, bounds, p, skip=given)
+    lower, upper = bound_vectors(model, rows, cols, bounds, p, skip=slots.given)
     bounded = bool(np.isfinite(lower).any() or np.isfinite(upper).any())
     x0 = np.clip(x0, lower, upper)  # an unconstrained start moved onto the feasible set
     n_obs = int(seg.mask.sum()) * n_states
@@ -197,7 +187,7 @@ def output_error(
     def simulate(X: np.ndarray) -> np.ndarray:
         """States (K, B, L, n_states) of K parameter vectors; diverged samples NaN."""
         K = X.shape[0]
-        theta = np.broadcast_to(base_theta, (K, B, *model.theta.shape)).copy()
+        theta = np.broadcast_to(slots.theta, (K, B, *model.theta.shape)).copy()
         theta[:, :, rows, cols] = X[:, None, :n_coef]
         s0 = np.broadcast_to(s0_base, (K, B, 6)).copy()
         s0[:, :, state_col] = X[:, n_coef:].reshape(K, B, n_states)
@@ -264,9 +254,7 @@ def output_error(
     cov_coef = cov[:n_coef, :n_coef]
     se = np.where(undetermined[:n_coef], np.inf, np.sqrt(np.clip(np.diag(cov_coef), 0.0, None)))
 
-    values = base_theta[all_rows, all_cols].copy()
-    values[free] = x[:n_coef]
-    fitted = with_coefficients(model, all_rows, all_cols, values,
+    fitted = with_coefficients(model, slots.all_rows, slots.all_cols, slots.values(x[:n_coef]),
                                f"output error ({model.structure.name})")  # fmt: skip
     std_errors: dict[str, dict[str, float]] = {dof: {} for dof in model.structure.dofs}
     labels = []
@@ -274,17 +262,9 @@ def output_error(
         std_errors[DOFS[i]][model.term_texts[j]] = float(value)
         labels.append([DOFS[i], model.term_texts[j]])
 
-    for j in np.flatnonzero(at_bound):
-        dof, term = DOFS[rows[j]], model.term_texts[cols[j]]
-        why = ((reasons or {}).get(dof) or {}).get(term)
-        notes.append(f"{dof}: {parse_term(term).display() or '1'} held at its bound {x[j]:.4g}"
-                     + (f" ({why})" if why else "") + ": the unbounded output-error fit goes "
-                     "past it")  # fmt: skip
-    for (dof, term), value in given.items():
+    for (dof, term) in slots.given:
         std_errors[dof][term] = 0.0  # known, not estimated: its interval is the value
-        why = ((reasons or {}).get(dof) or {}).get(term)
-        notes.append(f"{dof}: {parse_term(term).display() or '1'} held at {value:.4g}"
-                     + (f" ({why})" if why else "") + ": given, not fitted")
+    notes += slots.notes(model, x[:n_coef], at_bound, reasons, "output-error fit")
     if fit.status == 0:
         notes.append(f"output error stopped at the evaluation cap ({max_nfev}) before converging")
     if inflation > INFLATION_WARNING:

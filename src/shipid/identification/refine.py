@@ -216,15 +216,9 @@ def refine(
     seg, dt, seg_len = cut_logs(logs, names, segment_s, states, model)
     B, L = seg.inputs.shape[:2]
 
-    all_rows, all_cols = coefficient_slots(model)
-    given = given_coefficients(model, bounds)
-    free = np.array([(DOFS[i], model.term_texts[j]) not in given
-                     for i, j in zip(all_rows, all_cols, strict=True)], dtype=bool)  # fmt: skip
-    rows, cols = all_rows[free], all_cols[free]
-    base_theta = np.zeros_like(model.theta)
-    for (dof, term), value in given.items():
-        base_theta[DOFS.index(dof), model.term_texts.index(term)] = value
-    lower, upper = bound_vectors(model, rows, cols, bounds, len(rows), skip=given)
+    slots = FreeCoefficients.of(model, bounds)
+    rows, cols = slots.rows, slots.cols
+    lower, upper = bound_vectors(model, rows, cols, bounds, len(rows), skip=slots.given)
     x0 = np.clip(model.theta[rows, cols], lower, upper)
     sigma_e = _equation_error_spread(model, logs, dt)
     prior_scale = np.array([1.0 / (math.sqrt(gamma) * sigma_e[DOFS[i]]) for i in rows])
@@ -243,7 +237,7 @@ def refine(
 
     def residuals(x: np.ndarray) -> np.ndarray:
         bar.update()
-        theta = base_theta.copy()
+        theta = slots.theta.copy()
         theta[rows, cols] = x
         out, n_valid = run_kernel(model.code, theta, seg.t, seg.inputs, s0, method, speed_lim,
                                   yaw_lim)  # fmt: skip
@@ -265,27 +259,74 @@ def refine(
     # The bounds the trust-region fit holds active, put exactly on them.
     active = np.asarray(getattr(fit, "active_mask", np.zeros(len(x0))))
     x = np.where(active < 0, lower, np.where(active > 0, upper, fit.x))
-    values = base_theta[all_rows, all_cols].copy()
-    values[free] = x
-    refined = with_coefficients(model, all_rows, all_cols, values,
+    refined = with_coefficients(model, slots.all_rows, slots.all_cols, slots.values(x),
                                 f"refined ({model.structure.name})")  # fmt: skip
 
-    notes = []
-    for j in np.flatnonzero(active != 0):
-        dof, term = DOFS[rows[j]], model.term_texts[cols[j]]
-        why = ((reasons or {}).get(dof) or {}).get(term)
-        notes.append(f"{dof}: {parse_term(term).display() or '1'} held at its bound {x[j]:.4g}"
-                     + (f" ({why})" if why else "") + ": the unbounded refinement goes past it")
-    for (dof, term), value in given.items():
-        why = ((reasons or {}).get(dof) or {}).get(term)
-        notes.append(f"{dof}: {parse_term(term).display() or '1'} held at {value:.4g}"
-                     + (f" ({why})" if why else "") + ": given, not fitted")
+    notes = slots.notes(model, x, active != 0, reasons, "refinement")
     if fit.status == 0:
         notes.append(f"refinement stopped at the evaluation cap ({max_nfev}) before converging; "
                      "raise max_nfev or shorten the segments")  # fmt: skip
     runs = compare_free_runs(model, refined, logs, names, method, notes)
     return Refinement(refined, model, seg_len, B, states, cost_initial, float(fit.cost),
                       int(fit.nfev), bool(fit.success), str(fit.message), runs, notes)  # fmt: skip
+
+
+@dataclass
+class FreeCoefficients:
+    """The coefficients an output-error fit varies and those its bounds give: ``rows``,
+    ``cols`` (``coefficient_slots`` of the free ones), ``free`` (mask over ``all_rows``,
+    ``all_cols``, every slot), ``given`` ({(dof, term): value}, equal bounds) and ``theta``
+    (the model's θ shape, the given values in place, zero elsewhere)."""
+
+    all_rows: np.ndarray
+    all_cols: np.ndarray
+    free: np.ndarray
+    given: dict[tuple[str, str], float]
+    theta: np.ndarray
+
+    @property
+    def rows(self) -> np.ndarray:
+        return self.all_rows[self.free]
+
+    @property
+    def cols(self) -> np.ndarray:
+        return self.all_cols[self.free]
+
+    @classmethod
+    def of(cls, model: ManoeuvringModel,
+           bounds: Mapping[str, Mapping[str, tuple[float, float]]] | None) -> FreeCoefficients:
+        """A coefficient whose two bounds are equal is given, not fitted: held in every free
+        run, outside the parameters (SciPy's trust-region fit refuses an empty box)."""
+        all_rows, all_cols = coefficient_slots(model)
+        given = given_coefficients(model, bounds)
+        free = np.array([(DOFS[i], model.term_texts[j]) not in given
+                         for i, j in zip(all_rows, all_cols, strict=True)], dtype=bool)  # fmt: skip
+        theta = np.zeros_like(model.theta)
+        for (dof, term), value in given.items():
+            theta[DOFS.index(dof), model.term_texts.index(term)] = value
+        return cls(all_rows, all_cols, free, given, theta)
+
+    def values(self, x: np.ndarray) -> np.ndarray:
+        """Every slot's value: the free ones ``x``, the given ones theirs."""
+        out = self.theta[self.all_rows, self.all_cols].copy()
+        out[self.free] = x
+        return out
+
+    def notes(self, model: ManoeuvringModel, x: np.ndarray, at_bound: np.ndarray,
+              reasons: Mapping[str, Mapping[str, str]] | None, fit: str) -> list[str]:
+        """A note per free coefficient held at its bound (``at_bound``, over the free ones, the
+        value in ``x``) and per given one; ``fit`` names the fit that would go past the bound."""
+        notes = []
+        rows, cols = self.rows, self.cols
+        held = [((DOFS[rows[j]], model.term_texts[cols[j]]), x[j], f"at its bound {x[j]:.4g}",
+                 f": the unbounded {fit} goes past it") for j in np.flatnonzero(at_bound)]
+        held += [(key, value, f"at {value:.4g}", ": given, not fitted")
+                 for key, value in self.given.items()]  # fmt: skip
+        for (dof, term), _, where, what in held:
+            why = ((reasons or {}).get(dof) or {}).get(term)
+            notes.append(f"{dof}: {parse_term(term).display() or '1'} held {where}"
+                         + (f" ({why})" if why else "") + what)
+        return notes
 
 
 def given_coefficients(model: ManoeuvringModel,
