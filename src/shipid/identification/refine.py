@@ -286,10 +286,12 @@ class FreeCoefficients:
 
     @property
     def rows(self) -> np.ndarray:
+        """The DOF rows of θ of the free coefficients."""
         return self.all_rows[self.free]
 
     @property
     def cols(self) -> np.ndarray:
+        """The term columns of θ of the free coefficients."""
         return self.all_cols[self.free]
 
     @classmethod
