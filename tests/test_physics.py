@@ -312,16 +312,19 @@ def test_cli_prior_constraints_and_bounds(tmp_path, capsys, short_zigzag):
         code, _, err = run(["identify", log, "-o", tmp_path / "x.json", *argv], capsys)
         assert code == 1 and message in err and "Traceback" not in err, (argv, err)
         assert not (tmp_path / "x.json").exists()
-    # A bound on a term the given structure lacks is refused; the default's choice (here the
-    # paper's blanke, which has no |r|r) is fitted without it, and says so once.
+    # A bound on a term the given structure lacks is refused. The default's choice (here the
+    # paper's blanke, which has no |r|r) holds it at 0: within a bound around 0, and a bound
+    # that excludes 0 is one line saying it cannot be met.
     code, _, err = run(["identify", log, "--model", "blanke", "--bound", "r: |r|*r <= 0", "-o",
                         tmp_path / "x.json"], capsys)  # fmt: skip
     assert code == 1 and "r: |r|*r is not a free term of the r equation" in err
     code, _, err = run(["identify", log, "--bound", "r: |r|*r <= 0", "-o", tmp_path / "y.json"],
                        capsys)  # fmt: skip
-    assert code == 0, err
-    assert err.count("bounds: r: |r|*r not applied: the chosen structure's r equation has no "
-                     "such term") == 1
+    assert code == 0 and "bounds" not in err, err
+    code, _, err = run(["identify", log, "--bound", "r: |r|*r <= -0.5", "-o",
+                        tmp_path / "z.json"], capsys)  # fmt: skip
+    assert code == 1 and len(err.splitlines()) == 1 and not (tmp_path / "z.json").exists()
+    assert "r: |r|*r [-inf, -0.5] cannot be met: the structure has no such term" in err
 
 
 def test_a_steady_speed_the_logs_do_not_show_is_reported(short_zigzag):

@@ -209,6 +209,17 @@ def test_a_bound_holds_in_the_candidates_that_have_its_term(paper_trials, tmp_pa
     r = json.loads(out.read_text())["model"]["coefficients"]["r"]
     assert r["|u|*r"] == pytest.approx(-1.0, abs=1e-12)  # chosen without the bound: +0.16
     assert "r: |u| r held at its bound -1" in err
+    # A candidate without the term holds it at 0, outside this bound: it is dropped, so an
+    # average (of candidates each within the bound) is within it too.
+    code = main(["select", *paths, "--quiet", "--average", "--bound", "r: |u|*r <= -1", "-o",
+                 str(out), "--table", str(tmp_path / "table.csv")])  # fmt: skip
+    _, err = capsys.readouterr()
+    assert code == 0, err
+    assert json.loads(out.read_text())["model"]["coefficients"]["r"]["|u|*r"] <= -1.0 + 1e-12
+    table = pd.read_csv(tmp_path / "table.csv")
+    lacking = ~table["terms_r"].astype(str).str.contains("|u|*r", regex=False)
+    assert lacking.any() and np.isinf(table.loc[lacking, "score"]).all()
+    assert (table.loc[lacking, "note"] == "the constraints cannot be met with these terms").all()
     code = main(["select", *paths, "--quiet", "--bound", "r: u*r <= -1", "-o",
                  str(tmp_path / "c.json")])  # fmt: skip
     _, err = capsys.readouterr()

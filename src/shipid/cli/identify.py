@@ -504,11 +504,8 @@ def _choose_structure(args, logs, names):
                                 _structure_edit(args, logs),
                                 announce=lambda m: print(m, file=sys.stderr))  # fmt: skip
         print(choice.describe())
-        from shipid.identification.physics import is_unapplied_bound
-
         for w in choice.warnings:
-            if not is_unapplied_bound(w):  # the chosen structure's own fit says it, below
-                _warn(f"structure: {w}")
+            _warn(f"structure: {w}")
         args.model, args.drop = choice.structure, None  # the drop is in the structure
     if args.gamma is None:
         args.gamma = choice.gamma if choice is not None and choice.gamma else 1e4

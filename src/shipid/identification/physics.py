@@ -52,7 +52,7 @@ import numpy as np
 import pandas as pd
 
 from shipid.dynamics.terms import OPS, parse_term, rudder_normal_angle, term_matrix
-from shipid.errors import ShipidError
+from shipid.errors import InfeasibleConstraintsError, ShipidError
 
 RUDDER = "rudder"
 
@@ -105,9 +105,10 @@ class PhysicsOptions:
         ``with_approaches`` resolves them once for fits that repeat, as ``select``'s).
     rudder_positive : 'port' or 'starboard' (default: the logs' metadata).
     prior_source : where the prior comes from, in words (the model file keeps it).
-    bounds_where_present : a bound on a term the fitted structure lacks is passed over (and
-        said so) instead of refused: the structure was chosen (``select``'s candidates, the
-        default's choice), not given.
+    bounds_where_present : a bound on a term the fitted structure lacks is not refused: the
+        structure was chosen (``select``'s candidates, the default's choice), not given; the
+        lacking structure holds it at 0, which meets a bound around 0 (a sign) and is infeasible
+        for one that excludes 0 (``select`` drops such a candidate).
     """
 
     prior: Mapping[str, Mapping[str, float]] | None = None
@@ -477,15 +478,6 @@ def _approach_rows(dof_terms: Sequence[str], fixed: Mapping[str, float], has_con
     return E, f, states
 
 
-UNAPPLIED_BOUND = "has no such term"
-
-
-def is_unapplied_bound(note: str) -> bool:
-    """Whether ``note`` says a bound was passed over (``bounds_where_present``), which the fit
-    of the structure says once: the searches and refits before and after it need not."""
-    return note.startswith("bounds: ") and note.endswith(UNAPPLIED_BOUND)
-
-
 def dof_physics(options: PhysicsOptions | None, dof: str, names: Sequence[str], has_constant: bool,
                 fixed: Mapping[str, float], logs: Sequence[pd.DataFrame]) -> DofPhysics:  # fmt: skip
     """Prior, bounds and the steady-speed tie of one equation whose free regressors are
@@ -507,9 +499,13 @@ def dof_physics(options: PhysicsOptions | None, dof: str, names: Sequence[str], 
     if unknown and not options.bounds_where_present:
         raise ShipidError(f"bounds: {dof}: {', '.join(unknown)} is not a free term of the "
                           f"{dof} equation ({', '.join(names) or 'none'})")  # fmt: skip
-    if unknown:
-        out.notes.append(f"bounds: {dof}: {', '.join(unknown)} not applied: the chosen "
-                         f"structure's {dof} equation {UNAPPLIED_BOUND}")  # fmt: skip
+    # A chosen structure without the term holds it at 0: within its bound, or outside it.
+    outside = [t for t in unknown if not user[t][0] <= 0.0 <= user[t][1]]
+    if outside:
+        lo, hi = user[outside[0]]
+        raise InfeasibleConstraintsError(
+            f"bounds: {dof}: {outside[0]} [{lo:g}, {hi:g}] cannot be met: the structure has no "
+            f"such term, so its coefficient is 0 (give a structure with it, --model)")
     for j, name in enumerate(names):
         lo, hi, why = -math.inf, math.inf, []
         rule = _sign_bounds(dof, name, s) if options.signs else None
@@ -580,8 +576,7 @@ def coefficient_bounds(options: PhysicsOptions | None, model, logs: Sequence[pd.
     for dof, terms in model.coefficients.items():
         names = [t for t in terms if t != "1"]
         extra = dof_physics(options, dof, names, "1" in terms, {}, logs)
-        # A bound the structure has no term for: its LS-SVM fit, which comes first, said so.
-        notes += [n for n in extra.notes if not is_unapplied_bound(n)]
+        notes += extra.notes
         for j, name in enumerate(names):
             if math.isfinite(extra.lower[j]) or math.isfinite(extra.upper[j]):
                 bounds.setdefault(dof, {})[name] = (float(extra.lower[j]), float(extra.upper[j]))

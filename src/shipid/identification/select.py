@@ -297,7 +297,9 @@ def _bounds_in_library(physics: PhysicsOptions | None,
                        library: ModelStructure) -> PhysicsOptions | None:  # fmt: skip
     """``physics`` with its bounds held by the candidates that have their terms, after refusing
     a bound on a term the library lacks (no candidate could hold it). A candidate without the
-    term was refused the bound ("not a free term"), which stopped the search at its first."""
+    term holds it at 0: it meets a bound around 0 (a sign), and is dropped where the bound
+    excludes 0 (an average with it would pull the term toward 0, out of its bound). Such a
+    candidate was refused the bound ("not a free term"), which stopped the search at its first."""
     if physics is None or not physics.bounds:
         return physics
     for dof, terms in physics.bounds.items():
