@@ -320,7 +320,7 @@ def test_cli_prior_constraints_and_bounds(tmp_path, capsys, short_zigzag):
     assert code == 1 and "r: |r|*r is not a free term of the r equation" in err
     code, _, err = run(["identify", log, "--bound", "r: |r|*r <= 0", "-o", tmp_path / "y.json"],
                        capsys)  # fmt: skip
-    assert code == 0 and "bounds" not in err, err
+    assert code == 0 and "bounds: r" not in err, err
     code, _, err = run(["identify", log, "--bound", "r: |r|*r <= -0.5", "-o",
                         tmp_path / "z.json"], capsys)  # fmt: skip
     assert code == 1 and len(err.splitlines()) == 1 and not (tmp_path / "z.json").exists()
