@@ -373,6 +373,17 @@ def test_indices_print_an_epoch_execute_time_in_full(tmp_path, capsys, clean_zig
     assert "first_execute_time: 1700000001.8" in capsys.readouterr().out  # was 1.7e+09
 
 
+def test_a_kind_given_against_the_log_is_named(tmp_path, capsys, clean_zigzag_10):
+    """`indices --kind turning` of a zig-zag printed every turning index None without a word;
+    a kind the log reads as is said nothing of."""
+    path = tmp_path / "zz.csv"
+    write_log(clean_zigzag_10, path)
+    assert main(["indices", str(path), "--kind", "turning"]) == 0
+    assert "--kind turning, but the log reads as zigzag" in capsys.readouterr().err
+    assert main(["indices", str(path), "--kind", "zigzag"]) == 0
+    assert "reads as" not in capsys.readouterr().err
+
+
 def test_a_spiral_is_no_turning_circle():
     """Bug: a spiral's log (here the scale ship's, 30 s a step) was read as a turning circle of
     advance, transfer and tactical diameter 0, from an execute found 600 s in, after the ship

@@ -43,6 +43,13 @@ def cmd_indices(args) -> int:
     out = []
     for path, log in zip(args.logs, logs, strict=True):
         trial = describe_trial(log, args.kind, args.heading)
+        if args.kind and args.kind != "other":
+            # Its indices as that kind are those the log reaches; say so where it reads as
+            # another (every turning index printed None for a zig-zag, without a word).
+            found = describe_trial(log).kind
+            if found != args.kind:
+                _warn(f"{path}: --kind {args.kind}, but the log reads as {found}; its "
+                      f"{args.kind} indices are those it reaches (None where it never does)")
         ind = manoeuvre_indices(log, args.kind, heading_deg=args.heading, smooth_s=args.smooth,
                                 trial=trial)  # fmt: skip
         record = {"name": str(path), "indices": ind}
