@@ -161,6 +161,40 @@ def test_a_signal_constant_in_training_has_a_margin(tmp_path, trial, capsys):
             assert ("n spans" in err) == (name == "far"), (structure, name, err)
 
 
+@pytest.mark.parametrize(("kind", "given", "said"), [
+    ("spiral", ["--rudder", "5", "--first", "port"], ["--rudder", "--first"]),
+    ("turning", ["--heading", "10"], ["--heading"]),
+    ("stopping", ["--rudder", "10", "--rps", "10", "--speed", "1"], ["--rudder"]),
+    ("zigzag", ["--rudder", "10", "--heading", "5", "--first", "port"], []),
+])  # fmt: skip
+def test_a_manoeuvre_names_the_options_it_does_not_take(tmp_path, files, capsys, kind, given,
+                                                         said):
+    """A spiral's --rudder, a turn's --heading, a stopping's rudder changed nothing, silently."""
+    _, model = files
+    if kind == "stopping":  # a propeller to reverse: surge balanced at 1 m/s and 10 rps
+        from shipid.dynamics.model import ManoeuvringModel
+
+        model = tmp_path / "propelled.json"
+        ManoeuvringModel("u: |u|*u, |n|*n; v: u*v, delta; r: u*r, delta", {
+            "u": {"|u|*u": -0.2, "|n|*n": 0.002}, "v": {"u*v": -1.0, "delta": 0.1},
+            "r": {"u*r": -1.0, "delta": -0.5}}).save(model)  # fmt: skip
+    code, _, err = run(["manoeuvre", model, kind, *given, "--duration", "40"], capsys)
+    assert code == 0, err
+    for option in ("--rudder", "--heading", "--first"):
+        assert (f"{option} changes nothing in a {kind} manoeuvre" in err) == (option in said)
+
+
+def test_a_stopping_test_without_a_propeller_term_says_why(files, capsys):
+    """The paper's model and a reference ship at one rps: it said to give --rps, and given it,
+    that a model needs n terms (of the reference ship too)."""
+    _, model = files
+    for target, why in ((model, "this model has none"),
+                        ("kvlcc2", "this reference ship's propeller turns at one rate")):
+        code, _, err = run(["manoeuvre", target, "stopping"], capsys)
+        assert code == 1 and "a stopping test needs a model with propeller-speed terms" in err
+        assert why in err and len(err.splitlines()) == 1
+
+
 @pytest.mark.parametrize(("argv", "said"), [
     (["manoeuvre", "MODEL", "turning", "--wind-from", "90", "--duration", "30"],
      "--wind-from 90 changes nothing without --wind-speed"),

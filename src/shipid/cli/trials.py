@@ -246,6 +246,29 @@ def _pull_out_other_side(run, target, side: str, indices: dict):
     return res.indices, note
 
 
+# The options each manoeuvre takes: another given to it changed nothing without a word (a
+# spiral's --rudder, --first or wind, a stopping's rudder, a turn's --heading).
+MANOEUVRE_OPTIONS = {
+    "zigzag": {"rudder_deg", "heading", "first", "rudder_rate", "wind_speed"},
+    "turning": {"rudder_deg", "first", "rudder_rate", "wind_speed"},
+    "pull-out": {"rudder_deg", "first", "rudder_rate", "wind_speed"},
+    "spiral": {"rudder_rate"},
+    "stopping": {"astern_rps", "wind_speed"},
+}
+_OPTION_TEXT = {"rudder_deg": "--rudder", "heading": "--heading", "first": "--first",
+                "rudder_rate": "--rudder-rate", "wind_speed": "--wind-speed",
+                "astern_rps": "--astern-rps"}  # fmt: skip
+
+
+def _unused_manoeuvre_options(args) -> list[str]:
+    """A warning per option given that ``args.kind`` does not take (``MANOEUVRE_OPTIONS``)."""
+    defaults = {"first": "starboard"}
+    takes = MANOEUVRE_OPTIONS[args.kind]
+    return [f"{text} changes nothing in a {args.kind} manoeuvre" for dest, text in
+            _OPTION_TEXT.items() if dest not in takes
+            and getattr(args, dest, None) not in (None, defaults.get(dest))]  # fmt: skip
+
+
 def cmd_manoeuvre(args) -> int:
     """``shipid manoeuvre``: a standard manoeuvre on a model or vessel."""
     from shipid.evaluation.envelope import implausible_indices, outside_envelope
@@ -263,6 +286,8 @@ def cmd_manoeuvre(args) -> int:
 
     check_outputs({"--json": (args.json, "json"), "-o": (args.output, "log")},
                   _read_files(args, args.model if Path(args.model).exists() else None))
+    for note in _unused_manoeuvre_options(args):
+        _warn(note)
     target, cond = _ship_or_model(args.model, hybrid=True)
     speed, rps, unsteady = _run_approach(target, cond, args.speed, args.rps)
     steering, rudder_note = _steering(target, cond, args.rudder_rate)
@@ -293,6 +318,13 @@ def cmd_manoeuvre(args) -> int:
             kw["hold"] = kw.pop("duration")
         run = partial(spiral, **kw)
     else:
+        if not getattr(getattr(target, "dynamics", target), "uses_rps", False):
+            raise ShipidError(f"{args.model}: a stopping test needs a model with propeller-speed "
+                              "terms (n), whose thrust answers the astern order; "
+                              + ("this reference ship's propeller turns at one rate"
+                                 if not Path(args.model).exists() else
+                                 "this model has none (identify it from logs with the n "
+                                 "column)"))  # fmt: skip
         if not rps:
             raise ShipidError("stopping needs the approach propeller speed (--rps, or a model "
                               "trained with the n column)")  # fmt: skip
