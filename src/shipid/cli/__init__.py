@@ -75,23 +75,24 @@ def _quiet_lost_interrupts(hook):
     return unraisable
 
 
-# Options that act only beside another: dest → (the other's dest, option, the other, default).
-# Given alone they changed nothing without a word (`identify --segment 20` without --refine).
+# Options that act only beside another: dest → (whether the other is given, option, the
+# other, default). Given alone they changed nothing without a word (`identify --segment 20`
+# without --refine).
 OPTION_NEEDS = {
-    "segment": ("refine", "--segment", "--refine", None),
-    "block": ("bootstrap", "--block", "--bootstrap", "auto"),
-    "plot_format": ("plots", "--plot-format", "--plots", "png"),
-    "wind_from": ("wind_speed", "--wind-from", "--wind-speed", None),
-    "max_lag": ("resid", "--max-lag", "--resid", 50),
+    "segment": (lambda a: a.refine, "--segment", "--refine", None),
+    "block": (lambda a: a.bootstrap, "--block", "--bootstrap", "auto"),
+    "plot_format": (lambda a: a.plots, "--plot-format", "--plots", "png"),
+    "wind_from": (lambda a: a.wind_speed, "--wind-from", "--wind-speed", None),
+    "max_lag": (lambda a: a.resid, "--max-lag", "--resid", 50),
 }
 
 
 def check_options(args) -> None:
     """Range checks of the numeric options (``OPTION_RULES``) before any work, and a warning
     for an option given without the one it acts beside (``OPTION_NEEDS``)."""
-    for dest, (other, option, needed, default) in OPTION_NEEDS.items():
+    for dest, (given, option, needed, default) in OPTION_NEEDS.items():
         value = getattr(args, dest, None)
-        if value is not None and value != default and not getattr(args, other, None):
+        if value is not None and value != default and not given(args):
             shown = f"{value:g}" if isinstance(value, float) else value
             warnings.warn(f"{option} {shown} changes nothing without {needed}", ShipidWarning,
                           stacklevel=2)  # fmt: skip
