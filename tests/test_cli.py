@@ -184,6 +184,18 @@ def test_a_manoeuvre_names_the_options_it_does_not_take(tmp_path, files, capsys,
         assert (f"{option} changes nothing in a {kind} manoeuvre" in err) == (option in said)
 
 
+def test_selects_plausibility_condition_without_its_checks_is_named(tmp_path, files, capsys):
+    """`select --no-plausibility --speed 2`: the speed is the checks' condition, and nothing
+    else reads it."""
+    log, _ = files
+    argv = ["select", log, "--cv", "blocks:2", "--search", "none", "--quiet", "--speed", "2",
+            "-o", tmp_path / "s.json"]  # fmt: skip
+    code, _, err = run([*argv, "--no-plausibility"], capsys)
+    assert code == 0 and "--speed 2 changes nothing without the plausibility checks" in err
+    code, _, err = run(argv, capsys)
+    assert code == 0 and "changes nothing" not in err, err
+
+
 def test_a_stopping_test_without_a_propeller_term_says_why(files, capsys):
     """The paper's model and a reference ship at one rps: it said to give --rps, and given it,
     that a model needs n terms (of the reference ship too)."""

@@ -84,6 +84,11 @@ OPTION_NEEDS = {
     "plot_format": (lambda a: a.plots, "--plot-format", "--plots", "png"),
     "wind_from": (lambda a: a.wind_speed, "--wind-from", "--wind-speed", None),
     "max_lag": (lambda a: a.resid, "--max-lag", "--resid", 50),
+    # select's plausibility condition (the other commands' --speed has no such partner)
+    "speed": (lambda a: not getattr(a, "no_plausibility", False), "--speed",
+              "the plausibility checks (--no-plausibility leaves them out)", None),
+    "rps": (lambda a: not getattr(a, "no_plausibility", False), "--rps",
+            "the plausibility checks (--no-plausibility leaves them out)", None),
 }
 
 
