@@ -74,6 +74,15 @@ def test_refinement_holds_given_and_bounded_coefficients(trial):
     assert res.cost_final > 1e-6 * res.cost_initial  # no longer the truth's fit
 
 
+@pytest.mark.parametrize("column", ["t", "delta", "u", "v", "r"])
+def test_validate_names_a_missing_column(trial, column):
+    """A log without one of t, δ, u, v, r: a KeyError from inside the free run (or, for u, a
+    message on the initial state) before; now the log's error names the column."""
+    (res,) = validate(scale_ship_model(), trial.drop(columns=[column]), names=["x.csv"])
+    assert res.error == (f"x.csv: missing column(s) {column} (a log to validate against has t, "
+                         "delta, u, v and r)")
+
+
 def test_refinement_lowers_the_training_free_run_error_of_a_noisy_fit(trial):
     noisy = PAPER_IMU.apply(trial, seed=3)
     fit = identify(noisy, gamma=1e4)
