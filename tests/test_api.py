@@ -72,3 +72,39 @@ def test_the_cli_knows_every_reader():
     from shipid.data.formats import FORMATS
 
     assert CLI_FORMATS == FORMATS
+
+
+@pytest.fixture(scope="module")
+def short_trial():
+    from shipid.trials.manoeuvres import zigzag
+    from shipid.vessels import scale_ship
+
+    log = zigzag(scale_ship(), 20, 20, duration=40, dt=0.2, method="euler").log
+    log.attrs["name"] = "zz.csv"
+    return log
+
+
+@pytest.mark.parametrize(("call", "column"), [
+    ("identify", "v"), ("identify", "delta"), ("select", "r"), ("simulate_log", "delta"),
+    ("manoeuvre_indices", "r"), ("validate", "u"),
+])  # fmt: skip
+def test_a_dataframe_without_a_column_is_named(short_trial, call, column):
+    """The command line's reader checks its files; a DataFrame handed to these functions
+    without a column raised a KeyError from deep inside. Now one line names the log and it."""
+    from shipid.dynamics.simulate import simulate_log
+    from shipid.errors import ShipidError
+    from shipid.trials.indices import manoeuvre_indices
+    from shipid.vessels.scale_ship import scale_ship_model
+
+    log = short_trial.drop(columns=[column])
+    model = scale_ship_model()
+    calls = {"identify": lambda: shipid.identify(log),
+             "select": lambda: shipid.select([short_trial, log]),
+             "simulate_log": lambda: simulate_log(model, log),
+             "manoeuvre_indices": lambda: manoeuvre_indices(log)}  # fmt: skip
+    if call == "validate":  # a log that cannot be validated gets its error, the others go on
+        (res,) = shipid.validate(model, log)
+        assert res.error.startswith(f"zz.csv: missing column(s) {column} (")
+        return
+    with pytest.raises(ShipidError, match=rf"^zz\.csv: missing column\(s\) {column} \("):
+        calls[call]()

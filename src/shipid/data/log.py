@@ -87,6 +87,15 @@ def log_name(log: pd.DataFrame, default: str = "log") -> str:
     return str(log.attrs.get("name", default))
 
 
+def require_columns(log: pd.DataFrame, columns, name: str | None = None, why: str = "") -> None:
+    """One line naming the log and the ``columns`` it lacks (a DataFrame handed to the Python
+    API: the command line's reader checks its files, the functions raised a KeyError)."""
+    missing = [c for c in columns if c not in log.columns]
+    if missing:
+        raise ShipidError(f"{name or log_name(log)}: missing column(s) {', '.join(missing)}"
+                          + (f" ({why})" if why else ""))
+
+
 # A log whose first 2 % run slower than this share of its typical speed (the 90th percentile of
 # u) starts without headway (a random run from rest): its running condition is then the median
 # over the samples ahead at RUNNING_SHARE of the typical speed or more.

@@ -20,7 +20,7 @@ from typing import Protocol
 import numpy as np
 import pandas as pd
 
-from shipid.data.log import input_columns, log_name, make_log
+from shipid.data.log import input_columns, log_name, make_log, require_columns
 from shipid.data.preprocess import gap_text, time_gaps
 from shipid.dynamics import codegen, kernel
 from shipid.dynamics.hybrid import HybridModel
@@ -396,6 +396,7 @@ def simulate_log(
 ) -> SimulationResult:
     """Free-run simulation from a log's measured initial state, driven by its measured rudder (and
     thrust, propeller speed and wind where the model uses them): the paper's validation (§ 4)."""
+    require_columns(log, ("t", "delta"), why="a log drives a free run with its time and rudder")
     gaps = time_gaps(log["t"].to_numpy())
     if gaps:
         raise ShipidError(f"{log_name(log)}: {gap_text(log['t'].to_numpy(), gaps)}: a free run "

@@ -33,7 +33,13 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from shipid.data.log import mean_true_wind, rudder_positive, starboard_sign, steady_start
+from shipid.data.log import (
+    mean_true_wind,
+    require_columns,
+    rudder_positive,
+    starboard_sign,
+    steady_start,
+)
 from shipid.data.trim import DEFAULT_LEAD_S
 from shipid.dynamics.equilibrium import surge_equilibrium
 from shipid.dynamics.hybrid import HybridModel
@@ -136,10 +142,8 @@ def validate_log(model, log: pd.DataFrame, name: str, method: str = "euler",
     """Validate ``model`` on one log (raises ``ShipidError`` when it cannot). With a bootstrap
     ``ensemble`` of the model: prediction bands and intervals on the predicted indices; with a
     cross-validated ``error_band``: the share of the log's samples within it."""
-    missing = [c for c in ("t", "delta", "u", "v", "r") if c not in log.columns]
-    if missing:  # a KeyError from deep inside before
-        raise ShipidError(f"{name}: missing column(s) {', '.join(missing)} (a log to validate "
-                          "against has t, delta, u, v and r)")  # fmt: skip
+    require_columns(log, ("t", "delta", "u", "v", "r"), name,
+                    "a log to validate against has t, delta, u, v and r")  # fmt: skip
     sim, metrics = free_run(model, log, method)
     trial = describe_trial(log, kind)
     # The indices come from the manoeuvre's approach; the errors from the whole log's free run.

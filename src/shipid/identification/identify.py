@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from shipid.data.log import common_rudder_convention, true_air_velocity
+from shipid.data.log import common_rudder_convention, require_columns, true_air_velocity
 from shipid.dynamics.model import (
     ManoeuvringModel,
     ModelStructure,
@@ -341,6 +341,10 @@ def _prepare(logs, model, form, gamma, drop, fixed, names, estimator, physics):
         logs = [logs]
     if not logs:
         raise ShipidError("no training logs given")
+    for i, log in enumerate(logs):  # the regressors read every state, whatever the structure
+        require_columns(log, ("t", "delta", "u", "v", "r"),
+                        names[i] if names and i < len(names) else None,
+                        "a training log has t, delta, u, v and r")  # fmt: skip
     logs, convention_notes = common_rudder_convention(list(logs))
     if form not in FORMS:
         raise ShipidError(f"unknown form {form!r}; use one of {', '.join(FORMS)}")

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from shipid.data.log import require_columns
 from shipid.data.preprocess import cumulative_integral
 from shipid.data.rudder_signal import ramp_start, rise_rate, rudder_for_events, stand_samples
 from shipid.data.trim import DEFAULT_LEAD_S, EXECUTE_FRACTION, first_swing_index, swing_start
@@ -365,6 +366,9 @@ def describe_trial(
     for both."""
     if kind is not None and kind not in KINDS:
         raise ShipidError(f"manoeuvre kind must be one of {', '.join(KINDS)}, got {kind!r}")
+    # The heading, and the yaw rate it is read with (or from, without ψ), besides the rudder.
+    require_columns(log, ("t", "delta", "r"), why="a trial's facts are read off its time, "
+                    "rudder, yaw rate and heading")  # fmt: skip
     t = log["t"].to_numpy()
     raw = log["delta"].to_numpy()
     delta, rudder_noise = rudder_for_events(t, raw)
