@@ -86,13 +86,14 @@ def short_trial():
 
 @pytest.mark.parametrize(("call", "column"), [
     ("identify", "v"), ("identify", "delta"), ("select", "r"), ("simulate_log", "delta"),
-    ("manoeuvre_indices", "r"), ("validate", "u"),
+    ("manoeuvre_indices", "r"), ("validate", "u"), ("refine", "delta"), ("output_error", "t"),
 ])  # fmt: skip
 def test_a_dataframe_without_a_column_is_named(short_trial, call, column):
     """The command line's reader checks its files; a DataFrame handed to these functions
     without a column raised a KeyError from deep inside. Now one line names the log and it."""
     from shipid.dynamics.simulate import simulate_log
     from shipid.errors import ShipidError
+    from shipid.identification.output_error import output_error
     from shipid.trials.indices import manoeuvre_indices
     from shipid.vessels.scale_ship import scale_ship_model
 
@@ -101,7 +102,9 @@ def test_a_dataframe_without_a_column_is_named(short_trial, call, column):
     calls = {"identify": lambda: shipid.identify(log),
              "select": lambda: shipid.select([short_trial, log]),
              "simulate_log": lambda: simulate_log(model, log),
-             "manoeuvre_indices": lambda: manoeuvre_indices(log)}  # fmt: skip
+             "manoeuvre_indices": lambda: manoeuvre_indices(log),
+             "refine": lambda: shipid.refine(model, log),
+             "output_error": lambda: output_error(model, log)}  # fmt: skip
     if call == "validate":  # a log that cannot be validated gets its error, the others go on
         (res,) = shipid.validate(model, log)
         assert res.error.startswith(f"zz.csv: missing column(s) {column} (")

@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from shipid.data.log import input_columns
+from shipid.data.log import input_columns, require_columns
 from shipid.dynamics.model import DOFS, ManoeuvringModel
 from shipid.dynamics.simulate import METHODS, DivergenceBounds, run_kernel
 from shipid.dynamics.terms import INPUT_SIGNALS, parse_term
@@ -96,6 +96,8 @@ def cut_logs(
 ) -> tuple[_Segments, float, float]:
     """The logs cut into segments of ``segment_s`` seconds (None: each log whole), padded to one
     length for the batch simulator; returns them, the logs' Δk and the segment length [s]."""
+    for log, name in zip(logs, names, strict=True):
+        require_columns(log, ("t", "delta"), name, "the free runs are driven by its rudder")
     dt = common_sampling_time(logs, names)
     longest = max(len(log) for log in logs) - 1
     if segment_s is None:
