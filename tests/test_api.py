@@ -111,3 +111,16 @@ def test_a_dataframe_without_a_column_is_named(short_trial, call, column):
         return
     with pytest.raises(ShipidError, match=rf"^zz\.csv: missing column\(s\) {column} \("):
         calls[call]()
+
+
+def test_choose_prefilter_asks_for_a_fit_function(short_trial):
+    """Given a structure where the fit function is asked for, it failed with "'ModelStructure'
+    object is not callable" from inside."""
+    from shipid.dynamics.model import get_structure
+    from shipid.errors import ShipidError
+
+    with pytest.raises(ShipidError, match="fit must be a function of the logs"):
+        shipid.choose_prefilter([short_trial], get_structure("blanke"))
+    cutoff, table = shipid.choose_prefilter(short_trial, lambda logs: shipid.identify(logs).model,
+                                            cutoffs=[0.5])  # a single log, as identify takes
+    assert len(table) == 2 and cutoff in (None, 0.5)

@@ -57,6 +57,12 @@ def choose_prefilter(
     from shipid.dynamics.simulate import simulate_log
     from shipid.identification.cross_validation import normalised_error
 
+    if not callable(fit):  # a structure given where the fit is asked for
+        raise ShipidError(f"choose_prefilter: fit must be a function of the logs that returns a "
+                          f"model, e.g. lambda logs: identify(logs, STRUCTURE).model; got "
+                          f"{type(fit).__name__}")  # fmt: skip
+    if isinstance(logs, pd.DataFrame):
+        logs = [logs]
     dt = float(np.median(np.diff(logs[0]["t"].to_numpy())))
     grid = [None, *(cutoffs if cutoffs is not None else candidate_cutoffs(dt))]
     rows, models = [], {}
