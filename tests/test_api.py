@@ -113,14 +113,20 @@ def test_a_dataframe_without_a_column_is_named(short_trial, call, column):
         calls[call]()
 
 
-def test_choose_prefilter_asks_for_a_fit_function(short_trial):
-    """Given a structure where the fit function is asked for, it failed with "'ModelStructure'
-    object is not callable" from inside."""
+def test_a_function_is_asked_for_where_one_is_given_something_else(short_trial):
+    """A structure or a model given where the fit function is asked for failed with "'X' object
+    is not callable" from inside; trim's 'auto' without the rudder with a KeyError."""
     from shipid.dynamics.model import get_structure
     from shipid.errors import ShipidError
 
-    with pytest.raises(ShipidError, match="fit must be a function of the logs"):
-        shipid.choose_prefilter([short_trial], get_structure("blanke"))
+    for call in (lambda: shipid.choose_prefilter([short_trial], get_structure("blanke")),
+                 lambda: shipid.bootstrap([short_trial], get_structure("blanke")),
+                 lambda: shipid.choose_residual(shipid.identify(short_trial).model,
+                                                [short_trial])):  # fmt: skip
+        with pytest.raises(ShipidError, match=r"^\w+: fit must be a function, e\.g\. "):
+            call()
+    with pytest.raises(ShipidError, match=r"missing column\(s\) delta \('auto' finds"):
+        shipid.trim(short_trial.drop(columns=["delta"]), start="auto")
     cutoff, table = shipid.choose_prefilter(short_trial, lambda logs: shipid.identify(logs).model,
                                             cutoffs=[0.5])  # a single log, as identify takes
     assert len(table) == 2 and cutoff in (None, 0.5)

@@ -16,5 +16,13 @@ class InfeasibleConstraintsError(ShipidError):
     straight-line stable, say); ``select`` drops such a candidate instead of stopping."""
 
 
+def require_function(value, where: str, example: str) -> None:
+    """One line where a function is asked for and something else given (a structure or a model
+    in ``fit``'s place failed with "'X' object is not callable" from inside)."""
+    if not callable(value):
+        raise ShipidError(f"{where}: fit must be a function, e.g. {example}; got "
+                          f"{type(value).__name__}")
+
+
 class ShipidWarning(UserWarning):
     """A result that stands but should be looked at; the message names what and why."""

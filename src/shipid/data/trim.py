@@ -8,6 +8,7 @@ import warnings
 import numpy as np
 import pandas as pd
 
+from shipid.data.log import require_columns
 from shipid.errors import ShipidError, ShipidWarning
 
 EXECUTE_FRACTION = 0.5  # a swing reaching this fraction of the largest one is a manoeuvre
@@ -132,6 +133,9 @@ def trim(log: pd.DataFrame, start: float | str | None = None, end: float | str |
     before the detected rudder execute (``rudder_execute_time``); ``end="auto"`` ends with the
     manoeuvre (``manoeuvre_end_time``); ``end="dropout"`` before the first span whose logged
     propeller speed cannot have driven the ship (``dropout_end``; the whole log if none)."""
+    auto = "auto" in (start, end)
+    require_columns(log, ("t", "delta") if auto else ("t",), name,
+                    "'auto' finds the manoeuvre by its rudder" if auto else "")  # fmt: skip
     t = log["t"]
     if isinstance(end, str) and end == "dropout":
         end = dropout_end(log, name)

@@ -23,7 +23,7 @@ import numpy as np
 import pandas as pd
 
 from shipid.dynamics.model import ManoeuvringModel
-from shipid.errors import ShipidError
+from shipid.errors import ShipidError, require_function
 
 DIVERGENCE_PENALTY = 2.0
 SEGMENTS = 4
@@ -57,10 +57,7 @@ def choose_prefilter(
     from shipid.dynamics.simulate import simulate_log
     from shipid.identification.cross_validation import normalised_error
 
-    if not callable(fit):  # a structure given where the fit is asked for
-        raise ShipidError(f"choose_prefilter: fit must be a function of the logs that returns a "
-                          f"model, e.g. lambda logs: identify(logs, STRUCTURE).model; got "
-                          f"{type(fit).__name__}")  # fmt: skip
+    require_function(fit, "choose_prefilter", "lambda logs: identify(logs, STRUCTURE).model")
     if isinstance(logs, pd.DataFrame):
         logs = [logs]
     dt = float(np.median(np.diff(logs[0]["t"].to_numpy())))

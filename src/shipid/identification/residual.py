@@ -28,7 +28,7 @@ import pandas as pd
 
 from shipid.dynamics.hybrid import KernelResidual
 from shipid.dynamics.model import ManoeuvringModel
-from shipid.errors import ShipidError
+from shipid.errors import ShipidError, require_function
 from shipid.identification.identify import varies
 
 GAMMAS = (1e-3, 1e-2, 1e-1, 1.0, 10.0)
@@ -173,6 +173,7 @@ def choose_residual(fit: Callable[[list[pd.DataFrame]], tuple[ManoeuvringModel, 
     from shipid.dynamics.simulate import simulate_log
     from shipid.identification.cross_validation import held_out_logs, normalised_error
 
+    require_function(fit, "choose_residual", "lambda logs: (identify(logs).model, logs)")
     names = list(names or [f"log {i}" for i in range(len(logs))])
     logs, names, cv, _ = held_out_logs(logs, names, cv, "--cv")
     features = residual_features(logs)

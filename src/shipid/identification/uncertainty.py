@@ -27,7 +27,7 @@ import numpy as np
 import pandas as pd
 
 from shipid.dynamics.model import DOFS, ManoeuvringModel, ModelStructure
-from shipid.errors import ShipidError
+from shipid.errors import ShipidError, require_function
 
 METHOD = "moving-block bootstrap of the regression equations"
 SELECTION_METHOD = "selection on resampled held-out logs, then a moving-block bootstrap"
@@ -354,6 +354,8 @@ def bootstrap(
     ``sample_weight``) over the equations of ``logs`` (one per sample but the last of each):
     moving blocks of ``block_s`` seconds, or whole logs (``block_s="log"``; ``"auto"``: as
     ``resolve_block`` says)."""
+    require_function(fit, "bootstrap",
+                     "lambda w: identify(logs, STRUCTURE, sample_weight=w).model")  # fmt: skip
     draw, block_s = resampler(logs, replicates, block_s)
     rng = np.random.default_rng(seed)
     point = fit(None)
