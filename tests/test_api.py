@@ -130,3 +130,17 @@ def test_a_function_is_asked_for_where_one_is_given_something_else(short_trial):
     cutoff, table = shipid.choose_prefilter(short_trial, lambda logs: shipid.identify(logs).model,
                                             cutoffs=[0.5])  # a single log, as identify takes
     assert len(table) == 2 and cutoff in (None, 0.5)
+
+
+def test_save_model_says_what_it_writes(short_trial, tmp_path):
+    """save_model(model, path), in write_log's order, failed inside on a 'str'; a bare model
+    given for the identification likewise."""
+    from shipid.errors import ShipidError
+
+    fit = shipid.identify(short_trial)
+    with pytest.raises(ShipidError, match=r"got str \(the path comes first"):
+        shipid.save_model(fit.model, tmp_path / "a.json")
+    with pytest.raises(ShipidError, match="ident must be what identify returns, got Manoeuvring"):
+        shipid.save_model(tmp_path / "b.json", fit.model)
+    assert shipid.save_model(tmp_path / "c.json", fit).exists()
+    assert not (tmp_path / "a.json").exists() and not (tmp_path / "b.json").exists()

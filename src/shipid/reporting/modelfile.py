@@ -177,7 +177,14 @@ def save_model(path: str | Path, ident: Identification, training_files: Sequence
                model: ManoeuvringModel | None = None,
                residual: KernelResidual | None = None) -> Path:  # fmt: skip
     """Write the model file of an identification atomically (with a kernel residual of its
-    model: ``load_model`` then gives the ``HybridModel``)."""
+    model: ``load_model`` then gives the ``HybridModel``). A bare model writes itself:
+    ``ManoeuvringModel.save(path)``."""
+    if not hasattr(ident, "model") or not hasattr(ident, "diagnostics"):
+        # save_model(model, path), as write_log(log, path) reads, failed inside on a 'str'.
+        hint = (" (the path comes first: save_model(path, identify(logs)), or model.save(path) "
+                "for a bare model)" if isinstance(ident, str | Path) else "")  # fmt: skip
+        raise ShipidError(f"save_model: ident must be what identify returns, got "
+                          f"{type(ident).__name__}{hint}")  # fmt: skip
     record = None if residual is None else {"residual": residual.to_dict(), "selection": None}
     text = model_text(ident, training_files, preprocessing=preprocessing, refinement=refinement,
                       plausibility=plausibility, model=model, residual=record)  # fmt: skip
