@@ -545,7 +545,8 @@ def _refit_alternatives(choice, args, logs, names, gamma) -> tuple[dict, bool]:
         try:
             out[name] = identify(logs, model=compared.structure, form=args.form, gamma=gamma,
                                  names=names, force=True, estimator=args.estimator,
-                                 physics=_physics(args, logs, compared.structure)).model
+                                 physics=_physics(args, logs, compared.structure,
+                                                  chosen=True)).model
         except ShipidError as exc:
             _warn(f"structure: {name}, which tied, keeps the comparison's fit ({exc})")
             out[name], refitted = compared, False
