@@ -364,6 +364,31 @@ def mmg_tied(tmp_path_factory):
     return model
 
 
+def test_a_bound_on_a_term_some_compared_structures_lack(mmg_tied, tmp_path, capsys):
+    """A bound on the race's yaw damping r, which blanke and blanke-speed lack: where 0 meets it
+    they hold it at 0 and are compared as without it (they were dropped as "implausible, not
+    scored", select refusing a bound its library cannot hold), and blanke, tied, is refitted as
+    the model (it kept the comparison's fit, "not a free term"); where 0 does not, they are not
+    fitted, and the choice says why."""
+    from shipid.cli import main
+    from shipid.reporting.modelfile import alternatives_fit, load_document
+
+    log = str(mmg_tied.parent / "zz.csv")
+    code = main(["identify", log, "--bound", "r: r >= -10", "-o", str(tmp_path / "a.json")])
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    assert "blanke 0.367, blanke-speed 0.442, blanke-race+race-damping 0.379" in out
+    assert "keeps the comparison's fit" not in err
+    doc = load_document(tmp_path / "a.json")
+    assert alternatives_fit(doc) == "LS-SVM fits with the model's prefilter and γ"
+    assert list(doc["identification"]["structure_choice"]["alternatives"]) == ["blanke"]
+    code = main(["identify", log, "--bound", "r: r <= -0.01", "-o", str(tmp_path / "b.json")])
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    assert ("not fitted: blanke (bounds: r: r [-inf, -0.01] cannot be met: blanke has no such "
+            "term, so its coefficient is 0)") in out
+
+
 def test_the_tied_structures_are_fitted_as_the_models_own_fit(mmg_tied):
     """The file's tied fits are not the comparison's (γ 1e4, unfiltered): each is refitted on the
     logs as the file's model was (its prefilter and γ), so that a table of the model beside

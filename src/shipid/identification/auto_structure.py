@@ -50,7 +50,7 @@ from shipid.dynamics.model import ModelStructure, StructureEdit, get_structure
 from shipid.errors import ShipidError
 from shipid.identification.cross_validation import choice_cv
 from shipid.identification.identify import material_wind, spread, varies, varying_propulsion
-from shipid.identification.physics import PhysicsOptions
+from shipid.identification.physics import PhysicsOptions, bounds_held_by
 
 AUTO = "auto"
 PAPER = "blanke"
@@ -552,22 +552,27 @@ def _paper_or_race(logs, names, physics, cv, estimator, drop=None, announce=_qui
              + (", each with the rudder's normal force (--rudder-normal)" if rudder else "") + "…")
     inside = _blocks_inside(logs, cv)
     scores, models, failed, faults, ruled_out = {}, {}, [], {}, {}
+    not_fitted: dict[str, str] = {}
 
     def compare(name: str) -> None:
         """Fit ``name`` as the comparison fits each candidate and file its score or faults."""
         structure = _without(structures[name], drop)
         try:
+            # A bound on a term the structure lacks: held at 0 (select refuses it, as a typo
+            # in a library a user gives).
+            held = bounds_held_by(physics, structure)
             fitted_on = logs
             if prefilters is not None:
-                prefilters[name] = _prefilter(logs, structure, names, physics, estimator)
+                prefilters[name] = _prefilter(logs, structure, names, held, estimator)
                 if prefilters[name] is not None:
                     from shipid.data.preprocess import lowpass
 
                     fitted_on = [lowpass(log, prefilters[name]) for log in logs]
             sel = select(fitted_on, library=structure, search="none", cv=cv, gammas=(1e4,),
-                         physics=physics, estimator=estimator, names=names)  # fmt: skip
+                         physics=held, estimator=estimator, names=names)  # fmt: skip
         except ShipidError as exc:
             failed.append(exc)
+            not_fitted[name] = str(exc)
             return
         row = sel.candidates.iloc[0]
         score, se = float(row["score"]), float(row["score_se"])
@@ -642,9 +647,11 @@ def _paper_or_race(logs, names, physics, cv, estimator, drop=None, announce=_qui
     # The ones left out are named with why: the note read as if they had been scored (the
     # `tanker` vessel's 20/20 zig-zags: blanke and the race structure end their 35° turns astern).
     implausible = [f"{k} ({faults[k][2]})" if k in faults else k for k in candidates
-                   if k not in scores]  # fmt: skip
+                   if k not in scores and k not in not_fitted]  # fmt: skip
     if implausible:
         table += f"; implausible, not scored: {', '.join(implausible)}"
+    if not_fitted:  # they were listed as implausible
+        table += "; not fitted: " + ", ".join(f"{k} ({why})" for k, why in not_fitted.items())
     warnings = _predictions_apart({k: models[k] for k in tied}, logs) if len(tied) > 1 \
         else []  # fmt: skip
     alternatives = {k: models[k] for k in tied if k != name}

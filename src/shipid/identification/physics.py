@@ -47,12 +47,16 @@ import functools
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pandas as pd
 
 from shipid.dynamics.terms import OPS, parse_term, rudder_normal_angle, term_matrix
 from shipid.errors import InfeasibleConstraintsError, ShipidError
+
+if TYPE_CHECKING:
+    from shipid.dynamics.model import ModelStructure
 
 RUDDER = "rudder"
 
@@ -476,6 +480,27 @@ def _approach_rows(dof_terms: Sequence[str], fixed: Mapping[str, float], has_con
     E = np.column_stack([rows[:, :k], np.full(len(states), 1.0 if has_constant else 0.0)])
     f = -(rows[:, k:] @ np.array([fixed[t] for t in fixed])) if fixed else np.zeros(len(states))
     return E, f, states
+
+
+def bounds_held_by(options: PhysicsOptions | None,
+                   structure: ModelStructure) -> PhysicsOptions | None:  # fmt: skip
+    """``options`` for fitting ``structure`` where it was chosen, not given: a bound on a term
+    it lacks is left out where 0 meets it (the structure holds the term at 0), and makes it
+    infeasible where 0 does not (``InfeasibleConstraintsError``)."""
+    if options is None or not options.bounds:
+        return options
+    kept: dict[str, dict[str, tuple[float, float]]] = {}
+    for dof, terms in options.bounds.items():
+        have = {parse_term(t).text for t in structure.terms.get(dof, ())}
+        for term, (lo, hi) in terms.items():
+            text = parse_term(term).text
+            if text in have:
+                kept.setdefault(dof, {})[term] = (lo, hi)
+            elif not lo <= 0.0 <= hi:
+                raise InfeasibleConstraintsError(
+                    f"bounds: {dof}: {text} [{lo:g}, {hi:g}] cannot be met: {structure.name} "
+                    "has no such term, so its coefficient is 0")  # fmt: skip
+    return dataclasses.replace(options, bounds=kept or None)
 
 
 def dof_physics(options: PhysicsOptions | None, dof: str, names: Sequence[str], has_constant: bool,
