@@ -258,8 +258,8 @@ def _vessel_names() -> tuple[str, ...]:
 def _physics(args, logs, structure, searched: bool = False, chosen: bool = False):
     """PhysicsOptions of --prior, --constraints, --bound (None when none is given);
     ``searched``: ``structure`` is a library terms are chosen from, not the structure fitted;
-    ``chosen``: the structures fitted are chosen, not given, so a bound on a term one lacks is
-    passed over (and said so)."""
+    ``chosen``: the structures fitted are chosen, not given, so one without a bounded term holds
+    it at 0 (``PhysicsOptions.bounds_where_present``) instead of being refused."""
     from shipid.identification.physics import (
         PhysicsOptions,
         parse_constraints,

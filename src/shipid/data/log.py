@@ -96,6 +96,17 @@ def require_columns(log: pd.DataFrame, columns, name: str | None = None, why: st
                           + (f" ({why})" if why else ""))
 
 
+STATE_COLUMNS = ("t", "delta", "u", "v", "r")
+
+
+def require_states(logs, names=None, what: str = "log") -> None:
+    """``require_columns`` of t, δ, u, v and r on each of ``logs`` (a DataFrame or several),
+    named by ``names`` where given: what a fit or a free run of every state reads."""
+    for i, log in enumerate([logs] if isinstance(logs, pd.DataFrame) else logs):
+        require_columns(log, STATE_COLUMNS, names[i] if names and i < len(names) else None,
+                        f"a {what} has t, delta, u, v and r")  # fmt: skip
+
+
 # A log whose first 2 % run slower than this share of its typical speed (the 90th percentile of
 # u) starts without headway (a random run from rest): its running condition is then the median
 # over the samples ahead at RUNNING_SHARE of the typical speed or more.

@@ -35,7 +35,7 @@ import pandas as pd
 
 from shipid.data.log import (
     mean_true_wind,
-    require_columns,
+    require_states,
     rudder_positive,
     starboard_sign,
     steady_start,
@@ -142,8 +142,7 @@ def validate_log(model, log: pd.DataFrame, name: str, method: str = "euler",
     """Validate ``model`` on one log (raises ``ShipidError`` when it cannot). With a bootstrap
     ``ensemble`` of the model: prediction bands and intervals on the predicted indices; with a
     cross-validated ``error_band``: the share of the log's samples within it."""
-    require_columns(log, ("t", "delta", "u", "v", "r"), name,
-                    "a log to validate against has t, delta, u, v and r")  # fmt: skip
+    require_states(log, [name], "log to validate against")
     sim, metrics = free_run(model, log, method)
     trial = describe_trial(log, kind)
     # The indices come from the manoeuvre's approach; the errors from the whole log's free run.

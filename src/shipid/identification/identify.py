@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from shipid.data.log import common_rudder_convention, require_columns, true_air_velocity
+from shipid.data.log import common_rudder_convention, require_states, true_air_velocity
 from shipid.dynamics.model import (
     ManoeuvringModel,
     ModelStructure,
@@ -25,6 +25,7 @@ from shipid.identification.estimators import check_estimator_name, fit_linear
 from shipid.identification.physics import (
     PhysicsOptions,
     dof_physics,
+    held_note,
     inequality_notes,
     still_air,
     with_stability,
@@ -66,16 +67,6 @@ class Identification:
 
 def _display(name: str) -> str:
     return parse_term(name).display() or "1"
-
-
-def _held_note(dof: str, name: str, j: int, coef: np.ndarray, extra) -> str:
-    """The note of the coefficient ``j`` (``name``) the fit holds at a bound: given (its two
-    bounds equal) or where the unconstrained fit would go past it."""
-    why = extra.reasons.get(name, "bound")
-    if extra.lower[j] == extra.upper[j]:
-        return f"{dof}: {_display(name)} held at {coef[j]:.4g} ({why}): given, not fitted"
-    return (f"{dof}: {_display(name)} held at its bound {coef[j]:.4g} ({why}): the "
-            "unconstrained fit goes past it")
 
 
 def _diagnose(p: RegressionProblem, coef: np.ndarray, bias: float, gamma: float
@@ -341,10 +332,7 @@ def _prepare(logs, model, form, gamma, drop, fixed, names, estimator, physics):
         logs = [logs]
     if not logs:
         raise ShipidError("no training logs given")
-    for i, log in enumerate(logs):  # the regressors read every state, whatever the structure
-        require_columns(log, ("t", "delta", "u", "v", "r"),
-                        names[i] if names and i < len(names) else None,
-                        "a training log has t, delta, u, v and r")  # fmt: skip
+    require_states(logs, names, "training log")  # the regressors read every state
     logs, convention_notes = common_rudder_convention(list(logs))
     if form not in FORMS:
         raise ShipidError(f"unknown form {form!r}; use one of {', '.join(FORMS)}")
@@ -502,7 +490,10 @@ def identify(
         held = [] if extra.active is None else [n for n, a in zip(p.names, extra.active,
                                                                    strict=True) if a]  # fmt: skip
         diagnostics[dof]["at_bound"] = held
-        notes += extra.notes + [_held_note(dof, n, p.names.index(n), g, extra) for n in held]
+        notes += extra.notes + [
+            held_note(dof, n, g[j], extra.reasons.get(n, "bound"),
+                      extra.lower[j] == extra.upper[j], "unconstrained fit")
+            for j, n in ((p.names.index(n), n) for n in held)]  # fmt: skip
         if extra.equalities is not None and sample_weight is None:
             notes += _equality_cost(p, g, b, estimator, gamma, extra)
         cond = diagnostics[dof]["condition_number"]

@@ -482,6 +482,28 @@ def _approach_rows(dof_terms: Sequence[str], fixed: Mapping[str, float], has_con
     return E, f, states
 
 
+def held_note(dof: str, term: str, value: float, why: str | None, given: bool,
+              past: str) -> str:
+    """The note of a coefficient its bounds hold: given (the two bounds equal) or at a bound
+    the ``past`` fit ("unconstrained fit", "unbounded refinement") would go past. The LS-SVM fit,
+    output error and the refinement say it alike."""
+    where = f"at {value:.4g}" if given else f"at its bound {value:.4g}"
+    what = "given, not fitted" if given else f"the {past} goes past it"
+    return (f"{dof}: {parse_term(term).display() or '1'} held {where}"
+            + (f" ({why})" if why else "") + f": {what}")
+
+
+def _unmet_at_zero(dof: str, term: str, bound: tuple[float, float], who: str
+                   ) -> InfeasibleConstraintsError | None:  # fmt: skip
+    """A structure (``who``) without ``term`` holds it at 0: None where 0 meets ``bound``, else
+    the error that it cannot."""
+    lo, hi = bound
+    if lo <= 0.0 <= hi:
+        return None
+    return InfeasibleConstraintsError(f"bounds: {dof}: {term} [{lo:g}, {hi:g}] cannot be met: "
+                                      f"{who} has no such term, so its coefficient is 0")
+
+
 def bounds_held_by(options: PhysicsOptions | None,
                    structure: ModelStructure) -> PhysicsOptions | None:  # fmt: skip
     """``options`` for fitting ``structure`` where it was chosen, not given: a bound on a term
@@ -496,10 +518,8 @@ def bounds_held_by(options: PhysicsOptions | None,
             text = parse_term(term).text
             if text in have:
                 kept.setdefault(dof, {})[term] = (lo, hi)
-            elif not lo <= 0.0 <= hi:
-                raise InfeasibleConstraintsError(
-                    f"bounds: {dof}: {text} [{lo:g}, {hi:g}] cannot be met: {structure.name} "
-                    "has no such term, so its coefficient is 0")  # fmt: skip
+            elif (error := _unmet_at_zero(dof, text, (lo, hi), structure.name)) is not None:
+                raise error
     return dataclasses.replace(options, bounds=kept or None)
 
 
@@ -525,12 +545,9 @@ def dof_physics(options: PhysicsOptions | None, dof: str, names: Sequence[str], 
         raise ShipidError(f"bounds: {dof}: {', '.join(unknown)} is not a free term of the "
                           f"{dof} equation ({', '.join(names) or 'none'})")  # fmt: skip
     # A chosen structure without the term holds it at 0: within its bound, or outside it.
-    outside = [t for t in unknown if not user[t][0] <= 0.0 <= user[t][1]]
-    if outside:
-        lo, hi = user[outside[0]]
-        raise InfeasibleConstraintsError(
-            f"bounds: {dof}: {outside[0]} [{lo:g}, {hi:g}] cannot be met: the structure has no "
-            f"such term, so its coefficient is 0 (give a structure with it, --model)")
+    for term in unknown:
+        if (error := _unmet_at_zero(dof, term, user[term], "the structure")) is not None:
+            raise error
     for j, name in enumerate(names):
         lo, hi, why = -math.inf, math.inf, []
         rule = _sign_bounds(dof, name, s) if options.signs else None

@@ -33,9 +33,10 @@ import pandas as pd
 from shipid.data.log import input_columns, require_columns
 from shipid.dynamics.model import DOFS, ManoeuvringModel
 from shipid.dynamics.simulate import METHODS, DivergenceBounds, run_kernel
-from shipid.dynamics.terms import INPUT_SIGNALS, parse_term
+from shipid.dynamics.terms import INPUT_SIGNALS
 from shipid.errors import ShipidError
 from shipid.evaluation.validate import free_run
+from shipid.identification.physics import held_note
 from shipid.identification.regression import common_sampling_time
 
 SHOT_STATES = ("u", "v", "r")
@@ -320,17 +321,11 @@ class FreeCoefficients:
               reasons: Mapping[str, Mapping[str, str]] | None, fit: str) -> list[str]:
         """A note per free coefficient held at its bound (``at_bound``, over the free ones, the
         value in ``x``) and per given one; ``fit`` names the fit that would go past the bound."""
-        notes = []
-        rows, cols = self.rows, self.cols
-        held = [((DOFS[rows[j]], model.term_texts[cols[j]]), x[j], f"at its bound {x[j]:.4g}",
-                 f": the unbounded {fit} goes past it") for j in np.flatnonzero(at_bound)]
-        held += [(key, value, f"at {value:.4g}", ": given, not fitted")
-                 for key, value in self.given.items()]  # fmt: skip
-        for (dof, term), _, where, what in held:
-            why = ((reasons or {}).get(dof) or {}).get(term)
-            notes.append(f"{dof}: {parse_term(term).display() or '1'} held {where}"
-                         + (f" ({why})" if why else "") + what)
-        return notes
+        held = [((DOFS[self.rows[j]], model.term_texts[self.cols[j]]), x[j], False)
+                for j in np.flatnonzero(at_bound)]
+        held += [(key, value, True) for key, value in self.given.items()]
+        return [held_note(dof, term, value, ((reasons or {}).get(dof) or {}).get(term), given,
+                          f"unbounded {fit}") for (dof, term), value, given in held]
 
 
 def given_coefficients(model: ManoeuvringModel,

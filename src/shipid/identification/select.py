@@ -47,7 +47,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from shipid.data.log import approach, common_rudder_convention, input_columns, require_columns
+from shipid.data.log import approach, common_rudder_convention, input_columns, require_states
 from shipid.dynamics.model import DOFS, ManoeuvringModel, ModelStructure, get_structure
 from shipid.dynamics.similarity import similar_library
 from shipid.dynamics.simulate import DivergenceBounds, input_array, run_kernel
@@ -515,7 +515,7 @@ def cross_validate(
     options = SelectOptions(library=structure, search="none", gammas=tuple(gammas), cv=cv,
                             estimator=estimator, method=method,
                             divergence_penalty=divergence_penalty)  # fmt: skip
-    _require_states(logs, names)
+    require_states(logs, names, "log to select on")  # its free runs score every state
     logs, names, data, folds, scorer = _setup(logs, names, options)
     full = {d: tuple(data.library.terms[d]) for d in data.library.dofs}
     rows = []
@@ -588,14 +588,6 @@ def _each_at_one_rps(logs: Sequence[pd.DataFrame]) -> bool:
     from shipid.identification.plausibility import held_propeller_speeds
 
     return held_propeller_speeds(logs)[1]
-
-
-def _require_states(logs, names) -> None:
-    """The free runs are scored on every state: each log has t, δ, u, v and r."""
-    for i, log in enumerate([logs] if isinstance(logs, pd.DataFrame) else logs):
-        require_columns(log, ("t", "delta", "u", "v", "r"),
-                        names[i] if names and i < len(names) else None,
-                        "a log to select on has t, delta, u, v and r")  # fmt: skip
 
 
 def _setup(logs, names, options: SelectOptions):
@@ -677,7 +669,7 @@ def select(
     )
 
     options = dataclasses.replace(options or SelectOptions(), **overrides)
-    _require_states(logs, names)
+    require_states(logs, names, "log to select on")  # its free runs score every state
     given = given_steady_speeds(options.physics)  # before the logs' approaches fill them in
     # The constraints' approaches, resolved once for the thousand fits of the search.
     options = dataclasses.replace(options, physics=with_approaches(
