@@ -547,7 +547,7 @@ def dof_physics(options: PhysicsOptions | None, dof: str, names: Sequence[str], 
     # A chosen structure without the term holds it at 0: within its bound, or outside it.
     for term in unknown:
         if (error := _unmet_at_zero(dof, term, user[term], "the structure")) is not None:
-            raise error
+            raise InfeasibleConstraintsError(f"{error} (give a structure with it, --model)")
     for j, name in enumerate(names):
         lo, hi, why = -math.inf, math.inf, []
         rule = _sign_bounds(dof, name, s) if options.signs else None
