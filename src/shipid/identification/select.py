@@ -1008,7 +1008,10 @@ def _fold_report(data, scorer: _Scorer, weights, chosen: Candidate, logs, names)
         model = _averaged_model(data, weights, chosen, train, scorer.options, "fold model")
         for h in fold:
             try:
-                v = validate_log(model, logs[h], names[h], scorer.options.method)
+                # The report keeps the errors and indices, not how the closed loop's indices
+                # move with its start's noise: those ten runs per log were drawn for nothing.
+                v = validate_log(model, logs[h], names[h], scorer.options.method,
+                                 start_draws=False)  # fmt: skip
                 out.append({"held_out": names[h], "diverged": v.simulation.diverged,
                             "metrics": {s: v.metrics[s]["std"] for s in STATES},
                             "spread": {s: float(np.std(logs[h][s])) for s in STATES},
