@@ -53,6 +53,38 @@ def test_samples_after_a_divergence_are_outside():
     assert band.shares_within(measured, np.zeros((80, 3)))["u"] == 0.8
 
 
+def test_each_held_out_run_is_summed_up_by_its_rms_error_over_its_spread():
+    """A free run off its log by a constant c over a sine of amplitude a: rms error c, the log's
+    standard deviation a/√2 (closed forms); its mean alone, the ratio 1; a run that diverged
+    is judged over its part and says where it stopped."""
+    t = np.linspace(0.0, 20 * np.pi, 4001)[:-1]  # whole periods
+    measured = np.column_stack([2.0 * np.sin(t), 0.5 * np.cos(t), 0.1 * np.sin(t)])
+    offset = measured + np.array([0.3, 0.0, 0.01])
+    mean_only = np.tile(measured.mean(axis=0), (len(t), 1))
+    band = error_band([(measured, offset), (measured, mean_only), (measured, offset[:1000])],
+                      names=["a.csv", "b.csv", "c.csv"])  # fmt: skip
+    a, b, c = band.runs
+    assert a.name == "a.csv" and not a.diverged
+    assert a.error_over_spread["u"] == pytest.approx(0.3 / (2.0 / math.sqrt(2)), rel=1e-9)
+    assert a.error_over_spread["v"] == 0.0
+    assert a.error_over_spread["r"] == pytest.approx(0.01 / (0.1 / math.sqrt(2)), rel=1e-9)
+    assert b.error_over_spread == pytest.approx({"u": 1.0, "v": 1.0, "r": 1.0}, rel=1e-9)
+    assert c.diverged and (c.samples, c.simulated) == (4000, 1000)
+    assert band.run_rows()[2]["diverged"] == "after 1000 of 4000 samples"
+    # Kept through the model file and a rescaling (ratios have no units); older files had none.
+    back = ErrorBand.from_dict(json.loads(json.dumps(band.scaled(2.0).to_dict())))
+    assert back.runs == band.runs
+    old = band.to_dict()
+    del old["runs"]
+    assert ErrorBand.from_dict(old).runs == ()
+    bad = band.to_dict()
+    bad["runs"][1]["simulated"] = 0
+    with pytest.raises(ShipidError, match=r"runs\[1\]: simulated must be within"):
+        ErrorBand.from_dict(bad)
+    with pytest.raises(ShipidError, match="3 runs got 2 names"):
+        error_band([(measured, offset)] * 3, names=["a", "b"])
+
+
 @pytest.fixture(scope="module")
 def zigzags():
     return noisy_zigzags(30)
@@ -72,6 +104,10 @@ def test_select_band_is_the_quantile_of_its_held_out_free_runs(zigzags):
         assert sel.error_band.half_width[s] == pytest.approx(np.sort(errors[:, j])[k - 1],
                                                              rel=1e-9)  # fmt: skip
     assert sel.error_band.logs == 3 and sel.error_band.samples == len(errors)
+    for run_of, err, log, fold in zip(sel.error_band.runs, runs, zigzags, sel.folds, strict=True):
+        assert run_of.name == fold["held_out"]
+        assert run_of.error_over_spread["r"] == pytest.approx(
+            np.sqrt(np.mean(err[:, 2] ** 2)) / np.std(log["r"].to_numpy()), rel=1e-9)
     # Validated with it: each log's share of samples inside, as counted here.
     v = validate(sel.model, zigzags[:1], error_band=sel.error_band)[0]
     err = np.abs(v.simulation.log[["u", "v", "r"]].to_numpy() - zigzags[0][["u", "v", "r"]].to_numpy())
@@ -156,6 +192,14 @@ def test_identify_error_band_is_its_fit_without_each_log(zigzags, tmp_path, caps
         fit = identify([x for j, x in enumerate(logs) if j != i], model="blanke", force=True).model
         errors.append(np.abs(simulate_log(fit, log).log[["u", "v", "r"]].to_numpy()
                              - log[["u", "v", "r"]].to_numpy()))  # fmt: skip
+        # Each held-out log's own figure, printed and stored: rms error over its spread.
+        run_of_it = band.runs[i]
+        assert run_of_it.name == str(paths[i]) and not run_of_it.diverged
+        for j, s in enumerate("uvr"):
+            expected = np.sqrt(np.mean(errors[-1][:, j] ** 2)) / np.std(log[s].to_numpy())
+            assert run_of_it.error_over_spread[s] == pytest.approx(expected, rel=1e-9)
+    assert "each held-out log, run free on the model fitted without it" in out
+    assert f"| {paths[0]} |" in out
     errors = np.vstack(errors)
     k = math.ceil((len(errors) + 1) * 0.95)
     assert band.half_width["v"] == pytest.approx(np.sort(errors[:, 1])[k - 1], rel=1e-9)

@@ -219,10 +219,19 @@ def cmd_identify(args) -> int:
             residual["residual"] else "γ and the prefilter"
         return found, f"{found.describe()} ({chosen} as chosen on all logs); stored for validate"
 
+    def print_runs(found) -> None:
+        """How each held-out log (or block) of the band fared: what the fit predicts of a log
+        it was not fitted to."""
+        print(f"each held-out {found.held_out[:-1]}, run free on the model fitted without it "
+              "(rms error over its spread, bias included; 1: no better than the log's own "
+              "mean):")  # fmt: skip
+        print(_pd().DataFrame(found.run_rows()).to_markdown(index=False, floatfmt=".3g"))
+
     band = None
     if explicit_band:
         band, said = cv_band(args.error_band)
         print(said)
+        print_runs(band)
     ensemble = None
     if args.bootstrap is not None:
         from shipid.identification.identify import weighted_refit
@@ -338,6 +347,7 @@ def cmd_identify(args) -> int:
         # By default, from two logs on: how far the free runs stray from a log left out.
         band, said = cv_band("logo")
         print(f"{said} (--error-band none to skip)")
+        print_runs(band)
     sl = plausibility["straight_line"]
     if sl:
         print(f"straight-line {'stable' if sl['stable'] else 'UNSTABLE'} (largest sway–yaw "

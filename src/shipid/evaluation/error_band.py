@@ -30,6 +30,57 @@ METHOD = "conformal quantile of the absolute free-run errors on held-out logs"
 
 
 @dataclass(frozen=True)
+class HeldOutRun:
+    """How one held-out free run of a band fared: the log (or block) ``name``, its ``samples``,
+    how many of them the free run reached (``simulated``; fewer where it diverged) and, per
+    state, the rms error over that part divided by the log's standard deviation: 1 is no better
+    than the log's own mean, the error's bias included."""
+
+    name: str
+    samples: int
+    simulated: int
+    error_over_spread: Mapping[str, float]
+
+    @property
+    def diverged(self) -> bool:
+        """Whether the free run stopped short of the log's end."""
+        return self.simulated < self.samples
+
+    def to_dict(self) -> dict:
+        """JSON-ready (a ratio that cannot be formed, a log without spread, as null)."""
+        return {"name": self.name, "samples": self.samples, "simulated": self.simulated,
+                "error_over_spread": {s: None if not math.isfinite(x) else float(x)
+                                      for s, x in self.error_over_spread.items()}}  # fmt: skip
+
+    @classmethod
+    def from_dict(cls, data: Mapping, where: str) -> HeldOutRun:
+        """A run of a model file's band, validated."""
+        try:
+            ratios = {s: math.nan if data["error_over_spread"][s] is None
+                      else float(data["error_over_spread"][s]) for s in STATES}  # fmt: skip
+            run = cls(str(data["name"]), int(data["samples"]), int(data["simulated"]), ratios)
+        except (KeyError, TypeError, ValueError) as exc:
+            raise ShipidError(f"{where}: not a held-out run ({exc})") from None
+        if not 0 < run.simulated <= run.samples:
+            raise ShipidError(f"{where}: simulated must be within 1…samples ({run.samples}), "
+                              f"got {run.simulated}")  # fmt: skip
+        return run
+
+
+def held_out_run(name: str, measured: np.ndarray, simulated: np.ndarray) -> HeldOutRun:
+    """The ``HeldOutRun`` of one free run: ``measured`` (n, 3) u, v, r of the held-out log and
+    ``simulated`` (m ≤ n, 3), its free run up to where it stopped."""
+    n, m = len(measured), len(simulated)
+    err = simulated - measured[:m]
+    ratios = {}
+    for j, s in enumerate(STATES):
+        spread = float(np.std(measured[:, j]))
+        rms = float(np.sqrt(np.mean(err[:, j] ** 2))) if m else math.nan
+        ratios[s] = rms / spread if spread > 0 else math.nan
+    return HeldOutRun(name, n, m, ratios)
+
+
+@dataclass(frozen=True)
 class ErrorBand:
     """Half-width per state (u, v [m/s], r [rad/s]; ∞ where too many held-out samples came after a
     divergence) holding ``level`` of the held-out free-run errors of ``logs`` logs, ``samples``
@@ -42,6 +93,8 @@ class ErrorBand:
     method: str = METHOD
     # What was held out: "logs", or "blocks" (cut from logs: shorter runs that stray less)
     held_out: str = "logs"
+    # How each held-out run fared (none in files written before they were kept)
+    runs: tuple[HeldOutRun, ...] = ()
 
     def shares_within(self, measured: np.ndarray, simulated: np.ndarray) -> dict[str, float]:
         """Per state, the share of a log's samples (``measured`` (n, 3) u, v, r) whose free run
@@ -60,7 +113,7 @@ class ErrorBand:
         w = self.half_width
         return ErrorBand({"u": w["u"] * speed_ratio, "v": w["v"] * speed_ratio,
                           "r": w["r"] / speed_ratio}, self.level, self.logs, self.samples,
-                         self.method, self.held_out)  # fmt: skip
+                         self.method, self.held_out, self.runs)  # fmt: skip
 
     def describe(self) -> str:
         """One line: the half-widths and where they come from."""
@@ -73,12 +126,21 @@ class ErrorBand:
                 f"u {fmt(self.half_width['u'])} m/s, v {fmt(self.half_width['v'])} m/s, "
                 f"r {fmt(self.half_width['r'])} rad/s")
 
+    def run_rows(self) -> list[dict]:
+        """One row per held-out run, for a table: its name, the rms error over its spread of u,
+        v and r, and where its free run diverged."""
+        return [{f"held-out {self.held_out[:-1]}": r.name,
+                 **{f"{s} error / spread": r.error_over_spread[s] for s in STATES},
+                 "diverged": (f"after {r.simulated} of {r.samples} samples" if r.diverged
+                              else "no")} for r in self.runs]  # fmt: skip
+
     def to_dict(self) -> dict:
         """JSON-ready (∞ as null)."""
         return {"level": self.level, "logs": self.logs, "samples": self.samples,
                 "method": self.method, "held_out": self.held_out,
                 "half_width": {s: None if math.isinf(x) else float(x)
-                               for s, x in self.half_width.items()}}  # fmt: skip
+                               for s, x in self.half_width.items()},
+                "runs": [r.to_dict() for r in self.runs]}  # fmt: skip
 
     @classmethod
     def from_dict(cls, data: Mapping, where: str = "error band") -> ErrorBand:
@@ -94,7 +156,11 @@ class ErrorBand:
         held_out = str(data.get("held_out", "logs"))
         if held_out not in ("logs", "blocks"):
             raise ShipidError(f"{where}: held_out must be 'logs' or 'blocks', got {held_out!r}")
-        return cls(widths, level, logs, samples, str(data.get("method", METHOD)), held_out)
+        found = data.get("runs") or []
+        if not isinstance(found, list):
+            raise ShipidError(f"{where}: runs must be a list")
+        runs = tuple(HeldOutRun.from_dict(r, f"{where}: runs[{i}]") for i, r in enumerate(found))
+        return cls(widths, level, logs, samples, str(data.get("method", METHOD)), held_out, runs)
 
 
 def conformal_quantile(errors: np.ndarray, level: float = LEVEL) -> float:
@@ -106,12 +172,16 @@ def conformal_quantile(errors: np.ndarray, level: float = LEVEL) -> float:
 
 
 def error_band(runs: Sequence[tuple[np.ndarray, np.ndarray]], level: float = LEVEL,
-               held_out: str = "logs") -> ErrorBand:  # fmt: skip
+               held_out: str = "logs", names: Sequence[str] | None = None) -> ErrorBand:  # fmt: skip
     """The band from held-out free runs: pairs of ``measured`` (n, 3) and ``simulated`` (m ≤ n,
     3) u, v, r; the n − m samples after a divergence count as infinite errors. ``held_out``:
-    what the runs are ("logs", or "blocks" of logs)."""
+    what the runs are ("logs", or "blocks" of logs); ``names``: theirs, for the runs' summary
+    (``ErrorBand.runs``; by default "1", "2", ...)."""
     if not runs:
         raise ShipidError("an error band needs at least one held-out free run")
+    names = list(names) if names is not None else [str(i + 1) for i in range(len(runs))]
+    if len(names) != len(runs):
+        raise ShipidError(f"an error band of {len(runs)} runs got {len(names)} names")
     per_state = {s: [] for s in STATES}
     for measured, simulated in runs:
         n, m = len(measured), len(simulated)
@@ -119,8 +189,10 @@ def error_band(runs: Sequence[tuple[np.ndarray, np.ndarray]], level: float = LEV
         for j, s in enumerate(STATES):
             per_state[s].append(np.concatenate([err[:, j], np.full(n - m, np.inf)]))
     widths = {s: conformal_quantile(np.concatenate(per_state[s]), level) for s in STATES}
+    summary = tuple(held_out_run(name, np.asarray(m, float), np.asarray(sim, float))
+                    for name, (m, sim) in zip(names, runs, strict=True))  # fmt: skip
     return ErrorBand(widths, level, len(runs), int(sum(len(m) for m, _ in runs)), METHOD,
-                     held_out)
+                     held_out, summary)
 
 
 def cross_validated_band(fit, logs, names, cv: str = "auto", method: str = "euler",
@@ -138,4 +210,4 @@ def cross_validated_band(fit, logs, names, cv: str = "auto", method: str = "eule
         model = fit([x for j, x in enumerate(logs) if j != k])
         sim = simulate_log(model, held, method).log
         runs.append((held[list(STATES)].to_numpy(dtype=float), sim[list(STATES)].to_numpy()))
-    return error_band(runs, level, held_out)
+    return error_band(runs, level, held_out, names)

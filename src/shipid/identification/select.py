@@ -825,7 +825,8 @@ def select(
     if failed:
         notes.append(f"{len(failed)} candidate(s) diverged in every fold (kept in the table)")
     held = "blocks" if parse_cv(options.cv)[0] == "blocks" else "logs"
-    band = error_band(held_out_runs, held_out=held) if held_out_runs else None
+    band = error_band([run for _, run in held_out_runs], held_out=held,
+                      names=[name for name, _ in held_out_runs]) if held_out_runs else None
     return Selection(model, ident, current.gamma, current.score, table, folds_report,
                      options, library, ranking, notes + ident.warnings, shared, band,
                      ident.model, *checked, best_ruled_out=best_ruled_out,
@@ -998,7 +999,7 @@ def _table(cands, chosen: Candidate) -> pd.DataFrame:
 def _fold_report(data, scorer: _Scorer, weights, chosen: Candidate, logs, names):
     """Per held-out log: the model (the candidates of ``weights`` averaged; the chosen one
     alone: [(chosen, 1)]) fitted without it, its free-run errors (the ``validate`` metrics) and
-    indices; and the (measured, simulated) u, v, r of those runs."""
+    indices; and each run's name with the (measured, simulated) u, v, r of it."""
     from shipid.evaluation.validate import validate_log
 
     out, runs = [], []
@@ -1016,7 +1017,8 @@ def _fold_report(data, scorer: _Scorer, weights, chosen: Candidate, logs, names)
                             "metrics": {s: v.metrics[s]["std"] for s in STATES},
                             "spread": {s: float(np.std(logs[h][s])) for s in STATES},
                             "kind": v.kind, "indices": v.indices})  # fmt: skip
-                runs.append((data.measured[h], v.simulation.log[list(STATES)].to_numpy()))
+                runs.append((names[h], (data.measured[h],
+                                        v.simulation.log[list(STATES)].to_numpy())))
             except ShipidError as exc:
                 out.append({"held_out": names[h], "error": str(exc)})
     return out, runs
