@@ -71,12 +71,15 @@ def test_each_held_out_run_is_summed_up_by_its_rms_error_over_its_spread():
     assert b.error_over_spread == pytest.approx({"u": 1.0, "v": 1.0, "r": 1.0}, rel=1e-9)
     assert c.diverged and (c.samples, c.simulated) == (4000, 1000)
     assert band.run_rows()[2]["diverged"] == "after 1000 of 4000 samples"
+    assert band.runs_summary() == ("its 3 held-out logs, each run free on the fit without it, "
+                                   "missed their yaw rate by 0.14–1 of its spread (rms), 1 "
+                                   "diverged")  # fmt: skip
     # Kept through the model file and a rescaling (ratios have no units); older files had none.
     back = ErrorBand.from_dict(json.loads(json.dumps(band.scaled(2.0).to_dict())))
     assert back.runs == band.runs
     old = band.to_dict()
     del old["runs"]
-    assert ErrorBand.from_dict(old).runs == ()
+    assert ErrorBand.from_dict(old).runs == () and ErrorBand.from_dict(old).runs_summary() is None
     bad = band.to_dict()
     bad["runs"][1]["simulated"] = 0
     with pytest.raises(ShipidError, match=r"runs\[1\]: simulated must be within"):
@@ -126,6 +129,7 @@ def test_band_in_the_model_file_validate_and_rescale(zigzags, tmp_path, capsys):
                           tmp_path / "v.json"], capsys)  # fmt: skip
     assert code == 0, err
     assert "in CV band r [%]" in out and f"r ±{band.half_width['r']:.4g} rad/s" in out
+    assert f"; {band.runs_summary()}." in out and len(band.runs) == 3
     record = json.loads((tmp_path / "v.json").read_text(encoding="utf-8"))["logs"][0]
     assert 0.5 < record["within_error_band"]["r"] <= 1.0
     # A ship 16 times as long: speeds ×4, yaw rates ÷4.

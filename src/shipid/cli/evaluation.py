@@ -112,8 +112,10 @@ def cmd_validate(args) -> int:
     good = [v for v in vals if v.error is None]
     if good:
         if band is not None:
+            runs = band.runs_summary()
             print(f"The model's {band.describe()}: a log like those is inside it for about "
-                  f"{100 * band.level:g} % of its samples (columns 'in CV band').")  # fmt: skip
+                  f"{100 * band.level:g} % of its samples (columns 'in CV band')"
+                  + (f"; {runs}." if runs else "."))  # fmt: skip
         print(metrics_frame(good).to_markdown(index=False, floatfmt=".4g"))
         table = indices_frame(good)
         if len(table):

@@ -126,6 +126,18 @@ class ErrorBand:
                 f"u {fmt(self.half_width['u'])} m/s, v {fmt(self.half_width['v'])} m/s, "
                 f"r {fmt(self.half_width['r'])} rad/s")
 
+    def runs_summary(self) -> str | None:
+        """One clause on how the held-out runs fared: the range of their yaw rate's rms error
+        over spread and how many diverged; None for a band without runs (older files)."""
+        if not self.runs:
+            return None
+        r = [x.error_over_spread["r"] for x in self.runs if math.isfinite(x.error_over_spread["r"])]
+        diverged = sum(x.diverged for x in self.runs)
+        span = f"{min(r):.2g}–{max(r):.2g}" if len(r) > 1 else (f"{r[0]:.2g}" if r else "–")
+        return (f"its {len(self.runs)} held-out {self.held_out}, each run free on the fit "
+                f"without it, missed their yaw rate by {span} of its spread (rms)"
+                + (f", {diverged} diverged" if diverged else ""))
+
     def run_rows(self) -> list[dict]:
         """One row per held-out run, for a table: its name, the rms error over its spread of u,
         v and r, and where its free run diverged."""
