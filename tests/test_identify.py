@@ -399,3 +399,31 @@ def test_the_candidates_of_an_average_share_each_logs_term_columns(clean_zigzag,
     assert computed == [*names, "u*r", "u*v"]
     regression.log_terms(clean_zigzag, ["u*v"])
     assert computed[-1:] == ["u*v"] and len(computed) == 7
+
+
+def test_a_logs_sampling_time_and_envelope_are_read_once_where_it_is_fitted_again_and_again(
+        clean_zigzag, monkeypatch):  # fmt: skip
+    """Inside ``shared_term_columns`` a log's Δk and envelope are computed once (``per_log``),
+    the same as outside it; a log refused (non-uniform sampling) is refused every time, not
+    remembered; the envelope of several logs is that of their samples together."""
+    import shipid.identification.identify as ident_module
+    import shipid.identification.regression as regression
+    from shipid.evaluation.envelope import envelope
+
+    counted = []
+    compute = regression._sampling_time
+    monkeypatch.setattr(regression, "_sampling_time",
+                        lambda log, name: (counted.append(name), compute(log, name))[1])  # fmt: skip
+    gappy = clean_zigzag.drop(index=[50]).reset_index(drop=True)
+    other = clean_zigzag.iloc[: len(clean_zigzag) // 2].assign(u=lambda d: d["u"] * 1.5)
+    with regression.shared_term_columns():
+        dts = [regression.sampling_time(clean_zigzag, "a") for _ in range(3)]
+        for _ in range(2):
+            with pytest.raises(ShipidError, match="sampling is not uniform|one-step regression"):
+                regression.sampling_time(gappy, "gappy")
+        together = ident_module._envelope([clean_zigzag, other])
+        assert ident_module._envelope([clean_zigzag, other]) == together
+    assert dts == [regression._sampling_time(clean_zigzag, "alone")] * 3
+    assert counted == ["a", "gappy", "gappy", "alone"]
+    assert together == envelope([clean_zigzag, other])
+    assert together["u"][1] == pytest.approx(1.5 * clean_zigzag["u"].iloc[: len(other)].max())

@@ -33,6 +33,7 @@ from shipid.identification.physics import (
 from shipid.identification.regression import (
     FORMS,
     RegressionProblem,
+    per_log,
     regression_problem,
     shared_term_columns,
 )
@@ -519,10 +520,22 @@ def identify(
     model = ManoeuvringModel(ModelStructure(structure.name, terms), coefs,
                              name=_model_name(structure, form))  # fmt: skip
     return Identification(model, form, float(gamma), dt, discrete, diagnostics, notes,
-                          envelope(logs), estimator if isinstance(estimator, str)
+                          _envelope(logs), estimator if isinstance(estimator, str)
                           else type(estimator).__name__,
                           physics.describe() if physics is not None and physics.active
                           else None)  # fmt: skip
+
+
+def _envelope(logs: Sequence[pd.DataFrame]) -> dict[str, list[float]]:
+    """``envelope(logs)`` from each log's own, computed once per log where the logs are fitted
+    again and again (``shared_term_columns``): the smallest of the minima, the largest of the
+    maxima."""
+    out: dict[str, list[float]] = {}
+    for log in logs:
+        for s, (lo, hi) in per_log(log, "envelope", lambda log=log: envelope([log])).items():
+            bounds = out.setdefault(s, [lo, hi])
+            bounds[0], bounds[1] = min(bounds[0], lo), max(bounds[1], hi)
+    return out
 
 
 def averaged_model(

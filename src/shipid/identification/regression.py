@@ -13,10 +13,11 @@ its weight zero anyway). Samples pair k with k+1 of the same log only, never acr
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from contextvars import ContextVar
 from dataclasses import dataclass, field
+from typing import TypeVar
 
 import numpy as np
 import pandas as pd
@@ -31,6 +32,7 @@ FORMS = ("increment", "paper")
 # Sampling is uniform when every interval is within this fraction of the median: printed times
 # (6–9 digits) jitter by far less, and a 0.1 % error in one interval is far below the noise.
 DT_RTOL = 1e-3
+T = TypeVar("T")
 
 
 @dataclass
@@ -47,6 +49,10 @@ class RegressionProblem:
 
 def sampling_time(log: pd.DataFrame, name: str = "log") -> float:
     """Δk of a log, which must be uniform (resample it otherwise)."""
+    return per_log(log, "sampling_time", lambda: _sampling_time(log, name))
+
+
+def _sampling_time(log: pd.DataFrame, name: str) -> float:
     t = log["t"].to_numpy()
     if len(t) < 3:
         raise ShipidError(f"{name}: {len(t)} samples, too short for identification")
@@ -74,8 +80,9 @@ def common_sampling_time(logs: Sequence[pd.DataFrame], names: Sequence[str]) -> 
     return dts[0]
 
 
-# Inside ``shared_term_columns``: id(log) → (the log, {term: its values along the log}).
-_SHARED: ContextVar[dict[int, tuple[pd.DataFrame, dict[str, np.ndarray]]] | None] = \
+# Inside ``shared_term_columns``: id(log) → (the log, {term: its values along the log, and
+# ("fact", name): a fact of it, ``per_log``}).
+_SHARED: ContextVar[dict[int, tuple[pd.DataFrame, dict]] | None] = \
     ContextVar("shared_term_columns", default=None)  # fmt: skip
 
 
@@ -95,6 +102,23 @@ def shared_term_columns() -> Iterator[None]:
         yield
     finally:
         _SHARED.reset(token)
+
+
+def per_log(log: pd.DataFrame, fact: str, compute: Callable[[], T]) -> T:
+    """``compute()``, a fact of ``log`` (its Δk, its envelope), once per log inside
+    ``shared_term_columns``, where a search fits the same logs hundreds of times (4000 Δk and
+    150 envelopes of nine Esso zig-zags in one ``identify``); outside it, every time. A
+    ``compute`` that raises leaves nothing behind."""
+    shared = _SHARED.get()
+    if shared is None:
+        return compute()
+    held, columns = shared.setdefault(id(log), (log, {}))
+    if held is not log:  # pragma: no cover - an id is unique while its log is held
+        return compute()
+    key = ("fact", fact)  # not a term's name: a term is a string
+    if key not in columns:
+        columns[key] = compute()
+    return columns[key]
 
 
 def log_terms(log: pd.DataFrame, names: Sequence[str], name: str = "log") -> np.ndarray:
