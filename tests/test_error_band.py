@@ -13,7 +13,7 @@ from generated_logs import noisy_zigzags
 from shipid.data.io import read_log, write_log
 from shipid.dynamics.simulate import simulate_log
 from shipid.errors import ShipidError
-from shipid.evaluation.error_band import ErrorBand, conformal_quantile, error_band
+from shipid.evaluation.error_band import ErrorBand, conformal_quantile, error_band, key_indices
 from shipid.evaluation.validate import validate
 from shipid.identification.identify import identify
 from shipid.identification.select import select
@@ -86,6 +86,25 @@ def test_each_held_out_run_is_summed_up_by_its_rms_error_over_its_spread():
         ErrorBand.from_dict(bad)
     with pytest.raises(ShipidError, match="3 runs got 2 names"):
         error_band([(measured, offset)] * 3, names=["a", "b"])
+
+
+def test_a_held_out_trial_keeps_its_indices_measured_and_predicted():
+    """The indices a held-out run reports by the kind of trial it is, read off a validation's
+    measured and closed-loop ones; kept through the model file, a missing one as None."""
+    indices = {"measured": {"tactical_diameter": 7.27, "steady_yaw_rate": 0.0452, "advance": 8.2},
+               "closed_loop": {"tactical_diameter": 6.91, "steady_yaw_rate": None}}  # fmt: skip
+    turn = key_indices("turning", indices)
+    assert turn == {"tactical_diameter": (7.27, 6.91), "steady_yaw_rate": (0.0452, None)}
+    assert key_indices("other", indices) == {} and key_indices(None, {}) == {}
+    log = np.column_stack([np.sin(np.linspace(0, 6, 50))] * 3)
+    band = error_band([(log, log), (log, log)], names=["turn.csv", "random.csv"],
+                      indices=[turn, {}])  # fmt: skip
+    rows = band.run_rows()
+    assert rows[0]["indices: measured → predicted (closed loop)"] == \
+        "tactical diameter, steady r 7.27, 0.0452 → 6.91, –"
+    assert rows[1]["indices: measured → predicted (closed loop)"] == "–"
+    back = ErrorBand.from_dict(json.loads(json.dumps(band.to_dict())))
+    assert back.runs[0].indices == turn and back.runs[1].indices == {}
 
 
 @pytest.fixture(scope="module")
@@ -199,10 +218,20 @@ def test_identify_error_band_is_its_fit_without_each_log(zigzags, tmp_path, caps
         # Each held-out log's own figure, printed and stored: rms error over its spread.
         run_of_it = band.runs[i]
         assert run_of_it.name == str(paths[i]) and not run_of_it.diverged
+        # The held-out zig-zag run closed loop on the fit without it: its overshoots predicted.
+        v = validate(fit, log, start_draws=False)[0]
+        assert v.kind == "zigzag" and set(run_of_it.indices) == {"first_overshoot_deg",
+                                                                  "second_overshoot_deg"}
+        for k, (measured, predicted) in run_of_it.indices.items():
+            assert measured == pytest.approx(v.indices["measured"][k], rel=1e-12)
+            assert predicted == pytest.approx(v.indices["closed_loop"][k], rel=1e-12)
         for j, s in enumerate("uvr"):
             expected = np.sqrt(np.mean(errors[-1][:, j] ** 2)) / np.std(log[s].to_numpy())
             assert run_of_it.error_over_spread[s] == pytest.approx(expected, rel=1e-9)
     assert "each held-out log, run free on the model fitted without it" in out
+    first = band.runs[0].indices
+    assert (f"overshoots {first['first_overshoot_deg'][0]:.3g}, "
+            f"{first['second_overshoot_deg'][0]:.3g} → {first['first_overshoot_deg'][1]:.3g}") in out
     assert f"| {paths[0]} |" in out
     errors = np.vstack(errors)
     k = math.ceil((len(errors) + 1) * 0.95)

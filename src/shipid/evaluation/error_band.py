@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -40,6 +40,9 @@ class HeldOutRun:
     samples: int
     simulated: int
     error_over_spread: Mapping[str, float]
+    # A held-out zig-zag's or turn's indices, measured and predicted (its closed loop on the
+    # fit without it): {index: (measured, predicted)}, None where one has none
+    indices: Mapping[str, tuple[float | None, float | None]] = field(default_factory=dict)
 
     @property
     def diverged(self) -> bool:
@@ -50,7 +53,9 @@ class HeldOutRun:
         """JSON-ready (a ratio that cannot be formed, a log without spread, as null)."""
         return {"name": self.name, "samples": self.samples, "simulated": self.simulated,
                 "error_over_spread": {s: None if not math.isfinite(x) else float(x)
-                                      for s, x in self.error_over_spread.items()}}  # fmt: skip
+                                      for s, x in self.error_over_spread.items()},
+                "indices": {k: [_finite_or_none(a), _finite_or_none(b)]
+                            for k, (a, b) in self.indices.items()}}  # fmt: skip
 
     @classmethod
     def from_dict(cls, data: Mapping, where: str) -> HeldOutRun:
@@ -58,7 +63,10 @@ class HeldOutRun:
         try:
             ratios = {s: math.nan if data["error_over_spread"][s] is None
                       else float(data["error_over_spread"][s]) for s in STATES}  # fmt: skip
-            run = cls(str(data["name"]), int(data["samples"]), int(data["simulated"]), ratios)
+            indices = {str(k): (_finite_or_none(a), _finite_or_none(b))
+                       for k, (a, b) in (data.get("indices") or {}).items()}  # fmt: skip
+            run = cls(str(data["name"]), int(data["samples"]), int(data["simulated"]), ratios,
+                      indices)  # fmt: skip
         except (KeyError, TypeError, ValueError) as exc:
             raise ShipidError(f"{where}: not a held-out run ({exc})") from None
         if not 0 < run.simulated <= run.samples:
@@ -67,9 +75,31 @@ class HeldOutRun:
         return run
 
 
-def held_out_run(name: str, measured: np.ndarray, simulated: np.ndarray) -> HeldOutRun:
+def _finite_or_none(x) -> float | None:
+    return None if x is None or not math.isfinite(float(x)) else float(x)
+
+
+# The indices a held-out run reports, by the kind of trial it is.
+KEY_INDICES = {"zigzag": ("first_overshoot_deg", "second_overshoot_deg"),
+               "turning": ("tactical_diameter", "steady_yaw_rate"),
+               "pull-out": ("yaw_rate_at_release", "residual_yaw_rate")}  # fmt: skip
+INDEX_LABELS = {"first_overshoot_deg": "overshoots", "tactical_diameter": "tactical diameter, "
+                "steady r", "yaw_rate_at_release": "yaw rate held, left"}  # fmt: skip
+
+
+def key_indices(kind: str | None, indices: Mapping) -> dict[str, tuple[float | None, float | None]]:
+    """{index: (measured, predicted)} of a validation's ``indices`` (``validate_log``'s: the
+    closed loop is the prediction) for the ``KEY_INDICES`` of its ``kind``; {} for other logs."""
+    measured, predicted = indices.get("measured") or {}, indices.get("closed_loop") or {}
+    return {k: (_finite_or_none(measured.get(k)), _finite_or_none(predicted.get(k)))
+            for k in KEY_INDICES.get(kind or "", ()) if k in measured}  # fmt: skip
+
+
+def held_out_run(name: str, measured: np.ndarray, simulated: np.ndarray,
+                 indices: Mapping | None = None) -> HeldOutRun:  # fmt: skip
     """The ``HeldOutRun`` of one free run: ``measured`` (n, 3) u, v, r of the held-out log and
-    ``simulated`` (m ≤ n, 3), its free run up to where it stopped."""
+    ``simulated`` (m ≤ n, 3), its free run up to where it stopped; ``indices`` its
+    (measured, predicted) ``key_indices``."""
     n, m = len(measured), len(simulated)
     err = simulated - measured[:m]
     ratios = {}
@@ -77,7 +107,7 @@ def held_out_run(name: str, measured: np.ndarray, simulated: np.ndarray) -> Held
         spread = float(np.std(measured[:, j]))
         rms = float(np.sqrt(np.mean(err[:, j] ** 2))) if m else math.nan
         ratios[s] = rms / spread if spread > 0 else math.nan
-    return HeldOutRun(name, n, m, ratios)
+    return HeldOutRun(name, n, m, ratios, dict(indices or {}))
 
 
 @dataclass(frozen=True)
@@ -141,10 +171,14 @@ class ErrorBand:
     def run_rows(self) -> list[dict]:
         """One row per held-out run, for a table: its name, the rms error over its spread of u,
         v and r, and where its free run diverged."""
-        return [{f"held-out {self.held_out[:-1]}": r.name,
+        rows = [{f"held-out {self.held_out[:-1]}": r.name,
                  **{f"{s} error / spread": r.error_over_spread[s] for s in STATES},
                  "diverged": (f"after {r.simulated} of {r.samples} samples" if r.diverged
                               else "no")} for r in self.runs]  # fmt: skip
+        if any(r.indices for r in self.runs):
+            for row, r in zip(rows, self.runs, strict=True):
+                row["indices: measured → predicted (closed loop)"] = _indices_text(r.indices)
+        return rows
 
     def to_dict(self) -> dict:
         """JSON-ready (∞ as null)."""
@@ -175,6 +209,20 @@ class ErrorBand:
         return cls(widths, level, logs, samples, str(data.get("method", METHOD)), held_out, runs)
 
 
+def _indices_text(indices: Mapping[str, tuple[float | None, float | None]]) -> str:
+    """'overshoots 13.2, 16.4 → 13.6, 15.4' (``KEY_INDICES``' pairs, 3 significant digits)."""
+    if not indices:
+        return "–"
+
+    def fmt(x: float | None) -> str:
+        return "–" if x is None else f"{x:.3g}"
+
+    keys = list(indices)
+    label = INDEX_LABELS.get(keys[0], keys[0])
+    return (f"{label} {', '.join(fmt(indices[k][0]) for k in keys)} → "
+            f"{', '.join(fmt(indices[k][1]) for k in keys)}")
+
+
 def conformal_quantile(errors: np.ndarray, level: float = LEVEL) -> float:
     """The ⌈(N + 1)·level⌉-th smallest of N absolute errors (∞ if that exceeds N): a new
     exchangeable error is at most this with probability ≥ ``level``."""
@@ -184,11 +232,13 @@ def conformal_quantile(errors: np.ndarray, level: float = LEVEL) -> float:
 
 
 def error_band(runs: Sequence[tuple[np.ndarray, np.ndarray]], level: float = LEVEL,
-               held_out: str = "logs", names: Sequence[str] | None = None) -> ErrorBand:  # fmt: skip
+               held_out: str = "logs", names: Sequence[str] | None = None,
+               indices: Sequence[Mapping | None] | None = None) -> ErrorBand:  # fmt: skip
     """The band from held-out free runs: pairs of ``measured`` (n, 3) and ``simulated`` (m ≤ n,
     3) u, v, r; the n − m samples after a divergence count as infinite errors. ``held_out``:
     what the runs are ("logs", or "blocks" of logs); ``names``: theirs, for the runs' summary
-    (``ErrorBand.runs``; by default "1", "2", ...)."""
+    (``ErrorBand.runs``; by default "1", "2", ...); ``indices``: each run's (measured,
+    predicted) ``key_indices``."""
     if not runs:
         raise ShipidError("an error band needs at least one held-out free run")
     names = list(names) if names is not None else [str(i + 1) for i in range(len(runs))]
@@ -201,8 +251,9 @@ def error_band(runs: Sequence[tuple[np.ndarray, np.ndarray]], level: float = LEV
         for j, s in enumerate(STATES):
             per_state[s].append(np.concatenate([err[:, j], np.full(n - m, np.inf)]))
     widths = {s: conformal_quantile(np.concatenate(per_state[s]), level) for s in STATES}
-    summary = tuple(held_out_run(name, np.asarray(m, float), np.asarray(sim, float))
-                    for name, (m, sim) in zip(names, runs, strict=True))  # fmt: skip
+    indices = list(indices) if indices is not None else [None] * len(runs)
+    summary = tuple(held_out_run(name, np.asarray(m, float), np.asarray(sim, float), ind)
+                    for name, (m, sim), ind in zip(names, runs, indices, strict=True))  # fmt: skip
     return ErrorBand(widths, level, len(runs), int(sum(len(m) for m, _ in runs)), METHOD,
                      held_out, summary)
 
@@ -214,12 +265,16 @@ def cross_validated_band(fit, logs, names, cv: str = "auto", method: str = "eule
     with ``'blocks:K'``, every log cut into K blocks and each block left out. ``'auto'``: logo
     from two logs, four blocks of one."""
     from shipid.dynamics.simulate import simulate_log
+    from shipid.evaluation.validate import validate
     from shipid.identification.cross_validation import held_out_logs
 
     logs, names, _, held_out = held_out_logs(logs, names, cv, "--error-band")
-    runs = []
+    runs, indices = [], []
     for k, held in enumerate(logs):
         model = fit([x for j, x in enumerate(logs) if j != k])
-        sim = simulate_log(model, held, method).log
+        # Validated, a held-out zig-zag or turn is also run closed loop: its indices predicted.
+        v = validate(model, held, [names[k]], method, start_draws=False)[0]
+        sim = v.simulation.log if v.error is None else simulate_log(model, held, method).log
         runs.append((held[list(STATES)].to_numpy(dtype=float), sim[list(STATES)].to_numpy()))
-    return error_band(runs, level, held_out, names)
+        indices.append(key_indices(v.kind, v.indices) if v.error is None else None)
+    return error_band(runs, level, held_out, names, indices)

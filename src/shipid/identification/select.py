@@ -53,7 +53,7 @@ from shipid.dynamics.similarity import similar_library
 from shipid.dynamics.simulate import DivergenceBounds, input_array, run_kernel
 from shipid.dynamics.terms import INPUT_SIGNALS, parse_term, term_code
 from shipid.errors import InfeasibleConstraintsError, ShipidError
-from shipid.evaluation.error_band import ErrorBand, error_band
+from shipid.evaluation.error_band import ErrorBand, error_band, key_indices
 from shipid.identification.cross_validation import (
     folds as _folds,
 )
@@ -825,8 +825,9 @@ def select(
     if failed:
         notes.append(f"{len(failed)} candidate(s) diverged in every fold (kept in the table)")
     held = "blocks" if parse_cv(options.cv)[0] == "blocks" else "logs"
-    band = error_band([run for _, run in held_out_runs], held_out=held,
-                      names=[name for name, _ in held_out_runs]) if held_out_runs else None
+    band = error_band([run for _, run, _ in held_out_runs], held_out=held,
+                      names=[name for name, _, _ in held_out_runs],
+                      indices=[ind for _, _, ind in held_out_runs]) if held_out_runs else None
     return Selection(model, ident, current.gamma, current.score, table, folds_report,
                      options, library, ranking, notes + ident.warnings, shared, band,
                      ident.model, *checked, best_ruled_out=best_ruled_out,
@@ -999,7 +1000,8 @@ def _table(cands, chosen: Candidate) -> pd.DataFrame:
 def _fold_report(data, scorer: _Scorer, weights, chosen: Candidate, logs, names):
     """Per held-out log: the model (the candidates of ``weights`` averaged; the chosen one
     alone: [(chosen, 1)]) fitted without it, its free-run errors (the ``validate`` metrics) and
-    indices; and each run's name with the (measured, simulated) u, v, r of it."""
+    indices; and each run's name, the (measured, simulated) u, v, r of it and its
+    (measured, predicted) ``key_indices``."""
     from shipid.evaluation.validate import validate_log
 
     out, runs = [], []
@@ -1018,7 +1020,8 @@ def _fold_report(data, scorer: _Scorer, weights, chosen: Candidate, logs, names)
                             "spread": {s: float(np.std(logs[h][s])) for s in STATES},
                             "kind": v.kind, "indices": v.indices})  # fmt: skip
                 runs.append((names[h], (data.measured[h],
-                                        v.simulation.log[list(STATES)].to_numpy())))
+                                        v.simulation.log[list(STATES)].to_numpy()),
+                             key_indices(v.kind, v.indices)))  # fmt: skip
             except ShipidError as exc:
                 out.append({"held_out": names[h], "error": str(exc)})
     return out, runs
