@@ -747,6 +747,10 @@ def _run_approach(target, cond: dict, speed: float | None, rps: float | None):
 
     if not isinstance(target, ManoeuvringModel | HybridModel):
         return speed, rps, None
+    if target.uses_thrust:  # its straight approach needs the thrust too
+        from shipid.trials.manoeuvres import THRUST_REFUSED
+
+        raise ShipidError(THRUST_REFUSED)
     if speed is None and not cond["speed"]:
         return None, rps if rps is not None else cond["rps"], None  # the run names what is missing
     app = steady_approach(target, cond["speed"], cond["rps"], speed, rps,

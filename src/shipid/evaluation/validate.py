@@ -158,7 +158,12 @@ def validate_log(model, log: pd.DataFrame, name: str, method: str = "euler",
         steady = steady_log_approach(log, trial)
         measured["approach_speed"] = steady if steady else float(log["u"].iloc[0])
         indices = {"measured": measured, "simulated": _replay_indices(sim_indices, trial)}
-        if isinstance(model, ManoeuvringModel | HybridModel | Vessel):
+        if getattr(model, "uses_thrust", False):
+            # Replayed with the log's thrust; a closed loop of its own has none to run on.
+            notes.append("no closed-loop replica: the model is driven by the log's thrust, "
+                         "which a manoeuvre of its own does not have; the replay's indices are "
+                         "its prediction")  # fmt: skip
+        elif isinstance(model, ManoeuvringModel | HybridModel | Vessel):
             indices["closed_loop"] = _replica_indices(model, log, method, trial)
     out = Validation(name, sim, metrics, indices, trial.kind, warnings=notes)
     if indices.get("closed_loop") and start_draws:

@@ -276,6 +276,8 @@ def check_plausibility(
     (``sharpest_curvature``), for the held rudder's path (``WIDE_SHARE``); ``astern``: also a
     crash stop (``crash_stop``), a warning, not a reason to rule a model out (for the model a
     command hands out, not the thousands a search checks)."""
+    if getattr(model, "uses_thrust", False):
+        return _thrust_not_checked(speed, rps, rudder_deg, duration, curvature)
     report = {"approach_speed": speed, "rps": rps,
               "straight_line": straight_line_stability(model, speed, rps),
               "surge_equilibrium": surge_equilibrium(model, speed, rps),
@@ -286,6 +288,22 @@ def check_plausibility(
     if astern:
         report["astern"] = crash_stop(model, speed, rps, duration)
     return report, [note for _, note in failed_checks(report, model).values()]
+
+
+# A model driven by a logged thrust runs along its logs (simulate, validate), not a manoeuvre of
+# its own: nothing says what the thrust would be in a turn it never logged.
+THRUST_NOT_CHECKED = ("not checked: the model is driven by the logs' thrust, which a held "
+                      "turn or a straight run of its own does not have (its manoeuvres are "
+                      "refused for that reason); logs with the propeller speed n give a model "
+                      "whose thrust follows the speed, and these checks")  # fmt: skip
+
+
+def _thrust_not_checked(speed, rps, rudder_deg, duration, curvature) -> tuple[dict, list[str]]:
+    """The report of a model driven by a logged thrust: no check run, and why."""
+    return ({"approach_speed": speed, "rps": rps, "straight_line": {},
+             "surge_equilibrium": None, "rudder_deg": rudder_deg, "duration": duration,
+             "logs_curvature": curvature, "held_rudder": {}, "not_checked": THRUST_NOT_CHECKED},
+            [THRUST_NOT_CHECKED])  # fmt: skip
 
 
 def plausibility_at_approach(model: ManoeuvringModel, trained_speed: float,
@@ -299,6 +317,11 @@ def plausibility_at_approach(model: ManoeuvringModel, trained_speed: float,
     ``speed`` or ``rps`` is used as given. The report says which approach (``approach``)."""
     from shipid.dynamics.equilibrium import steady_approach
 
+    if getattr(model, "uses_thrust", False):
+        report, notes = _thrust_not_checked(speed or trained_speed, rps or trained_rps, 35.0,
+                                            None, curvature)  # fmt: skip
+        report["approach"] = f"approach: {report['approach_speed']:.4g} m/s (not checked)"
+        return report, notes
     app = steady_approach(model, trained_speed, trained_rps, speed=speed, rps=rps)
     report, notes = check_plausibility(model, app.speed, app.rps, curvature=curvature,
                                        astern=astern)  # fmt: skip
@@ -464,6 +487,8 @@ def failed_checks(report: dict, model: ManoeuvringModel) -> dict[str, tuple[int,
         out["straight_line"] = (1, f"straight-line unstable: a sway–yaw eigenvalue has real part "
                                    f"{sl['max_real_part']:.3g} 1/s > 0 (possible for full-form "
                                    "ships, but a rudder offset grows into a turn)")  # fmt: skip
+    if report.get("not_checked"):
+        return {"not_checked": (1, report["not_checked"])}
     eq = report.get("surge_equilibrium")
     if "u" in model.structure.dofs and (eq is None or eq <= 0):
         out["surge_equilibrium"] = (1, "no steady straight speed with the rudder amidships: the "
@@ -639,6 +664,8 @@ def disqualifying_checks(report: dict, model: ManoeuvringModel) -> dict[str, tup
     ``held_rudder_starboard``, ``held_rudder_port``) with their severity (``DIVERGED`` above
     ``WRONG_WAY``), to compare two models check by check."""
     reasons = {}
+    if report.get("not_checked"):
+        return reasons
     eq = report.get("surge_equilibrium")
     if "u" in model.structure.dofs and (eq is None or eq <= 0):
         reasons["surge_equilibrium"] = (WRONG_WAY, "no steady straight speed")

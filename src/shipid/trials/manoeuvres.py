@@ -43,6 +43,9 @@ from shipid.trials.indices import pull_out_yaw_rates, turning_indices, zigzag_in
 from shipid.vessels.vessel import Vessel
 
 SIDES = ("starboard", "port")
+THRUST_REFUSED = ("manoeuvres on a model with a thrust term need a thrust model: it runs along "
+                  "logs that give it its thrust (simulate, validate), not a straight run or "
+                  "manoeuvre of its own; identify with propeller speed (n) terms instead")  # fmt: skip
 
 
 @dataclass
@@ -215,8 +218,7 @@ def run_closed_loop(
                           "(rps=..., --rps)")  # fmt: skip
     if isinstance(dyn, ManoeuvringModel):
         if dyn.uses_thrust:
-            raise ShipidError("manoeuvres on a model with a thrust term need a thrust model; "
-                              "identify with propeller speed (n) terms instead")  # fmt: skip
+            raise ShipidError(THRUST_REFUSED)
         states = np.zeros((1, n, 6))
         rudder = np.zeros((1, n))
         n_valid = np.zeros(1, dtype=np.int64)
@@ -235,8 +237,7 @@ def run_closed_loop(
 
         phys = dyn.physical
         if phys.uses_thrust:
-            raise ShipidError("manoeuvres on a model with a thrust term need a thrust model; "
-                              "identify with propeller speed (n) terms instead")  # fmt: skip
+            raise ShipidError(THRUST_REFUSED)
         states, rudder = np.zeros((1, n, 6)), np.zeros((1, n))
         n_valid = np.zeros(1, dtype=np.int64)
         hybrid_kernel.integrate_closed(
