@@ -92,3 +92,19 @@ def test_two_thrust_logs_give_their_held_out_band(files, tmp_path, capsys):
     assert set(zigzag) == {"first_overshoot_deg", "second_overshoot_deg"}
     assert all(measured > 0 and predicted is None for measured, predicted in zigzag.values())
     assert "overshoots 30, 51.1 → –, –" in out
+
+
+def test_select_s_default_library_holds_the_logged_thrust(files, tmp_path, capsys):
+    """Without --library, ``select`` of thrust logs without rps adds the thrust as logged (T)
+    to its surge candidates, as ``identify``'s default fits ``blanke-thrust``: before, no
+    candidate held it, the chosen model was implausible and predicted the held-out logs with
+    0.8 of their spread; now the truth's surge comes back."""
+    code, out, err = run(["select", *files, "-o", tmp_path / "s.json"], capsys)
+    assert code == 0, err
+    assert "the thrust T varies (70 to 130 N), and no rps is logged: the surge holds it" in err
+    surge = json.loads((tmp_path / "s.json").read_text(encoding="utf-8"))["model"][
+        "coefficients"]["u"]  # fmt: skip
+    assert surge["thrust"] == pytest.approx(5e-4, rel=0.02)
+    assert surge["|u|*u"] == pytest.approx(-0.05, rel=0.02)
+    score = float(out.split("free-run CV score ")[1].split()[0])
+    assert score < 0.05

@@ -554,14 +554,24 @@ def default_library(logs: Sequence[pd.DataFrame], name: str = DEFAULT_LIBRARY,
     at 8–16.7 rps failed with it, none without); a log whose rps varies (a random run) shows
     within itself how the forces go with n, and there the constant stays (with it the Esso's
     thirteen logs predict the other turn 4.4 % off, without it 5.1 %)."""
+    from shipid.identification.identify import varying_propulsion
+
     library = get_structure(name)
     missing = sorted({c for log in logs for c in library.inputs if c not in log.columns})
+    thrust = [v for v in varying_propulsion(logs) if v.signal == "thrust"
+              and all("thrust" in log.columns for log in logs)]  # fmt: skip
+    if thrust:
+        # The thrust as logged, where no rps is (blanke-thrust's, as identify's default fits).
+        library = library.union({"u": ["T"]})
     replaced: tuple[str, ...] = ()
     if similar and "n" not in missing and _each_at_one_rps(logs):
         library, replaced = similar_library(library)
     drop = {d: [t for t in ts if set(parse_term(t).inputs) & set(missing)]
             for d, ts in library.terms.items()}  # fmt: skip
     notes = []
+    if thrust:
+        notes.append(f"{thrust[0].describe()}, and no rps is logged: the surge holds it as "
+                     "logged, T")  # fmt: skip
     if replaced:
         notes.append(f"{', '.join(replaced)} are written as advance-ratio similarity has them "
                      "(n|n|, n⁺²δ², which the library holds): a force that stays the same at "
