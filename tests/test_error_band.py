@@ -105,6 +105,12 @@ def test_a_held_out_trial_keeps_its_indices_measured_and_predicted():
     assert rows[1]["indices: measured → predicted (closed loop)"] == "–"
     back = ErrorBand.from_dict(json.loads(json.dumps(band.to_dict())))
     assert back.runs[0].indices == turn and back.runs[1].indices == {}
+    # A ship with speeds 3 times these (Froude, 9 times as long): lengths ×9, rates ÷3.
+    big = band.scaled(3.0).runs[0].indices
+    assert big["tactical_diameter"] == pytest.approx((7.27 * 9, 6.91 * 9), rel=1e-12)
+    assert big["steady_yaw_rate"][0] == pytest.approx(0.0452 / 3) and big["steady_yaw_rate"][1] is None
+    zigzag = error_band([(log, log)], indices=[{"first_overshoot_deg": (10.0, 11.0)}])
+    assert zigzag.scaled(3.0).runs[0].indices == {"first_overshoot_deg": (10.0, 11.0)}
 
 
 @pytest.fixture(scope="module")

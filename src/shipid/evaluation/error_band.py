@@ -16,6 +16,7 @@ stray further. Validation reports the share of each log's samples inside the ban
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -83,6 +84,10 @@ def _finite_or_none(x) -> float | None:
 KEY_INDICES = {"zigzag": ("first_overshoot_deg", "second_overshoot_deg"),
                "turning": ("tactical_diameter", "steady_yaw_rate"),
                "pull-out": ("yaw_rate_at_release", "residual_yaw_rate")}  # fmt: skip
+# How each reported index scales with a Froude-similar ship whose speeds are k times these:
+# lengths with k², rates with 1/k, angles not at all.
+INDEX_POWERS = {"first_overshoot_deg": 0, "second_overshoot_deg": 0, "tactical_diameter": 2,
+                "steady_yaw_rate": -1, "yaw_rate_at_release": -1, "residual_yaw_rate": -1}
 INDEX_LABELS = {"first_overshoot_deg": "overshoots", "tactical_diameter": "tactical diameter, "
                 "steady r", "yaw_rate_at_release": "yaw rate held, left"}  # fmt: skip
 
@@ -141,9 +146,12 @@ class ErrorBand:
         """The band of a Froude-similar ship whose speeds are ``speed_ratio`` times these (u, v
         × k, r ÷ k for k = speed_ratio, since lengths scale with k²)."""
         w = self.half_width
+        runs = tuple(dataclasses.replace(r, indices={
+            k: tuple(None if x is None else x * speed_ratio ** INDEX_POWERS.get(k, 0)
+                     for x in pair) for k, pair in r.indices.items()}) for r in self.runs)  # fmt: skip
         return ErrorBand({"u": w["u"] * speed_ratio, "v": w["v"] * speed_ratio,
                           "r": w["r"] / speed_ratio}, self.level, self.logs, self.samples,
-                         self.method, self.held_out, self.runs)  # fmt: skip
+                         self.method, self.held_out, runs)  # fmt: skip
 
     def describe(self) -> str:
         """One line: the half-widths and where they come from."""
