@@ -282,5 +282,7 @@ def test_identify_gives_the_band_by_default_from_two_logs(zigzags, tmp_path, cap
         code, out, err = run([*argv, "-o", tmp_path / f"{name}.json"], capsys)
         assert code == 0, err
         assert "error band" not in out
+        # One log: nothing held out, and identify says so with what to do.
+        assert ("one log: none was held out" in out) == (name == "o")
         assert json.loads((tmp_path / f"{name}.json").read_text())["identification"].get(
             "error_band") is None

@@ -348,6 +348,10 @@ def cmd_identify(args) -> int:
         band, said = cv_band("logo")
         print(f"{said} (--error-band none to skip)")
         print_runs(band)
+    elif args.error_band is None and len(raw_logs) == 1:
+        print("one log: none was held out, so nothing here says how the model predicts another; "
+              "judge it on a log it was not fitted to (shipid validate MODEL.json LOG), or on "
+              "quarters of this one (--error-band blocks:4)")  # fmt: skip
     sl = plausibility["straight_line"]
     if sl:
         print(f"straight-line {'stable' if sl['stable'] else 'UNSTABLE'} (largest sway–yaw "
