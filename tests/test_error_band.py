@@ -204,6 +204,9 @@ def test_the_report_draws_its_own_figures_with_both_bands(zigzags, monkeypatch):
     monkeypatch.setattr(plots, "measured_vs_simulated", record)
     text = validation_report(sel.model, vals, zigzags[:1], "report")
     assert "in CV band r" in text
+    # The model's training logs, each held out, as identify printed them.
+    assert "The model's training logs, each held out" in text
+    assert all(f"<td>{r.name}</td>" in text for r in sel.error_band.runs)
     assert seen and seen[0][0] is vals[0].bands and seen[0][1] is sel.error_band
 
 

@@ -84,6 +84,13 @@ def validation_report(
         parts.append("<h2>Warnings</h2><ul>" + "".join(
             f"<li class='warn'>{html.escape(w)}</li>" for w in warnings) + "</ul>")
     parts += ["<h2>Free-run errors</h2>", _table(metrics_frame([v for v, _ in good]))]
+    band = next((v.error_band for v, _ in good if v.error_band is not None), None)
+    if band is not None and band.runs:
+        parts += [f"<h2>The model's training {band.held_out}, each held out</h2>",
+                  f"<p>Each run free on the model fitted without it (its {band.describe()}): "
+                  "rms error over the log's spread, bias included (1: no better than the "
+                  "log's mean), and a zig-zag's or turn's indices run closed loop.</p>",
+                  _table(pd.DataFrame(band.run_rows()))]  # fmt: skip
     horizons = horizons_frame([v for v, _ in good])
     if len(horizons):
         parts += ["<h2>Predictions over a horizon</h2>",
