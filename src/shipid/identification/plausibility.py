@@ -263,6 +263,14 @@ def _held(model, speed, rps, rudder_deg, side, duration, dt) -> dict:
     return entry
 
 
+# A model driven by a logged thrust runs along its logs (simulate, validate), not a manoeuvre of
+# its own: nothing says what the thrust would be in a turn it never logged.
+THRUST_NOT_CHECKED = ("not checked: the model is driven by the logs' thrust, which a held "
+                      "turn or a straight run of its own does not have (its manoeuvres are "
+                      "refused for that reason); logs with the propeller speed n give a model "
+                      "whose thrust follows the speed, and these checks")  # fmt: skip
+
+
 def check_plausibility(
     model: ManoeuvringModel,
     speed: float,
@@ -277,7 +285,10 @@ def check_plausibility(
     crash stop (``crash_stop``), a warning, not a reason to rule a model out (for the model a
     command hands out, not the thousands a search checks)."""
     if getattr(model, "uses_thrust", False):
-        return _thrust_not_checked(speed, rps, rudder_deg, duration, curvature)
+        return ({"approach_speed": speed, "rps": rps, "straight_line": {},
+                 "surge_equilibrium": None, "rudder_deg": rudder_deg, "duration": duration,
+                 "logs_curvature": curvature, "held_rudder": {},
+                 "not_checked": THRUST_NOT_CHECKED}, [THRUST_NOT_CHECKED])  # fmt: skip
     report = {"approach_speed": speed, "rps": rps,
               "straight_line": straight_line_stability(model, speed, rps),
               "surge_equilibrium": surge_equilibrium(model, speed, rps),
@@ -288,22 +299,6 @@ def check_plausibility(
     if astern:
         report["astern"] = crash_stop(model, speed, rps, duration)
     return report, [note for _, note in failed_checks(report, model).values()]
-
-
-# A model driven by a logged thrust runs along its logs (simulate, validate), not a manoeuvre of
-# its own: nothing says what the thrust would be in a turn it never logged.
-THRUST_NOT_CHECKED = ("not checked: the model is driven by the logs' thrust, which a held "
-                      "turn or a straight run of its own does not have (its manoeuvres are "
-                      "refused for that reason); logs with the propeller speed n give a model "
-                      "whose thrust follows the speed, and these checks")  # fmt: skip
-
-
-def _thrust_not_checked(speed, rps, rudder_deg, duration, curvature) -> tuple[dict, list[str]]:
-    """The report of a model driven by a logged thrust: no check run, and why."""
-    return ({"approach_speed": speed, "rps": rps, "straight_line": {},
-             "surge_equilibrium": None, "rudder_deg": rudder_deg, "duration": duration,
-             "logs_curvature": curvature, "held_rudder": {}, "not_checked": THRUST_NOT_CHECKED},
-            [THRUST_NOT_CHECKED])  # fmt: skip
 
 
 def plausibility_at_approach(model: ManoeuvringModel, trained_speed: float,
@@ -317,9 +312,9 @@ def plausibility_at_approach(model: ManoeuvringModel, trained_speed: float,
     ``speed`` or ``rps`` is used as given. The report says which approach (``approach``)."""
     from shipid.dynamics.equilibrium import steady_approach
 
-    if getattr(model, "uses_thrust", False):
-        report, notes = _thrust_not_checked(speed or trained_speed, rps or trained_rps, 35.0,
-                                            None, curvature)  # fmt: skip
+    if getattr(model, "uses_thrust", False):  # no straight run of its own to start from
+        report, notes = check_plausibility(model, speed or trained_speed, rps or trained_rps,
+                                           curvature=curvature)  # fmt: skip
         report["approach"] = f"approach: {report['approach_speed']:.4g} m/s (not checked)"
         return report, notes
     app = steady_approach(model, trained_speed, trained_rps, speed=speed, rps=rps)
@@ -479,6 +474,8 @@ UNSETTLED, WRONG_WAY, DIVERGED = 1, 2, 3
 
 def failed_checks(report: dict, model: ManoeuvringModel) -> dict[str, tuple[int, str]]:
     """{check: (severity ≥ 1, warning)} of the checks ``report`` fails."""
+    if report.get("not_checked"):
+        return {"not_checked": (1, report["not_checked"])}
     rudder_deg = report.get("rudder_deg", 35.0)
     speed = report["approach_speed"]
     out: dict[str, tuple[int, str]] = {}
@@ -487,8 +484,6 @@ def failed_checks(report: dict, model: ManoeuvringModel) -> dict[str, tuple[int,
         out["straight_line"] = (1, f"straight-line unstable: a sway–yaw eigenvalue has real part "
                                    f"{sl['max_real_part']:.3g} 1/s > 0 (possible for full-form "
                                    "ships, but a rudder offset grows into a turn)")  # fmt: skip
-    if report.get("not_checked"):
-        return {"not_checked": (1, report["not_checked"])}
     eq = report.get("surge_equilibrium")
     if "u" in model.structure.dofs and (eq is None or eq <= 0):
         out["surge_equilibrium"] = (1, "no steady straight speed with the rudder amidships: the "

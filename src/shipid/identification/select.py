@@ -558,8 +558,8 @@ def default_library(logs: Sequence[pd.DataFrame], name: str = DEFAULT_LIBRARY,
 
     library = get_structure(name)
     missing = sorted({c for log in logs for c in library.inputs if c not in log.columns})
-    thrust = [v for v in varying_propulsion(logs) if v.signal == "thrust"
-              and all("thrust" in log.columns for log in logs)]  # fmt: skip
+    every_log_has_thrust = all("thrust" in log.columns for log in logs)
+    thrust = [v for v in varying_propulsion(logs) if v.signal == "thrust" and every_log_has_thrust]
     if thrust:
         # The thrust as logged, where no rps is (blanke-thrust's, as identify's default fits).
         library = library.union({"u": ["T"]})
