@@ -25,7 +25,9 @@ approach condition (speed u0, propeller speed n):
 
 from __future__ import annotations
 
+import copy
 import math
+from collections import OrderedDict
 from collections.abc import Callable, Sequence
 
 import numpy as np
@@ -284,6 +286,38 @@ def check_plausibility(
     (``sharpest_curvature``), for the held rudder's path (``WIDE_SHARE``); ``astern``: also a
     crash stop (``crash_stop``), a warning, not a reason to rule a model out (for the model a
     command hands out, not the thousands a search checks)."""
+    key = _checked_key(model, speed, rps, rudder_deg, duration, curvature, astern)
+    if key is not None and key in _CHECKED:
+        _CHECKED.move_to_end(key)
+        return copy.deepcopy(_CHECKED[key])
+    out = _check_plausibility(model, speed, rps, rudder_deg, duration, curvature, astern)
+    if key is not None:
+        _CHECKED[key] = copy.deepcopy(out)
+        while len(_CHECKED) > CHECKED_KEPT:
+            _CHECKED.popitem(last=False)
+    return out
+
+
+# The checks' reports of the models checked last, by what decides them (terms, coefficients and
+# the approach): the held turns are most of a search's time after the fits, and the same model
+# came to be checked again and again: a search run twice on the same logs (the structure
+# comparison's, then the prefilter's or the command's own), `selection_shares` re-judging its
+# candidates. Over the test suite 23 % of the checks repeated one before them.
+CHECKED_KEPT = 512
+_CHECKED: OrderedDict[tuple, tuple[dict, list[str]]] = OrderedDict()
+
+
+def _checked_key(model, *args) -> tuple | None:
+    """What decides ``check_plausibility``'s result for ``model``: None for a model it is not
+    known to be decided by (a reference ship, a hybrid model, a subclass)."""
+    if type(model) is not ManoeuvringModel:
+        return None
+    theta = np.ascontiguousarray(model.theta)
+    return (tuple(model.structure.dofs), tuple(model.term_texts), theta.shape, theta.tobytes(),
+            model.similar_at_rps, *args)  # fmt: skip
+
+
+def _check_plausibility(model, speed, rps, rudder_deg, duration, curvature, astern):
     if getattr(model, "uses_thrust", False):
         return ({"approach_speed": speed, "rps": rps, "straight_line": {},
                  "surge_equilibrium": None, "rudder_deg": rudder_deg, "duration": duration,

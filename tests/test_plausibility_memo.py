@@ -1,0 +1,92 @@
+"""The checks of a model already checked are not run again: a search checks the same models more
+than once (the structure comparison's search, then the prefilter's; ``selection_shares``), and the
+held turns are most of the checks' time. What is handed back must be what a fresh check gives,
+for the same model only, and not shared with the caller before."""
+
+import numpy as np
+import pytest
+
+import shipid.identification.plausibility as plausibility
+from shipid.dynamics.model import ManoeuvringModel, ModelStructure
+from shipid.identification.plausibility import check_plausibility
+from shipid.vessels import scale_ship_model
+
+
+@pytest.fixture
+def turns(monkeypatch):
+    """The held turns run, counted, with an empty memo."""
+    monkeypatch.setattr(plausibility, "_CHECKED", type(plausibility._CHECKED)())
+    calls = []
+    original = plausibility.turning_circle
+
+    def counted(*args, **kwargs):
+        calls.append(kwargs.get("side"))
+        return original(*args, **kwargs)
+
+    monkeypatch.setattr(plausibility, "turning_circle", counted)
+    return calls
+
+
+def _model(rudder_factor: float = 1.0) -> ManoeuvringModel:
+    truth = scale_ship_model()
+    coefficients = {d: dict(c) for d, c in truth.coefficients.items()}
+    for dof in ("v", "r"):
+        coefficients[dof]["delta"] *= rudder_factor
+    return ManoeuvringModel(truth.structure, coefficients)
+
+
+def test_the_same_model_checked_again_runs_no_turn_and_gets_a_fresh_checks_result(turns):
+    report, notes = check_plausibility(_model(), 1.6)
+    ran = len(turns)
+    assert ran >= 2  # both sides held (and entered drifting where they settle)
+    again, again_notes = check_plausibility(_model(), 1.6)  # an equal model, another object
+    assert len(turns) == ran
+    assert again == report and again_notes == notes
+    plausibility._CHECKED.clear()
+    fresh, fresh_notes = check_plausibility(_model(), 1.6)
+    assert len(turns) == 2 * ran
+    assert fresh == again and fresh_notes == again_notes
+
+
+def test_what_the_caller_changes_in_a_report_does_not_reach_the_next(turns):
+    report, notes = check_plausibility(_model(), 1.6)
+    steady = report["held_rudder"]["port"]["steady_speed"]
+    report["held_rudder"]["port"]["steady_speed"] = -1.0
+    report["approach"] = "changed by a caller"
+    notes.append("added by a caller")
+    again, again_notes = check_plausibility(_model(), 1.6)
+    assert again["held_rudder"]["port"]["steady_speed"] == steady
+    assert "approach" not in again and "added by a caller" not in again_notes
+
+
+@pytest.mark.parametrize("change", ["coefficient", "speed", "rudder", "structure"])
+def test_another_model_or_approach_is_checked_anew(turns, change):
+    check_plausibility(_model(), 1.6)
+    ran = len(turns)
+    model, kwargs = _model(), {"speed": 1.6}
+    if change == "coefficient":
+        model = _model(rudder_factor=0.5)
+    elif change == "speed":
+        kwargs["speed"] = 1.2
+    elif change == "rudder":
+        kwargs["rudder_deg"] = 25.0
+    else:  # the same coefficients, the surge left out of the structure
+        truth = scale_ship_model()
+        sway_yaw = ModelStructure("sway and yaw", {d: t for d, t in truth.structure.terms.items()
+                                                   if d != "u"})  # fmt: skip
+        model = ManoeuvringModel(sway_yaw, {d: c for d, c in truth.coefficients.items()
+                                            if d != "u"})  # fmt: skip
+    report, _ = check_plausibility(model, **kwargs)
+    assert len(turns) > ran
+    if change == "coefficient":  # half the rudder: a wider turn, as the fresh check has it
+        first = plausibility._CHECKED[next(iter(plausibility._CHECKED))][0]
+        assert (abs(report["held_rudder"]["starboard"]["steady_yaw_rate"])
+                < abs(first["held_rudder"]["starboard"]["steady_yaw_rate"]))  # fmt: skip
+
+
+def test_a_model_whose_coefficients_differ_in_the_last_bit_is_another():
+    model = _model()
+    other = _model()
+    other.theta = np.nextafter(other.theta, np.inf)
+    assert plausibility._checked_key(model, 1.6) != plausibility._checked_key(other, 1.6)
+    assert plausibility._checked_key(model, 1.6) == plausibility._checked_key(_model(), 1.6)
