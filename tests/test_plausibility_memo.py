@@ -1,7 +1,9 @@
 """The checks of a model already checked are not run again: a search checks the same models more
 than once (the structure comparison's search, then the prefilter's; ``selection_shares``), and the
 held turns are most of the checks' time. What is handed back must be what a fresh check gives,
-for the same model only, and not shared with the caller before."""
+for the same model only, and not shared with the caller before. A held turn that has not
+settled is made longer by going on from its last state, not by running again from the start:
+the same states to the bit, each second simulated once."""
 
 import numpy as np
 import pytest
@@ -90,3 +92,56 @@ def test_a_model_whose_coefficients_differ_in_the_last_bit_is_another():
     other.theta = np.nextafter(other.theta, np.inf)
     assert plausibility._checked_key(model, 1.6) != plausibility._checked_key(other, 1.6)
     assert plausibility._checked_key(model, 1.6) == plausibility._checked_key(_model(), 1.6)
+
+
+# --- a held turn that has not settled goes on from where it stopped --------------------------
+
+
+def _slowly_unstable() -> ManoeuvringModel:
+    """A yaw that grows as e^{0.004 t} under the held rudder: unsettled at 300 s, past the
+    divergence bound of 5 rad/s at 505 s."""
+    structure = ModelStructure("slowly unstable", {"v": ("v", "r", "delta"),
+                                                   "r": ("v", "r", "delta")})  # fmt: skip
+    return ManoeuvringModel(structure, {"v": {"v": -0.5, "r": 0.0, "delta": 0.0},
+                                        "r": {"v": 0.0, "r": 0.004, "delta": -0.005}})  # fmt: skip
+
+
+@pytest.mark.parametrize("case", ["tanker", "odd step", "diverges later"])
+def test_a_longer_held_turn_goes_on_from_the_last_and_equals_the_run_from_the_start(case):
+    from shipid.vessels import tanker
+
+    if case == "tanker":  # a full-scale VLCC: unsettled at 300 and 600 s, settled at 1200 s
+        ship = tanker()
+        model, speed, rudder, dt = ship, ship.approach_speed, 10.0, 0.1
+    elif case == "odd step":  # a step that divides none of the lengths
+        model, speed, rudder, dt = scale_ship_model(), 1.6, 35.0, 0.18471546577
+    else:
+        model, speed, rudder, dt = _slowly_unstable(), 1.0, 35.0, 0.2
+    run = plausibility._held_runs(model, speed, None, rudder, "starboard", dt)
+    for length in (300.0, 600.0, 1200.0, 2400.0):
+        assert run(length) == plausibility._held(model, speed, None, rudder, "starboard",
+                                                 length, dt)  # fmt: skip
+    if case == "tanker":
+        assert not run(300.0)["settled"] and run(1200.0)["settled"]
+    if case == "diverges later":
+        first, later = run(300.0), run(600.0)
+        assert not first["diverged"] and not first["settled"]
+        assert later["diverged"] and "t = 505.40 s" in later["reason"]
+
+
+def test_the_held_turns_simulate_each_second_once(monkeypatch):
+    from shipid.vessels import tanker
+
+    ship = tanker()
+    simulated = []
+    original = plausibility.turning_circle
+
+    def counted(*args, **kwargs):
+        simulated.append(kwargs["duration"])
+        return original(*args, **kwargs)
+
+    monkeypatch.setattr(plausibility, "turning_circle", counted)
+    out = plausibility.held_rudder(ship, ship.approach_speed, rudder_deg=10.0, drifting=False)
+    for side in ("starboard", "port"):
+        assert out[side]["settled"] and out[side]["duration"] == 1200.0
+    assert sum(simulated) == pytest.approx(2 * 1200.0)  # 300 + 300 + 600 a side, not 2100

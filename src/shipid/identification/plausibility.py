@@ -31,9 +31,11 @@ from collections import OrderedDict
 from collections.abc import Callable, Sequence
 
 import numpy as np
+import pandas as pd
 
 from shipid.dynamics.equilibrium import still_air_accelerations, surge_equilibrium
 from shipid.dynamics.model import ManoeuvringModel
+from shipid.dynamics.simulate import DivergenceBounds
 from shipid.errors import ShipidError
 from shipid.trials.manoeuvres import astern_thrust_note, doubling, stopping, turning_circle
 
@@ -184,7 +186,7 @@ def held_rudder(model: ManoeuvringModel, speed: float, rps: float | None = None,
     out = {}
     for side in ("starboard", "port"):
         out[side], _ = doubling(
-            lambda length, side=side: _held(model, speed, rps, rudder_deg, side, length, dt),
+            _held_runs(model, speed, rps, rudder_deg, side, dt),
             duration or HELD_DURATION,
             lambda entry: duration is not None or entry["diverged"] or entry["settled"],
             2**HELD_MAX_DOUBLINGS)  # fmt: skip
@@ -248,13 +250,51 @@ def _runaway_from_drift(model, speed, rps, rudder_deg, side, duration, dt,
     return None
 
 
+def _held_runs(model, speed, rps, rudder_deg, side, dt) -> Callable[[float], dict]:
+    """``run(duration)``: the held turn's entry (``_held``) for ``doubling``. A longer run
+    continues the one before from its last state and rudder instead of running again from the
+    start: the same RK4 steps from the same state, rudder and divergence bounds, so the same
+    states to the bit, and a turn that settles late costs its length once instead of twice (the
+    full-scale ships' turns, which double up to 4800 s, were two fifths of the test suite's held
+    turns). A continuation that diverges is run again from the start, for its report's time."""
+    bounds = DivergenceBounds(speed=DivergenceBounds().resolved(speed)[0])
+    before: list[pd.DataFrame] = []  # the last run that did not diverge
+
+    def run(duration: float) -> dict:
+        n = int(round(duration / dt)) + 1
+        if before and 2 <= len(before[0]) < n:
+            log = before[0]
+            last = log.iloc[-1]
+            initial = {k: float(last[k]) for k in ("u", "v", "r", "psi", "x", "y")}
+            # The rudder one sample back: its first step is the last sample's rudder.
+            initial["delta"] = float(log["delta"].iloc[-2])
+            more = turning_circle(model, rudder_deg, side=side, duration=(n - len(log)) * dt,
+                                  dt=dt, speed=speed, rps=rps, indices=False, initial=initial,
+                                  bounds=bounds)  # fmt: skip
+            if not more.diverged and len(more.log) == n - len(log) + 1:
+                joined = pd.concat([log, more.log.iloc[1:]], ignore_index=True)
+                before[:] = [joined]
+                return _held_entry(joined, False, "", duration, dt)
+        res = turning_circle(model, rudder_deg, side=side, duration=duration, dt=dt, speed=speed,
+                             rps=rps, indices=False, bounds=bounds)  # fmt: skip
+        before[:] = [] if res.diverged else [res.log]
+        return _held_entry(res.log, res.diverged, res.reason, duration, dt)
+
+    return run
+
+
 def _held(model, speed, rps, rudder_deg, side, duration, dt) -> dict:
-    res = turning_circle(model, rudder_deg, side=side, duration=duration, dt=dt, speed=speed,
-                         rps=rps, indices=False)  # fmt: skip
-    entry = {"diverged": res.diverged, "reason": res.reason, "duration": duration, "step": dt,
+    """The rudder held to ``side`` for ``duration`` s from the approach: ``_held_entry``."""
+    return _held_runs(model, speed, rps, rudder_deg, side, dt)(duration)
+
+
+def _held_entry(log, diverged: bool, reason: str, duration: float, dt: float) -> dict:
+    """{"diverged", "reason", "duration", "step", "settled"} of a held turn's ``log``, and where
+    it did not diverge its steady yaw rate and speed (the means of its last tenth)."""
+    entry = {"diverged": diverged, "reason": reason, "duration": duration, "step": dt,
              "settled": False}  # fmt: skip
-    if not res.diverged:
-        tail = res.log.iloc[int(0.9 * len(res.log)) :]
+    if not diverged:
+        tail = log.iloc[int(0.9 * len(log)) :]
         r, u = tail["r"].to_numpy(), tail["u"].to_numpy()
         steady_r, steady_u = float(np.mean(r)), float(np.mean(u))
         entry.update({

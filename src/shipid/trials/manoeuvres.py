@@ -421,6 +421,7 @@ def turning_circle(
     initial: Mapping[str, float] | None = None,
     release: float = math.inf,
     indices: bool = True,
+    bounds: DivergenceBounds | None = None,
 ) -> ManoeuvreResult:
     """Turning circle: rudder to ``side`` at t = ``approach`` (the rudder execute), held.
     ``duration`` [s]: by default 240 s, doubled until the heading has turned 180° and the turn is
@@ -428,7 +429,9 @@ def turning_circle(
     at its ``delta`` until ``approach`` (as ``zigzag``'s). ``release``: the time the rudder goes
     back to midships (a measured turn that ends in a pull-out; the indices are the held turn's).
     ``indices=False`` (with a ``duration``): the run alone, for a check that reads its states
-    (the plausibility checks' held rudder: the indices were a third of their time)."""
+    (the plausibility checks' held rudder: the indices were a third of their time).
+    ``bounds``: where the run counts as diverged (default: ``DivergenceBounds``' from the
+    starting speed)."""
     vessel = as_vessel(ship, speed, steering, rps)
     value = _rudder_to(side, vessel, rudder_deg)
     held = float((initial or {}).get("delta", 0.0))
@@ -436,7 +439,8 @@ def turning_circle(
                               rps=rps, wind=_check_wind(wind))  # fmt: skip
 
     def run(length: float) -> ManoeuvreResult:
-        res = run_closed_loop(vessel, params, length, dt, method, initial=initial, rps=rps)
+        res = run_closed_loop(vessel, params, length, dt, method, bounds=bounds, initial=initial,
+                              rps=rps)  # fmt: skip
         res.log.attrs["manoeuvre"] = f"turning circle {rudder_deg:g}° to {side}"
         if not res.diverged and indices:
             res.indices = turning_indices(res.log, t_order=approach,
