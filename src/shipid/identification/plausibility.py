@@ -258,29 +258,40 @@ def _held_runs(model, speed, rps, rudder_deg, side, dt) -> Callable[[float], dic
     full-scale ships' turns, which double up to 4800 s, were two fifths of the test suite's held
     turns). A continuation that diverges is run again from the start, for its report's time."""
     bounds = DivergenceBounds(speed=DivergenceBounds().resolved(speed)[0])
-    before: list[pd.DataFrame] = []  # the last run that did not diverge
+    before: dict = {}  # of the last run that did not diverge: its r, u, last state, rudder
 
     def run(duration: float) -> dict:
         n = int(round(duration / dt)) + 1
-        if before and 2 <= len(before[0]) < n:
-            log = before[0]
-            last = log.iloc[-1]
-            initial = {k: float(last[k]) for k in ("u", "v", "r", "psi", "x", "y")}
-            # The rudder one sample back: its first step is the last sample's rudder.
-            initial["delta"] = float(log["delta"].iloc[-2])
-            more = turning_circle(model, rudder_deg, side=side, duration=(n - len(log)) * dt,
-                                  dt=dt, speed=speed, rps=rps, indices=False, initial=initial,
+        if before and 2 <= len(before["r"]) < n:
+            m = len(before["r"])
+            more = turning_circle(model, rudder_deg, side=side, duration=(n - m) * dt, dt=dt,
+                                  speed=speed, rps=rps, indices=False, initial=before["initial"],
                                   bounds=bounds)  # fmt: skip
-            if not more.diverged and len(more.log) == n - len(log) + 1:
-                joined = pd.concat([log, more.log.iloc[1:]], ignore_index=True)
-                before[:] = [joined]
-                return _held_entry(joined, False, "", duration, dt)
+            if not more.diverged and len(more.log) == n - m + 1:
+                _keep(before, more.log, before)
+                return _held_entry(before["r"], before["u"], False, "", duration, dt)
         res = turning_circle(model, rudder_deg, side=side, duration=duration, dt=dt, speed=speed,
                              rps=rps, indices=False, bounds=bounds)  # fmt: skip
-        before[:] = [] if res.diverged else [res.log]
-        return _held_entry(res.log, res.diverged, res.reason, duration, dt)
+        before.clear()
+        if res.diverged:
+            return _held_entry(None, None, True, res.reason, duration, dt)
+        _keep(before, res.log)
+        return _held_entry(before["r"], before["u"], False, "", duration, dt)
 
     return run
+
+
+def _keep(before: dict, log: pd.DataFrame, joined: dict | None = None) -> None:
+    """What a held turn goes on from: ``log``'s r and u (after ``joined``'s, whose last sample is
+    ``log``'s first), its last state and the rudder one sample back (the first step's rudder is
+    then the last sample's)."""
+    r, u = log["r"].to_numpy(), log["u"].to_numpy()
+    if joined is not None:
+        r, u = np.concatenate([joined["r"], r[1:]]), np.concatenate([joined["u"], u[1:]])
+    last = log.iloc[-1]
+    initial = {k: float(last[k]) for k in ("u", "v", "r", "psi", "x", "y")}
+    initial["delta"] = float(log["delta"].iloc[-2])
+    before.update({"r": r, "u": u, "initial": initial})
 
 
 def _held(model, speed, rps, rudder_deg, side, duration, dt) -> dict:
@@ -288,14 +299,14 @@ def _held(model, speed, rps, rudder_deg, side, duration, dt) -> dict:
     return _held_runs(model, speed, rps, rudder_deg, side, dt)(duration)
 
 
-def _held_entry(log, diverged: bool, reason: str, duration: float, dt: float) -> dict:
-    """{"diverged", "reason", "duration", "step", "settled"} of a held turn's ``log``, and where
-    it did not diverge its steady yaw rate and speed (the means of its last tenth)."""
+def _held_entry(r, u, diverged: bool, reason: str, duration: float, dt: float) -> dict:
+    """{"diverged", "reason", "duration", "step", "settled"} of a held turn whose yaw rate and
+    speed ran ``r``, ``u``, and where it did not diverge its steady yaw rate and speed (the means
+    of their last tenth)."""
     entry = {"diverged": diverged, "reason": reason, "duration": duration, "step": dt,
              "settled": False}  # fmt: skip
     if not diverged:
-        tail = log.iloc[int(0.9 * len(log)) :]
-        r, u = tail["r"].to_numpy(), tail["u"].to_numpy()
+        r, u = r[int(0.9 * len(r)) :], u[int(0.9 * len(u)) :]
         steady_r, steady_u = float(np.mean(r)), float(np.mean(u))
         entry.update({
             "steady_yaw_rate": steady_r, "steady_speed": steady_u,
