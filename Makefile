@@ -29,6 +29,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_simulate.py
 	$(BIN)/python benchmarks/bench_select.py
 	$(BIN)/python benchmarks/bench_long_logs.py
+	$(BIN)/python benchmarks/bench_plausibility.py
 	$(BIN)/python benchmarks/bench_physics.py
 	$(BIN)/python benchmarks/bench_residual.py
 	$(BIN)/python benchmarks/study_hybrid.py
