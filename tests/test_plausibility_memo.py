@@ -145,3 +145,14 @@ def test_the_held_turns_simulate_each_second_once(monkeypatch):
     for side in ("starboard", "port"):
         assert out[side]["settled"] and out[side]["duration"] == 1200.0
     assert sum(simulated) == pytest.approx(2 * 1200.0)  # 300 + 300 + 600 a side, not 2100
+
+
+def test_threads_checking_side_by_side_get_each_its_own_models_report(turns):
+    from concurrent.futures import ThreadPoolExecutor
+
+    factors = [0.5, 0.75, 1.0, 1.25] * 4
+    with ThreadPoolExecutor(4) as pool:
+        reports = list(pool.map(lambda f: check_plausibility(_model(f), 1.6)[0], factors))
+    plausibility._CHECKED.clear()
+    alone = {f: check_plausibility(_model(f), 1.6)[0] for f in set(factors)}
+    assert all(r == alone[f] for r, f in zip(reports, factors, strict=True))

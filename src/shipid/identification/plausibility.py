@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import copy
 import math
+import threading
 from collections import OrderedDict
 from collections.abc import Callable, Sequence
 
@@ -338,14 +339,18 @@ def check_plausibility(
     crash stop (``crash_stop``), a warning, not a reason to rule a model out (for the model a
     command hands out, not the thousands a search checks)."""
     key = _checked_key(model, speed, rps, rudder_deg, duration, curvature, astern)
-    if key is not None and key in _CHECKED:
-        _CHECKED.move_to_end(key)
-        return copy.deepcopy(_CHECKED[key])
+    if key is not None:
+        with _CHECKED_LOCK:
+            known = _CHECKED.get(key)
+            if known is not None:
+                _CHECKED.move_to_end(key)
+                return copy.deepcopy(known)
     out = _check_plausibility(model, speed, rps, rudder_deg, duration, curvature, astern)
     if key is not None:
-        _CHECKED[key] = copy.deepcopy(out)
-        while len(_CHECKED) > CHECKED_KEPT:
-            _CHECKED.popitem(last=False)
+        with _CHECKED_LOCK:  # a study's threads check models side by side
+            _CHECKED[key] = copy.deepcopy(out)
+            while len(_CHECKED) > CHECKED_KEPT:
+                _CHECKED.popitem(last=False)
     return out
 
 
@@ -356,6 +361,7 @@ def check_plausibility(
 # candidates. Over the test suite 23 % of the checks repeated one before them.
 CHECKED_KEPT = 512
 _CHECKED: OrderedDict[tuple, tuple[dict, list[str]]] = OrderedDict()
+_CHECKED_LOCK = threading.Lock()
 
 
 def _checked_key(model, *args) -> tuple | None:
