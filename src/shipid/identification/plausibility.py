@@ -38,7 +38,13 @@ from shipid.dynamics.equilibrium import still_air_accelerations, surge_equilibri
 from shipid.dynamics.model import ManoeuvringModel
 from shipid.dynamics.simulate import DivergenceBounds
 from shipid.errors import ShipidError
-from shipid.trials.manoeuvres import astern_thrust_note, doubling, stopping, turning_circle
+from shipid.trials.manoeuvres import (
+    as_vessel,
+    astern_thrust_note,
+    doubling,
+    stopping,
+    turning_circle,
+)
 
 SETTLED_FRACTION = 0.02  # of the steady value, over the last 10 % of the run
 # A ship whose propeller keeps turning keeps a share of its approach speed in a steady turn with
@@ -259,19 +265,22 @@ def _held_runs(model, speed, rps, rudder_deg, side, dt) -> Callable[[float], dic
     full-scale ships' turns, which double up to 4800 s, were two fifths of the test suite's held
     turns). A continuation that diverges is run again from the start, for its report's time."""
     bounds = DivergenceBounds(speed=DivergenceBounds().resolved(speed)[0])
+    # The model as the ship of its turns, made once (where its rudder turns it, which a model
+    # works out from its terms, was a tenth of each run's time).
+    ship = as_vessel(model, speed, rps=rps)
     before: dict = {}  # of the last run that did not diverge: its r, u, last state, rudder
 
     def run(duration: float) -> dict:
         n = int(round(duration / dt)) + 1
         if before and 2 <= len(before["r"]) < n:
             m = len(before["r"])
-            more = turning_circle(model, rudder_deg, side=side, duration=(n - m) * dt, dt=dt,
+            more = turning_circle(ship, rudder_deg, side=side, duration=(n - m) * dt, dt=dt,
                                   speed=speed, rps=rps, indices=False, initial=before["initial"],
                                   bounds=bounds)  # fmt: skip
             if not more.diverged and len(more.log) == n - m + 1:
                 _keep(before, more.log, before)
                 return _held_entry(before["r"], before["u"], False, "", duration, dt)
-        res = turning_circle(model, rudder_deg, side=side, duration=duration, dt=dt, speed=speed,
+        res = turning_circle(ship, rudder_deg, side=side, duration=duration, dt=dt, speed=speed,
                              rps=rps, indices=False, bounds=bounds)  # fmt: skip
         before.clear()
         if res.diverged:
