@@ -2,9 +2,10 @@
 
 1. A held turn that has not settled in 300 s is made longer (doubled, up to 4800 s). It now goes
    on from its last state and rudder; before, each longer run started again from the approach.
-   Baseline in the same process: ``doubling`` over ``_held``, which runs each length from the
-   start, the way the code before did. Both sides held, not entered drifting (which runs once,
-   at the settled length, either way); the entries compared to the bit.
+   Baseline in the same process: ``doubling`` over a fresh ``_held_runs`` for each length,
+   which runs it from the start, the way the code before did. Both sides held, not entered
+   drifting (which runs once, at the settled length, either way); the entries compared to the
+   bit.
 2. A model checked again (the same terms, coefficients and approach) is served from a memo of
    the reports; baseline: the same check with the memo emptied before each call (identified
    models only: a reference ship is not what a search checks).
@@ -60,8 +61,8 @@ def _from_the_start(model, speed, rps, rudder) -> dict:
     out = {}
     for side in ("starboard", "port"):
         out[side], _ = doubling(
-            lambda length, side=side: plausibility._held(model, speed, rps, rudder, side, length,
-                                                         dt),
+            lambda length, side=side: plausibility._held_runs(model, speed, rps, rudder, side,
+                                                              dt)(length),
             plausibility.HELD_DURATION,
             lambda entry: entry["diverged"] or entry["settled"],
             2**plausibility.HELD_MAX_DOUBLINGS)  # fmt: skip

@@ -119,8 +119,8 @@ def test_a_longer_held_turn_goes_on_from_the_last_and_equals_the_run_from_the_st
         model, speed, rudder, dt = _slowly_unstable(), 1.0, 35.0, 0.2
     run = plausibility._held_runs(model, speed, None, rudder, "starboard", dt)
     for length in (300.0, 600.0, 1200.0, 2400.0):
-        assert run(length) == plausibility._held(model, speed, None, rudder, "starboard",
-                                                 length, dt)  # fmt: skip
+        from_the_start = plausibility._held_runs(model, speed, None, rudder, "starboard", dt)
+        assert run(length) == from_the_start(length)
     if case == "tanker":
         assert not run(300.0)["settled"] and run(1200.0)["settled"]
     if case == "diverges later":

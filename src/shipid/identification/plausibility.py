@@ -258,7 +258,8 @@ def _runaway_from_drift(model, speed, rps, rudder_deg, side, duration, dt,
 
 
 def _held_runs(model, speed, rps, rudder_deg, side, dt) -> Callable[[float], dict]:
-    """``run(duration)``: the held turn's entry (``_held``) for ``doubling``. A longer run
+    """``run(duration)``: the held turn's entry (``_held_entry``) for ``doubling``; a first call
+    runs from the approach. A longer run
     continues the one before from its last state and rudder instead of running again from the
     start: the same RK4 steps from the same state, rudder and divergence bounds, so the same
     states to the bit, and a turn that settles late costs its length once instead of twice (the
@@ -275,13 +276,13 @@ def _held_runs(model, speed, rps, rudder_deg, side, dt) -> Callable[[float], dic
         if before and 2 <= len(before["r"]) < n:
             m = len(before["r"])
             more = turning_circle(ship, rudder_deg, side=side, duration=(n - m) * dt, dt=dt,
-                                  speed=speed, rps=rps, indices=False, initial=before["initial"],
+                                  rps=rps, indices=False, initial=before["initial"],
                                   bounds=bounds)  # fmt: skip
             if not more.diverged and len(more.log) == n - m + 1:
-                _keep(before, more.log, before)
+                _keep(before, more.log, goes_on=True)
                 return _held_entry(before["r"], before["u"], False, "", duration, dt)
-        res = turning_circle(ship, rudder_deg, side=side, duration=duration, dt=dt, speed=speed,
-                             rps=rps, indices=False, bounds=bounds)  # fmt: skip
+        res = turning_circle(ship, rudder_deg, side=side, duration=duration, dt=dt, rps=rps,
+                             indices=False, bounds=bounds)  # fmt: skip
         before.clear()
         if res.diverged:
             return _held_entry(None, None, True, res.reason, duration, dt)
@@ -291,22 +292,17 @@ def _held_runs(model, speed, rps, rudder_deg, side, dt) -> Callable[[float], dic
     return run
 
 
-def _keep(before: dict, log: pd.DataFrame, joined: dict | None = None) -> None:
-    """What a held turn goes on from: ``log``'s r and u (after ``joined``'s, whose last sample is
-    ``log``'s first), its last state and the rudder one sample back (the first step's rudder is
-    then the last sample's)."""
+def _keep(before: dict, log: pd.DataFrame, goes_on: bool = False) -> None:
+    """What a held turn goes on from, in ``before``: ``log``'s r and u (``goes_on``: after
+    ``before``'s, whose last sample is ``log``'s first), its last state and the rudder one
+    sample back (the first step's rudder is then the last sample's)."""
     r, u = log["r"].to_numpy(), log["u"].to_numpy()
-    if joined is not None:
-        r, u = np.concatenate([joined["r"], r[1:]]), np.concatenate([joined["u"], u[1:]])
+    if goes_on:
+        r, u = np.concatenate([before["r"], r[1:]]), np.concatenate([before["u"], u[1:]])
     last = log.iloc[-1]
     initial = {k: float(last[k]) for k in ("u", "v", "r", "psi", "x", "y")}
     initial["delta"] = float(log["delta"].iloc[-2])
     before.update({"r": r, "u": u, "initial": initial})
-
-
-def _held(model, speed, rps, rudder_deg, side, duration, dt) -> dict:
-    """The rudder held to ``side`` for ``duration`` s from the approach: ``_held_entry``."""
-    return _held_runs(model, speed, rps, rudder_deg, side, dt)(duration)
 
 
 def _held_entry(r, u, diverged: bool, reason: str, duration: float, dt: float) -> dict:
