@@ -112,6 +112,8 @@ def _factor_expr(f) -> str:
         base = f"np.maximum({x}, 0.0)"
     elif op == "neg":
         base = f"np.maximum(-({x}), 0.0)"
+    elif f.propeller:  # n² ahead, −k n² astern
+        base = f"np.where({x} >= 0.0, 1.0, {-f.k!r}) * {x} * {x}"
     else:
         base = f"np.{op}({f.k} * {x})" if f.k != 1 else f"np.{op}({x})"
     return base if f.power == 1 else f"{base} ** {f.power}"

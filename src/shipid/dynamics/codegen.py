@@ -63,7 +63,8 @@ def _factor_expr(signal: int, op: int, k: float, power: int, name: str) -> list[
     s = f"s{signal}"
     base = {0: s, 1: f"abs({s})", 2: f"({s} if {s} > 0.0 else 0.0)",
             3: f"(-{s} if {s} < 0.0 else 0.0)", 4: f"math.sin({k!r} * {s})",
-            5: f"math.cos({k!r} * {s})"}[op]  # fmt: skip
+            5: f"math.cos({k!r} * {s})",
+            9: f"({s} * {s} if {s} >= 0.0 else {-k!r} * {s} * {s})"}[op]  # fmt: skip
     if power <= 1:
         return [f"{name} = {base}"]
     return [f"{name}_b = {base}", f"{name} = " + " * ".join([f"{name}_b"] * power)]

@@ -144,8 +144,10 @@ def _factor(x, op, k, p):
         b = -x if x < 0.0 else 0.0
     elif op == 4:
         b = math.sin(k * x)
-    else:
+    elif op == 5:
         b = math.cos(k * x)
+    else:  # 9, a propeller's thrust at the ratio k astern (6–8 are read from their slots)
+        b = x * x if x >= 0.0 else -k * x * x
     out = b
     for _ in range(p - 1):
         out *= b

@@ -22,7 +22,7 @@ import math
 from collections.abc import Mapping
 
 from shipid.dynamics.model import ManoeuvringModel, ModelStructure
-from shipid.dynamics.terms import CROSSFLOW, OPS, RUDDER, Factor, Term, parse_term
+from shipid.dynamics.terms import CROSSFLOW, OPS, PROPELLER, RUDDER, Factor, Term, parse_term
 from shipid.errors import ShipidError
 
 SPEEDS = ("u", "v", "U", "wind_speed")
@@ -36,6 +36,8 @@ def _factor_scale(name: str, op: str, power: int, length: float, speed: float,
                   rho: float) -> float:  # fmt: skip
     if op in (*CROSSFLOW, RUDDER):  # |w|w, w = v + x r, and U_R² sin α_R: a speed squared
         return speed ** (2 * power)
+    if op == PROPELLER:  # n² (−k n² astern): a rate squared
+        return (speed / length) ** (2 * power)
     if op in ("sin", "cos") or name in ANGLES:
         return 1.0
     if name in SPEEDS:

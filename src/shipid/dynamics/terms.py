@@ -21,6 +21,13 @@ sec. 6.7), one coefficient for what ``|v|v``, ``|v|r`` and ``|r|r`` split among 
 
 in closed form (``crossflow``). Where a zig-zag's small drift leaves the split of |v|v and |v|r
 free, the integral carries the drag to a turn's drift and yaw rate by the hull's geometry.
+A propeller's thrust at a ratio astern (``propeller(k)``, k the ratio) is a factor of n: n² ahead
+(n ≥ 0), −k·n² astern, the thrust of a fixed-pitch propeller at bollard in the four quadrants
+reduced to one number, which a fit to logs that never reverse the propeller cannot give
+(``shipid.dynamics.astern``)::
+
+    propeller(k) = n²  (n ≥ 0),   −k n²  (n < 0)
+
 The rudder's normal force (``rudder_normal(a c g x)``, four numbers) is a factor of u, v, r, n and δ
 together: one inflow to the rudder, shared by the three equations (the MMG standard method's,
 Yasukawa & Yoshimura 2015, with a quadratic race), whose coefficients the fit leaves free::
@@ -64,8 +71,9 @@ INPUT_SIGNALS = ("delta", "n", "thrust", "wind_speed", "wind_angle")
 ANGLE_SIGNALS = ("beta", "delta", "wind_angle")
 ALIASES = {"T": "thrust", "U_A": "wind_speed", "gamma_A": "wind_angle"}
 DISPLAY = {"delta": "δ", "beta": "β", "thrust": "T", "wind_speed": "U_A", "wind_angle": "γ_A"}
+# Op codes are the compiled kernel's (``kernel._factor``): append only.
 OPS = ("pow", "abs", "pos", "neg", "sin", "cos", "crossflow_sway", "crossflow_yaw",
-       "rudder_normal")  # fmt: skip
+       "rudder_normal", "propeller")  # fmt: skip
 OP_CODE = {op: i for i, op in enumerate(OPS)}
 FUNCTIONS = ("abs", "pos", "neg", "sin", "cos")
 # Factors of v and r together, with the hull's length [m] as their argument. The compiled kernel
@@ -79,6 +87,8 @@ RUDDER = "rudder_normal"
 RUDDER_SLOT = len(SIGNALS) + 2
 RUDDER_SIGNALS = ("u", "v", "r", "delta", "n")
 RUDDER_PARAMS = ("a", "c", "g", "x")
+# A propeller's thrust, n² ahead and −k·n² astern (k its astern ratio): a factor of n.
+PROPELLER = "propeller"
 # Order of factors in a term's text: states, derived, propulsion, wind, the rudder last (u² δ).
 FACTOR_ORDER = {s: i for i, s in enumerate(("u", "v", "r", "U", "beta", "n", "thrust",
                                             "wind_speed", "wind_angle", "delta"))}  # fmt: skip
@@ -114,6 +124,11 @@ class Factor:
         return OPS[self.op] in CROSSFLOW
 
     @cached_property
+    def propeller(self) -> bool:
+        """Whether this is a propeller's thrust at a ratio astern (of n, k the ratio)."""
+        return OPS[self.op] == PROPELLER
+
+    @cached_property
     def name(self) -> str:
         """The signal's name."""
         return SIGNALS[self.signal]
@@ -126,6 +141,8 @@ class Factor:
             return f"{op}({self.k:.12g})"
         if op == RUDDER:
             return f"{op}({' '.join(f'{p:.12g}' for p in self.params)})"
+        if op == PROPELLER:
+            return f"{op}({self.k:.12g})"
         if op == "pow":
             base = name
         elif op == "abs":
@@ -144,6 +161,8 @@ class Factor:
         if op == RUDDER:
             a, c, g, x = self.params
             return f"F_R(a {a:.4g}, c {c:.4g} m², γ {g:.4g}, x {x:.4g} m)"
+        if op == PROPELLER:
+            return f"n²(astern ×{self.k:.4g})"
         sup = str(self.power).translate(SUPERSCRIPT) if self.power != 1 else ""
         if op == "pow":
             return f"{name}{sup}"
@@ -165,6 +184,8 @@ class Factor:
             return sway if op == "crossflow_sway" else yaw
         if op == RUDDER:
             return rudder_normal(*(signals[s] for s in RUDDER_SIGNALS), *self.params)
+        if op == PROPELLER:
+            return np.where(x >= 0.0, 1.0, -self.k) * x * x
         if op == "pow":
             base = x
         elif op == "abs":
@@ -234,7 +255,8 @@ class Term:
         rudder's normal force, the square of its inflow speed, counts 2 in u."""
         i = SIGNAL_INDEX[signal]
         rudder = 2 * sum(f.power for f in self.factors if f.rudder) if signal == "u" else 0
-        return rudder + sum(2 * f.power if f.crossflow else f.power for f in self.factors
+        return rudder + sum(2 * f.power if f.crossflow or f.propeller else f.power
+                            for f in self.factors
                             if f.signal == i and OPS[f.op] not in ("sin", "cos", RUDDER))
 
     def __str__(self) -> str:
@@ -259,7 +281,7 @@ def _tokens(text: str) -> list[tuple[str, str]]:
         pos = m.end()
         kind = m.lastgroup
         value = m.group(kind)
-        if kind == "name" and value not in (*FUNCTIONS, *CROSSFLOW, RUDDER):
+        if kind == "name" and value not in (*FUNCTIONS, *CROSSFLOW, RUDDER, PROPELLER):
             out.extend(("name", n) for n in _split_names(value, text))
         else:
             out.append((kind, value))
@@ -358,10 +380,28 @@ class _Parser:
             raise self.error(f"{RUDDER}(a c g x) takes no power")
         return Factor(SIGNAL_INDEX["delta"], OP_CODE[RUDDER], 1, 1, tuple(params))
 
+    def propeller(self) -> Factor:
+        usage = (f"{PROPELLER}(k) takes the ratio k ≥ 0 of its thrust astern to ahead at the "
+                 f"same |n|, e.g. {PROPELLER}(0.5)")  # fmt: skip
+        self.take("name", PROPELLER)
+        self.take("sym", "(")
+        try:
+            ratio = self.number()
+        except ShipidError:
+            raise self.error(usage) from None
+        if self.peek() != ("sym", ")") or not (math.isfinite(ratio) and ratio >= 0):
+            raise self.error(usage)
+        self.i += 1
+        if self.peek() == ("sym", "^"):
+            raise self.error(f"{PROPELLER}(k) takes no power")
+        return Factor(SIGNAL_INDEX["n"], OP_CODE[PROPELLER], ratio, 1)
+
     def factor(self) -> Factor:
         tok = self.peek()
         if tok is not None and tok == ("name", RUDDER):
             return self.rudder()
+        if tok is not None and tok == ("name", PROPELLER):
+            return self.propeller()
         if tok is not None and tok[0] == "name" and tok[1] in CROSSFLOW:
             fn = self.take("name")
             self.take("sym", "(")
@@ -422,7 +462,7 @@ def _canonical(factors: list[Factor], parser: _Parser) -> Term:
         raise parser.error(f"{RUDDER} appears twice: a term has it once")
     out = []
     for (sig, op, k, params), p in sorted(merged.items()):
-        if OPS[op] in (*CROSSFLOW, RUDDER) and p > 1:
+        if OPS[op] in (*CROSSFLOW, RUDDER, PROPELLER) and p > 1:
             raise parser.error(f"{OPS[op]} appears twice: a term has it once")
         if p > MAX_POWER:
             raise parser.error(f"power {p} of {SIGNALS[sig]} out of range 1–{MAX_POWER}")
