@@ -101,7 +101,7 @@ def fitted_files(tmp_path_factory):
                                  method="euler", approach=2.0).log, seed=3).assign(n=N0)  # fmt: skip
     path = write_log(log, folder / "zz.csv")
     out = {}
-    for key, extra in (("ahead", []), ("fitted", ["--no-ahead-forms"])):
+    for key, extra in (("ahead", []), ("fitted", ["--no-ahead-forms", "--astern-thrust", "none"])):
         out[key] = folder / f"{key}.json"
         code, said, err = run(["identify", path, "--model", "blanke", "--no-output-error",
                                "--bootstrap", "10", *extra, "-o", out[key]])  # fmt: skip
@@ -203,7 +203,7 @@ def test_one_esso_zigzag_file_no_longer_diverges_in_a_random_run():
     held = read_trial_log(OSAKA / "random" / "random_03-Aug-2020_11_04_37.csv", fmt="osaka-frt")
     diverged = {}
     with tempfile.TemporaryDirectory() as tmp:
-        for key, extra in (("ahead", []), ("fitted", ["--no-ahead-forms"])):
+        for key, extra in (("ahead", []), ("fitted", ["--no-ahead-forms", "--astern-thrust", "none"])):
             out = Path(tmp) / f"{key}.json"
             with contextlib.redirect_stdout(io.StringIO()), \
                     contextlib.redirect_stderr(io.StringIO()):  # fmt: skip
@@ -218,7 +218,7 @@ def test_select_checks_the_model_as_written_from_a_given_approach_too(fitted_fil
     """select's report of its model is of the file's model: in its ahead forms, also where
     --speed and --rps set the approach (its own check of the fit, in the fitted forms, was
     kept there: a crash stop that diverged for a model that does not)."""
-    for extra, diverges in (([], False), (["--no-ahead-forms"], True)):
+    for extra, diverges in (([], False), (["--no-ahead-forms", "--astern-thrust", "none"], True)):
         out = tmp_path / "sel.json"
         code, _, err = run(["select", fitted_files["log"], "--library", "blanke", "--cv",
                             "blocks:3", "--quiet", "--speed", "2.0", "--rps", str(N0), *extra,

@@ -413,14 +413,15 @@ def test_the_tied_structures_are_fitted_as_the_models_own_fit(mmg_tied):
     log = lowpass(read_log(mmg_tied.parent / "zz.csv"), prep["filter_hz"])
     gamma = doc["identification"]["gamma"]
     # At the log's one rps each is written to scale with it, as the model is.
-    from shipid.dynamics.astern import written_ahead
+    from shipid.dynamics.astern import AsternForms
     from shipid.dynamics.model import get_structure
+    from shipid.dynamics.propeller import ASTERN_THRUST_RATIO
     from shipid.dynamics.similarity import rps_similar
 
     rps = doc["identification"]["rps_similarity"]["rps"]
     for name, model in alternatives_from_document(doc, mmg_tied).items():
-        want = written_ahead(rps_similar(identify(log, model=get_structure(name), gamma=gamma,
-                                                  force=True).model, rps))  # fmt: skip
+        want = AsternForms(True, ASTERN_THRUST_RATIO).written(rps_similar(identify(
+            log, model=get_structure(name), gamma=gamma, force=True).model, rps))  # fmt: skip
         for dof, terms in want.coefficients.items():
             for term, value in terms.items():
                 assert model.coefficients[dof][term] == pytest.approx(value, rel=1e-9), (name, term)

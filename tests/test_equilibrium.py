@@ -78,7 +78,8 @@ def test_manoeuvre_runs_a_propelled_model_file_from_a_steady_approach(tmp_path, 
                         "--no-rps-similarity", "-o", model_path], capsys)  # fmt: skip
     assert code == 0, err
     coef = json.loads(model_path.read_text())["model"]["coefficients"]["u"]
-    want = 13.0 * math.sqrt(-coef["pos(n)^2"] / coef["|u|*u"])
+    # Its thrust is written with a ratio astern (shipid.dynamics.astern): the fit's pos(n)² ahead.
+    want = 13.0 * math.sqrt(-coef["propeller(0.5)"] / coef["|u|*u"])
     out_json = tmp_path / "turn.json"
     code, out, err = run(["manoeuvre", model_path, "turning", "--rudder", "20", "--rps", "13",
                           "--duration", "30", "--no-bands", "--json", out_json], capsys)  # fmt: skip

@@ -397,7 +397,7 @@ def test_select_checks_its_one_rps_model_as_the_file_has_it_crash_stop_too(one_r
     going astern; in the fitted forms (--no-ahead-forms) its yaw damping u·r turns to a drive
     once u < 0, the crash stop diverges, and it says so."""
     log = one_rps["similar"].parent / "zz.csv"
-    for extra, diverges in (([], False), (["--no-ahead-forms"], True)):
+    for extra, diverges in (([], False), (["--no-ahead-forms", "--astern-thrust", "none"], True)):
         out = tmp_path / "sel.json"
         code, said, err = run(["select", log, "--library", "blanke", "--cv", "blocks:3",
                                "--quiet", *extra, "-o", out], capsys)  # fmt: skip

@@ -222,12 +222,16 @@ def _one_rps(logs, args) -> float | None:
     return _constant_rps(logs)
 
 
-def _ahead(logs, args) -> bool:
-    """Whether the model of ``logs`` is written in its ahead forms (``shipid.dynamics.astern``):
-    every log runs ahead throughout, and not --no-ahead-forms."""
-    from shipid.dynamics.astern import logs_ahead
+def _ahead(logs, args):
+    """The forms the model of ``logs`` is written in (``shipid.dynamics.astern.AsternForms``):
+    its ahead forms where every log runs ahead throughout (not with --no-ahead-forms), its
+    thrust at --astern-thrust's ratio astern where no log reverses the propeller."""
+    from shipid.dynamics.astern import AsternForms, logs_ahead, logs_never_reverse
+    from shipid.dynamics.propeller import ASTERN_THRUST_RATIO
 
-    return getattr(args, "ahead_forms", True) and logs_ahead(logs)
+    ratio = getattr(args, "astern_thrust", ASTERN_THRUST_RATIO)
+    return AsternForms(getattr(args, "ahead_forms", True) and logs_ahead(logs),
+                       ratio if ratio is not None and logs_never_reverse(logs) else None)
 
 
 def _constant_rps(logs) -> float | None:

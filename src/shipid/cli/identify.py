@@ -287,7 +287,8 @@ def cmd_identify(args) -> int:
     if residual is not None:
         one_rps = None  # its kernel residual is the fit's at that one rps
 
-    ahead = residual is None and _ahead(logs, args)
+    # A hybrid is written as fitted: its kernel residual is the fit's, at the fit's terms.
+    ahead = _ahead(logs, args) if residual is None else None
 
     def as_written(model):
         """The model as the file will have it: carried to every rps where the logs run at one
@@ -440,19 +441,18 @@ def _report_replicates(ensemble, record: dict, ident) -> None:
         ident.warnings.append(f"bootstrap: {weak}")
 
 
-def _as_written(model, rps: float | None, ahead: bool = False):
+def _as_written(model, rps: float | None, ahead=None):
     """``model`` as the model file will have it: carried to every propeller speed from ``rps``
-    (None: as it is), then in its ahead forms where ``ahead`` (``shipid.dynamics.astern``);
-    ``model`` itself where nothing changes."""
-    from shipid.dynamics.astern import written_ahead
+    (None: as it is), then in the forms ``ahead`` (``shipid.dynamics.astern.AsternForms``;
+    None: none); ``model`` itself where nothing changes."""
     from shipid.dynamics.similarity import rps_similar, similarity_map
 
     if rps is not None and similarity_map(model.structure, rps).changes:
         model = rps_similar(model, rps)
-    return written_ahead(model) if ahead else model
+    return ahead.written(model) if ahead else model
 
 
-def _written_text(text: str, rps: float | None, ahead: bool, path) -> tuple[str, dict | None]:
+def _written_text(text: str, rps: float | None, ahead, path) -> tuple[str, dict | None]:
     """The model file ``text`` as it is written (``_rps_similar``, then ``_ahead_forms``), and
     its prime record where either changed it (else None)."""
     prime = None
@@ -463,20 +463,33 @@ def _written_text(text: str, rps: float | None, ahead: bool, path) -> tuple[str,
     return text, prime
 
 
-def _ahead_forms(text: str, ahead: bool, path) -> dict | None:
-    """The model file ``text`` with its terms in their ahead forms where ``ahead``, said on the
-    command line; None where not, or no term changes."""
+def _ahead_forms(text: str, ahead, path) -> dict | None:
+    """The model file ``text`` with its terms in the forms ``ahead``
+    (``shipid.dynamics.astern.AsternForms``), said on the command line; None where there are
+    none, or no term changes."""
     from shipid.reporting.modelfile import ahead_forms_document
 
     if not ahead:
         return None
-    doc = ahead_forms_document(json.loads(text), path)
+    doc = ahead_forms_document(json.loads(text), path, ahead)
     if doc is not None:
-        print(f"going astern: the logs never do, and cannot tell these forms from the fitted "
-              f"ones; written as the physics carries them astern "
-              f"({doc['identification']['ahead_forms']['terms']}): the same fit ahead, its "
-              "damping damps and its rudder reverses astern (--no-ahead-forms keeps the "
-              "fit's)")  # fmt: skip
+        record = doc["identification"]["ahead_forms"]
+        ratio = record.get("astern_thrust_ratio")
+        hull = "the logs never go astern" in record["note"]
+        pushes = (f"its propeller pushes astern {ratio:g} times what it pushes ahead"
+                  if ratio is not None else "")  # fmt: skip
+        if hull:
+            never = "the logs never do" + (", nor reverse the propeller," if pushes else ",")
+            does = ("its damping damps, its rudder reverses astern and " + pushes if pushes
+                    else "its damping damps and its rudder reverses astern")  # fmt: skip
+            keeps = ("--no-ahead-forms keeps the fit's hull and rudder terms, --astern-thrust "
+                     "none its thrust" if pushes else "--no-ahead-forms keeps the fit's")
+        else:
+            never, does, keeps = ("the logs never reverse the propeller,", pushes,
+                                  "--astern-thrust RATIO|none to set or keep it")  # fmt: skip
+        print(f"going astern: {never} and cannot tell these forms from the fitted ones; "
+              f"written as the physics carries them astern ({record['terms']}): the same fit "
+              f"ahead, {does} ({keeps})")  # fmt: skip
     return doc
 
 

@@ -115,6 +115,19 @@ def _number_or_auto_or_none(text: str) -> float | str:
             from None
 
 
+def _astern_ratio(text: str) -> float | None:
+    """--astern-thrust: a ratio ≥ 0, or 'none'."""
+    if text == "none":
+        return None
+    try:
+        ratio = float(text)
+    except ValueError:
+        ratio = math.nan
+    if not (math.isfinite(ratio) and ratio >= 0):
+        raise argparse.ArgumentTypeError(f"expected a ratio ≥ 0 or 'none', got {text!r}")
+    return ratio
+
+
 def _time_or_auto(text: str) -> float | str:
     if text == "auto":
         return text
@@ -169,6 +182,15 @@ def _add_written_forms_options(p) -> None:
                    help="logs that never go astern: keep the fit's u·v, u·r, u²δ, u²δ² (default: "
                    "written |u|·v in the sway, |u|·r in the yaw, |u|·u·δ, |u|·u·δ², the same fit "
                    "ahead, whose damping damps and whose rudder reverses astern)")
+    from shipid.dynamics.propeller import ASTERN_THRUST_RATIO
+
+    p.add_argument("--astern-thrust", type=_astern_ratio, default=ASTERN_THRUST_RATIO,
+                   metavar="RATIO|none",
+                   help="logs that never reverse the propeller: its thrust astern over its thrust "
+                   f"ahead at the same |n| (default {ASTERN_THRUST_RATIO:g}: the surge's pos(n)² "
+                   "or |n|·n written propeller(k), n² ahead and −k·n² astern, the same fit "
+                   "ahead; 'none' keeps the fit's, which coasts (pos(n)²) or pushes astern as "
+                   "ahead (|n|·n) when reversed)")
 
 
 def _add_block_option(p: argparse.ArgumentParser) -> None:

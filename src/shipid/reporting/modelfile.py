@@ -601,21 +601,35 @@ def rps_similar_document(doc: Mapping, rps: float, path: str | Path = "model fil
                     "identification.discrete is the fit's"}))  # fmt: skip
 
 
-def ahead_forms_document(doc: Mapping, path: str | Path = "model file") -> dict | None:
+def ahead_forms_document(doc: Mapping, path: str | Path = "model file", forms=None
+                         ) -> dict | None:  # fmt: skip
     """The model file of a fit to logs that never go astern with its terms written in the form
-    that carries them astern (``shipid.dynamics.astern``: u·v → |u|·v in v̇, ...), renamed
-    throughout as ``rps_similar_document`` renames; ``identification.ahead_forms`` says what
-    was done. None where no term changes, or the bootstrap replicates' terms would merge."""
-    from shipid.dynamics.astern import ahead_forms, astern_form, written_ahead
+    that carries them astern (``shipid.dynamics.astern``: u·v → |u|·v in v̇, ...; ``forms``, an
+    ``AsternForms``, by default those alone), renamed throughout as ``rps_similar_document``
+    renames; ``identification.ahead_forms`` says what was done. None where no term changes, or
+    the bootstrap replicates' terms would merge."""
+    from shipid.dynamics.astern import AsternForms
 
-    found = ahead_forms(model_from_document(dict(doc), path).structure)
-    return _renamed_document(doc, path, found, lambda dof, term: (astern_form(dof, term), 1.0),
-                             written_ahead, (
-        "ahead_forms", {
-            "terms": found.describe(),
-            "note": "the logs never go astern, where these forms and the fitted ones agree; "
-                    "written in the forms whose astern extension is the physics (damping "
-                    "damps, the rudder's lift reverses with the flow): the same fit ahead"}))
+    forms = AsternForms(hull=True) if forms is None else forms
+    structure = model_from_document(dict(doc), path).structure
+    found = forms.renaming(structure)
+    hull = forms.hull and AsternForms(hull=True).renaming(structure).changes
+    thrust = forms.thrust_ratio is not None and AsternForms(
+        thrust_ratio=forms.thrust_ratio).renaming(structure).changes  # fmt: skip
+    notes = []
+    if hull:
+        notes.append("the logs never go astern, where these forms and the fitted ones agree; "
+                     "written in the forms whose astern extension is the physics (damping "
+                     "damps, the rudder's lift reverses with the flow)")  # fmt: skip
+    if thrust:
+        notes.append("the logs never reverse the propeller: its thrust is written "
+                     "propeller(k), n² ahead and −k·n² astern, k a prior "
+                     "(shipid.dynamics.propeller.ASTERN_THRUST_RATIO, or --astern-thrust)")
+    record = {"terms": found.describe(), "note": "; ".join(notes) + ": the same fit ahead"}
+    if thrust:
+        record["astern_thrust_ratio"] = float(forms.thrust_ratio)
+    return _renamed_document(doc, path, found, lambda dof, term: (forms.form(dof, term), 1.0),
+                             forms.written, ("ahead_forms", record))
 
 
 def _renamed_document(doc: Mapping, path, found, alone, carried, record: tuple[str, dict]

@@ -505,8 +505,9 @@ def pull_out(
 @dataclass(frozen=True)
 class AsternThrust:
     """What a model's stopping test rests on (``astern_thrust_note``): ``kind`` "coasting" (its
-    propeller does nothing reversed) or "mirrored" (its ahead thrust mirrored astern by
-    similarity), and the note that says so."""
+    propeller does nothing reversed), "mirrored" (its ahead thrust mirrored astern by
+    similarity) or "ratio" (its thrust astern a prior ratio of its thrust ahead,
+    ``shipid.dynamics.astern``), and the note that says so."""
 
     kind: str
     note: str
@@ -531,7 +532,20 @@ def astern_thrust_note(ship, speed: float, rps: float,
             "excite, and logs that never reverse the propeller leave the astern thrust out), so "
             "a full astern is the ship coasting to a stop on its resistance, a longer reach than "
             "the ship's own; logs with the propeller astern give it the terms"))
-    if getattr(ship, "physical", ship).similar_at_rps is None or not found["ahead"] > 0:
+    if not found["ahead"] > 0:
+        return None
+    physical = getattr(ship, "physical", ship)
+    from shipid.dynamics.terms import parse_term
+
+    ratios = [f.k for t in physical.structure.terms.get("u", ())
+              for f in parse_term(t).factors if f.propeller]  # fmt: skip
+    if ratios:
+        return AsternThrust("ratio", (
+            f"the model brakes astern at {-100 * found['braking'] / found['ahead']:.0f} % of its "
+            f"ahead push: its logs never reversed the propeller, so its thrust astern is "
+            f"{ratios[0]:g} times its thrust ahead at the same |n|, a prior those logs could not "
+            "test (identify --astern-thrust); logs with the propeller astern give it the terms"))
+    if physical.similar_at_rps is None:
         return None
     return AsternThrust("mirrored", (
         f"the model brakes astern at {-100 * found['braking'] / found['ahead']:.0f} % of its "

@@ -1,0 +1,182 @@
+"""A propeller's thrust at a ratio astern (``propeller(k)``; ``shipid.dynamics.astern``): models
+of logs that never reverse the propeller are written with it, the same fit wherever n ≥ 0, and
+every path that runs a model (NumPy, the compiled kernel, the generated loop, the exported
+module) computes it as its closed form, n² ahead and −k·n² astern."""
+
+import contextlib
+import importlib.util
+import io
+import json
+
+import numpy as np
+import pytest
+
+from shipid.data.io import write_log
+from shipid.dynamics import codegen
+from shipid.dynamics.astern import AsternForms, logs_never_reverse
+from shipid.dynamics.equilibrium import astern_braking
+from shipid.dynamics.model import ManoeuvringModel
+from shipid.dynamics.propeller import ASTERN_THRUST_RATIO
+from shipid.dynamics.simulate import simulate
+from shipid.dynamics.terms import parse_term
+from shipid.trials.manoeuvres import astern_thrust_note, stopping, zigzag
+from shipid.vessels import PAPER_IMU, scale_ship
+
+N0 = 12.0  # rps, logged constant
+
+
+def run(argv) -> tuple[int, str, str]:
+    from shipid.cli import main
+
+    with contextlib.redirect_stdout(io.StringIO()) as out, \
+            contextlib.redirect_stderr(io.StringIO()) as err:  # fmt: skip
+        code = main([str(a) for a in argv])
+    return code, out.getvalue(), err.getvalue()
+
+
+def surge_model(ratio: float | None) -> ManoeuvringModel:
+    """A surge of resistance and thrust (pos(n)², or propeller(ratio)); sway and yaw damped."""
+    thrust = "pos(n)^2" if ratio is None else f"propeller({ratio:g})"
+    return ManoeuvringModel(
+        f"u: |u|u, {thrust}; v: u*v, u*r, delta; r: u*v, u*r, delta",
+        {"u": {"|u|u": -0.05, thrust: 2e-3}, "v": {"u*v": -0.5, "u*r": -0.4, "delta": 0.05},
+         "r": {"u*v": -0.6, "u*r": -1.1, "delta": -0.5}})  # fmt: skip
+
+
+@pytest.mark.parametrize("ratio", [0.0, 0.5, 1.3])
+def test_the_factor_is_its_closed_form(ratio):
+    term = parse_term(f"propeller({ratio:g})")
+    assert term.text == f"propeller({ratio:g})" and term.degree_in("n") == 2
+    n = np.array([-3.0, -0.5, 0.0, 0.5, 3.0])
+    want = np.where(n >= 0, n**2, -ratio * n**2)
+    np.testing.assert_array_equal(term.factors[0].values(n), want)
+
+
+@pytest.mark.parametrize("text", ["propeller(-0.5)", "propeller(0.5)^2", "propeller()",
+                                  "propeller(0.5 1)"])  # fmt: skip
+def test_a_bad_ratio_is_named(text):
+    from shipid.errors import ShipidError
+
+    with pytest.raises(ShipidError, match=r"propeller\(k\)"):
+        parse_term(text)
+
+
+@pytest.mark.parametrize("engine", ["interpreted", "generated"])
+def test_the_compiled_runs_are_the_closed_form(engine, tmp_path, monkeypatch):
+    """A free run through a reversal: the compiled kernel (interpreted and generated) against
+    the same model with the thrust written pos(n)² − k·neg(n)², two terms NumPy and the kernel
+    already had."""
+    monkeypatch.setenv("SHIPID_CACHE_DIR", str(tmp_path))
+    t = np.arange(0, 120, 0.1)
+    n = 10 * np.cos(t / 15)  # ahead, astern, ahead
+    delta = 0.2 * np.sign(np.sin(t / 10))
+    model = surge_model(0.6)
+    split = ManoeuvringModel(
+        "u: |u|u, pos(n)^2, neg(n)^2; v: u*v, u*r, delta; r: u*v, u*r, delta",
+        {"u": {"|u|u": -0.05, "pos(n)^2": 2e-3, "neg(n)^2": -0.6 * 2e-3},
+         "v": model.coefficients["v"], "r": model.coefficients["r"]})  # fmt: skip
+    with codegen.use(engine):
+        a = simulate(model, t, delta, {"u": 1.0}, rps=n, method="rk4").log
+        b = simulate(split, t, delta, {"u": 1.0}, rps=n, method="rk4").log
+    assert a["u"].min() < 0 < a["u"].max()  # it went astern and ahead again
+    np.testing.assert_allclose(a[["u", "v", "r", "psi"]].to_numpy(),
+                               b[["u", "v", "r", "psi"]].to_numpy(), rtol=1e-12, atol=1e-12)
+
+
+def test_the_exported_module_runs_it(tmp_path):
+    from shipid.control.export import export_numpy
+
+    model = surge_model(0.4)
+    t = np.arange(0, 60, 0.1)
+    n, delta = 8 * np.cos(t / 8), 0.1 * np.sign(np.sin(t / 6))
+    ref = simulate(model, t, delta, {"u": 1.0}, rps=n, method="rk4").log[
+        ["u", "v", "r", "psi", "x", "y"]].to_numpy()  # fmt: skip
+    path = export_numpy(model, tmp_path / "exported.py")
+    spec = importlib.util.spec_from_file_location("exported", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    got = mod.simulate(t, np.column_stack([delta, n]), [1.0, 0, 0, 0, 0, 0], "rk4")
+    np.testing.assert_allclose(got, ref, atol=1e-9, rtol=0)
+
+
+@pytest.mark.parametrize("thrust", ["pos(n)^2", "|n|*n"])
+def test_written_the_same_ahead_and_k_times_the_push_astern(thrust):
+    fitted = ManoeuvringModel(f"u: |u|u, {thrust}, pos(n)^2*delta^2; v: u*v, pos(n)^2; r: u*r",
+                              {"u": {"|u|u": -0.05, thrust: 2e-3, "pos(n)^2*delta^2": -1e-3},
+                               "v": {"u*v": -0.5, "pos(n)^2": 1e-4},
+                               "r": {"u*r": -1.0}})  # fmt: skip
+    written = AsternForms(thrust_ratio=0.5).written(fitted)
+    # Only the surge's thrust: the rudder's drag in the race and the sway's side force stay.
+    assert written.structure.terms["u"] == ("|u|*u", "propeller(0.5)", "pos(n)^2*delta^2")
+    assert written.structure.terms["v"] == fitted.structure.terms["v"]
+    rng = np.random.default_rng(0)
+    s = {"u": rng.uniform(0.1, 2, 200), "v": rng.normal(0, 0.2, 200),
+         "r": rng.normal(0, 0.1, 200), "delta": rng.uniform(-0.6, 0.6, 200)}  # fmt: skip
+    ahead = rng.uniform(0, 15, 200)
+    np.testing.assert_allclose(written.accelerations(**s, rps=ahead),
+                               fitted.accelerations(**s, rps=ahead), rtol=1e-13, atol=1e-17)
+    found = astern_braking(written, 1.0, 10.0)
+    assert found["braking"] == pytest.approx(-0.5 * found["ahead"], rel=1e-12)
+
+
+def test_logs_that_reverse_the_propeller_are_left_as_fitted():
+    import pandas as pd
+
+    ahead = pd.DataFrame({"n": [0.0, 5.0, 10.0]})
+    assert logs_never_reverse([ahead, ahead])
+    assert not logs_never_reverse([ahead, pd.DataFrame({"n": [5.0, -1.0]})])
+    assert not logs_never_reverse([pd.DataFrame({"u": [1.0]})])  # no rps: nothing to write
+    assert not logs_never_reverse([])
+
+
+def test_the_crash_stop_note_names_the_ratio():
+    note = astern_thrust_note(surge_model(0.5), 1.0, 10.0)
+    assert note.kind == "ratio" and "brakes astern at 50 % of its ahead push" in note.note
+    assert astern_thrust_note(surge_model(None), 1.0, 10.0).kind == "coasting"
+    # A crash stop stops, later than with the thrust mirrored astern whole.
+    kw = {"speed": 1.0, "duration": 600, "dt": 0.5}
+    half, whole = (stopping(surge_model(k), 10.0, **kw).indices["time_to_stop"] for k in (0.5, 1))
+    assert np.isfinite(half) and half > whole > 0
+
+
+@pytest.fixture(scope="module")
+def one_rps_files(tmp_path_factory):
+    """The paper's ship's noisy 20/20 zig-zag at a constant 12 rps, identified as the default
+    writes it, at another ratio, and as fitted."""
+    folder = tmp_path_factory.mktemp("astern_thrust")
+    log = PAPER_IMU.apply(zigzag(scale_ship(rudder_rate_deg=9.6), 20, 20, duration=90, dt=0.2,
+                                 method="euler", approach=2.0).log, seed=5).assign(n=N0)  # fmt: skip
+    path = write_log(log, folder / "zz.csv")
+    out = {"log": path}
+    for key, extra in (("default", []), ("0.7", ["--astern-thrust", "0.7"]),
+                       ("fitted", ["--astern-thrust", "none"])):  # fmt: skip
+        out[key] = folder / f"{key}.json"
+        code, said, err = run(["identify", path, "--model", "blanke", "--no-output-error",
+                               *extra, "-o", out[key]])  # fmt: skip
+        assert code == 0, err
+        out[f"{key}_said"] = said
+    return out
+
+
+def test_identify_writes_the_thrust_at_the_ratio_and_says_so(one_rps_files):
+    docs = {k: json.loads(one_rps_files[k].read_text()) for k in ("default", "0.7", "fitted")}
+    thrust = docs["fitted"]["model"]["coefficients"]["u"]["|n|*n"]  # the similarity's "1"
+    for key, ratio in (("default", ASTERN_THRUST_RATIO), ("0.7", 0.7)):
+        coefs = docs[key]["model"]["coefficients"]["u"]
+        assert coefs[f"propeller({ratio:g})"] == thrust and "|n|*n" not in coefs
+        record = docs[key]["identification"]["ahead_forms"]
+        assert record["astern_thrust_ratio"] == ratio and "n²(astern" in record["terms"]
+        said = one_rps_files[f"{key}_said"]
+        assert f"its propeller pushes astern {ratio:g} times what it pushes ahead" in said
+    assert "ahead_forms" in docs["fitted"]["identification"]  # the hull's forms still
+    assert "astern_thrust_ratio" not in docs["fitted"]["identification"]["ahead_forms"]
+    # The crash stop identify ran was of the model as written: it brakes at the ratio.
+    astern = docs["default"]["identification"]["plausibility"]["astern"]
+    assert not astern["diverged"]
+
+
+def test_a_bad_ratio_on_the_command_line_is_one_line(one_rps_files, tmp_path):
+    out = tmp_path / "m.json"
+    with pytest.raises(SystemExit) as exc:  # argparse's usage error, as for every option
+        run(["identify", one_rps_files["log"], "--astern-thrust", "-1", "-o", out])
+    assert exc.value.code == 2 and not out.exists()
