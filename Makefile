@@ -64,6 +64,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/study_sign_table.py
 	$(BIN)/python benchmarks/study_esso_turn_in_training.py
 	$(BIN)/python benchmarks/study_esso_rps_range.py
+	$(BIN)/python benchmarks/study_astern_thrust.py
 	$(BIN)/python benchmarks/bench_blas_threads.py
 
 clean:
