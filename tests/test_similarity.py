@@ -410,3 +410,6 @@ def test_select_checks_its_one_rps_model_as_the_file_has_it_crash_stop_too(one_r
             is diverges  # fmt: skip
         assert ("ahead_forms" in doc["identification"]) is not diverges
         assert ("going astern: the logs never do" in said) is not diverges
+        if not diverges:  # select writes the thrust astern at the ratio too: similarity's n|n|
+            assert doc["identification"]["ahead_forms"]["astern_thrust_ratio"] == 0.5
+            assert "propeller(0.5)" in doc["model"]["coefficients"]["u"]
