@@ -126,6 +126,17 @@ def test_written_the_same_ahead_and_k_times_the_push_astern(thrust):
     assert found["braking"] == pytest.approx(-0.5 * found["ahead"], rel=1e-12)
 
 
+def test_a_negative_thrust_is_left_as_fitted():
+    """A fitted pos(n)² < 0 is no thrust (the fit carried it elsewhere): at a ratio astern it
+    would push the ship ahead when reversed."""
+    fitted = surge_model(None)
+    negative = ManoeuvringModel(fitted.structure, {**fitted.coefficients,
+                                                   "u": {"|u|u": -0.05, "pos(n)^2": -2e-4}})
+    assert AsternForms(True, 0.5).written(negative).structure.terms["u"] == ("|u|*u", "pos(n)^2")
+    assert AsternForms(True, 0.5).written(fitted).structure.terms["u"] == ("|u|*u",
+                                                                           "propeller(0.5)")
+
+
 def test_logs_that_reverse_the_propeller_are_left_as_fitted():
     import pandas as pd
 

@@ -128,8 +128,19 @@ class AsternForms:
         """The forms of ``structure``'s terms (ratio 1), as ``ahead_forms`` renames."""
         return TermRenaming(renamed_terms(structure, lambda dof, t: (self.form(dof, t), 1.0)))
 
+    def for_model(self, model: ManoeuvringModel) -> AsternForms:
+        """These forms for ``model``: its thrust written at the ratio only where it pushes ahead
+        (every fitted pos(n)², |n|·n of its surge > 0); a negative one is no thrust (the fit
+        carried it in another term), and mirrored at a ratio it would push ahead when
+        reversed: left as fitted."""
+        if self.thrust_ratio is None:
+            return self
+        coefs = model.coefficients.get("u", {})
+        pushes = all(float(c) > 0 for t, c in coefs.items() if parse_term(t).text in AHEAD_THRUST)
+        return self if pushes else AsternForms(self.hull, None)
+
     def written(self, model: ManoeuvringModel) -> ManoeuvringModel:
-        """``model`` in these forms: the same accelerations wherever u ≥ 0 (``hull``) and
-        n ≥ 0 (``thrust_ratio``)."""
-        found = self.renaming(model.structure)
+        """``model`` in these forms (``for_model``): the same accelerations wherever u ≥ 0
+        (``hull``) and n ≥ 0 (``thrust_ratio``)."""
+        found = self.for_model(model).renaming(model.structure)
         return renamed_model(model, found) if found.changes else model

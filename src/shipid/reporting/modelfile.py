@@ -610,8 +610,9 @@ def ahead_forms_document(doc: Mapping, path: str | Path = "model file", forms=No
     the bootstrap replicates' terms would merge."""
     from shipid.dynamics.astern import AsternForms
 
-    forms = AsternForms(hull=True) if forms is None else forms
-    structure = model_from_document(dict(doc), path).structure
+    model = model_from_document(dict(doc), path)
+    forms = AsternForms(hull=True) if forms is None else forms.for_model(model)
+    structure = model.structure
     found = forms.renaming(structure)
     hull = forms.hull and AsternForms(hull=True).renaming(structure).changes
     thrust = forms.thrust_ratio is not None and AsternForms(
