@@ -198,3 +198,23 @@ def test_a_bad_ratio_on_the_command_line_is_one_line(one_rps_files, tmp_path):
     with pytest.raises(SystemExit) as exc:  # argparse's usage error, as for every option
         run(["identify", one_rps_files["log"], "--astern-thrust", "-1", "-o", out])
     assert exc.value.code == 2 and not out.exists()
+
+
+def test_a_model_file_prior_in_the_other_thrust_form_holds_the_fit(one_rps_files):
+    """A model file written with its thrust as propeller(k) as the prior of a fit whose surge
+    holds pos(n)², or, at one rps, the constant that similarity writes |n|·n: the thrust takes
+    the file's value, not 0."""
+    from shipid.dynamics.model import ModelStructure
+    from shipid.identification.priors import prior_at_rps, prior_from_model, prior_in_forms
+    from shipid.reporting.modelfile import load_model
+
+    written = prior_from_model(load_model(one_rps_files["default"]))
+    value = written["u"]["propeller(0.5)"]
+    pos = ModelStructure("s", {"u": ("|u|*u", "pos(n)^2")})
+    assert prior_in_forms(written, pos)["u"]["pos(n)^2"] == value
+    constant = ModelStructure("s", {"u": ("|u|*u", "1")})
+    at_rps = prior_at_rps(prior_in_forms(written, constant), constant, N0)
+    assert at_rps["u"]["1"] == pytest.approx(value * N0**2, rel=1e-12)
+    # And the other way: a file's pos(n)² for a structure written with propeller(k).
+    back = ModelStructure("s", {"u": ("|u|*u", "propeller(0.7)")})
+    assert prior_in_forms({"u": {"pos(n)^2": 2.0}}, back)["u"]["propeller(0.7)"] == 2.0

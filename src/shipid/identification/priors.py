@@ -172,22 +172,40 @@ def prior_at_rps(prior: dict[str, dict[str, float]], structure: ModelStructure,
 
     def similar(dof: str, text: str) -> list[tuple[str, float]]:
         form, k = similar_term(text)
-        return [(form, rps**k)] if k else []
+        return [(t, rps**k) for t in (form, *_thrust_twins(prior, dof, form))] if k else []
 
     return _from_twins(prior, structure, similar)
+
+
+def _thrust_twins(prior: dict[str, dict[str, float]], dof: str, text: str) -> list[str]:
+    """The prior's other forms of the surge's thrust ``text`` (``shipid.dynamics.astern``: a
+    model file of logs that never reverse the propeller writes pos(n)² or |n|·n as
+    propeller(k), the same term ahead); [] for any other term."""
+    from shipid.dynamics.astern import AHEAD_THRUST
+
+    if dof != "u":
+        return []
+    names = list(prior.get("u", {}))
+    if text in AHEAD_THRUST:
+        return [t for t in names if any(f.propeller for f in parse_term(t).factors)]
+    if any(f.propeller for f in parse_term(text).factors):
+        return [t for t in names if t in AHEAD_THRUST]
+    return []
 
 
 def prior_in_forms(prior: dict[str, dict[str, float]], structure: ModelStructure
                    ) -> dict[str, dict[str, float]]:  # fmt: skip
     """``prior`` with a value for each term of ``structure`` that the prior holds in its other
-    ahead form (``shipid.dynamics.astern``: u·v and |u|·v in v̇, ...), the same term on logs
-    that run ahead. A model file of such logs is written in the one form; a fit in the other
-    had no prior on those terms, and drew them toward 0."""
+    ahead form (``shipid.dynamics.astern``: u·v and |u|·v in v̇, ..., the thrust pos(n)² or
+    |n|·n and propeller(k)), the same term on logs that run ahead. A model file of such logs is
+    written in the one form; a fit in the other had no prior on those terms, and drew them
+    toward 0."""
     from shipid.dynamics.astern import AHEAD_FORMS, astern_form
 
     def other_form(dof: str, text: str) -> list[tuple[str, float]]:
         fitted = [f for (d, f), w in AHEAD_FORMS.items() if w == text and d in (dof, None)]
-        return [(t, 1.0) for t in (astern_form(dof, text), *fitted) if t != text]
+        return [(t, 1.0) for t in (astern_form(dof, text), *fitted,
+                                   *_thrust_twins(prior, dof, text)) if t != text]
 
     return _from_twins(prior, structure, other_form)
 
