@@ -193,11 +193,25 @@ def test_identify_writes_the_thrust_at_the_ratio_and_says_so(one_rps_files):
     assert not astern["diverged"]
 
 
-def test_a_bad_ratio_on_the_command_line_is_one_line(one_rps_files, tmp_path):
+def test_a_bad_ratio_on_the_command_line_is_a_usage_error(one_rps_files, tmp_path):
+    from shipid.cli import main
+
     out = tmp_path / "m.json"
-    with pytest.raises(SystemExit) as exc:  # argparse's usage error, as for every option
-        run(["identify", one_rps_files["log"], "--astern-thrust", "-1", "-o", out])
+    # argparse's usage error, as for every option's value: exit 2 and a line naming it.
+    with contextlib.redirect_stderr(io.StringIO()) as err, pytest.raises(SystemExit) as exc:
+        main(["identify", str(one_rps_files["log"]), "--astern-thrust", "-1", "-o", str(out)])
     assert exc.value.code == 2 and not out.exists()
+    assert "argument --astern-thrust: expected a ratio ≥ 0 or 'none', got '-1'" in err.getvalue()
+
+
+def test_the_forms_say_which_part_they_change():
+    from shipid.dynamics.model import ModelStructure
+
+    both = ModelStructure("s", {"u": ("|u|u", "pos(n)^2"), "v": ("u*v",)})
+    assert AsternForms(True, 0.5).parts(both) == (True, True)
+    assert AsternForms(True, None).parts(both) == (True, False)
+    assert AsternForms(False, 0.5).parts(both) == (False, True)
+    assert AsternForms(True, 0.5).parts(ModelStructure("s", {"u": ("|u|u",)})) == (False, False)
 
 
 def test_a_model_file_prior_in_the_other_thrust_form_holds_the_fit(one_rps_files):

@@ -467,15 +467,17 @@ def _ahead_forms(text: str, ahead, path) -> dict | None:
     """The model file ``text`` with its terms in the forms ``ahead``
     (``shipid.dynamics.astern.AsternForms``), said on the command line; None where there are
     none, or no term changes."""
-    from shipid.reporting.modelfile import ahead_forms_document
+    from shipid.reporting.modelfile import ahead_forms_document, model_from_document
 
     if not ahead:
         return None
-    doc = ahead_forms_document(json.loads(text), path, ahead)
+    fitted = json.loads(text)
+    doc = ahead_forms_document(fitted, path, ahead)
     if doc is not None:
         record = doc["identification"]["ahead_forms"]
         ratio = record.get("astern_thrust_ratio")
-        hull = "the logs never go astern" in record["note"]
+        model = model_from_document(fitted, path)
+        hull = ahead.for_model(model).parts(model.structure)[0]
         pushes = (f"its propeller pushes astern {ratio:g} times what it pushes ahead"
                   if ratio is not None else "")  # fmt: skip
         if hull:

@@ -73,20 +73,6 @@ def logs_ahead(logs: Sequence[pd.DataFrame]) -> bool:
     return bool(logs) and all(float(np.min(log["u"].to_numpy(dtype=float))) > 0 for log in logs)
 
 
-def ahead_forms(structure: ModelStructure) -> TermRenaming:
-    """The ``AHEAD_FORMS`` of ``structure``'s terms (``shipid.dynamics.renaming``, ratio 1); a
-    term whose form the equation already has (u·v beside |u|·v) keeps its fitted one, as the
-    two are the fit's separate terms."""
-    return TermRenaming(renamed_terms(structure, lambda dof, t: (astern_form(dof, t), 1.0)))
-
-
-def written_ahead(model: ManoeuvringModel) -> ManoeuvringModel:
-    """``model`` with its terms in their ``AHEAD_FORMS``: the same accelerations wherever
-    u ≥ 0."""
-    found = ahead_forms(model.structure)
-    return renamed_model(model, found) if found.changes else model
-
-
 # The surge's thrust terms that logs which never reverse the propeller cannot tell apart.
 AHEAD_THRUST = frozenset(parse_term(t).text for t in ("pos(n)^2", "|n|*n"))
 
@@ -125,8 +111,18 @@ class AsternForms:
         return text if self.thrust_ratio is None else thrust_form(dof, text, self.thrust_ratio)
 
     def renaming(self, structure: ModelStructure) -> TermRenaming:
-        """The forms of ``structure``'s terms (ratio 1), as ``ahead_forms`` renames."""
+        """The forms of ``structure``'s terms (``shipid.dynamics.renaming``, ratio 1); a term
+        whose form the equation already has (u·v beside |u|·v) keeps its fitted one, as the two
+        are the fit's separate terms."""
         return TermRenaming(renamed_terms(structure, lambda dof, t: (self.form(dof, t), 1.0)))
+
+    def parts(self, structure: ModelStructure) -> tuple[bool, bool]:
+        """Which of these forms change ``structure``: (its hull's and rudder's terms, its
+        thrust)."""
+        changed = [new for eq in self.renaming(structure).renamed.values()
+                   for old, (new, _) in eq.items() if new != old]  # fmt: skip
+        thrust = [any(f.propeller for f in parse_term(t).factors) for t in changed]
+        return (not all(thrust), any(thrust))
 
     def for_model(self, model: ManoeuvringModel) -> AsternForms:
         """These forms for ``model``: its thrust written at the ratio only where it pushes ahead
@@ -144,3 +140,15 @@ class AsternForms:
         (``hull``) and n ≥ 0 (``thrust_ratio``)."""
         found = self.for_model(model).renaming(model.structure)
         return renamed_model(model, found) if found.changes else model
+
+
+def ahead_forms(structure: ModelStructure) -> TermRenaming:
+    """The ``AHEAD_FORMS`` of ``structure``'s terms (``AsternForms.renaming``, the hull's and
+    rudder's alone)."""
+    return AsternForms(hull=True).renaming(structure)
+
+
+def written_ahead(model: ManoeuvringModel) -> ManoeuvringModel:
+    """``model`` with its terms in their ``AHEAD_FORMS``: the same accelerations wherever
+    u ≥ 0."""
+    return AsternForms(hull=True).written(model)

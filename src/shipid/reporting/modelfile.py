@@ -612,11 +612,8 @@ def ahead_forms_document(doc: Mapping, path: str | Path = "model file", forms=No
 
     model = model_from_document(dict(doc), path)
     forms = AsternForms(hull=True) if forms is None else forms.for_model(model)
-    structure = model.structure
-    found = forms.renaming(structure)
-    hull = forms.hull and AsternForms(hull=True).renaming(structure).changes
-    thrust = forms.thrust_ratio is not None and AsternForms(
-        thrust_ratio=forms.thrust_ratio).renaming(structure).changes  # fmt: skip
+    found = forms.renaming(model.structure)
+    hull, thrust = forms.parts(model.structure)
     notes = []
     if hull:
         notes.append("the logs never go astern, where these forms and the fitted ones agree; "
