@@ -112,14 +112,19 @@ def test_a_model_that_fails_above_the_logs_rps_is_named(rps, warned):
 
 @needs_data
 @pytest.mark.parametrize("command", ["identify", "select"])
-def test_where_nothing_similar_is_plausible_the_library_keeps_its_constant(tmp_path, capsys,
-                                                                           command):
+def test_where_nothing_similar_is_plausible_the_surge_alone_keeps_its_constant(tmp_path, capsys,
+                                                                               command):
     """The nine Esso zig-zag files: every candidate of the default library with its constant and
     δ² written as advance-ratio similarity has them ends its held 35° turns astern (its thrust
     rides on u|n| against a negative n⁺², one column along runs whose speed goes with n).
-    identify and select (without --library) then search the library with them as they are, say
-    so, and hand out a plausible model, the one they gave before the similar forms."""
+    identify and select (without --library) then search the library with them as they are in
+    the surge alone, the side force's constant written as similarity has it, say so, and hand
+    out a plausible model. With a side force the same at every rps (the library with every
+    constant, searched before) a 10° turn to starboard at 6 rps was 12 times as wide in
+    lengths as at 16.7 rps; a ship's is about as wide at every speed."""
+    from shipid.dynamics.equilibrium import surge_equilibrium
     from shipid.identification.plausibility import disqualifying, plausibility_at_approach
+    from shipid.trials.manoeuvres import turning_circle
 
     files = sorted(ZIGZAG.glob("*.csv"))
     out = tmp_path / "nine.json"
@@ -127,11 +132,20 @@ def test_where_nothing_similar_is_plausible_the_library_keeps_its_constant(tmp_p
     code, said, err = run([command, "--format", "osaka-frt", "--dt", "0.5", *quiet, *files,
                            "-o", out], capsys)  # fmt: skip
     assert code == 0, err
-    assert "with its constant and δ² (logo)…" in err
-    assert "the library with them as they are was searched instead" in said + err
+    assert "with its constant and δ² in the surge (logo)…" in err
+    assert ("so the library with its constant and δ² in the surge was searched instead (the "
+            "side force's constant written as similarity has it)") in said + err
     doc = load_document(out)
     model = model_from_document(doc, str(out), "model")
     assert "1" in model.structure.terms["u"]
+    assert "1" not in model.structure.terms["v"] and "1" not in model.structure.terms["r"]
     cond = training_conditions(doc)
     report, _ = plausibility_at_approach(model, cond["speed"], cond["rps"])
     assert disqualifying(report, model) == []
+    for side in ("starboard", "port"):
+        across = []
+        for rps in (6.0, 16.67):
+            speed = surge_equilibrium(model, cond["speed"], rps)
+            turn = turning_circle(model, 10.0, side, rps=rps, speed=speed, dt=0.2, wind=(0, 0))
+            across.append(turn.indices["tactical_diameter"])
+        assert max(across) / min(across) < 1.5, (side, across)

@@ -150,6 +150,32 @@ def test_a_library_at_several_rps_holds_no_force_the_same_at_every_rps():
     assert "1" in library.all_terms and "advance-ratio" not in note
 
 
+def test_the_side_forces_form_writes_the_constant_of_sway_and_yaw_alone():
+    """``SIDE_FORCE``: the surge keeps its constant and δ², sway and yaw lose their constant to
+    n|n| (here in the span of the library's n⁺² and n⁻², so written by them), as the default's
+    second search has it (``auto_structure.SIMILAR_FORMS``)."""
+    from shipid.dynamics.model import get_structure
+    from shipid.dynamics.similarity import SIDE_FORCE, similar_library
+    from shipid.identification.select import DEFAULT_LIBRARY, default_library
+
+    full = get_structure(DEFAULT_LIBRARY)
+    sides, replaced = similar_library(full, SIDE_FORCE)
+    assert replaced == ("1",)
+    assert {d: set(full.terms[d]) ^ set(sides.terms[d]) for d in full.terms} == {
+        "u": set(), "v": {"1"}, "r": {"1"}}
+    low, _ = similar_library(get_structure("low-speed"), SIDE_FORCE)
+    assert "|n|*n" in low.terms["v"] and "1" not in low.terms["r"] and "1" in low.terms["u"]
+    log = pd.DataFrame({"t": np.arange(0, 10.0, 0.5), "u": 0.5, "v": 0.01, "r": 0.01,
+                        "delta": 0.1, "n": 10.0, "wind_speed": 1.0, "wind_angle": 0.3})  # fmt: skip
+    library, note = default_library([log, log.assign(n=12.0)], similar=SIDE_FORCE)
+    assert "1" in library.terms["u"] and "delta^2" in library.terms["u"]
+    assert "1" not in library.terms["v"] and "1" not in library.terms["r"]
+    assert note.startswith("the constant of v, r is written as advance-ratio similarity")
+    # and () keeps every constant, as the default's last search does
+    library, note = default_library([log, log.assign(n=12.0)], similar=())
+    assert all("1" in library.terms[d] for d in "uvr") and "advance-ratio" not in note
+
+
 def test_froude_scaling_carries_the_anchor():
     similar = rps_similar(_fitted(), N0)
     assert froude_scaled(similar, 4.0).similar_at_rps == pytest.approx(N0 / 2)

@@ -47,6 +47,7 @@ import numpy as np
 import pandas as pd
 
 from shipid.dynamics.model import ModelStructure, StructureEdit, get_structure
+from shipid.dynamics.similarity import SIDE_FORCE
 from shipid.errors import ShipidError
 from shipid.identification.cross_validation import choice_cv
 from shipid.identification.identify import material_wind, spread, varies, varying_propulsion
@@ -202,7 +203,7 @@ def _auto_structure(logs, names, physics, cv, estimator, drop, announce) -> Stru
         found = _searched(logs, names, options, drop, announce)
         if found.why and found.similar:
             constant = searched_with_the_constant(logs, names, options, drop, announce,
-                                                  found.why)  # fmt: skip
+                                                  found.why, found.similar)  # fmt: skip
             if constant is not None:
                 constant.widening = [*found.widening, *constant.widening]
                 found = constant
@@ -235,7 +236,8 @@ def _auto_structure(logs, names, physics, cv, estimator, drop, announce) -> Stru
 class _Search:
     """What the default library's search found (``_searched``): the selection, the library's
     name and note, the widening's notes and warning, why the choice cannot be used (None where
-    it can), and whether the library was written as advance-ratio similarity has it."""
+    it can), and the equations whose constant and δ² the library wrote as advance-ratio
+    similarity has them (() where none did)."""
 
     selection: object
     library_name: str
@@ -243,26 +245,47 @@ class _Search:
     widening: list[str]
     apart: str | None
     why: str | None
-    similar: bool
+    similar: tuple[str, ...]
 
 
-def _searched(logs, names, options, drop, announce, similar: bool = True,
-              crossflow: bool = True) -> _Search:
-    """``select`` on the default library (``similar``: its constant and δ² written as
-    advance-ratio similarity has them), widened where its best candidate is ruled out, with the
-    hull's cross-flow drag where the logs give the length (``crossflow``: ``identify``'s
-    default; ``select`` takes it with ``--crossflow`` alone)."""
+# The forms of the default library searched in turn where the one before offers nothing usable
+# (its every candidate implausible, say): the constant and δ² of every equation written as
+# advance-ratio similarity has them, then the side force's alone (the surge keeping its own),
+# then none. The Esso Osaka's nine zig-zag files find nothing plausible in the first; in the
+# second, against the third (the default before): their random runs' yaw rate 0.65 of its rms
+# against 0.79 (error with its mean), the turns' steady yaw rates 12 % and 7 % off against 9 %
+# and 11 %, and every eight of the nine files whose model held a side constant likewise (0.64–
+# 0.71 against 0.96–2.19; steady yaw rates 13 % off on average against 26 %), the turns'
+# tactical diameters 19 % off on average against 22 %. Held at 6–16.7 rps, the third's turns
+# came up to 103 times as wide at one rps as at another (a 10° turn to starboard at 8 rps not
+# turning at all), the second's within 2.6 times (``benchmarks/study_esso_side_constant.py``).
+SIMILAR_FORMS = (("u", "v", "r"), SIDE_FORCE, ())
+
+
+def _library_name(similar: Sequence[str]) -> str:
+    """How the default library's form ``similar`` (one of ``SIMILAR_FORMS``) is named."""
+    if set(similar) >= {"u", "v", "r"}:
+        return ""
+    return " with its constant and δ²" + (" in the surge" if similar else "")
+
+
+def _searched(logs, names, options, drop, announce, similar: Sequence[str] = SIMILAR_FORMS[0],
+              crossflow: bool = True) -> _Search:  # fmt: skip
+    """``select`` on the default library (``similar``: the equations whose constant and δ² are
+    written as advance-ratio similarity has them), widened where its best candidate is ruled
+    out, with the hull's cross-flow drag where the logs give the length (``crossflow``:
+    ``identify``'s default; ``select`` takes it with ``--crossflow`` alone)."""
     import dataclasses
 
     from shipid.identification.select import DEFAULT_LIBRARY, default_library, select
 
     library, note = default_library(logs, similar=similar)
-    library_name = DEFAULT_LIBRARY + ("" if similar else " with its constant and δ²") + (
+    library_name = DEFAULT_LIBRARY + _library_name(similar) + (
         " (less what the logs lack)" if note else "")
     # The default library is passed as None (select trims it and says so) unless terms are
     # dropped from it or its constant kept.
-    given = _without(library, drop) if drop or not similar else None
-    if similar:
+    given = _without(library, drop) if drop or tuple(similar) != SIMILAR_FORMS[0] else None
+    if tuple(similar) == SIMILAR_FORMS[0]:
         announce(f"choosing the terms from {library_name} by free-run cross-validation "
                  f"({options.cv})…")  # fmt: skip
     sel = select(logs, dataclasses.replace(options, library=given), names=names)
@@ -277,8 +300,8 @@ def _searched(logs, names, options, drop, announce, similar: bool = True,
     if found is not None:
         sel, library_name = found, f"{library_name} with the hull's cross-flow drag"
     # The default library loses its constant only to similarity.
-    return _Search(sel, library_name, note, widening, apart, unusable(sel),
-                   "1" not in library.all_terms)  # fmt: skip
+    written = tuple(d for d in similar if "1" not in library.terms.get(d, ("1",)))
+    return _Search(sel, library_name, note, widening, apart, unusable(sel), written)
 
 
 def unusable(selection) -> str | None:
@@ -294,24 +317,40 @@ def unusable(selection) -> str | None:
 
 
 def searched_with_the_constant(logs, names, options, drop, announce, why: str,
-                               crossflow: bool = True) -> _Search | None:
-    """The default library searched again with its constant and δ² as they are, where the
-    search with them written as advance-ratio similarity has them found nothing usable
-    (``why``): ``identify``'s default and ``select`` without ``--library`` (on the Esso's nine
-    zig-zag files every similar candidate ends its held turns astern). None where this search
-    finds nothing usable either; its notes begin with why it was made."""
+                               similar: Sequence[str] = SIMILAR_FORMS[0],
+                               crossflow: bool = True) -> _Search | None:  # fmt: skip
+    """The default library searched again in the next of ``SIMILAR_FORMS`` after ``similar``
+    (the equations whose constant and δ² the search that found nothing usable, ``why``, wrote
+    as advance-ratio similarity has them), and so on: ``identify``'s default and ``select``
+    without ``--library`` (on the Esso's nine zig-zag files every candidate written so in all
+    three equations ends its held turns astern). None where no form finds anything usable; the
+    notes begin with why each search was made."""
     from shipid.identification.select import DEFAULT_LIBRARY
 
-    announce(f"{why}; choosing again from {DEFAULT_LIBRARY} with its constant and δ² "
-             f"({options.cv})…")  # fmt: skip
-    found = _searched(logs, names, options, drop, announce, similar=False, crossflow=crossflow)
-    if found.why:
-        return None
-    found.widening = [f"{why} with its constant and δ² written as advance-ratio similarity has "
-                      "them (n|n|, n⁺²δ²), so the library with them as they are was searched "
-                      "instead: its model holds a force that stays the same at every propeller "
-                      "speed", *found.widening]  # fmt: skip
-    return found
+    forms = [f for f in SIMILAR_FORMS if set(f) < set(similar)]
+    said = []
+    for form in forms:
+        name = _library_name(form)
+        announce(f"{why}; choosing again from {DEFAULT_LIBRARY}{name} ({options.cv})…")
+        said.append(f"{why} with {_written(similar)} written as advance-ratio similarity has "
+                    f"them, so the library{name} was searched instead" + (
+                        ": its model holds a force that stays the same at every propeller "
+                        "speed" if not form else " (the side force's constant written as "
+                        "similarity has it)"))  # fmt: skip
+        found = _searched(logs, names, options, drop, announce, similar=form,
+                          crossflow=crossflow)  # fmt: skip
+        if not found.why:
+            found.widening = [*said, *found.widening]
+            return found
+        why, similar = found.why, form
+    return None
+
+
+def _written(similar: Sequence[str]) -> str:
+    """What the form ``similar`` wrote, in words."""
+    if set(similar) >= {"u", "v", "r"}:
+        return "its constant and δ² (n|n|, n⁺²δ²)"
+    return f"the constant of {', '.join(similar)} (n|n|)"
 
 
 # The most logs the default's ``select`` path also searches the library with the hull's
@@ -370,7 +409,8 @@ def _crossflow_selection(sel, logs, names, library, drop, options, announce):
 WIDENING = "rudder-drift"
 
 
-def widened_selection(sel, logs, names, options, drop=None, announce=_quiet, similar=True):
+def widened_selection(sel, logs, names, options, drop=None, announce=_quiet,
+                      similar=SIMILAR_FORMS[0]):
     """``select`` (with ``options``, a ``SelectOptions``) on the default library widened by
     ``WIDENING``, for logs whose best-scoring candidate from the default library the
     plausibility checks rule out (``sel.best_ruled_out``): the logs then prefer what physics

@@ -538,7 +538,7 @@ DEFAULT_LIBRARY = "low-speed+wind+propeller-asymmetry+astern"
 
 
 def default_library(logs: Sequence[pd.DataFrame], name: str = DEFAULT_LIBRARY,
-                    similar: bool = True) -> tuple[ModelStructure, str]:  # fmt: skip
+                    similar: Sequence[str] = DOFS) -> tuple[ModelStructure, str]:  # fmt: skip
     """``DEFAULT_LIBRARY`` (or the library ``name``) less the terms that need a log column some
     log lacks (the wind of a basin's logs, the propeller speed of a log without it) and the
     terms that are zero along every log (astern propeller terms where the propeller never
@@ -548,7 +548,8 @@ def default_library(logs: Sequence[pd.DataFrame], name: str = DEFAULT_LIBRARY,
     and 12 rps). Where each log runs at one propeller speed, its constant and δ² are written as
     advance-ratio similarity has them, n|n| and n⁺²δ², which it already holds
     (``shipid.dynamics.similarity.similar_library``): no candidate holds a force that stays the
-    same at every propeller speed (``similar=False`` keeps them). Logs at a few propeller speeds
+    same at every propeller speed (``similar``: the equations so written; ``SIDE_FORCE``, the
+    side force's alone; () keeps them). Logs at a few propeller speeds
     tell a constant from the thrust only across those few, and the constant is then what
     carries a model wrong beyond them (the Esso's pairs of zig-zag files: 17 of 360 held turns
     at 8–16.7 rps failed with it, none without); a log whose rps varies (a random run) shows
@@ -565,17 +566,21 @@ def default_library(logs: Sequence[pd.DataFrame], name: str = DEFAULT_LIBRARY,
         library = library.union({"u": ["T"]})
     replaced: tuple[str, ...] = ()
     if similar and "n" not in missing and _each_at_one_rps(logs):
-        library, replaced = similar_library(library)
+        library, replaced = similar_library(library, similar)
     drop = {d: [t for t in ts if set(parse_term(t).inputs) & set(missing)]
             for d, ts in library.terms.items()}  # fmt: skip
     notes = []
     if thrust:
         notes.append(f"{thrust[0].describe()}, and no rps is logged: the surge holds it as "
                      "logged, T")  # fmt: skip
-    if replaced:
+    if replaced and set(similar) >= set(DOFS):
         notes.append(f"{', '.join(replaced)} are written as advance-ratio similarity has them "
                      "(n|n|, n⁺²δ², which the library holds): a force that stays the same at "
                      "every propeller speed is no ship's")  # fmt: skip
+    elif replaced:
+        notes.append(f"the constant of {', '.join(similar)} is written as advance-ratio "
+                     "similarity has it (n|n|, which the library holds): a side force that "
+                     "stays the same at every propeller speed is no ship's")  # fmt: skip
     if missing:
         n = sum(len(ts) for ts in drop.values())
         notes.append(f"the default library's {n} term(s) that need the log column(s) "
