@@ -1,12 +1,16 @@
 """A side force that stays the same at every propeller speed, on the Esso Osaka's random runs
-(issue #10). The default model of the nine zig-zag files holds a constant in v̇ and ṙ (its
-similar library's candidates end their held turns astern, so ``identify`` searches the library
-with its constant: docs/structures.md). The random runs go at 1–5 rps on the mean, astern a
-sixth to a third of the time: there the constant is no longer balanced by the rudder in the
-race. Printed: each term's mean contribution to ṙ along the measured runs (one-step, the model's
-equation at the logged states), then the random runs' yaw-rate error with and without its mean
-for the default, ``select`` on the default library with the constant kept in surge alone, and
-the default's terms refitted with the constant of v̇ and ṙ written n|n|.
+(issue #10). The default library's candidates for the nine zig-zag files, written as
+advance-ratio similarity has them, end their held turns astern; ``identify`` then searched the
+library with every constant (a side force the same at every rps, and astern and stopped too),
+and since 2026-11-29 first the library with the side force's constant alone written n|n| (the
+surge keeping its constant and δ²: ``auto_structure.SIMILAR_FORMS``). Printed: each ṙ term's
+mean contribution along the measured runs (one-step, the model's equation at the logged states)
+for the library with every constant; then, for the nine files and every eight of them whose
+default searched past the similar library, the default against ``select --average`` on the
+library with every constant (the default before): the two 35° turns (closed loop), the four
+random runs' yaw-rate error with its mean (free run), and the held 10° and 35° turns at 6–16.7
+rps from the model's own straight speed (the largest ratio of a turn's tactical diameter at
+one rps to the same turn's at another: a ship's is about as wide at every speed).
 
 Run: .venv/bin/python benchmarks/study_esso_side_constant.py
 """
@@ -23,11 +27,11 @@ from cli_models import model_by_cli
 from esso_logs import held_out_files
 from study_esso_rudder_normal import FORMAT, KEYS
 
-from shipid.dynamics.model import ModelStructure, get_structure
-from shipid.dynamics.similarity import similar_library
+from shipid.dynamics.model import ModelStructure
 from shipid.dynamics.terms import parse_term, term_matrix
 from shipid.evaluation.validate import validate_log
-from shipid.identification.select import DEFAULT_LIBRARY
+from shipid.identification.select import default_library
+from shipid.reporting.modelfile import load_document
 
 
 def _spec(structure: ModelStructure) -> str:
@@ -70,6 +74,49 @@ def _judged(model, turns, randoms, logs) -> tuple[list[float], list[tuple[float,
     return errors, ratios
 
 
+# The held turns across the propeller speeds: the logs' 10–16.7 rps and below, where the random
+# runs go.
+ACROSS_RPS = (6.0, 8.0, 10.0, 12.0, 14.0, 16.67)
+
+
+def _across_rps(model) -> tuple[float, int]:
+    """The 10° and 35° turns to either side held at each of ``ACROSS_RPS`` from the model's own
+    straight speed: the largest ratio of a turn's tactical diameter at one rps to the same
+    turn's at another, and how many of the 24 turns diverge or never turn 180°."""
+    from shipid.dynamics.equilibrium import surge_equilibrium
+    from shipid.trials.manoeuvres import turning_circle
+
+    worst, failed = 1.0, 0
+    for rudder in (10.0, 35.0):
+        for side in ("starboard", "port"):
+            across = []
+            for rps in ACROSS_RPS:
+                speed = surge_equilibrium(model, 0.3, rps)
+                turn = turning_circle(model, rudder, side, rps=rps, speed=speed, dt=0.1,
+                                      wind=(0.0, 0.0))  # fmt: skip
+                td = None if turn.diverged else turn.indices.get("tactical_diameter")
+                if td is None:
+                    failed += 1
+                else:
+                    across.append(td)
+            if across:
+                worst = max(worst, max(across) / min(across))
+    return worst, failed
+
+
+def _row(label: str, name: str, model, turns, randoms, logs) -> None:
+    if model is None:
+        print(f"| {label} | {name} | failed | | | |")
+        return
+    errors, ratios = _judged(model, turns, randoms, logs)
+    rms = [b for _, b in ratios]
+    worst, failed = _across_rps(model)
+    print(f"| {label} | {name} | " + ", ".join(f"{x:+.0f}" for x in errors[0::2]) + " | "
+          + ", ".join(f"{x:+.0f}" for x in errors[1::2]) + " | "
+          + ", ".join(f"{b:.2f}" for b in rms) + f" ({np.mean(rms):.2f}) | {worst:.2f}, "
+          f"{failed} |", flush=True)  # fmt: skip
+
+
 def main() -> None:
     files = held_out_files()
     if files is None:
@@ -77,79 +124,44 @@ def main() -> None:
     zigzags, turns, randoms, logs = files
     t0 = time.perf_counter()
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores\n")
-    library = get_structure(DEFAULT_LIBRARY)
-    similar, _ = similar_library(library)
-    surge_constant = ModelStructure("the constant in surge alone", {
-        d: similar.terms[d] if d in ("v", "r") else library.terms[d] for d in library.terms})
-    with tempfile.TemporaryDirectory() as scratch:
-        paths = [str(p) for p in zigzags]
-        default = model_by_cli(["identify", *FORMAT], paths, f"{scratch}/d.json")
-        from shipid.data.io import read_log
+    from shipid.data.io import read_log
 
+    read = {p: read_log(p, fmt="osaka-frt", dt=0.5, start="auto", end="auto") for p in zigzags}
+    with tempfile.TemporaryDirectory() as scratch:
+        before = _every_constant(zigzags, read, scratch)
         shown = {p.name: logs[p] for p in randoms}
-        shown.update({p.name: read_log(p, fmt="osaka-frt", dt=0.5, start="auto", end="auto")
-                      for p in zigzags[:2]})  # fmt: skip
-        _contributions(default, shown)
-        makers = {
-            "identify (default)": default,
-            "select, the constant in surge alone": model_by_cli(
-                ["select", *FORMAT, "--quiet", "--library", _spec(surge_constant)], paths,
-                f"{scratch}/s.json"),
-            "the default's terms, the constant of v̇ and ṙ as n|n|": model_by_cli(
-                ["identify", *FORMAT, "--model", _side_constant_as_nn(default.structure)], paths,
-                f"{scratch}/n.json"),
-        }  # fmt: skip
-        print("\nTrained on the nine zig-zag files; the two 35° turns (closed loop) and the four "
-              "random runs (free run)\n")  # fmt: skip
-        print("| model | 35° TD off: median, mean |abs| [%] | steady r off: median, mean |abs| "
-              "[%] | random runs: r error std / r std, median | r rms error / r rms: median, "
-              "each |")  # fmt: skip
-        print("|---|---|---|---|---|")
-        for name, model in makers.items():
-            if model is None:
-                print(f"| {name} | failed | | | |")
+        shown.update({p.name: read[p] for p in zigzags[:2]})
+        _contributions(before, shown)
+        print("\nTrained on the zig-zag files (all nine, then every eight whose default searched "
+              "past the similar library); judged on the two 35° turns (closed loop) and the "
+              "four random runs (free run)\n")  # fmt: skip
+        print("| left out | model | 35° TD off, stbd, port [%] | steady r off, stbd, port [%] | "
+              "random runs' r rms error / r rms (mean) | held 10° and 35° turns at 6–16.7 rps: "
+              "largest ratio of tactical diameters, failed of 24 |")  # fmt: skip
+        print("|---|---|---|---|---|---|")
+        for left in [None, *zigzags]:
+            kept = [p for p in zigzags if p != left]
+            out = f"{scratch}/d.json"
+            default = model_by_cli(["identify", *FORMAT], [str(p) for p in kept], out)
+            if default is None:
                 continue
-            errors, ratios = _judged(model, turns, randoms, logs)
-            td, r = np.array(errors[0::2]), np.array(errors[1::2])
-            std, rms = np.array(ratios).T
-            print(f"| {name} | {np.nanmedian(td):+.0f}, {np.nanmean(np.abs(td)):.0f} | "
-                  f"{np.nanmedian(r):+.0f}, {np.nanmean(np.abs(r)):.0f} | {np.median(std):.2f} | "
-                  f"{np.median(rms):.2f}: " + ", ".join(f"{x:.2f}" for x in rms) + " |")
-        _leave_one_out(zigzags, turns, randoms, logs, scratch)
+            library = load_document(out)["identification"]["structure_choice"]["library"] or ""
+            if left is not None and " in the surge" not in library:
+                continue  # the similar library's choice: as before
+            label = "none" if left is None else left.stem[-8:]
+            _row(label, "identify (default)", default, turns, randoms, logs)
+            other = before if left is None else _every_constant(kept, read, scratch)
+            _row(label, "select --average, every constant (the default before)", other, turns,
+                 randoms, logs)  # fmt: skip
     print(f"\n{time.perf_counter() - t0:.0f} s")
 
 
-def _side_constant_as_nn(structure: ModelStructure) -> str:
-    """``structure`` with the constant of v̇ and ṙ written n|n|, as a ``--model`` text."""
-    nn = parse_term("|n|*n").text
-    return _spec(ModelStructure("the constant of v̇ and ṙ as n|n|", {
-        d: tuple(dict.fromkeys(nn if (t == "1" and d != "u") else t for t in ts))
-        for d, ts in structure.terms.items()}))  # fmt: skip
-
-
-def _leave_one_out(zigzags, turns, randoms, logs, scratch: str) -> None:
-    """The same on every eight of the nine files whose default holds a side constant."""
-    print("\nEvery eight of the nine files whose default model holds a constant in v̇ or ṙ: "
-          "the default, and its terms refitted with that constant written n|n|\n")
-    print("| left out | model | 35° TD off, stbd, port [%] | steady r off, stbd, port [%] | "
-          "random runs' r rms error / r rms |")  # fmt: skip
-    print("|---|---|---|---|---|")
-    for left in zigzags:
-        paths = [str(p) for p in zigzags if p != left]
-        default = model_by_cli(["identify", *FORMAT], paths, f"{scratch}/d.json")
-        if default is None or not any("1" in default.structure.terms.get(d, ()) for d in "vr"):
-            continue
-        refit = model_by_cli(["identify", *FORMAT, "--model",
-                              _side_constant_as_nn(default.structure)], paths,
-                             f"{scratch}/n.json")  # fmt: skip
-        for name, model in (("default", default), ("side constant as n|n|", refit)):
-            if model is None:
-                print(f"| {left.stem[-8:]} | {name} | failed | | |")
-                continue
-            errors, ratios = _judged(model, turns, randoms, logs)
-            print(f"| {left.stem[-8:]} | {name} | " + ", ".join(f"{x:+.0f}" for x in errors[0::2])
-                  + " | " + ", ".join(f"{x:+.0f}" for x in errors[1::2]) + " | "
-                  + ", ".join(f"{b:.2f}" for _, b in ratios) + " |")
+def _every_constant(zigzags, read, scratch: str):
+    """``select --average`` on the default library trimmed to the logs with its constant and δ²
+    as they are: the search ``identify``'s default fell back to before the side force's form."""
+    library, _ = default_library([read[p] for p in zigzags], similar=())
+    return model_by_cli(["select", *FORMAT, "--quiet", "--average", "--library", _spec(library)],
+                        [str(p) for p in zigzags], f"{scratch}/c.json")  # fmt: skip
 
 
 if __name__ == "__main__":

@@ -434,10 +434,11 @@ def widened_selection(sel, logs, names, options, drop=None, announce=_quiet,
 
     from shipid.identification.select import DEFAULT_LIBRARY, default_library, select
 
-    name = f"{DEFAULT_LIBRARY}+{WIDENING}"
-    why = (f"the best-scoring candidate of {DEFAULT_LIBRARY} is ruled out ({sel.best_ruled_out}"
-           f"): the logs prefer what physics rejects")  # fmt: skip
-    library, note = default_library(logs, name, similar)
+    # (named as searched: the library with its constant, say, widened)
+    name = f"{DEFAULT_LIBRARY}+{WIDENING}{_library_name(similar)}"
+    why = (f"the best-scoring candidate of {DEFAULT_LIBRARY}{_library_name(similar)} is ruled "
+           f"out ({sel.best_ruled_out}): the logs prefer what physics rejects")  # fmt: skip
+    library, note = default_library(logs, f"{DEFAULT_LIBRARY}+{WIDENING}", similar)
     added = set(get_structure(WIDENING).all_terms)
     if not added & set(_without(library, drop).all_terms):
         return None, [], None  # its terms need what the logs lack (the propeller speed)
