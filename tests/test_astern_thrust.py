@@ -137,6 +137,21 @@ def test_a_negative_thrust_is_left_as_fitted():
                                                                            "propeller(0.5)")
 
 
+def test_a_surge_with_both_thrust_forms_is_left_as_fitted():
+    """pos(n)² and |n|·n side by side (a ``select --average`` of candidates with either) are
+    one term ahead: the first written propeller(k) beside the second as fitted braked astern
+    at k·a + b of a + b, neither the ratio nor the fit's. Both stay as fitted, and the model
+    brakes astern as fitted (−b n²)."""
+    both = ManoeuvringModel("u: |u|u, pos(n)^2, |n|*n; v: u*v; r: u*r",
+                            {"u": {"|u|u": -0.05, "pos(n)^2": 1.5e-3, "|n|*n": 0.5e-3},
+                             "v": {"u*v": -0.5}, "r": {"u*r": -1.0}})  # fmt: skip
+    forms = AsternForms(True, 0.5)
+    assert forms.for_model(both) == AsternForms(True, None)
+    written = forms.written(both)
+    assert written.structure.terms["u"] == ("|u|*u", "pos(n)^2", "|n|*n")
+    assert astern_braking(written, 1.0, 10.0)["braking"] == pytest.approx(-0.5e-3 * 100)
+
+
 def test_logs_that_reverse_the_propeller_are_left_as_fitted():
     import pandas as pd
 

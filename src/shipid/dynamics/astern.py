@@ -126,13 +126,16 @@ class AsternForms:
 
     def for_model(self, model: ManoeuvringModel) -> AsternForms:
         """These forms for ``model``: its thrust written at the ratio only where it pushes ahead
-        (every fitted pos(n)², |n|·n of its surge > 0); a negative one is no thrust (the fit
-        carried it in another term), and mirrored at a ratio it would push ahead when
-        reversed: left as fitted."""
+        in one term (its surge's fitted pos(n)² or |n|·n > 0); a negative one is no thrust (the
+        fit carried it in another term), and mirrored at a ratio it would push ahead when
+        reversed; a surge with both (a ``select --average`` of candidates with either) cannot
+        write their sum as one ``propeller(k)`` (the two are one term there) and renaming one
+        would brake astern at neither ratio: left as fitted."""
         if self.thrust_ratio is None:
             return self
         coefs = model.coefficients.get("u", {})
-        pushes = all(float(c) > 0 for t, c in coefs.items() if parse_term(t).text in AHEAD_THRUST)
+        thrust = [float(c) for t, c in coefs.items() if parse_term(t).text in AHEAD_THRUST]
+        pushes = len(thrust) == 1 and thrust[0] > 0
         return self if pushes else AsternForms(self.hull, None)
 
     def written(self, model: ManoeuvringModel) -> ManoeuvringModel:
