@@ -5,9 +5,9 @@ library with every constant (a side force the same at every rps, and astern and 
 and since 2026-11-29 first the library with the side force's constant alone written n|n| (the
 surge keeping its constant and δ²: ``auto_structure.SIMILAR_FORMS``). Printed: each ṙ term's
 mean contribution along the measured runs (one-step, the model's equation at the logged states)
-for the library with every constant; then, for the nine files and every eight of them whose
-default searched past the similar library, the default against ``select --average`` on the
-library with every constant (the default before): the two 35° turns (closed loop), the four
+for the default before (every constant); then, for the nine files and every eight of them whose
+default searched past the similar library, the default against the default before (its
+searches without the side force's form): the two 35° turns (closed loop), the four
 random runs' yaw-rate error with its mean (free run), and the held 10° and 35° turns at 6–16.7
 rps from the model's own straight speed (the largest ratio of a turn's tactical diameter at
 one rps to the same turn's at another: a ship's is about as wide at every speed).
@@ -30,7 +30,6 @@ from study_esso_rudder_normal import FORMAT, KEYS
 from shipid.dynamics.model import ModelStructure
 from shipid.dynamics.terms import parse_term, term_matrix
 from shipid.evaluation.validate import validate_log
-from shipid.identification.select import default_library
 from shipid.reporting.modelfile import load_document
 
 
@@ -126,11 +125,11 @@ def main() -> None:
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores\n")
     from shipid.data.io import read_log
 
-    read = {p: read_log(p, fmt="osaka-frt", dt=0.5, start="auto", end="auto") for p in zigzags}
     with tempfile.TemporaryDirectory() as scratch:
-        before = _every_constant(zigzags, read, scratch)
+        before = _every_constant(zigzags, scratch)
         shown = {p.name: logs[p] for p in randoms}
-        shown.update({p.name: read[p] for p in zigzags[:2]})
+        shown.update({p.name: read_log(p, fmt="osaka-frt", dt=0.5, start="auto", end="auto")
+                      for p in zigzags[:2]})  # fmt: skip
         _contributions(before, shown)
         print("\nTrained on the zig-zag files (all nine, then every eight whose default searched "
               "past the similar library); judged on the two 35° turns (closed loop) and the "
@@ -150,18 +149,25 @@ def main() -> None:
                 continue  # the similar library's choice: as before
             label = "none" if left is None else left.stem[-8:]
             _row(label, "identify (default)", default, turns, randoms, logs)
-            other = before if left is None else _every_constant(kept, read, scratch)
-            _row(label, "select --average, every constant (the default before)", other, turns,
-                 randoms, logs)  # fmt: skip
+            other = before if left is None else _every_constant(kept, scratch)
+            _row(label, "the default before (every constant)", other, turns, randoms, logs)
     print(f"\n{time.perf_counter() - t0:.0f} s")
 
 
-def _every_constant(zigzags, read, scratch: str):
-    """``select --average`` on the default library trimmed to the logs with its constant and δ²
-    as they are: the search ``identify``'s default fell back to before the side force's form."""
-    library, _ = default_library([read[p] for p in zigzags], similar=())
-    return model_by_cli(["select", *FORMAT, "--quiet", "--average", "--library", _spec(library)],
-                        [str(p) for p in zigzags], f"{scratch}/c.json")  # fmt: skip
+def _every_constant(zigzags, scratch: str):
+    """``identify``'s default as it was before the side force's form: its searches in
+    ``SIMILAR_FORMS`` less ``SIDE_FORCE`` (the similar library, then the one with every
+    constant)."""
+    from shipid.dynamics.similarity import SIDE_FORCE
+    from shipid.identification import auto_structure
+
+    forms = auto_structure.SIMILAR_FORMS
+    auto_structure.SIMILAR_FORMS = tuple(f for f in forms if f != SIDE_FORCE)
+    try:
+        return model_by_cli(["identify", *FORMAT], [str(p) for p in zigzags],
+                            f"{scratch}/c.json")  # fmt: skip
+    finally:
+        auto_structure.SIMILAR_FORMS = forms
 
 
 if __name__ == "__main__":

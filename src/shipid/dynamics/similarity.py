@@ -116,12 +116,12 @@ def rps_similar(model: ManoeuvringModel, rps: float) -> ManoeuvringModel:
     return renamed_model(model, found, similar_at_rps=found.rps)
 
 
-# The equations of the side force: its constant written n|n| alone (``similar_library``), the
-# surge keeping its own. A single screw pushes the stern sideways as n|n| (n² ahead, reversed
-# astern); a side force the same at every rps held by the Esso Osaka's nine zig-zag files
-# turned the model 35° to port and 10° not at all to starboard at 8 rps, its yaw 0.79 of the
-# random runs' rms against 0.65 with the constant so written
-# (``benchmarks/study_esso_side_constant.py``).
+# The equations of the side force: its constant written n|n| alone (``similar_library``; in a
+# library with n⁺² and n⁻², by them), the surge keeping its own. A single screw's side force goes
+# with n²; a side force the same at every rps, at rest and astern too, held by the Esso Osaka's
+# nine zig-zag files turned their model's 10° turn to starboard at 6 rps 12 times as wide in
+# lengths as at 16.7, and its yaw missed the random runs (1–5 rps) by 0.79 of their rms against
+# 0.65 with the constant so written (``benchmarks/study_esso_side_constant.py``).
 SIDE_FORCE = ("v", "r")
 
 # |n|n = n⁺² − n⁻²: an equation that holds both has the constant's similar form in its span.

@@ -251,14 +251,14 @@ class _Search:
 # The forms of the default library searched in turn where the one before offers nothing usable
 # (its every candidate implausible, say): the constant and δ² of every equation written as
 # advance-ratio similarity has them, then the side force's alone (the surge keeping its own),
-# then none. The Esso Osaka's nine zig-zag files find nothing plausible in the first; in the
-# second, against the third (the default before): their random runs' yaw rate 0.65 of its rms
-# against 0.79 (error with its mean), the turns' steady yaw rates 12 % and 7 % off against 9 %
-# and 11 %, and every eight of the nine files whose model held a side constant likewise (0.64–
-# 0.71 against 0.96–2.19; steady yaw rates 13 % off on average against 26 %), the turns'
-# tactical diameters 19 % off on average against 22 %. Held at 6–16.7 rps, the third's turns
-# came up to 103 times as wide at one rps as at another (a 10° turn to starboard at 8 rps not
-# turning at all), the second's within 2.6 times (``benchmarks/study_esso_side_constant.py``).
+# then none. The Esso Osaka's nine zig-zag files find nothing plausible in the first; from the
+# second, against the third (the default before), their model's held 10° and 35° turns are as
+# wide in lengths at 6 rps as at 16.7 within 1.4 times (12.5 times before: its 10° turn to
+# starboard at 6 rps hardly turned), the random runs' yaw rate misses by 0.65 of its rms against
+# 0.79, the 35° turns' tactical diameters +4 %, −7 % against +6 %, −12 %; over the three sets
+# of eight of those files that come to it, the turns 14 % off on average against 23 %, their
+# steady yaw rates 10 % against 22 %, the random runs 1.15 of their rms against 1.19 (worse in
+# two of the three; ``benchmarks/study_esso_side_constant.py``).
 SIMILAR_FORMS = (("u", "v", "r"), SIDE_FORCE, ())
 
 
