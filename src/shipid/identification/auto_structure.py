@@ -10,8 +10,10 @@ from the logs:
 - a varying propeller speed: the terms ``select`` chooses from its default library (the
   four-quadrant ``low-speed`` terms, ``wind``, ``propeller-asymmetry`` and ``astern``, less what
   the logs lack or never excite) by free-run cross-validation on the logs (leave one log out;
-  four blocks of each of one or two logs: ``cross_validation.choice_cv``), with its γ; where its
-  best-scoring candidate is ruled out by the
+  four blocks of each of one or two logs: ``cross_validation.choice_cv``), with its γ; where each
+  log runs at one rps, its constant and δ² written as advance-ratio similarity has them, and
+  where nothing there is usable, the side force's constant alone, then none
+  (``SIMILAR_FORMS``); where its best-scoring candidate is ruled out by the
   plausibility checks (the logs prefer what physics rejects), the search is repeated with
   ``rudder-drift`` added and kept where it predicts the held-out logs better
   (``widened_selection``);
