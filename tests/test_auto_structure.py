@@ -578,3 +578,45 @@ def test_a_turn_among_the_logs_lets_the_scores_decide_how_the_model_turns():
     zz = zigzag(scale_ship(), 20, 20, duration=60, dt=0.2).log
     assert not _logs_hold_a_turn([zz])
     assert _logs_hold_a_turn([zz, turning_log("port")])
+
+
+def test_where_no_form_is_usable_the_searches_go_on_in_turn_and_say_why(monkeypatch):
+    """``searched_with_the_constant`` after the similar library: the side force's form, then
+    every constant, each search's reason carried into the notes; None where none is usable,
+    and no form searched twice (a similar library that wrote the side force's constant alone
+    goes straight to every constant)."""
+    from shipid.dynamics.similarity import SIDE_FORCE
+    from shipid.identification import auto_structure as auto
+
+    searched = []
+
+    def fake(logs, names, options, drop, announce, similar=auto.SIMILAR_FORMS[0],
+             crossflow=True):  # fmt: skip
+        searched.append(tuple(similar))
+        usable = tuple(similar) == ()
+        return auto._Search(object(), "lib", "", [f"widened in {similar}"], None,
+                            None if usable else f"nothing plausible in {similar}",
+                            tuple(similar))  # fmt: skip
+
+    class Options:
+        cv = "logo"
+
+    monkeypatch.setattr(auto, "_searched", fake)
+    said = []
+    found = auto.searched_with_the_constant([], [], Options(), None, said.append, "first why")
+    assert searched == [SIDE_FORCE, ()]
+    assert found.widening[0].startswith("first why with its constant and δ² (n|n|, n⁺²δ²) "
+                                        "written as advance-ratio similarity has them, so the "
+                                        "library with its constant and δ² in the surge was "
+                                        "searched instead")  # fmt: skip
+    assert found.widening[1].startswith(f"nothing plausible in {SIDE_FORCE} with the constant "
+                                        "of v, r (n|n|) written as advance-ratio similarity "
+                                        "has them, so the library with its constant and δ² "
+                                        "was searched instead: its model holds a force")
+    assert found.widening[2] == "widened in ()"
+    assert [m.split(";")[0] for m in said] == ["first why", f"nothing plausible in {SIDE_FORCE}"]
+    searched.clear()
+    auto.searched_with_the_constant([], [], Options(), None, said.append, "why", SIDE_FORCE)
+    assert searched == [()]
+    monkeypatch.setattr(auto, "SIMILAR_FORMS", (("u", "v", "r"), SIDE_FORCE))
+    assert auto.searched_with_the_constant([], [], Options(), None, said.append, "why") is None
