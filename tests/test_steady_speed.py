@@ -100,6 +100,50 @@ def test_a_turn_that_ends_going_astern_rules_a_model_out():
     assert "ends the turn going astern" in note[1] and "-0.739" in note[1]
 
 
+@pytest.mark.parametrize("thrust, advance, astern_below", [
+    (8e-5, -1e-3, None),  # thrust falling with the advance: ahead all the way from rest
+    (-8.05e-5, 0.0139, "root"),  # the Esso's eight files' fit: riding on u·|n|
+])
+def test_a_surge_that_pushes_a_ship_at_rest_astern_is_warned_of(thrust, advance, astern_below):
+    """u̇ = a n² + b u|n| − c |u|u has two roots where a < 0 < b: the straight speed (the larger)
+    and, below it, a speed under which the ship goes astern. ``from_rest`` finds the smaller
+    within one step of its grid; the checks warn of it and do not rule the model out (as a
+    rule it sent the Esso's zig-zag sets to worse fits)."""
+    import numpy as np
+
+    from shipid.dynamics.model import ManoeuvringModel
+    from shipid.identification.plausibility import (
+        FROM_REST_POINTS,
+        FROM_REST_SHARE,
+        disqualifying,
+        failed_checks,
+        from_rest,
+        plausibility_at_approach,
+    )
+
+    n, c = 16.67, 0.324
+    model = ManoeuvringModel("u: |u|u, pos(n)^2, u*|n|; v: v; r: r",
+                             {"u": {"|u|u": -c, "pos(n)^2": thrust, "u*|n|": advance},
+                              "v": {"v": -1.0}, "r": {"r": -1.0}})  # fmt: skip
+    roots = np.sort(np.roots([-c, advance * n, thrust * n**2]).real)
+    straight = surge_equilibrium(model, 0.3, n)
+    assert straight == pytest.approx(roots[-1], rel=1e-6)
+    found = from_rest(model, n, straight)
+    if astern_below is None:
+        assert found is None
+        return
+    step = FROM_REST_SHARE * straight / (FROM_REST_POINTS - 1)
+    assert roots[0] - step < found <= roots[0]
+    report, notes = plausibility_at_approach(model, 0.3, n)
+    assert report["from_rest"] == pytest.approx(found)
+    assert not any("from rest" in reason for reason in disqualifying(report, model))
+    said = (f"from rest, the propeller ahead at 16.67 rps and the rudder amidships, the surge "
+            f"pushes astern (below {found:.3g} m/s), short of its straight speed "
+            f"{straight:.3g} m/s: it cannot get under way")  # fmt: skip
+    assert said in notes
+    assert failed_checks(report, model)["from_rest"][1] == said
+
+
 @pytest.mark.skipif(not (DATA / "esso-osaka").is_dir(), reason="../shared/data is not present")
 def test_the_search_leaves_out_models_that_end_a_turn_going_astern(tmp_path, capsys):
     """The same fit: a candidate whose held-rudder turn ends going astern is ruled out (from the
