@@ -146,7 +146,7 @@ def main() -> None:
                 continue
             library = load_document(out)["identification"]["structure_choice"]["library"] or ""
             if left is not None and " in the surge" not in library:
-                continue  # the similar library's choice: as before
+                continue  # not the side force's form: as before
             label = "none" if left is None else left.stem[-8:]
             _row(label, "identify (default)", default, turns, randoms, logs)
             other = before if left is None else _every_constant(kept, scratch)
