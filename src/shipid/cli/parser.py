@@ -115,17 +115,21 @@ def _number_or_auto_or_none(text: str) -> float | str:
             from None
 
 
+def _finite(text: str, expected: str, least: float = -math.inf) -> float:
+    """``text`` as a finite number ≥ ``least``, or argparse's error naming what was
+    ``expected``."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value >= least):
+        raise argparse.ArgumentTypeError(f"expected {expected}, got {text!r}")
+    return value
+
+
 def _astern_ratio(text: str) -> float | None:
     """--astern-thrust: a ratio ≥ 0, or 'none'."""
-    if text == "none":
-        return None
-    try:
-        ratio = float(text)
-    except ValueError:
-        ratio = math.nan
-    if not (math.isfinite(ratio) and ratio >= 0):
-        raise argparse.ArgumentTypeError(f"expected a ratio ≥ 0 or 'none', got {text!r}")
-    return ratio
+    return None if text == "none" else _finite(text, "a ratio ≥ 0 or 'none'", least=0.0)
 
 
 def _time_or_auto(text: str) -> float | str:
@@ -138,15 +142,7 @@ def _time_or_auto(text: str) -> float | str:
 
 
 def _offset_or_auto(text: str) -> float | str:
-    if text == "auto":
-        return text
-    try:
-        value = float(text)
-    except ValueError:
-        value = math.nan
-    if not math.isfinite(value):
-        raise argparse.ArgumentTypeError(f"expected °/s or 'auto', got {text!r}")
-    return math.radians(value)
+    return text if text == "auto" else math.radians(_finite(text, "°/s or 'auto'"))
 
 
 def _seconds_list(text: str) -> list[float]:

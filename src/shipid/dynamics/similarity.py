@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from shipid.dynamics.model import ManoeuvringModel, ModelStructure
+from shipid.dynamics.model import DOFS, ManoeuvringModel, ModelStructure
 from shipid.dynamics.renaming import TermRenaming, renamed_model, renamed_terms
 from shipid.dynamics.terms import Term, parse_term
 
@@ -128,7 +128,7 @@ SIDE_FORCE = ("v", "r")
 _SIGNED_THRUST = ("pos(n)^2", "neg(n)^2")
 
 
-def similar_library(library: ModelStructure, dofs: Sequence[str] = ("u", "v", "r")
+def similar_library(library: ModelStructure, dofs: Sequence[str] = DOFS
                     ) -> tuple[ModelStructure, tuple[str, ...]]:  # fmt: skip
     """A candidate library for logs with a propeller speed, written as advance-ratio similarity
     has a ship's forces: each term of degree below 2 (the constant, δ²) of the equations

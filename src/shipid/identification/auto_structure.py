@@ -48,7 +48,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from shipid.dynamics.model import ModelStructure, StructureEdit, get_structure
+from shipid.dynamics.model import DOFS, ModelStructure, StructureEdit, get_structure
 from shipid.dynamics.similarity import SIDE_FORCE
 from shipid.errors import ShipidError
 from shipid.identification.cross_validation import choice_cv
@@ -261,12 +261,12 @@ class _Search:
 # of eight of those files that come to it, the turns 14 % off on average against 23 %, their
 # steady yaw rates 10 % against 22 %, the random runs 1.15 of their rms against 1.19 (worse in
 # two of the three; ``benchmarks/study_esso_side_constant.py``).
-SIMILAR_FORMS = (("u", "v", "r"), SIDE_FORCE, ())
+SIMILAR_FORMS = (DOFS, SIDE_FORCE, ())
 
 
 def _library_name(similar: Sequence[str]) -> str:
     """How the default library's form ``similar`` (one of ``SIMILAR_FORMS``) is named."""
-    if set(similar) >= {"u", "v", "r"}:
+    if set(similar) >= set(DOFS):
         return ""
     return " with its constant and δ²" + (" in the surge" if similar else "")
 
@@ -350,7 +350,7 @@ def searched_with_the_constant(logs, names, options, drop, announce, why: str,
 
 def _written(similar: Sequence[str]) -> str:
     """What the form ``similar`` wrote, in words."""
-    if set(similar) >= {"u", "v", "r"}:
+    if set(similar) >= set(DOFS):
         return "its constant and δ² (n|n|, n⁺²δ²)"
     return f"the constant of {', '.join(similar)} (n|n|)"
 
