@@ -144,6 +144,44 @@ def test_a_surge_that_pushes_a_ship_at_rest_astern_is_warned_of(thrust, advance,
     assert failed_checks(report, model)["from_rest"][1] == said
 
 
+@pytest.mark.parametrize("thrust, advance, warned", [(8e-5, -1e-3, False), (-8.05e-5, 0.0139, True)])
+def test_the_commands_that_run_a_model_file_repeat_the_from_rest_warning(
+        tmp_path, capsys, thrust, advance, warned):  # fmt: skip
+    """``identify`` warned once of a model that cannot get under way; ``manoeuvre``,
+    ``criteria`` and ``validate`` of its file said nothing. They check it on the model as they
+    run it (the model at its own straight speed, or at the one given)."""
+    import json
+
+    from shipid.dynamics.model import ManoeuvringModel
+    from shipid.identification.plausibility import from_rest
+    from shipid.trials.manoeuvres import zigzag
+
+    n = 16.67
+    model = ManoeuvringModel("u: |u|u, pos(n)^2, u*|n|; v: v, delta; r: r, delta",
+                             {"u": {"|u|u": -0.324, "pos(n)^2": thrust, "u*|n|": advance},
+                              "v": {"v": -1.0, "delta": 0.01}, "r": {"r": -1.0, "delta": -0.05}})
+    straight = surge_equilibrium(model, 0.5, n)
+    found = from_rest(model, n, straight)
+    assert (found is not None) == warned
+    path = model.save(tmp_path / "m.json")
+    doc = json.loads(path.read_text())
+    doc["identification"] = {"preprocessing": {"approach_speed": straight, "approach_rps": n}}
+    path.write_text(json.dumps(doc))
+    log = tmp_path / "zz.csv"
+    write_log(zigzag(model, 20, 20, duration=20, dt=0.2, speed=straight, rps=n).log, log)
+    said = (f"plausibility: from rest, the propeller ahead at 16.67 rps and the rudder amidships, "
+            f"the surge pushes astern (below {found or 0:.3g} m/s), short of its straight speed "
+            f"{straight:.3g} m/s: it cannot get under way")  # fmt: skip
+    for argv in (["manoeuvre", path, "zigzag", "--duration", "20"],
+                 ["manoeuvre", path, "turning", "--speed", "0.3", "--rps", str(n),
+                  "--duration", "20"],
+                 ["criteria", path, "--length", "3", "--scale", "1"],
+                 ["validate", path, log, "--no-bands"]):  # fmt: skip
+        code, _, err = run(argv, capsys)
+        assert code == 0, err
+        assert (said in err) == warned, (argv[0], err)
+
+
 @pytest.mark.skipif(not (DATA / "esso-osaka").is_dir(), reason="../shared/data is not present")
 def test_the_search_leaves_out_models_that_end_a_turn_going_astern(tmp_path, capsys):
     """The same fit: a candidate whose held-rudder turn ends going astern is ruled out (from the

@@ -763,6 +763,21 @@ def _run_approach(target, cond: dict, speed: float | None, rps: float | None):
     return app.speed, app.rps, app.warning
 
 
+def _from_rest_note(target, speed: float | None, rps: float | None) -> str | None:
+    """The plausibility warning of a model whose surge, from rest at ``rps``, pushes astern
+    (``shipid.identification.plausibility.from_rest_warning``), checked on the model as the
+    command runs it; None for a reference ship or a model that gets under way."""
+    from shipid.dynamics.hybrid import HybridModel
+    from shipid.dynamics.model import ManoeuvringModel
+
+    if not isinstance(target, ManoeuvringModel | HybridModel):
+        return None
+    from shipid.identification.plausibility import from_rest_warning
+
+    note = from_rest_warning(target, speed, rps)
+    return f"plausibility: {note}" if note else None
+
+
 def _unused_inputs(target, args) -> list[str]:
     """Warnings for --rps, --astern-rps and --wind-speed given to a model without a term in the
     propeller speed or the wind: the run takes them and nothing changes (a manoeuvre "at 5 rps"

@@ -11,6 +11,7 @@ from pathlib import Path
 from shipid.cli.common import (
     _check_length,
     _check_scale,
+    _from_rest_note,
     _json_text,
     _markdown_dashed,
     _particulars,
@@ -76,6 +77,10 @@ def cmd_validate(args) -> int:
         _check_length(args.model, model, cond, given.length, f"--particulars {args.particulars}")
         _check_scale(args.model, cond, given.scale, f"--particulars {args.particulars}")
     env = cond["envelope"]
+    # Logs that start from rest or slow down meet it (the Esso's random runs).
+    from_rest = _from_rest_note(model, cond["speed"], cond["rps"])
+    if from_rest:
+        _warn(from_rest)
     from shipid.data.log import common_rudder_convention
     from shipid.trials.reading import read_trial_log
 

@@ -12,6 +12,7 @@ from shipid.cli.common import (
     MANOEUVRE_STEP,
     _check_length,
     _check_scale,
+    _from_rest_note,
     _json_text,
     _markdown_dashed,
     _pd,
@@ -80,6 +81,7 @@ def cmd_criteria(args) -> int:
     if args.particulars and not args.scale:  # --scale is the user's to override with
         _check_scale(args.model, cond, particulars.scale, f"--particulars {args.particulars}")
     speed, rps, _ = _run_approach(target, cond, args.speed, args.rps)  # imo_criteria notes it
+    from_rest = _from_rest_note(target, speed, rps)
     # Given, else the ship's gear or the training logs' rate, else imo_criteria's SOLAS rate.
     steering, _ = _steering(target, cond, args.rudder_rate, fallback="caller")
     # The scale the training logs were read at, where neither option nor particulars give one.
@@ -91,7 +93,7 @@ def cmd_criteria(args) -> int:
                   scale=scale, rps=rps, steering=steering, astern_rps=args.astern_rps,
                   dt=args.dt, steady_window=_steady_window(cond))  # fmt: skip
     crit = run(target)
-    crit.notes += [rate_note] if rate_note else []
+    crit.notes += [note for note in (rate_note, from_rest) if note]
     crit.notes += _unused_inputs(target, args)
     crit.notes += [n for n in (_step_note(cond, args.dt, CRITERIA_STEP),) if n]
     from shipid.evaluation.validate import faded_residual_notes
@@ -290,6 +292,9 @@ def cmd_manoeuvre(args) -> int:
         _warn(note)
     target, cond = _ship_or_model(args.model, hybrid=True)
     speed, rps, unsteady = _run_approach(target, cond, args.speed, args.rps)
+    from_rest = _from_rest_note(target, speed, rps)
+    if from_rest:
+        _warn(from_rest)
     steering, rudder_note = _steering(target, cond, args.rudder_rate)
     kw = {"dt": args.step, "speed": speed, "rps": rps, "steering": steering}
     coarse = _step_note(cond, args.step, MANOEUVRE_STEP)

@@ -603,11 +603,27 @@ def missed_steady_speed(model, speed: float, rps: float) -> str | None:
 UNSETTLED, WRONG_WAY, DIVERGED = 1, 2, 3
 
 
-def _astern_from_rest(report: dict) -> str:
+def _astern_from_rest(astern_below: float, rps: float | None, straight_speed: float) -> str:
     """What ``from_rest`` found, in words."""
-    rps = f" at {report['rps']:.4g} rps" if report.get("rps") else ""
-    return (f"from rest, the propeller ahead{rps} and the rudder amidships, the surge pushes "
-            f"astern (below {report['from_rest']:.3g} m/s)")
+    at = f" at {rps:.4g} rps" if rps else ""
+    return (f"from rest, the propeller ahead{at} and the rudder amidships, the surge pushes "
+            f"astern (below {astern_below:.3g} m/s), short of its straight speed "
+            f"{straight_speed:.3g} m/s: it cannot get under way")
+
+
+def from_rest_warning(model, speed: float | None, rps: float | None) -> str | None:
+    """``from_rest``'s warning for ``model`` at the propeller speed ``rps``, its straight speed
+    the surge's equilibrium nearest ``speed``; None where the model gets under way, has no surge
+    or no straight speed (a check of its own), or is driven by a logged thrust. ``identify``
+    gives it once; the commands that run a model file again (``validate``, ``manoeuvre``,
+    ``criteria``) repeat it, checked on the model as they run it (a rescaled file too), where a
+    run that starts slow or stops meets it."""
+    if (getattr(model, "uses_thrust", False) or "u" not in model.structure.dofs
+            or not (speed and speed > 0)):  # fmt: skip
+        return None
+    straight = surge_equilibrium(model, speed, rps)
+    found = from_rest(model, rps, straight)
+    return None if found is None else _astern_from_rest(found, rps, straight)
 
 
 def failed_checks(report: dict, model: ManoeuvringModel) -> dict[str, tuple[int, str]]:
@@ -628,8 +644,8 @@ def failed_checks(report: dict, model: ManoeuvringModel) -> dict[str, tuple[int,
                                        f"surge equation does not balance between 0 and "
                                        f"{3 * speed:.3g} m/s")  # fmt: skip
     elif report.get("from_rest") is not None:
-        out["from_rest"] = (WRONG_WAY, f"{_astern_from_rest(report)}, short of its straight "
-                                       f"speed {eq:.3g} m/s: it cannot get under way")
+        out["from_rest"] = (WRONG_WAY, _astern_from_rest(report["from_rest"], report.get("rps"),
+                                                         eq))  # fmt: skip
     astern = report.get("astern")
     if astern and astern.get("diverged"):
         out["astern"] = (1, f"propeller reversed to −{report['rps']:.4g} rps from the approach "
