@@ -139,7 +139,9 @@ def test_a_surge_that_pushes_a_ship_at_rest_astern_is_warned_of(thrust, advance,
     assert not any("from rest" in reason for reason in disqualifying(report, model))
     said = (f"from rest, the propeller ahead at 16.67 rps and the rudder amidships, the surge "
             f"pushes astern (below {found:.3g} m/s), short of its straight speed "
-            f"{straight:.3g} m/s: it cannot get under way")  # fmt: skip
+            f"{straight:.3g} m/s: it cannot get under way; its thrust rides on the advance, "
+            f"u |n| at +0.0139 against pos(n)² at -8.05e-05: --bound 'u: u*|n| <= 0' (or "
+            "--constraints signs) holds it to the thrust's fall with the advance")  # fmt: skip
     assert said in notes
     assert failed_checks(report, model)["from_rest"][1] == said
 
@@ -171,7 +173,8 @@ def test_the_commands_that_run_a_model_file_repeat_the_from_rest_warning(
     write_log(zigzag(model, 20, 20, duration=20, dt=0.2, speed=straight, rps=n).log, log)
     said = (f"plausibility: from rest, the propeller ahead at 16.67 rps and the rudder amidships, "
             f"the surge pushes astern (below {found or 0:.3g} m/s), short of its straight speed "
-            f"{straight:.3g} m/s: it cannot get under way")  # fmt: skip
+            f"{straight:.3g} m/s: it cannot get under way; its thrust rides on the advance, "
+            f"u |n| at +0.0139 against pos(n)² at -8.05e-05: --bound 'u: u*|n| <= 0'")  # fmt: skip
     for argv in (["manoeuvre", path, "zigzag", "--duration", "20"],
                  ["manoeuvre", path, "turning", "--speed", "0.3", "--rps", str(n),
                   "--duration", "20"],
@@ -311,3 +314,25 @@ def test_a_model_that_does_not_hold_a_given_speed_is_named():
     note = missed_steady_speed(PROPELLED, 1.2 * steady(10.0), 10.0)
     assert note.startswith(f"--steady-speed {1.2 * steady(10.0):.4g}@10: the model holds "
                            f"{steady(10.0):.4g} m/s straight at 10 rps, not the speed given")
+
+
+@pytest.mark.parametrize("surge, named", [
+    ({"u*|n|": 0.0139, "pos(n)^2": -8.05e-5}, "u |n| at +0.0139 against pos(n)² at -8.05e-05"),
+    ({"u*pos(n)": 0.01}, "u pos(n) at +0.01 with no thrust in n²"),
+    ({"u*|n|": 0.0139, "pos(n)^2": 8e-5}, None),  # a thrust ahead: the advance is not why
+    ({"u*|n|": -0.001, "pos(n)^2": -8e-5}, None),  # the advance falls as it should
+])
+def test_a_thrust_riding_on_the_advance_is_named_with_the_bound_that_holds_it(surge, named):
+    from shipid.dynamics.model import ManoeuvringModel
+    from shipid.identification.plausibility import _thrust_on_the_advance
+
+    terms = ", ".join(["|u|u", *surge])
+    model = ManoeuvringModel(f"u: {terms}; v: v; r: r",
+                             {"u": {"|u|u": -0.3, **surge}, "v": {"v": -1.0}, "r": {"r": -1.0}})
+    note = _thrust_on_the_advance(model)
+    if named is None:
+        assert note == ""
+    else:
+        term = next(t for t in surge if t.startswith("u*"))
+        assert note == (f"; its thrust rides on the advance, {named}: --bound 'u: {term} <= 0' "
+                        "(or --constraints signs) holds it to the thrust's fall with the advance")

@@ -603,12 +603,43 @@ def missed_steady_speed(model, speed: float, rps: float) -> str | None:
 UNSETTLED, WRONG_WAY, DIVERGED = 1, 2, 3
 
 
-def _astern_from_rest(astern_below: float, rps: float | None, straight_speed: float) -> str:
-    """What ``from_rest`` found, in words."""
+def _astern_from_rest(astern_below: float, rps: float | None, straight_speed: float,
+                      model=None) -> str:  # fmt: skip
+    """What ``from_rest`` found, in words, and where ``model``'s thrust rides on the advance
+    (``_thrust_on_the_advance``), why."""
     at = f" at {rps:.4g} rps" if rps else ""
     return (f"from rest, the propeller ahead{at} and the rudder amidships, the surge pushes "
             f"astern (below {astern_below:.3g} m/s), short of its straight speed "
-            f"{straight_speed:.3g} m/s: it cannot get under way")
+            f"{straight_speed:.3g} m/s: it cannot get under way"
+            + (_thrust_on_the_advance(model) if model is not None else ""))
+
+
+# The surge's thrust: its terms in n² and its fall with the advance (``physics.SIGN_RULES``).
+THRUST_TERMS = ("pos(n)^2", "|n|*n")
+ADVANCE_TERMS = ("u*|n|", "u*pos(n)")
+
+
+def _thrust_on_the_advance(model) -> str:
+    """Where ``model``'s surge carries its thrust on an advance term of the wrong sign (u·|n| >
+    0, which the thrust's fall with the advance forbids) against no positive n² term: '; its
+    thrust rides on ... (the bound that holds it)'; else ''. Five of the nine sets of eight Esso
+    zig-zag files take such a surge (u·|n| +0.012 to +0.014 against n⁺² −7e-5 to −1e-4): each
+    goes astern from rest and coasts in a crash stop, its reversed propeller's |n| giving what the
+    ahead one gave. The bound is a trade there, not a cure (``benchmarks/README.md``, *The
+    eight-file sets' surge*), so it is named, not applied."""
+    surge = getattr(model, "coefficients", {}).get("u") or {}
+    advance = [(t, surge[t]) for t in ADVANCE_TERMS if surge.get(t, 0.0) > 0]
+    thrust = [(t, surge[t]) for t in THRUST_TERMS if surge.get(t, 0.0) != 0]
+    if not advance or any(c > 0 for _, c in thrust):
+        return ""
+    from shipid.dynamics.terms import parse_term
+
+    term, value = advance[0]
+    against = (" against " + ", ".join(f"{parse_term(t).display()} at {c:.3g}" for t, c in thrust)
+               if thrust else " with no thrust in n²")  # fmt: skip
+    return (f"; its thrust rides on the advance, {parse_term(term).display()} at {value:+.3g}"
+            f"{against}: --bound 'u: {term} <= 0' (or --constraints signs) holds it to the "
+            "thrust's fall with the advance")
 
 
 def from_rest_warning(model, speed: float | None, rps: float | None) -> str | None:
@@ -623,7 +654,7 @@ def from_rest_warning(model, speed: float | None, rps: float | None) -> str | No
         return None
     straight = surge_equilibrium(model, speed, rps)
     found = from_rest(model, rps, straight)
-    return None if found is None else _astern_from_rest(found, rps, straight)
+    return None if found is None else _astern_from_rest(found, rps, straight, model)
 
 
 def failed_checks(report: dict, model: ManoeuvringModel) -> dict[str, tuple[int, str]]:
@@ -645,7 +676,7 @@ def failed_checks(report: dict, model: ManoeuvringModel) -> dict[str, tuple[int,
                                        f"{3 * speed:.3g} m/s")  # fmt: skip
     elif report.get("from_rest") is not None:
         out["from_rest"] = (WRONG_WAY, _astern_from_rest(report["from_rest"], report.get("rps"),
-                                                         eq))  # fmt: skip
+                                                         eq, model))  # fmt: skip
     astern = report.get("astern")
     if astern and astern.get("diverged"):
         out["astern"] = (1, f"propeller reversed to −{report['rps']:.4g} rps from the approach "
