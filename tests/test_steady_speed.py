@@ -320,6 +320,7 @@ def test_a_model_that_does_not_hold_a_given_speed_is_named():
     ({"u*|n|": 0.0139, "pos(n)^2": -8.05e-5}, "u |n| at +0.0139 against pos(n)² at -8.05e-05"),
     ({"u*pos(n)": 0.01}, "u pos(n) at +0.01 with no thrust in n²"),
     ({"u*|n|": 0.0139, "pos(n)^2": 8e-5}, None),  # a thrust ahead: the advance is not why
+    ({"u*|n|": 0.0139, "propeller(0.5)": 8e-5}, None),  # the same, written for going astern
     ({"u*|n|": -0.001, "pos(n)^2": -8e-5}, None),  # the advance falls as it should
 ])
 def test_a_thrust_riding_on_the_advance_is_named_with_the_bound_that_holds_it(surge, named):

@@ -604,17 +604,18 @@ UNSETTLED, WRONG_WAY, DIVERGED = 1, 2, 3
 
 
 def _astern_from_rest(astern_below: float, rps: float | None, straight_speed: float,
-                      model=None) -> str:  # fmt: skip
+                      model) -> str:  # fmt: skip
     """What ``from_rest`` found, in words, and where ``model``'s thrust rides on the advance
     (``_thrust_on_the_advance``), why."""
     at = f" at {rps:.4g} rps" if rps else ""
     return (f"from rest, the propeller ahead{at} and the rudder amidships, the surge pushes "
             f"astern (below {astern_below:.3g} m/s), short of its straight speed "
             f"{straight_speed:.3g} m/s: it cannot get under way"
-            + (_thrust_on_the_advance(model) if model is not None else ""))
+            + _thrust_on_the_advance(model))
 
 
-# The surge's thrust: its terms in n² and its fall with the advance (``physics.SIGN_RULES``).
+# The surge's thrust: its terms in n² (and ``propeller(k)``, pos(n)² written for going astern)
+# and its fall with the advance (``physics.SIGN_RULES``).
 THRUST_TERMS = ("pos(n)^2", "|n|*n")
 ADVANCE_TERMS = ("u*|n|", "u*pos(n)")
 
@@ -627,9 +628,11 @@ def _thrust_on_the_advance(model) -> str:
     goes astern from rest and coasts in a crash stop, its reversed propeller's |n| giving what the
     ahead one gave. The bound is a trade there, not a cure (``benchmarks/README.md``, *The
     eight-file sets' surge*), so it is named, not applied."""
-    surge = getattr(model, "coefficients", {}).get("u") or {}
+    physical = getattr(model, "physical", model)  # a hybrid's terms are its physical model's
+    surge = getattr(physical, "coefficients", {}).get("u") or {}
     advance = [(t, surge[t]) for t in ADVANCE_TERMS if surge.get(t, 0.0) > 0]
-    thrust = [(t, surge[t]) for t in THRUST_TERMS if surge.get(t, 0.0) != 0]
+    thrust = [(t, c) for t, c in surge.items()
+              if c != 0 and (t in THRUST_TERMS or t.startswith("propeller("))]  # fmt: skip
     if not advance or any(c > 0 for _, c in thrust):
         return ""
     from shipid.dynamics.terms import parse_term
