@@ -6,9 +6,9 @@ yaw rate's error std over its std, as the README's table has it, and its rms ove
 mean kept), the held 10° and 35° turns at 6–16.7 rps from the model's own straight speed (the
 largest ratio of a turn's tactical diameter at one rps to the same turn's at another), and which
 surge the fit took: a thrust riding on the advance (u·|n| > 0 against no positive n² term) is
-the from-rest warning's named cause (``plausibility._thrust_on_the_advance``). Each set is fitted
-again with the bound that warning names, ``--bound 'u: u*|n| <= 0'`` (the thrust's fall with the
-advance, the sign table's row alone), as a user who follows it would.
+the from-rest warning's named cause (``shipid.dynamics.propeller.thrust_on_the_advance``). Each
+set is fitted again with the bound that warning names, ``--bound 'u: u*|n| <= 0'`` (the
+thrust's fall with the advance, the sign table's row alone), as a user who follows it would.
 
 Run: .venv/bin/python benchmarks/study_esso_eight_files.py
 """
@@ -26,7 +26,7 @@ from esso_logs import held_out_files
 from study_esso_rudder_normal import FORMAT
 from study_esso_side_constant import _across_rps, _judged
 
-from shipid.identification.plausibility import _thrust_on_the_advance
+from shipid.dynamics.propeller import thrust_on_the_advance
 
 MAKERS = {"identify": [], "identify --bound 'u: u*|n| <= 0'": ["--bound", "u: u*|n| <= 0"]}
 
@@ -70,7 +70,7 @@ def main() -> None:
                       + " | " + ", ".join(f"{x:+.0f}" for x in errors[1::2]) + " | "
                       + ", ".join(f"{x:.2f}" for x in std) + f" ({np.mean(std):.2f}) | "
                       + ", ".join(f"{x:.2f}" for x in rms) + f" ({np.mean(rms):.2f}) | "
-                      f"{worst:.2f} | " + ("yes" if _thrust_on_the_advance(model) else "no")
+                      f"{worst:.2f} | " + ("no" if thrust_on_the_advance(model) is None else "yes")
                       + " |", flush=True)  # fmt: skip
     print("\nThe nine sets of eight: |error| median, mean (largest) of the 35° turns' tactical "
           "diameters and steady yaw rates; the random runs' mean over the four, median (range) "

@@ -165,7 +165,9 @@ def test_logs_that_reverse_the_propeller_are_left_as_fitted():
 def test_the_crash_stop_note_names_the_ratio():
     note = astern_thrust_note(surge_model(0.5), 1.0, 10.0)
     assert note.kind == "ratio" and "brakes astern at 50 % of its ahead push" in note.note
-    assert astern_thrust_note(surge_model(None), 1.0, 10.0).kind == "coasting"
+    coasting = astern_thrust_note(surge_model(None), 1.0, 10.0)
+    assert coasting.kind == "coasting" and "none of its propeller terms acts with n < 0" in \
+        coasting.note  # fmt: skip
     # A crash stop stops, later than with the thrust mirrored astern whole.
     kw = {"speed": 1.0, "duration": 600, "dt": 0.5}
     half, whole = (stopping(surge_model(k), 10.0, **kw).indices["time_to_stop"] for k in (0.5, 1))
@@ -247,3 +249,21 @@ def test_a_model_file_prior_in_the_other_thrust_form_holds_the_fit(one_rps_files
     # And the other way: a file's pos(n)² for a structure written with propeller(k).
     back = ModelStructure("s", {"u": ("|u|*u", "propeller(0.7)")})
     assert prior_in_forms({"u": {"pos(n)^2": 2.0}}, back)["u"]["propeller(0.7)"] == 2.0
+
+
+def test_a_crash_stop_that_coasts_on_a_thrust_riding_on_the_advance_says_why():
+    """u·|n| is even in n: a surge whose thrust rides on it (against a negative n⁺², as five of
+    the nine sets of eight Esso zig-zag files take) pushes ahead whichever way the propeller
+    turns. The crash stop's note said none of its terms acted with n < 0, which u·|n| does."""
+    from shipid.dynamics.model import ManoeuvringModel
+
+    model = ManoeuvringModel("u: |u|u, pos(n)^2, u*|n|; v: v; r: r",
+                             {"u": {"|u|u": -0.324, "pos(n)^2": -8.05e-5, "u*|n|": 0.0139},
+                              "v": {"v": -1.0}, "r": {"r": -1.0}})  # fmt: skip
+    note = astern_thrust_note(model, 0.5, 16.67)
+    braking = astern_braking(model, 0.5, 16.67)
+    assert note.kind == "coasting" and braking["braking"] > 0  # reversed, it pushes ahead
+    assert ("its thrust rides on the advance, u |n| at +0.0139 against pos(n)² at -8.05e-05, a "
+            "term even in n that pushes ahead whichever way the propeller turns") in note.note
+    assert note.note.endswith("--bound 'u: u*|n| <= 0' (or --constraints signs) holds it to the "
+                              "thrust's fall with the advance")  # fmt: skip

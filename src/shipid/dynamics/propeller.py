@@ -12,3 +12,44 @@ apart from both so that the command line reads it without importing either.
 # runs choose for the model of its nine zig-zags, judged on the fourth, is 0.5 or 0.6 in each
 # fold.
 ASTERN_THRUST_RATIO = 0.5
+
+
+# The surge's thrust: its terms in n² (and ``propeller(k)``, pos(n)² written for going astern)
+# and its fall with the advance (``shipid.identification.physics.SIGN_RULES``).
+THRUST_TERMS = ("pos(n)^2", "|n|*n")
+ADVANCE_TERMS = ("u*|n|", "u*pos(n)")
+
+
+def thrust_on_the_advance(model) -> tuple[str, float, list[tuple[str, float]]] | None:
+    """(advance term, its coefficient, the thrust terms in n² and theirs) where ``model``'s
+    surge carries its thrust on an advance term of the wrong sign (u·|n| > 0, which the thrust's
+    fall with the advance forbids) against no positive term in n²; else None. u·|n| is even in
+    n: it pushes ahead whichever way the propeller turns, so such a model goes astern from rest
+    and coasts in a crash stop. Five of the nine sets of eight Esso zig-zag files take such a
+    surge (u·|n| +0.012 to +0.014 against n⁺² −7e-5 to −1e-4; ``benchmarks/README.md``, *Leave
+    one zig-zag file out*). A hybrid model's are its physical model's terms."""
+    physical = getattr(model, "physical", model)
+    surge = getattr(physical, "coefficients", {}).get("u") or {}
+    advance = [(t, surge[t]) for t in ADVANCE_TERMS if surge.get(t, 0.0) > 0]
+    thrust = [(t, c) for t, c in surge.items()
+              if c != 0 and (t in THRUST_TERMS or t.startswith("propeller("))]  # fmt: skip
+    if not advance or any(c > 0 for _, c in thrust):
+        return None
+    return advance[0][0], advance[0][1], thrust
+
+
+def thrust_on_the_advance_text(found: tuple[str, float, list[tuple[str, float]]]) -> str:
+    """``thrust_on_the_advance``'s finding in words: 'its thrust rides on the advance, u |n| at
+    +0.0139 against pos(n)² at -8.05e-05'."""
+    from shipid.dynamics.terms import parse_term
+
+    term, value, thrust = found
+    against = (" against " + ", ".join(f"{parse_term(t).display()} at {c:.3g}" for t, c in thrust)
+               if thrust else " with no thrust in n²")  # fmt: skip
+    return f"its thrust rides on the advance, {parse_term(term).display()} at {value:+.3g}{against}"
+
+
+def advance_bound(found: tuple[str, float, list[tuple[str, float]]]) -> str:
+    """The bound that holds ``thrust_on_the_advance``'s term to the thrust's fall with the
+    advance, as the command line takes it."""
+    return f"--bound 'u: {found[0]} <= 0' (or --constraints signs)"

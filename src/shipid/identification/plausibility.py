@@ -614,34 +614,21 @@ def _astern_from_rest(astern_below: float, rps: float | None, straight_speed: fl
             + _thrust_on_the_advance(model))
 
 
-# The surge's thrust: its terms in n² (and ``propeller(k)``, pos(n)² written for going astern)
-# and its fall with the advance (``physics.SIGN_RULES``).
-THRUST_TERMS = ("pos(n)^2", "|n|*n")
-ADVANCE_TERMS = ("u*|n|", "u*pos(n)")
-
-
 def _thrust_on_the_advance(model) -> str:
-    """Where ``model``'s surge carries its thrust on an advance term of the wrong sign (u·|n| >
-    0, which the thrust's fall with the advance forbids) against no positive n² term: '; its
-    thrust rides on ... (the bound that holds it)'; else ''. Five of the nine sets of eight Esso
-    zig-zag files take such a surge (u·|n| +0.012 to +0.014 against n⁺² −7e-5 to −1e-4): each
-    goes astern from rest and coasts in a crash stop, its reversed propeller's |n| giving what the
-    ahead one gave. The bound is a trade there, not a cure (``benchmarks/README.md``, *The
-    eight-file sets' surge*), so it is named, not applied."""
-    physical = getattr(model, "physical", model)  # a hybrid's terms are its physical model's
-    surge = getattr(physical, "coefficients", {}).get("u") or {}
-    advance = [(t, surge[t]) for t in ADVANCE_TERMS if surge.get(t, 0.0) > 0]
-    thrust = [(t, c) for t, c in surge.items()
-              if c != 0 and (t in THRUST_TERMS or t.startswith("propeller("))]  # fmt: skip
-    if not advance or any(c > 0 for _, c in thrust):
-        return ""
-    from shipid.dynamics.terms import parse_term
+    """Where ``model``'s thrust rides on the advance (``shipid.dynamics.propeller.
+    thrust_on_the_advance``): '; its thrust rides on ... (the bound that holds it)'; else ''.
+    The bound is a trade on the Esso's zig-zag sets, not a cure (``benchmarks/README.md``,
+    *Leave one zig-zag file out*), so it is named, not applied."""
+    from shipid.dynamics.propeller import (
+        advance_bound,
+        thrust_on_the_advance,
+        thrust_on_the_advance_text,
+    )
 
-    term, value = advance[0]
-    against = (" against " + ", ".join(f"{parse_term(t).display()} at {c:.3g}" for t, c in thrust)
-               if thrust else " with no thrust in n²")  # fmt: skip
-    return (f"; its thrust rides on the advance, {parse_term(term).display()} at {value:+.3g}"
-            f"{against}: --bound 'u: {term} <= 0' (or --constraints signs) holds it to the "
+    found = thrust_on_the_advance(model)
+    if found is None:
+        return ""
+    return (f"; {thrust_on_the_advance_text(found)}: {advance_bound(found)} holds it to the "
             "thrust's fall with the advance")
 
 

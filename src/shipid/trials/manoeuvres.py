@@ -525,13 +525,25 @@ def astern_thrust_note(ship, speed: float, rps: float,
         return None
     found = astern_braking(ship, speed, rps, astern_rps)
     if found["none"]:
+        from shipid.dynamics.propeller import (
+            advance_bound,
+            thrust_on_the_advance,
+            thrust_on_the_advance_text,
+        )
+
+        even = thrust_on_the_advance(ship)
+        why, remedy = ((f"{thrust_on_the_advance_text(even)}, a term even in n that pushes ahead "
+                        "whichever way the propeller turns",
+                        f"{advance_bound(even)} holds it to the thrust's fall with the advance")
+                       if even else
+                       ("none of its propeller terms acts with n < 0; a selection keeps only the "
+                        "terms its logs excite, and logs that never reverse the propeller leave "
+                        "the astern thrust out", "logs with the propeller astern give it the terms"))
         return AsternThrust("coasting", (
             "the model's propeller does not brake astern: reversed, it changes u̇ by "
-            f"{found['braking']:+.3g} m/s² where ahead it gives {found['ahead']:+.3g} (none of "
-            "its propeller terms acts with n < 0; a selection keeps only the terms its logs "
-            "excite, and logs that never reverse the propeller leave the astern thrust out), so "
-            "a full astern is the ship coasting to a stop on its resistance, a longer reach than "
-            "the ship's own; logs with the propeller astern give it the terms"))
+            f"{found['braking']:+.3g} m/s² where ahead it gives {found['ahead']:+.3g} ({why}), "
+            "so a full astern is the ship coasting to a stop on its resistance, a longer reach "
+            f"than the ship's own; {remedy}"))  # fmt: skip
     if not found["ahead"] > 0:
         return None
     physical = getattr(ship, "physical", ship)
