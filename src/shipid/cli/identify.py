@@ -536,6 +536,8 @@ def _choose_structure(args, logs, names):
         for w in choice.warnings:
             _warn(f"structure: {w}")
         args.model, args.drop = choice.structure, None  # the drop is in the structure
+        if choice.bounds:  # the search held them: the fit of its choice holds them too
+            args.bound = [*(args.bound or []), *choice.bounds]
     if args.gamma is None:
         args.gamma = choice.gamma if choice is not None and choice.gamma else 1e4
     return choice

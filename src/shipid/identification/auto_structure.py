@@ -83,6 +83,9 @@ class StructureChoice:
     # (structure, γ, share), most often chosen first; ``identify`` fits the model as their
     # average weighted by the shares (as ``select --average``), where two or more have one.
     members: list = field(default_factory=list)
+    # Bounds the fit of the chosen structure must hold, as the command line takes them
+    # (``--bound``): those the search that found it held (``searched_with_the_advance_held``).
+    bounds: list[str] = field(default_factory=list)
 
     def describe(self) -> str:
         """One paragraph for the command line."""
@@ -212,6 +215,11 @@ def _auto_structure(logs, names, physics, cv, estimator, drop, announce) -> Stru
     except ShipidError as exc:  # too little data to hold logs out, say
         return StructureChoice(get_structure(fallback), "named", reasons,
                                notes=[f"select found no structure ({exc}); {fallback} instead"])
+    bounds = []
+    if found.why:
+        held = searched_with_the_advance_held(logs, names, options, drop, announce, found.why)
+        if held is not None:
+            found, bounds = held, list(ADVANCE_HELD_BOUNDS)
     sel, library_name, note, widening, apart = (found.selection, found.library_name, found.note,
                                                 found.widening, found.apart)  # fmt: skip
     if found.why:
@@ -224,14 +232,16 @@ def _auto_structure(logs, names, physics, cv, estimator, drop, announce) -> Stru
     structure = ModelStructure(f"selected from {library_name}", chosen.terms)
     members = [(ModelStructure(f"selected from {library_name}", c.terms), float(c.gamma),
                 float(c.share)) for c in sel.shares]  # fmt: skip
+    # A bound held (the fit as --bound fits it) fits the chosen candidate alone, as
+    # ``identify`` fits any structure under physics options.
     return StructureChoice(structure, "select", reasons, gamma=float(sel.gamma),
-                           members=members if len(members) > 1 else [],
+                           members=members if len(members) > 1 and not bounds else [],
                            library=library_name, cv=cv, score=float(sel.score),
                            candidates=len(sel.candidates),
                            notes=([note] if note else []) + widening,
                            warnings=[w for w in sel.warnings
                                      if not w.startswith(("u: ", "v: ", "r: "))]
-                           + ([apart] if apart else []))  # fmt: skip
+                           + ([apart] if apart else []), bounds=bounds)  # fmt: skip
 
 
 @dataclass
@@ -304,6 +314,59 @@ def _searched(logs, names, options, drop, announce, similar: Sequence[str] = SIM
     # The default library loses its constant only to similarity.
     written = tuple(d for d in similar if "1" not in library.terms.get(d, ("1",)))
     return _Search(sel, library_name, note, widening, apart, unusable(sel), written)
+
+
+# The thrust held to its fall with the advance (``physics.SIGN_RULES``' row alone), as
+# ``--bound`` takes it: the last search before a named structure. A thrust that rises with the
+# advance (u·|n| > 0 against a negative n⁺²: ``shipid.dynamics.propeller.thrust_on_the_advance``)
+# goes astern from rest, so its held turns that slow down end astern and are ruled out. Of the
+# nine sets of eight Esso zig-zag files, the one without 13_14_21 found nothing plausible in any
+# form of the library and fell back to blanke-rps+wind, whose side force is the same at every
+# rps (random runs 2.19 of r's rms, turns 102 times as wide at 6 rps as at 16.7); searched so,
+# 0.75 and as wide at every rps, the 35° turns' tactical diameters −28 %, −40 % against +22 %,
+# +25 % and their steady yaw rates +23 %, +12 % against −24 %, −43 %
+# (``benchmarks/study_esso_eight_files.py``). Held in every search, not only the last, it is a
+# trade, not a default: the nine files' turns −33 %, −37 % against +4 %, −7 %.
+ADVANCE_HELD_BOUNDS = ("u: u*|n| <= 0",)  # the command line's form of the bound held below
+
+
+def searched_with_the_advance_held(logs, names, options, drop, announce, why: str
+                                   ) -> _Search | None:  # fmt: skip
+    """The default library searched again, every form of it as ``_auto_structure`` searches
+    them, with the thrust held to its fall with the advance (``ADVANCE_HELD_BOUNDS``): where no
+    form finds anything usable (``why``), before the named structure. None where the library has
+    no u·|n|, the physics already holds the sign table, or this search finds nothing usable
+    either."""
+    import dataclasses
+
+    from shipid.identification.select import default_library
+
+    library = _without(default_library(logs)[0], drop)
+    physics = options.physics
+    if "u*|n|" not in library.terms.get("u", ()) or (physics is not None and physics.signs):
+        return None
+    bounds = {dof: dict(terms) for dof, terms in ((physics.bounds or {}) if physics else {}).items()}
+    bounds.setdefault("u", {}).setdefault("u*|n|", (-math.inf, 0.0))  # ADVANCE_HELD_BOUNDS
+    held = dataclasses.replace(physics or PhysicsOptions(), bounds=bounds,
+                               bounds_where_present=True)  # fmt: skip
+    announce(f"{why}; choosing again with the thrust held to its fall with the advance "
+             f"(u·|n| ≤ 0) ({options.cv})…")  # fmt: skip
+    held_options = dataclasses.replace(options, physics=held)
+    found = _searched(logs, names, held_options, drop, announce)
+    if found.why and found.similar:
+        constant = searched_with_the_constant(logs, names, held_options, drop, announce,
+                                              found.why, found.similar)  # fmt: skip
+        if constant is not None:
+            constant.widening = [*found.widening, *constant.widening]
+            found = constant
+    if found.why:
+        return None
+    found.widening = [f"{why} in any form of the library, so it was searched again with the "
+                      "thrust held to its fall with the advance (u·|n| ≤ 0, as --bound "
+                      f"'{ADVANCE_HELD_BOUNDS[0]}': a thrust that rises with the advance pushes a "
+                      "ship at rest astern, and a held turn that slows down ends astern); the "
+                      "model is the chosen candidate fitted so", *found.widening]
+    return found
 
 
 def unusable(selection) -> str | None:
