@@ -205,13 +205,7 @@ def _auto_structure(logs, names, physics, cv, estimator, drop, announce) -> Stru
     fallback = "blanke-rps" + ("+wind" if wind else "")
     options = SelectOptions(cv=cv, physics=physics, estimator=estimator)
     try:
-        found = _searched(logs, names, options, drop, announce)
-        if found.why and found.similar:
-            constant = searched_with_the_constant(logs, names, options, drop, announce,
-                                                  found.why, found.similar)  # fmt: skip
-            if constant is not None:
-                constant.widening = [*found.widening, *constant.widening]
-                found = constant
+        found = _every_form(logs, names, options, drop, announce)
     except ShipidError as exc:  # too little data to hold logs out, say
         return StructureChoice(get_structure(fallback), "named", reasons,
                                notes=[f"select found no structure ({exc}); {fallback} instead"])
@@ -351,14 +345,7 @@ def searched_with_the_advance_held(logs, names, options, drop, announce, why: st
                                bounds_where_present=True)  # fmt: skip
     announce(f"{why}; choosing again with the thrust held to its fall with the advance "
              f"(u·|n| ≤ 0) ({options.cv})…")  # fmt: skip
-    held_options = dataclasses.replace(options, physics=held)
-    found = _searched(logs, names, held_options, drop, announce)
-    if found.why and found.similar:
-        constant = searched_with_the_constant(logs, names, held_options, drop, announce,
-                                              found.why, found.similar)  # fmt: skip
-        if constant is not None:
-            constant.widening = [*found.widening, *constant.widening]
-            found = constant
+    found = _every_form(logs, names, dataclasses.replace(options, physics=held), drop, announce)
     if found.why:
         return None
     found.widening = [f"{why} in any form of the library, so it was searched again with the "
@@ -366,6 +353,19 @@ def searched_with_the_advance_held(logs, names, options, drop, announce, why: st
                       f"'{ADVANCE_HELD_BOUNDS[0]}': a thrust that rises with the advance pushes a "
                       "ship at rest astern, and a held turn that slows down ends astern); the "
                       "model is the chosen candidate fitted so", *found.widening]
+    return found
+
+
+def _every_form(logs, names, options, drop, announce) -> _Search:
+    """The default library searched (``_searched``) and, where that finds nothing usable, in
+    its next forms (``searched_with_the_constant``): the first usable search, else the first."""
+    found = _searched(logs, names, options, drop, announce)
+    if found.why and found.similar:
+        constant = searched_with_the_constant(logs, names, options, drop, announce, found.why,
+                                              found.similar)  # fmt: skip
+        if constant is not None:
+            constant.widening = [*found.widening, *constant.widening]
+            found = constant
     return found
 
 
