@@ -296,3 +296,26 @@ def test_the_criteria_turn_it_at_its_largest_rudder(capsys):
     code, out, err = run(["criteria", "tanker", "--no-bands"], capsys)
     assert code == 0, err
     assert "turning 10° starboard" in out
+
+
+def test_select_searches_with_the_advance_held_where_no_form_is_usable(two_rps_zigzags, tmp_path,
+                                                                      capsys, monkeypatch):  # fmt: skip
+    """`select` without --library makes identify's last search too: where no form of the
+    default library is usable, every form again with the thrust held to its fall with the
+    advance, without the hull's cross-flow drag (select's default)."""
+    from shipid.data.io import write_log
+    from shipid.identification import auto_structure as auto
+
+    calls = []
+
+    def held(logs, names, options, drop, announce, why, crossflow=True):
+        calls.append((why, crossflow))
+
+    monkeypatch.setattr(auto, "unusable", lambda selection: "nothing usable (forced)")
+    monkeypatch.setattr(auto, "searched_with_the_constant", lambda *a, **k: None)
+    monkeypatch.setattr(auto, "searched_with_the_advance_held", held)
+    paths = [write_log(log, tmp_path / f"zz{i}.csv") for i, log in enumerate(two_rps_zigzags)]
+    code, _, err = run(["select", "--quiet", "--search", "none", *paths, "-o",
+                        tmp_path / "m.json"], capsys)  # fmt: skip
+    assert code == 0, err
+    assert calls == [("nothing usable (forced)", False)]

@@ -324,13 +324,14 @@ def _searched(logs, names, options, drop, announce, similar: Sequence[str] = SIM
 ADVANCE_HELD_BOUNDS = ("u: u*|n| <= 0",)  # the command line's form of the bound held below
 
 
-def searched_with_the_advance_held(logs, names, options, drop, announce, why: str
-                                   ) -> _Search | None:  # fmt: skip
+def searched_with_the_advance_held(logs, names, options, drop, announce, why: str,
+                                   crossflow: bool = True) -> _Search | None:  # fmt: skip
     """The default library searched again, every form of it as ``_auto_structure`` searches
     them, with the thrust held to its fall with the advance (``ADVANCE_HELD_BOUNDS``): where no
     form finds anything usable (``why``), before the named structure. None where the library has
     no u·|n|, the physics already holds the sign table, or this search finds nothing usable
-    either."""
+    either. ``crossflow``: as ``_searched`` takes it (``select`` without ``--crossflow`` searches
+    without the hull's cross-flow drag)."""
     import dataclasses
 
     from shipid.identification.select import default_library
@@ -345,24 +346,25 @@ def searched_with_the_advance_held(logs, names, options, drop, announce, why: st
                                bounds_where_present=True)  # fmt: skip
     announce(f"{why}; choosing again with the thrust held to its fall with the advance "
              f"(u·|n| ≤ 0) ({options.cv})…")  # fmt: skip
-    found = _every_form(logs, names, dataclasses.replace(options, physics=held), drop, announce)
+    found = _every_form(logs, names, dataclasses.replace(options, physics=held), drop, announce,
+                        crossflow)  # fmt: skip
     if found.why:
         return None
     found.widening = [f"{why} in any form of the library, so it was searched again with the "
                       "thrust held to its fall with the advance (u·|n| ≤ 0, as --bound "
                       f"'{ADVANCE_HELD_BOUNDS[0]}': a thrust that rises with the advance pushes a "
-                      "ship at rest astern, and a held turn that slows down ends astern); the "
-                      "model is the chosen candidate fitted so", *found.widening]
+                      "ship at rest astern, and a held turn that slows down ends astern); every "
+                      "fit of the choice holds it", *found.widening]
     return found
 
 
-def _every_form(logs, names, options, drop, announce) -> _Search:
+def _every_form(logs, names, options, drop, announce, crossflow: bool = True) -> _Search:
     """The default library searched (``_searched``) and, where that finds nothing usable, in
     its next forms (``searched_with_the_constant``): the first usable search, else the first."""
-    found = _searched(logs, names, options, drop, announce)
+    found = _searched(logs, names, options, drop, announce, crossflow=crossflow)
     if found.why and found.similar:
         constant = searched_with_the_constant(logs, names, options, drop, announce, found.why,
-                                              found.similar)  # fmt: skip
+                                              found.similar, crossflow)  # fmt: skip
         if constant is not None:
             constant.widening = [*found.widening, *constant.widening]
             found = constant
