@@ -140,8 +140,9 @@ def test_a_surge_that_pushes_a_ship_at_rest_astern_is_warned_of(thrust, advance,
     said = (f"from rest, the propeller ahead at 16.67 rps and the rudder amidships, the surge "
             f"pushes astern (below {found:.3g} m/s), short of its straight speed "
             f"{straight:.3g} m/s: it cannot get under way; its thrust rides on the advance, "
-            f"u |n| at +0.0139 against pos(n)² at -8.05e-05: --bound 'u: u*|n| <= 0' (or "
-            "--constraints signs) holds it to the thrust's fall with the advance")  # fmt: skip
+            f"u |n| at +0.0139 against pos(n)² at -8.05e-05, a term even in n that pushes "
+            "ahead whichever way the propeller turns: --bound 'u: u*|n| <= 0' (or --constraints "
+            "signs) holds it to the thrust's fall with the advance")  # fmt: skip
     assert said in notes
     assert failed_checks(report, model)["from_rest"][1] == said
 
@@ -174,7 +175,7 @@ def test_the_commands_that_run_a_model_file_repeat_the_from_rest_warning(
     said = (f"plausibility: from rest, the propeller ahead at 16.67 rps and the rudder amidships, "
             f"the surge pushes astern (below {found or 0:.3g} m/s), short of its straight speed "
             f"{straight:.3g} m/s: it cannot get under way; its thrust rides on the advance, "
-            f"u |n| at +0.0139 against pos(n)² at -8.05e-05: --bound 'u: u*|n| <= 0'")  # fmt: skip
+            f"u |n| at +0.0139 against pos(n)² at -8.05e-05, a term even in n")  # fmt: skip
     for argv in (["manoeuvre", path, "zigzag", "--duration", "20"],
                  ["manoeuvre", path, "turning", "--speed", "0.3", "--rps", str(n),
                   "--duration", "20"],
@@ -335,5 +336,7 @@ def test_a_thrust_riding_on_the_advance_is_named_with_the_bound_that_holds_it(su
         assert note == ""
     else:
         term = next(t for t in surge if t.startswith("u*"))
-        assert note == (f"; its thrust rides on the advance, {named}: --bound 'u: {term} <= 0' "
-                        "(or --constraints signs) holds it to the thrust's fall with the advance")
+        assert note == (f"; its thrust rides on the advance, {named}, a term even in n that "
+                        "pushes ahead whichever way the propeller turns: --bound "
+                        f"'u: {term} <= 0' (or --constraints signs) holds it to the thrust's "
+                        "fall with the advance")  # fmt: skip

@@ -107,13 +107,13 @@ def cmd_select(args) -> int:
 
         constant = searched_with_the_constant(logs, names, options, edit, say, why,
                                               crossflow=False)  # fmt: skip
-        if constant is None and unusable(sel):
+        if constant is None:
             # As identify's default: every form once more with the thrust held to its fall
             # with the advance, the selection's own fits holding it.
             from shipid.identification.auto_structure import searched_with_the_advance_held
 
-            constant = searched_with_the_advance_held(logs, names, options, edit, say,
-                                                      unusable(sel), crossflow=False)  # fmt: skip
+            constant = searched_with_the_advance_held(logs, names, options, edit, say, why,
+                                                      crossflow=False)  # fmt: skip
         if constant is not None:
             sel = constant.selection
             for note in constant.widening:

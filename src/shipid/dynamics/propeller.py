@@ -38,18 +38,20 @@ def thrust_on_the_advance(model) -> tuple[str, float, list[tuple[str, float]]] |
     return advance[0][0], advance[0][1], thrust
 
 
-def thrust_on_the_advance_text(found: tuple[str, float, list[tuple[str, float]]]) -> str:
-    """``thrust_on_the_advance``'s finding in words: 'its thrust rides on the advance, u |n| at
-    +0.0139 against pos(n)² at -8.05e-05'."""
+def thrust_on_the_advance_note(model) -> tuple[str, str] | None:
+    """Where ``thrust_on_the_advance`` finds ``model``'s thrust riding on the advance: (why, in
+    words: 'its thrust rides on the advance, u |n| at +0.0139 against pos(n)² at -8.05e-05, a
+    term even in n ...', and the bound that holds it, as the command line takes it); else None.
+    The from-rest warning and the crash stop's note give both."""
+    found = thrust_on_the_advance(model)
+    if found is None:
+        return None
     from shipid.dynamics.terms import parse_term
 
     term, value, thrust = found
     against = (" against " + ", ".join(f"{parse_term(t).display()} at {c:.3g}" for t, c in thrust)
                if thrust else " with no thrust in n²")  # fmt: skip
-    return f"its thrust rides on the advance, {parse_term(term).display()} at {value:+.3g}{against}"
-
-
-def advance_bound(found: tuple[str, float, list[tuple[str, float]]]) -> str:
-    """The bound that holds ``thrust_on_the_advance``'s term to the thrust's fall with the
-    advance, as the command line takes it."""
-    return f"--bound 'u: {found[0]} <= 0' (or --constraints signs)"
+    return (f"its thrust rides on the advance, {parse_term(term).display()} at {value:+.3g}"
+            f"{against}, a term even in n that pushes ahead whichever way the propeller turns",
+            f"--bound 'u: {term} <= 0' (or --constraints signs) holds it to the thrust's fall "
+            "with the advance")

@@ -321,7 +321,8 @@ def _searched(logs, names, options, drop, announce, similar: Sequence[str] = SIM
 # +25 % and their steady yaw rates +23 %, +12 % against −24 %, −43 %
 # (``benchmarks/study_esso_eight_files.py``). Held in every search, not only the last, it is a
 # trade, not a default: the nine files' turns −33 %, −37 % against +4 %, −7 %.
-ADVANCE_HELD_BOUNDS = ("u: u*|n| <= 0",)  # the command line's form of the bound held below
+ADVANCE_HELD = "u*|n|"
+ADVANCE_HELD_BOUNDS = (f"u: {ADVANCE_HELD} <= 0",)  # the command line's form of the bound
 
 
 def searched_with_the_advance_held(logs, names, options, drop, announce, why: str,
@@ -338,10 +339,10 @@ def searched_with_the_advance_held(logs, names, options, drop, announce, why: st
 
     library = _without(default_library(logs)[0], drop)
     physics = options.physics
-    if "u*|n|" not in library.terms.get("u", ()) or (physics is not None and physics.signs):
+    if ADVANCE_HELD not in library.terms.get("u", ()) or (physics is not None and physics.signs):
         return None
     bounds = {dof: dict(terms) for dof, terms in ((physics.bounds or {}) if physics else {}).items()}
-    bounds.setdefault("u", {}).setdefault("u*|n|", (-math.inf, 0.0))  # ADVANCE_HELD_BOUNDS
+    bounds.setdefault("u", {}).setdefault(ADVANCE_HELD, (-math.inf, 0.0))
     held = dataclasses.replace(physics or PhysicsOptions(), bounds=bounds,
                                bounds_where_present=True)  # fmt: skip
     announce(f"{why}; choosing again with the thrust held to its fall with the advance "

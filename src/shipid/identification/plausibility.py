@@ -616,20 +616,13 @@ def _astern_from_rest(astern_below: float, rps: float | None, straight_speed: fl
 
 def _thrust_on_the_advance(model) -> str:
     """Where ``model``'s thrust rides on the advance (``shipid.dynamics.propeller.
-    thrust_on_the_advance``): '; its thrust rides on ... (the bound that holds it)'; else ''.
-    The bound is a trade on the Esso's zig-zag sets, not a cure (``benchmarks/README.md``,
+    thrust_on_the_advance_note``): '; its thrust rides on ...: (the bound that holds it)'; else
+    ''. The bound is a trade on the Esso's zig-zag sets, not a cure (``benchmarks/README.md``,
     *Leave one zig-zag file out*), so it is named, not applied."""
-    from shipid.dynamics.propeller import (
-        advance_bound,
-        thrust_on_the_advance,
-        thrust_on_the_advance_text,
-    )
+    from shipid.dynamics.propeller import thrust_on_the_advance_note
 
-    found = thrust_on_the_advance(model)
-    if found is None:
-        return ""
-    return (f"; {thrust_on_the_advance_text(found)}: {advance_bound(found)} holds it to the "
-            "thrust's fall with the advance")
+    note = thrust_on_the_advance_note(model)
+    return f"; {note[0]}: {note[1]}" if note else ""
 
 
 def from_rest_warning(model, speed: float | None, rps: float | None) -> str | None:

@@ -525,20 +525,12 @@ def astern_thrust_note(ship, speed: float, rps: float,
         return None
     found = astern_braking(ship, speed, rps, astern_rps)
     if found["none"]:
-        from shipid.dynamics.propeller import (
-            advance_bound,
-            thrust_on_the_advance,
-            thrust_on_the_advance_text,
-        )
+        from shipid.dynamics.propeller import thrust_on_the_advance_note
 
-        even = thrust_on_the_advance(ship)
-        why, remedy = ((f"{thrust_on_the_advance_text(even)}, a term even in n that pushes ahead "
-                        "whichever way the propeller turns",
-                        f"{advance_bound(even)} holds it to the thrust's fall with the advance")
-                       if even else
-                       ("none of its propeller terms acts with n < 0; a selection keeps only the "
-                        "terms its logs excite, and logs that never reverse the propeller leave "
-                        "the astern thrust out", "logs with the propeller astern give it the terms"))
+        why, remedy = thrust_on_the_advance_note(ship) or (
+            "none of its propeller terms acts with n < 0; a selection keeps only the terms its "
+            "logs excite, and logs that never reverse the propeller leave the astern thrust out",
+            "logs with the propeller astern give it the terms")  # fmt: skip
         return AsternThrust("coasting", (
             "the model's propeller does not brake astern: reversed, it changes u̇ by "
             f"{found['braking']:+.3g} m/s² where ahead it gives {found['ahead']:+.3g} ({why}), "
