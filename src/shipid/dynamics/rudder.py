@@ -73,18 +73,25 @@ class RudderInflow:
         """The inflow of a ship with these particulars (``shipid.data.particulars``: length,
         propeller_diameter and block_coefficient needed, rudder_height used where given) whose
         positive rudder turns it to ``rudder_positive`` ('port' or 'starboard')."""
-        missing = [k for k in ("propeller_diameter", "block_coefficient")
-                   if getattr(particulars, k) is None]  # fmt: skip
-        if missing:
-            raise ShipidError(f"the rudder's inflow needs the particulars' {' and '.join(missing)}"
-                              " (--particulars FILE)")  # fmt: skip
         if rudder_positive not in ("port", "starboard"):
             raise ShipidError(f"the rudder's inflow needs the logs' rudder convention ('port' or "
                               f"'starboard'), got {rudder_positive!r}")  # fmt: skip
-        diameter = particulars.propeller_diameter
-        wake = 0.5 * particulars.block_coefficient - 0.05
-        height = particulars.rudder_height
-        eta = ETA_DEFAULT if height is None else min(1.0, diameter / height)
-        race = eta * KAPPA**2 * 8.0 * KT0 / math.pi * diameter**2
+        a, race = inflow_speed(particulars)
         sign = 1.0 if rudder_positive == "starboard" else -1.0
-        return cls((1.0 - wake) ** 2, race, sign * STRAIGHTENING, POSITION * particulars.length)
+        return cls(a, race, sign * STRAIGHTENING, POSITION * particulars.length)
+
+
+def inflow_speed(particulars) -> tuple[float, float]:
+    """(a, c [m²]) of the rudder's inflow speed u_R² = a u² + c n⁺² from the particulars (the
+    module's note; length, propeller_diameter and block_coefficient needed, rudder_height used
+    where given). Its side needs no convention: what the rudder's drag takes from it."""
+    missing = [k for k in ("propeller_diameter", "block_coefficient")
+               if getattr(particulars, k) is None]  # fmt: skip
+    if missing:
+        raise ShipidError(f"the rudder's inflow needs the particulars' {' and '.join(missing)}"
+                          " (--particulars FILE)")  # fmt: skip
+    diameter = particulars.propeller_diameter
+    wake = 0.5 * particulars.block_coefficient - 0.05
+    height = particulars.rudder_height
+    eta = ETA_DEFAULT if height is None else min(1.0, diameter / height)
+    return (1.0 - wake) ** 2, eta * KAPPA**2 * 8.0 * KT0 / math.pi * diameter**2

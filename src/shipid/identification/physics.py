@@ -67,11 +67,12 @@ def _canonical(*texts: str) -> frozenset[str]:
 
 _RUDDER_TERMS = _canonical("delta", "u*delta", "|u|*delta", "U*delta", "u^2*delta", "|u|*u*delta",
                            "U^2*delta", "pos(n)^2*delta")  # fmt: skip
+# The rudder's drag in u̇, in the free stream and in the propeller's race.
+RUDDER_DRAG_TERMS = _canonical("delta^2", "u^2*delta^2", "|u|*u*delta^2", "pos(n)^2*delta^2")
 # (equation, terms, sign, why): sign −1 (≤ 0), +1 (≥ 0), or RUDDER / "-" + RUDDER (s, −s).
 SIGN_RULES: tuple[tuple[str, frozenset[str], object, str], ...] = (
     ("u", _canonical("|u|*u"), -1, "hull resistance grows with speed"),
-    ("u", _canonical("delta^2", "u^2*delta^2", "|u|*u*delta^2", "pos(n)^2*delta^2"), -1,
-     "rudder drag"),
+    ("u", RUDDER_DRAG_TERMS, -1, "rudder drag"),
     ("u", _canonical("|n|*n", "pos(n)^2", "thrust"), 1, "propeller thrust ahead"),
     ("u", _canonical("neg(n)^2"), -1, "propeller astern pulls back"),
     ("u", _canonical("u*|n|", "u*pos(n)"), -1, "thrust falls with the advance"),

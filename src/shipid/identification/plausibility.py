@@ -598,6 +598,61 @@ def missed_steady_speed(model, speed: float, rps: float) -> str | None:
             "terms, which holds one speed at every rps)")
 
 
+def rudder_drag_ahead(model, particulars, speed: float | None, rps: float | None,
+                      std_errors: dict | None = None) -> str | None:  # fmt: skip
+    """A warning where ``model``'s surge has its rudder drag push the ship ahead: its terms of
+    ``physics.RUDDER_DRAG_TERMS`` summed at the straight approach (``speed``, ``rps``) per δ²
+    come out > 0, which no rudder does. A zig-zag holds its rudder at one angle most of the time,
+    where δ² is one with the thrust, so logs at one rps hardly determine it (the Esso's single
+    zig-zag files: ±0.005 to ±0.08, three of nine fitted > 0), and a turn's loss of speed rests
+    on it. The warning gives the particulars' value (``priors.rudder_drag``) and the bound that
+    holds a single term there: a trade on those files (``benchmarks/README.md``, *The rudder's
+    drag of one zig-zag file*), so named, not applied. ``std_errors``: the fit's {term: ±} of
+    u̇. None where the drag is a drag, or the particulars cannot give its value."""
+    from shipid.data.particulars import Particulars
+    from shipid.dynamics.terms import parse_term, term_matrix
+    from shipid.identification.physics import RUDDER_DRAG_TERMS
+    from shipid.identification.priors import rudder_drag
+
+    if not (speed and speed > 0) or "u" not in getattr(model, "coefficients", {}):
+        return None
+    terms = {t: c for t, c in model.coefficients["u"].items()
+             if parse_term(t).text in RUDDER_DRAG_TERMS and c != 0}  # fmt: skip
+    if not terms or particulars is None:
+        return None
+    n0 = float(rps) if rps else 0.0
+    at = {t: float(term_matrix([t], np.array([speed]), np.zeros(1), np.zeros(1),
+                               {"delta": np.ones(1), "n": np.array([n0])})[0, 0])
+          for t in terms}  # fmt: skip
+    drag = sum(c * at[t] for t, c in terms.items())
+    if not drag > 0:
+        return None
+    if not isinstance(particulars, Particulars):
+        particulars = Particulars.from_mapping(particulars)
+    physical = rudder_drag(particulars, speed, rps)
+    if physical is None:
+        return None
+    errors = std_errors or {}
+    shown = ", ".join(f"{t} {c:+.3g}" + (f" ± {errors[t]:.2g}" if t in errors else "")
+                      for t, c in terms.items())  # fmt: skip
+    loose = [t for t, c in terms.items() if t in errors and abs(c) < 2 * errors[t]]
+    where = f"{speed:.3g} m/s" + (f" and {n0:.4g} rps" if n0 > 0 else "")
+    if len(terms) == 1 and at[next(iter(terms))] > 0:
+        term = next(iter(terms))
+        value = physical / at[term]
+        remedy = (f"--bound 'u: {term} <= {value:.3g}' --bound 'u: {term} >= {value:.3g}' "
+                  "holds it there")  # fmt: skip
+    else:
+        remedy = "--constraints signs holds each of its terms to a drag"
+    return (f"surge: the rudder's drag pushes the ship ahead ({shown}"
+            + (", which these logs do not determine" if loose else "")
+            + "), so its turns keep too much of their speed: a zig-zag holds its rudder at one "
+            "angle most of the time, where δ² is one with the thrust; the particulars put it "
+            f"at {physical:.3g} per δ² (the rudder's normal force in its inflow at {where}): "
+            f"{remedy}, a trade (benchmarks/README.md, *The rudder's drag of one zig-zag "
+            "file*)")
+
+
 # How badly a check fails, to compare two models check by check: a rudder held to a side that
 # diverges is worse than one that turns the wrong way, which is worse than one still settling.
 UNSETTLED, WRONG_WAY, DIVERGED = 1, 2, 3

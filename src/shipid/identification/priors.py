@@ -41,6 +41,7 @@ from shipid.dynamics.terms import parse_term, rudder_normal_angle
 from shipid.errors import ShipidError
 
 ASPECT_RATIO = 1.5
+F_ALPHA = 6.13 * ASPECT_RATIO / (ASPECT_RATIO + 2.25)  # Fujii's normal-force slope [1/rad]
 A_H, X_H, X_R = 0.2, -0.45, -0.5  # hull interaction, its position and the rudder's, in L
 T_R = 0.3  # the rudder's drag less its resistance deduction: −(1 − t_R) F sin δ
 # Terms of the acceleration form each linear coefficient maps to, with the power of the approach
@@ -85,8 +86,7 @@ def clarke_linear(p: Particulars, rudder_positive: str | None) -> dict[str, dict
     acc = np.linalg.solve(M, F)
     out = {"v": {"v": acc[0, 0], "r": acc[0, 1]}, "r": {"v": acc[1, 0], "r": acc[1, 1]}}
     if rudder_positive is not None and p.rudder_area is not None:
-        f_alpha = 6.13 * ASPECT_RATIO / (ASPECT_RATIO + 2.25)
-        force = q * p.rudder_area * f_alpha  # per u² δ, for a rudder turning to starboard
+        force = q * p.rudder_area * F_ALPHA  # per u² δ, for a rudder turning to starboard
         sign = 1.0 if rudder_positive == "starboard" else -1.0
         rud = np.linalg.solve(M, sign * force * np.array([-(1 + A_H), -(X_R + A_H * X_H) * L]))
         out["v"]["delta"], out["r"]["delta"] = rud[0], rud[1]
@@ -128,6 +128,22 @@ def clarke_prior(p: Particulars, structure: ModelStructure, speed: float,
                           f"the rudder's normal force) of v̇ and ṙ; the structure "
                           f"{structure.name} has none of them")
     return prior
+
+
+def rudder_drag(p: Particulars, speed: float, rps: float | None) -> float | None:
+    """The surge's rudder drag per δ² [1/s² per rad², as u̇ = c δ²] at the straight approach
+    (``speed`` [m/s], ``rps``): −(1 − t_R) ½ρ A_R f_α U_R² / m, the rudder's normal force of the
+    module's note in the inflow U_R² = a u² + c n⁺² (``shipid.dynamics.rudder.inflow_speed``),
+    sin α_R sin δ ≈ δ² straight ahead; None where the particulars lack the rudder's area, the
+    propeller's diameter, the block coefficient or the mass."""
+    from shipid.dynamics.rudder import inflow_speed
+
+    mass = p.mass if p.mass is not None else (None if p.volume is None else p.rho * p.volume)
+    if None in (p.rudder_area, p.propeller_diameter, p.block_coefficient, mass):
+        return None
+    a, c = inflow_speed(p)
+    inflow = a * speed**2 + c * max(rps or 0.0, 0.0) ** 2
+    return -(1 - T_R) * 0.5 * p.rho * p.rudder_area * F_ALPHA * inflow / mass
 
 
 def rudder_parity(texts) -> dict[str, int]:
