@@ -24,7 +24,7 @@ import time
 import warnings
 
 import numpy as np
-from esso_logs import DATA
+from esso_logs import DATA, trial_files
 from study_esso_single_logs import _errors, _turn_errors, _validations
 
 from shipid.cli import main as shipid
@@ -32,7 +32,6 @@ from shipid.data.log import approach
 from shipid.data.particulars import logs_particulars
 from shipid.identification.priors import rudder_drag
 from shipid.reporting.modelfile import load_model
-from shipid.trials.reading import read_trial_log
 
 BOUND = re.compile(r"(--bound 'u: delta\^2 <= \S+' --bound 'u: delta\^2 >= \S+')")
 
@@ -50,14 +49,13 @@ def _held(value: float) -> list[str]:
 
 def main() -> None:
     warnings.simplefilter("ignore")
-    if not DATA.is_dir():
-        print("../shared/data is absent")
+    found = trial_files()
+    if found is None:
         return
-    zigzags = sorted((DATA / "zigzag").glob("*.csv"))
+    zigzags, every = found
     turns = sorted((DATA / "turning").glob("*.csv"))
-    logs = {f: read_trial_log(f, fmt="osaka-frt") for f in zigzags + turns}
-    randoms = {f: read_trial_log(f, fmt="osaka-frt")
-               for f in sorted((DATA / "random").glob("*.csv"))}  # fmt: skip
+    logs = {f: log for f, log in every.items() if f in zigzags or f in turns}
+    randoms = {f: log for f, log in every.items() if f not in logs}
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores\n")
     start = time.perf_counter()
     rows = {"default": [], "held where the warning names it": [], "held on every file": []}
