@@ -72,6 +72,14 @@ def test_the_warning_names_a_drag_that_pushes_ahead_and_the_bound_that_holds_it(
     assert "--constraints signs" in rudder_drag_ahead(two, ESSO, 0.25, 15.0)
 
 
+def test_a_drag_that_pushes_ahead_by_a_trifle_is_left_unsaid():
+    """Against the particulars' drag: a tenth of it is the line (``DRAG_AHEAD_SHARE``)."""
+    value = _closed_form(ESSO, 0.25, 15.0)
+    for share, said in ((0.05, False), (0.2, True)):
+        model = _model({"|u|*u": -0.05, "delta^2": -share * value})
+        assert (rudder_drag_ahead(model, ESSO, 0.25, 15.0) is not None) is said
+
+
 @pytest.mark.parametrize("surge, particulars, speed", [
     ({"|u|*u": -0.05, "delta^2": -0.03}, ESSO, 0.25),  # a drag
     ({"|u|*u": -0.05, "u^2*delta^2": 0.5, "pos(n)^2*delta^2": -1e-3}, ESSO, 0.25),  # summed, one

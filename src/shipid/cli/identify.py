@@ -184,14 +184,14 @@ def cmd_identify(args) -> int:
         choice.alternatives_fit = "model" if refitted else "comparison"
     speed, rps = _approach(logs[0], "u"), _approach(logs[0], "n")
     _warn_approach(logs, names)
-    if not members:  # an average's coefficients are its candidates', each fitted alike
-        from shipid.data.particulars import logs_particulars
-        from shipid.identification.plausibility import rudder_drag_ahead
+    from shipid.data.particulars import logs_particulars
+    from shipid.identification.plausibility import rudder_drag_ahead
 
-        drag = rudder_drag_ahead(ident.model, logs_particulars(logs), speed, rps,
-                                 _std_errors(ident).get("u"))  # fmt: skip
-        if drag:
-            ident.warnings.append(drag)
+    # An average has no standard errors of its own (its candidates' are each fit's).
+    drag = rudder_drag_ahead(ident.model, logs_particulars(logs), speed, rps,
+                             None if members else _std_errors(ident).get("u"))  # fmt: skip
+    if drag:
+        ident.warnings.append(drag)
     prep = {**_log_record(args, logs), "filter_hz": cutoff,
             "filter_by": filter_by if cutoff is not None else None}
     refinement = None
