@@ -654,8 +654,8 @@ def rudder_drag_ahead(model, particulars, speed: float | None, rps: float | None
         remedy = "--constraints signs holds each of its terms to a drag"
     return (f"surge: the rudder's drag pushes the ship ahead ({shown}"
             + (", which these logs do not determine" if loose else "")
-            + "), so its turns keep too much of their speed: a zig-zag holds its rudder at one "
-            "angle most of the time, where δ² is one with the thrust; the particulars put it "
+            + "), so its turns lose too little speed (logs whose rudder rests at one angle most "
+            "of the time, as a zig-zag's does, leave δ² one with the thrust); the particulars put it "
             f"at {physical:.3g} per δ² (the rudder's normal force in its inflow at {where}): "
             f"{remedy}, a trade (benchmarks/README.md, *The rudder's drag of one zig-zag "
             "file*)")

@@ -131,7 +131,7 @@ def clarke_prior(p: Particulars, structure: ModelStructure, speed: float,
 
 
 def rudder_drag(p: Particulars, speed: float, rps: float | None) -> float | None:
-    """The surge's rudder drag per δ² [1/s² per rad², as u̇ = c δ²] at the straight approach
+    """The surge's rudder drag per δ² [m/s² per rad², as u̇ = c δ²] at the straight approach
     (``speed`` [m/s], ``rps``): −(1 − t_R) ½ρ A_R f_α U_R² / m, the rudder's normal force of the
     module's note in the inflow U_R² = a u² + c n⁺² (``shipid.dynamics.rudder.inflow_speed``),
     sin α_R sin δ ≈ δ² straight ahead; None where the particulars lack the rudder's area, the
