@@ -67,6 +67,12 @@ def test_the_warning_names_a_drag_that_pushes_ahead_and_the_bound_that_holds_it(
     # In the race's form, per n⁺² at the approach: the bound is the drag over n0².
     note = rudder_drag_ahead(_model({"|u|*u": -0.05, "pos(n)^2*delta^2": 1e-4}), ESSO, 0.25, 15.0)
     assert f"'u: pos(n)^2*delta^2 <= {value / 225:.3g}'" in note and "±" not in note
+    # The rudder's normal force (--rudder-normal): its drag's factor U_R² sin α_R sin δ is the
+    # particulars' inflow itself, so the bound is −(1 − t_R) ½ρ A_R f_α / m.
+    normal = "sin(delta)*rudder_normal(0.403225 0.000943318 0.5 -3)"
+    note = rudder_drag_ahead(_model({"|u|*u": -0.05, normal: 0.0475}), ESSO, 0.25, 15.0)
+    k = _closed_form(ESSO, 0.25, 15.0) / (0.403225 * 0.25**2 + 0.000943318 * 15.0**2)
+    assert f"'u: {normal} <= {k:.3g}'" in note
     # Two forms whose sum pushes ahead: each held to a drag by the sign table.
     two = _model({"|u|*u": -0.05, "u^2*delta^2": 0.5, "pos(n)^2*delta^2": -1e-4})
     assert "--constraints signs" in rudder_drag_ahead(two, ESSO, 0.25, 15.0)

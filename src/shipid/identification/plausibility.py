@@ -608,7 +608,8 @@ DRAG_AHEAD_SHARE = 0.1
 def rudder_drag_ahead(model, particulars, speed: float | None, rps: float | None,
                       std_errors: dict | None = None) -> str | None:  # fmt: skip
     """A warning where ``model``'s surge has its rudder drag push the ship ahead: its terms of
-    ``physics.RUDDER_DRAG_TERMS`` summed at the straight approach (``speed``, ``rps``) per δ²
+    ``physics.RUDDER_DRAG_TERMS`` and the rudder's normal force's drag (``--rudder-normal``'s
+    F_N sin δ) summed at the straight approach (``speed``, ``rps``) per δ² as δ → 0
     come out > 0, which no rudder does (by more than ``DRAG_AHEAD_SHARE`` of the particulars'
     drag). A zig-zag holds its rudder at one angle most of the time,
     where δ² is one with the thrust, so logs at one rps hardly determine it (the Esso's single
@@ -618,19 +619,22 @@ def rudder_drag_ahead(model, particulars, speed: float | None, rps: float | None
     drag of one zig-zag file*), so named, not applied. ``std_errors``: the fit's {term: ±} of
     u̇. None where the drag is a drag, or the particulars cannot give its value."""
     from shipid.data.particulars import Particulars
-    from shipid.dynamics.terms import parse_term, term_matrix
+    from shipid.dynamics.terms import parse_term, rudder_normal_angle, term_matrix
     from shipid.identification.physics import RUDDER_DRAG_TERMS
     from shipid.identification.priors import rudder_drag
 
     if not (speed and speed > 0) or "u" not in getattr(model, "coefficients", {}):
         return None
     terms = {t: c for t, c in model.coefficients["u"].items()
-             if parse_term(t).text in RUDDER_DRAG_TERMS and c != 0}  # fmt: skip
+             if c != 0 and (parse_term(t).text in RUDDER_DRAG_TERMS
+                            or rudder_normal_angle(t) == "sin")}  # fmt: skip
     if not terms or particulars is None:
         return None
     n0 = float(rps) if rps else 0.0
+    # Per δ² as δ → 0, where the normal force's drag U_R² sin α_R sin δ is U_R² δ² straight ahead.
+    small = 1e-3
     at = {t: float(term_matrix([t], np.array([speed]), np.zeros(1), np.zeros(1),
-                               {"delta": np.ones(1), "n": np.array([n0])})[0, 0])
+                               {"delta": np.array([small]), "n": np.array([n0])})[0, 0]) / small**2
           for t in terms}  # fmt: skip
     drag = sum(c * at[t] for t, c in terms.items())
     if not drag > 0:
