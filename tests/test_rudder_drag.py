@@ -118,3 +118,39 @@ def test_identify_warns_of_the_esso_zigzag_whose_rudder_drag_pushes_ahead(tmp_pa
     # Written to scale with the propeller (δ² → pos(n)² δ² at the logs' 15 rps).
     assert surge["pos(n)^2*delta^2"] * 15.0**2 == pytest.approx(value, rel=1e-9)
     assert np.isfinite(value)
+
+
+def test_select_gives_the_warning_of_the_model_it_writes(tmp_path, capsys, monkeypatch):
+    """``select`` checks the model it writes as ``identify`` does: the same function, given the
+    selection's model (the fit's terms, before the file carries them anywhere), the logs'
+    particulars and their approach. Its text here is a stand-in (the paper's small zig-zags
+    fit a drag that is one)."""
+    from generated_logs import noisy_zigzags
+
+    import shipid.identification.plausibility as plausibility
+    from shipid.data.io import write_log
+
+    seen = []
+
+    def spy(model, particulars, speed, rps, std_errors=None):
+        seen.append((model, particulars, speed, rps))
+        return "surge: (a stand-in for the rudder drag's warning)"
+
+    monkeypatch.setattr(plausibility, "rudder_drag_ahead", spy)
+    logs = noisy_zigzags(seed=3)[:2]
+    for log in logs:
+        log.attrs["particulars"] = ESSO.to_dict()
+    paths = [write_log(log, tmp_path / f"zz{i}.csv") for i, log in enumerate(logs)]
+    code, _, err = run(["select", "--quiet", *paths, "-o", tmp_path / "m.json"], capsys)
+    assert code == 0, err
+    assert "warning: surge: (a stand-in for the rudder drag's warning)" in err
+    ((model, particulars, speed, rps),) = seen
+    assert particulars == ESSO and rps is None
+    assert speed == pytest.approx(float(logs[0]["u"].iloc[0]), rel=0.05)
+    # The file writes it in its ahead forms (u·v → |u|·v, ...): the terms both hold agree.
+    written = load_model(tmp_path / "m.json").coefficients
+    shared = [(d, t) for d, terms in model.coefficients.items() for t in terms
+              if t in written.get(d, {})]  # fmt: skip
+    assert ("u", "|u|*u") in shared
+    for d, t in shared:
+        assert model.coefficients[d][t] == pytest.approx(written[d][t], rel=1e-12), (d, t)

@@ -466,6 +466,16 @@ def _std_errors(ident) -> dict:
     return {d: ident.diagnostics[d].get("std_errors", {}) for d in ident.diagnostics}
 
 
+def _rudder_drag_note(model, logs, speed, rps, std_errors=None) -> str | None:
+    """``identify``'s and ``select``'s warning where the fitted surge's rudder drag pushes the
+    ship ahead (``plausibility.rudder_drag_ahead``), against the logs' particulars; None where it
+    is a drag or they cannot tell. ``std_errors``: the fit's {term: ±} of u̇ (not an average's)."""
+    from shipid.data.particulars import logs_particulars
+    from shipid.identification.plausibility import rudder_drag_ahead
+
+    return rudder_drag_ahead(model, logs_particulars(logs), speed, rps, std_errors)
+
+
 def _print_yaw_rate_offsets(args, paths, logs) -> None:
     """One line of the offsets ``--yaw-rate-offset auto`` read off the logs' headings."""
     if args.yaw_rate_offset == "auto" and logs:

@@ -19,6 +19,7 @@ from shipid.cli.common import (
     _pd,
     _physics,
     _read_files,
+    _rudder_drag_note,
     _std_errors,
     _structure,
     _structure_edit,
@@ -184,11 +185,8 @@ def cmd_identify(args) -> int:
         choice.alternatives_fit = "model" if refitted else "comparison"
     speed, rps = _approach(logs[0], "u"), _approach(logs[0], "n")
     _warn_approach(logs, names)
-    from shipid.data.particulars import logs_particulars
-    from shipid.identification.plausibility import rudder_drag_ahead
-
     # An average has no standard errors of its own (its candidates' are each fit's).
-    drag = rudder_drag_ahead(ident.model, logs_particulars(logs), speed, rps,
+    drag = _rudder_drag_note(ident.model, logs, speed, rps,
                              None if members else _std_errors(ident).get("u"))  # fmt: skip
     if drag:
         ident.warnings.append(drag)

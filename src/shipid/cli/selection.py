@@ -18,6 +18,8 @@ from shipid.cli.common import (
     _pd,
     _physics,
     _read_files,
+    _rudder_drag_note,
+    _std_errors,
     _structure_edit,
     _term_display,
     _training_logs,
@@ -164,6 +166,12 @@ def cmd_select(args) -> int:
         missed = missed_steady_speed(written, u, n)
         if missed:
             ident.warnings.append(missed)
+    drag = _rudder_drag_note(sel.model, logs,
+                             args.speed if args.speed is not None else _approach(logs[0], "u"),
+                             args.rps if args.rps is not None else _approach(logs[0], "n"),
+                             _std_errors(ident).get("u") if sel.model is sel.chosen_model else None)
+    if drag:
+        ident.warnings.append(drag)
     prep = _log_record(args, logs)
     ensemble = None
     others = len(sel.shares) - (sel.chosen_share > 0)
