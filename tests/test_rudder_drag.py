@@ -1,4 +1,4 @@
-"""The surge's rudder drag from the particulars, and identify's warning where a fit's drag pushes
+"""The surge's rudder drag from the particulars, and identify's and select's warning where a fit's
 the ship ahead (issue #10: a zig-zag at one rps holds δ² one with the thrust)."""
 
 import importlib
