@@ -1,5 +1,5 @@
-"""The surge's rudder drag from the particulars, and identify's and select's warning where a fit's
-the ship ahead (issue #10: a zig-zag at one rps holds δ² one with the thrust)."""
+"""The surge's rudder drag from the particulars, and identify's and select's warning where a
+fit's drag pushes the ship ahead (issue #10: a zig-zag at one rps holds δ² one with the thrust)."""
 
 import importlib
 import math
