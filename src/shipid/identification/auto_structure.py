@@ -49,6 +49,7 @@ import numpy as np
 import pandas as pd
 
 from shipid.dynamics.model import DOFS, ModelStructure, StructureEdit, get_structure
+from shipid.dynamics.propeller import ADVANCE_TERMS
 from shipid.dynamics.similarity import SIDE_FORCE
 from shipid.errors import ShipidError
 from shipid.identification.cross_validation import choice_cv
@@ -321,7 +322,7 @@ def _searched(logs, names, options, drop, announce, similar: Sequence[str] = SIM
 # +25 % and their steady yaw rates +23 %, +12 % against −24 %, −43 %
 # (``benchmarks/study_esso_eight_files.py``). Held in every search, not only the last, it is a
 # trade, not a default: the nine files' turns −33 %, −37 % against +4 %, −7 %.
-ADVANCE_HELD = "u*|n|"
+ADVANCE_HELD = ADVANCE_TERMS[0]  # u·|n|, the default library's form of it
 ADVANCE_HELD_BOUNDS = (f"u: {ADVANCE_HELD} <= 0",)  # the command line's form of the bound
 
 

@@ -52,6 +52,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pandas as pd
 
+from shipid.dynamics.propeller import ADVANCE_TERMS, THRUST_TERMS
 from shipid.dynamics.terms import OPS, parse_term, rudder_normal_angle, term_matrix
 from shipid.errors import InfeasibleConstraintsError, ShipidError
 
@@ -73,9 +74,9 @@ RUDDER_DRAG_TERMS = _canonical("delta^2", "u^2*delta^2", "|u|*u*delta^2", "pos(n
 SIGN_RULES: tuple[tuple[str, frozenset[str], object, str], ...] = (
     ("u", _canonical("|u|*u"), -1, "hull resistance grows with speed"),
     ("u", RUDDER_DRAG_TERMS, -1, "rudder drag"),
-    ("u", _canonical("|n|*n", "pos(n)^2", "thrust"), 1, "propeller thrust ahead"),
+    ("u", _canonical(*THRUST_TERMS, "thrust"), 1, "propeller thrust ahead"),
     ("u", _canonical("neg(n)^2"), -1, "propeller astern pulls back"),
-    ("u", _canonical("u*|n|", "u*pos(n)"), -1, "thrust falls with the advance"),
+    ("u", _canonical(*ADVANCE_TERMS), -1, "thrust falls with the advance"),
     ("v", _canonical("u*v", "|u|*v", "U*v", "|v|*v", "v*|n|", "v"), -1, "sway damping"),
     ("r", _canonical("u*r", "|u|*r", "U*r", "|r|*r", "r*|n|", "r"), -1, "yaw damping"),
     ("r", _RUDDER_TERMS, RUDDER, "the rudder turns the ship its way"),

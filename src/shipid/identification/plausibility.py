@@ -633,9 +633,9 @@ def rudder_drag_ahead(model, particulars, speed: float | None, rps: float | None
     n0 = float(rps) if rps else 0.0
     # Per δ² as δ → 0, where the normal force's drag U_R² sin α_R sin δ is U_R² δ² straight ahead.
     small = 1e-3
-    at = {t: float(term_matrix([t], np.array([speed]), np.zeros(1), np.zeros(1),
-                               {"delta": np.array([small]), "n": np.array([n0])})[0, 0]) / small**2
-          for t in terms}  # fmt: skip
+    values = term_matrix(list(terms), np.array([speed]), np.zeros(1), np.zeros(1),
+                         {"delta": np.array([small]), "n": np.array([n0])})[0] / small**2
+    at = dict(zip(terms, values.tolist(), strict=True))
     drag = sum(c * at[t] for t, c in terms.items())
     if not drag > 0:
         return None
