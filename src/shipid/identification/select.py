@@ -39,6 +39,7 @@ draws the terms of its replicates from these shares.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import warnings
 from collections.abc import Mapping, Sequence
@@ -171,9 +172,10 @@ class Candidate:
         f = np.asarray(self.fold_scores)
         return float(f.std(ddof=1) / math.sqrt(f.size)) if f.size > 1 else 0.0
 
-    @property
+    @functools.cached_property
     def key(self) -> tuple:
-        """Identity of the candidate: its terms per DOF and γ."""
+        """Identity of the candidate: its terms per DOF and γ (a candidate's terms and γ are
+        set once: the key is looked up hundreds of thousands of times in a search)."""
         return (tuple((d, tuple(sorted(t))) for d, t in sorted(self.terms.items())), self.gamma)
 
     def n_terms(self) -> int:
@@ -877,17 +879,24 @@ def selection_shares(cands: Sequence[Candidate], plausible, one_standard_error: 
     sizes = np.array([c.n_terms() for c in pool])
     rng = np.random.default_rng(seed)
     counts = np.zeros(len(pool))
+    checked: dict[int, bool] = {}  # asked only where a resample reaches it: a check is a fit
+
+    def ok(i) -> bool:
+        if i not in checked:
+            checked[i] = plausible(pool[i])
+        return checked[i]
+
     for _ in range(resamples):
         f = F[:, rng.integers(0, K, K)]
         score = f.mean(axis=1)
-        best = next((i for i in np.argsort(score, kind="stable") if plausible(pool[i])), None)
+        best = next((i for i in np.argsort(score, kind="stable") if ok(i)), None)
         if best is None:
             continue
         if one_standard_error and K > 1:
             limit = score[best] + f[best].std(ddof=1) / math.sqrt(K)
             within = np.flatnonzero(score <= limit)
             within = within[np.lexsort((score[within], sizes[within]))]
-            best = next(i for i in within if plausible(pool[i]))
+            best = next(i for i in within if ok(i))
         counts[best] += 1
     total = counts.sum()
     return {c.key: float(n / total) for c, n in zip(pool, counts, strict=True) if n} if total \
