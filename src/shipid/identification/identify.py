@@ -312,7 +312,8 @@ def _check_states_measured(logs, structure: ModelStructure, names) -> None:
                                   for s in parse_term(n).signals}  # fmt: skip
     names = names or [f"log {i + 1}" for i in range(len(logs))]
     for log, name in zip(logs, names, strict=False):
-        span = {c: float(np.ptp(log[c].to_numpy(dtype=float))) for c in ("delta", "v", "r")}
+        span = per_log(log, "span of delta, v, r", lambda log=log: {
+            c: float(np.ptp(log[c].to_numpy(dtype=float))) for c in ("delta", "v", "r")})
         if "v" in used and span["v"] < STILL_V and span["r"] >= STILL_R:
             why, hint = "v", ("the ship turns, so it drifts: derive u, v from the track (x, y "
                               "or lat, lon) with --velocities-from-track")  # fmt: skip
@@ -548,14 +549,17 @@ def averaged_model(
     """The candidates ``members`` ((structure, γ, weight) each) fitted on ``logs`` by
     ``identify(logs, model=structure, gamma=γ, force=True, **options)``, their coefficients
     averaged with the weights (a candidate's coefficient of a term it lacks is 0): bagging the
-    choice of terms, as ``select --average`` does. Terms: ``first``'s, then the others'."""
+    choice of terms, as ``select --average`` does. Terms: ``first``'s, then the others'. Each
+    member is fitted by ``weighted_refit`` (the same model to the bit, without the diagnostics
+    no one reads here: a third of an average's time)."""
     if not members:
         raise ShipidError("an average of candidates needs at least one candidate")
     total = float(sum(w for _, _, w in members))
     if not total > 0:
         raise ShipidError("the candidates' weights must add up to more than 0")
+    weights = options.pop("sample_weight", None)
     with shared_term_columns():
-        fits = [(identify(logs, model=s, gamma=g, force=True, **options).model, w / total)
+        fits = [(weighted_refit(logs, model=s, gamma=g, **options)(weights), w / total)
                 for s, g, w in members]  # fmt: skip
     return average_models(fits, first, name)
 
