@@ -12,7 +12,12 @@ from shipid import identify, lowpass, zigzag
 from shipid.control.autopilot import follow_path, heading_step, pid_from_nomoto
 from shipid.control.export import export_numpy, linearised_control, to_control
 from shipid.control.linear import linearise, nomoto, trim
-from shipid.dynamics.model import ManoeuvringModel, ModelStructure, nomoto_parameters
+from shipid.dynamics.model import (
+    ManoeuvringModel,
+    ModelStructure,
+    nomoto_parameters,
+    sway_yaw_nomoto,
+)
 from shipid.dynamics.simulate import simulate
 from shipid.errors import ShipidError
 from shipid.vessels import PAPER_IMU, scale_ship, scale_ship_model
@@ -40,6 +45,70 @@ def test_linearisation_of_the_paper_model_against_its_coefficients():
     for k in ("K", "T1", "T2", "T3"):  # trimmed at 0.6° of rudder: the same to 1e-3
         assert got[k] == pytest.approx(ref[k], rel=1e-3)
     assert got["K"] == pytest.approx(-0.517, abs=0.002)  # §7.2: steady r/δ = −0.517
+
+
+# A sway–yaw pair with complex poles (tr −1.1, det 1.1) and one with real poles (the paper's
+# ship's at 2 m/s, reference-ships.md §7.2).
+OSCILLATORY = np.array([[-0.5, -1.0], [0.8, -0.6]])
+REAL = np.array([[-1.0568, -0.9062], [-1.3392, -2.3398]])
+
+
+@pytest.mark.parametrize("A", [OSCILLATORY, REAL], ids=["oscillatory", "real"])
+def test_nomotos_k_t3_and_first_order_t_hold_for_complex_poles_too(A):
+    """Against the transfer function G(s) = r/δ = [0 1] (sI − A)⁻¹ b itself: K = G(0), the
+    first-order T = −G′(0)/G(0) (central difference), T3 from G's zero at s = −1/T3, the poles' natural
+    frequency and damping ratio from A's eigenvalues; T1, T2 only where the poles are real."""
+    b = np.array([0.12, -0.35])
+
+    def transfer(s):
+        return np.linalg.solve(s * np.eye(2) - A, b)[1]
+
+    got = sway_yaw_nomoto(A, b)
+    h = 1e-6
+    assert got["K"] == pytest.approx(transfer(0.0), rel=1e-12)
+    slope = (transfer(h) - transfer(-h)) / (2 * h)
+    assert got["T"] == pytest.approx(-slope / transfer(0.0), rel=1e-6)
+    assert abs(transfer(-1.0 / got["T3"])) < 1e-12
+    lam = np.linalg.eigvals(A)
+    assert got["natural_frequency"] == pytest.approx(math.sqrt(abs(lam[0] * lam[1])), rel=1e-12)
+    assert got["stable"]
+    if np.iscomplexobj(lam) and abs(lam[0].imag) > 0:
+        assert got["oscillatory"] and got["T1"] is None and got["T2"] is None
+        assert got["damping_ratio"] == pytest.approx(-lam[0].real / abs(lam[0]), rel=1e-12)
+    else:
+        assert not got["oscillatory"]
+        assert [got["T1"], got["T2"]] == pytest.approx(sorted(-1.0 / lam.real, reverse=True))
+        assert got["T"] == pytest.approx(got["T1"] + got["T2"] - got["T3"], rel=1e-12)
+        assert got["damping_ratio"] > 1.0
+
+
+def test_nomoto_parameters_of_an_oscillatory_model_give_no_real_time_constants():
+    """Its T1, T2 came out as the real parts of complex time constants, with no word."""
+    lsy = ManoeuvringModel("linear-sway-yaw", {"v": {"v": -0.5, "r": -1.0, "delta": 0.12},
+                                               "r": {"v": 0.8, "r": -0.6, "delta": -0.35}})
+    got = nomoto_parameters(lsy)
+    assert got["T1"] is None and got["T2"] is None
+    assert got["K"] == pytest.approx(sway_yaw_nomoto(OSCILLATORY, [0.12, -0.35])["K"])
+
+
+def test_cli_linearise_and_autopilot_of_a_model_whose_sway_and_yaw_oscillate(tmp_path, capsys):
+    """`linearise` refused such a model outright (one Esso Osaka zig-zag file's default fit is
+    one): it now gives A, B, K, T3 and the first-order T, with the poles said."""
+    m = scale_ship_model()
+    coefficients = {d: dict(c) for d, c in m.coefficients.items()}
+    coefficients["r"]["u*v"] = abs(coefficients["r"]["u*v"])  # complex sway–yaw poles
+    model = ManoeuvringModel(m.structure, coefficients)
+    path = tmp_path / "m.json"
+    model.save(path)
+    nm = nomoto(model, 1.93)
+    assert nm["oscillatory"] and nm["stable"]
+    code, out, err = run(["linearise", path, "--speed", "1.93"], capsys)
+    assert code == 0, err
+    assert "A =" in out and "the sway–yaw poles are a complex pair" in out
+    assert f"K = {nm['K']:.5g} 1/s" in out and f"first order T = T1 + T2 − T3 = {nm['T']:.5g} s" in out
+    code, out, err = run(["autopilot", path, "--speed", "1.93", "--heading", "20"], capsys)
+    assert code == 0, err
+    assert "the PID is tuned on its first-order Nomoto approximation" in err
 
 
 def test_the_linearisation_is_about_the_trimmed_straight_run():

@@ -59,6 +59,15 @@ def _for_truth(pid, target, truth, speed, rps):
         f"{side}: the model-tuned controller's rudder is mirrored for the truth")
 
 
+def _oscillatory_note(nm: dict) -> None:
+    """Warn where the PID's first-order Nomoto model stands for an oscillatory sway–yaw pair."""
+    if nm["oscillatory"]:
+        _warn(f"the model's sway–yaw poles are a complex pair (damping ratio "
+              f"{nm['damping_ratio']:.3g}): the PID is tuned on its first-order Nomoto "
+              "approximation K/(1 + T s), which keeps its low-frequency response only; check the "
+              "step on the model")  # fmt: skip
+
+
 def _tuned(ship, speed, rps, omega):
     from shipid.control.autopilot import pid_from_nomoto
     from shipid.control.linear import nomoto
@@ -94,10 +103,24 @@ def cmd_linearise(args) -> int:
         floatfmt=".5g"))
     print("B =")
     print(pd.DataFrame({"δ": nm["B"]}, index=["u", "v", "r"]).to_markdown(floatfmt=".5g"))
-    print(f"Nomoto: K = {nm['K']:.5g} 1/s, T1 = {nm['T1']:.5g} s, T2 = {nm['T2']:.5g} s, "
-          f"T3 = {nm['T3']:.5g} s; first order T = T1 + T2 − T3 = {nm['T']:.5g} s; "
-          f"{'stable' if nm['stable'] else 'UNSTABLE'}")  # fmt: skip
+    print(_nomoto_line(nm))
     return 0
+
+
+def _nomoto_line(nm: dict) -> str:
+    """Nomoto's parameters in one line; an oscillatory sway–yaw pair with its poles, natural
+    frequency and damping ratio in place of the real T1, T2 it does not have."""
+    verdict = "stable" if nm["stable"] else "UNSTABLE"
+    if not nm["oscillatory"]:
+        return (f"Nomoto: K = {nm['K']:.5g} 1/s, T1 = {nm['T1']:.5g} s, T2 = {nm['T2']:.5g} s, "
+                f"T3 = {nm['T3']:.5g} s; first order T = T1 + T2 − T3 = {nm['T']:.5g} s; "
+                f"{verdict}")  # fmt: skip
+    p = nm["poles"][0]
+    return (f"Nomoto: K = {nm['K']:.5g} 1/s; the sway–yaw poles are a complex pair, "
+            f"{p.real:.4g} ± {abs(p.imag):.4g}i 1/s (natural frequency {nm['natural_frequency']:.4g} "
+            f"rad/s, damping ratio {nm['damping_ratio']:.3g}), so T1 and T2 are not real; "
+            f"T3 = {nm['T3']:.5g} s; first order T = T1 + T2 − T3 = {nm['T']:.5g} s (T1 + T2 "
+            f"= −tr/det, real: the same low-frequency response K/(1 + T s)); {verdict}")  # fmt: skip
 
 
 def cmd_export(args) -> int:
@@ -135,6 +158,7 @@ def cmd_autopilot(args) -> int:
     nm, pid = _tuned(target, speed, rps, args.omega)
     print(f"PID tuned on {args.model} (Nomoto K = {nm['K']:.4g} 1/s, T = {nm['T']:.4g} s): "
           f"Kp = {pid.kp:.4g}, Ki = {pid.ki:.4g} 1/s, Kd = {pid.kd:.4g} s")
+    _oscillatory_note(nm)
     runs = {args.model: heading_step(target, pid, args.heading, args.duration, args.dt,
                                      speed, rps, steering=steering)}  # fmt: skip
     if truth is not None:
@@ -203,6 +227,7 @@ def cmd_follow(args) -> int:
     source = ("given" if args.lookahead else f"2 L{of}" if known
               else "the model file gives no length; --lookahead to set it")
     nm, pid = _tuned(target, speed, rps, args.omega)
+    _oscillatory_note(nm)
     runs, rows = {}, []
     cases = [("model", target, pid, speed, rps, steering)]
     if truth is not None:

@@ -20,6 +20,7 @@ import math
 
 import numpy as np
 
+from shipid.dynamics.model import sway_yaw_nomoto
 from shipid.errors import ShipidError
 
 STATES = ("u", "v", "r")
@@ -114,23 +115,12 @@ def linearise(dynamics, speed: float, rps: float | None = None, trimmed: bool = 
 
 
 def nomoto(dynamics, speed: float, rps: float | None = None, trimmed: bool = True) -> dict:
-    """Nomoto's K, T1, T2, T3 of the sway–yaw block, and the first-order T = T1 + T2 − T3.
+    """Nomoto's K, T1, T2, T3 of the sway–yaw block, and the first-order T = T1 + T2 − T3
+    (``shipid.dynamics.model.sway_yaw_nomoto``).
 
     r/δ = (b2 s + a21 b1 − a11 b2) / (s² − tr s + det) for [v̇, ṙ] = [[a11, a12], [a21, a22]]
-    [v, r] + [b1, b2] δ. Complex time constants (an oscillatory sway–yaw pair) are refused."""
+    [v, r] + [b1, b2] δ. An oscillatory sway–yaw pair (complex poles) has no real T1, T2 (None);
+    its K, T3 and first-order T are real, with the pair's natural frequency and damping ratio."""
     lin = linearise(dynamics, speed, rps, trimmed)
-    A2, b = lin["A"][1:, 1:], lin["B"][1:]
-    det, tr = float(np.linalg.det(A2)), float(np.trace(A2))
-    if det == 0:
-        raise ShipidError("the sway–yaw dynamics are singular at this speed: no Nomoto model")
-    roots = np.roots([1.0, -tr, det])
-    if np.any(np.abs(roots.imag) > 1e-12):
-        raise ShipidError("the sway–yaw poles are complex: Nomoto's real time constants do not "
-                          "apply")  # fmt: skip
-    T1, T2 = sorted((-1.0 / roots.real).tolist(), reverse=True)
-    num0 = A2[1, 0] * b[0] - A2[0, 0] * b[1]
-    K = num0 / det
-    T3 = b[1] / num0 if num0 != 0 else math.nan
-    return {"K": float(K), "T1": float(T1), "T2": float(T2), "T3": float(T3),
-            "T": float(T1 + T2 - T3), "stable": bool(np.all(roots.real < 0)),
+    return {**sway_yaw_nomoto(lin["A"][1:, 1:], lin["B"][1:]),
             "A": lin["A"], "B": lin["B"], "trim": lin["trim"], "residual": lin["residual"]}  # fmt: skip

@@ -648,8 +648,41 @@ def coefficients_from_gamma(
     return c
 
 
-def nomoto_parameters(model: ManoeuvringModel) -> dict[str, float]:
-    """Nomoto's second-order parameters K, T1, T2, T3 of a linear sway–yaw model.
+def sway_yaw_nomoto(A: np.ndarray, b: np.ndarray) -> dict:
+    """Nomoto's parameters of the sway–yaw pair [v̇, ṙ] = A [v, r] + b δ.
+
+    r/δ = K (1 + T3 s) / ((1 + T1 s)(1 + T2 s)) = (b2 s + a21 b1 − a11 b2) / (s² − tr s + det),
+    and the first-order T = T1 + T2 − T3 of the low-frequency response K / (1 + T s) (T =
+    −G′(0)/G(0)). Where the poles are a complex pair (an oscillatory sway–yaw mode, as the fit of
+    one Esso Osaka zig-zag file has) T1 and T2 are not real and are None; their sum −tr/det is,
+    and with it K, T3 and T. ``natural_frequency`` √det [rad/s] and ``damping_ratio``
+    −tr/(2√det) (≥ 1 for real stable poles) where det > 0, else None; ``poles`` [1/s]."""
+    A, b = np.asarray(A, dtype=float), np.asarray(b, dtype=float)
+    det, tr = float(np.linalg.det(A)), float(np.trace(A))
+    if det == 0:
+        raise ShipidError("the sway–yaw dynamics are singular at this speed: no Nomoto model")
+    roots = np.roots([1.0, -tr, det])
+    num0 = float(A[1, 0] * b[0] - A[0, 0] * b[1])
+    K = num0 / det
+    T3 = float(b[1]) / num0 if num0 != 0 else math.nan
+    oscillatory = bool(np.any(np.abs(roots.imag) > 1e-12))
+    if oscillatory:
+        T1 = T2 = None
+        T = -tr / det - T3
+    else:
+        T1, T2 = sorted((-1.0 / roots.real).tolist(), reverse=True)
+        T = T1 + T2 - T3
+    omega = math.sqrt(det) if det > 0 else None
+    return {"K": float(K), "T1": T1, "T2": T2, "T3": float(T3), "T": float(T),
+            "oscillatory": oscillatory, "poles": [complex(p) for p in roots],
+            "natural_frequency": omega,
+            "damping_ratio": -tr / (2.0 * omega) if omega else None,
+            "stable": bool(np.all(roots.real < 0))}  # fmt: skip
+
+
+def nomoto_parameters(model: ManoeuvringModel) -> dict:
+    """Nomoto's second-order parameters K, T1, T2, T3 of a linear sway–yaw model
+    (``sway_yaw_nomoto``: T1 and T2 None where its poles are a complex pair).
 
     r/δ = K (1 + T3 s) / ((1 + T1 s)(1 + T2 s)) for v̇ = a11 v + a12 r + b1 δ, ṙ = a21 v + a22 r + b2 δ.
     """
@@ -657,15 +690,8 @@ def nomoto_parameters(model: ManoeuvringModel) -> dict[str, float]:
         raise ValueError("Nomoto parameters need a model with sway and yaw equations only")
     cv, cr = model.coefficients["v"], model.coefficients["r"]
     A = np.array([[cv.get("v", 0.0), cv.get("r", 0.0)], [cr.get("v", 0.0), cr.get("r", 0.0)]])
-    b1, b2 = cv.get("delta", 0.0), cr.get("delta", 0.0)
-    det, tr = np.linalg.det(A), np.trace(A)
-    # Characteristic polynomial s² − tr s + det = det (1 + T1 s)(1 + T2 s).
-    roots = np.roots([1.0, -tr, det])
-    T1, T2 = sorted((-1.0 / roots).real, reverse=True)
-    K = (A[1, 0] * b1 - A[0, 0] * b2) / det
-    # Numerator of r/δ: b2 s + (a21 b1 − a11 b2) = K det (1 + T3 s)/… → T3 = b2 / (a21 b1 − a11 b2).
-    T3 = b2 / (A[1, 0] * b1 - A[0, 0] * b2)
-    return {"K": float(K), "T1": float(T1), "T2": float(T2), "T3": float(T3)}
+    found = sway_yaw_nomoto(A, np.array([cv.get("delta", 0.0), cr.get("delta", 0.0)]))
+    return {k: found[k] for k in ("K", "T1", "T2", "T3")}
 
 
 INPUT_COLUMNS = INPUT_SIGNALS
