@@ -9,6 +9,7 @@ from functools import partial
 from pathlib import Path
 
 from shipid.cli.common import (
+    VESSEL_NAMES,
     _check_length,
     _check_scale,
     _from_rest_note,
@@ -61,17 +62,29 @@ def cmd_validate(args) -> int:
         switch_heading_note,
     )
 
+    reference = args.model in VESSEL_NAMES
     check_outputs({"--json": (args.json, "json"), "--plots": (args.plots, "dir"),
                    "--report": (args.report, "dir")},
-                  [args.model, *args.logs, *_read_files(args)])  # fmt: skip
-    doc = load_document(args.model)
-    if args.lssvm and not has_refinement(doc):
-        _warn(f"{args.model} has no refinement: its model is the LS-SVM one, which --lssvm "
-              "validates")  # fmt: skip
-    model = model_from_document(doc, args.model, "lssvm" if args.lssvm else "model", hybrid=True)
-    ensemble = None if args.no_bands else ensemble_from_document(doc, args.model, model)
-    band = None if args.no_bands or args.lssvm else error_band_from_document(doc, args.model)
-    cond = training_conditions(doc)
+                  [*([] if reference else [args.model]), *args.logs, *_read_files(args)])  # fmt: skip
+    if reference:
+        # A reference ship against the logs (the published KVLCC2 MMG model against MARIN's
+        # runs): no fit, so no training logs, intervals, error band or tied structures.
+        if args.lssvm:
+            raise ShipidError(f"--lssvm: {args.model} is a reference ship, not an identified "
+                              "model with an LS-SVM fit")  # fmt: skip
+        doc, ensemble, band = None, None, None
+        model, cond = _ship_or_model(args.model)
+        cond["rudder_positive"] = model.rudder_positive  # the logs are turned to its convention
+    else:
+        doc = load_document(args.model)
+        if args.lssvm and not has_refinement(doc):
+            _warn(f"{args.model} has no refinement: its model is the LS-SVM one, which --lssvm "
+                  "validates")  # fmt: skip
+        model = model_from_document(doc, args.model, "lssvm" if args.lssvm else "model",
+                                    hybrid=True)  # fmt: skip
+        ensemble = None if args.no_bands else ensemble_from_document(doc, args.model, model)
+        band = None if args.no_bands or args.lssvm else error_band_from_document(doc, args.model)
+        cond = training_conditions(doc)
     given = _particulars(args)  # checked before the runs: the criteria of the logs need it
     if given is not None:
         _check_length(args.model, model, cond, given.length, f"--particulars {args.particulars}")
@@ -101,7 +114,8 @@ def cmd_validate(args) -> int:
         for note in notes:
             _warn(note)
     for note in (_scale_notes(cond, logs, names) + _sampling_notes(cond, logs, names)
-                 + _yaw_rate_notes(cond, logs, names)):
+                 + _yaw_rate_notes(cond, logs, names)
+                 + (_reference_speed_notes(model, logs, names) if reference else [])):
         _warn(note)
     from tqdm.auto import tqdm
 
@@ -113,7 +127,8 @@ def cmd_validate(args) -> int:
         if v.error is None:
             v.warnings.extend(outside_envelope(env, log) + _reversed_propeller_notes(model, cond,
                                                                                     log))
-    _mark_training_logs(doc, vals)
+    if doc is not None:
+        _mark_training_logs(doc, vals)
     good = [v for v in vals if v.error is None]
     if good:
         if band is not None:
@@ -134,7 +149,7 @@ def cmd_validate(args) -> int:
                 print(spread)
     if args.horizon and good:
         _print_horizons(model, vals, logs, args, env)
-    tied, tied_table, tied_runs = ({}, None, {}) if args.lssvm or not good else \
+    tied, tied_table, tied_runs = ({}, None, {}) if args.lssvm or not good or doc is None else \
         _tied_validations(doc, args, vals, logs)  # fmt: skip
     residuals = {}
     if args.resid or args.report:
@@ -207,7 +222,8 @@ def cmd_validate(args) -> int:
         if args.report:
             from shipid.reporting.html import validation_report
 
-            se, se_label = _coefficient_errors(doc, model, args.lssvm)
+            se, se_label = (None, "") if doc is None else \
+                _coefficient_errors(doc, model, args.lssvm)  # fmt: skip
             text = validation_report(model, vals, logs, f"Validation of {Path(args.model).name}",
                                      std_errors=se, std_errors_label=se_label, criteria=crit,
                                      warnings=[w for v in good for w in v.warnings],
@@ -216,6 +232,30 @@ def cmd_validate(args) -> int:
             out.write(Path(args.report) / "report.html",
                       lambda p: p.write_text(text, encoding="utf-8"))
     return 1 if errors else 0
+
+
+# A log whose approach is this many times a reference ship's own (or less than its inverse)
+# is of another ship or scale (MARIN's KVLCC2 files read without --scale run at 8.1 m/s, the
+# reference 7 m model at 1.18).
+REFERENCE_SPEED_FACTOR = 2.0
+
+
+def _reference_speed_notes(vessel, logs, names) -> list[str]:
+    """A warning per log whose approach speed is far from the reference ship's own: the logs
+    carry no length to check, their speed says the scale."""
+    own = getattr(vessel, "approach_speed", None)
+    out = []
+    for log, name in zip(logs, names, strict=True):
+        u0 = float(log["u"].iloc[0]) if len(log) else math.nan
+        if own and u0 > 0 and not 1 / REFERENCE_SPEED_FACTOR <= u0 / own <= REFERENCE_SPEED_FACTOR:
+            # Only MARIN's reader Froude-scales its full-scale data (``_scale_notes``).
+            marin = str(log.attrs.get("source", "")).startswith("MARIN")
+            out.append(f"{name}: it starts at {u0:.3g} m/s, {u0 / own:.2g} times {vessel.name}'s "
+                       f"approach ({own:.3g} m/s, its {vessel.length:g} m): a log of another "
+                       "ship or scale" + (" (MARIN's files at the 7 m model: --scale 45.7)"
+                                          if marin else "")
+                       + " is run at a speed the reference ship was never made for")  # fmt: skip
+    return out
 
 
 def _mark_training_logs(doc, vals) -> None:

@@ -13,6 +13,7 @@ from shipid.cli.common import (
     KINDS,
     LINEAR_ESTIMATORS,
     MANOEUVRE_STEP,
+    VESSEL_NAMES,
 )
 from shipid.cli.control import cmd_autopilot, cmd_export, cmd_follow, cmd_linearise
 from shipid.cli.data import cmd_import, cmd_indices, cmd_plot
@@ -393,8 +394,10 @@ def build_parser() -> argparse.ArgumentParser:
     _add_log_options(p)
     p.set_defaults(func=cmd_compare)
 
-    p = sub.add_parser("validate", help="free-run a model against logs: error table and indices")
-    p.add_argument("model", metavar="MODEL.json")
+    p = sub.add_parser("validate", help="free-run a model (or a reference ship) against logs: "
+                       "error table and indices")  # fmt: skip
+    p.add_argument("model", metavar="MODEL.json|VESSEL",
+                   help=f"a model file, or a reference ship ({', '.join(VESSEL_NAMES)})")
     p.add_argument("logs", nargs="+", metavar="LOG")
     p.add_argument("--json", metavar="OUT.json", help="write the results as JSON")
     p.add_argument("--plots", metavar="DIR", help="write measured-vs-simulated figures")

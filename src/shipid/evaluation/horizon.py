@@ -26,6 +26,7 @@ import pandas as pd
 from shipid.dynamics.simulate import model_inputs, simulate_batch
 from shipid.errors import ShipidError
 from shipid.evaluation.envelope import allowed_ranges
+from shipid.vessels.vessel import Vessel
 
 STATES = ("u", "v", "r")
 # The caption of the columns the envelope adds (``validate --horizon``, its report).
@@ -82,6 +83,8 @@ def horizon_errors(model, log: pd.DataFrame, horizon_s: float, method: str = "eu
     model's training envelope, {signal: [min, max]}), the windows within it and the rest are
     also reported apart."""
     name = name or log.attrs.get("name", "log")
+    if isinstance(model, Vessel):  # a reference ship runs its dynamics
+        model = model.dynamics
     if not (isinstance(horizon_s, int | float) and math.isfinite(horizon_s) and horizon_s > 0):
         raise ShipidError(f"--horizon must be seconds > 0, got {horizon_s!r}")
     t = log["t"].to_numpy(dtype=float)

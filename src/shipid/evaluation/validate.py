@@ -34,6 +34,7 @@ import numpy as np
 import pandas as pd
 
 from shipid.data.log import (
+    in_rudder_convention,
     mean_true_wind,
     require_states,
     rudder_positive,
@@ -113,8 +114,9 @@ class Validation:
 
 def free_run(model, log: pd.DataFrame, method: str = "euler") -> tuple[SimulationResult, dict]:
     """The free run of ``model`` on ``log`` and its error metrics per state (over the part
-    simulated before any divergence)."""
-    sim = simulate_log(model, log, method=method)
+    simulated before any divergence); a reference ship (``Vessel``) runs its dynamics."""
+    sim = simulate_log(model.dynamics if isinstance(model, Vessel) else model, log,
+                       method=method)  # fmt: skip
     n = len(sim.log)
     return sim, {s: error_metrics(log[s].to_numpy()[:n], sim.log[s].to_numpy()) for s in STATES}
 
@@ -143,6 +145,9 @@ def validate_log(model, log: pd.DataFrame, name: str, method: str = "euler",
     ``ensemble`` of the model: prediction bands and intervals on the predicted indices; with a
     cross-validated ``error_band``: the share of the log's samples within it."""
     require_states(log, [name], "log to validate against")
+    convention = None
+    if isinstance(model, Vessel):  # it says its rudder's convention: the log is turned to it
+        log, convention = in_rudder_convention(log, model.rudder_positive)
     sim, metrics = free_run(model, log, method)
     trial = describe_trial(log, kind)
     # The indices come from the manoeuvre's approach; the errors from the whole log's free run.
@@ -165,7 +170,8 @@ def validate_log(model, log: pd.DataFrame, name: str, method: str = "euler",
                          "its prediction")  # fmt: skip
         elif isinstance(model, ManoeuvringModel | HybridModel | Vessel):
             indices["closed_loop"] = _replica_indices(model, log, method, trial)
-    out = Validation(name, sim, metrics, indices, trial.kind, warnings=notes)
+    out = Validation(name, sim, metrics, indices, trial.kind,
+                     warnings=[convention] * bool(convention) + notes)  # fmt: skip
     if indices.get("closed_loop") and start_draws:
         out.start_spread = start_spread(model, log, method, trial, indices["closed_loop"])
     out.warnings += _approach_notes(indices)

@@ -40,6 +40,15 @@ table.t th{background:#f3f3f3} pre{background:#f6f6f6;padding:1em;overflow-x:aut
 h2{border-bottom:2px solid #ccc;padding-bottom:3px}.warn{color:#a40}"""
 
 
+def _model_text(model, std_errors) -> str:
+    """The model's equations; a reference ship (``shipid validate VESSEL``), what it is."""
+    if hasattr(model, "equations"):
+        return model.equations(std_errors=std_errors)
+    return (f"reference ship {model.name}: {model.source or 'shipid.vessels'}; Lpp "
+            f"{model.length:g} m, approach {model.approach_speed:.4g} m/s, positive rudder to "
+            f"{model.rudder_positive}")
+
+
 def validation_report(
     model,
     validations: Sequence,
@@ -76,7 +85,7 @@ def validation_report(
              f"<p>shipid {__version__}. Errors are measured − simulated over the free run from "
              "each log's measured initial state, driven by its measured inputs. Fit % as "
              "MATLAB's compare (100 % perfect, 0 % no better than the mean).</p>",
-             "<h2>Model</h2>", f"<pre>{html.escape(model.equations(std_errors=std_errors))}</pre>"]
+             "<h2>Model</h2>", f"<pre>{html.escape(_model_text(model, std_errors))}</pre>"]
     if std_errors:
         parts.append(f"<p>± one standard error of each coefficient "
                      f"({html.escape(std_errors_label)}).</p>")
