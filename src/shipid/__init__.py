@@ -45,6 +45,7 @@ _EXPORTS = {
     "stopping": "shipid.trials.manoeuvres",
     "spiral": "shipid.trials.manoeuvres",
     "refine": "shipid.identification.refine",
+    "identify_correction": "shipid.identification.correction",
     "output_error": "shipid.identification.output_error",
     "coefficient_intervals": "shipid.identification.output_error",
     "PhysicsOptions": "shipid.identification.physics",
