@@ -5,6 +5,7 @@ known coefficients, and on the real KVLCC2 runs against the published MMG model 
 import dataclasses
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from shipid.dynamics.model import ManoeuvringModel
@@ -63,6 +64,24 @@ def test_a_perfect_reference_needs_no_correction_and_its_convention_is_kept():
     mirrored.attrs = {**log.attrs, "rudder_positive": other}
     again = identify_correction(mirrored, reference, "blanke-race")
     assert again.correction.coefficients == fit.correction.coefficients
+
+
+def test_an_equation_without_a_constant_is_fitted_without_a_bias():
+    """Against least squares without an intercept on the same increments (γ large), the terms
+    short of the truth's difference (its rudder moment) so that a bias would take a share."""
+    from shipid.dynamics.model import ModelStructure
+    from shipid.dynamics.terms import term_matrix
+
+    reference, truth = _truth()
+    log = zigzag(truth, 20, 20, duration=60, dt=0.1, method="euler").log
+    terms = ("u*v", "u*r")
+    fit = identify_correction(log, reference, ModelStructure("lateral", {"r": terms}), gamma=1e8)
+    nu, delta = log[["u", "v", "r"]].to_numpy(), log["delta"].to_numpy()
+    y = np.diff(nu[:, 2]) / 0.1 - reference.dynamics.derivatives(nu[:-1], delta[:-1])[:, 2]
+    X = term_matrix(list(terms), nu[:-1, 0], nu[:-1, 1], nu[:-1, 2], {"delta": delta[:-1]})
+    expected = np.linalg.lstsq(X, y, rcond=None)[0]
+    assert "1" not in fit.correction.coefficients["r"]
+    assert [fit.correction.coefficients["r"][t] for t in terms] == pytest.approx(expected, rel=1e-6)
 
 
 @pytest.mark.parametrize(("kwargs", "said"), [

@@ -33,6 +33,7 @@ from shipid.dynamics.model import ManoeuvringModel, ModelStructure, get_structur
 from shipid.dynamics.terms import parse_term
 from shipid.errors import ShipidError
 from shipid.identification.estimators import fit_linear
+from shipid.identification.physics import dof_physics
 from shipid.identification.regression import common_sampling_time, log_terms
 from shipid.vessels.vessel import Vessel
 
@@ -133,7 +134,9 @@ def identify_correction(
             raw.append(increment)
             Xs.append(log_terms(log, free, name)[:-1])
         X, y = np.vstack(Xs), np.concatenate(ys)
-        theta, bias = fit_linear(X, y, "lssvm", gamma)
+        # Without "1" in the equation the fit has no bias either (b = 0), as identify's.
+        physics = dof_physics(None, dof, free, "1" in structure.terms[dof], {}, logs)
+        theta, bias = fit_linear(X, y, "lssvm", gamma, physics=physics)
         coefficients[dof] = dict(zip(free, theta.tolist(), strict=True))
         terms[dof] = tuple(free)
         if "1" in structure.terms[dof]:
