@@ -118,3 +118,46 @@ def test_the_mmg_model_corrected_on_one_marin_run_predicts_the_other_closer():
     measured, closed = corrected.indices["measured"], corrected.indices["closed_loop"]
     for k in ("first_overshoot_deg", "second_overshoot_deg"):
         assert abs(closed[k] - measured[k]) < 1.0, k
+
+
+def test_cli_correct_writes_a_ship_the_commands_run(tmp_path, capsys):
+    """``shipid correct`` on the truth's logs, then the file through validate, manoeuvre and
+    linearise as a reference ship; the commands that need an identified model refuse it by
+    name, and so does a correction with terms the reference ship cannot take."""
+    import json
+
+    from cli_helpers import run
+
+    from shipid.data.io import write_log
+
+    reference, truth = _truth()
+    paths = [write_log(zigzag(truth, 20, 20, first=side, duration=60, dt=0.1,
+                              method="euler").log, tmp_path / f"zz_{side}.csv")
+             for side in ("starboard", "port")]  # fmt: skip
+    unseen = write_log(zigzag(truth, 10, 10, duration=60, dt=0.1, method="euler").log,
+                       tmp_path / "zz10.csv")  # fmt: skip
+    spec = "; ".join(f"{d}: " + ", ".join(t) for d, t in scale_ship_model().structure.terms.items())
+    ship = tmp_path / "ship.json"
+    code, out, err = run(["correct", "scale-ship", *paths, "--model", spec, "--gamma", "1e8",
+                          "-o", ship], capsys)  # fmt: skip
+    assert code == 0, err
+    assert "the reference's share of the increments' variance" in out
+    assert json.loads(ship.read_text())["reference"] == "scale-ship"
+    code, out, err = run(["validate", ship, unseen, "--method", "euler", "--json",
+                          tmp_path / "v.json"], capsys)  # fmt: skip
+    assert code == 0, err
+    (record,) = json.loads((tmp_path / "v.json").read_text())["logs"]
+    assert max(record["metrics"][s]["rmse"] for s in "uvr") < 1e-6
+    for argv in (["manoeuvre", ship, "zigzag", "--rudder", "10"], ["linearise", ship]):
+        code, _, err = run(argv, capsys)
+        assert code == 0, (argv, err)
+    code, _, err = run(["export", ship, "-o", tmp_path / "m.py"], capsys)
+    assert code == 1 and err.count("\n") == 1 and "shipid correct" in err
+    code, _, err = run(["correct", "scale-ship", *paths, "--model", "blanke-rps", "-o",
+                        tmp_path / "bad.json"], capsys)  # fmt: skip
+    assert code == 1 and err.count("\n") == 1 and "|n|*n" in err
+    assert not (tmp_path / "bad.json").exists()
+    broken = json.loads(ship.read_text()) | {"reference": "titanic"}
+    (tmp_path / "broken.json").write_text(json.dumps(broken))
+    code, _, err = run(["validate", tmp_path / "broken.json", unseen], capsys)
+    assert code == 1 and err.count("\n") == 1 and "broken.json: reference 'titanic'" in err

@@ -681,13 +681,18 @@ def _ship_or_model(name: str, hybrid: bool = False):
     from shipid.reporting.modelfile import load_document, model_from_document, training_conditions
     from shipid.vessels import get_vessel
 
+    vessel_conditions = {"speed": None, "rps": None, "envelope": {}, "particulars": None,
+                         "rudder_rate": None, "rudder_positive": None, "alternatives": {},
+                         "alternatives_fit": ""}  # fmt: skip
     if name in VESSEL_NAMES:
-        return get_vessel(name), {"speed": None, "rps": None, "envelope": {}, "particulars": None,
-                                  "rudder_rate": None, "rudder_positive": None,
-                                  "alternatives": {}, "alternatives_fit": ""}  # fmt: skip
+        return get_vessel(name), vessel_conditions
     if not Path(name).exists():
         raise ShipidError(f"{name}: neither a model file nor a known vessel "
                           f"({', '.join(VESSEL_NAMES)})")  # fmt: skip
+    from shipid.identification.correction import is_corrected_file, load_corrected
+
+    if is_corrected_file(name):  # a reference ship kept whole and corrected (shipid correct)
+        return load_corrected(name), vessel_conditions
     from shipid.reporting.modelfile import (
         alternatives_fit,
         alternatives_from_document,

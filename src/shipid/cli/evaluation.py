@@ -46,6 +46,7 @@ def cmd_validate(args) -> int:
     """``shipid validate``: free runs on logs, metrics, indices, figures, report."""
     from shipid.evaluation.envelope import outside_envelope
     from shipid.evaluation.validate import validate
+    from shipid.identification.correction import is_corrected_file
     from shipid.outputs import OutputSet, check_outputs
     from shipid.reporting.modelfile import (
         ensemble_from_document,
@@ -62,16 +63,17 @@ def cmd_validate(args) -> int:
         switch_heading_note,
     )
 
-    reference = args.model in VESSEL_NAMES
+    reference = args.model in VESSEL_NAMES or is_corrected_file(args.model)
     check_outputs({"--json": (args.json, "json"), "--plots": (args.plots, "dir"),
                    "--report": (args.report, "dir")},
-                  [*([] if reference else [args.model]), *args.logs, *_read_files(args)])  # fmt: skip
+                  [*([] if args.model in VESSEL_NAMES else [args.model]), *args.logs,
+                   *_read_files(args)])  # fmt: skip
     if reference:
         # A reference ship against the logs (the published KVLCC2 MMG model against MARIN's
         # runs): no fit, so no training logs, intervals, error band or tied structures.
         if args.lssvm:
             raise ShipidError(f"--lssvm: {args.model} is a reference ship, not an identified "
-                              "model with an LS-SVM fit")  # fmt: skip
+                              "model with an LS-SVM fit of its own")  # fmt: skip
         doc, ensemble, band = None, None, None
         model, cond = _ship_or_model(args.model)
         cond["rudder_positive"] = model.rudder_positive  # the logs are turned to its convention

@@ -16,6 +16,7 @@ from shipid.cli.common import (
     VESSEL_NAMES,
 )
 from shipid.cli.control import cmd_autopilot, cmd_export, cmd_follow, cmd_linearise
+from shipid.cli.correction import cmd_correct
 from shipid.cli.data import cmd_import, cmd_indices, cmd_plot
 from shipid.cli.evaluation import cmd_simulate, cmd_validate
 from shipid.cli.experiments import cmd_demo, cmd_study
@@ -545,6 +546,22 @@ def build_parser() -> argparse.ArgumentParser:
             p.add_argument("-o", "--output", metavar="FIG.png", help="figure of the tracks")
             p.add_argument("--json", metavar="OUT.json")
             p.set_defaults(func=cmd_follow)
+
+    p = sub.add_parser("correct", help="a reference ship's model kept whole, an LS-SVM "
+                       "correction fitted to logs of the same ship (the corrected ship a file "
+                       "the commands run as a reference ship)")  # fmt: skip
+    p.add_argument("reference", choices=VESSEL_NAMES, metavar="VESSEL",
+                   help=f"the reference ship ({', '.join(VESSEL_NAMES)})")
+    p.add_argument("logs", nargs="+", metavar="LOG")
+    p.add_argument("--model", default="blanke-race", metavar="STRUCTURE",
+                   help="the correction's terms, in u, v, r and δ (default %(default)s)")
+    p.add_argument("--gamma", type=float, default=1e4,
+                   help="LS-SVM γ: smaller keeps the correction smaller (default %(default)g)")
+    p.add_argument("--filter", type=float, metavar="HZ",
+                   help="zero-phase low-pass of u, v, r before the fit [Hz] (default: none)")
+    p.add_argument("-o", "--output", required=True, metavar="SHIP.json")
+    _add_log_options(p)
+    p.set_defaults(func=cmd_correct)
 
     p = sub.add_parser("rescale", help="a model carried to a geometrically similar ship of "
                        "another length (Froude scaling, equal prime coefficients)")

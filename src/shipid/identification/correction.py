@@ -151,3 +151,73 @@ def identify_correction(
         dynamics=CorrectedDynamics(reference.dynamics, correction),
         source=f"{reference.source}, corrected by an LS-SVM fit to {len(logs)} log(s)")  # fmt: skip
     return Correction(vessel, correction, explained, float(gamma))
+
+
+# The file of a corrected reference ship (``shipid correct``): another format than a model
+# file's, so that the commands that need an identified model refuse it by name.
+CORRECTED_FORMAT = "shipid-corrected-ship"
+CORRECTED_VERSION = 1
+
+
+def correction_document(fit: Correction, reference: str, training_files: Sequence[str] = (),
+                        filter_hz: float | None = None) -> dict:  # fmt: skip
+    """The JSON document of a corrected reference ship: the reference's name, the correction
+    (a model's dict), how it was fitted and from which files (SHA-256)."""
+    from shipid import __version__
+    from shipid.reporting.modelfile import sha256
+
+    return {"format": CORRECTED_FORMAT, "version": CORRECTED_VERSION, "shipid": __version__,
+            "reference": reference, "correction": fit.correction.to_dict(),
+            "gamma": fit.gamma, "filter_hz": filter_hz, "explained": fit.explained,
+            "training_files": [{"path": str(p), "sha256": sha256(p)} for p in training_files]}
+
+
+def is_corrected_file(path) -> bool:
+    """Whether ``path`` is a readable file whose JSON says it is a corrected reference ship."""
+    import json
+    from pathlib import Path
+
+    p = Path(path)
+    if not p.is_file():
+        return False
+    try:
+        doc = json.loads(p.read_text(encoding="utf-8"))
+    except (UnicodeDecodeError, ValueError, RecursionError):
+        return False
+    return isinstance(doc, dict) and doc.get("format") == CORRECTED_FORMAT
+
+
+def load_corrected(path) -> Vessel:
+    """The corrected reference ship of a ``shipid correct`` file (one-line errors naming it)."""
+    import json
+    from pathlib import Path
+
+    from shipid.vessels import VESSELS
+
+    p = Path(path)
+    try:
+        doc = json.loads(p.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, ValueError, RecursionError) as exc:
+        raise ShipidError(f"{path}: not a corrected ship file ({str(exc)[:120]})") from None
+    if not isinstance(doc, dict) or doc.get("format") != CORRECTED_FORMAT:
+        raise ShipidError(f"{path}: not a corrected ship file (no \"format\": "
+                          f"\"{CORRECTED_FORMAT}\")")  # fmt: skip
+    if doc.get("version") != CORRECTED_VERSION:
+        raise ShipidError(f"{path}: corrected ship file version {doc.get('version')!r} is not "
+                          f"supported (this shipid reads {CORRECTED_VERSION})")  # fmt: skip
+    name = doc.get("reference")
+    if name not in VESSELS:
+        raise ShipidError(f"{path}: reference {name!r} is not a reference ship of this shipid "
+                          f"({', '.join(VESSELS)})")  # fmt: skip
+    try:
+        correction = ManoeuvringModel.from_dict(doc.get("correction"))
+    except ShipidError as exc:
+        raise ShipidError(f"{path}: correction: {exc}") from None
+    except (KeyError, TypeError, ValueError, AttributeError) as exc:
+        raise ShipidError(f"{path}: malformed correction ({exc})") from None
+    _structure(correction.structure)  # states and rudder only, as fitted
+    reference = VESSELS[name]()
+    return dataclasses.replace(
+        reference, name=f"{name} + correction",
+        dynamics=CorrectedDynamics(reference.dynamics, correction),
+        source=f"{reference.source}, corrected by {p.name}")  # fmt: skip

@@ -292,6 +292,10 @@ def load_document(path: str | Path) -> dict:
         raise ShipidError(f"{path}: not a JSON model file (not UTF-8 text)") from None
     except (json.JSONDecodeError, ValueError, RecursionError) as exc:
         raise ShipidError(f"{path}: not a JSON model file ({str(exc)[:120]})") from None
+    if isinstance(doc, dict) and doc.get("format") == "shipid-corrected-ship":
+        raise ShipidError(f"{path}: a reference ship corrected by its logs (shipid correct), not "
+                          "an identified model: validate, simulate, manoeuvre, criteria, "
+                          "linearise, autopilot and follow run it")  # fmt: skip
     if not isinstance(doc, dict) or doc.get("format") != FORMAT:
         raise ShipidError(f"{path}: not a shipid model file (no \"format\": \"{FORMAT}\")")
     if doc.get("version") not in READABLE_VERSIONS:
