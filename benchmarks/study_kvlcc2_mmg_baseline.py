@@ -3,10 +3,10 @@ the baseline an identified model has to beat), and the MMG model corrected by th
 model (reference-ships.md §2, Yasukawa & Yoshimura 2015: a fit to captive tests, ``shipid
 validate kvlcc2``), the default ``shipid identify`` on one and on two of the KVLCC2's three real
 zig-zags (MARIN's ±20° at 1:45.7, HSVA's 20/10), and the MMG model with an LS-SVM correction
-fitted to the same runs (``shipid.identify_correction``, `blanke-race` terms, the 1.25 Hz
-prefilter ``identify`` chooses for these runs, γ 1e4 and 100), each judged on the runs it was
-not fitted to: the free run's yaw-rate error std (rad/s) and the zig-zag's overshoots run
-closed loop, against the measured.
+fitted to the same runs (``shipid correct``, `blanke-race` terms, the 1.25 Hz prefilter
+``identify`` chooses for these runs; γ 1e4, 100, and chosen by the free runs of held-out blocks
+or logs of the training runs), each judged on the runs it was not fitted to: the free run's
+yaw-rate error std (rad/s) and the zig-zag's overshoots run closed loop, against the measured.
 
 Run: .venv/bin/python benchmarks/study_kvlcc2_mmg_baseline.py
 """
@@ -34,7 +34,7 @@ from shipid.vessels import get_vessel
 
 OVERSHOOTS = ("first_overshoot_deg", "second_overshoot_deg")
 # The correction's structure, prefilter (what ``identify`` chooses for these runs) and γs.
-CORRECTION, CORRECTION_HZ, CORRECTION_GAMMAS = "blanke-race", 1.25, (1e4, 1e2)
+CORRECTION, CORRECTION_HZ, CORRECTION_GAMMAS = "blanke-race", 1.25, (1e4, 1e2, "auto")
 
 
 def _judged(model, log, name: str, side: str | None) -> tuple[float, list[float], list[float]]:
@@ -58,6 +58,10 @@ def _identified(paths: list[str], out: str):
     return model_from_document(doc, out), training_conditions(doc)["rudder_positive"]
 
 
+def _label(gamma) -> str:
+    return f"MMG model + correction, γ {gamma if isinstance(gamma, str) else f'{gamma:g}'}"
+
+
 def _cell(r: float, closed: list[float], measured: list[float]) -> str:
     miss = ", ".join(f"{c - m:+.1f}°" for c, m in zip(closed, measured, strict=True))
     return f"{r:.5f}; {closed[0]:.1f}°, {closed[1]:.1f}° ({miss})"
@@ -74,13 +78,13 @@ def main() -> None:
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores\n")
     print("| held out | measured overshoots | MMG model: r error std [rad/s]; closed-loop "
           "overshoots (miss) | trained on | identified: r error std; closed-loop overshoots "
-          "(miss) | " + " | ".join(f"MMG model + correction, γ {g:g}" for g in CORRECTION_GAMMAS)
+          "(miss) | " + " | ".join(_label(g) for g in CORRECTION_GAMMAS)
           + " |")  # fmt: skip
     print("|---|---|---|---|---|" + "---|" * len(CORRECTION_GAMMAS))
     scores: dict[str, list[tuple[float, list[float]]]] = {"MMG model": [], "one run": [],
                                                            "two runs": []}  # fmt: skip
     for gamma in CORRECTION_GAMMAS:
-        scores[f"MMG model + correction, γ {gamma:g}"] = []
+        scores[_label(gamma)] = []
     with tempfile.TemporaryDirectory() as folder:
         files = {name: str(write_log(log, f"{folder}/{i}.csv"))
                  for i, (name, log) in enumerate(logs.items())}  # fmt: skip
@@ -109,7 +113,7 @@ def main() -> None:
                     fit = identify_correction([logs[n] for n in train], mmg, CORRECTION, gamma,
                                               filter_hz=CORRECTION_HZ)  # fmt: skip
                     cr, cc, _ = _judged(fit.vessel, log, held, None)
-                    scores[f"MMG model + correction, γ {gamma:g}"].append(
+                    scores[_label(gamma)].append(
                         (cr, np.subtract(cc, measured)))  # fmt: skip
                     cells.append(_cell(cr, cc, measured))
                 print(f"{lead}| {label} | " + " | ".join(cells) + " |")

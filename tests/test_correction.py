@@ -51,6 +51,19 @@ def test_the_correction_is_what_the_truth_differs_by():
     assert all(0.0 < fit.explained[d] < 1.0 for d in "uvr")
 
 
+def test_gamma_auto_chooses_by_the_free_runs_of_held_out_logs():
+    """Noise-free logs of the truth pin the correction down: the free runs of held-out blocks
+    favour the least regularised fit; every γ is scored, the lowest chosen."""
+    from shipid.identification.correction import GAMMAS
+
+    reference, truth = _truth()
+    log = zigzag(truth, 20, 20, duration=90, dt=0.1, method="euler").log
+    fit = identify_correction(log, reference, scale_ship_model().structure, gamma="auto")
+    assert set(fit.gamma_scores) == set(GAMMAS)
+    assert fit.gamma == min(fit.gamma_scores, key=fit.gamma_scores.get) >= 1e4
+    assert fit.gamma_scores[fit.gamma] < fit.gamma_scores[1.0]
+
+
 def test_a_perfect_reference_needs_no_correction_and_its_convention_is_kept():
     reference = scale_ship()
     log = zigzag(reference, 20, 20, duration=60, dt=0.1, method="euler").log
@@ -138,6 +151,9 @@ def test_cli_correct_writes_a_ship_the_commands_run(tmp_path, capsys):
                        tmp_path / "zz10.csv")  # fmt: skip
     spec = "; ".join(f"{d}: " + ", ".join(t) for d, t in scale_ship_model().structure.terms.items())
     ship = tmp_path / "ship.json"
+    code, out, err = run(["correct", "scale-ship", *paths, "--model", spec, "--gamma", "auto",
+                          "-o", tmp_path / "auto.json"], capsys)  # fmt: skip
+    assert code == 0 and "γ by the free runs of held-out logs" in out, err
     code, out, err = run(["correct", "scale-ship", *paths, "--model", spec, "--gamma", "1e8",
                           "-o", ship], capsys)  # fmt: skip
     assert code == 0, err

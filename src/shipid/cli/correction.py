@@ -20,7 +20,10 @@ def cmd_correct(args) -> int:
     for note in _reference_speed_notes(reference, logs, names):
         _warn(note)
     fit = identify_correction(logs, reference, args.model, args.gamma, args.filter, names)
-    print(f"{args.reference} kept whole, corrected by an LS-SVM fit (γ {args.gamma:g}) to what "
+    if fit.gamma_scores:
+        print("γ by the free runs of held-out logs: " + ", ".join(
+            f"{g:g} {s:.4g}" for g, s in fit.gamma_scores.items()) + f" → {fit.gamma:g}")
+    print(f"{args.reference} kept whole, corrected by an LS-SVM fit (γ {fit.gamma:g}) to what "
           f"it misses of {len(logs)} log(s):")  # fmt: skip
     print(fit.correction.equations())
     shares = ", ".join(f"{d}̇ {100 * x:.0f} %" for d, x in fit.explained.items())

@@ -555,8 +555,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("logs", nargs="+", metavar="LOG")
     p.add_argument("--model", default="blanke-race", metavar="STRUCTURE",
                    help="the correction's terms, in u, v, r and δ (default %(default)s)")
-    p.add_argument("--gamma", type=float, default=1e4,
-                   help="LS-SVM γ: smaller keeps the correction smaller (default %(default)g)")
+    p.add_argument("--gamma", type=_number_or_auto, default=1e4, metavar="G|auto",
+                   help="LS-SVM γ: smaller keeps the correction smaller; 'auto': by the free runs "
+                   "of held-out logs (each left out from three, else blocks) (default %(default)g)")
     p.add_argument("--filter", type=float, metavar="HZ",
                    help="zero-phase low-pass of u, v, r before the fit [Hz] (default: none)")
     p.add_argument("-o", "--output", required=True, metavar="SHIP.json")

@@ -64,12 +64,14 @@ class CorrectedDynamics:
 class Correction:
     """The corrected ship (``vessel``), the fitted ``correction`` and the reference's share of
     each equation: ``explained`` [dof] = 1 − var(target left after the reference) / var(the
-    increments' own), over the training logs (1: the reference alone fits the logs)."""
+    increments' own), over the training logs (1: the reference alone fits the logs); with
+    γ "auto", each γ's cross-validated free-run score (``gamma_scores``, the lowest chosen)."""
 
     vessel: Vessel
     correction: ManoeuvringModel
     explained: dict[str, float]
     gamma: float
+    gamma_scores: dict[float, float] = dataclasses.field(default_factory=dict)  # γ "auto"
 
 
 def _structure(model) -> ModelStructure:
@@ -85,11 +87,17 @@ def _structure(model) -> ModelStructure:
     return structure
 
 
+# γ searched by ``gamma="auto"``: from a correction drawn hard toward zero (the reference
+# trusted) to the paper's 1e4 and beyond; the free runs of held-out logs choose.
+GAMMAS = (1.0, 10.0, 1e2, 1e3, 1e4, 1e5)
+DIVERGENCE_PENALTY = 2.0  # normalised error of each held-out sample after a run diverged
+
+
 def identify_correction(
     logs: Sequence[pd.DataFrame] | pd.DataFrame,
     reference: Vessel,
     model: str | ModelStructure = "blanke-race",
-    gamma: float = 1e4,
+    gamma: float | str = 1e4,
     filter_hz: float | None = None,
     names: Sequence[str] | None = None,
 ) -> Correction:
@@ -102,14 +110,17 @@ def identify_correction(
     reference : the reference ship (``shipid.vessels.get_vessel``) whose dynamics give
         ``derivatives(nu, delta)``.
     model : the correction's structure (terms in u, v, r and δ; "1" a constant).
-    gamma : the LS-SVM's regularisation; a small γ keeps the correction small.
+    gamma : the LS-SVM's regularisation (a small γ keeps the correction small), or "auto":
+        the one of ``GAMMAS`` whose corrections run free closest to held-out logs (each log
+        left out in turn from three logs, else four blocks of each; ``Correction.gamma_scores``).
     filter_hz : zero-phase low-pass of u, v, r before the increments (``identify``'s prefilter),
-        or None.
+        or None. Held-out logs are run against as measured.
     """
     if not isinstance(reference, Vessel) or not hasattr(reference.dynamics, "derivatives"):
         raise ShipidError("the reference must be a reference ship (shipid.vessels.get_vessel)")
-    if not (isinstance(gamma, int | float) and np.isfinite(gamma) and gamma > 0):
-        raise ShipidError(f"gamma must be > 0, got {gamma!r}")
+    if gamma != "auto" and not (isinstance(gamma, int | float) and np.isfinite(gamma)
+                                and gamma > 0):  # fmt: skip
+        raise ShipidError(f"gamma must be > 0 or 'auto', got {gamma!r}")
     structure = _structure(model)
     logs = [logs] if isinstance(logs, pd.DataFrame) else list(logs)
     if not logs:
@@ -118,8 +129,23 @@ def identify_correction(
                                        for i, log in enumerate(logs)]  # fmt: skip
     require_states(logs, names, "training log")
     logs = [in_rudder_convention(log, reference.rudder_positive)[0] for log in logs]
-    if filter_hz is not None:
-        logs = [lowpass(log, filter_hz) for log in logs]
+    scores = {}
+    if gamma == "auto":
+        scores = _gamma_scores(logs, names, reference, structure, filter_hz)
+        gamma = min(scores, key=scores.get)
+    fitted = [lowpass(log, filter_hz) for log in logs] if filter_hz is not None else logs
+    correction, explained = _fit(fitted, names, reference, structure, float(gamma))
+    vessel = dataclasses.replace(
+        reference, name=f"{reference.name} + correction",
+        dynamics=CorrectedDynamics(reference.dynamics, correction),
+        source=f"{reference.source}, corrected by an LS-SVM fit to {len(logs)} log(s)")  # fmt: skip
+    return Correction(vessel, correction, explained, float(gamma), scores)
+
+
+def _fit(logs, names, reference: Vessel, structure: ModelStructure, gamma: float
+         ) -> tuple[ManoeuvringModel, dict[str, float]]:  # fmt: skip
+    """The correction of ``reference`` on ``logs`` (filtered already) and the reference's
+    share of each equation's increments."""
     dt = common_sampling_time(logs, names)
     coefficients, terms, explained = {}, {}, {}
     for dof in structure.dofs:
@@ -146,11 +172,44 @@ def identify_correction(
         explained[dof] = 1.0 - float(np.var(y)) / spread if spread > 0 else float("nan")
     correction = ManoeuvringModel(ModelStructure(f"correction ({structure.name})", terms),
                                   coefficients, name=f"correction of {reference.name}")  # fmt: skip
-    vessel = dataclasses.replace(
-        reference, name=f"{reference.name} + correction",
-        dynamics=CorrectedDynamics(reference.dynamics, correction),
-        source=f"{reference.source}, corrected by an LS-SVM fit to {len(logs)} log(s)")  # fmt: skip
-    return Correction(vessel, correction, explained, float(gamma))
+    return correction, explained
+
+
+def _gamma_scores(logs, names, reference: Vessel, structure: ModelStructure,
+                  filter_hz: float | None) -> dict[float, float]:  # fmt: skip
+    """Per γ of ``GAMMAS``: the mean over folds of the held-out logs' free-run error (each
+    state's rms over its spread, ``normalised_error``, averaged over u, v, r), the correction
+    fitted on the other logs (filtered) and run from each held-out log's first sample."""
+    from shipid.dynamics.simulate import simulate_log
+    from shipid.identification.cross_validation import (
+        choice_cv,
+        folds,
+        normalised_error,
+        parse_cv,
+        split_blocks,
+    )
+
+    cv = choice_cv(logs)
+    if cv.startswith("blocks"):
+        logs, names = split_blocks(logs, names, parse_cv(cv)[1])
+        cv = "logo"
+    fitted = [lowpass(log, filter_hz) for log in logs] if filter_hz is not None else logs
+    scores = {}
+    for gamma in GAMMAS:
+        fold_scores = []
+        for held in folds(len(logs), cv):
+            train = [i for i in range(len(logs)) if i not in held]
+            correction, _ = _fit([fitted[i] for i in train], [names[i] for i in train],
+                                 reference, structure, gamma)  # fmt: skip
+            dynamics = CorrectedDynamics(reference.dynamics, correction)
+            for i in held:
+                measured = logs[i][list(DOFS)].to_numpy(dtype=float)
+                sim = simulate_log(dynamics, logs[i], method="euler")
+                simulated = sim.log[list(DOFS)].to_numpy(dtype=float)
+                fold_scores.append(float(np.mean(normalised_error(measured, simulated,
+                                                                  DIVERGENCE_PENALTY))))
+        scores[gamma] = float(np.mean(fold_scores))
+    return scores
 
 
 # The file of a corrected reference ship (``shipid correct``): another format than a model
@@ -169,6 +228,7 @@ def correction_document(fit: Correction, reference: str, training_files: Sequenc
     return {"format": CORRECTED_FORMAT, "version": CORRECTED_VERSION, "shipid": __version__,
             "reference": reference, "correction": fit.correction.to_dict(),
             "gamma": fit.gamma, "filter_hz": filter_hz, "explained": fit.explained,
+            "gamma_scores": {f"{g:g}": v for g, v in fit.gamma_scores.items()},
             "training_files": [{"path": str(p), "sha256": sha256(p)} for p in training_files]}
 
 
