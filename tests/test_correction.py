@@ -164,6 +164,8 @@ def test_cli_correct_writes_a_ship_the_commands_run(tmp_path, capsys):
     assert code == 0, err
     (record,) = json.loads((tmp_path / "v.json").read_text())["logs"]
     assert max(record["metrics"][s]["rmse"] for s in "uvr") < 1e-6
+    code, _, err = run(["validate", ship, unseen, "--report", tmp_path / "rep"], capsys)
+    assert code == 0 and "its correction:" in (tmp_path / "rep" / "report.html").read_text()
     for argv in (["manoeuvre", ship, "zigzag", "--rudder", "10"], ["linearise", ship]):
         code, _, err = run(argv, capsys)
         assert code == 0, (argv, err)

@@ -44,9 +44,11 @@ def _model_text(model, std_errors) -> str:
     """The model's equations; a reference ship (``shipid validate VESSEL``), what it is."""
     if hasattr(model, "equations"):
         return model.equations(std_errors=std_errors)
-    return (f"reference ship {model.name}: {model.source or 'shipid.vessels'}; Lpp "
+    text = (f"reference ship {model.name}: {model.source or 'shipid.vessels'}; Lpp "
             f"{model.length:g} m, approach {model.approach_speed:.4g} m/s, positive rudder to "
             f"{model.rudder_positive}")
+    correction = getattr(model.dynamics, "correction", None)  # shipid correct's
+    return text if correction is None else f"{text}\nits correction:\n{correction.equations()}"
 
 
 def validation_report(
