@@ -64,6 +64,20 @@ def test_gamma_auto_chooses_by_the_free_runs_of_held_out_logs():
     assert fit.gamma_scores[fit.gamma] < fit.gamma_scores[1.0]
 
 
+def test_bootstrap_replicates_of_exact_data_agree_with_the_fit():
+    """Noise-free logs hold the same correction in every resampled set of their equations: the
+    replicates equal the point fit, and their ships are the corrected ship's."""
+    reference, truth = _truth()
+    log = zigzag(truth, 20, 20, duration=60, dt=0.1, method="euler").log
+    fit = identify_correction(log, reference, scale_ship_model().structure, gamma=1e8,
+                              bootstrap=12, seed=3)  # fmt: skip
+    assert len(fit.replicates) == len(fit.replicate_vessels()) == 12
+    for replicate in fit.replicates:
+        np.testing.assert_allclose(replicate.theta, fit.correction.theta, atol=1e-6)
+    with pytest.raises(ShipidError, match="at least 10 replicates"):
+        identify_correction(log, reference, "blanke-race", bootstrap=5)
+
+
 def test_a_perfect_reference_needs_no_correction_and_its_convention_is_kept():
     reference = scale_ship()
     log = zigzag(reference, 20, 20, duration=60, dt=0.1, method="euler").log
@@ -152,8 +166,11 @@ def test_cli_correct_writes_a_ship_the_commands_run(tmp_path, capsys):
     spec = "; ".join(f"{d}: " + ", ".join(t) for d, t in scale_ship_model().structure.terms.items())
     ship = tmp_path / "ship.json"
     code, out, err = run(["correct", "scale-ship", *paths, "--model", spec, "--gamma", "auto",
-                          "-o", tmp_path / "auto.json"], capsys)  # fmt: skip
+                          "--bootstrap", "10", "-o", tmp_path / "auto.json"], capsys)  # fmt: skip
     assert code == 0 and "γ by the free runs of held-out logs" in out, err
+    assert "intervals over 10 bootstrap replicates" in out
+    rows = json.loads((tmp_path / "auto.json").read_text())["beyond_the_logs"]
+    assert len(rows) == 10 and all("95 % interval" in row for row in rows)
     code, out, err = run(["correct", "scale-ship", *paths, "--model", spec, "--gamma", "1e8",
                           "-o", ship], capsys)  # fmt: skip
     assert code == 0, err

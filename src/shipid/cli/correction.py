@@ -19,7 +19,8 @@ def cmd_correct(args) -> int:
     names = [str(p) for p in args.logs]
     for note in _reference_speed_notes(reference, logs, names):
         _warn(note)
-    fit = identify_correction(logs, reference, args.model, args.gamma, args.filter, names)
+    fit = identify_correction(logs, reference, args.model, args.gamma, args.filter, names,
+                              args.bootstrap, args.seed)  # fmt: skip
     if fit.gamma_scores:
         print("γ by the free runs of held-out logs: " + ", ".join(
             f"{g:g} {s:.4g}" for g, s in fit.gamma_scores.items()) + f" → {fit.gamma:g}")
@@ -28,9 +29,10 @@ def cmd_correct(args) -> int:
     print(fit.correction.equations())
     shares = ", ".join(f"{d}̇ {100 * x:.0f} %" for d, x in fit.explained.items())
     print(f"the reference's share of the increments' variance on the logs: {shares}")
-    _beyond_the_logs(reference, fit.vessel)
-    atomic_write_text(args.output, _json_text(correction_document(
-        fit, args.reference, names, args.filter)))  # fmt: skip
+    beyond = _beyond_the_logs(reference, fit.vessel, fit.replicate_vessels())
+    doc = correction_document(fit, args.reference, names, args.filter)
+    doc["beyond_the_logs"] = beyond
+    atomic_write_text(args.output, _json_text(doc))
     print(f"corrected ship written to {args.output} (validate, simulate, manoeuvre, criteria, "
           "linearise, autopilot and follow run it)")  # fmt: skip
     return 0
@@ -43,18 +45,33 @@ BEYOND = (("turning", "tactical_diameter"), ("turning", "steady_speed"),
           ("zigzag", "second_overshoot_deg"))  # fmt: skip
 
 
-def _beyond_the_logs(reference, corrected) -> None:
-    """Print the standard manoeuvres of both ships side by side, and warn where the corrected
-    ship's turn diverges, never settles into one, or turns the other way."""
-    from shipid.cli.common import _pd
+# The bootstrap replicates' manoeuvres step coarser than the point's (the corrected ship runs
+# in Python): four times the manoeuvres' default step.
+REPLICATE_STEP = 0.2
+
+
+def _standard(ship, side: str, dt: float | None = None) -> dict:
+    """The held 35° turn and the 10°/10° zig-zag of ``ship`` to ``side`` (at ``dt``, else the
+    manoeuvres' default step)."""
     from shipid.trials.manoeuvres import turning_circle, zigzag
+
+    step = {} if dt is None else {"dt": dt}
+    return {"turning": turning_circle(ship, 35.0, side=side, **step),
+            "zigzag": zigzag(ship, 10.0, 10.0, first=side, **step)}  # fmt: skip
+
+
+def _beyond_the_logs(reference, corrected, replicates=()) -> list[dict]:
+    """Print the standard manoeuvres of both ships side by side (with the 95 % interval over
+    the bootstrap ``replicates`` where there are some), warn where the corrected ship's turn
+    diverges, never comes round, or turns the other way; the rows, for the file."""
+    from shipid.cli.common import _pd
+    from shipid.identification.uncertainty import interval
 
     rows = []
     for side in ("starboard", "port"):
-        runs = {}
-        for label, ship in (("reference", reference), ("corrected", corrected)):
-            runs[label] = {"turning": turning_circle(ship, 35.0, side=side),
-                           "zigzag": zigzag(ship, 10.0, 10.0, first=side)}  # fmt: skip
+        runs = {label: _standard(ship, side)
+                for label, ship in (("reference", reference), ("corrected", corrected))}
+        drawn = [_standard(ship, side, REPLICATE_STEP) for ship in replicates]
         turn = runs["corrected"]["turning"]
         if turn.diverged or turn.indices.get("tactical_diameter") is None:
             _warn(f"the corrected ship's 35° turn to {side} "
@@ -65,8 +82,15 @@ def _beyond_the_logs(reference, corrected) -> None:
             _warn(f"the corrected ship turns to {turn.indices['turn_direction']} with its 35° "
                   f"rudder to {side}")  # fmt: skip
         for kind, key in BEYOND:
-            rows.append({"manoeuvre": f"{'35° turn' if kind == 'turning' else '10°/10°'} "
-                                      f"{side}", "index": key,
-                         **{label: runs[label][kind].indices.get(key) for label in runs}})
-    print("Beyond the logs (the standard manoeuvres from the reference's approach):")
+            row = {"manoeuvre": f"{'35° turn' if kind == 'turning' else '10°/10°'} {side}",
+                   "index": key, **{label: runs[label][kind].indices.get(key) for label in runs}}
+            if drawn:
+                values = [d[kind].indices.get(key) for d in drawn]
+                lo, hi = interval([float("nan") if v is None else v for v in values])
+                row["95 % interval"] = f"[{lo:.4g}, {hi:.4g}]"
+            rows.append(row)
+    print("Beyond the logs (the standard manoeuvres from the reference's approach"
+          + (f"; intervals over {len(replicates)} bootstrap replicates of the correction, "
+             f"run at {REPLICATE_STEP:g} s steps" if replicates else "") + "):")  # fmt: skip
     print(_pd().DataFrame(rows).to_markdown(index=False, floatfmt=".4g"))
+    return rows

@@ -72,13 +72,21 @@ class Correction:
     """The corrected ship (``vessel``), the fitted ``correction`` and the reference's share of
     each equation: ``explained`` [dof] = 1 − var(target left after the reference) / var(the
     increments' own), over the training logs (1: the reference alone fits the logs); with
-    γ "auto", each γ's cross-validated free-run score (``gamma_scores``, the lowest chosen)."""
+    γ "auto", each γ's cross-validated free-run score (``gamma_scores``, the lowest chosen);
+    with a bootstrap, the corrections of its ``replicates`` (resampled equations, as
+    ``identify --bootstrap`` resamples them)."""
 
     vessel: Vessel
     correction: ManoeuvringModel
     explained: dict[str, float]
     gamma: float
     gamma_scores: dict[float, float] = dataclasses.field(default_factory=dict)  # γ "auto"
+    replicates: list[ManoeuvringModel] = dataclasses.field(default_factory=list)  # bootstrap
+
+    def replicate_vessels(self) -> list[Vessel]:
+        """The corrected ship of each bootstrap replicate's correction."""
+        return [dataclasses.replace(self.vessel, dynamics=CorrectedDynamics(
+            self.vessel.dynamics.reference, c)) for c in self.replicates]  # fmt: skip
 
 
 def _structure(model) -> ModelStructure:
@@ -107,6 +115,8 @@ def identify_correction(
     gamma: float | str = 1e4,
     filter_hz: float | None = None,
     names: Sequence[str] | None = None,
+    bootstrap: int | None = None,
+    seed: int = 0,
 ) -> Correction:
     """Fit a correction to ``reference``'s accelerations on ``logs`` (see the module's note).
 
@@ -122,6 +132,8 @@ def identify_correction(
         left out in turn from three logs, else four blocks of each; ``Correction.gamma_scores``).
     filter_hz : zero-phase low-pass of u, v, r before the increments (``identify``'s prefilter),
         or None. Held-out logs are run against as measured.
+    bootstrap : replicates of the correction, refitted on the logs' equations resampled
+        (moving 10 s blocks, whole logs from five logs: ``uncertainty.resampler``), ``seed``.
     """
     if not isinstance(reference, Vessel) or not hasattr(reference.dynamics, "derivatives"):
         raise ShipidError("the reference must be a reference ship (shipid.vessels.get_vessel)")
@@ -142,17 +154,26 @@ def identify_correction(
         gamma = min(scores, key=scores.get)
     fitted = [lowpass(log, filter_hz) for log in logs] if filter_hz is not None else logs
     correction, explained = _fit(fitted, names, reference, structure, float(gamma))
+    replicates = []
+    if bootstrap is not None:
+        from shipid.identification.uncertainty import resampler
+
+        draw, _ = resampler(fitted, bootstrap, "auto")
+        rng = np.random.default_rng(seed)
+        replicates = [_fit(fitted, names, reference, structure, float(gamma), draw(rng))[0]
+                      for _ in range(bootstrap)]  # fmt: skip
     vessel = dataclasses.replace(
         reference, name=f"{reference.name} + correction",
         dynamics=CorrectedDynamics(reference.dynamics, correction),
         source=f"{reference.source}, corrected by an LS-SVM fit to {len(logs)} log(s)")  # fmt: skip
-    return Correction(vessel, correction, explained, float(gamma), scores)
+    return Correction(vessel, correction, explained, float(gamma), scores, replicates)
 
 
-def _fit(logs, names, reference: Vessel, structure: ModelStructure, gamma: float
-         ) -> tuple[ManoeuvringModel, dict[str, float]]:  # fmt: skip
+def _fit(logs, names, reference: Vessel, structure: ModelStructure, gamma: float,
+         weights: np.ndarray | None = None) -> tuple[ManoeuvringModel, dict[str, float]]:
     """The correction of ``reference`` on ``logs`` (filtered already) and the reference's
-    share of each equation's increments."""
+    share of each equation's increments; ``weights``: each equation's multiplicity (the logs'
+    samples but the last of each, in order: a bootstrap replicate)."""
     dt = common_sampling_time(logs, names)
     coefficients, terms, explained = {}, {}, {}
     for dof in structure.dofs:
@@ -169,7 +190,7 @@ def _fit(logs, names, reference: Vessel, structure: ModelStructure, gamma: float
         X, y = np.vstack(Xs), np.concatenate(ys)
         # Without "1" in the equation the fit has no bias either (b = 0), as identify's.
         physics = dof_physics(None, dof, free, "1" in structure.terms[dof], {}, logs)
-        theta, bias = fit_linear(X, y, "lssvm", gamma, physics=physics)
+        theta, bias = fit_linear(X, y, "lssvm", gamma, weights, physics=physics)
         coefficients[dof] = dict(zip(free, theta.tolist(), strict=True))
         terms[dof] = tuple(free)
         if "1" in structure.terms[dof]:
