@@ -67,6 +67,23 @@ class CorrectedDynamics:
         return own + self.correction.compiled_accelerations(nu, inputs)
 
 
+def corrected_dynamics(reference, correction: ManoeuvringModel):
+    """The reference's dynamics plus ``correction``: where the reference is itself a term model
+    (the paper's scale ship), one term model of the two summed, which the compiled simulator
+    runs (the same accelerations: the terms' union, each coefficient the sum); else a
+    ``CorrectedDynamics`` the simulator steps in Python. Either keeps ``correction``."""
+    if type(reference) is not ManoeuvringModel or reference.similar_at_rps is not None:
+        return CorrectedDynamics(reference, correction)
+    structure = reference.structure.union(correction.structure.terms,
+                                          name=f"{reference.name} + correction")  # fmt: skip
+    coefficients = {d: {t: reference.coefficients.get(d, {}).get(t, 0.0)
+                        + correction.coefficients.get(d, {}).get(t, 0.0) for t in terms}
+                    for d, terms in structure.terms.items()}  # fmt: skip
+    merged = ManoeuvringModel(structure, coefficients, name=structure.name)
+    merged.correction = correction  # what validate's report shows
+    return merged
+
+
 @dataclasses.dataclass(frozen=True)
 class Correction:
     """The corrected ship (``vessel``), the fitted ``correction`` and the reference's share of
@@ -82,11 +99,12 @@ class Correction:
     gamma: float
     gamma_scores: dict[float, float] = dataclasses.field(default_factory=dict)  # γ "auto"
     replicates: list[ManoeuvringModel] = dataclasses.field(default_factory=list)  # bootstrap
+    reference: Vessel | None = None  # the ship corrected
 
     def replicate_vessels(self) -> list[Vessel]:
         """The corrected ship of each bootstrap replicate's correction."""
-        return [dataclasses.replace(self.vessel, dynamics=CorrectedDynamics(
-            self.vessel.dynamics.reference, c)) for c in self.replicates]  # fmt: skip
+        return [dataclasses.replace(self.vessel, dynamics=corrected_dynamics(
+            self.reference.dynamics, c)) for c in self.replicates]  # fmt: skip
 
 
 def _structure(model) -> ModelStructure:
@@ -164,9 +182,9 @@ def identify_correction(
                       for _ in range(bootstrap)]  # fmt: skip
     vessel = dataclasses.replace(
         reference, name=f"{reference.name} + correction",
-        dynamics=CorrectedDynamics(reference.dynamics, correction),
+        dynamics=corrected_dynamics(reference.dynamics, correction),
         source=f"{reference.source}, corrected by an LS-SVM fit to {len(logs)} log(s)")  # fmt: skip
-    return Correction(vessel, correction, explained, float(gamma), scores, replicates)
+    return Correction(vessel, correction, explained, float(gamma), scores, replicates, reference)
 
 
 def _fit(logs, names, reference: Vessel, structure: ModelStructure, gamma: float,
@@ -229,7 +247,7 @@ def _gamma_scores(logs, names, reference: Vessel, structure: ModelStructure,
             train = [i for i in range(len(logs)) if i not in held]
             correction, _ = _fit([fitted[i] for i in train], [names[i] for i in train],
                                  reference, structure, gamma)  # fmt: skip
-            dynamics = CorrectedDynamics(reference.dynamics, correction)
+            dynamics = corrected_dynamics(reference.dynamics, correction)
             for i in held:
                 measured = logs[i][list(DOFS)].to_numpy(dtype=float)
                 sim = simulate_log(dynamics, logs[i], method="euler")
@@ -307,5 +325,5 @@ def load_corrected(path) -> Vessel:
     reference = VESSELS[name]()
     return dataclasses.replace(
         reference, name=f"{name} + correction",
-        dynamics=CorrectedDynamics(reference.dynamics, correction),
+        dynamics=corrected_dynamics(reference.dynamics, correction),
         source=f"{reference.source}, corrected by {p.name}")  # fmt: skip
