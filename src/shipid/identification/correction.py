@@ -9,10 +9,11 @@ terms of a structure to what they leave of the logs::
 
 the increment form of the paper's eqs. (11)–(12) with f_ref moved to the target side: each
 equation regresses (ξ(k+1) − ξ(k))/Δk − f_ref(ν(k), δ(k)) on the structure's terms, so at a
-large γ a perfect reference leaves θ = 0. The corrected ship is a ``Vessel``: the commands'
-Python API (``validate``, ``zigzag``, ``turning_circle``) runs it as any reference ship, its
-steering and trim those of the reference. The reference's propeller stays at its own trim; a
-correction has no propeller, thrust or wind terms.
+large γ a perfect reference leaves θ = 0. The corrected ship is a ``Vessel``, its steering and
+trim the reference's: the Python API (``validate``, ``zigzag``, ``turning_circle``) runs it as
+any reference ship, and ``shipid correct`` writes it to a file (``correction_document``) that
+the commands taking a reference ship load (``load_corrected``). The reference's propeller
+stays at its own trim; a correction has no propeller, thrust or wind terms.
 
 On the KVLCC2's three real zig-zags (``benchmarks/study_kvlcc2_mmg_baseline.py``) the MMG model
 with a correction fitted to one or two of them predicts the others' yaw rate and closed-loop
@@ -43,8 +44,8 @@ ALLOWED_SIGNALS = {"u", "v", "r", "delta", "U", "beta"}
 
 
 class CorrectedDynamics:
-    """The reference ship's accelerations plus a ``ManoeuvringModel`` correction (NumPy
-    ``derivatives``: the simulator's and the manoeuvres' generic path)."""
+    """The reference ship's accelerations plus a ``ManoeuvringModel`` correction, as
+    ``derivatives`` (the simulator's and the manoeuvres' generic path, stepped in Python)."""
 
     uses_thrust = False
     uses_rps = False
