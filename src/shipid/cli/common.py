@@ -690,9 +690,12 @@ def _ship_or_model(name: str, hybrid: bool = False):
         raise ShipidError(f"{name}: neither a model file nor a known vessel "
                           f"({', '.join(VESSEL_NAMES)})")  # fmt: skip
     from shipid.identification.correction import is_corrected_file, load_corrected
+    from shipid.vessels.mmg_file import is_mmg_file, read_mmg
 
     if is_corrected_file(name):  # a reference ship kept whole and corrected (shipid correct)
         return load_corrected(name), vessel_conditions
+    if is_mmg_file(name):  # a ship's own MMG coefficients
+        return read_mmg(name), vessel_conditions
     from shipid.reporting.modelfile import (
         alternatives_fit,
         alternatives_from_document,

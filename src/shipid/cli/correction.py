@@ -8,13 +8,24 @@ from shipid.cli.common import _json_text, _read_files, _training_logs, _warn
 
 def cmd_correct(args) -> int:
     """``shipid correct VESSEL LOG... -o SHIP.json``."""
+    from shipid.cli.common import VESSEL_NAMES
     from shipid.cli.evaluation import _reference_speed_notes
+    from shipid.errors import ShipidError
     from shipid.identification.correction import correction_document, identify_correction
     from shipid.outputs import atomic_write_text, check_outputs
     from shipid.vessels import get_vessel
+    from shipid.vessels.mmg_file import is_mmg_file, read_document, read_mmg
 
-    check_outputs({"-o": (args.output, "json")}, [*args.logs, *_read_files(args)])
-    reference = get_vessel(args.reference)
+    given = [] if args.reference in VESSEL_NAMES else [args.reference]
+    check_outputs({"-o": (args.output, "json")}, [*given, *args.logs, *_read_files(args)])
+    if args.reference in VESSEL_NAMES:
+        reference, stored = get_vessel(args.reference), args.reference
+    elif is_mmg_file(args.reference):  # kept whole in the file: it needs no other to load
+        reference, stored = read_mmg(args.reference), {"mmg": read_document(args.reference)}
+    else:
+        raise ShipidError(f"{args.reference}: neither a reference ship "
+                          f"({', '.join(VESSEL_NAMES)}) nor an MMG model file "
+                          "(format: shipid-mmg, shipid.vessels.mmg_file)")  # fmt: skip
     logs = _training_logs(args)
     names = [str(p) for p in args.logs]
     for note in _reference_speed_notes(reference, logs, names):
@@ -24,13 +35,13 @@ def cmd_correct(args) -> int:
     if fit.gamma_scores:
         print("γ by the free runs of held-out logs: " + ", ".join(
             f"{g:g} {s:.4g}" for g, s in fit.gamma_scores.items()) + f" → {fit.gamma:g}")
-    print(f"{args.reference} kept whole, corrected by an LS-SVM fit (γ {fit.gamma:g}) to what "
+    print(f"{reference.name} kept whole, corrected by an LS-SVM fit (γ {fit.gamma:g}) to what "
           f"it misses of {len(logs)} log(s):")  # fmt: skip
     print(fit.correction.equations())
     shares = ", ".join(f"{d}̇ {100 * x:.0f} %" for d, x in fit.explained.items())
     print(f"the reference's share of the increments' variance on the logs: {shares}")
     beyond = _beyond_the_logs(reference, fit.vessel, fit.replicate_vessels())
-    doc = correction_document(fit, args.reference, names, args.filter)
+    doc = correction_document(fit, stored, names, args.filter)
     doc["beyond_the_logs"] = beyond
     atomic_write_text(args.output, _json_text(doc))
     print(f"corrected ship written to {args.output} (validate, simulate, manoeuvre, criteria, "

@@ -62,8 +62,10 @@ def cmd_validate(args) -> int:
         start_spread_note,
         switch_heading_note,
     )
+    from shipid.vessels.mmg_file import is_mmg_file
 
-    reference = args.model in VESSEL_NAMES or is_corrected_file(args.model)
+    reference = (args.model in VESSEL_NAMES or is_corrected_file(args.model)
+                 or is_mmg_file(args.model))  # fmt: skip
     check_outputs({"--json": (args.json, "json"), "--plots": (args.plots, "dir"),
                    "--report": (args.report, "dir")},
                   [*([] if args.model in VESSEL_NAMES else [args.model]), *args.logs,

@@ -550,8 +550,9 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("correct", help="a reference ship's model kept whole, an LS-SVM "
                        "correction fitted to logs of the same ship (the corrected ship a file "
                        "the commands run as a reference ship)")  # fmt: skip
-    p.add_argument("reference", choices=VESSEL_NAMES, metavar="VESSEL",
-                   help=f"the reference ship ({', '.join(VESSEL_NAMES)})")
+    p.add_argument("reference", metavar="VESSEL|MMG.yml",
+                   help=f"the reference ship ({', '.join(VESSEL_NAMES)}) or a ship's own MMG "
+                   "model file (format: shipid-mmg; see shipid.vessels.mmg_file)")
     p.add_argument("logs", nargs="+", metavar="LOG")
     p.add_argument("--model", default="blanke-race", metavar="STRUCTURE",
                    help="the correction's terms, in u, v, r and δ (default %(default)s)")

@@ -265,10 +265,11 @@ CORRECTED_FORMAT = "shipid-corrected-ship"
 CORRECTED_VERSION = 1
 
 
-def correction_document(fit: Correction, reference: str, training_files: Sequence[str] = (),
+def correction_document(fit: Correction, reference: str | dict, training_files: Sequence[str] = (),
                         filter_hz: float | None = None) -> dict:  # fmt: skip
-    """The JSON document of a corrected reference ship: the reference's name, the correction
-    (a model's dict), how it was fitted and from which files (SHA-256)."""
+    """The JSON document of a corrected reference ship: the reference (a reference ship's name,
+    or {"mmg": an MMG document} kept whole), the correction (a model's dict), how it was fitted
+    and from which files (SHA-256)."""
     from shipid import __version__
     from shipid.reporting.modelfile import sha256
 
@@ -313,9 +314,16 @@ def load_corrected(path) -> Vessel:
         raise ShipidError(f"{path}: corrected ship file version {doc.get('version')!r} is not "
                           f"supported (this shipid reads {CORRECTED_VERSION})")  # fmt: skip
     name = doc.get("reference")
-    if name not in VESSELS:
+    if isinstance(name, dict) and "mmg" in name:
+        from shipid.vessels.mmg_file import mmg_vessel
+
+        reference = mmg_vessel(name["mmg"], f"{path}: reference.mmg")
+        name = reference.name
+    elif name not in VESSELS:
         raise ShipidError(f"{path}: reference {name!r} is not a reference ship of this shipid "
-                          f"({', '.join(VESSELS)})")  # fmt: skip
+                          f"({', '.join(VESSELS)}) nor an MMG model (reference.mmg)")  # fmt: skip
+    else:
+        reference = VESSELS[name]()
     try:
         correction = ManoeuvringModel.from_dict(doc.get("correction"))
     except ShipidError as exc:
@@ -323,7 +331,6 @@ def load_corrected(path) -> Vessel:
     except (KeyError, TypeError, ValueError, AttributeError) as exc:
         raise ShipidError(f"{path}: malformed correction ({exc})") from None
     _structure(correction.structure)  # states and rudder only, as fitted
-    reference = VESSELS[name]()
     return dataclasses.replace(
         reference, name=f"{name} + correction",
         dynamics=corrected_dynamics(reference.dynamics, correction),

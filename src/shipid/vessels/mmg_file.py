@@ -1,0 +1,226 @@
+"""A ship's own MMG standard-method model (Yasukawa & Yoshimura 2015) from a file of its
+coefficients, as a reference ship: what a basin's captive tests give, for ``shipid validate``,
+``manoeuvre`` and the other commands that take a ``VESSEL``, and as the reference that
+``shipid correct`` keeps whole.
+
+The formulas are the built-in KVLCC2's (``shipid.vessels.kvlcc2``, reference-ships.md §2:
+midship sway velocity, dimensional lever arms, the wake in drift, flow straightening γ_R that
+differs with the sign of the drift at the rudder), in NumPy, the propeller at a constant rps
+trimmed for the approach speed unless the file gives it. The file (YAML or JSON)::
+
+    format: shipid-mmg
+    name: my-ship
+    length: 7.0          # Lpp [m]
+    beam: 1.27
+    draught: 0.46
+    volume: 3.27         # displacement [m³]
+    x_g: 0.25            # [m] forward of midship
+    k_zz: 0.25           # yaw radius of gyration / Lpp
+    rho: 1025
+    approach_speed: 1.179
+    rudder_rate: 15.8    # [deg/s]; rudder_limit [deg], default 35
+    scale: 45.7          # optional; rps: optional (else trimmed for the approach)
+    hull: {m_x:, m_y:, j_z:, r0:, x_vv:, x_vr:, x_rr:, x_vvvv:, y_v:, y_r:, y_vvv:, y_vvr:,
+           y_vrr:, y_rrr:, n_v:, n_r:, n_vvv:, n_vvr:, n_vrr:, n_rrr:}     # prime
+    propeller: {diameter:, t_p:, w_p0:, k0:, k1:, k2:, x_p:, c1:, c2_pos:, c2_neg:}
+    rudder: {area:, height:, t_r:, a_h:, x_h:, x_r:, l_r:, epsilon:, kappa:, f_alpha:,
+             gamma_r_pos:, gamma_r_neg:}   # x_h, x_r, l_r prime; γ_R for β_R ≥ 0 and < 0
+
+Positive δ turns to starboard.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Mapping
+from pathlib import Path
+
+import numpy as np
+
+from shipid.dynamics.steering import SteeringMachine
+from shipid.errors import ShipidError
+
+from .vessel import Vessel
+
+FORMAT = "shipid-mmg"
+TOP = ("length", "beam", "draught", "volume", "x_g", "k_zz", "rho", "approach_speed",
+       "rudder_rate")  # fmt: skip
+HULL = ("m_x", "m_y", "j_z", "r0", "x_vv", "x_vr", "x_rr", "x_vvvv", "y_v", "y_r", "y_vvv",
+        "y_vvr", "y_vrr", "y_rrr", "n_v", "n_r", "n_vvv", "n_vvr", "n_vrr", "n_rrr")  # fmt: skip
+PROPELLER = ("diameter", "t_p", "w_p0", "k0", "k1", "k2", "x_p", "c1", "c2_pos", "c2_neg")
+RUDDER = ("area", "height", "t_r", "a_h", "x_h", "x_r", "l_r", "epsilon", "kappa", "f_alpha",
+          "gamma_r_pos", "gamma_r_neg")  # fmt: skip
+POSITIVE = ("length", "beam", "draught", "volume", "rho", "approach_speed", "rudder_rate",
+            "k_zz", "diameter", "area", "height")  # fmt: skip
+
+
+def _number(value, where: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        raise ShipidError(f"{where} must be a finite number, got {value!r}")
+    return float(value)
+
+
+def coefficients(doc: Mapping, where: str = "MMG file") -> dict:
+    """The flat, checked coefficients of an MMG document (one-line errors naming the field)."""
+    if not isinstance(doc, Mapping) or doc.get("format") != FORMAT:
+        raise ShipidError(f"{where}: not an MMG model file (no \"format\": \"{FORMAT}\")")
+    out: dict = {"name": str(doc.get("name") or "mmg")}
+    for key in TOP:
+        if key not in doc:
+            raise ShipidError(f"{where}: missing field {key!r}")
+        out[key] = _number(doc[key], f"{where}: {key}")
+    for group, keys in (("hull", HULL), ("propeller", PROPELLER), ("rudder", RUDDER)):
+        section = doc.get(group)
+        if not isinstance(section, Mapping):
+            raise ShipidError(f"{where}: missing section {group!r} ({', '.join(keys)})")
+        for key in keys:
+            if key not in section:
+                raise ShipidError(f"{where}: missing field {group}.{key}")
+            out[f"{group}.{key}"] = _number(section[key], f"{where}: {group}.{key}")
+    for key in POSITIVE:
+        full = key if key in out else next(k for k in out if k.endswith("." + key))
+        if not out[full] > 0:
+            raise ShipidError(f"{where}: {full} must be > 0, got {out[full]:g}")
+    out["rudder_limit"] = _number(doc.get("rudder_limit", 35.0), f"{where}: rudder_limit")
+    out["scale"] = _number(doc["scale"], f"{where}: scale") if "scale" in doc else math.nan
+    out["rps"] = _number(doc["rps"], f"{where}: rps") if doc.get("rps") is not None else None
+    return out
+
+
+class MMGDynamics:
+    """The MMG model's body accelerations at a constant propeller speed ``n_prop`` [rps]
+    (``derivatives``: the simulator's and the manoeuvres' generic path)."""
+
+    uses_thrust = False
+    uses_rps = False
+
+    def __init__(self, c: Mapping, n_prop: float) -> None:
+        self.c = dict(c)
+        self.n_prop = float(n_prop)
+        rho, L, d = c["rho"], c["length"], c["draught"]
+        self.m = rho * c["volume"]
+        half = 0.5 * rho * L**2 * d
+        self.mx, self.my = c["hull.m_x"] * half, c["hull.m_y"] * half
+        jz = c["hull.j_z"] * 0.5 * rho * L**4 * d
+        izg = self.m * (c["k_zz"] * L) ** 2
+        xg = c["x_g"]
+        msy = np.array([[self.m + self.my, xg * self.m], [xg * self.m, izg + xg**2 * self.m + jz]])
+        self.inverse = np.linalg.inv(msy).tolist()
+
+    def derivatives(self, nu, delta, thrust=None):
+        """(B, 3) body accelerations at states nu (B, 3) (midship sway) and rudder delta (B,).
+        Row by row in plain floats: the manoeuvres step one state at a time, where NumPy's
+        per-call cost was most of a step."""
+        nu = np.asarray(nu, dtype=float)
+        delta = np.broadcast_to(np.asarray(delta, dtype=float), nu.shape[:1])
+        return np.array([self.accelerations(*row, d) for row, d in
+                         zip(nu.tolist(), delta.tolist(), strict=True)]).reshape(-1, 3)  # fmt: skip
+
+    def accelerations(self, u: float, vm: float, r: float, delta: float
+                      ) -> tuple[float, float, float]:  # fmt: skip
+        """(u̇, v̇m, ṙ) at one state: hull, propeller and rudder forces through the mass matrix
+        (the built-in KVLCC2's ``accelerations``, these coefficients)."""
+        c, n = self.c, self.n_prop
+        L, d, rho = c["length"], c["draught"], c["rho"]
+        U = math.sqrt(u * u + vm * vm)
+        beta = math.atan2(-vm, u)
+        vp, rp = vm / U, r * L / U
+        q = 0.5 * rho * L * d * U * U
+        XH = q * (-c["hull.r0"] + c["hull.x_vv"] * vp**2 + c["hull.x_vr"] * vp * rp
+                  + c["hull.x_rr"] * rp**2 + c["hull.x_vvvv"] * vp**4)  # fmt: skip
+        YH = q * (c["hull.y_v"] * vp + c["hull.y_r"] * rp + c["hull.y_vvv"] * vp**3
+                  + c["hull.y_vvr"] * vp**2 * rp + c["hull.y_vrr"] * vp * rp**2
+                  + c["hull.y_rrr"] * rp**3)  # fmt: skip
+        NH = q * L * (c["hull.n_v"] * vp + c["hull.n_r"] * rp + c["hull.n_vvv"] * vp**3
+                      + c["hull.n_vvr"] * vp**2 * rp + c["hull.n_vrr"] * vp * rp**2
+                      + c["hull.n_rrr"] * rp**3)  # fmt: skip
+        DP = c["propeller.diameter"]
+        beta_p = beta - c["propeller.x_p"] * rp
+        c2 = c["propeller.c2_pos"] if beta_p > 0 else c["propeller.c2_neg"]
+        one_minus_wp = (1 - c["propeller.w_p0"]) * (
+            1 + (1 - math.exp(-c["propeller.c1"] * abs(beta_p))) * (c2 - 1))
+        Jp = u * one_minus_wp / (n * DP)
+        KT = c["propeller.k0"] + c["propeller.k1"] * Jp + c["propeller.k2"] * Jp**2
+        XP = (1 - c["propeller.t_p"]) * rho * n**2 * DP**4 * KT
+        beta_r = beta - c["rudder.l_r"] * rp
+        gamma_r = c["rudder.gamma_r_neg"] if beta_r < 0 else c["rudder.gamma_r_pos"]
+        vR = U * gamma_r * beta_r
+        eta = DP / c["rudder.height"]
+        uR = c["rudder.epsilon"] * u * one_minus_wp * math.sqrt(
+            eta * (1 + c["rudder.kappa"] * (math.sqrt(1 + 8 * KT / (math.pi * Jp**2)) - 1)) ** 2
+            + (1 - eta))  # fmt: skip
+        alpha_r = delta - math.atan2(vR, uR)
+        FN = 0.5 * rho * c["rudder.area"] * (uR**2 + vR**2) * c["rudder.f_alpha"] \
+            * math.sin(alpha_r)  # fmt: skip
+        X = XH + XP - (1 - c["rudder.t_r"]) * FN * math.sin(delta)
+        Y = YH - (1 + c["rudder.a_h"]) * FN * math.cos(delta)
+        N = NH - (c["rudder.x_r"] * L + c["rudder.a_h"] * c["rudder.x_h"] * L) * FN \
+            * math.cos(delta)  # fmt: skip
+        m, mx, my, xg = self.m, self.mx, self.my, c["x_g"]
+        ry = Y - (m + mx) * u * r
+        rn = N - xg * m * u * r
+        (i00, i01), (i10, i11) = self.inverse
+        return ((X + (m + my) * vm * r + xg * m * r * r) / (m + mx),
+                i00 * ry + i01 * rn, i10 * ry + i11 * rn)
+
+
+def trimmed_rps(c: Mapping, speed: float) -> float:
+    """Propeller rps for u̇ = 0 at ``speed`` in straight running."""
+    from scipy.optimize import brentq
+
+    state = np.array([[speed, 0.0, 0.0]])
+
+    def surge(n: float) -> float:
+        return float(MMGDynamics(c, n).derivatives(state, np.zeros(1))[0, 0])
+
+    if not surge(1e-3 * speed / c["propeller.diameter"] + 1e-6) < 0 < surge(1e4):
+        raise ShipidError(f"{c['name']}: no propeller speed holds {speed:g} m/s straight ahead "
+                          "(check the resistance and the propeller's coefficients)")  # fmt: skip
+    return brentq(surge, 1e-3 * speed / c["propeller.diameter"] + 1e-6, 1e4, xtol=1e-12)
+
+
+def mmg_vessel(doc: Mapping, where: str = "MMG file") -> Vessel:
+    """The reference ship of an MMG document (``coefficients``)."""
+    c = coefficients(doc, where)
+    n = c["rps"] if c["rps"] is not None else trimmed_rps(c, c["approach_speed"])
+    return Vessel(name=c["name"], dynamics=MMGDynamics(c, n), length=c["length"],
+                  approach_speed=c["approach_speed"],
+                  steering=SteeringMachine(math.radians(c["rudder_limit"]),
+                                           math.radians(c["rudder_rate"])),
+                  rudder_positive="starboard", scale=c["scale"],
+                  source=f"MMG standard method, {where}")  # fmt: skip
+
+
+def read_document(path) -> dict:
+    """The parsed MMG file (YAML or JSON), or a one-line error naming it."""
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ShipidError(f"{path}: cannot read the MMG file ({exc})") from None
+    try:
+        if p.suffix.lower() == ".json":
+            return json.loads(text)
+        import yaml
+
+        return yaml.safe_load(text)
+    except Exception as exc:  # noqa: BLE001 - a parser's error, named in one line
+        raise ShipidError(f"{path}: not a readable MMG file ({str(exc)[:120]})") from None
+
+
+def is_mmg_file(path) -> bool:
+    """Whether ``path`` is a YAML or JSON file that says it is an MMG model."""
+    p = Path(str(path))
+    if not p.is_file() or p.suffix.lower() not in (".yml", ".yaml", ".json"):
+        return False
+    try:
+        doc = read_document(p)
+    except ShipidError:
+        return False
+    return isinstance(doc, Mapping) and doc.get("format") == FORMAT
+
+
+def read_mmg(path) -> Vessel:
+    """The reference ship of the MMG file ``path``."""
+    return mmg_vessel(read_document(path), str(path))

@@ -1,0 +1,95 @@
+"""A ship's own MMG model from a file (``shipid.vessels.mmg_file``): the KVLCC2's coefficients
+written out reproduce the built-in, compiled KVLCC2; the file runs where a ``VESSEL`` does and
+as the reference ``shipid correct`` keeps whole; bad files are named field by field."""
+
+import importlib
+import json
+
+import numpy as np
+import pytest
+import yaml
+from cli_helpers import run
+
+from shipid.data.io import write_log
+from shipid.errors import ShipidError
+from shipid.trials.manoeuvres import turning_circle, zigzag
+from shipid.vessels.mmg_file import mmg_vessel, read_mmg
+
+K = importlib.import_module("shipid.vessels.kvlcc2")  # the module (shipid.vessels.kvlcc2 is
+# the function that builds the ship)
+
+
+def kvlcc2_document() -> dict:
+    """The built-in KVLCC2's coefficients (reference-ships.md §2) as an MMG file holds them."""
+    return {"format": "shipid-mmg", "name": "kvlcc2-file", "length": K.L, "beam": K.B,
+            "draught": K.D_DRAUGHT, "volume": K.VOLUME, "x_g": K.XG, "k_zz": 0.25,
+            "rho": K.RHO, "approach_speed": K.APPROACH_SPEED, "rudder_rate": K.RUDDER_RATE_DEG,
+            "scale": K.SCALE,
+            "hull": {"m_x": K.MX, "m_y": K.MY, "j_z": K.JZ, "r0": K.R0, "x_vv": K.XVV,
+                     "x_vr": K.XVR, "x_rr": K.XRR, "x_vvvv": K.XVVVV, "y_v": K.YV, "y_r": K.YR,
+                     "y_vvv": K.YVVV, "y_vvr": K.YVVR, "y_vrr": K.YVRR, "y_rrr": K.YRRR,
+                     "n_v": K.NV, "n_r": K.NR, "n_vvv": K.NVVV, "n_vvr": K.NVVR, "n_vrr": K.NVRR,
+                     "n_rrr": K.NRRR},
+            "propeller": {"diameter": K.DP, "t_p": K.TP, "w_p0": K.WP0, "k0": K.K0, "k1": K.K1,
+                          "k2": K.K2, "x_p": K.XP_PRIME, "c1": K.C1, "c2_pos": 1.6,
+                          "c2_neg": 1.1},
+            "rudder": {"area": K.AR, "height": K.HR, "t_r": K.TR, "a_h": K.AH,
+                       "x_h": K.XH_PRIME, "x_r": K.XR_PRIME, "l_r": K.LR_PRIME,
+                       "epsilon": K.EPS, "kappa": K.KAPPA, "f_alpha": K.F_ALPHA,
+                       "gamma_r_pos": 0.640, "gamma_r_neg": 0.395}}  # fmt: skip
+
+
+def test_the_kvlcc2_written_out_is_the_built_in_kvlcc2():
+    ship, built_in = mmg_vessel(kvlcc2_document()), K.kvlcc2()
+    assert ship.dynamics.n_prop == pytest.approx(built_in.dynamics.n_prop, rel=1e-10)
+    rng = np.random.default_rng(0)
+    nu = np.column_stack([rng.uniform(0.3, 1.4, 200), rng.uniform(-0.3, 0.3, 200),
+                          rng.uniform(-0.1, 0.1, 200)])  # fmt: skip
+    delta = rng.uniform(-0.6, 0.6, 200)
+    np.testing.assert_allclose(ship.dynamics.derivatives(nu, delta),
+                               built_in.dynamics.derivatives(nu, delta), rtol=0, atol=1e-14)
+    ours, theirs = (turning_circle(s, 35.0).indices for s in (ship, built_in))
+    assert ours["tactical_diameter"] == pytest.approx(theirs["tactical_diameter"], rel=1e-9)
+
+
+@pytest.mark.parametrize(("edit", "said"), [
+    (lambda d: d.pop("volume"), "missing field 'volume'"),
+    (lambda d: d["rudder"].pop("gamma_r_neg"), "missing field rudder.gamma_r_neg"),
+    (lambda d: d.update(length=-7.0), "length must be > 0"),
+    (lambda d: d["hull"].update(n_r="big"), "hull.n_r must be a finite number"),
+    (lambda d: d.update(format="shipid-model"), "not an MMG model file"),
+    (lambda d: d.pop("propeller"), "missing section 'propeller'"),
+])  # fmt: skip
+def test_a_bad_file_is_named_field_by_field(edit, said):
+    doc = kvlcc2_document()
+    edit(doc)
+    with pytest.raises(ShipidError) as info:
+        mmg_vessel(doc, "ship.yml")
+    assert said in str(info.value) and str(info.value).startswith("ship.yml: ")
+
+
+def test_the_file_runs_where_a_vessel_does_and_is_corrected(tmp_path, capsys):
+    """``validate``, ``manoeuvre`` and ``correct`` take the file; the corrected ship's file
+    holds the MMG model whole and runs without it."""
+    path = tmp_path / "ship.yml"
+    path.write_text(yaml.safe_dump(kvlcc2_document()), encoding="utf-8")
+    ship = read_mmg(path)
+    log = zigzag(ship, 20, 20, duration=60, dt=0.2, method="euler").log
+    log_path = write_log(log, tmp_path / "zz.csv")
+    code, out, err = run(["validate", path, log_path, "--method", "euler", "--json",
+                          tmp_path / "v.json"], capsys)  # fmt: skip
+    assert code == 0, err
+    (record,) = json.loads((tmp_path / "v.json").read_text())["logs"]
+    assert max(record["metrics"][s]["rmse"] for s in "uvr") < 1e-9
+    code, out, err = run(["manoeuvre", path, "zigzag", "--rudder", "10"], capsys)
+    assert code == 0, err
+    corrected = tmp_path / "corrected.json"
+    code, out, err = run(["correct", path, log_path, "-o", corrected], capsys)
+    assert code == 0 and "kvlcc2-file kept whole" in out, err
+    assert json.loads(corrected.read_text())["reference"]["mmg"]["name"] == "kvlcc2-file"
+    path.unlink()  # the corrected ship needs the MMG file no more
+    code, _, err = run(["validate", corrected, log_path], capsys)
+    assert code == 0, err
+    code, _, err = run(["correct", tmp_path / "nothing.yml", log_path, "-o",
+                        tmp_path / "x.json"], capsys)  # fmt: skip
+    assert code == 1 and err.count("\n") == 1 and "neither a reference ship" in err
