@@ -81,8 +81,13 @@ def test_the_file_runs_where_a_vessel_does_and_is_corrected(tmp_path, capsys):
     assert code == 0, err
     (record,) = json.loads((tmp_path / "v.json").read_text())["logs"]
     assert max(record["metrics"][s]["rmse"] for s in "uvr") < 1e-9
-    code, out, err = run(["manoeuvre", path, "zigzag", "--rudder", "10"], capsys)
-    assert code == 0, err
+    for argv in (["manoeuvre", path, "zigzag", "--rudder", "10"],
+                 ["simulate", path, log_path, "-o", tmp_path / "sim.csv"]):  # fmt: skip
+        code, out, err = run(argv, capsys)
+        assert code == 0, (argv, err)
+    code, out, err = run(["linearise", path], capsys)
+    _, built_in, _ = run(["linearise", "kvlcc2"], capsys)
+    assert code == 0 and out.splitlines()[-1] == built_in.splitlines()[-1]  # Nomoto alike
     corrected = tmp_path / "corrected.json"
     code, out, err = run(["correct", path, log_path, "-o", corrected], capsys)
     assert code == 0 and "kvlcc2-file kept whole" in out, err

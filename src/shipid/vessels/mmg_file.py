@@ -114,10 +114,10 @@ class MMGDynamics:
         per-call cost was most of a step."""
         nu = np.asarray(nu, dtype=float)
         delta = np.broadcast_to(np.asarray(delta, dtype=float), nu.shape[:1])
-        return np.array([self.accelerations(*row, d) for row, d in
+        return np.array([self.state_accelerations(*row, d) for row, d in
                          zip(nu.tolist(), delta.tolist(), strict=True)]).reshape(-1, 3)  # fmt: skip
 
-    def accelerations(self, u: float, vm: float, r: float, delta: float
+    def state_accelerations(self, u: float, vm: float, r: float, delta: float
                       ) -> tuple[float, float, float]:  # fmt: skip
         """(u̇, v̇m, ṙ) at one state: hull, propeller and rudder forces through the mass matrix
         (the built-in KVLCC2's ``accelerations``, these coefficients)."""
