@@ -78,3 +78,21 @@ def test_the_mmg_model_on_hsvas_run_as_the_benchmark_reads_it(tmp_path, capsys):
     assert np.allclose([closed["first_overshoot_deg"], closed["second_overshoot_deg"]],
                        [10.39, 11.46], atol=0.02)  # fmt: skip
     assert measured["first_overshoot_deg"] == pytest.approx(11.0, abs=0.01)
+
+
+def test_identify_names_the_published_model_of_a_ship_it_has(tmp_path, capsys):
+    """Logs that say they are the KVLCC2 (as MARIN's and HSVA's files do), at the built-in
+    model's scale: identify points to validate and correct with it; at another scale it does
+    not (the built-in ship is the 7 m model)."""
+    ship = get_vessel("kvlcc2")
+    log = zigzag(ship, 20, 20, duration=60, dt=0.2).log
+    assert log.attrs["ship"] == "kvlcc2"
+    said = {}
+    for label, run_log in (("model scale", log), ("full scale", log.assign(u=6.76 * log["u"]))):
+        path = write_log(run_log, tmp_path / f"{label}.csv")
+        code, out, err = run(["identify", path, "--model", "blanke-speed", "-o",
+                              tmp_path / f"{label}.json"], capsys)  # fmt: skip
+        assert code == 0, err
+        said[label] = out
+    assert "shipid correct kvlcc2 LOG..." in said["model scale"]
+    assert "published model" not in said["full scale"]

@@ -409,7 +409,32 @@ def cmd_identify(args) -> int:
     for w in ident.warnings:
         _warn(w)
     print(f"model written to {args.output}")
+    note = _published_model_note(logs)
+    if note:
+        print(note)
     return 0
+
+
+def _published_model_note(logs) -> str | None:
+    """Where the logs say their ship is one whose published model is built in (the KVLCC2's
+    MMG model): the commands that use it, and what it did on that ship's real runs."""
+    from shipid.cli.common import VESSEL_NAMES
+    from shipid.cli.evaluation import _reference_speed_notes
+    from shipid.vessels import get_vessel
+
+    ships = {str(log.attrs.get("ship", "")).strip().lower() for log in logs}
+    known = sorted(ships & set(VESSEL_NAMES) - {"scale-ship"})
+    if not known:
+        return None
+    name = known[0]
+    # Not where the logs run at another scale than the built-in ship (MARIN's files read
+    # without --scale: the full-scale ship, the MMG model's 7 m one).
+    if _reference_speed_notes(get_vessel(name), logs, [""] * len(logs)):
+        return None
+    return (f"{name}: its published model is built in: shipid validate {name} LOG... judges it "
+            f"on your logs, and shipid correct {name} LOG... -o SHIP.json keeps it whole and "
+            "fits only what it misses (on the KVLCC2's real runs, closer to the runs left out "
+            "than a model identified from scratch: docs/kvlcc2.md)")  # fmt: skip
 
 
 def _replicates_checked(ensemble, report: dict, model, as_written, speed, rps, curvature,
