@@ -674,6 +674,38 @@ def _np():
     return np
 
 
+# A log whose approach is this many times a reference ship's own (or less than its inverse)
+# is of another ship or scale (MARIN's KVLCC2 files read without --scale run at 8.1 m/s, the
+# reference 7 m model at 1.18).
+REFERENCE_SPEED_FACTOR = 2.0
+
+
+def _reference_speed_notes(vessel, logs, names) -> list[str]:
+    """A warning per log whose approach speed is far from the reference ship's own: the logs
+    carry no length to check, their speed says the scale."""
+    own = getattr(vessel, "approach_speed", None)
+    out = []
+    for log, name in zip(logs, names, strict=True):
+        u0 = float(log["u"].iloc[0]) if len(log) else math.nan
+        if own and u0 > 0 and not 1 / REFERENCE_SPEED_FACTOR <= u0 / own <= REFERENCE_SPEED_FACTOR:
+            # Only MARIN's reader Froude-scales its full-scale data (``_scale_notes``).
+            marin = str(log.attrs.get("source", "")).startswith("MARIN")
+            out.append(f"{name}: it starts at {u0:.3g} m/s, {u0 / own:.2g} times {vessel.name}'s "
+                       f"approach ({own:.3g} m/s, its {vessel.length:g} m): a log of another "
+                       "ship or scale" + (" (MARIN's files at the 7 m model: --scale 45.7)"
+                                          if marin else "")
+                       + " is run at a speed the reference ship was never made for")  # fmt: skip
+    return out
+
+
+def _vessel_conditions() -> dict:
+    """A reference ship's "training conditions": none (no logs, no envelope, no convention of
+    logs: the ship says its own)."""
+    return {"speed": None, "rps": None, "envelope": {}, "particulars": None,
+            "rudder_rate": None, "rudder_positive": None, "alternatives": {},
+            "alternatives_fit": ""}  # fmt: skip
+
+
 def _ship_or_model(name: str, hybrid: bool = False):
     """A reference ship (its trimmed speed applies) or a model file with its training
     conditions (approach speed, propeller speed, envelope); a model with a kernel residual
@@ -681,21 +713,16 @@ def _ship_or_model(name: str, hybrid: bool = False):
     from shipid.reporting.modelfile import load_document, model_from_document, training_conditions
     from shipid.vessels import get_vessel
 
-    vessel_conditions = {"speed": None, "rps": None, "envelope": {}, "particulars": None,
-                         "rudder_rate": None, "rudder_positive": None, "alternatives": {},
-                         "alternatives_fit": ""}  # fmt: skip
     if name in VESSEL_NAMES:
-        return get_vessel(name), vessel_conditions
+        return get_vessel(name), _vessel_conditions()
     if not Path(name).exists():
         raise ShipidError(f"{name}: neither a model file nor a known vessel "
                           f"({', '.join(VESSEL_NAMES)})")  # fmt: skip
-    from shipid.identification.correction import is_corrected_file, load_corrected
-    from shipid.vessels.mmg_file import is_mmg_file, read_mmg
+    from shipid.identification.correction import reference_file
 
-    if is_corrected_file(name):  # a reference ship kept whole and corrected (shipid correct)
-        return load_corrected(name), vessel_conditions
-    if is_mmg_file(name):  # a ship's own MMG coefficients
-        return read_mmg(name), vessel_conditions
+    ship = reference_file(name)  # shipid correct's corrected ship, or a ship's own MMG model
+    if ship is not None:
+        return ship, _vessel_conditions()
     from shipid.reporting.modelfile import (
         alternatives_fit,
         alternatives_from_document,

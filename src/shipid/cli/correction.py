@@ -3,29 +3,39 @@ of the same ship; the corrected ship written to a file the commands run as a ref
 
 from __future__ import annotations
 
-from shipid.cli.common import _json_text, _read_files, _training_logs, _warn
+from shipid.cli.common import (
+    VESSEL_NAMES,
+    _json_text,
+    _read_files,
+    _reference_speed_notes,
+    _training_logs,
+    _warn,
+)
 
 
 def cmd_correct(args) -> int:
     """``shipid correct VESSEL LOG... -o SHIP.json``."""
-    from shipid.cli.common import VESSEL_NAMES
-    from shipid.cli.evaluation import _reference_speed_notes
     from shipid.errors import ShipidError
     from shipid.identification.correction import correction_document, identify_correction
     from shipid.outputs import atomic_write_text, check_outputs
     from shipid.vessels import get_vessel
-    from shipid.vessels.mmg_file import is_mmg_file, read_document, read_mmg
+    from shipid.vessels.mmg_file import FORMAT as MMG_FORMAT
+    from shipid.vessels.mmg_file import mmg_vessel, read_document
 
     given = [] if args.reference in VESSEL_NAMES else [args.reference]
     check_outputs({"-o": (args.output, "json")}, [*given, *args.logs, *_read_files(args)])
-    if args.reference in VESSEL_NAMES:
+    if not given:
         reference, stored = get_vessel(args.reference), args.reference
-    elif is_mmg_file(args.reference):  # kept whole in the file: it needs no other to load
-        reference, stored = read_mmg(args.reference), {"mmg": read_document(args.reference)}
     else:
-        raise ShipidError(f"{args.reference}: neither a reference ship "
-                          f"({', '.join(VESSEL_NAMES)}) nor an MMG model file "
-                          "(format: shipid-mmg, shipid.vessels.mmg_file)")  # fmt: skip
+        from pathlib import Path
+
+        mmg = read_document(args.reference) if Path(args.reference).is_file() else None
+        if not (isinstance(mmg, dict) and mmg.get("format") == MMG_FORMAT):
+            raise ShipidError(f"{args.reference}: neither a reference ship "
+                              f"({', '.join(VESSEL_NAMES)}) nor an MMG model file "
+                              "(format: shipid-mmg, shipid.vessels.mmg_file)")  # fmt: skip
+        # Kept whole in the corrected ship's file: it needs no other to load.
+        reference, stored = mmg_vessel(mmg, args.reference), {"mmg": mmg}
     logs = _training_logs(args)
     names = [str(p) for p in args.logs]
     for note in _reference_speed_notes(reference, logs, names):

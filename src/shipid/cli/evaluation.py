@@ -20,10 +20,12 @@ from shipid.cli.common import (
     _print_yaw_rate_offsets,
     _read_files,
     _read_options,
+    _reference_speed_notes,
     _sampling_notes,
     _scale_notes,
     _ship_or_model,
     _simulated_metadata,
+    _vessel_conditions,
     _warn,
     _warn_beyond_training,
     _warn_cut,
@@ -46,7 +48,7 @@ def cmd_validate(args) -> int:
     """``shipid validate``: free runs on logs, metrics, indices, figures, report."""
     from shipid.evaluation.envelope import outside_envelope
     from shipid.evaluation.validate import validate
-    from shipid.identification.correction import is_corrected_file
+    from shipid.identification.correction import reference_file
     from shipid.outputs import OutputSet, check_outputs
     from shipid.reporting.modelfile import (
         ensemble_from_document,
@@ -62,10 +64,11 @@ def cmd_validate(args) -> int:
         start_spread_note,
         switch_heading_note,
     )
-    from shipid.vessels.mmg_file import is_mmg_file
+    from shipid.vessels import get_vessel
 
-    reference = (args.model in VESSEL_NAMES or is_corrected_file(args.model)
-                 or is_mmg_file(args.model))  # fmt: skip
+    # A reference ship, shipid correct's corrected one or a ship's own MMG model, read once.
+    ship = get_vessel(args.model) if args.model in VESSEL_NAMES else reference_file(args.model)
+    reference = ship is not None
     check_outputs({"--json": (args.json, "json"), "--plots": (args.plots, "dir"),
                    "--report": (args.report, "dir")},
                   [*([] if args.model in VESSEL_NAMES else [args.model]), *args.logs,
@@ -76,9 +79,9 @@ def cmd_validate(args) -> int:
         if args.lssvm:
             raise ShipidError(f"--lssvm: {args.model} is a reference ship, not an identified "
                               "model with an LS-SVM fit of its own")  # fmt: skip
-        doc, ensemble, band = None, None, None
-        model, cond = _ship_or_model(args.model)
-        cond["rudder_positive"] = model.rudder_positive  # the logs are turned to its convention
+        doc, ensemble, band, model = None, None, None, ship
+        # The logs are turned to the ship's own rudder convention.
+        cond = {**_vessel_conditions(), "rudder_positive": model.rudder_positive}
     else:
         doc = load_document(args.model)
         if args.lssvm and not has_refinement(doc):
@@ -236,30 +239,6 @@ def cmd_validate(args) -> int:
             out.write(Path(args.report) / "report.html",
                       lambda p: p.write_text(text, encoding="utf-8"))
     return 1 if errors else 0
-
-
-# A log whose approach is this many times a reference ship's own (or less than its inverse)
-# is of another ship or scale (MARIN's KVLCC2 files read without --scale run at 8.1 m/s, the
-# reference 7 m model at 1.18).
-REFERENCE_SPEED_FACTOR = 2.0
-
-
-def _reference_speed_notes(vessel, logs, names) -> list[str]:
-    """A warning per log whose approach speed is far from the reference ship's own: the logs
-    carry no length to check, their speed says the scale."""
-    own = getattr(vessel, "approach_speed", None)
-    out = []
-    for log, name in zip(logs, names, strict=True):
-        u0 = float(log["u"].iloc[0]) if len(log) else math.nan
-        if own and u0 > 0 and not 1 / REFERENCE_SPEED_FACTOR <= u0 / own <= REFERENCE_SPEED_FACTOR:
-            # Only MARIN's reader Froude-scales its full-scale data (``_scale_notes``).
-            marin = str(log.attrs.get("source", "")).startswith("MARIN")
-            out.append(f"{name}: it starts at {u0:.3g} m/s, {u0 / own:.2g} times {vessel.name}'s "
-                       f"approach ({own:.3g} m/s, its {vessel.length:g} m): a log of another "
-                       "ship or scale" + (" (MARIN's files at the 7 m model: --scale 45.7)"
-                                          if marin else "")
-                       + " is run at a speed the reference ship was never made for")  # fmt: skip
-    return out
 
 
 def _mark_training_logs(doc, vals) -> None:

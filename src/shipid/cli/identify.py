@@ -8,6 +8,7 @@ import sys
 from types import SimpleNamespace
 
 from shipid.cli.common import (
+    VESSEL_NAMES,
     _ahead,
     _approach,
     _fmt_speed,
@@ -19,6 +20,7 @@ from shipid.cli.common import (
     _pd,
     _physics,
     _read_files,
+    _reference_speed_notes,
     _rudder_drag_note,
     _std_errors,
     _structure,
@@ -418,8 +420,6 @@ def cmd_identify(args) -> int:
 def _published_model_note(logs) -> str | None:
     """Where the logs say their ship is one whose published model is built in (the KVLCC2's
     MMG model): the commands that use it, and what it did on that ship's real runs."""
-    from shipid.cli.common import VESSEL_NAMES
-    from shipid.cli.evaluation import _reference_speed_notes
     from shipid.vessels import get_vessel
 
     ships = {str(log.attrs.get("ship", "")).strip().lower() for log in logs}

@@ -12,7 +12,7 @@ equation regresses (ξ(k+1) − ξ(k))/Δk − f_ref(ν(k), δ(k)) on the struct
 large γ a perfect reference leaves θ = 0. The corrected ship is a ``Vessel``, its steering and
 trim the reference's: the Python API (``validate``, ``zigzag``, ``turning_circle``) runs it as
 any reference ship, and ``shipid correct`` writes it to a file (``correction_document``) that
-the commands taking a reference ship load (``load_corrected``). The reference's propeller
+the commands taking a reference ship load (``reference_file``). The reference's propeller
 stays at its own trim; a correction has no propeller, thrust or wind terms.
 
 On the KVLCC2's three real zig-zags (``benchmarks/study_kvlcc2_mmg_baseline.py``) the MMG model
@@ -35,7 +35,7 @@ from shipid.dynamics.terms import INPUT_SIGNALS, parse_term
 from shipid.errors import ShipidError
 from shipid.identification.estimators import fit_linear
 from shipid.identification.physics import dof_physics
-from shipid.identification.regression import common_sampling_time, log_terms
+from shipid.identification.regression import regression_problem
 from shipid.vessels.vessel import Vessel
 
 DOFS = ("u", "v", "r")
@@ -75,12 +75,11 @@ def corrected_dynamics(reference, correction: ManoeuvringModel):
     ``CorrectedDynamics`` the simulator steps in Python. Either keeps ``correction``."""
     if type(reference) is not ManoeuvringModel or reference.similar_at_rps is not None:
         return CorrectedDynamics(reference, correction)
-    structure = reference.structure.union(correction.structure.terms,
-                                          name=f"{reference.name} + correction")  # fmt: skip
-    coefficients = {d: {t: reference.coefficients.get(d, {}).get(t, 0.0)
-                        + correction.coefficients.get(d, {}).get(t, 0.0) for t in terms}
-                    for d, terms in structure.terms.items()}  # fmt: skip
-    merged = ManoeuvringModel(structure, coefficients, name=structure.name)
+    from shipid.identification.identify import average_models
+
+    # Weights 1 and 1: each coefficient the sum of the two, a term one lacks counting 0.
+    merged = average_models([(reference, 1.0), (correction, 1.0)], reference.structure,
+                            f"{reference.name} + correction")  # fmt: skip
     merged.correction = correction  # what validate's report shows
     return merged
 
@@ -192,31 +191,27 @@ def _fit(logs, names, reference: Vessel, structure: ModelStructure, gamma: float
          weights: np.ndarray | None = None) -> tuple[ManoeuvringModel, dict[str, float]]:
     """The correction of ``reference`` on ``logs`` (filtered already) and the reference's
     share of each equation's increments; ``weights``: each equation's multiplicity (the logs'
-    samples but the last of each, in order: a bootstrap replicate)."""
-    dt = common_sampling_time(logs, names)
+    samples but the last of each, in order: a bootstrap replicate). Each equation is
+    ``regression_problem``'s with the reference's accelerations as the known part of the
+    target, computed once per log for the three."""
+    own = {id(log): reference.dynamics.derivatives(log[list(DOFS)].to_numpy(dtype=float)[:-1],
+                                                   log["delta"].to_numpy(dtype=float)[:-1])
+           for log in logs}  # fmt: skip
     coefficients, terms, explained = {}, {}, {}
     for dof in structure.dofs:
         j = DOFS.index(dof)
-        free = [t for t in structure.terms[dof] if t != "1"]
-        Xs, ys, raw = [], [], []
-        for log, name in zip(logs, names, strict=True):
-            nu = log[list(DOFS)].to_numpy(dtype=float)
-            delta = log["delta"].to_numpy(dtype=float)
-            increment = (nu[1:, j] - nu[:-1, j]) / dt
-            ys.append(increment - reference.dynamics.derivatives(nu[:-1], delta[:-1])[:, j])
-            raw.append(increment)
-            Xs.append(log_terms(log, free, name)[:-1])
-        X, y = np.vstack(Xs), np.concatenate(ys)
+        p = regression_problem(logs, structure, dof, names=names,
+                               known=lambda log, j=j: own[id(log)][:, j])  # fmt: skip
         # Without "1" in the equation the fit has no bias either (b = 0), as identify's.
-        physics = dof_physics(None, dof, free, "1" in structure.terms[dof], {}, logs)
-        theta, bias = fit_linear(X, y, "lssvm", gamma, weights, physics=physics)
-        coefficients[dof] = dict(zip(free, theta.tolist(), strict=True))
-        terms[dof] = tuple(free)
-        if "1" in structure.terms[dof]:
+        physics = dof_physics(None, dof, p.names, p.has_constant, {}, logs)
+        theta, bias = fit_linear(p.X, p.y, "lssvm", gamma, weights, physics=physics)
+        coefficients[dof] = dict(zip(p.names, theta.tolist(), strict=True))
+        terms[dof] = tuple(p.names) + (("1",) if p.has_constant else ())
+        if p.has_constant:
             coefficients[dof]["1"] = float(bias)
-            terms[dof] += ("1",)
-        spread = float(np.var(np.concatenate(raw)))
-        explained[dof] = 1.0 - float(np.var(y)) / spread if spread > 0 else float("nan")
+        increments = p.y + np.concatenate([own[id(log)][:, j] for log in logs])
+        spread = float(np.var(increments))
+        explained[dof] = 1.0 - float(np.var(p.y)) / spread if spread > 0 else float("nan")
     correction = ManoeuvringModel(ModelStructure(f"correction ({structure.name})", terms),
                                   coefficients, name=f"correction of {reference.name}")  # fmt: skip
     return correction, explained
@@ -280,36 +275,38 @@ def correction_document(fit: Correction, reference: str | dict, training_files: 
             "training_files": [{"path": str(p), "sha256": sha256(p)} for p in training_files]}
 
 
-def is_corrected_file(path) -> bool:
-    """Whether ``path`` is a readable file whose JSON says it is a corrected reference ship."""
-    import json
+def reference_file(path) -> Vessel | None:
+    """The ship of a file that holds one, read once: a corrected reference ship (``shipid
+    correct``) or a ship's own MMG model (``shipid.vessels.mmg_file``); None for any other file
+    (a model file, which its own reader reads)."""
     from pathlib import Path
 
-    p = Path(path)
-    if not p.is_file():
-        return False
+    from shipid.vessels.mmg_file import FORMAT as MMG_FORMAT
+    from shipid.vessels.mmg_file import mmg_vessel, read_document
+
+    p = Path(str(path))
+    if not p.is_file() or p.suffix.lower() not in (".json", ".yml", ".yaml"):
+        return None
     try:
-        doc = json.loads(p.read_text(encoding="utf-8"))
-    except (UnicodeDecodeError, ValueError, RecursionError):
-        return False
-    return isinstance(doc, dict) and doc.get("format") == CORRECTED_FORMAT
+        doc = read_document(p)
+    except ShipidError:
+        return None
+    kind = doc.get("format") if isinstance(doc, dict) else None
+    if kind == CORRECTED_FORMAT:
+        return corrected_from_document(doc, p)
+    if kind == MMG_FORMAT:
+        return mmg_vessel(doc, str(p))
+    return None
 
 
-def load_corrected(path) -> Vessel:
-    """The corrected reference ship of a ``shipid correct`` file (one-line errors naming it)."""
-    import json
+def corrected_from_document(doc: dict, path) -> Vessel:
+    """The corrected reference ship of a parsed ``shipid correct`` file (one-line errors naming
+    it)."""
     from pathlib import Path
 
     from shipid.vessels import VESSELS
 
-    p = Path(path)
-    try:
-        doc = json.loads(p.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, ValueError, RecursionError) as exc:
-        raise ShipidError(f"{path}: not a corrected ship file ({str(exc)[:120]})") from None
-    if not isinstance(doc, dict) or doc.get("format") != CORRECTED_FORMAT:
-        raise ShipidError(f"{path}: not a corrected ship file (no \"format\": "
-                          f"\"{CORRECTED_FORMAT}\")")  # fmt: skip
+    p = Path(str(path))
     if doc.get("version") != CORRECTED_VERSION:
         raise ShipidError(f"{path}: corrected ship file version {doc.get('version')!r} is not "
                           f"supported (this shipid reads {CORRECTED_VERSION})")  # fmt: skip
@@ -319,7 +316,7 @@ def load_corrected(path) -> Vessel:
 
         reference = mmg_vessel(name["mmg"], f"{path}: reference.mmg")
         name = reference.name
-    elif name not in VESSELS:
+    elif not isinstance(name, str) or name not in VESSELS:
         raise ShipidError(f"{path}: reference {name!r} is not a reference ship of this shipid "
                           f"({', '.join(VESSELS)}) nor an MMG model (reference.mmg)")  # fmt: skip
     else:

@@ -149,10 +149,13 @@ def regression_problem(
     form: str = "increment",
     fixed: Mapping[str, float] | None = None,
     names: Sequence[str] | None = None,
+    known: Callable[[pd.DataFrame], np.ndarray] | None = None,
 ) -> RegressionProblem:
     """Stack the regression of one degree of freedom over several logs.
 
-    ``fixed`` terms (name → continuous-time coefficient) are moved to the target side.
+    ``fixed`` terms (name → continuous-time coefficient) are moved to the target side, and so
+    is ``known(log)``: an acceleration of this DOF already known at each sample but the last (a
+    reference ship's, ``shipid.identification.correction``; increment form).
     """
     if form not in FORMS:
         raise ShipidError(f"unknown form {form!r}; use one of {', '.join(FORMS)}")
@@ -177,6 +180,8 @@ def regression_problem(
         if fixed:
             Ffix = log_terms(log, list(fixed), name)[:-1]
             target = target - Ffix @ np.fromiter(fixed.values(), float)
+        if known is not None:
+            target = target - known(log)
         if form == "paper":
             # Eq. (12) as printed: raw terms, so Γ = [ξ(k) coefficient, Δk·θ...] is what the
             # LS-SVM regularises, exactly as in the paper.

@@ -209,18 +209,6 @@ def read_document(path) -> dict:
         raise ShipidError(f"{path}: not a readable MMG file ({str(exc)[:120]})") from None
 
 
-def is_mmg_file(path) -> bool:
-    """Whether ``path`` is a YAML or JSON file that says it is an MMG model."""
-    p = Path(str(path))
-    if not p.is_file() or p.suffix.lower() not in (".yml", ".yaml", ".json"):
-        return False
-    try:
-        doc = read_document(p)
-    except ShipidError:
-        return False
-    return isinstance(doc, Mapping) and doc.get("format") == FORMAT
-
-
 def read_mmg(path) -> Vessel:
     """The reference ship of the MMG file ``path``."""
     return mmg_vessel(read_document(path), str(path))
