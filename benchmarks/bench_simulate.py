@@ -25,6 +25,7 @@ from shipid.dynamics import codegen, kernel
 from shipid.dynamics.model import ManoeuvringModel, ModelStructure
 from shipid.dynamics.simulate import input_array, run_kernel, simulate, simulate_batch
 from shipid.vessels import scale_ship_model
+from shipid.vessels.mmg import accelerations as mmg_accelerations
 
 TERMS_20 = ("|u|u", "v*r", "r^2", "delta^2", "1", "u*r", "u*v", "|v|v", "|v|r", "delta",
             "u^2*delta", "v^3", "v^2*r", "v*r^2", "r^3", "u*delta", "delta^3", "v*delta^2",
@@ -337,6 +338,115 @@ def reference_ships() -> None:
               f"{slow / fast:.0f}× |")
 
 
+_TURN_SHIP = None  # the hand-written loop's coefficients: a global, frozen into its code
+
+
+@numba.njit(cache=False)
+def _typed_in_turn(n, dt, u0, rate, target, k_uv, k_ur, k_uud, states):
+    """A 35° turn hand-written in numba: the MMG formula with the ship's coefficients frozen in
+    as constants (``_TURN_SHIP``), a correction's three terms typed in, RK4, the rudder moving
+    at its rate to ``target`` (the practical limit of the compiled closed loop)."""
+    c, rps = _TURN_SHIP
+    u, v, r, psi, x, y, d = u0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    for k in range(n):
+        states[k, 0], states[k, 1], states[k, 2] = u, v, r
+        states[k, 3], states[k, 4], states[k, 5] = psi, x, y
+        d = min(d + rate * dt, target)
+        ks = np.empty((4, 6))
+        su, sv, sr, sp = u, v, r, psi
+        for i in range(4):
+            a0, a1, a2 = mmg_accelerations(c, su, sv, sr, d, rps)
+            ks[i, 0] = a0
+            ks[i, 1] = a1 + k_uv * su * sv
+            ks[i, 2] = a2 + k_ur * su * sr + k_uud * su * su * d
+            ks[i, 3] = sr
+            ks[i, 4] = su * math.cos(sp) - sv * math.sin(sp)
+            ks[i, 5] = su * math.sin(sp) + sv * math.cos(sp)
+            h = dt if i == 2 else 0.5 * dt
+            su, sv, sr, sp = u + h * ks[i, 0], v + h * ks[i, 1], r + h * ks[i, 2], psi + h * ks[i, 3]
+        w = dt / 6.0
+        u += w * (ks[0, 0] + 2 * ks[1, 0] + 2 * ks[2, 0] + ks[3, 0])
+        v += w * (ks[0, 1] + 2 * ks[1, 1] + 2 * ks[2, 1] + ks[3, 1])
+        r += w * (ks[0, 2] + 2 * ks[1, 2] + 2 * ks[2, 2] + ks[3, 2])
+        psi += w * (ks[0, 3] + 2 * ks[1, 3] + 2 * ks[2, 3] + ks[3, 3])
+        x += w * (ks[0, 4] + 2 * ks[1, 4] + 2 * ks[2, 4] + ks[3, 4])
+        y += w * (ks[0, 5] + 2 * ks[1, 5] + 2 * ks[2, 5] + ks[3, 5])
+    return n
+
+
+def mmg_ships() -> None:
+    """The MMG model compiled once for any coefficients (``shipid.vessels.mmg``): the built-in
+    KVLCC2, the same ship from an MMG file and the KVLCC2 with a correction (``shipid
+    correct``), a 35° turning circle's closed loop (the kernel entry, no log), against the
+    generic Python loop they ran on before (``derivatives`` per RK4 stage; the NumPy-free MMG
+    file's, the correction through its compiled term kernel) and a hand-written numba loop with
+    the coefficients frozen in as constants and the correction's terms typed in."""
+    import dataclasses
+
+    from shipid.dynamics.model import get_structure
+    from shipid.identification.correction import CorrectedDynamics, corrected_dynamics
+    from shipid.trials.manoeuvres import _generic_closed_loop, manoeuvre_params
+    from shipid.vessels import kvlcc2
+    from shipid.vessels.mmg import MMGDynamics
+    from shipid.vessels.mmg_file import mmg_vessel
+
+    global _TURN_SHIP
+
+    ship = kvlcc2()
+    _TURN_SHIP = (ship.dynamics.packed, ship.dynamics.n_prop)
+    doc = {"format": "shipid-mmg", "name": "kvlcc2-file", **{
+        k: v for k, v in ship.dynamics.c.items() if "." not in k and k not in ("name", "rps")}}
+    for key, value in ship.dynamics.c.items():
+        if "." in key:
+            group, name = key.split(".")
+            doc.setdefault(group, {})[name] = value
+    from_file = mmg_vessel(doc)
+    structure = get_structure("blanke-race")
+    coefficients = {d: dict.fromkeys(t, 0.0) for d, t in structure.terms.items()}
+    coefficients["v"]["u*v"], coefficients["r"]["u*r"] = 0.01, -0.02
+    coefficients["r"]["u^2*delta"] = 0.003
+    correction = ManoeuvringModel(structure, coefficients)
+    corrected = dataclasses.replace(ship, dynamics=corrected_dynamics(ship.dynamics, correction))
+    duration, dt = 2000.0, 0.05
+    n = int(duration / dt) + 1
+    params = manoeuvre_params(ship, kernel.MODE_HOLD, ship.steering.max_angle, 0.0, 0.0)
+    s0 = np.zeros((1, 6))
+    s0[0, 0] = ship.approach_speed
+    lim = (np.array([10.0]), np.array([10.0]))
+    states, rudder, valid = np.zeros((1, n, 6)), np.zeros((1, n)), np.zeros(1, dtype=np.int64)
+    mine = np.zeros((n, 6))
+    m = n // 10  # the generic loop runs a tenth of the turn: 20 s of it otherwise
+
+    def ours(dyn):
+        dyn.integrate_closed(dt, n, s0, params[None].copy(), True, *lim, states, rudder, valid)
+        return states[0].copy()
+
+    print(f"\nMMG ships, a {duration:g} s 35° turning circle's closed loop (RK4, Δt {dt} s, "
+          f"{n} steps): the compiled kernel entry against the generic Python loop and a "
+          "hand-written numba loop (coefficients as constants, the correction typed in)\n")
+    print("| ship | compiled (ms) | steps/s | generic Python loop (s) | speed-up | "
+          "hand-written numba (ms) | vs hand-written | largest state difference |")
+    print("|---|---|---|---|---|---|---|---|")
+    rows = (("built-in KVLCC2", ship.dynamics, (0.0, 0.0, 0.0)),
+            ("KVLCC2 from an MMG file", from_file.dynamics, (0.0, 0.0, 0.0)),
+            ("KVLCC2 + correction", corrected.dynamics, (0.01, -0.02, 0.003)))
+    for label, dyn, k in rows:
+        assert isinstance(getattr(dyn, "reference", dyn), MMGDynamics)
+        ours(dyn)
+        _typed_in_turn(n, dt, ship.approach_speed, ship.steering.max_rate,
+                       ship.steering.max_angle, *k, mine)  # fmt: skip
+        fast = best_of(lambda d=dyn: ours(d), 5)
+        hand = best_of(lambda k=k: _typed_in_turn(n, dt, ship.approach_speed,
+                                                  ship.steering.max_rate,
+                                                  ship.steering.max_angle, *k, mine), 5)
+        generic = CorrectedDynamics(dyn.reference, dyn.correction) if k[0] else NumpyPath(dyn)
+        slow = best_of(lambda g=generic: _generic_closed_loop(g, params, m, dt, s0, "rk4",
+                                                              10.0, 10.0, None), 1) * n / m
+        diff = float(np.max(np.abs(ours(dyn)[:, :3] - mine[:, :3])))
+        print(f"| {label} | {1e3 * fast:.1f} | {n / fast:.3g} | {slow:.1f} | {slow / fast:.0f}× | "
+              f"{1e3 * hand:.1f} | {hand / fast:.2f}× | {diff:.1e} |")
+
+
 def python_heading(a, b, c, n, dt, u0, rk4, target, gains, max_angle, rate):
     """Plain Python heading autopilot on the Blanke model: PID on the wrapped heading error
     (integral frozen while the command exceeds the rudder limit), a rate-limited steering
@@ -450,11 +560,18 @@ def kvlcc2_against_solve_ivp() -> None:
 
     from shipid.trials.indices import turning_indices
     from shipid.trials.manoeuvres import turning_circle
-    from shipid.vessels import kvlcc2
-    from shipid.vessels.kvlcc2 import accelerations
+    from shipid.vessels import kvlcc2, mmg
 
     ship = kvlcc2()
     n, u0, duration, dt = ship.dynamics.n_prop, ship.approach_speed, 200.0, 0.05
+    c = ship.dynamics.packed
+
+    def python_formulas(u, v, r, delta, n):
+        return mmg.accelerations.py_func(c, u, v, r, delta, n)
+
+    def compiled_formulas(u, v, r, delta, n):
+        return mmg.accelerations(c, u, v, r, delta, n)
+
     rate, target = ship.steering.max_rate, ship.steering.max_angle  # starboard: δ > 0
 
     def rhs_of(acc):
@@ -468,7 +585,7 @@ def kvlcc2_against_solve_ivp() -> None:
 
     t = np.arange(int(duration / dt) + 1) * dt
 
-    def run_ivp(acc=accelerations.py_func, **tol):
+    def run_ivp(acc=python_formulas, **tol):
         sol = solve_ivp(rhs_of(acc), (0.0, t[-1]), [u0, 0, 0, 0, 0, 0], method="RK45",
                         t_eval=t, **tol)  # fmt: skip
         log = pd.DataFrame({"t": t, "u": sol.y[0], "v": sol.y[1], "r": sol.y[2],
@@ -485,8 +602,8 @@ def kvlcc2_against_solve_ivp() -> None:
     t_ivp = best_of(baseline)
     td_ivp, nfev = baseline()
     # The stronger simple alternative: the same solve_ivp calling our compiled formulas.
-    baseline(acc=accelerations)
-    t_fast = best_of(lambda: baseline(acc=accelerations))
+    baseline(acc=compiled_formulas)
+    t_fast = best_of(lambda: baseline(acc=compiled_formulas))
     print(f"\nKVLCC2 35° turning circle, {duration:g} s, run, logged and its indices computed: "
           "our compiled RK4 against scipy solve_ivp RK45 on the Python MMG formulas (shipmmg's "
           "method); the tactical diameter against a tight-tolerance solve_ivp run "
@@ -511,5 +628,6 @@ if __name__ == "__main__":
     main()
     closed_loop()
     reference_ships()
+    mmg_ships()
     heading_autopilot()
     kvlcc2_against_solve_ivp()

@@ -150,6 +150,7 @@ def force_split() -> None:
 
     ship = mmg.kvlcc2()
     n = trimmed_revolutions(ship.approach_speed)
+    c = ship.dynamics.packed  # masses and the mass matrix's inverse
 
     def split(u, v, r, delta):
         U = np.hypot(u, v)
@@ -160,10 +161,10 @@ def force_split() -> None:
                           + mmg.YRRR * rp**3),
                      q * mmg.L * (mmg.NVVV * vp**3 + mmg.NVVR * vp**2 * rp
                                   + mmg.NVRR * vp * rp**2 + mmg.NRRR * rp**3))  # fmt: skip
-        rigid = (-(mmg.m + mmg.mx) * u * r, -mmg.XG * mmg.m * u * r)
-        yaw = {k: mmg._MI10 * y + mmg._MI11 * nn for k, (y, nn) in
+        rigid = (-(c.m + c.mx) * u * r, -c.x_g * c.m * u * r)
+        yaw = {k: c.inv10 * y + c.inv11 * nn for k, (y, nn) in
                (("hull, linear", linear), ("hull, nonlinear", nonlinear), ("rigid body", rigid))}
-        total = np.array([mmg.accelerations(*s, n)[2] for s in zip(u, v, r, delta, strict=True)])
+        total = mmg.KVLCC2Dynamics(n).derivatives(np.column_stack([u, v, r]), delta)[:, 2]
         yaw["rudder (the rest)"] = total - sum(yaw.values())
         return yaw
 

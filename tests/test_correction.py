@@ -111,6 +111,61 @@ def test_an_equation_without_a_constant_is_fitted_without_a_bias():
     assert [fit.correction.coefficients["r"][t] for t in terms] == pytest.approx(expected, rel=1e-6)
 
 
+def _mmg_truth():
+    """The KVLCC2's MMG model and a truth that adds known forces to it (stronger yaw damping
+    and rudder moment, weaker sway damping), the truth stepped by the generic Python loop."""
+    from shipid.dynamics.model import ModelStructure
+    from shipid.identification.correction import CorrectedDynamics
+
+    mmg = get_vessel("kvlcc2")
+    added = ManoeuvringModel(ModelStructure("added", {"v": ("u*v",), "r": ("u*r", "u^2*delta")}),
+                             {"v": {"u*v": 0.01}, "r": {"u*r": -0.02, "u^2*delta": 0.003}})
+    return mmg, added, dataclasses.replace(mmg, dynamics=CorrectedDynamics(mmg.dynamics, added))
+
+
+def test_a_corrected_mmg_ship_runs_compiled_as_the_python_loop_does():
+    """The MMG model plus a correction in the compiled integrators: its zig-zag, turn and a
+    replayed log are the generic loop's (each state stepped through ``derivatives`` in
+    Python) to rounding, and 30-50 times faster (benchmarks/README.md)."""
+    from shipid.dynamics.simulate import simulate_log
+    from shipid.identification.correction import CorrectedMMGDynamics, corrected_dynamics
+    from shipid.trials.manoeuvres import turning_circle
+
+    mmg, added, generic = _mmg_truth()
+    compiled = dataclasses.replace(mmg, dynamics=corrected_dynamics(mmg.dynamics, added))
+    assert isinstance(compiled.dynamics, CorrectedMMGDynamics)
+    for run in (lambda s: zigzag(s, 10, 10, duration=60), lambda s: turning_circle(s, 35)):
+        ours, theirs = run(compiled), run(generic)
+        np.testing.assert_allclose(ours.log.to_numpy(), theirs.log.to_numpy(), rtol=1e-10,
+                                   atol=1e-12)  # fmt: skip
+        numbers = {k: v for k, v in theirs.indices.items() if isinstance(v, float)}
+        assert len(numbers) >= 4
+        assert {k: ours.indices[k] for k in numbers} == pytest.approx(numbers, rel=1e-9)
+    log = zigzag(mmg, 20, 20, duration=40).log
+    ours, theirs = (simulate_log(s.dynamics, log).log for s in (compiled, generic))
+    np.testing.assert_allclose(ours.to_numpy(), theirs.to_numpy(), rtol=1e-10, atol=1e-12)
+    nu, delta = log[["u", "v", "r"]].to_numpy(), log["delta"].to_numpy()
+    inputs = np.c_[delta, np.zeros((len(delta), 4))]
+    np.testing.assert_allclose(compiled.dynamics.derivatives(nu, delta),
+                               mmg.dynamics.derivatives(nu, delta)
+                               + added.compiled_accelerations(nu, inputs), rtol=1e-12, atol=1e-15)
+
+
+def test_the_mmg_models_correction_is_what_its_truth_adds():
+    """Noise-free Euler logs of the MMG model plus known forces: at a large γ the correction
+    of the MMG reference is those forces, and the corrected ship (compiled) runs an unseen
+    10°/10° zig-zag of the truth to 1e-6."""
+    mmg, added, truth = _mmg_truth()
+    train = [zigzag(truth, 20, 20, first=side, duration=80, dt=0.1, method="euler").log
+             for side in ("starboard", "port")]  # fmt: skip
+    fit = identify_correction(train, mmg, added.structure, gamma=1e8)
+    for dof, terms in added.coefficients.items():
+        assert fit.correction.coefficients[dof] == pytest.approx(terms, abs=1e-7), dof
+    unseen = zigzag(truth, 10, 10, duration=80, dt=0.1, method="euler").log
+    run = validate(fit.vessel, unseen, ["unseen"], method="euler", start_draws=False)[0]
+    assert max(run.metrics[s]["rmse"] for s in "uvr") < 1e-6
+
+
 @pytest.mark.parametrize(("kwargs", "said"), [
     ({"model": "blanke-rps"}, "|n|*n"),
     ({"model": "blanke+wind"}, "wind_speed"),

@@ -39,10 +39,11 @@ def test_the_rudder_drag_is_its_closed_form_and_the_kvlcc2_mmg_models():
     # per δ² at its approach, by a central difference in δ, is the generic one's within 10 %.
     mmg = importlib.import_module("shipid.vessels.kvlcc2")
     u0, n0, d = mmg.APPROACH_SPEED, mmg.trimmed_revolutions(), math.radians(1.0)
-    surge = [mmg.accelerations(u0, 0.0, 0.0, x, n0)[0] for x in (-d, 0.0, d)]
+    dynamics = mmg.KVLCC2Dynamics(n0)
+    surge = [dynamics.derivatives([[u0, 0.0, 0.0]], [x])[0, 0] for x in (-d, 0.0, d)]
     per_delta2 = (surge[0] + surge[2] - 2 * surge[1]) / (2 * d**2)
     kvlcc2 = Particulars(length=mmg.L, beam=mmg.B, draught=mmg.D_DRAUGHT, block_coefficient=0.81,
-                         mass=mmg.m, rudder_area=mmg.AR, propeller_diameter=mmg.DP,
+                         mass=dynamics.packed.m, rudder_area=mmg.AR, propeller_diameter=mmg.DP,
                          rudder_height=mmg.HR, rho=mmg.RHO)  # fmt: skip
     assert rudder_drag(kvlcc2, u0, n0) == pytest.approx(per_delta2, rel=0.10)
     no_rudder = Particulars(length=3.0, beam=0.489, draught=0.201, block_coefficient=0.83,

@@ -6,8 +6,8 @@ the source (``__pycache__``). A cold cache costs the first command that needs a 
 compilation (about 9 s of the demo's 13 s on a fresh install) and each of two test workers its
 own copy; so every compiled path is exercised here once, with the argument types the commands
 use: the term model's open and closed runs, its accelerations and path following, the kernel
-residual (hybrid), the reference ships, the zero-phase filter, the track smoother and the
-LS-SVM's blocked leave-one-out. Python's bytecode of the package is written too.
+residual (hybrid), the reference ships (and an MMG one corrected), the zero-phase filter, the
+track smoother and the LS-SVM's blocked leave-one-out. Python's bytecode of the package is written too.
 """
 
 from __future__ import annotations
@@ -29,6 +29,7 @@ def precompile() -> list[str]:
     from shipid.dynamics.hybrid import HybridModel
     from shipid.dynamics.simulate import simulate, simulate_log
     from shipid.evaluation.validate import validate
+    from shipid.identification.correction import identify_correction
     from shipid.identification.identify import identify
     from shipid.identification.residual import fit_residual
     from shipid.lssvm.selection import PrimalLOOPath
@@ -58,6 +59,11 @@ def precompile() -> list[str]:
         ship.dynamics.derivatives(np.array([[ship.approach_speed, 0.0, 0.0]]), np.zeros(1))
         done.append(ship.name)
     turning_circle(mariner(), 35, duration=5.0)
+    # An MMG reference with a correction (shipid correct): the MMG formula plus a term model.
+    corrected = identify_correction(zigzag(kvlcc2(), 10, 10, duration=20.0).log, kvlcc2())
+    simulate(corrected.vessel.dynamics, run.log["t"], run.log["delta"], np.r_[1.0, np.zeros(5)])
+    zigzag(corrected.vessel, 10, 10, duration=5.0)
+    done.append("corrected MMG")
     rng = np.random.default_rng(0)
     PrimalLOOPath(rng.normal(size=(64, 3)), rng.normal(size=(64, 3)), np.ones(64)).mse_grid([1.0, 10.0])
     done.append("blocked leave-one-out")

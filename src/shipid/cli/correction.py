@@ -66,9 +66,19 @@ BEYOND = (("turning", "tactical_diameter"), ("turning", "steady_speed"),
           ("zigzag", "second_overshoot_deg"))  # fmt: skip
 
 
-# The bootstrap replicates' manoeuvres step coarser than the point's (the corrected ship runs
-# in Python): four times the manoeuvres' default step.
+# The bootstrap replicates' manoeuvres step coarser than the point's where the corrected ship
+# runs in Python (a correction of a reference ship other than an MMG model or a term model):
+# four times the manoeuvres' default step.
 REPLICATE_STEP = 0.2
+
+
+def _replicate_step(ship) -> float | None:
+    """The replicates' step: the manoeuvres' default where ``ship`` runs compiled."""
+    from shipid.dynamics.model import ManoeuvringModel
+
+    compiled = isinstance(ship.dynamics, ManoeuvringModel) or hasattr(ship.dynamics,
+                                                                      "integrate_closed")
+    return None if compiled else REPLICATE_STEP
 
 
 def _standard(ship, side: str, dt: float | None = None) -> dict:
@@ -89,10 +99,11 @@ def _beyond_the_logs(reference, corrected, replicates=()) -> list[dict]:
     from shipid.identification.uncertainty import interval
 
     rows = []
+    step = _replicate_step(corrected)
     for side in ("starboard", "port"):
         runs = {label: _standard(ship, side)
                 for label, ship in (("reference", reference), ("corrected", corrected))}
-        drawn = [_standard(ship, side, REPLICATE_STEP) for ship in replicates]
+        drawn = [_standard(ship, side, step) for ship in replicates]
         turn = runs["corrected"]["turning"]
         if turn.diverged or turn.indices.get("tactical_diameter") is None:
             _warn(f"the corrected ship's 35° turn to {side} "
@@ -111,7 +122,8 @@ def _beyond_the_logs(reference, corrected, replicates=()) -> list[dict]:
                 row["95 % interval"] = f"[{lo:.4g}, {hi:.4g}]"
             rows.append(row)
     print("Beyond the logs (the standard manoeuvres from the reference's approach"
-          + (f"; intervals over {len(replicates)} bootstrap replicates of the correction, "
-             f"run at {REPLICATE_STEP:g} s steps" if replicates else "") + "):")  # fmt: skip
+          + (f"; intervals over {len(replicates)} bootstrap replicates of the correction"
+             + (f", run at {step:g} s steps" if step else "") if replicates else "")
+          + "):")  # fmt: skip
     print(_pd().DataFrame(rows).to_markdown(index=False, floatfmt=".4g"))
     return rows

@@ -68,11 +68,45 @@ class CorrectedDynamics:
         return own + self.correction.compiled_accelerations(nu, inputs)
 
 
+class CorrectedMMGDynamics(CorrectedDynamics):
+    """An MMG reference (the built-in KVLCC2, a ship's MMG file) plus its correction, run in the
+    compiled integrators: the correction's accelerations added to the MMG model's at every
+    evaluation (``shipid.vessels.mmg.rhs_corrected``)."""
+
+    def __init__(self, reference, correction: ManoeuvringModel) -> None:
+        super().__init__(reference, correction)
+        code = correction.code
+        self._terms = (np.ascontiguousarray(correction.theta, dtype=float), *code.arrays(),
+                       code.uses_derived)  # fmt: skip
+
+    def integrate_open(self, t, inputs, n_steps, s0, rk4, speed_lim, yaw_lim, out, n_valid):
+        """Free runs driven by (B, N, 5) inputs, the propeller at the reference's trim."""
+        from shipid.vessels import mmg
+
+        ref = self.reference
+        mmg.open_corrected(ref.packed, ref.n_prop, *self._terms, t, inputs, n_steps, s0, rk4,
+                           speed_lim, yaw_lim, out, n_valid)  # fmt: skip
+
+    def integrate_closed(self, dt, n_steps, s0, params, rk4, speed_lim, yaw_lim, states, rudder,
+                         n_valid):  # fmt: skip
+        """Closed-loop manoeuvres of parameter rows ``params``."""
+        from shipid.vessels import mmg
+
+        ref = self.reference
+        mmg.closed_corrected(ref.packed, ref.n_prop, *self._terms, dt, n_steps, s0, params, rk4,
+                             speed_lim, yaw_lim, states, rudder, n_valid)  # fmt: skip
+
+
 def corrected_dynamics(reference, correction: ManoeuvringModel):
     """The reference's dynamics plus ``correction``: where the reference is itself a term model
     (the paper's scale ship), one term model of the two summed, which the compiled simulator
-    runs (the same accelerations: the terms' union, each coefficient the sum); else a
-    ``CorrectedDynamics`` the simulator steps in Python. Either keeps ``correction``."""
+    runs (the same accelerations: the terms' union, each coefficient the sum); where it is an
+    MMG model, a ``CorrectedMMGDynamics``, compiled too; else a ``CorrectedDynamics`` the
+    simulator steps in Python. Each keeps ``correction``."""
+    from shipid.vessels.mmg import MMGDynamics
+
+    if isinstance(reference, MMGDynamics):
+        return CorrectedMMGDynamics(reference, correction)
     if type(reference) is not ManoeuvringModel or reference.similar_at_rps is not None:
         return CorrectedDynamics(reference, correction)
     from shipid.identification.identify import average_models

@@ -3,6 +3,7 @@
 reference-ships.md §2 with x′P = −0.48, the wake formula of pitfall 1, midship sway velocity
 throughout (pitfall 3) and dimensional lever arms (pitfall 4). Propeller revolutions are trimmed
 numerically for the SIMMAN approach speed 1.179 m/s (≈ 11.85 rps). Positive δ turns to starboard.
+The formula is ``shipid.vessels.mmg``'s, which a ship's own MMG file runs too.
 """
 
 from __future__ import annotations
@@ -10,16 +11,13 @@ from __future__ import annotations
 import math
 from functools import lru_cache
 
-import numba
 import numpy as np
 
-import shipid.vessels.kvlcc2 as _this  # this module: see the entries below
-from shipid.dynamics import kernel
 from shipid.dynamics.steering import SteeringMachine
 
-from .vessel import ConstantRpsDynamics, Vessel
-
-kernel.drop_stale_caches(__file__)
+from .mmg import MMGDynamics, pack
+from .mmg import accelerations as mmg_accelerations
+from .vessel import Vessel
 
 RHO = 1025.0
 L, B, D_DRAUGHT, VOLUME, XG = 7.00, 1.27, 0.46, 3.27, 0.25
@@ -36,93 +34,40 @@ NV, NR, NVVV, NVVR, NVRR, NRRR = -0.137, -0.049, -0.030, -0.294, 0.055, -0.013
 TP, WP0, K0, K1, K2, XP_PRIME, C1 = 0.220, 0.40, 0.2931, -0.2753, -0.1385, -0.48, 2.0
 TR, AH, XH_PRIME, XR_PRIME, LR_PRIME, EPS, KAPPA, F_ALPHA = (
     0.387, 0.312, -0.464, -0.5, -0.710, 1.09, 0.50, 2.747)  # fmt: skip
-ETA = DP / HR
-
-m = RHO * VOLUME
-mx = MX * 0.5 * RHO * L**2 * D_DRAUGHT
-my = MY * 0.5 * RHO * L**2 * D_DRAUGHT
-Jz = JZ * 0.5 * RHO * L**4 * D_DRAUGHT
-IzG = m * (0.25 * L) ** 2
-# Mass matrix of the sway–yaw equations: [[m + my, xG m], [xG m, IzG + xG² m + Jz]].
-_MSY = np.array([[m + my, XG * m], [XG * m, IzG + XG**2 * m + Jz]])
-(_MI00, _MI01), (_MI10, _MI11) = np.linalg.inv(_MSY).tolist()
-
-
-@numba.njit(cache=True)
-def accelerations(u, vm, r, delta, n):
-    """(u̇, v̇m, ṙ) of the MMG model at midship sway vm, rudder δ and propeller speed n [rps]:
-    hull, propeller and rudder forces (reference-ships.md §2) through the mass matrix."""
-    U = math.sqrt(u * u + vm * vm)
-    beta = math.atan2(-vm, u)
-    vp, rp = vm / U, r * L / U
-    q = 0.5 * RHO * L * D_DRAUGHT * U * U
-    XH = q * (-R0 + XVV * vp**2 + XVR * vp * rp + XRR * rp**2 + XVVVV * vp**4)
-    YH = q * (YV * vp + YR * rp + YVVV * vp**3 + YVVR * vp**2 * rp + YVRR * vp * rp**2
-              + YRRR * rp**3)  # fmt: skip
-    NH = q * L * (NV * vp + NR * rp + NVVV * vp**3 + NVVR * vp**2 * rp + NVRR * vp * rp**2
-                  + NRRR * rp**3)  # fmt: skip
-    beta_p = beta - XP_PRIME * rp
-    c2 = 1.6 if beta_p > 0 else 1.1
-    one_minus_wp = (1 - WP0) * (1 + (1 - math.exp(-C1 * abs(beta_p))) * (c2 - 1))
-    Jp = u * one_minus_wp / (n * DP)
-    KT = K0 + K1 * Jp + K2 * Jp**2
-    XP = (1 - TP) * RHO * n**2 * DP**4 * KT
-    beta_r = beta - LR_PRIME * rp
-    gamma_r = 0.395 if beta_r < 0 else 0.640
-    vR = U * gamma_r * beta_r
-    uR = EPS * u * one_minus_wp * math.sqrt(
-        ETA * (1 + KAPPA * (math.sqrt(1 + 8 * KT / (math.pi * Jp**2)) - 1)) ** 2 + (1 - ETA))
-    alpha_r = delta - math.atan2(vR, uR)
-    FN = 0.5 * RHO * AR * (uR**2 + vR**2) * F_ALPHA * math.sin(alpha_r)
-    X = XH + XP - (1 - TR) * FN * math.sin(delta)
-    Y = YH - (1 + AH) * FN * math.cos(delta)
-    N = NH - (XR_PRIME * L + AH * XH_PRIME * L) * FN * math.cos(delta)
-    # Sway–yaw: [[m + my, xG m], [xG m, IzG + xG² m + Jz]] (v̇, ṙ) = (Y − (m + mx) u r, N − xG m u r)
-    ry = Y - (m + mx) * u * r
-    rn = N - XG * m * u * r
-    return ((X + (m + my) * vm * r + XG * m * r * r) / (m + mx),
-            _MI00 * ry + _MI01 * rn, _MI10 * ry + _MI11 * rn)  # fmt: skip
+# The MMG file's fields (``shipid.vessels.mmg_file``): the built-in ship is one such file's.
+COEFFICIENTS = {
+    "name": "kvlcc2", "length": L, "beam": B, "draught": D_DRAUGHT, "volume": VOLUME, "x_g": XG,
+    "k_zz": 0.25, "rho": RHO, "approach_speed": APPROACH_SPEED, "rudder_rate": RUDDER_RATE_DEG,
+    "rudder_limit": 35.0, "scale": SCALE, "rps": None,
+    "hull.m_x": MX, "hull.m_y": MY, "hull.j_z": JZ, "hull.r0": R0, "hull.x_vv": XVV,
+    "hull.x_vr": XVR, "hull.x_rr": XRR, "hull.x_vvvv": XVVVV, "hull.y_v": YV, "hull.y_r": YR,
+    "hull.y_vvv": YVVV, "hull.y_vvr": YVVR, "hull.y_vrr": YVRR, "hull.y_rrr": YRRR,
+    "hull.n_v": NV, "hull.n_r": NR, "hull.n_vvv": NVVV, "hull.n_vvr": NVVR, "hull.n_vrr": NVRR,
+    "hull.n_rrr": NRRR,
+    "propeller.diameter": DP, "propeller.t_p": TP, "propeller.w_p0": WP0, "propeller.k0": K0,
+    "propeller.k1": K1, "propeller.k2": K2, "propeller.x_p": XP_PRIME, "propeller.c1": C1,
+    "propeller.c2_pos": 1.6, "propeller.c2_neg": 1.1,
+    "rudder.area": AR, "rudder.height": HR, "rudder.t_r": TR, "rudder.a_h": AH,
+    "rudder.x_h": XH_PRIME, "rudder.x_r": XR_PRIME, "rudder.l_r": LR_PRIME, "rudder.epsilon": EPS,
+    "rudder.kappa": KAPPA, "rudder.f_alpha": F_ALPHA, "rudder.gamma_r_pos": 0.640,
+    "rudder.gamma_r_neg": 0.395}  # fmt: skip
 
 
-@numba.njit(cache=True)
-def rhs(ctx, u, v, r, psi):
-    """State derivative for the compiled integrators; ctx = (inputs, n): δ = inputs[0]."""
-    a0, a1, a2 = accelerations(u, v, r, ctx[0][0], ctx[1])
-    psi_dot, xd, yd = kernel.kinematics(u, v, r, psi)
-    return a0, a1, a2, psi_dot, xd, yd
+PACKED = pack(COEFFICIENTS)
 
 
-class KVLCC2Dynamics(ConstantRpsDynamics):
+def accelerations(u: float, vm: float, r: float, delta: float, n: float
+                  ) -> tuple[float, float, float]:  # fmt: skip
+    """(u̇, v̇m, ṙ) of the KVLCC2 at midship sway vm, rudder δ and propeller speed n [rps]
+    (``shipid.vessels.mmg.accelerations`` with its coefficients)."""
+    return mmg_accelerations(PACKED, u, vm, r, delta, n)
+
+
+class KVLCC2Dynamics(MMGDynamics):
     """MMG accelerations at constant propeller revolutions ``n_prop`` [rps]."""
 
-    def kernels(self):
-        """This module's compiled entries."""
-        return _batch, _open, _closed
-
-
-# Entries reach ``rhs`` as a module attribute: numba caches them only then.
-@numba.njit(cache=True)
-def _batch(nu, delta, n):
-    out = np.empty_like(nu)
-    for i in range(nu.shape[0]):
-        out[i, 0], out[i, 1], out[i, 2] = accelerations(nu[i, 0], nu[i, 1], nu[i, 2], delta[i], n)
-    return out
-
-
-@numba.njit(cache=True)
-def _open(n, t, inputs, n_steps, s0, rk4, speed_lim, yaw_lim, out, n_valid):
-    for b in range(inputs.shape[0]):
-        inp = np.zeros(kernel.N_INPUTS)
-        n_valid[b] = kernel.open_run(_this.rhs, (inp, n), inp, t, inputs[b], n_steps[b], s0[b],
-                                     rk4, speed_lim[b], yaw_lim[b], out[b])  # fmt: skip
-
-
-@numba.njit(cache=True)
-def _closed(n, dt, n_steps, s0, params, rk4, speed_lim, yaw_lim, states, rudder, n_valid):
-    for b in range(params.shape[0]):
-        inp = np.zeros(kernel.N_INPUTS)
-        n_valid[b] = kernel.closed_run(_this.rhs, (inp, n), inp, params[b], dt, n_steps, s0[b],
-                                       rk4, speed_lim[b], yaw_lim[b], states[b], rudder[b])
+    def __init__(self, n_prop: float) -> None:
+        super().__init__(COEFFICIENTS, n_prop)
 
 
 @lru_cache(maxsize=8)

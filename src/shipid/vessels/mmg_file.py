@@ -3,10 +3,11 @@ coefficients, as a reference ship: what a basin's captive tests give, for ``ship
 ``manoeuvre`` and the other commands that take a ``VESSEL``, and as the reference that
 ``shipid correct`` keeps whole.
 
-The formulas are the built-in KVLCC2's (``shipid.vessels.kvlcc2``, reference-ships.md §2:
-midship sway velocity, dimensional lever arms, the wake in drift, flow straightening γ_R that
-differs with the sign of the drift at the rudder), in NumPy, the propeller at a constant rps
-trimmed for the approach speed unless the file gives it. The file (YAML or JSON)::
+The formula is the built-in KVLCC2's, compiled once for any coefficients
+(``shipid.vessels.mmg``, reference-ships.md §2: midship sway velocity, dimensional lever arms,
+the wake in drift, flow straightening γ_R that differs with the sign of the drift at the
+rudder), the propeller at a constant rps trimmed for the approach speed unless the file gives
+it. The file (YAML or JSON)::
 
     format: shipid-mmg
     name: my-ship
@@ -41,6 +42,7 @@ import numpy as np
 from shipid.dynamics.steering import SteeringMachine
 from shipid.errors import ShipidError
 
+from .mmg import MMGDynamics
 from .vessel import Vessel
 
 FORMAT = "shipid-mmg"
@@ -86,83 +88,6 @@ def coefficients(doc: Mapping, where: str = "MMG file") -> dict:
     out["scale"] = _number(doc["scale"], f"{where}: scale") if "scale" in doc else math.nan
     out["rps"] = _number(doc["rps"], f"{where}: rps") if doc.get("rps") is not None else None
     return out
-
-
-class MMGDynamics:
-    """The MMG model's body accelerations at a constant propeller speed ``n_prop`` [rps]
-    (``derivatives``: the simulator's and the manoeuvres' generic path)."""
-
-    uses_thrust = False
-    uses_rps = False
-
-    def __init__(self, c: Mapping, n_prop: float) -> None:
-        self.c = dict(c)
-        self.n_prop = float(n_prop)
-        rho, L, d = c["rho"], c["length"], c["draught"]
-        self.m = rho * c["volume"]
-        half = 0.5 * rho * L**2 * d
-        self.mx, self.my = c["hull.m_x"] * half, c["hull.m_y"] * half
-        jz = c["hull.j_z"] * 0.5 * rho * L**4 * d
-        izg = self.m * (c["k_zz"] * L) ** 2
-        xg = c["x_g"]
-        msy = np.array([[self.m + self.my, xg * self.m], [xg * self.m, izg + xg**2 * self.m + jz]])
-        self.inverse = np.linalg.inv(msy).tolist()
-
-    def derivatives(self, nu, delta, thrust=None):
-        """(B, 3) body accelerations at states nu (B, 3) (midship sway) and rudder delta (B,).
-        Row by row in plain floats: the manoeuvres step one state at a time, where NumPy's
-        per-call cost was most of a step."""
-        nu = np.asarray(nu, dtype=float)
-        delta = np.broadcast_to(np.asarray(delta, dtype=float), nu.shape[:1])
-        return np.array([self.state_accelerations(*row, d) for row, d in
-                         zip(nu.tolist(), delta.tolist(), strict=True)]).reshape(-1, 3)  # fmt: skip
-
-    def state_accelerations(self, u: float, vm: float, r: float, delta: float
-                      ) -> tuple[float, float, float]:  # fmt: skip
-        """(u̇, v̇m, ṙ) at one state: hull, propeller and rudder forces through the mass matrix
-        (the built-in KVLCC2's ``accelerations``, these coefficients)."""
-        c, n = self.c, self.n_prop
-        L, d, rho = c["length"], c["draught"], c["rho"]
-        U = math.sqrt(u * u + vm * vm)
-        beta = math.atan2(-vm, u)
-        vp, rp = vm / U, r * L / U
-        q = 0.5 * rho * L * d * U * U
-        XH = q * (-c["hull.r0"] + c["hull.x_vv"] * vp**2 + c["hull.x_vr"] * vp * rp
-                  + c["hull.x_rr"] * rp**2 + c["hull.x_vvvv"] * vp**4)  # fmt: skip
-        YH = q * (c["hull.y_v"] * vp + c["hull.y_r"] * rp + c["hull.y_vvv"] * vp**3
-                  + c["hull.y_vvr"] * vp**2 * rp + c["hull.y_vrr"] * vp * rp**2
-                  + c["hull.y_rrr"] * rp**3)  # fmt: skip
-        NH = q * L * (c["hull.n_v"] * vp + c["hull.n_r"] * rp + c["hull.n_vvv"] * vp**3
-                      + c["hull.n_vvr"] * vp**2 * rp + c["hull.n_vrr"] * vp * rp**2
-                      + c["hull.n_rrr"] * rp**3)  # fmt: skip
-        DP = c["propeller.diameter"]
-        beta_p = beta - c["propeller.x_p"] * rp
-        c2 = c["propeller.c2_pos"] if beta_p > 0 else c["propeller.c2_neg"]
-        one_minus_wp = (1 - c["propeller.w_p0"]) * (
-            1 + (1 - math.exp(-c["propeller.c1"] * abs(beta_p))) * (c2 - 1))
-        Jp = u * one_minus_wp / (n * DP)
-        KT = c["propeller.k0"] + c["propeller.k1"] * Jp + c["propeller.k2"] * Jp**2
-        XP = (1 - c["propeller.t_p"]) * rho * n**2 * DP**4 * KT
-        beta_r = beta - c["rudder.l_r"] * rp
-        gamma_r = c["rudder.gamma_r_neg"] if beta_r < 0 else c["rudder.gamma_r_pos"]
-        vR = U * gamma_r * beta_r
-        eta = DP / c["rudder.height"]
-        uR = c["rudder.epsilon"] * u * one_minus_wp * math.sqrt(
-            eta * (1 + c["rudder.kappa"] * (math.sqrt(1 + 8 * KT / (math.pi * Jp**2)) - 1)) ** 2
-            + (1 - eta))  # fmt: skip
-        alpha_r = delta - math.atan2(vR, uR)
-        FN = 0.5 * rho * c["rudder.area"] * (uR**2 + vR**2) * c["rudder.f_alpha"] \
-            * math.sin(alpha_r)  # fmt: skip
-        X = XH + XP - (1 - c["rudder.t_r"]) * FN * math.sin(delta)
-        Y = YH - (1 + c["rudder.a_h"]) * FN * math.cos(delta)
-        N = NH - (c["rudder.x_r"] * L + c["rudder.a_h"] * c["rudder.x_h"] * L) * FN \
-            * math.cos(delta)  # fmt: skip
-        m, mx, my, xg = self.m, self.mx, self.my, c["x_g"]
-        ry = Y - (m + mx) * u * r
-        rn = N - xg * m * u * r
-        (i00, i01), (i10, i11) = self.inverse
-        return ((X + (m + my) * vm * r + xg * m * r * r) / (m + mx),
-                i00 * ry + i01 * rn, i10 * ry + i11 * rn)
 
 
 def trimmed_rps(c: Mapping, speed: float) -> float:

@@ -1,0 +1,251 @@
+"""The MMG standard method (Yasukawa & Yoshimura 2015) compiled once for any ship's coefficients:
+the built-in KVLCC2 (``shipid.vessels.kvlcc2``), a ship's own MMG file
+(``shipid.vessels.mmg_file``) and either of them with a correction fitted by ``shipid correct``
+(``shipid.identification.correction``) run this one formula in the kernels' integrators.
+
+reference-ships.md §2: midship sway velocity throughout, dimensional lever arms, the
+propeller's wake in drift, flow straightening γ_R that differs with the sign of the drift at
+the rudder. The coefficients travel as a ``Coefficients`` named tuple (prime values and the
+mass matrix's inverse); numba reads each field as a constant offset, so the formula with its
+coefficients as arguments runs as fast as it did with them typed in (``benchmarks/README.md``).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import NamedTuple
+
+import numba
+import numpy as np
+
+import shipid.vessels.mmg as _this  # this module: see the entries below
+from shipid.dynamics import kernel
+
+from .vessel import CompiledDynamics
+
+kernel.drop_stale_caches(__file__)
+
+
+class Coefficients(NamedTuple):
+    """One ship's MMG model as the compiled formula reads it: dimensional particulars, prime
+    hull, propeller and rudder coefficients (``mmg_file``'s names), the sway–yaw mass matrix's
+    inverse."""
+
+    rho: float
+    length: float
+    draught: float
+    m: float
+    mx: float
+    my: float
+    x_g: float
+    inv00: float
+    inv01: float
+    inv10: float
+    inv11: float
+    r0: float
+    x_vv: float
+    x_vr: float
+    x_rr: float
+    x_vvvv: float
+    y_v: float
+    y_r: float
+    y_vvv: float
+    y_vvr: float
+    y_vrr: float
+    y_rrr: float
+    n_v: float
+    n_r: float
+    n_vvv: float
+    n_vvr: float
+    n_vrr: float
+    n_rrr: float
+    diameter: float
+    t_p: float
+    w_p0: float
+    k0: float
+    k1: float
+    k2: float
+    x_p: float
+    c1: float
+    c2_pos: float
+    c2_neg: float
+    area: float
+    eta: float
+    t_r: float
+    a_h: float
+    x_h: float
+    x_r: float
+    l_r: float
+    epsilon: float
+    kappa: float
+    f_alpha: float
+    gamma_r_pos: float
+    gamma_r_neg: float
+
+
+def pack(c: Mapping) -> Coefficients:
+    """The compiled formula's coefficients from ``mmg_file.coefficients``' flat dictionary
+    (``hull.y_v``, ``rudder.area``, ...): masses, added masses and the mass matrix's inverse
+    worked out here, once."""
+    rho, L, d = c["rho"], c["length"], c["draught"]
+    m = rho * c["volume"]
+    half = 0.5 * rho * L**2 * d
+    mx, my = c["hull.m_x"] * half, c["hull.m_y"] * half
+    jz = c["hull.j_z"] * 0.5 * rho * L**4 * d
+    izg = m * (c["k_zz"] * L) ** 2
+    xg = c["x_g"]
+    # Sway–yaw: [[m + my, xG m], [xG m, IzG + xG² m + Jz]] (v̇, ṙ) = (Y − (m + mx) u r, N − xG m u r)
+    (i00, i01), (i10, i11) = np.linalg.inv([[m + my, xg * m],
+                                            [xg * m, izg + xg**2 * m + jz]]).tolist()  # fmt: skip
+    fields = {"rho": rho, "length": L, "draught": d, "m": m, "mx": mx, "my": my, "x_g": xg,
+              "inv00": i00, "inv01": i01, "inv10": i10, "inv11": i11,
+              "eta": c["propeller.diameter"] / c["rudder.height"]}  # fmt: skip
+    for key, value in c.items():
+        name = key.rpartition(".")[2]
+        if "." in key and name in Coefficients._fields:
+            fields[name] = float(value)
+    return Coefficients(**{name: float(fields[name]) for name in Coefficients._fields})
+
+
+@numba.njit(cache=True)
+def accelerations(c, u, vm, r, delta, n):
+    """(u̇, v̇m, ṙ) of the MMG model ``c`` (``Coefficients``) at midship sway vm, rudder δ and
+    propeller speed n [rps]: hull, propeller and rudder forces through the mass matrix."""
+    L = c.length
+    U = math.sqrt(u * u + vm * vm)
+    beta = math.atan2(-vm, u)
+    vp, rp = vm / U, r * L / U
+    q = 0.5 * c.rho * L * c.draught * U * U
+    XH = q * (-c.r0 + c.x_vv * vp**2 + c.x_vr * vp * rp + c.x_rr * rp**2 + c.x_vvvv * vp**4)
+    YH = q * (c.y_v * vp + c.y_r * rp + c.y_vvv * vp**3 + c.y_vvr * vp**2 * rp
+              + c.y_vrr * vp * rp**2 + c.y_rrr * rp**3)  # fmt: skip
+    NH = q * L * (c.n_v * vp + c.n_r * rp + c.n_vvv * vp**3 + c.n_vvr * vp**2 * rp
+                  + c.n_vrr * vp * rp**2 + c.n_rrr * rp**3)  # fmt: skip
+    DP = c.diameter
+    beta_p = beta - c.x_p * rp
+    c2 = c.c2_pos if beta_p > 0 else c.c2_neg
+    one_minus_wp = (1 - c.w_p0) * (1 + (1 - math.exp(-c.c1 * abs(beta_p))) * (c2 - 1))
+    Jp = u * one_minus_wp / (n * DP)
+    KT = c.k0 + c.k1 * Jp + c.k2 * Jp**2
+    XP = (1 - c.t_p) * c.rho * n**2 * DP**4 * KT
+    beta_r = beta - c.l_r * rp
+    gamma_r = c.gamma_r_neg if beta_r < 0 else c.gamma_r_pos
+    vR = U * gamma_r * beta_r
+    uR = c.epsilon * u * one_minus_wp * math.sqrt(
+        c.eta * (1 + c.kappa * (math.sqrt(1 + 8 * KT / (math.pi * Jp**2)) - 1)) ** 2
+        + (1 - c.eta))  # fmt: skip
+    alpha_r = delta - math.atan2(vR, uR)
+    FN = 0.5 * c.rho * c.area * (uR**2 + vR**2) * c.f_alpha * math.sin(alpha_r)
+    X = XH + XP - (1 - c.t_r) * FN * math.sin(delta)
+    Y = YH - (1 + c.a_h) * FN * math.cos(delta)
+    N = NH - (c.x_r * L + c.a_h * c.x_h * L) * FN * math.cos(delta)
+    m = c.m
+    ry = Y - (m + c.mx) * u * r
+    rn = N - c.x_g * m * u * r
+    return ((X + (m + c.my) * vm * r + c.x_g * m * r * r) / (m + c.mx),
+            c.inv00 * ry + c.inv01 * rn, c.inv10 * ry + c.inv11 * rn)  # fmt: skip
+
+
+@numba.njit(cache=True)
+def rhs(ctx, u, v, r, psi):
+    """State derivative for the compiled integrators; ctx = (inputs, n, coefficients):
+    δ = inputs[0]."""
+    a0, a1, a2 = accelerations(ctx[2], u, v, r, ctx[0][0], ctx[1])
+    psi_dot, xd, yd = kernel.kinematics(u, v, r, psi)
+    return a0, a1, a2, psi_dot, xd, yd
+
+
+@numba.njit(cache=True)
+def rhs_corrected(ctx, u, v, r, psi):
+    """``rhs`` plus a term model's accelerations (a correction); ctx = (inputs, n,
+    coefficients, the term model's context, whose input buffer ``inputs`` is)."""
+    a0, a1, a2 = accelerations(ctx[2], u, v, r, ctx[0][0], ctx[1])
+    terms = ctx[3]
+    if terms[13] == kernel.SLOTS_CROSSFLOW:
+        b0, b1, b2, rd, xd, yd = kernel.terms_rhs_crossflow(terms, u, v, r, psi)
+    elif terms[13] == kernel.SLOTS_RUDDER:
+        b0, b1, b2, rd, xd, yd = kernel.terms_rhs_rudder(terms, u, v, r, psi)
+    else:
+        b0, b1, b2, rd, xd, yd = kernel.terms_rhs(terms, u, v, r, psi)
+    return a0 + b0, a1 + b1, a2 + b2, rd, xd, yd
+
+
+# Entries reach ``rhs`` as a module attribute: numba caches them only then.
+@numba.njit(cache=True)
+def _batch(c, nu, delta, n):
+    out = np.empty_like(nu)
+    for i in range(nu.shape[0]):
+        out[i, 0], out[i, 1], out[i, 2] = accelerations(c, nu[i, 0], nu[i, 1], nu[i, 2],
+                                                        delta[i], n)  # fmt: skip
+    return out
+
+
+@numba.njit(cache=True)
+def _open(c, n, t, inputs, n_steps, s0, rk4, speed_lim, yaw_lim, out, n_valid):
+    for b in range(inputs.shape[0]):
+        inp = np.zeros(kernel.N_INPUTS)
+        n_valid[b] = kernel.open_run(_this.rhs, (inp, n, c), inp, t, inputs[b], n_steps[b],
+                                     s0[b], rk4, speed_lim[b], yaw_lim[b], out[b])  # fmt: skip
+
+
+@numba.njit(cache=True)
+def _closed(c, n, dt, n_steps, s0, params, rk4, speed_lim, yaw_lim, states, rudder, n_valid):
+    for b in range(params.shape[0]):
+        inp = np.zeros(kernel.N_INPUTS)
+        n_valid[b] = kernel.closed_run(_this.rhs, (inp, n, c), inp, params[b], dt, n_steps,
+                                       s0[b], rk4, speed_lim[b], yaw_lim[b], states[b],
+                                       rudder[b])  # fmt: skip
+
+
+@numba.njit(cache=True)
+def open_corrected(c, n, theta, start, sig, op, kk, pw, rud, derived, t, inputs, n_steps, s0,
+                   rk4, speed_lim, yaw_lim, out, n_valid):  # fmt: skip
+    """Free runs of the MMG model ``c`` at propeller speed ``n`` plus the term model θ (3, T)
+    with its factor table (``kernel.integrate_open``'s arguments)."""
+    for b in range(inputs.shape[0]):
+        terms = kernel._terms_ctx(theta, start, sig, op, kk, pw, rud, derived, False, 0.0, 0.0)
+        inp = terms[8]
+        n_valid[b] = kernel.open_run(_this.rhs_corrected, (inp, n, c, terms), inp, t, inputs[b],
+                                     n_steps[b], s0[b], rk4, speed_lim[b], yaw_lim[b], out[b])
+
+
+@numba.njit(cache=True)
+def closed_corrected(c, n, theta, start, sig, op, kk, pw, rud, derived, dt, n_steps, s0, params,
+                     rk4, speed_lim, yaw_lim, states, rudder, n_valid):  # fmt: skip
+    """Closed-loop manoeuvres of the MMG model ``c`` plus the term model θ (3, T)."""
+    for b in range(params.shape[0]):
+        # A correction has no wind terms: the term model's wind stays the inputs' (zero).
+        terms = kernel._terms_ctx(theta, start, sig, op, kk, pw, rud, derived, False, 0.0, 0.0)
+        inp = terms[8]
+        n_valid[b] = kernel.closed_run(_this.rhs_corrected, (inp, n, c, terms), inp, params[b],
+                                       dt, n_steps, s0[b], rk4, speed_lim[b], yaw_lim[b],
+                                       states[b], rudder[b])  # fmt: skip
+
+
+class MMGDynamics(CompiledDynamics):
+    """The MMG model's accelerations at a constant propeller speed ``n_prop`` [rps]; ``c`` the
+    flat coefficients of ``mmg_file.coefficients`` (kept: a corrected ship's file embeds
+    them)."""
+
+    def __init__(self, c: Mapping, n_prop: float) -> None:
+        self.c = dict(c)
+        self.n_prop = float(n_prop)
+        self.packed = pack(self.c)
+
+    def derivatives(self, nu, delta, thrust=None):
+        """(B, 3) body accelerations at states nu (B, 3) (midship sway) and rudder delta (B,)."""
+        nu = kernel.c_array(nu).reshape(-1, 3)
+        delta = kernel.c_array(np.broadcast_to(np.asarray(delta, dtype=float), nu.shape[:1]))
+        return _batch(self.packed, nu, delta, self.n_prop)
+
+    def integrate_open(self, t, inputs, n_steps, s0, rk4, speed_lim, yaw_lim, out, n_valid):
+        """Free runs driven by (B, N, 5) inputs, the propeller at ``n_prop``."""
+        _open(self.packed, self.n_prop, t, inputs, n_steps, s0, rk4, speed_lim, yaw_lim, out,
+              n_valid)  # fmt: skip
+
+    def integrate_closed(self, dt, n_steps, s0, params, rk4, speed_lim, yaw_lim, states, rudder,
+                         n_valid):  # fmt: skip
+        """Closed-loop manoeuvres of parameter rows ``params``, the propeller at ``n_prop``."""
+        _closed(self.packed, self.n_prop, dt, n_steps, s0, params, rk4, speed_lim, yaw_lim,
+                states, rudder, n_valid)  # fmt: skip
