@@ -166,6 +166,55 @@ def test_the_mmg_models_correction_is_what_its_truth_adds():
     assert max(run.metrics[s]["rmse"] for s in "uvr") < 1e-6
 
 
+def test_a_corrected_ships_bootstrap_travels_with_its_file_into_the_bands(tmp_path, capsys):
+    """``shipid correct --bootstrap`` keeps the replicates in the corrected ship's file;
+    ``manoeuvre`` and ``validate`` of the file give the intervals the replicates' own runs give
+    (recomputed here from the API's replicates), and on noisy logs of the MMG truth the truth's
+    unseen 10°/10° overshoots lie inside the closed loop's intervals."""
+    import json
+
+    from cli_helpers import run
+
+    from shipid.data.io import read_log, write_log
+    from shipid.identification.uncertainty import index_intervals
+    from shipid.trials.manoeuvres import turning_circle
+    from shipid.vessels.sensors import SensorModel
+
+    mmg, _, truth = _mmg_truth()
+    # A model basin's noise at the KVLCC2's 1:45.7 (MARIN's runs: about this).
+    sensors = SensorModel(white={"u": 0.005, "v": 0.003, "r": 5e-4, "psi": np.radians(0.05)})
+    paths = [write_log(sensors.apply(zigzag(truth, 20, 20, first=side, duration=80,
+                                            dt=0.2).log, seed), tmp_path / f"{side}.csv")
+             for seed, side in enumerate(("starboard", "port"))]  # fmt: skip
+    ship = tmp_path / "ship.json"
+    code, _, err = run(["correct", "kvlcc2", *paths, "--bootstrap", "20", "--seed", "2", "-o",
+                        ship], capsys)  # fmt: skip
+    assert code == 0, err
+    record = json.loads(ship.read_text())["uncertainty"]
+    assert record["replicates"] == 20 and "bootstrap" in record["method"]
+    fit = identify_correction([read_log(p) for p in paths], mmg, bootstrap=20, seed=2)
+    np.testing.assert_allclose(np.asarray(record["thetas"]), fit.ensemble.thetas, atol=1e-12)
+    expected = index_intervals([turning_circle(s, 35).indices for s in fit.replicate_vessels()])
+    code, out, err = run(["manoeuvre", ship, "turning", "--json", tmp_path / "t.json"], capsys)
+    assert code == 0 and "over the model's 20 bootstrap replicates of the correction" in out, err
+    lo, hi = expected["tactical_diameter"]
+    assert f"[{lo:.4g}, {hi:.4g}]" in out
+    unseen = write_log(sensors.apply(zigzag(truth, 10, 10, duration=80, dt=0.2).log, 7),
+                       tmp_path / "zz10.csv")  # fmt: skip
+    code, _, err = run(["validate", ship, unseen, "--json", tmp_path / "v.json"], capsys)
+    assert code == 0, err
+    (logged,) = json.loads((tmp_path / "v.json").read_text())["logs"]
+    closed = logged["index_intervals"]["closed_loop"]
+    truth_zz = zigzag(truth, 10, 10, duration=80).indices
+    for key in ("first_overshoot_deg", "second_overshoot_deg"):
+        lo, hi = closed[key]
+        assert lo <= truth_zz[key] <= hi, (key, lo, truth_zz[key], hi)
+    code, _, err = run(["validate", ship, unseen, "--no-bands", "--json", tmp_path / "n.json"],
+                       capsys)  # fmt: skip
+    (plain,) = json.loads((tmp_path / "n.json").read_text())["logs"]
+    assert code == 0 and plain["index_intervals"] == {}
+
+
 @pytest.mark.parametrize(("kwargs", "said"), [
     ({"model": "blanke-rps"}, "|n|*n"),
     ({"model": "blanke+wind"}, "wind_speed"),

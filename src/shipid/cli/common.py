@@ -718,11 +718,12 @@ def _ship_or_model(name: str, hybrid: bool = False):
     if not Path(name).exists():
         raise ShipidError(f"{name}: neither a model file nor a known vessel "
                           f"({', '.join(VESSEL_NAMES)})")  # fmt: skip
-    from shipid.identification.correction import reference_file
+    from shipid.identification.correction import reference_file, ship_ensemble
 
     ship = reference_file(name)  # shipid correct's corrected ship, or a ship's own MMG model
     if ship is not None:
-        return ship, _vessel_conditions()
+        # A corrected ship's bootstrap replicates, where its file has them: the bands.
+        return ship, {**_vessel_conditions(), "ensemble": ship_ensemble(ship)}
     from shipid.reporting.modelfile import (
         alternatives_fit,
         alternatives_from_document,

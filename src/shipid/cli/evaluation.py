@@ -48,7 +48,7 @@ def cmd_validate(args) -> int:
     """``shipid validate``: free runs on logs, metrics, indices, figures, report."""
     from shipid.evaluation.envelope import outside_envelope
     from shipid.evaluation.validate import validate
-    from shipid.identification.correction import reference_file
+    from shipid.identification.correction import reference_file, ship_ensemble
     from shipid.outputs import OutputSet, check_outputs
     from shipid.reporting.modelfile import (
         ensemble_from_document,
@@ -75,11 +75,13 @@ def cmd_validate(args) -> int:
                    *_read_files(args)])  # fmt: skip
     if reference:
         # A reference ship against the logs (the published KVLCC2 MMG model against MARIN's
-        # runs): no fit, so no training logs, intervals, error band or tied structures.
+        # runs): no fit of its own, so no training logs, error band or tied structures; a
+        # corrected one's bootstrap replicates give bands and intervals.
         if args.lssvm:
             raise ShipidError(f"--lssvm: {args.model} is a reference ship, not an identified "
                               "model with an LS-SVM fit of its own")  # fmt: skip
-        doc, ensemble, band, model = None, None, None, ship
+        doc, band, model = None, None, ship
+        ensemble = None if args.no_bands else ship_ensemble(ship)
         # The logs are turned to the ship's own rudder convention.
         cond = {**_vessel_conditions(), "rudder_positive": model.rudder_positive}
     else:

@@ -36,6 +36,7 @@ from shipid.errors import ShipidError
 from shipid.identification.estimators import fit_linear
 from shipid.identification.physics import dof_physics
 from shipid.identification.regression import regression_problem
+from shipid.identification.uncertainty import Ensemble
 from shipid.vessels.vessel import Vessel
 
 DOFS = ("u", "v", "r")
@@ -119,26 +120,66 @@ def corrected_dynamics(reference, correction: ManoeuvringModel):
 
 
 @dataclasses.dataclass(frozen=True)
+class CorrectedEnsemble:
+    """A correction's bootstrap replicates as corrected ships: the members whose runs give
+    ``validate``'s bands and ``manoeuvre``'s and ``criteria``'s intervals, as a model file's
+    ``Ensemble`` gives an identified model's. ``ensemble``: the correction's replicates;
+    ``vessel``: the corrected ship; ``reference``: the ship corrected."""
+
+    ensemble: Ensemble
+    vessel: Vessel
+    reference: Vessel
+    members_label = "bootstrap replicates of the correction"
+
+    @property
+    def replicates(self) -> int:
+        """Number of replicates."""
+        return self.ensemble.replicates
+
+    def members(self) -> list[Vessel]:
+        """The corrected ship of each replicate's correction."""
+        return [dataclasses.replace(self.vessel, dynamics=corrected_dynamics(
+            self.reference.dynamics, c)) for c in self.ensemble.members()]  # fmt: skip
+
+
+def ship_ensemble(ship) -> CorrectedEnsemble | None:
+    """The bootstrap replicates a corrected ship carries (``identify_correction(...,
+    bootstrap=N)``, or its file's ``uncertainty``), or None."""
+    return getattr(getattr(ship, "dynamics", None), "correction_ensemble", None)
+
+
+def _with_ensemble(vessel: Vessel, reference: Vessel, ensemble: Ensemble | None) -> Vessel:
+    if ensemble is not None:
+        vessel.dynamics.correction_ensemble = CorrectedEnsemble(ensemble, vessel, reference)
+    return vessel
+
+
+@dataclasses.dataclass(frozen=True)
 class Correction:
     """The corrected ship (``vessel``), the fitted ``correction`` and the reference's share of
     each equation: ``explained`` [dof] = 1 − var(target left after the reference) / var(the
     increments' own), over the training logs (1: the reference alone fits the logs); with
     γ "auto", each γ's cross-validated free-run score (``gamma_scores``, the lowest chosen);
-    with a bootstrap, the corrections of its ``replicates`` (resampled equations, as
-    ``identify --bootstrap`` resamples them)."""
+    with a bootstrap, the corrections' ``ensemble`` (resampled equations, as ``identify
+    --bootstrap`` resamples them), which the corrected ship carries (``ship_ensemble``)."""
 
     vessel: Vessel
     correction: ManoeuvringModel
     explained: dict[str, float]
     gamma: float
     gamma_scores: dict[float, float] = dataclasses.field(default_factory=dict)  # γ "auto"
-    replicates: list[ManoeuvringModel] = dataclasses.field(default_factory=list)  # bootstrap
+    ensemble: Ensemble | None = None  # bootstrap
     reference: Vessel | None = None  # the ship corrected
+
+    @property
+    def replicates(self) -> list[ManoeuvringModel]:
+        """The bootstrap replicates' corrections ([] without a bootstrap)."""
+        return [] if self.ensemble is None else self.ensemble.members()
 
     def replicate_vessels(self) -> list[Vessel]:
         """The corrected ship of each bootstrap replicate's correction."""
-        return [dataclasses.replace(self.vessel, dynamics=corrected_dynamics(
-            self.reference.dynamics, c)) for c in self.replicates]  # fmt: skip
+        found = ship_ensemble(self.vessel)
+        return [] if found is None else found.members()
 
 
 def _structure(model) -> ModelStructure:
@@ -206,19 +247,24 @@ def identify_correction(
         gamma = min(scores, key=scores.get)
     fitted = [lowpass(log, filter_hz) for log in logs] if filter_hz is not None else logs
     correction, explained = _fit(fitted, names, reference, structure, float(gamma))
-    replicates = []
+    ensemble = None
     if bootstrap is not None:
         from shipid.identification.uncertainty import resampler
 
-        draw, _ = resampler(fitted, bootstrap, "auto")
+        draw, block_s = resampler(fitted, bootstrap, "auto")
         rng = np.random.default_rng(seed)
         replicates = [_fit(fitted, names, reference, structure, float(gamma), draw(rng))[0]
                       for _ in range(bootstrap)]  # fmt: skip
+        terms = correction.structure.all_terms
+        thetas = np.array([[[m.coefficients.get(d, {}).get(t, 0.0) for t in terms] for d in DOFS]
+                           for m in replicates])  # fmt: skip
+        ensemble = Ensemble(correction, thetas, block_s, seed)
     vessel = dataclasses.replace(
         reference, name=f"{reference.name} + correction",
         dynamics=corrected_dynamics(reference.dynamics, correction),
         source=f"{reference.source}, corrected by an LS-SVM fit to {len(logs)} log(s)")  # fmt: skip
-    return Correction(vessel, correction, explained, float(gamma), scores, replicates, reference)
+    vessel = _with_ensemble(vessel, reference, ensemble)
+    return Correction(vessel, correction, explained, float(gamma), scores, ensemble, reference)
 
 
 def _fit(logs, names, reference: Vessel, structure: ModelStructure, gamma: float,
@@ -298,7 +344,8 @@ def correction_document(fit: Correction, reference: str | dict, training_files: 
                         filter_hz: float | None = None) -> dict:  # fmt: skip
     """The JSON document of a corrected reference ship: the reference (a reference ship's name,
     or {"mmg": an MMG document} kept whole), the correction (a model's dict), how it was fitted
-    and from which files (SHA-256)."""
+    and from which files (SHA-256); with a bootstrap, its replicates (``uncertainty``, a model
+    file's record of them)."""
     from shipid import __version__
     from shipid.reporting.modelfile import sha256
 
@@ -306,7 +353,8 @@ def correction_document(fit: Correction, reference: str | dict, training_files: 
             "reference": reference, "correction": fit.correction.to_dict(),
             "gamma": fit.gamma, "filter_hz": filter_hz, "explained": fit.explained,
             "gamma_scores": {f"{g:g}": v for g, v in fit.gamma_scores.items()},
-            "training_files": [{"path": str(p), "sha256": sha256(p)} for p in training_files]}
+            "training_files": [{"path": str(p), "sha256": sha256(p)} for p in training_files],
+            "uncertainty": None if fit.ensemble is None else fit.ensemble.to_dict()}
 
 
 def reference_file(path) -> Vessel | None:
@@ -362,7 +410,12 @@ def corrected_from_document(doc: dict, path) -> Vessel:
     except (KeyError, TypeError, ValueError, AttributeError) as exc:
         raise ShipidError(f"{path}: malformed correction ({exc})") from None
     _structure(correction.structure)  # states and rudder only, as fitted
-    return dataclasses.replace(
+    data = doc.get("uncertainty")
+    if data is not None and not isinstance(data, dict):
+        raise ShipidError(f"{path}: uncertainty must be a mapping")
+    ensemble = None if not data else Ensemble.from_dict(data, correction, f"{path}: uncertainty")
+    ship = dataclasses.replace(
         reference, name=f"{name} + correction",
         dynamics=corrected_dynamics(reference.dynamics, correction),
         source=f"{reference.source}, corrected by {p.name}")  # fmt: skip
+    return _with_ensemble(ship, reference, ensemble)

@@ -380,10 +380,13 @@ Bands = dict[str, tuple[np.ndarray, np.ndarray]]
 
 
 def ensemble_runs(ensemble: Ensemble, log: pd.DataFrame, method: str = "euler") -> list:
-    """The replicates' free runs on ``log`` (``simulate_log`` of each member)."""
+    """The replicates' free runs on ``log`` (``simulate_log`` of each member; a corrected
+    ship's replicates are ships, their dynamics run)."""
     from shipid.dynamics.simulate import simulate_log
+    from shipid.vessels.vessel import Vessel
 
-    return [simulate_log(member, log, method) for member in ensemble.members()]
+    return [simulate_log(member.dynamics if isinstance(member, Vessel) else member, log, method)
+            for member in ensemble.members()]  # fmt: skip
 
 
 def free_run_bands(runs: Sequence, n: int, level: float = LEVEL) -> tuple[Bands, int]:
