@@ -11,7 +11,7 @@ import pytest
 from shipid.dynamics.model import ManoeuvringModel
 from shipid.errors import ShipidError
 from shipid.evaluation.validate import validate
-from shipid.identification.correction import identify_correction
+from shipid.identification.correction import corrected_dynamics, identify_correction
 from shipid.trials.manoeuvres import zigzag
 from shipid.vessels import get_vessel, scale_ship, scale_ship_model
 
@@ -164,6 +164,32 @@ def test_the_mmg_models_correction_is_what_its_truth_adds():
     unseen = zigzag(truth, 10, 10, duration=80, dt=0.1, method="euler").log
     run = validate(fit.vessel, unseen, ["unseen"], method="euler", start_draws=False)[0]
     assert max(run.metrics[s]["rmse"] for s in "uvr") < 1e-6
+
+
+def test_a_reference_whose_propeller_follows_the_logs_is_corrected_at_each_logs_rate():
+    """An MMG ship whose propeller turns at each log's rate (``rps: logs``): the truth, that
+    ship plus known forces, run at 9 and 12 rps; the correction fitted with the reference at
+    each log's rate is those forces, and the corrected ship runs an unseen zig-zag at 10.5 rps
+    as the truth does. A log without its propeller speed is named."""
+    from test_mmg_file import kvlcc2_document
+
+    from shipid.vessels.mmg_file import mmg_vessel
+
+    follow = mmg_vessel({**kvlcc2_document(), "rps": "logs"})
+    _, added, _ = _mmg_truth()
+    truth = dataclasses.replace(follow, dynamics=corrected_dynamics(follow.dynamics, added))
+    train = [zigzag(truth, 20, 20, first=side, duration=80, dt=0.1, method="euler", rps=n,
+                    speed=speed).log.assign(n=n)
+             for side, n, speed in (("starboard", 9.0, 0.9), ("port", 12.0, 1.2))]  # fmt: skip
+    fit = identify_correction(train, follow, added.structure, gamma=1e8)
+    for dof, terms in added.coefficients.items():
+        assert fit.correction.coefficients[dof] == pytest.approx(terms, abs=1e-7), dof
+    unseen = zigzag(truth, 10, 10, duration=80, dt=0.1, method="euler", rps=10.5,
+                    speed=1.05).log.assign(n=10.5)  # fmt: skip
+    run = validate(fit.vessel, unseen, ["unseen"], method="euler", start_draws=False)[0]
+    assert max(run.metrics[s]["rmse"] for s in "uvr") < 1e-6
+    with pytest.raises(ShipidError, match="no propeller speed"):
+        identify_correction(train[0].drop(columns="n"), follow, added.structure)
 
 
 def test_a_corrected_ships_bootstrap_travels_with_its_file_into_the_bands(tmp_path, capsys):

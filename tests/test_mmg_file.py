@@ -98,3 +98,48 @@ def test_the_file_runs_where_a_vessel_does_and_is_corrected(tmp_path, capsys):
     code, _, err = run(["correct", tmp_path / "nothing.yml", log_path, "-o",
                         tmp_path / "x.json"], capsys)  # fmt: skip
     assert code == 1 and err.count("\n") == 1 and "neither a reference ship" in err
+
+
+def test_a_propeller_that_follows_the_logs_runs_at_each_logs_rate(tmp_path, capsys):
+    """``rps: logs``: each run at the propeller speed its log (or --rps) gives, as the same
+    ship with that constant rps runs; a manoeuvre at --rps starts from the straight-running
+    speed there; a log whose propeller stops or reverses is refused in one line."""
+    follow = mmg_vessel({**kvlcc2_document(), "rps": "logs"})
+    assert follow.dynamics.uses_rps
+    rng = np.random.default_rng(1)
+    nu = np.column_stack([rng.uniform(0.5, 1.3, 50), rng.uniform(-0.2, 0.2, 50),
+                          rng.uniform(-0.05, 0.05, 50)])  # fmt: skip
+    delta, n = rng.uniform(-0.6, 0.6, 50), rng.uniform(6.0, 14.0, 50)
+    at_each = np.vstack([mmg_vessel({**kvlcc2_document(), "rps": float(k)}).dynamics.derivatives(
+        row[None], d) for row, d, k in zip(nu, delta, n, strict=True)])  # fmt: skip
+    np.testing.assert_allclose(follow.dynamics.derivatives(nu, delta, None, n), at_each,
+                               rtol=1e-13, atol=1e-15)  # fmt: skip
+    fixed = mmg_vessel({**kvlcc2_document(), "rps": 9.0})
+    log = zigzag(fixed, 20, 20, duration=60, dt=0.2, method="euler").log.assign(n=9.0)
+    path = tmp_path / "follow.yml"
+    path.write_text(yaml.safe_dump({**kvlcc2_document(), "rps": "logs"}), encoding="utf-8")
+    log_path = write_log(log, tmp_path / "zz9.csv")
+    code, _, err = run(["validate", path, log_path, "--method", "euler", "--json",
+                        tmp_path / "v.json"], capsys)  # fmt: skip
+    assert code == 0, err
+    (record,) = json.loads((tmp_path / "v.json").read_text())["logs"]
+    assert max(record["metrics"][s]["rmse"] for s in "uvr") < 1e-9
+    closed = record["indices"]["closed_loop"]
+    measured = record["indices"]["measured"]
+    assert closed["first_overshoot_deg"] == pytest.approx(measured["first_overshoot_deg"],
+                                                          abs=0.05)  # fmt: skip
+    code, out, err = run(["manoeuvre", path, "turning", "--rps", "9", "--json",
+                          tmp_path / "t.json"], capsys)  # fmt: skip
+    assert code == 0 and "straight-running speed at 9 rps" in out, err
+    speed = float(out.split("approach: ")[1].split(" m/s")[0])
+    assert fixed.dynamics.derivatives([[speed, 0.0, 0.0]], [0.0])[0, 0] == pytest.approx(0.0,
+                                                                                      abs=1e-5)
+    turn = turning_circle(fixed, 35.0, speed=speed).indices
+    ours = json.loads((tmp_path / "t.json").read_text())["indices"]
+    assert ours["tactical_diameter"] == pytest.approx(turn["tactical_diameter"], rel=1e-3)
+    astern = write_log(log.assign(n=np.where(log["t"] > 30, -5.0, 9.0)), tmp_path / "astern.csv")
+    code, _, err = run(["validate", path, astern], capsys)
+    assert code == 1 and err.count("\n") == 1 and "propeller turning ahead only" in err
+    assert "t = 30.2 s" in err
+    with pytest.raises(ShipidError, match="rps"):
+        mmg_vessel({**kvlcc2_document(), "rps": "fast"})

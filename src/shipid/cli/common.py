@@ -796,7 +796,7 @@ def _run_approach(target, cond: dict, speed: float | None, rps: float | None):
     from shipid.dynamics.model import ManoeuvringModel
 
     if not isinstance(target, ManoeuvringModel | HybridModel):
-        return speed, rps, None
+        return _ship_approach(target, speed, rps)
     if target.uses_thrust:  # its straight approach needs the thrust too
         from shipid.trials.manoeuvres import THRUST_REFUSED
 
@@ -807,6 +807,34 @@ def _run_approach(target, cond: dict, speed: float | None, rps: float | None):
                           window=_steady_window(cond))  # fmt: skip
     print(app.describe())
     return app.speed, app.rps, app.warning
+
+
+def _ship_approach(ship, speed: float | None, rps: float | None):
+    """A reference ship's run: its own trim; where its propeller follows the run's rate (an MMG
+    file's ``rps: logs``), the trimmed rps unless given, and at a given rps without --speed the
+    ship's straight-running speed at it, printed. Returns (speed, rps, None)."""
+    dyn = getattr(ship, "dynamics", None)
+    if not getattr(dyn, "uses_rps", False):
+        return speed, rps, None
+    if rps is None:
+        return speed, dyn.reference.n_prop if hasattr(dyn, "reference") else dyn.n_prop, None
+    if speed is None:
+        import numpy as np
+        from scipy.optimize import brentq
+
+        def surge(u: float) -> float:
+            return float(dyn.derivatives(np.array([[u, 0.0, 0.0]]), np.zeros(1), None,
+                                         np.array([rps]))[0, 0])  # fmt: skip
+
+        top = 1e-3
+        while surge(top) > 0 and top < 1e3:
+            top *= 2.0
+        if not surge(1e-3) > 0 > surge(top):
+            raise ShipidError(f"{ship.name}: no straight-running speed at {rps:g} rps (the "
+                              "propeller's thrust does not meet the resistance); give --speed")
+        speed = brentq(surge, 1e-3, top, xtol=1e-10)
+        print(f"approach: {speed:.4g} m/s, {ship.name}'s straight-running speed at {rps:g} rps")
+    return speed, rps, None
 
 
 def _from_rest_note(target, speed: float | None, rps: float | None) -> str | None:

@@ -84,9 +84,12 @@ def _replicate_step(ship) -> float | None:
 def _standard(ship, side: str, dt: float | None = None) -> dict:
     """The held 35° turn and the 10°/10° zig-zag of ``ship`` to ``side`` (at ``dt``, else the
     manoeuvres' default step)."""
+    from shipid.cli.common import _ship_approach
     from shipid.trials.manoeuvres import turning_circle, zigzag
 
     step = {} if dt is None else {"dt": dt}
+    # A propeller that follows the runs' rate turns at its trim for the approach.
+    step["rps"] = _ship_approach(ship, None, None)[1]
     return {"turning": turning_circle(ship, 35.0, side=side, **step),
             "zigzag": zigzag(ship, 10.0, 10.0, first=side, **step)}  # fmt: skip
 

@@ -317,10 +317,11 @@ def simulate_batch(
         series = {"delta": delta, "thrust": thrust, "n": rps, **extra}
         out, n_valid = run_hybrid_kernel(dynamics, t, input_array(series, n_traj, n_steps), s0,
                                          method, speed_lim, yaw_lim)  # fmt: skip
-    elif hasattr(dynamics, "integrate_open"):  # a compiled reference ship: rudder input only
+    elif hasattr(dynamics, "integrate_open"):  # a compiled reference ship: rudder (and rps)
         out = np.zeros((n_traj, n_steps, 6))
         n_valid = np.zeros(n_traj, dtype=np.int64)
-        dynamics.integrate_open(kernel.c_array(t), input_array({"delta": delta}, n_traj, n_steps),
+        series = {"delta": delta, "n": rps if getattr(dynamics, "uses_rps", False) else None}
+        dynamics.integrate_open(kernel.c_array(t), input_array(series, n_traj, n_steps),
                                 np.full(n_traj, n_steps, dtype=np.int64), s0, method == "rk4",
                                 np.full(n_traj, speed_lim), np.full(n_traj, yaw_lim), out,
                                 n_valid)  # fmt: skip

@@ -49,23 +49,31 @@ class CorrectedDynamics:
     ``derivatives`` (the simulator's and the manoeuvres' generic path, stepped in Python)."""
 
     uses_thrust = False
-    uses_rps = False
 
     def __init__(self, reference, correction: ManoeuvringModel) -> None:
         self.reference = reference
         self.correction = correction
 
-    def derivatives(self, nu, delta, thrust=None):
-        """(B, 3) body accelerations at states nu (B, 3) and rudder delta (B,). The correction
-        through the compiled term kernel (a twentieth of the NumPy terms' time: the
-        manoeuvres step this once per sample, in Python)."""
+    @property
+    def uses_rps(self) -> bool:
+        """The reference's: an MMG ship whose propeller follows the runs' rps."""
+        return getattr(self.reference, "uses_rps", False)
+
+    def derivatives(self, nu, delta, thrust=None, rps=None):
+        """(B, 3) body accelerations at states nu (B, 3) and rudder delta (B,) (and the
+        propeller's ``rps`` where the reference follows it). The correction through the
+        compiled term kernel (a twentieth of the NumPy terms' time: the manoeuvres step this
+        once per sample, in Python)."""
         nu = np.ascontiguousarray(nu, dtype=float)
         inputs = np.zeros((nu.shape[0], len(INPUT_SIGNALS)))
         rudder = INPUT_SIGNALS.index("delta")
         inputs[:, rudder] = delta
-        own = self.reference.compiled_accelerations(nu, inputs) \
-            if isinstance(self.reference, ManoeuvringModel) \
-            else self.reference.derivatives(nu, inputs[:, rudder])  # fmt: skip
+        if isinstance(self.reference, ManoeuvringModel):
+            own = self.reference.compiled_accelerations(nu, inputs)
+        elif self.uses_rps:
+            own = self.reference.derivatives(nu, inputs[:, rudder], None, rps)
+        else:
+            own = self.reference.derivatives(nu, inputs[:, rudder])
         return own + self.correction.compiled_accelerations(nu, inputs)
 
 
@@ -85,8 +93,8 @@ class CorrectedMMGDynamics(CorrectedDynamics):
         from shipid.vessels import mmg
 
         ref = self.reference
-        mmg.open_corrected(ref.packed, ref.n_prop, *self._terms, t, inputs, n_steps, s0, rk4,
-                           speed_lim, yaw_lim, out, n_valid)  # fmt: skip
+        mmg.open_corrected(ref.packed, ref.n_prop, ref.follow_rps, *self._terms, t, inputs,
+                           n_steps, s0, rk4, speed_lim, yaw_lim, out, n_valid)  # fmt: skip
 
     def integrate_closed(self, dt, n_steps, s0, params, rk4, speed_lim, yaw_lim, states, rudder,
                          n_valid):  # fmt: skip
@@ -94,8 +102,9 @@ class CorrectedMMGDynamics(CorrectedDynamics):
         from shipid.vessels import mmg
 
         ref = self.reference
-        mmg.closed_corrected(ref.packed, ref.n_prop, *self._terms, dt, n_steps, s0, params, rk4,
-                             speed_lim, yaw_lim, states, rudder, n_valid)  # fmt: skip
+        mmg.closed_corrected(ref.packed, ref.n_prop, ref.follow_rps, *self._terms, dt, n_steps,
+                             s0, params, rk4, speed_lim, yaw_lim, states, rudder,
+                             n_valid)  # fmt: skip
 
 
 def corrected_dynamics(reference, correction: ManoeuvringModel):
@@ -240,6 +249,14 @@ def identify_correction(
     names = list(names) if names else [log.attrs.get("name", f"log {i + 1}")
                                        for i, log in enumerate(logs)]  # fmt: skip
     require_states(logs, names, "training log")
+    if getattr(reference.dynamics, "uses_rps", False):
+        for log, name in zip(logs, names, strict=True):
+            if "n" not in log.columns:
+                raise ShipidError(f"{name}: no propeller speed (column n), which the reference "
+                                  f"{reference.name} runs at (its propeller follows the logs')")
+            from shipid.vessels.mmg import ahead_only
+
+            ahead_only(log["n"].to_numpy(dtype=float), log["t"].to_numpy(dtype=float), name)
     logs = [in_rudder_convention(log, reference.rudder_positive)[0] for log in logs]
     scores = {}
     if gamma == "auto":
@@ -267,6 +284,16 @@ def identify_correction(
     return Correction(vessel, correction, explained, float(gamma), scores, ensemble, reference)
 
 
+def _reference_accelerations(reference: Vessel, log: pd.DataFrame) -> np.ndarray:
+    """The reference's accelerations at the log's samples but the last (at the log's propeller
+    speed where the reference follows it)."""
+    nu = log[list(DOFS)].to_numpy(dtype=float)[:-1]
+    delta = log["delta"].to_numpy(dtype=float)[:-1]
+    if not getattr(reference.dynamics, "uses_rps", False):
+        return reference.dynamics.derivatives(nu, delta)
+    return reference.dynamics.derivatives(nu, delta, None, log["n"].to_numpy(dtype=float)[:-1])
+
+
 def _fit(logs, names, reference: Vessel, structure: ModelStructure, gamma: float,
          weights: np.ndarray | None = None) -> tuple[ManoeuvringModel, dict[str, float]]:
     """The correction of ``reference`` on ``logs`` (filtered already) and the reference's
@@ -274,9 +301,7 @@ def _fit(logs, names, reference: Vessel, structure: ModelStructure, gamma: float
     samples but the last of each, in order: a bootstrap replicate). Each equation is
     ``regression_problem``'s with the reference's accelerations as the known part of the
     target, computed once per log for the three."""
-    own = {id(log): reference.dynamics.derivatives(log[list(DOFS)].to_numpy(dtype=float)[:-1],
-                                                   log["delta"].to_numpy(dtype=float)[:-1])
-           for log in logs}  # fmt: skip
+    own = {id(log): _reference_accelerations(reference, log) for log in logs}
     coefficients, terms, explained = {}, {}, {}
     for dof in structure.dofs:
         j = DOFS.index(dof)

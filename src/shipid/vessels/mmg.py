@@ -149,9 +149,11 @@ def accelerations(c, u, vm, r, delta, n):
 
 @numba.njit(cache=True)
 def rhs(ctx, u, v, r, psi):
-    """State derivative for the compiled integrators; ctx = (inputs, n, coefficients):
-    δ = inputs[0]."""
-    a0, a1, a2 = accelerations(ctx[2], u, v, r, ctx[0][0], ctx[1])
+    """State derivative for the compiled integrators; ctx = (inputs, n, coefficients, follow):
+    δ = inputs[0]; the propeller at inputs[1] (the log's or the manoeuvre's) where ``follow``,
+    else at n."""
+    inp = ctx[0]
+    a0, a1, a2 = accelerations(ctx[2], u, v, r, inp[0], inp[1] if ctx[3] else ctx[1])
     psi_dot, xd, yd = kernel.kinematics(u, v, r, psi)
     return a0, a1, a2, psi_dot, xd, yd
 
@@ -159,9 +161,10 @@ def rhs(ctx, u, v, r, psi):
 @numba.njit(cache=True)
 def rhs_corrected(ctx, u, v, r, psi):
     """``rhs`` plus a term model's accelerations (a correction); ctx = (inputs, n,
-    coefficients, the term model's context, whose input buffer ``inputs`` is)."""
-    a0, a1, a2 = accelerations(ctx[2], u, v, r, ctx[0][0], ctx[1])
-    terms = ctx[3]
+    coefficients, follow, the term model's context, whose input buffer ``inputs`` is)."""
+    inp = ctx[0]
+    a0, a1, a2 = accelerations(ctx[2], u, v, r, inp[0], inp[1] if ctx[3] else ctx[1])
+    terms = ctx[4]
     if terms[13] == kernel.SLOTS_CROSSFLOW:
         b0, b1, b2, rd, xd, yd = kernel.terms_rhs_crossflow(terms, u, v, r, psi)
     elif terms[13] == kernel.SLOTS_RUDDER:
@@ -177,75 +180,110 @@ def _batch(c, nu, delta, n):
     out = np.empty_like(nu)
     for i in range(nu.shape[0]):
         out[i, 0], out[i, 1], out[i, 2] = accelerations(c, nu[i, 0], nu[i, 1], nu[i, 2],
-                                                        delta[i], n)  # fmt: skip
+                                                        delta[i], n[i])  # fmt: skip
     return out
 
 
 @numba.njit(cache=True)
-def _open(c, n, t, inputs, n_steps, s0, rk4, speed_lim, yaw_lim, out, n_valid):
+def _open(c, n, follow, t, inputs, n_steps, s0, rk4, speed_lim, yaw_lim, out, n_valid):
     for b in range(inputs.shape[0]):
         inp = np.zeros(kernel.N_INPUTS)
-        n_valid[b] = kernel.open_run(_this.rhs, (inp, n, c), inp, t, inputs[b], n_steps[b],
+        n_valid[b] = kernel.open_run(_this.rhs, (inp, n, c, follow), inp, t, inputs[b], n_steps[b],
                                      s0[b], rk4, speed_lim[b], yaw_lim[b], out[b])  # fmt: skip
 
 
 @numba.njit(cache=True)
-def _closed(c, n, dt, n_steps, s0, params, rk4, speed_lim, yaw_lim, states, rudder, n_valid):
+def _closed(c, n, follow, dt, n_steps, s0, params, rk4, speed_lim, yaw_lim, states, rudder,
+            n_valid):  # fmt: skip
     for b in range(params.shape[0]):
         inp = np.zeros(kernel.N_INPUTS)
-        n_valid[b] = kernel.closed_run(_this.rhs, (inp, n, c), inp, params[b], dt, n_steps,
+        n_valid[b] = kernel.closed_run(_this.rhs, (inp, n, c, follow), inp, params[b], dt, n_steps,
                                        s0[b], rk4, speed_lim[b], yaw_lim[b], states[b],
                                        rudder[b])  # fmt: skip
 
 
 @numba.njit(cache=True)
-def open_corrected(c, n, theta, start, sig, op, kk, pw, rud, derived, t, inputs, n_steps, s0,
-                   rk4, speed_lim, yaw_lim, out, n_valid):  # fmt: skip
-    """Free runs of the MMG model ``c`` at propeller speed ``n`` plus the term model θ (3, T)
-    with its factor table (``kernel.integrate_open``'s arguments)."""
+def open_corrected(c, n, follow, theta, start, sig, op, kk, pw, rud, derived, t, inputs, n_steps,
+                   s0, rk4, speed_lim, yaw_lim, out, n_valid):  # fmt: skip
+    """Free runs of the MMG model ``c`` at propeller speed ``n`` (the inputs' where ``follow``)
+    plus the term model θ (3, T) with its factor table (``kernel.integrate_open``'s
+    arguments)."""
     for b in range(inputs.shape[0]):
         terms = kernel._terms_ctx(theta, start, sig, op, kk, pw, rud, derived, False, 0.0, 0.0)
         inp = terms[8]
-        n_valid[b] = kernel.open_run(_this.rhs_corrected, (inp, n, c, terms), inp, t, inputs[b],
-                                     n_steps[b], s0[b], rk4, speed_lim[b], yaw_lim[b], out[b])
+        n_valid[b] = kernel.open_run(_this.rhs_corrected, (inp, n, c, follow, terms), inp, t,
+                                     inputs[b], n_steps[b], s0[b], rk4, speed_lim[b],
+                                     yaw_lim[b], out[b])  # fmt: skip
 
 
 @numba.njit(cache=True)
-def closed_corrected(c, n, theta, start, sig, op, kk, pw, rud, derived, dt, n_steps, s0, params,
-                     rk4, speed_lim, yaw_lim, states, rudder, n_valid):  # fmt: skip
+def closed_corrected(c, n, follow, theta, start, sig, op, kk, pw, rud, derived, dt, n_steps, s0,
+                     params, rk4, speed_lim, yaw_lim, states, rudder, n_valid):  # fmt: skip
     """Closed-loop manoeuvres of the MMG model ``c`` plus the term model θ (3, T)."""
     for b in range(params.shape[0]):
         # A correction has no wind terms: the term model's wind stays the inputs' (zero).
         terms = kernel._terms_ctx(theta, start, sig, op, kk, pw, rud, derived, False, 0.0, 0.0)
         inp = terms[8]
-        n_valid[b] = kernel.closed_run(_this.rhs_corrected, (inp, n, c, terms), inp, params[b],
-                                       dt, n_steps, s0[b], rk4, speed_lim[b], yaw_lim[b],
-                                       states[b], rudder[b])  # fmt: skip
+        n_valid[b] = kernel.closed_run(_this.rhs_corrected, (inp, n, c, follow, terms), inp,
+                                       params[b], dt, n_steps, s0[b], rk4, speed_lim[b],
+                                       yaw_lim[b], states[b], rudder[b])  # fmt: skip
+
+
+def ahead_only(rps: np.ndarray, t: np.ndarray | None = None, what: str = "") -> None:
+    """Refuse a propeller speed that is not ahead (> 0): the MMG standard method's propeller
+    (K_T of the advance ratio J = u (1 − w_P) / (n D_P)) and the rudder's inflow in its race
+    hold for a propeller turning ahead only (the harbour manoeuvres of the Esso Osaka's random
+    runs stop and reverse it)."""
+    rps = np.asarray(rps, dtype=float)
+    bad = np.argwhere(~(rps > 0.0))
+    if bad.size:
+        from shipid.errors import ShipidError
+
+        first = tuple(bad[0])
+        when = f" at t = {t[first[-1]]:.4g} s" if t is not None and first[-1] < len(t) else ""
+        raise ShipidError(f"{what + ': ' if what else ''}the propeller speed is {rps[first]:.3g} "
+                          f"rps{when} (its lowest {np.min(rps):.3g}), and the MMG standard "
+                          "method models a propeller turning ahead only; cut the log before it "
+                          "(--end) or use a model identified from logs that reverse it")
 
 
 class MMGDynamics(CompiledDynamics):
-    """The MMG model's accelerations at a constant propeller speed ``n_prop`` [rps]; ``c`` the
-    flat coefficients of ``mmg_file.coefficients`` (kept: a corrected ship's file embeds
-    them)."""
+    """The MMG model's accelerations, its propeller at a constant ``n_prop`` [rps] (trimmed for
+    the approach speed) or, where ``follow_rps``, at the rate each run gives (a log's column n,
+    a manoeuvre's rps: ``uses_rps``); ``c`` the flat coefficients of ``mmg_file.coefficients``
+    (kept: a corrected ship's file embeds them)."""
 
-    def __init__(self, c: Mapping, n_prop: float) -> None:
+    def __init__(self, c: Mapping, n_prop: float, follow_rps: bool = False) -> None:
         self.c = dict(c)
         self.n_prop = float(n_prop)
+        self.follow_rps = bool(follow_rps)
         self.packed = pack(self.c)
 
-    def derivatives(self, nu, delta, thrust=None):
-        """(B, 3) body accelerations at states nu (B, 3) (midship sway) and rudder delta (B,)."""
+    @property
+    def uses_rps(self) -> bool:
+        """Whether a run gives the propeller speed (the simulator then asks for it)."""
+        return self.follow_rps
+
+    def derivatives(self, nu, delta, thrust=None, rps=None):
+        """(B, 3) body accelerations at states nu (B, 3) (midship sway) and rudder delta (B,),
+        the propeller at ``rps`` (B,) where the ship follows it, else at ``n_prop``."""
         nu = kernel.c_array(nu).reshape(-1, 3)
         delta = kernel.c_array(np.broadcast_to(np.asarray(delta, dtype=float), nu.shape[:1]))
-        return _batch(self.packed, nu, delta, self.n_prop)
+        n = rps if self.follow_rps and rps is not None else self.n_prop
+        ahead_only(n)
+        return _batch(self.packed, nu, delta,
+                      kernel.c_array(np.broadcast_to(np.asarray(n, dtype=float), nu.shape[:1])))
 
     def integrate_open(self, t, inputs, n_steps, s0, rk4, speed_lim, yaw_lim, out, n_valid):
-        """Free runs driven by (B, N, 5) inputs, the propeller at ``n_prop``."""
-        _open(self.packed, self.n_prop, t, inputs, n_steps, s0, rk4, speed_lim, yaw_lim, out,
-              n_valid)  # fmt: skip
+        """Free runs driven by (B, N, 5) inputs, the propeller at ``n_prop`` or the inputs'."""
+        if self.follow_rps:
+            ahead_only(inputs[:, :-1, 1], t)
+        _open(self.packed, self.n_prop, self.follow_rps, t, inputs, n_steps, s0, rk4, speed_lim,
+              yaw_lim, out, n_valid)  # fmt: skip
 
     def integrate_closed(self, dt, n_steps, s0, params, rk4, speed_lim, yaw_lim, states, rudder,
                          n_valid):  # fmt: skip
-        """Closed-loop manoeuvres of parameter rows ``params``, the propeller at ``n_prop``."""
-        _closed(self.packed, self.n_prop, dt, n_steps, s0, params, rk4, speed_lim, yaw_lim,
-                states, rudder, n_valid)  # fmt: skip
+        """Closed-loop manoeuvres of parameter rows ``params``, the propeller at ``n_prop`` or
+        the manoeuvre's."""
+        _closed(self.packed, self.n_prop, self.follow_rps, dt, n_steps, s0, params, rk4,
+                speed_lim, yaw_lim, states, rudder, n_valid)  # fmt: skip

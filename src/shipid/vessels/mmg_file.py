@@ -20,7 +20,10 @@ it. The file (YAML or JSON)::
     rho: 1025
     approach_speed: 1.179
     rudder_rate: 15.8    # [deg/s]; rudder_limit [deg], default 35
-    scale: 45.7          # optional; rps: optional (else trimmed for the approach)
+    scale: 45.7          # optional
+    rps: 11.8            # optional: the propeller's constant rate, else trimmed for the
+                         # approach; "logs": each log's measured rate (column n) and a
+                         # manoeuvre's --rps (trimmed for the approach where none is given)
     hull: {m_x:, m_y:, j_z:, r0:, x_vv:, x_vr:, x_rr:, x_vvvv:, y_v:, y_r:, y_vvv:, y_vvr:,
            y_vrr:, y_rrr:, n_v:, n_r:, n_vvv:, n_vvr:, n_vrr:, n_rrr:}     # prime
     propeller: {diameter:, t_p:, w_p0:, k0:, k1:, k2:, x_p:, c1:, c2_pos:, c2_neg:}
@@ -46,6 +49,8 @@ from .mmg import MMGDynamics
 from .vessel import Vessel
 
 FORMAT = "shipid-mmg"
+# ``rps: logs``: the propeller turns at each log's measured rate and at a manoeuvre's --rps.
+FOLLOW = "logs"
 TOP = ("length", "beam", "draught", "volume", "x_g", "k_zz", "rho", "approach_speed",
        "rudder_rate")  # fmt: skip
 HULL = ("m_x", "m_y", "j_z", "r0", "x_vv", "x_vr", "x_rr", "x_vvvv", "y_v", "y_r", "y_vvv",
@@ -86,7 +91,12 @@ def coefficients(doc: Mapping, where: str = "MMG file") -> dict:
             raise ShipidError(f"{where}: {full} must be > 0, got {out[full]:g}")
     out["rudder_limit"] = _number(doc.get("rudder_limit", 35.0), f"{where}: rudder_limit")
     out["scale"] = _number(doc["scale"], f"{where}: scale") if "scale" in doc else math.nan
-    out["rps"] = _number(doc["rps"], f"{where}: rps") if doc.get("rps") is not None else None
+    rps = doc.get("rps")
+    out["follow_rps"] = rps == FOLLOW
+    out["rps"] = _number(rps, f"{where}: rps (a number, or \"{FOLLOW}\")") \
+        if rps is not None and rps != FOLLOW else None  # fmt: skip
+    if out["rps"] is not None and not out["rps"] > 0:
+        raise ShipidError(f"{where}: rps must be > 0, got {out['rps']:g}")
     return out
 
 
@@ -109,7 +119,8 @@ def mmg_vessel(doc: Mapping, where: str = "MMG file") -> Vessel:
     """The reference ship of an MMG document (``coefficients``)."""
     c = coefficients(doc, where)
     n = c["rps"] if c["rps"] is not None else trimmed_rps(c, c["approach_speed"])
-    return Vessel(name=c["name"], dynamics=MMGDynamics(c, n), length=c["length"],
+    dynamics = MMGDynamics(c, n, follow_rps=c["follow_rps"])
+    return Vessel(name=c["name"], dynamics=dynamics, length=c["length"],
                   approach_speed=c["approach_speed"],
                   steering=SteeringMachine(math.radians(c["rudder_limit"]),
                                            math.radians(c["rudder_rate"])),
