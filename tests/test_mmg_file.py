@@ -143,3 +143,65 @@ def test_a_propeller_that_follows_the_logs_runs_at_each_logs_rate(tmp_path, caps
     assert "t = 30.2 s" in err
     with pytest.raises(ShipidError, match="rps"):
         mmg_vessel({**kvlcc2_document(), "rps": "fast"})
+
+
+def _particulars(tmp_path, k: float = 1.0, **drop) -> str:
+    """The KVLCC2's particulars (the built-in's values) of a ship k times as long."""
+    values = {"length": K.L * k, "beam": K.B * k, "draught": K.D_DRAUGHT * k,
+              "mass": K.RHO * K.VOLUME * k**3, "rudder_area": K.AR * k**2,
+              "rudder_height": K.HR * k, "propeller_diameter": K.DP * k, "xg": K.XG * k,
+              "rho": K.RHO}  # fmt: skip
+    for key in drop:
+        values.pop(key)
+    path = tmp_path / f"p{k:g}.yml"
+    path.write_text("".join(f"{key}: {v!r}\n" for key, v in values.items()), encoding="utf-8")
+    return str(path)
+
+
+def test_shipid_mmg_carries_a_similar_ships_coefficients_to_this_ships_particulars(tmp_path,
+                                                                                  capsys):
+    """``shipid mmg kvlcc2 --particulars``: with the KVLCC2's own particulars, the KVLCC2; with
+    those of a ship twice as long, the KVLCC2 Froude-scaled (equal prime coefficients): its
+    accelerations at Froude-similar states are the KVLCC2's (surge and sway) and half of them
+    (yaw), its trimmed rps the KVLCC2's over √2, its approach √2 times the KVLCC2's."""
+    built_in = K.kvlcc2()
+    code, out, err = run(["mmg", "kvlcc2", "--particulars", _particulars(tmp_path), "--speed",
+                          K.APPROACH_SPEED, "--rudder-rate", K.RUDDER_RATE_DEG, "-o",
+                          tmp_path / "same.yml"], capsys)  # fmt: skip
+    assert code == 0 and "MMG model written" in out, err
+    same = read_mmg(tmp_path / "same.yml")
+    rng = np.random.default_rng(3)
+    nu = np.column_stack([rng.uniform(0.4, 1.4, 40), rng.uniform(-0.2, 0.2, 40),
+                          rng.uniform(-0.05, 0.05, 40)])  # fmt: skip
+    delta = rng.uniform(-0.6, 0.6, 40)
+    np.testing.assert_allclose(same.dynamics.derivatives(nu, delta),
+                               built_in.dynamics.derivatives(nu, delta), rtol=1e-9, atol=1e-13)
+    code, _, err = run(["mmg", "kvlcc2", "--particulars", _particulars(tmp_path, 2.0), "-o",
+                        tmp_path / "twice.yml"], capsys)  # fmt: skip
+    assert code == 0 and "equal Froude number" in err
+    twice = read_mmg(tmp_path / "twice.yml")
+    root = np.sqrt(2.0)
+    assert twice.approach_speed == pytest.approx(K.APPROACH_SPEED * root, rel=1e-12)
+    assert twice.dynamics.n_prop == pytest.approx(built_in.dynamics.n_prop / root, rel=1e-8)
+    scaled = twice.dynamics.derivatives(nu * [root, root, 1 / root], delta)
+    np.testing.assert_allclose(scaled, built_in.dynamics.derivatives(nu, delta) * [1, 1, 0.5],
+                               rtol=1e-9, atol=1e-13)  # fmt: skip
+
+
+@pytest.mark.parametrize(("argv", "said"), [
+    (["kvlcc2", "--drop", "mass"], "an MMG model needs mass"),
+    (["mariner"], "mariner is not an MMG model"),
+    (["kvlcc2", "--rps", "fast"], "--rps must be a number or 'logs'"),
+    (["kvlcc2", "-o", "ship.txt"], "unknown extension"),
+])  # fmt: skip
+def test_shipid_mmg_bad_input_is_named(tmp_path, capsys, argv, said):
+    drop = {}
+    if "--drop" in argv:
+        drop = {argv.pop(argv.index("--drop") + 1): None}
+        argv.remove("--drop")
+    output = [] if "-o" in argv else ["-o", tmp_path / "ship.yml"]
+    argv = [a if a != "ship.txt" else tmp_path / "ship.txt" for a in argv]
+    code, _, err = run(["mmg", *argv, "--particulars", _particulars(tmp_path, **drop), *output],
+                       capsys)  # fmt: skip
+    assert code == 1 and err.count("\n") == 1 and said in err, err
+    assert not list(tmp_path.glob("ship.*"))

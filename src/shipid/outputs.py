@@ -58,7 +58,8 @@ JSON_EXTENSIONS = (".json",)
 FIGURE_EXTENSIONS = (".png", ".svg", ".pdf")
 HTML_EXTENSIONS = (".html", ".htm")
 KIND_EXTENSIONS = {"log": LOG_EXTENSIONS, "json": JSON_EXTENSIONS, "figure": FIGURE_EXTENSIONS,
-                   "html": HTML_EXTENSIONS, "python": (".py",), "dir": None}  # fmt: skip
+                   "html": HTML_EXTENSIONS, "python": (".py",), "dir": None,
+                   "yaml or json": (".yml", ".yaml", ".json")}  # fmt: skip
 
 
 def _umask() -> int:
@@ -100,7 +101,7 @@ def check_outputs(
     Parameters
     ----------
     outputs : option name (as the user typed it, e.g. ``"-o"``) → (path or None, kind); kind is
-        'log', 'json', 'figure', 'html', 'python' or 'dir'.
+        'log', 'json', 'figure', 'html', 'python', 'yaml or json' or 'dir'.
     inputs : the files the command reads.
     """
     inputs = [Path(p) for p in inputs]

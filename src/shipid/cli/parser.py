@@ -21,6 +21,7 @@ from shipid.cli.data import cmd_import, cmd_indices, cmd_plot
 from shipid.cli.evaluation import cmd_simulate, cmd_validate
 from shipid.cli.experiments import cmd_demo, cmd_study
 from shipid.cli.identify import cmd_identify
+from shipid.cli.mmg import cmd_mmg
 from shipid.cli.rescale import cmd_rescale
 from shipid.cli.selection import cmd_compare, cmd_select
 from shipid.cli.trials import cmd_criteria, cmd_manoeuvre
@@ -568,6 +569,25 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", required=True, metavar="SHIP.json")
     _add_log_options(p)
     p.set_defaults(func=cmd_correct)
+
+    p = sub.add_parser("mmg", help="an MMG model file of a ship without one: a similar "
+                       "ship's prime coefficients with this ship's particulars")  # fmt: skip
+    p.add_argument("source", metavar="VESSEL|MMG.yml",
+                   help="the similar ship: a built-in MMG ship (kvlcc2) or an MMG model file")
+    p.add_argument("--particulars", required=True, metavar="FILE",
+                   help="this ship's particulars (length, beam, draught, mass; propeller "
+                   "diameter, rudder area and height, xg, rho where known)")
+    p.add_argument("--speed", type=float, metavar="U",
+                   help="approach speed [m/s] (default: the particulars' design speed, else the "
+                   "source's at equal Froude number)")
+    p.add_argument("--rps", metavar="N|logs",
+                   help="the propeller's rate: a number, or 'logs': each log's measured rate "
+                   "(and a manoeuvre's --rps) (default: trimmed for the approach speed)")
+    p.add_argument("--rudder-rate", type=float, metavar="DEG/S",
+                   help="rudder rate (default: the source's at equal Froude number)")
+    p.add_argument("--name", help="the ship's name (default: the output's)")
+    p.add_argument("-o", "--output", required=True, metavar="SHIP.yml")
+    p.set_defaults(func=cmd_mmg)
 
     p = sub.add_parser("rescale", help="a model carried to a geometrically similar ship of "
                        "another length (Froude scaling, equal prime coefficients)")

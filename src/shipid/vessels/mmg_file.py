@@ -128,6 +128,88 @@ def mmg_vessel(doc: Mapping, where: str = "MMG file") -> Vessel:
                   source=f"MMG standard method, {where}")  # fmt: skip
 
 
+def document_of(c: Mapping) -> dict:
+    """The MMG file's document of flat coefficients ``c`` (``coefficients``' form)."""
+    doc: dict = {"format": FORMAT, "name": c.get("name", "mmg")}
+    for key in TOP:
+        doc[key] = c[key]
+    for key in ("rudder_limit", "scale"):
+        if key in c and math.isfinite(c[key]):
+            doc[key] = c[key]
+    doc["rps"] = FOLLOW if c.get("follow_rps") else c.get("rps")
+    for group, keys in (("hull", HULL), ("propeller", PROPELLER), ("rudder", RUDDER)):
+        doc[group] = {k: c[f"{group}.{k}"] for k in keys}
+    return doc
+
+
+def like(source: Mapping, particulars, name: str, speed: float | None = None,
+         rps: float | str | None = None, rudder_rate: float | None = None
+         ) -> tuple[dict, list[str]]:  # fmt: skip
+    """An MMG file of a ship that has no model of its own, from a similar ship's: the
+    ``source``'s prime coefficients (flat, ``coefficients``' form: hull, propeller and rudder)
+    with the ship's ``particulars`` (``shipid.data.particulars.Particulars``: length, beam,
+    draught and mass needed; the propeller's diameter, the rudder's area and height where given,
+    else the source's scaled by length, the rudder's height by the source's aspect ratio for
+    the given area). The approach ``speed`` (else the particulars' design speed, else the
+    source's at equal Froude number), ``rps`` (a number, "logs", or None: trimmed) and
+    ``rudder_rate`` [deg/s] (else the source's at equal Froude number). Returns the document and
+    notes saying what was scaled rather than given. The prime coefficients hold for the ship as
+    far as the hulls are alike: the notes set both hulls' form side by side."""
+    missing = [k for k in ("beam", "draught", "mass") if getattr(particulars, k) is None]
+    if missing:
+        raise ShipidError(f"particulars: an MMG model needs {', '.join(missing)} too")
+    ratio = particulars.length / source["length"]
+    froude = math.sqrt(ratio)
+    notes = []
+
+    def given_or_scaled(value, scaled: float, what: str) -> float:
+        if value is not None:
+            return float(value)
+        notes.append(f"{what}: {scaled:.4g}, the source's scaled by length (not in the particulars)")
+        return scaled
+
+    diameter = given_or_scaled(particulars.propeller_diameter,
+                               source["propeller.diameter"] * ratio, "propeller diameter")
+    area = given_or_scaled(particulars.rudder_area, source["rudder.area"] * ratio**2,
+                           "rudder area")  # fmt: skip
+    if particulars.rudder_height is not None:
+        height = float(particulars.rudder_height)
+    else:
+        height = math.sqrt(source["rudder.height"] ** 2 / source["rudder.area"] * area)
+        notes.append(f"rudder height: {height:.4g} m, for the given area at the source's aspect "
+                     "ratio (not in the particulars)")  # fmt: skip
+    if speed is None and particulars.design_speed is not None:
+        speed = particulars.design_speed
+    if speed is None:
+        speed = source["approach_speed"] * froude
+        notes.append(f"approach speed: {speed:.4g} m/s, the source's at equal Froude number "
+                     "(give --speed or design_speed)")  # fmt: skip
+    if rudder_rate is None:
+        rudder_rate = source["rudder_rate"] / froude
+        notes.append(f"rudder rate: {rudder_rate:.4g} °/s, the source's at equal Froude number "
+                     "(give --rudder-rate)")  # fmt: skip
+    c = dict(source)
+    c.update(name=name, length=particulars.length, beam=particulars.beam,
+             draught=particulars.draught, volume=particulars.mass / particulars.rho,
+             x_g=particulars.xg, rho=particulars.rho, approach_speed=float(speed),
+             rudder_rate=float(rudder_rate),
+             scale=particulars.scale if particulars.scale is not None else math.nan,
+             follow_rps=rps == FOLLOW, rps=None if rps in (None, FOLLOW) else float(rps))
+    c["propeller.diameter"], c["rudder.area"], c["rudder.height"] = diameter, area, height
+    doc = document_of(c)
+    coefficients(doc, "the MMG model")  # the same checks as a file's
+    form = {}
+    for label, (L, B, T, V) in (("ship", (particulars.length, particulars.beam,
+                                          particulars.draught, c["volume"])),
+                                ("source", (source["length"], source["beam"], source["draught"],
+                                            source["volume"]))):  # fmt: skip
+        form[label] = f"Cb {V / (L * B * T):.3f}, L/B {L / B:.2f}, B/T {B / T:.2f}"
+    notes.append(f"the hull's, propeller's and rudder's coefficients are {source.get('name')}'s "
+                 f"(prime): they hold as far as the hulls are alike (this ship: {form['ship']}; "
+                 f"{source.get('name')}: {form['source']})")  # fmt: skip
+    return doc, notes
+
+
 def read_document(path) -> dict:
     """The parsed MMG file (YAML or JSON), or a one-line error naming it."""
     p = Path(path)
