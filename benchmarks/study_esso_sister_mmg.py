@@ -2,9 +2,11 @@
 (prime hull, propeller and rudder coefficients; another VLCC, Cb 0.80 against the Esso's 0.83)
 with the Esso's own particulars, its propeller at each log's rate (``shipid mmg kvlcc2
 --particulars esso.yml --rps logs``), not fitted to any Esso log; against the default ``shipid
-identify`` of one zig-zag file; and that MMG model corrected by one zig-zag file (``shipid
-correct``, `blanke-race` terms, γ 1e4, 100, 1 and chosen by the free runs of the file's
-held-out blocks). Each model is judged on the logs it was not fitted to, as
+identify`` of one zig-zag file, and the same file fitted with the KVLCC2 (carried to 3 m at
+equal Froude number) or the sister's MMG file as the prior (``--prior``, the best one-file
+setting of ``study_reference_prior.py``); and the sister's MMG model corrected by one zig-zag
+file (``shipid correct``, `blanke-race` terms, γ 1e4, 100, 1 and chosen by the free runs of the
+file's held-out blocks). Each model is judged on the logs it was not fitted to, as
 ``study_esso_single_logs.py`` judges: the free run's yaw-rate error std over the log's spread
 (the median over a model's held-out zig-zags and turns, then over the models), the two 35°
 turns' tactical diameter and steady yaw rate run closed loop (|error| median / mean, largest,
@@ -50,6 +52,13 @@ def _judge(model, logs: dict) -> tuple[float, list[float], list[float]]:
     turns = [v for path, v in zip(logs, runs, strict=True) if "turn" in path.stem]
     return (float(np.median(_errors(runs, logs))), list(_turn_errors(turns)),
             list(_turn_errors(turns, "steady_yaw_rate")))  # fmt: skip
+
+
+def _add(store: tuple[list, list, list], judged: tuple) -> None:
+    """Append one model's ``_judge`` to the three lists of ``store``."""
+    store[0].append(judged[0])
+    store[1].extend(judged[1])
+    store[2].extend(judged[2])
 
 
 def _cell(errors: list[float]) -> str:
@@ -102,22 +111,28 @@ def main() -> None:
         rows["the sister's MMG model alone, each fold's 10 logs"] = (per_fold, alone[1],
                                                                      alone[2])  # fmt: skip
         identified: tuple[list, list, list] = ([], [], [])
+        priors = {p: ([], [], []) for p in ("kvlcc2", f"{tmp}/esso-mmg.yml")}
         corrected = {g: ([], [], []) for g in GAMMAS}
         chosen = []
         for f in zigzags:
             others = {g: log for g, log in logs.items() if g != f}
             if _quiet(["identify", "--format", "osaka-frt", str(f), "-o", f"{tmp}/m.json"]) == 0:
-                judged = _judge(load_model(f"{tmp}/m.json"), others)
-                for store, value in zip(identified, judged, strict=True):
-                    store.extend(value if isinstance(value, list) else [value])
+                _add(identified, _judge(load_model(f"{tmp}/m.json"), others))
+            for prior, store in priors.items():
+                if _quiet(["identify", "--format", "osaka-frt", str(f), "--model",
+                           "blanke-speed+wind", "--crossflow", "--prior", prior, "--gamma", "1",
+                           "-o", f"{tmp}/p.json"]) == 0:  # fmt: skip
+                    _add(store, _judge(load_model(f"{tmp}/p.json"), others))
             for gamma in GAMMAS:
                 fit = identify_correction(logs[f], sister, "blanke-race", gamma)
                 if gamma == "auto":
                     chosen.append(fit.gamma)
-                judged = _judge(fit.vessel, others)
-                for store, value in zip(corrected[gamma], judged, strict=True):
-                    store.extend(value if isinstance(value, list) else [value])
+                _add(corrected[gamma], _judge(fit.vessel, others))
         rows["default identify, one zig-zag file (9 models)"] = identified
+        for prior, judged in priors.items():
+            label = "the sister's MMG file" if prior.endswith(".yml") else prior
+            rows[f"identify --model blanke-speed+wind --crossflow --prior {label} --gamma 1 "
+                 "(9)"] = judged
         for gamma, judged in corrected.items():
             label = "auto" if gamma == "auto" else f"{gamma:g}"
             rows[f"the sister + correction from one file, γ {label} (9)"] = judged

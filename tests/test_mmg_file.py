@@ -205,3 +205,26 @@ def test_shipid_mmg_bad_input_is_named(tmp_path, capsys, argv, said):
                        capsys)  # fmt: skip
     assert code == 1 and err.count("\n") == 1 and said in err, err
     assert not list(tmp_path.glob("ship.*"))
+
+
+def test_an_mmg_file_is_a_prior_as_the_built_in_ship_is(tmp_path, capsys):
+    """``identify --prior SHIP.yml``: the KVLCC2 written out gives the prior the built-in KVLCC2
+    gives (its trials fitted in the structure), and so the same model."""
+    path = tmp_path / "kvlcc2.yml"
+    path.write_text(yaml.safe_dump(kvlcc2_document()), encoding="utf-8")
+    log = write_log(zigzag(K.kvlcc2(), 20, 20, duration=60, dt=0.2).log, tmp_path / "zz.csv")
+    models = []
+    for prior in ("kvlcc2", path):
+        out = tmp_path / f"m{len(models)}.json"
+        code, text, err = run(["identify", log, "--particulars", _particulars(tmp_path),
+                               "--model", "blanke-speed", "--crossflow", "--prior", prior,
+                               "--gamma", "1", "-o", out], capsys)  # fmt: skip
+        assert code == 0 and "prior: the reference ship" in text, err
+        models.append(json.loads(out.read_text())["model"]["coefficients"])
+    for dof, terms in models[0].items():
+        assert models[1][dof] == pytest.approx(terms, rel=1e-6, abs=1e-9), dof
+    code, _, err = run(["identify", log, "--particulars", _particulars(tmp_path), "--model",
+                        "blanke-speed", "--crossflow", "--gamma", "1", "-o",
+                        tmp_path / "none.json"], capsys)  # fmt: skip
+    plain = json.loads((tmp_path / "none.json").read_text())["model"]["coefficients"]
+    assert code == 0 and plain["r"] != pytest.approx(models[0]["r"], rel=0.05), err

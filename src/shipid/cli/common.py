@@ -298,6 +298,8 @@ def _physics(args, logs, structure, searched: bool = False, chosen: bool = False
         prior = clarke_prior(part, structure, speed or 0.0, _logs_side(logs))
     elif name and name in _vessel_names():
         prior, source = _reference_ship_prior(name, logs, structure, searched)
+    elif args.prior and _is_reference_file(args.prior):
+        prior, source = _reference_ship_prior(args.prior, logs, structure, searched)
     elif args.prior:
         from shipid.identification.priors import prior_from_model, prior_in_forms
 
@@ -312,6 +314,13 @@ def _physics(args, logs, structure, searched: bool = False, chosen: bool = False
                              prior_source=source, bounds_where_present=chosen,
                              **flags)  # fmt: skip
     return options if options.active else None
+
+
+def _is_reference_file(path: str) -> bool:
+    """Whether ``path`` holds a reference ship (an MMG model, a corrected ship), not a model."""
+    from shipid.identification.correction import reference_file
+
+    return reference_file(path) is not None
 
 
 def _reference_ship_prior(name: str, logs, structure, searched: bool) -> tuple[dict, str]:

@@ -209,13 +209,13 @@ def _end_time(text: str) -> float | str:
 # ---------------------------------------------------------------------------- parser
 def _add_physics_options(p) -> None:
     g = p.add_argument_group("physics (increment form; lssvm or ols)")
-    g.add_argument("--prior", metavar="clarke|SHIP|MODEL.json",
+    g.add_argument("--prior", metavar="clarke|SHIP|SHIP.yml|MODEL.json",
                    help="draw the fit toward a prior instead of zero: 'clarke' (linear sway–yaw "
                    "and rudder terms from the particulars, Clarke et al. 1983), a reference "
-                   "ship (kvlcc2, mariner, tanker, cybership2, scale-ship: its trials fitted in "
-                   "the structure and carried to the particulars' length at equal Froude "
-                   "number) or a model file (carried to the logs' length and rudder "
-                   "convention where the two differ)")
+                   "ship (kvlcc2, mariner, tanker, cybership2, scale-ship, or a file of one: "
+                   "an MMG model, shipid mmg; its trials fitted in the structure and carried "
+                   "to the particulars' length at equal Froude number) or a model file "
+                   "(carried to the logs' length and rudder convention where the two differ)")
     g.add_argument("--constraints", metavar="LIST",
                    help="comma list: signs (damping, resistance, thrust, its fall with the "
                    "advance and rudder terms keep their physical sign), derivatives (the "

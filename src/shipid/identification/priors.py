@@ -262,13 +262,18 @@ REFERENCE_STEP = 1 / 40
 def _reference_trials(name: str) -> tuple:
     """The reference ship's trials (``REFERENCE_TRIALS``, both sides) as canonical logs, and
     the ship; computed once per process."""
+    from shipid.identification.correction import reference_file
     from shipid.trials.manoeuvres import turning_circle, zigzag
-    from shipid.vessels import get_vessel
+    from shipid.vessels import VESSELS, get_vessel
 
-    try:
-        ship = get_vessel(name)
-    except ValueError as exc:
-        raise ShipidError(str(exc)) from None
+    ship = None if name in VESSELS else reference_file(name)  # an MMG file, a corrected ship
+    if ship is None:
+        try:
+            ship = get_vessel(name)
+        except ValueError as exc:
+            raise ShipidError(str(exc)) from None
+    # A propeller that follows the runs' rate turns at its trim for the approach.
+    rps = {"rps": ship.dynamics.n_prop} if getattr(ship.dynamics, "uses_rps", False) else {}
     lu = ship.length / ship.approach_speed
     dt = lu * REFERENCE_STEP
     limit = math.degrees(ship.steering.max_angle) if ship.steering.max_angle else 35.0
@@ -282,10 +287,10 @@ def _reference_trials(name: str) -> tuple:
             duration = REFERENCE_LENGTHS[kind] * lu
             if kind == "zigzag":
                 res = zigzag(ship, rudder, heading, first=side, duration=duration, dt=dt,
-                             method="euler")
+                             method="euler", **rps)  # fmt: skip
             else:
                 res = turning_circle(ship, rudder, side=side, duration=duration, dt=dt,
-                                     method="euler")
+                                     method="euler", **rps)  # fmt: skip
             if res.diverged:
                 raise ShipidError(f"the reference ship {name}'s {res.log.attrs.get('manoeuvre')} "
                                   "diverged")  # fmt: skip
@@ -296,7 +301,9 @@ def _reference_trials(name: str) -> tuple:
 def reference_prior(name: str, structure: ModelStructure, length: float,
                     rudder_positive: str | None = None) -> dict[str, dict[str, float]]:  # fmt: skip
     """Prior coefficients of ``structure`` for a ship ``length`` m long from the reference ship
-    ``name`` of ``shipid.vessels`` (e.g. the KVLCC2 for a full-form tanker): the structure's
+    ``name`` of ``shipid.vessels`` (e.g. the KVLCC2 for a full-form tanker), or of a reference
+    ship's file (an MMG model, ``shipid mmg``; a corrected ship, ``shipid correct``): the
+    structure's
     terms fitted (LS-SVM, γ = 1e4) on the reference's noise-free 10°/10° and 20°/20° zig-zags
     and 35° turns to both sides, carried to ``length`` at equal Froude number
     (``shipid.dynamics.prime.froude_scaled``), the rudder in the ship's convention
