@@ -40,7 +40,14 @@ def cmd_correct(args) -> int:
     names = [str(p) for p in args.logs]
     for note in _reference_speed_notes(reference, logs, names):
         _warn(note)
-    fit = identify_correction(logs, reference, args.model, args.gamma, args.filter, names,
+    model = args.model
+    if model is None:
+        from shipid.identification.correction import default_structure
+
+        model = default_structure(logs, reference)
+        print(f"correction's structure: {model}" + (" (the logs measure the relative wind, which "
+              "the reference does not model)" if model.endswith("+wind") else ""))  # fmt: skip
+    fit = identify_correction(logs, reference, model, args.gamma, args.filter, names,
                               args.bootstrap, args.seed)  # fmt: skip
     if fit.gamma_scores:
         print("γ by the free runs of held-out logs: " + ", ".join(

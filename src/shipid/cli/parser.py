@@ -555,8 +555,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help=f"the reference ship ({', '.join(VESSEL_NAMES)}) or a ship's own MMG "
                    "model file (format: shipid-mmg; see shipid.vessels.mmg_file)")
     p.add_argument("logs", nargs="+", metavar="LOG")
-    p.add_argument("--model", default="blanke-race", metavar="STRUCTURE",
-                   help="the correction's terms, in u, v, r and δ (default %(default)s)")
+    p.add_argument("--model", metavar="STRUCTURE",
+                   help="the correction's terms, in u, v, r, δ and the relative wind (default "
+                   "blanke-race, blanke-race+wind where the logs measure the relative wind)")
     p.add_argument("--gamma", type=_number_or_auto, default=1e4, metavar="G|auto",
                    help="LS-SVM γ: smaller keeps the correction smaller; 'auto': by the free runs "
                    "of held-out logs (each left out from three, else blocks) (default %(default)g)")

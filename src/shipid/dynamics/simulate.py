@@ -317,10 +317,11 @@ def simulate_batch(
         series = {"delta": delta, "thrust": thrust, "n": rps, **extra}
         out, n_valid = run_hybrid_kernel(dynamics, t, input_array(series, n_traj, n_steps), s0,
                                          method, speed_lim, yaw_lim)  # fmt: skip
-    elif hasattr(dynamics, "integrate_open"):  # a compiled reference ship: rudder (and rps)
+    elif hasattr(dynamics, "integrate_open"):  # a compiled reference ship: rudder (rps, wind)
         out = np.zeros((n_traj, n_steps, 6))
         n_valid = np.zeros(n_traj, dtype=np.int64)
-        series = {"delta": delta, "n": rps if getattr(dynamics, "uses_rps", False) else None}
+        series = {"delta": delta, "n": rps if getattr(dynamics, "uses_rps", False) else None,
+                  **{c: x for c, x in extra.items() if c in getattr(dynamics, "inputs", ())}}
         dynamics.integrate_open(kernel.c_array(t), input_array(series, n_traj, n_steps),
                                 np.full(n_traj, n_steps, dtype=np.int64), s0, method == "rk4",
                                 np.full(n_traj, speed_lim), np.full(n_traj, yaw_lim), out,

@@ -360,7 +360,8 @@ def _log_wind(model, log: pd.DataFrame) -> tuple[float, float] | None:
     with wind terms (it met still air before: on the Esso Osaka's +35° turn, 1.1 m/s at three
     times the ship's speed, its tactical diameter came 8.47 m instead of 8.02 m, measured 7.27
     m), else None."""
-    return mean_true_wind(log) if getattr(model, "uses_wind", False) else None
+    uses = getattr(model.dynamics if isinstance(model, Vessel) else model, "uses_wind", False)
+    return mean_true_wind(log) if uses else None
 
 
 def _own_approach(model, log: pd.DataFrame, trial: Trial, wind: tuple[float, float] | None

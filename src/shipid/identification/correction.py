@@ -13,7 +13,16 @@ large γ a perfect reference leaves θ = 0. The corrected ship is a ``Vessel``, 
 trim the reference's: the Python API (``validate``, ``zigzag``, ``turning_circle``) runs it as
 any reference ship, and ``shipid correct`` writes it to a file (``correction_document``) that
 the commands taking a reference ship load (``reference_file``). The reference's propeller
-stays at its own trim; a correction has no propeller, thrust or wind terms.
+stays at its own trim, or at each log's rate where it follows it (an MMG file's ``rps: logs``);
+a correction has no propeller or thrust terms (the reference keeps its own), but may have the
+relative wind's, a force no reference ship models (``blanke-race+wind``, the default where the
+logs measure it; an MMG model's and a term model's corrected runs meet the wind, the other
+reference ships' step in Python without it, and refuse them).
+
+On the Esso Osaka, which has no published model, the KVLCC2's MMG model with the Esso's
+particulars (``shipid mmg``) predicts the zig-zags and turns better than the default fitted to
+one of its files; corrected by the logs with the wind's terms, its held-out zig-zags and steady
+turns closer still, its tactical diameters not (``benchmarks/study_esso_sister_mmg.py``).
 
 On the KVLCC2's three real zig-zags (``benchmarks/study_kvlcc2_mmg_baseline.py``) the MMG model
 with a correction fitted to one or two of them predicts the others' yaw rate and closed-loop
@@ -40,8 +49,12 @@ from shipid.identification.uncertainty import Ensemble
 from shipid.vessels.vessel import Vessel
 
 DOFS = ("u", "v", "r")
-# Terms the correction may hold: states and rudder only, as the reference ship's runs give.
-ALLOWED_SIGNALS = {"u", "v", "r", "delta", "U", "beta"}
+# Terms the correction may hold: states, rudder and the relative wind (a force no reference
+# ship models). Not the propeller's: the reference keeps its own.
+ALLOWED_SIGNALS = {"u", "v", "r", "delta", "U", "beta", "wind_speed", "wind_angle"}
+WIND = ("wind_speed", "wind_angle")
+# The default structure; with the wind's terms where the logs measure the relative wind.
+DEFAULT, DEFAULT_WIND = "blanke-race", "blanke-race+wind"
 
 
 class CorrectedDynamics:
@@ -59,15 +72,30 @@ class CorrectedDynamics:
         """The reference's: an MMG ship whose propeller follows the runs' rps."""
         return getattr(self.reference, "uses_rps", False)
 
-    def derivatives(self, nu, delta, thrust=None, rps=None):
+    @property
+    def uses_wind(self) -> bool:
+        """Whether the correction has wind terms (the runs then give the relative wind)."""
+        return self.correction.uses_wind
+
+    @property
+    def inputs(self) -> tuple[str, ...]:
+        """The input series a run takes: the rudder, the propeller's rate where the reference
+        follows it, the relative wind where the correction has its terms."""
+        return ("delta", *(("n",) if self.uses_rps else ()),
+                *(c for c in self.correction.inputs if c in WIND))  # fmt: skip
+
+    def derivatives(self, nu, delta, thrust=None, rps=None, **wind):
         """(B, 3) body accelerations at states nu (B, 3) and rudder delta (B,) (and the
-        propeller's ``rps`` where the reference follows it). The correction through the
+        propeller's ``rps`` where the reference follows it, the relative ``wind_speed`` and
+        ``wind_angle`` where the correction has wind terms). The correction through the
         compiled term kernel (a twentieth of the NumPy terms' time: the manoeuvres step this
         once per sample, in Python)."""
         nu = np.ascontiguousarray(nu, dtype=float)
         inputs = np.zeros((nu.shape[0], len(INPUT_SIGNALS)))
         rudder = INPUT_SIGNALS.index("delta")
         inputs[:, rudder] = delta
+        for name, series in wind.items():
+            inputs[:, INPUT_SIGNALS.index(name)] = series
         if isinstance(self.reference, ManoeuvringModel):
             own = self.reference.compiled_accelerations(nu, inputs)
         elif self.uses_rps:
@@ -191,13 +219,41 @@ class Correction:
         return [] if found is None else found.members()
 
 
+def default_structure(logs: Sequence[pd.DataFrame], reference: Vessel | None = None) -> str:
+    """The correction's structure where none is given: ``blanke-race``, with the wind's terms
+    where every log measures the relative wind (the reference ships have no wind force) and
+    the corrected ship can run them (``reference``: an MMG model or a term model)."""
+    windy = logs and all(set(WIND) <= set(log.columns) for log in logs)
+    return DEFAULT_WIND if windy and (reference is None or _runs_wind(reference)) else DEFAULT
+
+
+def _runs_wind(reference: Vessel) -> bool:
+    """Whether the corrected ``reference`` meets the wind in its closed loops: an MMG model's
+    compiled runs and a term model's do; the other reference ships step in Python, without."""
+    from shipid.vessels.mmg import MMGDynamics
+
+    dyn = reference.dynamics
+    return isinstance(dyn, MMGDynamics) or (type(dyn) is ManoeuvringModel
+                                            and dyn.similar_at_rps is None)
+
+
+def _check_wind(structure: ModelStructure, reference: Vessel, where: str = "") -> None:
+    windy = sorted({t for terms in structure.terms.values() for t in terms
+                    if set(parse_term(t).signals) & set(WIND)})  # fmt: skip
+    if windy and not _runs_wind(reference):
+        raise ShipidError(f"{where}the correction's wind terms ({', '.join(windy)}) are not run "
+                          f"in {reference.name}'s manoeuvres (only an MMG model's and a term "
+                          "model's meet the wind): give a structure without them")  # fmt: skip
+
+
 def _structure(model) -> ModelStructure:
     structure = get_structure(model) if isinstance(model, str) else model
     bad = sorted({t for terms in structure.terms.values() for t in terms
                   if not set(parse_term(t).signals) <= ALLOWED_SIGNALS})  # fmt: skip
     if bad:
-        raise ShipidError(f"a correction of a reference ship holds terms in u, v, r and δ only "
-                          f"(the reference keeps its own propeller and no wind): {', '.join(bad)}")
+        raise ShipidError(f"a correction of a reference ship holds terms in u, v, r, δ and the "
+                          f"relative wind only (the reference keeps its own propeller): "
+                          f"{', '.join(bad)}")  # fmt: skip
     missing = [d for d in structure.dofs if d not in DOFS]
     if missing:
         raise ShipidError(f"unknown equation(s) {missing} in the correction's structure")
@@ -213,7 +269,7 @@ DIVERGENCE_PENALTY = 2.0  # normalised error of each held-out sample after a run
 def identify_correction(
     logs: Sequence[pd.DataFrame] | pd.DataFrame,
     reference: Vessel,
-    model: str | ModelStructure = "blanke-race",
+    model: str | ModelStructure | None = None,
     gamma: float | str = 1e4,
     filter_hz: float | None = None,
     names: Sequence[str] | None = None,
@@ -228,7 +284,9 @@ def identify_correction(
         convention where they state theirs.
     reference : the reference ship (``shipid.vessels.get_vessel``) whose dynamics give
         ``derivatives(nu, delta)``.
-    model : the correction's structure (terms in u, v, r and δ; "1" a constant).
+    model : the correction's structure (terms in u, v, r, δ and the relative wind; "1" a
+        constant); None: ``default_structure`` (``blanke-race``, ``+wind`` where every log
+        measures the relative wind).
     gamma : the LS-SVM's regularisation (a small γ keeps the correction small), or "auto":
         the one of ``GAMMAS`` whose corrections run free closest to held-out logs (each log
         left out in turn from three logs, else four blocks of each; ``Correction.gamma_scores``).
@@ -242,10 +300,11 @@ def identify_correction(
     if gamma != "auto" and not (isinstance(gamma, int | float) and np.isfinite(gamma)
                                 and gamma > 0):  # fmt: skip
         raise ShipidError(f"gamma must be > 0 or 'auto', got {gamma!r}")
-    structure = _structure(model)
     logs = [logs] if isinstance(logs, pd.DataFrame) else list(logs)
     if not logs:
         raise ShipidError("no training logs given")
+    structure = _structure(default_structure(logs, reference) if model is None else model)
+    _check_wind(structure, reference)
     names = list(names) if names else [log.attrs.get("name", f"log {i + 1}")
                                        for i, log in enumerate(logs)]  # fmt: skip
     require_states(logs, names, "training log")
@@ -434,7 +493,8 @@ def corrected_from_document(doc: dict, path) -> Vessel:
         raise ShipidError(f"{path}: correction: {exc}") from None
     except (KeyError, TypeError, ValueError, AttributeError) as exc:
         raise ShipidError(f"{path}: malformed correction ({exc})") from None
-    _structure(correction.structure)  # states and rudder only, as fitted
+    _structure(correction.structure)  # states, rudder and wind only, as fitted
+    _check_wind(correction.structure, reference, f"{path}: ")
     data = doc.get("uncertainty")
     if data is not None and not isinstance(data, dict):
         raise ShipidError(f"{path}: uncertainty must be a mapping")

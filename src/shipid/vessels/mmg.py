@@ -219,10 +219,14 @@ def open_corrected(c, n, follow, theta, start, sig, op, kk, pw, rud, derived, t,
 @numba.njit(cache=True)
 def closed_corrected(c, n, follow, theta, start, sig, op, kk, pw, rud, derived, dt, n_steps, s0,
                      params, rk4, speed_lim, yaw_lim, states, rudder, n_valid):  # fmt: skip
-    """Closed-loop manoeuvres of the MMG model ``c`` plus the term model θ (3, T)."""
+    """Closed-loop manoeuvres of the MMG model ``c`` plus the term model θ (3, T), in the true
+    wind of each row of ``params``."""
     for b in range(params.shape[0]):
-        # A correction has no wind terms: the term model's wind stays the inputs' (zero).
-        terms = kernel._terms_ctx(theta, start, sig, op, kk, pw, rud, derived, False, 0.0, 0.0)
+        p = params[b]
+        # The true wind of the manoeuvre, met by the correction's wind terms (the MMG model has
+        # none) as the relative wind of the ship's own motion, as a term model's.
+        terms = kernel._terms_ctx(theta, start, sig, op, kk, pw, rud, derived, True,
+                                  p[kernel.P_WIND_SPEED], p[kernel.P_WIND_DIR])  # fmt: skip
         inp = terms[8]
         n_valid[b] = kernel.closed_run(_this.rhs_corrected, (inp, n, c, follow, terms), inp,
                                        params[b], dt, n_steps, s0[b], rk4, speed_lim[b],
