@@ -30,12 +30,7 @@ def hybrid_rhs(ctx, u, v, r, psi):
     indices into (u, v, r, δ, n), buffers of 5 for the raw and the standardised features)."""
     tctx, mean, scale, centres, weights, intercept, inv_s2, inv_reach, fidx, x, z = ctx
     # A hybrid's own cost dwarfs the choice (its centres' kernel sums): made per evaluation.
-    if tctx[13] == kernel.SLOTS_CROSSFLOW:
-        a0, a1, a2, rd, xd, yd = kernel.terms_rhs_crossflow(tctx, u, v, r, psi)
-    elif tctx[13] == kernel.SLOTS_RUDDER:
-        a0, a1, a2, rd, xd, yd = kernel.terms_rhs_rudder(tctx, u, v, r, psi)
-    else:
-        a0, a1, a2, rd, xd, yd = kernel.terms_rhs(tctx, u, v, r, psi)
+    a0, a1, a2, rd, xd, yd = kernel.terms_rhs_any(tctx, u, v, r, psi)
     inp = tctx[8]
     x[0], x[1], x[2], x[3], x[4] = u, v, r, inp[0], inp[1]
     d = fidx.size

@@ -231,6 +231,18 @@ def terms_rhs_rudder(ctx, u, v, r, psi):
     return terms_rhs(ctx, u, v, r, psi)
 
 
+@numba.njit(cache=True, inline="always")
+def terms_rhs_any(ctx, u, v, r, psi):
+    """``terms_rhs``, or its cross-flow or rudder variant as ctx[13] says, chosen at every
+    evaluation: for a state derivative that adds its own to a term model's (a hybrid's kernel
+    residual, an MMG model's correction), whose own cost dwarfs the branch."""
+    if ctx[13] == SLOTS_CROSSFLOW:
+        return terms_rhs_crossflow(ctx, u, v, r, psi)
+    if ctx[13] == SLOTS_RUDDER:
+        return terms_rhs_rudder(ctx, u, v, r, psi)
+    return terms_rhs(ctx, u, v, r, psi)
+
+
 # Inlined: a function passed on through two calls would make numba refuse to cache the caller.
 @numba.njit(cache=True, inline="always")
 def step(rhs, ctx, st, h, rk4):

@@ -164,13 +164,7 @@ def rhs_corrected(ctx, u, v, r, psi):
     coefficients, follow, the term model's context, whose input buffer ``inputs`` is)."""
     inp = ctx[0]
     a0, a1, a2 = accelerations(ctx[2], u, v, r, inp[0], inp[1] if ctx[3] else ctx[1])
-    terms = ctx[4]
-    if terms[13] == kernel.SLOTS_CROSSFLOW:
-        b0, b1, b2, rd, xd, yd = kernel.terms_rhs_crossflow(terms, u, v, r, psi)
-    elif terms[13] == kernel.SLOTS_RUDDER:
-        b0, b1, b2, rd, xd, yd = kernel.terms_rhs_rudder(terms, u, v, r, psi)
-    else:
-        b0, b1, b2, rd, xd, yd = kernel.terms_rhs(terms, u, v, r, psi)
+    b0, b1, b2, rd, xd, yd = kernel.terms_rhs_any(ctx[4], u, v, r, psi)
     return a0 + b0, a1 + b1, a2 + b2, rd, xd, yd
 
 
