@@ -228,3 +228,21 @@ def test_an_mmg_file_is_a_prior_as_the_built_in_ship_is(tmp_path, capsys):
                         tmp_path / "none.json"], capsys)  # fmt: skip
     plain = json.loads((tmp_path / "none.json").read_text())["model"]["coefficients"]
     assert code == 0 and plain["r"] != pytest.approx(models[0]["r"], rel=0.05), err
+
+
+def test_an_mmg_ship_refuses_runs_outside_its_method_in_one_line(tmp_path, capsys):
+    """The MMG standard method's propeller turns ahead and its hull forces need headway: a
+    crash stop of a ship whose propeller follows the orders, and a run from rest, are refused
+    in one line; criteria says why it does not judge the stopping ability."""
+    path = tmp_path / "follow.yml"
+    path.write_text(yaml.safe_dump({**kvlcc2_document(), "rps": "logs"}), encoding="utf-8")
+    code, _, err = run(["manoeuvre", path, "stopping"], capsys)
+    assert code == 1 and err.count("\n") == 1 and "propeller turning ahead only" in err
+    code, out, err = run(["criteria", path], capsys)
+    assert code == 0 and "MMG model has a propeller turning ahead only" in err
+    rest = zigzag(read_mmg(path), 10, 10, duration=20, rps=10.0).log
+    rest["u"] = rest["v"] = 0.0
+    code, _, err = run(["simulate", path, write_log(rest, tmp_path / "rest.csv"), "-o",
+                        tmp_path / "sim.csv"], capsys)  # fmt: skip
+    assert code == 1 and err.count("\n") == 1 and "starts at rest" in err
+    assert not (tmp_path / "sim.csv").exists()

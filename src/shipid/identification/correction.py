@@ -117,12 +117,18 @@ class CorrectedMMGDynamics(CorrectedDynamics):
                        code.uses_derived)  # fmt: skip
 
     def integrate_open(self, t, inputs, n_steps, s0, rk4, speed_lim, yaw_lim, out, n_valid):
-        """Free runs driven by (B, N, 5) inputs, the propeller at the reference's trim."""
+        """Free runs driven by (B, N, 5) inputs, the propeller at the reference's trim (or the
+        inputs' rate, where it follows it)."""
         from shipid.vessels import mmg
 
         ref = self.reference
+        mmg.under_way(s0)
+        if ref.follow_rps:
+            mmg.ahead_only(inputs[:, :-1, 1], t)
         mmg.open_corrected(ref.packed, ref.n_prop, ref.follow_rps, *self._terms, t, inputs,
                            n_steps, s0, rk4, speed_lim, yaw_lim, out, n_valid)  # fmt: skip
+
+    ahead_only = True  # the MMG model's propeller
 
     def integrate_closed(self, dt, n_steps, s0, params, rk4, speed_lim, yaw_lim, states, rudder,
                          n_valid):  # fmt: skip
@@ -130,6 +136,9 @@ class CorrectedMMGDynamics(CorrectedDynamics):
         from shipid.vessels import mmg
 
         ref = self.reference
+        mmg.under_way(s0)
+        if ref.follow_rps:
+            mmg.ahead_orders(params)
         mmg.closed_corrected(ref.packed, ref.n_prop, ref.follow_rps, *self._terms, dt, n_steps,
                              s0, params, rk4, speed_lim, yaw_lim, states, rudder,
                              n_valid)  # fmt: skip

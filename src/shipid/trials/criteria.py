@@ -193,7 +193,7 @@ def imo_criteria(
         notes.append(f"20/20 first overshoot not judged: the gear's {turn_deg:g}° cannot run a "
                      "20°/20° zig-zag")
     dyn = getattr(ship, "dynamics", ship)
-    if getattr(dyn, "uses_rps", False) and rps:
+    if getattr(dyn, "uses_rps", False) and rps and not getattr(dyn, "ahead_only", False):
         res = stopping(ship, rps, astern_rps, reversal_time=10.0 / math.sqrt(lam),
                        duration=3 * duration, dt=dt, speed=V, method=method)  # fmt: skip
         runs["full astern"] = res  # keyed as its row's manoeuvre
@@ -213,9 +213,12 @@ def imo_criteria(
     else:
         # A reference ship's own physics may run a propeller, at the one speed it was set to
         # (the KVLCC2's MMG model): it takes no order to reverse it.
+        name = getattr(ship, "name", "the ship")
         what = ("the model has no propeller-speed terms"
                 if isinstance(ship, (ManoeuvringModel, HybridModel))
-                else f"{getattr(ship, 'name', 'the ship')}'s dynamics take no propeller-speed order")
+                else f"{name}'s MMG model has a propeller turning ahead only"
+                if getattr(dyn, "ahead_only", False) and getattr(dyn, "uses_rps", False)
+                else f"{name}'s dynamics take no propeller-speed order")  # fmt: skip
         notes.append(f"stopping ability not judged: {what}, so no full astern can be run")
     conditions = {"length": L, "speed": V, "scale": lam, "L_over_V_full_scale": l_over_v,
                   "rudder_rate_deg_s": (math.degrees(steering.max_rate) if steering.max_rate

@@ -108,7 +108,9 @@ def pack(c: Mapping) -> Coefficients:
     return Coefficients(**{name: float(fields[name]) for name in Coefficients._fields})
 
 
-@numba.njit(cache=True)
+# NumPy's error model: a state at rest mid-run (U = 0, where the prime forces are undefined)
+# gives NaN, which the integrators report as the run's end, not a crash.
+@numba.njit(cache=True, error_model="numpy")
 def accelerations(c, u, vm, r, delta, n):
     """(u̇, v̇m, ṙ) of the MMG model ``c`` (``Coefficients``) at midship sway vm, rudder δ and
     propeller speed n [rps]: hull, propeller and rudder forces through the mass matrix."""
@@ -245,11 +247,40 @@ def ahead_only(rps: np.ndarray, t: np.ndarray | None = None, what: str = "") -> 
                           "(--end) or use a model identified from logs that reverse it")
 
 
+def under_way(s0: np.ndarray) -> None:
+    """Refuse a run that starts at rest: the MMG model's hull forces are written in the drift
+    angle and the yaw rate per ship length travelled, undefined where the ship does not move."""
+    speed = np.hypot(np.asarray(s0)[:, 0], np.asarray(s0)[:, 1])
+    if not np.all(speed > 0):
+        from shipid.errors import ShipidError
+
+        raise ShipidError("the run starts at rest (u = v = 0), where the MMG standard method's "
+                          "hull forces are undefined: start it under way (a log cut to its "
+                          "manoeuvre, --start auto)")  # fmt: skip
+
+
+def ahead_orders(params: np.ndarray) -> None:
+    """Refuse a manoeuvre whose propeller order is not ahead (a crash stop's astern, a stopped
+    propeller): ``ahead_only``'s reason, for the closed loops' parameter rows."""
+    p = np.atleast_2d(params)
+    start = p[:, kernel.P_RPS]
+    order = np.where(p[:, kernel.P_RPS_RAMP] < 0, start, p[:, kernel.P_RPS_TO])
+    if not (np.all(start > 0) and np.all(order > 0)):
+        from shipid.errors import ShipidError
+
+        raise ShipidError(f"the propeller is ordered to {float(np.min(order)):.3g} rps (from "
+                          f"{float(np.min(start)):.3g}), and the MMG standard method models a "
+                          "propeller turning ahead only (no crash stop, no propeller stopped)")
+
+
 class MMGDynamics(CompiledDynamics):
     """The MMG model's accelerations, its propeller at a constant ``n_prop`` [rps] (trimmed for
     the approach speed) or, where ``follow_rps``, at the rate each run gives (a log's column n,
     a manoeuvre's rps: ``uses_rps``); ``c`` the flat coefficients of ``mmg_file.coefficients``
     (kept: a corrected ship's file embeds them)."""
+
+    # The MMG standard method's propeller turns ahead: no crash stop (``shipid.trials.criteria``).
+    ahead_only = True
 
     def __init__(self, c: Mapping, n_prop: float, follow_rps: bool = False) -> None:
         self.c = dict(c)
@@ -274,6 +305,7 @@ class MMGDynamics(CompiledDynamics):
 
     def integrate_open(self, t, inputs, n_steps, s0, rk4, speed_lim, yaw_lim, out, n_valid):
         """Free runs driven by (B, N, 5) inputs, the propeller at ``n_prop`` or the inputs'."""
+        under_way(s0)
         if self.follow_rps:
             ahead_only(inputs[:, :-1, 1], t)
         _open(self.packed, self.n_prop, self.follow_rps, t, inputs, n_steps, s0, rk4, speed_lim,
@@ -283,5 +315,8 @@ class MMGDynamics(CompiledDynamics):
                          n_valid):  # fmt: skip
         """Closed-loop manoeuvres of parameter rows ``params``, the propeller at ``n_prop`` or
         the manoeuvre's."""
+        under_way(s0)
+        if self.follow_rps:
+            ahead_orders(params)
         _closed(self.packed, self.n_prop, self.follow_rps, dt, n_steps, s0, params, rk4,
                 speed_lim, yaw_lim, states, rudder, n_valid)  # fmt: skip
