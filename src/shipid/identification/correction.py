@@ -128,7 +128,7 @@ class CorrectedMMGDynamics(CorrectedDynamics):
         mmg.open_corrected(ref.packed, ref.n_prop, ref.follow_rps, *self._terms, t, inputs,
                            n_steps, s0, rk4, speed_lim, yaw_lim, out, n_valid)  # fmt: skip
 
-    ahead_only = True  # the MMG model's propeller
+    propeller_ahead_only = True  # the MMG model's propeller
 
     def integrate_closed(self, dt, n_steps, s0, params, rk4, speed_lim, yaw_lim, states, rudder,
                          n_valid):  # fmt: skip

@@ -193,7 +193,7 @@ def imo_criteria(
         notes.append(f"20/20 first overshoot not judged: the gear's {turn_deg:g}° cannot run a "
                      "20°/20° zig-zag")
     dyn = getattr(ship, "dynamics", ship)
-    if getattr(dyn, "uses_rps", False) and rps and not getattr(dyn, "ahead_only", False):
+    if getattr(dyn, "uses_rps", False) and rps and not getattr(dyn, "propeller_ahead_only", False):
         res = stopping(ship, rps, astern_rps, reversal_time=10.0 / math.sqrt(lam),
                        duration=3 * duration, dt=dt, speed=V, method=method)  # fmt: skip
         runs["full astern"] = res  # keyed as its row's manoeuvre
@@ -217,7 +217,7 @@ def imo_criteria(
         what = ("the model has no propeller-speed terms"
                 if isinstance(ship, (ManoeuvringModel, HybridModel))
                 else f"{name}'s MMG model has a propeller turning ahead only"
-                if getattr(dyn, "ahead_only", False) and getattr(dyn, "uses_rps", False)
+                if getattr(dyn, "propeller_ahead_only", False) and getattr(dyn, "uses_rps", False)
                 else f"{name}'s dynamics take no propeller-speed order")  # fmt: skip
         notes.append(f"stopping ability not judged: {what}, so no full astern can be run")
     conditions = {"length": L, "speed": V, "scale": lam, "L_over_V_full_scale": l_over_v,

@@ -280,7 +280,7 @@ class MMGDynamics(CompiledDynamics):
     (kept: a corrected ship's file embeds them)."""
 
     # The MMG standard method's propeller turns ahead: no crash stop (``shipid.trials.criteria``).
-    ahead_only = True
+    propeller_ahead_only = True
 
     def __init__(self, c: Mapping, n_prop: float, follow_rps: bool = False) -> None:
         self.c = dict(c)
