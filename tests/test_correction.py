@@ -353,7 +353,19 @@ def test_cli_correct_writes_a_ship_the_commands_run(tmp_path, capsys):
     for argv in (["manoeuvre", ship, "zigzag", "--rudder", "10"], ["linearise", ship]):
         code, _, err = run(argv, capsys)
         assert code == 0, (argv, err)
+    # A term model corrected is one term model: it exports as one, and runs the unseen log.
     code, _, err = run(["export", ship, "-o", tmp_path / "m.py"], capsys)
+    assert code == 0, err
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("corrected_ship", tmp_path / "m.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    logged = __import__("shipid").read_log(unseen)
+    states = module.simulate(logged["t"], logged[["delta"]].to_numpy(),
+                             logged[["u", "v", "r"]].iloc[0].to_numpy(), "euler")  # fmt: skip
+    assert np.max(np.abs(states[:, :3] - logged[["u", "v", "r"]].to_numpy())) < 1e-6
+    code, _, err = run(["rescale", ship, "--factor", "2", "-o", tmp_path / "r.json"], capsys)
     assert code == 1 and err.count("\n") == 1 and "shipid correct" in err
     code, _, err = run(["correct", "scale-ship", *paths, "--model", "blanke-rps", "-o",
                         tmp_path / "bad.json"], capsys)  # fmt: skip

@@ -246,3 +246,61 @@ def test_an_mmg_ship_refuses_runs_outside_its_method_in_one_line(tmp_path, capsy
                         tmp_path / "sim.csv"], capsys)  # fmt: skip
     assert code == 1 and err.count("\n") == 1 and "starts at rest" in err
     assert not (tmp_path / "sim.csv").exists()
+
+
+def _module(path):
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location(path.stem, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_an_mmg_ship_exports_as_a_standalone_module(tmp_path, capsys):
+    """``shipid export`` of the KVLCC2, of an MMG file whose propeller follows the logs and of
+    that file corrected with wind terms: each module's accelerations are the ship's in shipid
+    (to rounding), and its simulate replays a log as shipid's Euler free run does."""
+    from shipid.dynamics.model import ModelStructure
+    from shipid.dynamics.simulate import simulate_log
+    from shipid.identification.correction import correction_document, identify_correction
+
+    follow = tmp_path / "follow.yml"
+    follow.write_text(yaml.safe_dump({**kvlcc2_document(), "rps": "logs"}), encoding="utf-8")
+    ship = read_mmg(follow)
+    wind = "wind_speed^2*sin(wind_angle)"
+    log = zigzag(ship, 20, 20, duration=40, dt=0.1, method="euler", rps=9.0, speed=0.9,
+                 wind=(3.0, 1.0)).log  # fmt: skip
+    log["wind_speed"], log["wind_angle"] = 3.0 + 0.1 * np.sin(log["t"]), 0.5
+    fit = identify_correction(log, ship, ModelStructure("w", {"r": ("u*r", wind)}), gamma=1e4)
+    corrected = tmp_path / "corrected.json"
+    corrected.write_text(json.dumps(correction_document(fit, {"mmg": yaml.safe_load(
+        follow.read_text())})), encoding="utf-8")  # fmt: skip
+    rng = np.random.default_rng(2)
+    nu = np.column_stack([rng.uniform(0.5, 1.3, 30), rng.uniform(-0.2, 0.2, 30),
+                          rng.uniform(-0.05, 0.05, 30)])  # fmt: skip
+    delta, n = rng.uniform(-0.6, 0.6, 30), rng.uniform(6.0, 12.0, 30)
+    gusts = {"wind_speed": rng.uniform(0.0, 4.0, 30), "wind_angle": rng.uniform(-3.0, 3.0, 30)}
+    cases = (("kvlcc2", K.kvlcc2().dynamics, {}, ()),
+             (follow, ship.dynamics, {"n": n}, ("n",)),
+             (corrected, fit.vessel.dynamics, {"n": n, **gusts}, ("n", "wind_speed", "wind_angle")))
+    for i, (source, dyn, inputs, columns) in enumerate(cases):
+        out = tmp_path / f"ship{i}.py"
+        code, text, err = run(["export", source, "-o", out], capsys)
+        assert code == 0 and "standalone NumPy module" in text, err
+        module = _module(out)
+        assert module.INPUTS == ("delta", *columns)
+        ours = np.column_stack(module.accelerations(nu[:, 0], nu[:, 1], nu[:, 2], delta,
+                                                    *inputs.values()))  # fmt: skip
+        theirs = dyn.derivatives(nu, delta, None, inputs.get("n"), **gusts) if len(columns) > 1 \
+            else dyn.derivatives(nu, delta, None, inputs.get("n"))  # fmt: skip
+        np.testing.assert_allclose(ours, theirs, rtol=1e-12, atol=1e-15)
+        run_log = log if columns else log.drop(columns=["n", "wind_speed", "wind_angle"])
+        replay = simulate_log(dyn, run_log, "euler").log
+        states = module.simulate(run_log["t"], run_log[["delta", *columns]].to_numpy(),
+                                 run_log[["u", "v", "r", "psi", "x", "y"]].iloc[0].to_numpy())
+        np.testing.assert_allclose(states, replay[["u", "v", "r", "psi", "x", "y"]].to_numpy(),
+                                   rtol=1e-9, atol=1e-10)  # fmt: skip
+    code, _, err = run(["export", "mariner", "-o", tmp_path / "m.py"], capsys)
+    assert code == 1 and err.count("\n") == 1 and "MMG ships" in err
+    assert not (tmp_path / "m.py").exists()

@@ -131,7 +131,23 @@ def cmd_export(args) -> int:
 
     if Path(args.output).suffix != ".py":
         raise ShipidError(f"-o {args.output}: the exported module must be a .py file")
-    check_outputs({"-o": (args.output, "python")}, [args.model])
+    check_outputs({"-o": (args.output, "python")},
+                  [] if args.model in VESSEL_NAMES else [args.model])  # fmt: skip
+    from shipid.identification.correction import reference_file
+    from shipid.vessels import get_vessel
+
+    ship = get_vessel(args.model) if args.model in VESSEL_NAMES else reference_file(args.model)
+    if ship is not None:  # an MMG ship (the KVLCC2, an MMG file, one corrected)
+        from shipid.control.export import export_ship
+        from shipid.dynamics.model import ManoeuvringModel
+
+        if isinstance(ship.dynamics, ManoeuvringModel):  # a term model corrected: one model
+            export_numpy(ship.dynamics, args.output, ship.rudder_positive)
+        else:
+            export_ship(ship, args.output)
+        print(f"standalone NumPy module of {ship.name} written to {args.output} (accelerations, "
+              "derivatives, simulate)")  # fmt: skip
+        return 0
     doc = load_document(args.model)
     model = model_from_document(doc, args.model, hybrid=True)
     trained = training_conditions(doc)

@@ -509,8 +509,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--rps", type=float, help="propeller speed for models with n terms")
     p.set_defaults(func=cmd_linearise)
 
-    p = sub.add_parser("export", help="a model as a standalone NumPy module (no shipid needed)")
-    p.add_argument("model", metavar="MODEL.json")
+    p = sub.add_parser("export", help="a model, or an MMG ship (kvlcc2, an MMG file, one "
+                       "corrected), as a standalone NumPy module (no shipid needed)")  # fmt: skip
+    p.add_argument("model", metavar="MODEL.json|SHIP")
     p.add_argument("-o", "--output", required=True, metavar="MODEL.py")
     p.set_defaults(func=cmd_export)
 

@@ -223,25 +223,39 @@ def numpy_source(model: ManoeuvringModel | HybridModel, rudder_positive: str | N
         '    """(u̇, v̇, ṙ) at arrays of states and inputs."""',
         "    u, v, r, delta = (np.asarray(a, dtype=float) for a in (u, v, r, delta))",
     ]
-    for dof in DOFS:
-        coefs = model.coefficients.get(dof)
-        if not coefs:
-            lines.append(f"    {dof}dot = np.zeros_like(u)")
-            continue
-        parts = []
-        for text, c in coefs.items():
-            term = parse_term(text)
-            factors = " * ".join(_factor_expr(f) for f in term.factors)
-            parts.append(f"{c!r}" + (f" * {factors}" if factors else " * np.ones_like(u)"))
-        lines.append(f"    {dof}dot = (" + "\n             + ".join(parts) + ")")
+    lines += _sum_lines(model)
     if hybrid:
         names = ", ".join(hybrid.residual.features)
         lines += [f"    ru, rv, rr = residual({names})",
                   "    shape = np.shape(udot)",
                   "    udot, vdot, rdot = (udot + ru.reshape(shape), vdot + rv.reshape(shape),",
                   "                        rdot + rr.reshape(shape))"]  # fmt: skip
-    lines += [
-        "    return udot, vdot, rdot",
+    lines += ["    return udot, vdot, rdot", *_integrator_lines(),
+              *(_residual_source(hybrid) if hybrid else ()), ""]
+    return "\n".join(lines)
+
+
+def _sum_lines(model: ManoeuvringModel, prefix: str = "") -> list[str]:
+    """The lines of ``accelerations`` that sum the model's terms into {prefix}udot, vdot, rdot
+    (arrays u, v, r, delta and the inputs in scope)."""
+    lines = []
+    for dof in DOFS:
+        coefs = model.coefficients.get(dof)
+        if not coefs:
+            lines.append(f"    {prefix}{dof}dot = np.zeros_like(u)")
+            continue
+        parts = []
+        for text, c in coefs.items():
+            term = parse_term(text)
+            factors = " * ".join(_factor_expr(f) for f in term.factors)
+            parts.append(f"{c!r}" + (f" * {factors}" if factors else " * np.ones_like(u)"))
+        lines.append(f"    {prefix}{dof}dot = (" + "\n             + ".join(parts) + ")")
+    return lines
+
+
+def _integrator_lines() -> list[str]:
+    """``derivatives`` and ``simulate`` of an exported module, after its ``accelerations``."""
+    return [
         "",
         "",
         "def derivatives(state, inputs):",
@@ -284,10 +298,7 @@ def numpy_source(model: ManoeuvringModel | HybridModel, rudder_positive: str | N
         "            x = x + (h / 6.0) * (k1 + 2 * k2 + 2 * k3 + k4)",
         "        out[k + 1] = x",
         "    return out",
-        *(_residual_source(hybrid) if hybrid else ()),
-        "",
     ]
-    return "\n".join(lines)
 
 
 def export_numpy(model: ManoeuvringModel | HybridModel, path: str | Path,
@@ -296,3 +307,94 @@ def export_numpy(model: ManoeuvringModel | HybridModel, path: str | Path,
     from shipid.outputs import atomic_write_text
 
     return atomic_write_text(path, numpy_source(model, rudder_positive, dt))
+
+
+def _mmg_function_source() -> list[str]:
+    """The MMG formula as shipid runs it (``shipid.vessels.mmg.accelerations``, its source
+    without numba's decorator), named ``mmg_accelerations``."""
+    import inspect
+
+    from shipid.vessels import mmg
+
+    source = inspect.getsource(mmg.accelerations.py_func).splitlines()
+    start = next(i for i, line in enumerate(source) if line.startswith("def "))
+    return [source[start].replace("def accelerations(", "def mmg_accelerations("),
+            *source[start + 1:]]  # fmt: skip
+
+
+def mmg_source(ship) -> str:
+    """Python source of a standalone module (NumPy only) of an MMG ship (a ``Vessel`` whose
+    dynamics are ``shipid.vessels.mmg.MMGDynamics``: the built-in KVLCC2, an MMG file) or of one
+    corrected by ``shipid correct`` (its correction's terms added): the MMG formula shipid runs,
+    its coefficients written out exactly, ``accelerations``, ``derivatives`` and ``simulate``."""
+    from shipid import __version__
+    from shipid.vessels.mmg import MMGDynamics
+
+    dyn = ship.dynamics
+    reference = getattr(dyn, "reference", dyn)
+    correction = getattr(dyn, "correction", None) if reference is not dyn else None
+    if not isinstance(reference, MMGDynamics):
+        raise ShipidError(f"{ship.name}: only identified models and MMG ships (an MMG file, the "
+                          "KVLCC2, one of them corrected) export")  # fmt: skip
+    inputs = (["n"] if reference.follow_rps else []) + [
+        c for c in (correction.inputs if correction is not None else ()) if c != "delta"]
+    fields = ",\n".join(f"    {k}={v!r}" for k, v in reference.packed._asdict().items())
+    rps = ("the rate the inputs give (N_PROP, the trim for the approach, by default)"
+           if reference.follow_rps else "N_PROP")
+    corrected = [] if correction is None else [
+        "", "Its correction (shipid correct), added to the MMG model's accelerations:", "",
+        *("    " + ln for ln in correction.equations(precision=6).splitlines())]
+    defaults = "".join(f", {s}=" + ("N_PROP" if s == "n" else "0.0") for s in inputs)
+    names = ", ".join(["u", "v", "r", "delta"] + (["n"] if reference.follow_rps else []))
+    lines = [
+        f'"""{ship.name}: an MMG standard-method ship (Yasukawa & Yoshimura 2015) exported by '
+        f"shipid {__version__}.",
+        "",
+        "Standalone (NumPy only).",
+        f"Its propeller turns at {rps}.",
+        "The MMG standard method models it turning ahead only (n > 0), and the ship under way",
+        "(u, v not both 0).",
+        *corrected,
+        "",
+        *_conventions(inputs, ship.rudder_positive, None),
+        '"""',
+        "",
+        "import math",
+        "from types import SimpleNamespace",
+        "",
+        "import numpy as np",
+        "",
+        f"INPUTS = {('delta', *inputs)!r}",
+        f"RUDDER_POSITIVE = {ship.rudder_positive!r}  # which way positive delta turns the ship",
+        f"N_PROP = {reference.n_prop!r}  # [rps], trimmed for {ship.approach_speed!r} m/s",
+        "# The MMG model's coefficients: masses, the sway–yaw mass matrix's inverse, prime "
+        "hull,",
+        "# propeller and rudder coefficients (shipid.vessels.mmg.Coefficients).",
+        f"C = SimpleNamespace(\n{fields},\n)",
+        "",
+        "",
+        *_mmg_function_source(),
+        "",
+        "",
+        *([] if correction is None else _factor_sources(correction)),
+        f"def accelerations(u, v, r, delta{defaults}):",
+        '    """(u̇, v̇, ṙ) at arrays of states and inputs (v the sway velocity at midship)."""',
+        f"    {names} = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in ({names})))",
+        "    own = np.array([mmg_accelerations(C, *s) for s in zip(",
+        "        u.ravel(), v.ravel(), r.ravel(), delta.ravel(), "
+        + ("n.ravel()" if reference.follow_rps else "np.full(u.size, N_PROP)") + ")])",
+        "    own = own.reshape(u.shape + (3,))",
+        "    udot, vdot, rdot = own[..., 0], own[..., 1], own[..., 2]",
+    ]
+    if correction is not None:
+        lines += _sum_lines(correction, "c")
+        lines += ["    udot, vdot, rdot = udot + cudot, vdot + cvdot, rdot + crdot"]
+    lines += ["    return udot, vdot, rdot", *_integrator_lines(), ""]
+    return "\n".join(lines)
+
+
+def export_ship(ship, path: str | Path) -> Path:
+    """Write ``mmg_source(ship)`` atomically to ``path`` (a .py file)."""
+    from shipid.outputs import atomic_write_text
+
+    return atomic_write_text(path, mmg_source(ship))
