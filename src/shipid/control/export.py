@@ -170,8 +170,8 @@ def _residual_source(model: HybridModel) -> list[str]:
     ]
 
 
-def _conventions(inputs: list[str], rudder_positive: str | None, dt: float | None
-                 ) -> list[str]:  # fmt: skip
+def _conventions(inputs: list[str], rudder_positive: str | None, dt: float | None,
+                 meanings: dict[str, str] | None = None) -> list[str]:  # fmt: skip
     """The exported module's docstring lines on units and signs: a module used without shipid
     has no log metadata to say which way its rudder turns (the Esso Osaka's models turn to
     starboard with positive delta, the KVLCC2's to port)."""
@@ -180,7 +180,7 @@ def _conventions(inputs: list[str], rudder_positive: str | None, dt: float | Non
               "delta [rad], the rudder angle (which way positive delta turns the ship: as in "
               "the training logs)")  # fmt: skip
     lines = ["Inputs, in INPUTS order:", "", f"- {rudder}"]
-    lines += [f"- {INPUT_MEANINGS.get(s, s)}" for s in inputs]
+    lines += [f"- {(meanings or INPUT_MEANINGS).get(s, INPUT_MEANINGS.get(s, s))}" for s in inputs]
     lines += ["", "States: u, v [m/s] surge and sway (body axes, v to starboard), r [rad/s] yaw",
               "rate (positive to starboard), psi [rad] heading (clockwise from north), x, y [m]",
               "position (x north, y east, as derivatives() integrates them)."]  # fmt: skip
@@ -356,7 +356,8 @@ def mmg_source(ship) -> str:
         "(u, v not both 0).",
         *corrected,
         "",
-        *_conventions(inputs, ship.rudder_positive, None),
+        *_conventions(inputs, ship.rudder_positive, None,
+                      {"n": "n [rps], the propeller speed (ahead: n > 0)"}),
         '"""',
         "",
         "import math",
