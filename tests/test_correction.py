@@ -128,7 +128,7 @@ def test_a_corrected_mmg_ship_runs_compiled_as_the_python_loop_does():
     replayed log are the generic loop's (each state stepped through ``derivatives`` in
     Python) to rounding, and 30-50 times faster (benchmarks/README.md)."""
     from shipid.dynamics.simulate import simulate_log
-    from shipid.identification.correction import CorrectedMMGDynamics, corrected_dynamics
+    from shipid.identification.correction import CorrectedDynamics, CorrectedMMGDynamics
     from shipid.trials.manoeuvres import turning_circle
 
     mmg, added, generic = _mmg_truth()
@@ -149,6 +149,15 @@ def test_a_corrected_mmg_ship_runs_compiled_as_the_python_loop_does():
     np.testing.assert_allclose(compiled.dynamics.derivatives(nu, delta),
                                mmg.dynamics.derivatives(nu, delta)
                                + added.compiled_accelerations(nu, inputs), rtol=1e-12, atol=1e-15)
+    # A correction may hold the hull's cross-flow drag (its own branch of the compiled step).
+    from shipid.dynamics.model import ModelStructure
+
+    drag = ManoeuvringModel(ModelStructure("drag", {"r": ("u*r", "crossflow_yaw(7)")}),
+                            {"r": {"u*r": -0.02, "crossflow_yaw(7)": -0.5}})  # fmt: skip
+    ours, theirs = (simulate_log(d, log).log for d in (corrected_dynamics(mmg.dynamics, drag),
+                                                        CorrectedDynamics(mmg.dynamics, drag)))
+    np.testing.assert_allclose(ours.to_numpy(), theirs.to_numpy(), rtol=1e-10, atol=1e-12)
+    assert not np.allclose(ours["r"], simulate_log(mmg.dynamics, log).log["r"], atol=1e-3)
 
 
 def test_the_mmg_models_correction_is_what_its_truth_adds():

@@ -235,7 +235,7 @@ def terms_rhs_rudder(ctx, u, v, r, psi):
 def terms_rhs_any(ctx, u, v, r, psi):
     """``terms_rhs``, or its cross-flow or rudder variant as ctx[13] says, chosen at every
     evaluation: for a state derivative that adds its own to a term model's (a hybrid's kernel
-    residual, an MMG model's correction), whose own cost dwarfs the branch."""
+    residual), whose own cost dwarfs the branch."""
     if ctx[13] == SLOTS_CROSSFLOW:
         return terms_rhs_crossflow(ctx, u, v, r, psi)
     if ctx[13] == SLOTS_RUDDER:

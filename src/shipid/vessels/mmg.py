@@ -166,7 +166,13 @@ def rhs_corrected(ctx, u, v, r, psi):
     coefficients, follow, the term model's context, whose input buffer ``inputs`` is)."""
     inp = ctx[0]
     a0, a1, a2 = accelerations(ctx[2], u, v, r, inp[0], inp[1] if ctx[3] else ctx[1])
-    b0, b1, b2, rd, xd, yd = kernel.terms_rhs_any(ctx[4], u, v, r, psi)
+    # A correction's terms are in u, v, r, δ and the wind: the hull's cross-flow drag may be
+    # among them, the rudder's normal force (its propeller's inflow) not. Two ways, not
+    # ``terms_rhs_any``'s three: half the compilation.
+    if ctx[4][13] == kernel.SLOTS_CROSSFLOW:
+        b0, b1, b2, rd, xd, yd = kernel.terms_rhs_crossflow(ctx[4], u, v, r, psi)
+    else:
+        b0, b1, b2, rd, xd, yd = kernel.terms_rhs(ctx[4], u, v, r, psi)
     return a0 + b0, a1 + b1, a2 + b2, rd, xd, yd
 
 
