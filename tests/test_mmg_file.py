@@ -81,6 +81,9 @@ def test_the_file_runs_where_a_vessel_does_and_is_corrected(tmp_path, capsys):
     assert code == 0, err
     (record,) = json.loads((tmp_path / "v.json").read_text())["logs"]
     assert max(record["metrics"][s]["rmse"] for s in "uvr") < 1e-9
+    code, _, err = run(["validate", path, log_path, "--report", tmp_path / "rep"], capsys)
+    report = (tmp_path / "rep" / "report.html").read_text()
+    assert code == 0 and "hull: m_x 0.022" in report and "f_alpha 2.747" in report, err
     for argv in (["manoeuvre", path, "zigzag", "--rudder", "10"],
                  ["simulate", path, log_path, "-o", tmp_path / "sim.csv"]):  # fmt: skip
         code, out, err = run(argv, capsys)

@@ -47,7 +47,19 @@ def _model_text(model, std_errors) -> str:
     text = (f"reference ship {model.name}: {model.source or 'shipid.vessels'}; Lpp "
             f"{model.length:g} m, approach {model.approach_speed:.4g} m/s, positive rudder to "
             f"{model.rudder_positive}")
-    correction = getattr(model.dynamics, "correction", None)  # shipid correct's
+    dyn = model.dynamics
+    mmg = getattr(getattr(dyn, "reference", dyn), "packed", None) is not None
+    if mmg:  # an MMG ship: its coefficients, as its file holds them
+        from shipid.vessels.mmg_file import document_of
+
+        ref = getattr(dyn, "reference", dyn)
+        doc = document_of(ref.c)
+        text += ("\npropeller: " + ("each log's measured rate (rps: logs), trimmed "
+                                    f"{ref.n_prop:.4g} rps for the approach" if ref.follow_rps
+                                    else f"{ref.n_prop:.4g} rps"))  # fmt: skip
+        for group in ("hull", "propeller", "rudder"):
+            text += f"\n{group}: " + ", ".join(f"{k} {v:.6g}" for k, v in doc[group].items())
+    correction = getattr(dyn, "correction", None)  # shipid correct's
     return text if correction is None else f"{text}\nits correction:\n{correction.equations()}"
 
 
