@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import contextlib
 import io
+import math
 import os
 import tempfile
 import time
@@ -166,6 +167,40 @@ def main() -> None:
     print(f"\n{time.perf_counter() - start:.0f} s")
 
 
+def tanker_truth() -> None:
+    """The same sister (the KVLCC2's coefficients) with the particulars of another VLCC whose
+    truth is known: the `tanker` (van Berlekom & Goddard's Esso 190 000 dwt, a Norrbin-type
+    model of another laboratory, course-unstable; reference-ships.md §4, its rudder limited to
+    10°): the sister's manoeuvres against the truth's, fitted to nothing. Its rudder area and
+    propeller diameter are not published: the KVLCC2's scaled by length."""
+    from shipid.data.particulars import Particulars
+    from shipid.trials.manoeuvres import turning_circle, zigzag
+    from shipid.vessels import get_vessel, kvlcc2
+    from shipid.vessels.mmg_file import like, mmg_vessel
+
+    truth = get_vessel("tanker")
+    particulars = Particulars(length=truth.length, beam=47.17, draught=18.46, mass=225.5e6)
+    doc, _ = like(kvlcc2().dynamics.c, particulars, "tanker sister", truth.approach_speed,
+                  rudder_rate=math.degrees(truth.steering.max_rate))  # fmt: skip
+    doc["rudder_limit"] = math.degrees(truth.steering.max_angle)
+    sister = mmg_vessel(doc)
+    print("\nThe tanker as a truth: the sister with its particulars (L 304.8 m, B 47.17 m, T "
+          "18.46 m, 225 500 t; rudder limit 10°, 2.33 °/s), fitted to nothing\n")
+    print("| ship | 10° turn: TD / L, steady r [rad/s] (starboard, port) | 10°/10° overshoots "
+          "[deg] | 5°/5° overshoots [deg] |")
+    print("|---|---|---|---|")
+    rows = {}
+    for name, ship in (("tanker (truth)", truth), ("sister", sister)):
+        turns = [turning_circle(ship, 10, side=side, duration=3000, dt=0.5).indices
+                 for side in ("starboard", "port")]  # fmt: skip
+        zz = [zigzag(ship, a, a, duration=1500, dt=0.5).indices for a in (10, 5)]
+        rows[name] = (turns, zz)
+        print(f"| {name} | " + ", ".join(f"{t['tactical_diameter'] / truth.length:.2f}, "
+                                         f"{abs(t['steady_yaw_rate']):.5f}" for t in turns)
+              + " | " + " | ".join(f"{z['first_overshoot_deg']:.1f}, "
+                                   f"{z['second_overshoot_deg']:.1f}" for z in zz) + " |")
+
+
 def _straight(ship, rps: float):
     from shipid.cli.common import _ship_approach
 
@@ -175,3 +210,4 @@ def _straight(ship, rps: float):
 
 if __name__ == "__main__":
     main()
+    tanker_truth()
