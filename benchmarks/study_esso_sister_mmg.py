@@ -176,12 +176,12 @@ def tanker_truth() -> None:
     from shipid.data.particulars import Particulars
     from shipid.trials.manoeuvres import turning_circle, zigzag
     from shipid.vessels import get_vessel, kvlcc2
-    from shipid.vessels.mmg_file import like, mmg_vessel
+    from shipid.vessels.mmg_file import mmg_vessel, sister_ship
 
     truth = get_vessel("tanker")
     particulars = Particulars(length=truth.length, beam=47.17, draught=18.46, mass=225.5e6)
-    doc, _ = like(kvlcc2().dynamics.c, particulars, "tanker sister", truth.approach_speed,
-                  rudder_rate=math.degrees(truth.steering.max_rate))  # fmt: skip
+    doc, _ = sister_ship(kvlcc2().dynamics.c, particulars, "tanker sister",
+                         truth.approach_speed, rudder_rate=math.degrees(truth.steering.max_rate))
     doc["rudder_limit"] = math.degrees(truth.steering.max_angle)
     sister = mmg_vessel(doc)
     print("\nThe tanker as a truth: the sister with its particulars (L 304.8 m, B 47.17 m, T "

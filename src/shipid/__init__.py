@@ -66,6 +66,8 @@ _EXPORTS = {
     "LSSVR": "shipid.lssvm",
     "LSSVRCV": "shipid.lssvm",
     "get_vessel": "shipid.vessels",
+    "read_mmg": "shipid.vessels.mmg_file",
+    "sister_ship": "shipid.vessels.mmg_file",
 }
 
 __all__ = ["__version__", *_EXPORTS]

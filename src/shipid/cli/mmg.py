@@ -13,7 +13,7 @@ def cmd_mmg(args) -> int:
     from shipid.data.particulars import read_particulars
     from shipid.errors import ShipidError
     from shipid.outputs import atomic_write_text, check_outputs
-    from shipid.vessels.mmg_file import FOLLOW, coefficients, like, mmg_vessel, read_document
+    from shipid.vessels.mmg_file import FOLLOW, coefficients, mmg_vessel, read_document, sister_ship
 
     inputs = [args.particulars] + ([] if args.source in VESSEL_NAMES else [args.source])
     check_outputs({"-o": (args.output, "yaml or json")}, inputs)
@@ -38,7 +38,7 @@ def cmd_mmg(args) -> int:
             raise ShipidError(f"--rps must be a number or '{FOLLOW}', got {rps!r}") from None
     particulars = read_particulars(args.particulars)
     name = args.name or Path(args.output).stem
-    doc, notes = like(source, particulars, name, args.speed, rps, args.rudder_rate)
+    doc, notes = sister_ship(source, particulars, name, args.speed, rps, args.rudder_rate)
     ship = mmg_vessel(doc, f"the MMG model of {name}")  # trims its propeller: checks it holds
     if Path(args.output).suffix.lower() == ".json":
         from shipid.cli.common import _json_text

@@ -142,7 +142,7 @@ def document_of(c: Mapping) -> dict:
     return doc
 
 
-def like(source: Mapping, particulars, name: str, speed: float | None = None,
+def sister_ship(source: Mapping, particulars, name: str, speed: float | None = None,
          rps: float | str | None = None, rudder_rate: float | None = None
          ) -> tuple[dict, list[str]]:  # fmt: skip
     """An MMG file of a ship that has no model of its own, from a similar ship's: the
