@@ -31,3 +31,14 @@ def copy_identified(source: Path, target: Path, log_name: str = "zz.csv",
     text = (source / model_name).read_text(encoding="utf-8")
     model.write_text(text.replace(str(source / log_name), str(log)), encoding="utf-8")
     return log, model
+
+
+def validated(model, log, capsys, folder: Path, *options) -> dict:
+    """``shipid validate MODEL LOG --json`` (exit 0 asserted): the one log's record."""
+    import json
+
+    out = Path(folder) / "validated.json"
+    code, _, err = run(["validate", model, log, *options, "--json", out], capsys)
+    assert code == 0, err
+    (record,) = json.loads(out.read_text())["logs"]
+    return record

@@ -245,7 +245,7 @@ def test_a_corrected_ships_bootstrap_travels_with_its_file_into_the_bands(tmp_pa
     unseen 10°/10° overshoots lie inside the closed loop's intervals."""
     import json
 
-    from cli_helpers import run
+    from cli_helpers import run, validated
 
     from shipid.data.io import read_log, write_log
     from shipid.identification.uncertainty import index_intervals
@@ -273,18 +273,13 @@ def test_a_corrected_ships_bootstrap_travels_with_its_file_into_the_bands(tmp_pa
     assert f"[{lo:.4g}, {hi:.4g}]" in out
     unseen = write_log(sensors.apply(zigzag(truth, 10, 10, duration=80, dt=0.2).log, 7),
                        tmp_path / "zz10.csv")  # fmt: skip
-    code, _, err = run(["validate", ship, unseen, "--json", tmp_path / "v.json"], capsys)
-    assert code == 0, err
-    (logged,) = json.loads((tmp_path / "v.json").read_text())["logs"]
+    logged = validated(ship, unseen, capsys, tmp_path)
     closed = logged["index_intervals"]["closed_loop"]
     truth_zz = zigzag(truth, 10, 10, duration=80).indices
     for key in ("first_overshoot_deg", "second_overshoot_deg"):
         lo, hi = closed[key]
         assert lo <= truth_zz[key] <= hi, (key, lo, truth_zz[key], hi)
-    code, _, err = run(["validate", ship, unseen, "--no-bands", "--json", tmp_path / "n.json"],
-                       capsys)  # fmt: skip
-    (plain,) = json.loads((tmp_path / "n.json").read_text())["logs"]
-    assert code == 0 and plain["index_intervals"] == {}
+    assert validated(ship, unseen, capsys, tmp_path, "--no-bands")["index_intervals"] == {}
 
 
 @pytest.mark.parametrize(("kwargs", "said"), [
@@ -329,7 +324,7 @@ def test_cli_correct_writes_a_ship_the_commands_run(tmp_path, capsys):
     name, and so does a correction with terms the reference ship cannot take."""
     import json
 
-    from cli_helpers import run
+    from cli_helpers import run, validated
 
     from shipid.data.io import write_log
 
@@ -352,10 +347,7 @@ def test_cli_correct_writes_a_ship_the_commands_run(tmp_path, capsys):
     assert code == 0, err
     assert "the reference's share of the increments' variance" in out
     assert json.loads(ship.read_text())["reference"] == "scale-ship"
-    code, out, err = run(["validate", ship, unseen, "--method", "euler", "--json",
-                          tmp_path / "v.json"], capsys)  # fmt: skip
-    assert code == 0, err
-    (record,) = json.loads((tmp_path / "v.json").read_text())["logs"]
+    record = validated(ship, unseen, capsys, tmp_path, "--method", "euler")
     assert max(record["metrics"][s]["rmse"] for s in "uvr") < 1e-6
     code, _, err = run(["validate", ship, unseen, "--report", tmp_path / "rep"], capsys)
     assert code == 0 and "its correction:" in (tmp_path / "rep" / "report.html").read_text()

@@ -8,7 +8,7 @@ import json
 import numpy as np
 import pytest
 import yaml
-from cli_helpers import run
+from cli_helpers import run, validated
 
 from shipid.data.io import write_log
 from shipid.errors import ShipidError
@@ -37,6 +37,12 @@ def kvlcc2_document() -> dict:
                        "x_h": K.XH_PRIME, "x_r": K.XR_PRIME, "l_r": K.LR_PRIME,
                        "epsilon": K.EPS, "kappa": K.KAPPA, "f_alpha": K.F_ALPHA,
                        "gamma_r_pos": 0.640, "gamma_r_neg": 0.395}}  # fmt: skip
+
+
+def mmg_file(path, **changes):
+    """The KVLCC2's MMG file (``kvlcc2_document`` with ``changes``) written to ``path``."""
+    path.write_text(yaml.safe_dump({**kvlcc2_document(), **changes}), encoding="utf-8")
+    return path
 
 
 def test_the_kvlcc2_written_out_is_the_built_in_kvlcc2():
@@ -71,15 +77,11 @@ def test_a_bad_file_is_named_field_by_field(edit, said):
 def test_the_file_runs_where_a_vessel_does_and_is_corrected(tmp_path, capsys):
     """``validate``, ``manoeuvre`` and ``correct`` take the file; the corrected ship's file
     holds the MMG model whole and runs without it."""
-    path = tmp_path / "ship.yml"
-    path.write_text(yaml.safe_dump(kvlcc2_document()), encoding="utf-8")
+    path = mmg_file(tmp_path / "ship.yml")
     ship = read_mmg(path)
     log = zigzag(ship, 20, 20, duration=60, dt=0.2, method="euler").log
     log_path = write_log(log, tmp_path / "zz.csv")
-    code, out, err = run(["validate", path, log_path, "--method", "euler", "--json",
-                          tmp_path / "v.json"], capsys)  # fmt: skip
-    assert code == 0, err
-    (record,) = json.loads((tmp_path / "v.json").read_text())["logs"]
+    record = validated(path, log_path, capsys, tmp_path, "--method", "euler")
     assert max(record["metrics"][s]["rmse"] for s in "uvr") < 1e-9
     code, _, err = run(["validate", path, log_path, "--report", tmp_path / "rep"], capsys)
     report = (tmp_path / "rep" / "report.html").read_text()
@@ -119,13 +121,9 @@ def test_a_propeller_that_follows_the_logs_runs_at_each_logs_rate(tmp_path, caps
                                rtol=1e-13, atol=1e-15)  # fmt: skip
     fixed = mmg_vessel({**kvlcc2_document(), "rps": 9.0})
     log = zigzag(fixed, 20, 20, duration=60, dt=0.2, method="euler").log.assign(n=9.0)
-    path = tmp_path / "follow.yml"
-    path.write_text(yaml.safe_dump({**kvlcc2_document(), "rps": "logs"}), encoding="utf-8")
+    path = mmg_file(tmp_path / "follow.yml", rps="logs")
     log_path = write_log(log, tmp_path / "zz9.csv")
-    code, _, err = run(["validate", path, log_path, "--method", "euler", "--json",
-                        tmp_path / "v.json"], capsys)  # fmt: skip
-    assert code == 0, err
-    (record,) = json.loads((tmp_path / "v.json").read_text())["logs"]
+    record = validated(path, log_path, capsys, tmp_path, "--method", "euler")
     assert max(record["metrics"][s]["rmse"] for s in "uvr") < 1e-9
     closed = record["indices"]["closed_loop"]
     measured = record["indices"]["measured"]
@@ -213,8 +211,7 @@ def test_shipid_mmg_bad_input_is_named(tmp_path, capsys, argv, said):
 def test_an_mmg_file_is_a_prior_as_the_built_in_ship_is(tmp_path, capsys):
     """``identify --prior SHIP.yml``: the KVLCC2 written out gives the prior the built-in KVLCC2
     gives (its trials fitted in the structure), and so the same model."""
-    path = tmp_path / "kvlcc2.yml"
-    path.write_text(yaml.safe_dump(kvlcc2_document()), encoding="utf-8")
+    path = mmg_file(tmp_path / "kvlcc2.yml")
     log = write_log(zigzag(K.kvlcc2(), 20, 20, duration=60, dt=0.2).log, tmp_path / "zz.csv")
     models = []
     for prior in ("kvlcc2", path):
@@ -237,8 +234,7 @@ def test_an_mmg_ship_refuses_runs_outside_its_method_in_one_line(tmp_path, capsy
     """The MMG standard method's propeller turns ahead and its hull forces need headway: a
     crash stop of a ship whose propeller follows the orders, and a run from rest, are refused
     in one line; criteria says why it does not judge the stopping ability."""
-    path = tmp_path / "follow.yml"
-    path.write_text(yaml.safe_dump({**kvlcc2_document(), "rps": "logs"}), encoding="utf-8")
+    path = mmg_file(tmp_path / "follow.yml", rps="logs")
     code, _, err = run(["manoeuvre", path, "stopping"], capsys)
     assert code == 1 and err.count("\n") == 1 and "propeller turning ahead only" in err
     code, out, err = run(["criteria", path], capsys)
@@ -268,8 +264,7 @@ def test_an_mmg_ship_exports_as_a_standalone_module(tmp_path, capsys):
     from shipid.dynamics.simulate import simulate_log
     from shipid.identification.correction import correction_document, identify_correction
 
-    follow = tmp_path / "follow.yml"
-    follow.write_text(yaml.safe_dump({**kvlcc2_document(), "rps": "logs"}), encoding="utf-8")
+    follow = mmg_file(tmp_path / "follow.yml", rps="logs")
     ship = read_mmg(follow)
     wind = "wind_speed^2*sin(wind_angle)"
     log = zigzag(ship, 20, 20, duration=40, dt=0.1, method="euler", rps=9.0, speed=0.9,

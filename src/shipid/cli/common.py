@@ -298,7 +298,7 @@ def _physics(args, logs, structure, searched: bool = False, chosen: bool = False
         prior = clarke_prior(part, structure, speed or 0.0, _logs_side(logs))
     elif name and name in _vessel_names():
         prior, source = _reference_ship_prior(name, logs, structure, searched)
-    elif args.prior and _is_reference_file(args.prior):
+    elif args.prior and _reference_ship(args.prior) is not None:  # an MMG file, a corrected ship
         prior, source = _reference_ship_prior(args.prior, logs, structure, searched)
     elif args.prior:
         from shipid.identification.priors import prior_from_model, prior_in_forms
@@ -314,13 +314,6 @@ def _physics(args, logs, structure, searched: bool = False, chosen: bool = False
                              prior_source=source, bounds_where_present=chosen,
                              **flags)  # fmt: skip
     return options if options.active else None
-
-
-def _is_reference_file(path: str) -> bool:
-    """Whether ``path`` holds a reference ship (an MMG model, a corrected ship), not a model."""
-    from shipid.identification.correction import reference_file
-
-    return reference_file(path) is not None
 
 
 def _reference_ship_prior(name: str, logs, structure, searched: bool) -> tuple[dict, str]:
@@ -715,21 +708,29 @@ def _vessel_conditions() -> dict:
             "alternatives_fit": ""}  # fmt: skip
 
 
+def _reference_ship(name: str):
+    """The reference ship ``name`` says: a built-in one, or a ship's file (an MMG model,
+    ``shipid correct``'s corrected ship); None for a model file."""
+    if name in VESSEL_NAMES:
+        from shipid.vessels import get_vessel
+
+        return get_vessel(name)
+    from shipid.identification.correction import reference_file
+
+    return reference_file(name)
+
+
 def _ship_or_model(name: str, hybrid: bool = False):
     """A reference ship (its trimmed speed applies) or a model file with its training
     conditions (approach speed, propeller speed, envelope); a model with a kernel residual
     where the command runs one (``hybrid``), else refused."""
     from shipid.reporting.modelfile import load_document, model_from_document, training_conditions
-    from shipid.vessels import get_vessel
-
-    if name in VESSEL_NAMES:
-        return get_vessel(name), _vessel_conditions()
-    if not Path(name).exists():
+    if name not in VESSEL_NAMES and not Path(name).exists():
         raise ShipidError(f"{name}: neither a model file nor a known vessel "
                           f"({', '.join(VESSEL_NAMES)})")  # fmt: skip
-    from shipid.identification.correction import reference_file, ship_ensemble
+    from shipid.identification.correction import ship_ensemble
 
-    ship = reference_file(name)  # shipid correct's corrected ship, or a ship's own MMG model
+    ship = _reference_ship(name)
     if ship is not None:
         # A corrected ship's bootstrap replicates, where its file has them: the bands.
         return ship, {**_vessel_conditions(), "ensemble": ship_ensemble(ship)}

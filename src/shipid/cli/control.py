@@ -12,6 +12,7 @@ from shipid.cli.common import (
     _np,
     _pd,
     _read_files,
+    _reference_ship,
     _run_approach,
     _ship_or_model,
     _steering,
@@ -133,10 +134,7 @@ def cmd_export(args) -> int:
         raise ShipidError(f"-o {args.output}: the exported module must be a .py file")
     check_outputs({"-o": (args.output, "python")},
                   [] if args.model in VESSEL_NAMES else [args.model])  # fmt: skip
-    from shipid.identification.correction import reference_file
-    from shipid.vessels import get_vessel
-
-    ship = get_vessel(args.model) if args.model in VESSEL_NAMES else reference_file(args.model)
+    ship = _reference_ship(args.model)
     if ship is not None:  # an MMG ship (the KVLCC2, an MMG file, one corrected)
         from shipid.control.export import export_ship
         from shipid.dynamics.model import ManoeuvringModel

@@ -20,6 +20,7 @@ from shipid.cli.common import (
     _print_yaw_rate_offsets,
     _read_files,
     _read_options,
+    _reference_ship,
     _reference_speed_notes,
     _sampling_notes,
     _scale_notes,
@@ -48,7 +49,7 @@ def cmd_validate(args) -> int:
     """``shipid validate``: free runs on logs, metrics, indices, figures, report."""
     from shipid.evaluation.envelope import outside_envelope
     from shipid.evaluation.validate import validate
-    from shipid.identification.correction import reference_file, ship_ensemble
+    from shipid.identification.correction import ship_ensemble
     from shipid.outputs import OutputSet, check_outputs
     from shipid.reporting.modelfile import (
         ensemble_from_document,
@@ -64,10 +65,9 @@ def cmd_validate(args) -> int:
         start_spread_note,
         switch_heading_note,
     )
-    from shipid.vessels import get_vessel
 
-    # A reference ship, shipid correct's corrected one or a ship's own MMG model, read once.
-    ship = get_vessel(args.model) if args.model in VESSEL_NAMES else reference_file(args.model)
+    # A reference ship, shipid correct's corrected one or a ship's own MMG model.
+    ship = _reference_ship(args.model)
     reference = ship is not None
     check_outputs({"--json": (args.json, "json"), "--plots": (args.plots, "dir"),
                    "--report": (args.report, "dir")},

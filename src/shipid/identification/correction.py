@@ -32,6 +32,7 @@ overshoots closer than the MMG model alone and than the models identified from t
 from __future__ import annotations
 
 import dataclasses
+import functools
 from collections.abc import Sequence
 
 import numpy as np
@@ -139,9 +140,9 @@ class CorrectedMMGDynamics(CorrectedDynamics):
         mmg.under_way(s0)
         if ref.follow_rps:
             mmg.ahead_orders(params)
-        mmg.closed_corrected(ref.packed, ref.n_prop, ref.follow_rps, *self._terms, dt, n_steps,
-                             s0, params, rk4, speed_lim, yaw_lim, states, rudder,
-                             n_valid)  # fmt: skip
+        mmg.closed_corrected(ref.packed, ref.n_prop, ref.follow_rps, *self._terms,
+                             self.correction.uses_wind, dt, n_steps, s0, params, rk4, speed_lim,
+                             yaw_lim, states, rudder, n_valid)  # fmt: skip
 
 
 def corrected_dynamics(reference, correction: ManoeuvringModel):
@@ -194,7 +195,14 @@ def ship_ensemble(ship) -> CorrectedEnsemble | None:
     return getattr(getattr(ship, "dynamics", None), "correction_ensemble", None)
 
 
-def _with_ensemble(vessel: Vessel, reference: Vessel, ensemble: Ensemble | None) -> Vessel:
+def _corrected_vessel(reference: Vessel, correction: ManoeuvringModel, by: str,
+                      ensemble: Ensemble | None = None) -> Vessel:  # fmt: skip
+    """The reference ship with ``correction`` added (``corrected_dynamics``), named for it and
+    carrying the correction's bootstrap ``ensemble`` where there is one (``ship_ensemble``)."""
+    vessel = dataclasses.replace(
+        reference, name=f"{reference.name} + correction",
+        dynamics=corrected_dynamics(reference.dynamics, correction),
+        source=f"{reference.source}, corrected by {by}")  # fmt: skip
     if ensemble is not None:
         vessel.dynamics.correction_ensemble = CorrectedEnsemble(ensemble, vessel, reference)
     return vessel
@@ -331,25 +339,26 @@ def identify_correction(
         scores = _gamma_scores(logs, names, reference, structure, filter_hz)
         gamma = min(scores, key=scores.get)
     fitted = [lowpass(log, filter_hz) for log in logs] if filter_hz is not None else logs
-    correction, explained = _fit(fitted, names, reference, structure, float(gamma))
-    ensemble = None
-    if bootstrap is not None:
-        from shipid.identification.uncertainty import resampler
+    point: dict = {}
 
-        draw, block_s = resampler(fitted, bootstrap, "auto")
-        rng = np.random.default_rng(seed)
-        replicates = [_fit(fitted, names, reference, structure, float(gamma), draw(rng))[0]
-                      for _ in range(bootstrap)]  # fmt: skip
-        terms = correction.structure.all_terms
-        thetas = np.array([[[m.coefficients.get(d, {}).get(t, 0.0) for t in terms] for d in DOFS]
-                           for m in replicates])  # fmt: skip
-        ensemble = Ensemble(correction, thetas, block_s, seed)
-    vessel = dataclasses.replace(
-        reference, name=f"{reference.name} + correction",
-        dynamics=corrected_dynamics(reference.dynamics, correction),
-        source=f"{reference.source}, corrected by an LS-SVM fit to {len(logs)} log(s)")  # fmt: skip
-    vessel = _with_ensemble(vessel, reference, ensemble)
-    return Correction(vessel, correction, explained, float(gamma), scores, ensemble, reference)
+    def refit(weights: np.ndarray | None) -> ManoeuvringModel:
+        correction, explained = _fit(fitted, names, reference, structure, float(gamma), weights)
+        if weights is None:  # the point fit: its shares are the ones reported
+            point["explained"] = explained
+        return correction
+
+    if bootstrap is None:
+        ensemble, correction = None, refit(None)
+    else:
+        # identify --bootstrap's resampling of the equations, the point fit its first call.
+        from shipid.identification.uncertainty import bootstrap as resampled
+
+        ensemble = resampled(fitted, refit, bootstrap, "auto", seed)
+        correction = ensemble.model
+    vessel = _corrected_vessel(reference, correction, f"an LS-SVM fit to {len(logs)} log(s)",
+                               ensemble)  # fmt: skip
+    return Correction(vessel, correction, point["explained"], float(gamma), scores, ensemble,
+                      reference)  # fmt: skip
 
 
 def _reference_accelerations(reference: Vessel, log: pd.DataFrame) -> np.ndarray:
@@ -451,17 +460,28 @@ def correction_document(fit: Correction, reference: str | dict, training_files: 
 
 
 def reference_file(path) -> Vessel | None:
-    """The ship of a file that holds one, read once: a corrected reference ship (``shipid
-    correct``) or a ship's own MMG model (``shipid.vessels.mmg_file``); None for any other file
-    (a model file, which its own reader reads)."""
+    """The ship of a file that holds one: a corrected reference ship (``shipid correct``) or a
+    ship's own MMG model (``shipid.vessels.mmg_file``); None for any other file (a model file,
+    which its own reader reads). Read once per process while the file is unchanged: a command
+    asks for it where it tells a ship's file from a model's and again where it runs it (the
+    prior's trials, the report)."""
+    from pathlib import Path
+
+    p = Path(str(path))
+    if not p.is_file() or p.suffix.lower() not in (".json", ".yml", ".yaml"):
+        return None
+    stat = p.stat()
+    return _read_reference_file(str(p.resolve()), stat.st_mtime_ns, stat.st_size, str(path))
+
+
+@functools.lru_cache(maxsize=16)
+def _read_reference_file(resolved: str, mtime_ns: int, size: int, given: str) -> Vessel | None:
     from pathlib import Path
 
     from shipid.vessels.mmg_file import FORMAT as MMG_FORMAT
     from shipid.vessels.mmg_file import mmg_vessel, read_document
 
-    p = Path(str(path))
-    if not p.is_file() or p.suffix.lower() not in (".json", ".yml", ".yaml"):
-        return None
+    p = Path(given)
     try:
         doc = read_document(p)
     except ShipidError:
@@ -490,7 +510,6 @@ def corrected_from_document(doc: dict, path) -> Vessel:
         from shipid.vessels.mmg_file import mmg_vessel
 
         reference = mmg_vessel(name["mmg"], f"{path}: reference.mmg")
-        name = reference.name
     elif not isinstance(name, str) or name not in VESSELS:
         raise ShipidError(f"{path}: reference {name!r} is not a reference ship of this shipid "
                           f"({', '.join(VESSELS)}) nor an MMG model (reference.mmg)")  # fmt: skip
@@ -508,8 +527,4 @@ def corrected_from_document(doc: dict, path) -> Vessel:
     if data is not None and not isinstance(data, dict):
         raise ShipidError(f"{path}: uncertainty must be a mapping")
     ensemble = None if not data else Ensemble.from_dict(data, correction, f"{path}: uncertainty")
-    ship = dataclasses.replace(
-        reference, name=f"{name} + correction",
-        dynamics=corrected_dynamics(reference.dynamics, correction),
-        source=f"{reference.source}, corrected by {p.name}")  # fmt: skip
-    return _with_ensemble(ship, reference, ensemble)
+    return _corrected_vessel(reference, correction, p.name, ensemble)

@@ -47,12 +47,13 @@ def _model_text(model, std_errors) -> str:
     text = (f"reference ship {model.name}: {model.source or 'shipid.vessels'}; Lpp "
             f"{model.length:g} m, approach {model.approach_speed:.4g} m/s, positive rudder to "
             f"{model.rudder_positive}")
+    from shipid.vessels.mmg import MMGDynamics
+
     dyn = model.dynamics
-    mmg = getattr(getattr(dyn, "reference", dyn), "packed", None) is not None
-    if mmg:  # an MMG ship: its coefficients, as its file holds them
+    ref = getattr(dyn, "reference", dyn)  # a corrected ship's, or the ship's own
+    if isinstance(ref, MMGDynamics):  # an MMG ship: its coefficients, as its file holds them
         from shipid.vessels.mmg_file import document_of
 
-        ref = getattr(dyn, "reference", dyn)
         doc = document_of(ref.c)
         text += ("\npropeller: " + ("each log's measured rate (rps: logs), trimmed "
                                     f"{ref.n_prop:.4g} rps for the approach" if ref.follow_rps

@@ -11,11 +11,9 @@ from __future__ import annotations
 import math
 from functools import lru_cache
 
-import numpy as np
-
 from shipid.dynamics.steering import SteeringMachine
 
-from .mmg import MMGDynamics, pack
+from .mmg import MMGDynamics, pack, trimmed_rps
 from .mmg import accelerations as mmg_accelerations
 from .vessel import Vessel
 
@@ -72,15 +70,9 @@ class KVLCC2Dynamics(MMGDynamics):
 
 @lru_cache(maxsize=8)
 def trimmed_revolutions(speed: float = APPROACH_SPEED) -> float:
-    """Propeller rps for u̇ = 0 at ``speed`` in straight running (≈ 11.85 rps at 1.179 m/s)."""
-    from scipy.optimize import brentq  # 0.4 s to import: only when a KVLCC2 is built
-
-    state = np.array([[speed, 0.0, 0.0]])
-
-    def surge_acc(n: float) -> float:
-        return float(KVLCC2Dynamics(n).derivatives(state, np.zeros(1))[0, 0])
-
-    return brentq(surge_acc, 1.0, 60.0, xtol=1e-12)
+    """Propeller rps for u̇ = 0 at ``speed`` in straight running (≈ 11.85 rps at 1.179 m/s):
+    ``shipid.vessels.mmg.trimmed_rps`` of its coefficients."""
+    return trimmed_rps(COEFFICIENTS, speed)
 
 
 def kvlcc2(speed: float = APPROACH_SPEED) -> Vessel:

@@ -219,15 +219,16 @@ def open_corrected(c, n, follow, theta, start, sig, op, kk, pw, rud, derived, t,
 
 
 @numba.njit(cache=True)
-def closed_corrected(c, n, follow, theta, start, sig, op, kk, pw, rud, derived, dt, n_steps, s0,
-                     params, rk4, speed_lim, yaw_lim, states, rudder, n_valid):  # fmt: skip
+def closed_corrected(c, n, follow, theta, start, sig, op, kk, pw, rud, derived, windy, dt, n_steps,
+                     s0, params, rk4, speed_lim, yaw_lim, states, rudder, n_valid):  # fmt: skip
     """Closed-loop manoeuvres of the MMG model ``c`` plus the term model θ (3, T), in the true
-    wind of each row of ``params``."""
+    wind of each row of ``params`` where the correction has wind terms (``windy``)."""
     for b in range(params.shape[0]):
         p = params[b]
         # The true wind of the manoeuvre, met by the correction's wind terms (the MMG model has
-        # none) as the relative wind of the ship's own motion, as a term model's.
-        terms = kernel._terms_ctx(theta, start, sig, op, kk, pw, rud, derived, True,
+        # none) as the relative wind of the ship's own motion, as a term model's; without such
+        # terms, not computed at every evaluation.
+        terms = kernel._terms_ctx(theta, start, sig, op, kk, pw, rud, derived, windy,
                                   p[kernel.P_WIND_SPEED], p[kernel.P_WIND_DIR])  # fmt: skip
         inp = terms[8]
         n_valid[b] = kernel.closed_run(_this.rhs_corrected, (inp, n, c, follow, terms), inp,
@@ -279,6 +280,28 @@ def ahead_orders(params: np.ndarray) -> None:
                           "propeller turning ahead only (no crash stop, no propeller stopped)")
 
 
+def trimmed_rps(c: Mapping, speed: float) -> float:
+    """The propeller rps for u̇ = 0 at ``speed`` in straight running of the MMG model of flat
+    coefficients ``c`` (``mmg_file.coefficients``' form; the KVLCC2's ≈ 11.85 rps at 1.179 m/s),
+    or a one-line error naming the ship where no rate holds it."""
+    from scipy.optimize import brentq  # 0.4 s to import: only when an MMG ship is trimmed
+
+    packed = pack(c)
+    state, rudder = np.array([[speed, 0.0, 0.0]]), np.zeros(1)
+
+    def surge(n: float) -> float:
+        return float(_batch(packed, state, rudder, np.array([n]))[0, 0])
+
+    low = 1e-3 * speed / c["propeller.diameter"] + 1e-6
+    if not surge(low) < 0 < surge(1e4):
+        from shipid.errors import ShipidError
+
+        raise ShipidError(f"{c.get('name', 'the MMG ship')}: no propeller speed holds {speed:g} "
+                          "m/s straight ahead (check the resistance and the propeller's "
+                          "coefficients)")  # fmt: skip
+    return brentq(surge, low, 1e4, xtol=1e-12)
+
+
 class MMGDynamics(CompiledDynamics):
     """The MMG model's accelerations, its propeller at a constant ``n_prop`` [rps] (trimmed for
     the approach speed) or, where ``follow_rps``, at the rate each run gives (a log's column n,
@@ -304,8 +327,10 @@ class MMGDynamics(CompiledDynamics):
         the propeller at ``rps`` (B,) where the ship follows it, else at ``n_prop``."""
         nu = kernel.c_array(nu).reshape(-1, 3)
         delta = kernel.c_array(np.broadcast_to(np.asarray(delta, dtype=float), nu.shape[:1]))
-        n = rps if self.follow_rps and rps is not None else self.n_prop
-        ahead_only(n)
+        n = self.n_prop  # checked ahead where it was trimmed or read
+        if self.follow_rps and rps is not None:
+            n = rps
+            ahead_only(n)
         return _batch(self.packed, nu, delta,
                       kernel.c_array(np.broadcast_to(np.asarray(n, dtype=float), nu.shape[:1])))
 

@@ -40,12 +40,10 @@ import math
 from collections.abc import Mapping
 from pathlib import Path
 
-import numpy as np
-
 from shipid.dynamics.steering import SteeringMachine
 from shipid.errors import ShipidError
 
-from .mmg import MMGDynamics
+from .mmg import MMGDynamics, trimmed_rps
 from .vessel import Vessel
 
 FORMAT = "shipid-mmg"
@@ -98,21 +96,6 @@ def coefficients(doc: Mapping, where: str = "MMG file") -> dict:
     if out["rps"] is not None and not out["rps"] > 0:
         raise ShipidError(f"{where}: rps must be > 0, got {out['rps']:g}")
     return out
-
-
-def trimmed_rps(c: Mapping, speed: float) -> float:
-    """Propeller rps for u̇ = 0 at ``speed`` in straight running."""
-    from scipy.optimize import brentq
-
-    state = np.array([[speed, 0.0, 0.0]])
-
-    def surge(n: float) -> float:
-        return float(MMGDynamics(c, n).derivatives(state, np.zeros(1))[0, 0])
-
-    if not surge(1e-3 * speed / c["propeller.diameter"] + 1e-6) < 0 < surge(1e4):
-        raise ShipidError(f"{c['name']}: no propeller speed holds {speed:g} m/s straight ahead "
-                          "(check the resistance and the propeller's coefficients)")  # fmt: skip
-    return brentq(surge, 1e-3 * speed / c["propeller.diameter"] + 1e-6, 1e4, xtol=1e-12)
 
 
 def mmg_vessel(doc: Mapping, where: str = "MMG file") -> Vessel:
