@@ -6,7 +6,7 @@ the source (``__pycache__``). A cold cache costs the first command that needs a 
 compilation (about 9 s of the demo's 13 s on a fresh install) and each of two test workers its
 own copy; so every compiled path is exercised here once, with the argument types the commands
 use: the term model's open and closed runs, its accelerations and path following, the kernel
-residual (hybrid), the reference ships (and an MMG one corrected), the zero-phase filter, the
+residual (hybrid), the reference ships (and each corrected), the zero-phase filter, the
 track smoother and the LS-SVM's blocked leave-one-out. Python's bytecode of the package is written too.
 """
 
@@ -59,11 +59,14 @@ def precompile() -> list[str]:
         ship.dynamics.derivatives(np.array([[ship.approach_speed, 0.0, 0.0]]), np.zeros(1))
         done.append(ship.name)
     turning_circle(mariner(), 35, duration=5.0)
-    # An MMG reference with a correction (shipid correct): the MMG formula plus a term model.
-    corrected = identify_correction(zigzag(kvlcc2(), 10, 10, duration=20.0).log, kvlcc2())
-    simulate(corrected.vessel.dynamics, run.log["t"], run.log["delta"], np.r_[1.0, np.zeros(5)])
-    zigzag(corrected.vessel, 10, 10, duration=5.0)
-    done.append("corrected MMG")
+    # Each reference ship with a correction (shipid correct): its formula plus a term model.
+    for ship in (kvlcc2(), tanker(), mariner(), cybership2()):
+        own = zigzag(ship, 10, 10, duration=20.0).log
+        corrected = identify_correction(own, ship)
+        simulate(corrected.vessel.dynamics, own["t"], own["delta"],
+                 np.r_[ship.approach_speed, np.zeros(5)])  # fmt: skip
+        zigzag(corrected.vessel, 10, 10, duration=5.0)
+        done.append(f"corrected {ship.name}")
     rng = np.random.default_rng(0)
     PrimalLOOPath(rng.normal(size=(64, 3)), rng.normal(size=(64, 3)), np.ones(64)).mse_grid([1.0, 10.0])
     done.append("blocked leave-one-out")

@@ -471,6 +471,56 @@ def integrate_closed(theta, start, sig, op, kk, pw, rud, derived, dt, n_steps, s
 
 
 @numba.njit(cache=True)
+def corrected_rhs(ctx, u, v, r, psi):
+    """A reference ship's state derivative plus a correction's terms (``shipid correct``); ctx =
+    (inputs, the reference's ``rhs``, its context, the terms' context, which share the input
+    buffer). A correction's terms are in u, v, r, δ and the wind: the hull's cross-flow drag
+    may be among them, the rudder's normal force (its propeller's inflow) not. Two ways, not
+    ``terms_rhs_any``'s three: half the compilation."""
+    a0, a1, a2, rd, xd, yd = ctx[1](ctx[2], u, v, r, psi)
+    if ctx[3][13] == SLOTS_CROSSFLOW:
+        b0, b1, b2, _, _, _ = terms_rhs_crossflow(ctx[3], u, v, r, psi)
+    else:
+        b0, b1, b2, _, _, _ = terms_rhs(ctx[3], u, v, r, psi)
+    return a0 + b0, a1 + b1, a2 + b2, rd, xd, yd
+
+
+# Inlined into each ship's entries (``shipid.vessels``), which hand on their own ``rhs``: a
+# function passed on through two calls would make numba refuse to cache the caller.
+@numba.njit(cache=True, inline="always")
+def open_corrected_runs(rhs, extra, terms, t, inputs, n_steps, s0, rk4, speed_lim, yaw_lim, out,
+                        n_valid):  # fmt: skip
+    """Free runs of a reference ship (``rhs``, its context the input buffer and ``extra``) plus
+    a correction's terms (``terms``: θ (3, T), its factor table and ``derived``)."""
+    theta, start, sig, op, kk, pw, rud, derived = terms
+    for b in range(inputs.shape[0]):
+        own = _terms_ctx(theta, start, sig, op, kk, pw, rud, derived, False, 0.0, 0.0)
+        inp = own[8]
+        n_valid[b] = open_run(_kernel.corrected_rhs, (inp, rhs, (inp,) + extra, own), inp, t,
+                              inputs[b], n_steps[b], s0[b], rk4, speed_lim[b], yaw_lim[b],
+                              out[b])  # fmt: skip
+
+
+@numba.njit(cache=True, inline="always")
+def closed_corrected_runs(rhs, extra, terms, windy, dt, n_steps, s0, params, rk4, speed_lim,
+                          yaw_lim, states, rudder, n_valid):  # fmt: skip
+    """Closed-loop manoeuvres of a reference ship plus a correction's terms
+    (``open_corrected_runs``), in the true wind of each row of ``params`` where the correction
+    has wind terms (``windy``): the reference ships model none, so the terms meet it as the
+    relative wind of the ship's own motion, as a term model's do; without such terms it is not
+    computed at every evaluation."""
+    theta, start, sig, op, kk, pw, rud, derived = terms
+    for b in range(params.shape[0]):
+        p = params[b]
+        own = _terms_ctx(theta, start, sig, op, kk, pw, rud, derived, windy, p[P_WIND_SPEED],
+                         p[P_WIND_DIR])  # fmt: skip
+        inp = own[8]
+        n_valid[b] = closed_run(_kernel.corrected_rhs, (inp, rhs, (inp,) + extra, own), inp, p,
+                                dt, n_steps, s0[b], rk4, speed_lim[b], yaw_lim[b], states[b],
+                                rudder[b])  # fmt: skip
+
+
+@numba.njit(cache=True)
 def accelerations(theta, start, sig, op, kk, pw, rud, derived, states, inputs, out):
     """(M, 3) accelerations of one coefficient set θ (3, T) at states (M, 3) and inputs (M, 5):
     the compiled evaluation, checked against ``term_matrix`` by the tests."""

@@ -16,8 +16,9 @@ the commands taking a reference ship load (``reference_file``). The reference's 
 stays at its own trim, or at each log's rate where it follows it (an MMG file's ``rps: logs``);
 a correction has no propeller or thrust terms (the reference keeps its own), but may have the
 relative wind's, a force no reference ship models (``blanke-race+wind``, the default where the
-logs measure it; an MMG model's and a term model's corrected runs meet the wind, the other
-reference ships' step in Python without it, and refuse them).
+logs measure it). Every reference ship corrected runs compiled, its formula and the
+correction's terms in one state derivative (``shipid.dynamics.kernel.corrected_rhs``), and
+meets the wind; a term model run at similar rps steps in Python, without it, and refuses them.
 
 On the Esso Osaka, which has no published model, the KVLCC2's MMG model with the Esso's
 particulars (``shipid mmg``) predicts the zig-zags and turns better than the default fitted to
@@ -60,7 +61,8 @@ DEFAULT, DEFAULT_WIND = "blanke-race", "blanke-race+wind"
 
 class CorrectedDynamics:
     """The reference ship's accelerations plus a ``ManoeuvringModel`` correction, as
-    ``derivatives`` (the simulator's and the manoeuvres' generic path, stepped in Python)."""
+    ``derivatives`` (the simulator's and the manoeuvres' generic path, stepped in Python: a
+    model at similar rps corrected, and the reference the compiled runs are tested against)."""
 
     uses_thrust = False
 
@@ -106,10 +108,12 @@ class CorrectedDynamics:
         return own + self.correction.compiled_accelerations(nu, inputs)
 
 
-class CorrectedMMGDynamics(CorrectedDynamics):
-    """An MMG reference (the built-in KVLCC2, a ship's MMG file) plus its correction, run in the
-    compiled integrators: the correction's accelerations added to the MMG model's at every
-    evaluation (``shipid.vessels.mmg.rhs_corrected``)."""
+class CorrectedCompiledDynamics(CorrectedDynamics):
+    """A reference ship with compiled entries for a correction (an MMG model, the tanker,
+    CyberShip II, the Mariner: their ``corrected_kernels``) plus its correction, run in the
+    compiled integrators: the correction's accelerations added to the ship's own at every
+    evaluation (``shipid.dynamics.kernel.corrected_rhs``). Stepped in Python instead, a
+    corrected tanker's 10° turns and zig-zags took ``shipid correct`` 16 s."""
 
     def __init__(self, reference, correction: ManoeuvringModel) -> None:
         super().__init__(reference, correction)
@@ -118,43 +122,59 @@ class CorrectedMMGDynamics(CorrectedDynamics):
                        code.uses_derived)  # fmt: skip
 
     def integrate_open(self, t, inputs, n_steps, s0, rk4, speed_lim, yaw_lim, out, n_valid):
+        """Free runs driven by (B, N, 5) inputs, the reference's propeller as it runs its own."""
+        entry, _, lead = self.reference.corrected_kernels()
+        entry(*lead, self._terms, t, inputs, n_steps, s0, rk4, speed_lim, yaw_lim, out, n_valid)
+
+    def integrate_closed(self, dt, n_steps, s0, params, rk4, speed_lim, yaw_lim, states, rudder,
+                         n_valid):  # fmt: skip
+        """Closed-loop manoeuvres of parameter rows ``params``."""
+        _, entry, lead = self.reference.corrected_kernels()
+        entry(*lead, self._terms, self.correction.uses_wind, dt, n_steps, s0, params, rk4,
+              speed_lim, yaw_lim, states, rudder, n_valid)  # fmt: skip
+
+
+class CorrectedMMGDynamics(CorrectedCompiledDynamics):
+    """An MMG reference (the built-in KVLCC2, a ship's MMG file) plus its correction: the
+    runs it refuses are the MMG model's (a propeller not ahead, a ship not under way)."""
+
+    propeller_ahead_only = True  # the MMG model's propeller
+
+    def integrate_open(self, t, inputs, n_steps, s0, rk4, speed_lim, yaw_lim, out, n_valid):
         """Free runs driven by (B, N, 5) inputs, the propeller at the reference's trim (or the
         inputs' rate, where it follows it)."""
         from shipid.vessels import mmg
 
-        ref = self.reference
         mmg.under_way(s0)
-        if ref.follow_rps:
+        if self.reference.follow_rps:
             mmg.ahead_only(inputs[:, :-1, 1], t)
-        mmg.open_corrected(ref.packed, ref.n_prop, ref.follow_rps, *self._terms, t, inputs,
-                           n_steps, s0, rk4, speed_lim, yaw_lim, out, n_valid)  # fmt: skip
-
-    propeller_ahead_only = True  # the MMG model's propeller
+        super().integrate_open(t, inputs, n_steps, s0, rk4, speed_lim, yaw_lim, out, n_valid)
 
     def integrate_closed(self, dt, n_steps, s0, params, rk4, speed_lim, yaw_lim, states, rudder,
                          n_valid):  # fmt: skip
         """Closed-loop manoeuvres of parameter rows ``params``."""
         from shipid.vessels import mmg
 
-        ref = self.reference
         mmg.under_way(s0)
-        if ref.follow_rps:
+        if self.reference.follow_rps:
             mmg.ahead_orders(params)
-        mmg.closed_corrected(ref.packed, ref.n_prop, ref.follow_rps, *self._terms,
-                             self.correction.uses_wind, dt, n_steps, s0, params, rk4, speed_lim,
-                             yaw_lim, states, rudder, n_valid)  # fmt: skip
+        super().integrate_closed(dt, n_steps, s0, params, rk4, speed_lim, yaw_lim, states,
+                                 rudder, n_valid)  # fmt: skip
 
 
 def corrected_dynamics(reference, correction: ManoeuvringModel):
     """The reference's dynamics plus ``correction``: where the reference is itself a term model
     (the paper's scale ship), one term model of the two summed, which the compiled simulator
     runs (the same accelerations: the terms' union, each coefficient the sum); where it is an
-    MMG model, a ``CorrectedMMGDynamics``, compiled too; else a ``CorrectedDynamics`` the
-    simulator steps in Python. Each keeps ``correction``."""
+    MMG model, a ``CorrectedMMGDynamics``, and another reference ship with compiled entries, a
+    ``CorrectedCompiledDynamics``, compiled too; else (a model at similar rps) a
+    ``CorrectedDynamics`` the simulator steps in Python. Each keeps ``correction``."""
     from shipid.vessels.mmg import MMGDynamics
 
     if isinstance(reference, MMGDynamics):
         return CorrectedMMGDynamics(reference, correction)
+    if getattr(reference, "corrected_kernels", None) is not None:
+        return CorrectedCompiledDynamics(reference, correction)
     if type(reference) is not ManoeuvringModel or reference.similar_at_rps is not None:
         return CorrectedDynamics(reference, correction)
     from shipid.identification.identify import average_models
@@ -245,13 +265,12 @@ def default_structure(logs: Sequence[pd.DataFrame], reference: Vessel | None = N
 
 
 def _runs_wind(reference: Vessel) -> bool:
-    """Whether the corrected ``reference`` meets the wind in its closed loops: an MMG model's
-    compiled runs and a term model's do; the other reference ships step in Python, without."""
-    from shipid.vessels.mmg import MMGDynamics
-
+    """Whether the corrected ``reference`` meets the wind in its closed loops: the compiled
+    reference ships' runs and a term model's do; another (a model at similar rps) steps in
+    Python, without."""
     dyn = reference.dynamics
-    return isinstance(dyn, MMGDynamics) or (type(dyn) is ManoeuvringModel
-                                            and dyn.similar_at_rps is None)
+    return getattr(dyn, "corrected_kernels", None) is not None or (
+        type(dyn) is ManoeuvringModel and dyn.similar_at_rps is None)
 
 
 def _check_wind(structure: ModelStructure, reference: Vessel, where: str = "") -> None:
@@ -259,8 +278,8 @@ def _check_wind(structure: ModelStructure, reference: Vessel, where: str = "") -
                     if set(parse_term(t).signals) & set(WIND)})  # fmt: skip
     if windy and not _runs_wind(reference):
         raise ShipidError(f"{where}the correction's wind terms ({', '.join(windy)}) are not run "
-                          f"in {reference.name}'s manoeuvres (only an MMG model's and a term "
-                          "model's meet the wind): give a structure without them")  # fmt: skip
+                          f"in {reference.name}'s manoeuvres (only a reference ship's and a "
+                          "term model's meet the wind): give a structure without them")  # fmt: skip
 
 
 def _structure(model) -> ModelStructure:

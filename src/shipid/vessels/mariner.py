@@ -93,6 +93,11 @@ class MarinerDynamics(CompiledDynamics):
         """Closed-loop manoeuvres of parameter rows ``params`` (``kernel.closed_run``)."""
         _closed(dt, n_steps, s0, params, rk4, speed_lim, yaw_lim, states, rudder, n_valid)
 
+    def corrected_kernels(self):
+        """(open runs, closed runs) plus a correction's terms, and the arguments that lead
+        theirs: none."""
+        return _this.open_corrected, _this.closed_corrected, ()
+
 
 # Entries reach ``rhs`` as a module attribute: numba caches them only then.
 @numba.njit(cache=True)
@@ -117,6 +122,21 @@ def _closed(dt, n_steps, s0, params, rk4, speed_lim, yaw_lim, states, rudder, n_
         inp = np.zeros(kernel.N_INPUTS)
         n_valid[b] = kernel.closed_run(_this.rhs, (inp,), inp, params[b], dt, n_steps, s0[b], rk4,
                                        speed_lim[b], yaw_lim[b], states[b], rudder[b])  # fmt: skip
+
+
+@numba.njit(cache=True)
+def open_corrected(terms, t, inputs, n_steps, s0, rk4, speed_lim, yaw_lim, out, n_valid):
+    """Free runs of the Mariner plus a correction's terms (``kernel.open_corrected_runs``)."""
+    kernel.open_corrected_runs(_this.rhs, (), terms, t, inputs, n_steps, s0, rk4, speed_lim,
+                               yaw_lim, out, n_valid)  # fmt: skip
+
+
+@numba.njit(cache=True)
+def closed_corrected(terms, windy, dt, n_steps, s0, params, rk4, speed_lim, yaw_lim, states,
+                     rudder, n_valid):  # fmt: skip
+    """Closed-loop manoeuvres of the Mariner plus a correction's terms."""
+    kernel.closed_corrected_runs(_this.rhs, (), terms, windy, dt, n_steps, s0, params, rk4,
+                                 speed_lim, yaw_lim, states, rudder, n_valid)  # fmt: skip
 
 
 def mariner() -> Vessel:

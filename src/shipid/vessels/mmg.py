@@ -160,22 +160,6 @@ def rhs(ctx, u, v, r, psi):
     return a0, a1, a2, psi_dot, xd, yd
 
 
-@numba.njit(cache=True)
-def rhs_corrected(ctx, u, v, r, psi):
-    """``rhs`` plus a term model's accelerations (a correction); ctx = (inputs, n,
-    coefficients, follow, the term model's context, whose input buffer ``inputs`` is)."""
-    inp = ctx[0]
-    a0, a1, a2 = accelerations(ctx[2], u, v, r, inp[0], inp[1] if ctx[3] else ctx[1])
-    # A correction's terms are in u, v, r, δ and the wind: the hull's cross-flow drag may be
-    # among them, the rudder's normal force (its propeller's inflow) not. Two ways, not
-    # ``terms_rhs_any``'s three: half the compilation.
-    if ctx[4][13] == kernel.SLOTS_CROSSFLOW:
-        b0, b1, b2, rd, xd, yd = kernel.terms_rhs_crossflow(ctx[4], u, v, r, psi)
-    else:
-        b0, b1, b2, rd, xd, yd = kernel.terms_rhs(ctx[4], u, v, r, psi)
-    return a0 + b0, a1 + b1, a2 + b2, rd, xd, yd
-
-
 # Entries reach ``rhs`` as a module attribute: numba caches them only then.
 @numba.njit(cache=True)
 def _batch(c, nu, delta, n):
@@ -205,35 +189,21 @@ def _closed(c, n, follow, dt, n_steps, s0, params, rk4, speed_lim, yaw_lim, stat
 
 
 @numba.njit(cache=True)
-def open_corrected(c, n, follow, theta, start, sig, op, kk, pw, rud, derived, t, inputs, n_steps,
-                   s0, rk4, speed_lim, yaw_lim, out, n_valid):  # fmt: skip
+def open_corrected(c, n, follow, terms, t, inputs, n_steps, s0, rk4, speed_lim, yaw_lim, out,
+                   n_valid):  # fmt: skip
     """Free runs of the MMG model ``c`` at propeller speed ``n`` (the inputs' where ``follow``)
-    plus the term model θ (3, T) with its factor table (``kernel.integrate_open``'s
-    arguments)."""
-    for b in range(inputs.shape[0]):
-        terms = kernel._terms_ctx(theta, start, sig, op, kk, pw, rud, derived, False, 0.0, 0.0)
-        inp = terms[8]
-        n_valid[b] = kernel.open_run(_this.rhs_corrected, (inp, n, c, follow, terms), inp, t,
-                                     inputs[b], n_steps[b], s0[b], rk4, speed_lim[b],
-                                     yaw_lim[b], out[b])  # fmt: skip
+    plus a correction's terms (``kernel.open_corrected_runs``)."""
+    kernel.open_corrected_runs(_this.rhs, (n, c, follow), terms, t, inputs, n_steps, s0, rk4,
+                               speed_lim, yaw_lim, out, n_valid)  # fmt: skip
 
 
 @numba.njit(cache=True)
-def closed_corrected(c, n, follow, theta, start, sig, op, kk, pw, rud, derived, windy, dt, n_steps,
-                     s0, params, rk4, speed_lim, yaw_lim, states, rudder, n_valid):  # fmt: skip
-    """Closed-loop manoeuvres of the MMG model ``c`` plus the term model θ (3, T), in the true
-    wind of each row of ``params`` where the correction has wind terms (``windy``)."""
-    for b in range(params.shape[0]):
-        p = params[b]
-        # The true wind of the manoeuvre, met by the correction's wind terms (the MMG model has
-        # none) as the relative wind of the ship's own motion, as a term model's; without such
-        # terms, not computed at every evaluation.
-        terms = kernel._terms_ctx(theta, start, sig, op, kk, pw, rud, derived, windy,
-                                  p[kernel.P_WIND_SPEED], p[kernel.P_WIND_DIR])  # fmt: skip
-        inp = terms[8]
-        n_valid[b] = kernel.closed_run(_this.rhs_corrected, (inp, n, c, follow, terms), inp,
-                                       params[b], dt, n_steps, s0[b], rk4, speed_lim[b],
-                                       yaw_lim[b], states[b], rudder[b])  # fmt: skip
+def closed_corrected(c, n, follow, terms, windy, dt, n_steps, s0, params, rk4, speed_lim, yaw_lim,
+                     states, rudder, n_valid):  # fmt: skip
+    """Closed-loop manoeuvres of the MMG model ``c`` plus a correction's terms, in the true
+    wind of each row of ``params`` where they have wind terms (``windy``)."""
+    kernel.closed_corrected_runs(_this.rhs, (n, c, follow), terms, windy, dt, n_steps, s0,
+                                 params, rk4, speed_lim, yaw_lim, states, rudder, n_valid)
 
 
 def ahead_only(rps: np.ndarray, t: np.ndarray | None = None, what: str = "") -> None:
@@ -351,3 +321,9 @@ class MMGDynamics(CompiledDynamics):
             ahead_orders(params)
         _closed(self.packed, self.n_prop, self.follow_rps, dt, n_steps, s0, params, rk4,
                 speed_lim, yaw_lim, states, rudder, n_valid)  # fmt: skip
+
+    def corrected_kernels(self):
+        """(open runs, closed runs) plus a correction's terms, and the arguments that lead
+        theirs (``shipid.identification.correction.CorrectedMMGDynamics``)."""
+        return _this.open_corrected, _this.closed_corrected, (self.packed, self.n_prop,
+                                                              self.follow_rps)

@@ -70,7 +70,7 @@ class TankerDynamics(ConstantRpsDynamics):
 
     def kernels(self):
         """This module's compiled entries."""
-        return _batch, _open, _closed
+        return _batch, _open, _closed, _this.open_corrected, _this.closed_corrected
 
 
 # Entries reach ``rhs`` as a module attribute: numba caches them only then.
@@ -96,6 +96,22 @@ def _closed(n, dt, n_steps, s0, params, rk4, speed_lim, yaw_lim, states, rudder,
         inp = np.zeros(kernel.N_INPUTS)
         n_valid[b] = kernel.closed_run(_this.rhs, (inp, n), inp, params[b], dt, n_steps, s0[b],
                                        rk4, speed_lim[b], yaw_lim[b], states[b], rudder[b])
+
+
+@numba.njit(cache=True)
+def open_corrected(n, terms, t, inputs, n_steps, s0, rk4, speed_lim, yaw_lim, out, n_valid):
+    """Free runs of the tanker at propeller speed ``n`` plus a correction's terms
+    (``kernel.open_corrected_runs``)."""
+    kernel.open_corrected_runs(_this.rhs, (n,), terms, t, inputs, n_steps, s0, rk4, speed_lim,
+                               yaw_lim, out, n_valid)  # fmt: skip
+
+
+@numba.njit(cache=True)
+def closed_corrected(n, terms, windy, dt, n_steps, s0, params, rk4, speed_lim, yaw_lim, states,
+                     rudder, n_valid):  # fmt: skip
+    """Closed-loop manoeuvres of the tanker at propeller speed ``n`` plus a correction's terms."""
+    kernel.closed_corrected_runs(_this.rhs, (n,), terms, windy, dt, n_steps, s0, params, rk4,
+                                 speed_lim, yaw_lim, states, rudder, n_valid)  # fmt: skip
 
 
 def equilibrium_speed(rpm: float) -> float:

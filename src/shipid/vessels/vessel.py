@@ -41,8 +41,14 @@ class ConstantRpsDynamics(CompiledDynamics):
         self.n_prop = n_prop
 
     def kernels(self):
-        """(batch accelerations, open runs, closed runs) of the ship's module."""
+        """(batch accelerations, open runs, closed runs, the open and the closed runs plus a
+        correction's terms) of the ship's module."""
         raise NotImplementedError
+
+    def corrected_kernels(self):
+        """(open runs, closed runs) plus a correction's terms, and the arguments that lead
+        theirs (``shipid.identification.correction.CorrectedCompiledDynamics``)."""
+        return (*self.kernels()[3:], (float(self.n_prop),))
 
     def derivatives(self, nu, delta, thrust=None):
         """(B, 3) body accelerations at states nu and rudder delta, the propeller at n_prop."""
