@@ -391,6 +391,40 @@ def test_cli_correct_writes_a_ship_the_commands_run(tmp_path, capsys):
     assert code == 1 and err.count("\n") == 1 and "broken.json: reference 'titanic'" in err
 
 
+def test_a_ship_whose_gear_stops_short_of_35_degrees_is_corrected_and_turned_at_its_limit(
+        tmp_path, capsys):  # fmt: skip
+    """The tanker's rudder stops at 10°: ``correct tanker`` ended in "rudder 35.0° is beyond the
+    steering machine's limit" after printing its fit, and wrote no ship; ``manoeuvre tanker
+    turning`` stopped on its own default. Both now run the largest rudder the gear allows, the
+    same runs as asked for by hand, and say so."""
+    import json
+
+    from cli_helpers import run
+
+    from shipid.data.io import write_log
+    from shipid.trials.manoeuvres import turning_circle
+
+    tanker = get_vessel("tanker")
+    assert np.degrees(tanker.steering.max_angle) == pytest.approx(10.0)
+    log = write_log(zigzag(tanker, 10, 10, duration=300, dt=0.5).log, tmp_path / "zz.csv")
+    code, out, err = run(["correct", "tanker", log, "-o", tmp_path / "t.json"], capsys)
+    assert code == 0, err
+    rows = json.loads((tmp_path / "t.json").read_text())["beyond_the_logs"]
+    assert {row["manoeuvre"] for row in rows} == {"10° turn starboard", "10° turn port",
+                                                  "10°/10° starboard", "10°/10° port"}
+    by_hand = turning_circle(tanker, 10.0, side="port").indices["tactical_diameter"]
+    assert next(row["reference"] for row in rows if row["manoeuvre"] == "10° turn port"
+                and row["index"] == "tactical_diameter") == pytest.approx(by_hand, rel=1e-12)
+    outputs = []
+    for extra in ([], ["--rudder", "10"]):
+        code, out, err = run(["manoeuvre", "tanker", "turning", *extra, "--json",
+                              tmp_path / f"tc{len(extra)}.json"], capsys)  # fmt: skip
+        assert code == 0, err
+        outputs.append(json.loads((tmp_path / f"tc{len(extra)}.json").read_text()))
+        assert ("largest rudder is 10°: the turning circle is run with it" in err) == (not extra)
+    assert outputs[0] == outputs[1]
+
+
 @pytest.mark.parametrize("name", ["tanker", "mariner", "cybership2"])
 def test_a_corrected_reference_ship_runs_compiled_and_meets_the_wind(name):
     """The tanker, the Mariner and CyberShip II corrected stepped in Python (16 s of ``shipid

@@ -3,6 +3,8 @@ of the same ship; the corrected ship written to a file the commands run as a ref
 
 from __future__ import annotations
 
+import math
+
 from shipid.cli.common import (
     VESSEL_NAMES,
     _json_text,
@@ -67,14 +69,15 @@ def cmd_correct(args) -> int:
 
 
 # What the correction does where the logs do not reach: the reference's and the corrected ship's
-# held 35° turns and 10°/10° zig-zags to either side, from the reference's own approach.
+# held 35° turns and 10°/10° zig-zags to either side, from the reference's own approach (at
+# the largest rudder its gear allows where that is less: the tanker's is 10°).
 BEYOND = (("turning", "tactical_diameter"), ("turning", "steady_speed"),
           ("turning", "steady_yaw_rate"), ("zigzag", "first_overshoot_deg"),
           ("zigzag", "second_overshoot_deg"))  # fmt: skip
 
 
 # The bootstrap replicates' manoeuvres step coarser than the point's where the corrected ship
-# runs in Python (a correction of a reference ship other than an MMG model or a term model):
+# runs in Python (a correction of a model run at similar rps):
 # four times the manoeuvres' default step.
 REPLICATE_STEP = 0.2
 
@@ -88,17 +91,25 @@ def _replicate_step(ship) -> float | None:
     return None if compiled else REPLICATE_STEP
 
 
+def _standard_rudders(ship) -> tuple[float, float]:
+    """The held turn's and the zig-zag's rudder [deg]: 35° and 10°, or the largest the ship's
+    steering gear allows where that is less."""
+    limit = math.degrees(ship.steering.max_angle) if ship.steering.max_angle else 35.0
+    return min(35.0, round(limit, 6)), min(10.0, round(limit, 6))
+
+
 def _standard(ship, side: str, dt: float | None = None) -> dict:
-    """The held 35° turn and the 10°/10° zig-zag of ``ship`` to ``side`` (at ``dt``, else the
-    manoeuvres' default step)."""
+    """The held turn and the 10°/10° zig-zag of ``ship`` to ``side`` (``_standard_rudders``;
+    at ``dt``, else the manoeuvres' default step)."""
     from shipid.cli.common import _ship_approach
     from shipid.trials.manoeuvres import turning_circle, zigzag
 
     step = {} if dt is None else {"dt": dt}
     # A propeller that follows the runs' rate turns at its trim for the approach.
     step["rps"] = _ship_approach(ship, None, None)[1]
-    return {"turning": turning_circle(ship, 35.0, side=side, **step),
-            "zigzag": zigzag(ship, 10.0, 10.0, first=side, **step)}  # fmt: skip
+    turn, zig = _standard_rudders(ship)
+    return {"turning": turning_circle(ship, turn, side=side, **step),
+            "zigzag": zigzag(ship, zig, zig, first=side, **step)}  # fmt: skip
 
 
 def _beyond_the_logs(reference, corrected, replicates=()) -> list[dict]:
@@ -110,21 +121,23 @@ def _beyond_the_logs(reference, corrected, replicates=()) -> list[dict]:
 
     rows = []
     step = _replicate_step(corrected)
+    turn_deg, zig_deg = _standard_rudders(corrected)
+    labels = {"turning": f"{turn_deg:g}° turn", "zigzag": f"{zig_deg:g}°/{zig_deg:g}°"}
     for side in ("starboard", "port"):
         runs = {label: _standard(ship, side)
                 for label, ship in (("reference", reference), ("corrected", corrected))}
         drawn = [_standard(ship, side, step) for ship in replicates]
         turn = runs["corrected"]["turning"]
         if turn.diverged or turn.indices.get("tactical_diameter") is None:
-            _warn(f"the corrected ship's 35° turn to {side} "
+            _warn(f"the corrected ship's {labels['turning']} to {side} "
                   + ("diverges" if turn.diverged else "does not complete 180°")
                   + ": the correction does not hold beyond its logs; a smaller --gamma keeps it "
                   "nearer the reference")  # fmt: skip
         elif turn.indices.get("turn_direction") not in (None, side):
-            _warn(f"the corrected ship turns to {turn.indices['turn_direction']} with its 35° "
-                  f"rudder to {side}")  # fmt: skip
+            _warn(f"the corrected ship turns to {turn.indices['turn_direction']} with its "
+                  f"{turn_deg:g}° rudder to {side}")  # fmt: skip
         for kind, key in BEYOND:
-            row = {"manoeuvre": f"{'35° turn' if kind == 'turning' else '10°/10°'} {side}",
+            row = {"manoeuvre": f"{labels[kind]} {side}",
                    "index": key, **{label: runs[label][kind].indices.get(key) for label in runs}}
             if drawn:
                 values = [d[kind].indices.get(key) for d in drawn]

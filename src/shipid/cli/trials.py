@@ -305,7 +305,16 @@ def cmd_manoeuvre(args) -> int:
     if args.duration is not None:
         kw["duration"] = args.duration
     if args.rudder_deg is None:
-        args.rudder_deg = 35.0 if args.kind == "turning" else 20.0
+        standard = 35.0 if args.kind == "turning" else 20.0
+        # The largest rudder the gear allows where it is less (MSC.137(76) §4.2; the tanker's
+        # is 10°, and `manoeuvre tanker turning` stopped on its own default).
+        gear = steering if steering is not None else getattr(target, "steering", None)
+        limit = round(math.degrees(gear.max_angle), 6) if gear is not None else standard
+        args.rudder_deg = min(standard, limit)
+        if args.rudder_deg < standard and args.kind in ("turning", "zigzag", "pull-out"):
+            kind = {"turning": "turning circle", "zigzag": "zig-zag"}.get(args.kind, args.kind)
+            _warn(f"the steering gear's largest rudder is {args.rudder_deg:g}°: the {kind} is "
+                  f"run with it instead of {standard:g}° (--rudder to choose)")  # fmt: skip
     if args.kind == "zigzag":
         heading = args.heading if args.heading is not None else args.rudder_deg
         run = partial(zigzag, rudder_deg=args.rudder_deg, heading_deg=heading, first=args.first,
