@@ -26,6 +26,7 @@ from shipid.dynamics.model import ManoeuvringModel, ModelStructure
 from shipid.dynamics.simulate import input_array, run_kernel, simulate, simulate_batch
 from shipid.vessels import scale_ship_model
 from shipid.vessels.mmg import accelerations as mmg_accelerations
+from shipid.vessels.tanker import accelerations as tanker_accelerations
 
 TERMS_20 = ("|u|u", "v*r", "r^2", "delta^2", "1", "u*r", "u*v", "|v|v", "|v|r", "delta",
             "u^2*delta", "v^3", "v^2*r", "v*r^2", "r^3", "u*delta", "delta^3", "v*delta^2",
@@ -342,11 +343,26 @@ _TURN_SHIP = None  # the hand-written loop's coefficients: a global, frozen into
 
 
 @numba.njit(cache=False)
-def _typed_in_turn(n, dt, u0, rate, target, k_uv, k_ur, k_uud, states):
-    """A 35° turn hand-written in numba: the MMG formula with the ship's coefficients frozen in
-    as constants (``_TURN_SHIP``), a correction's three terms typed in, RK4, the rudder moving
-    at its rate to ``target`` (the practical limit of the compiled closed loop)."""
+def _mmg_turning_ship(u, v, r, d):
+    """The MMG formula with the ship's coefficients frozen in as constants (``_TURN_SHIP``)."""
     c, rps = _TURN_SHIP
+    return mmg_accelerations(c, u, v, r, d, rps)
+
+
+_TANKER_RPS = 80.0 / 60.0  # the tanker's nominal propeller speed, frozen in
+
+
+@numba.njit(cache=False)
+def _tanker_turning_ship(u, v, r, d):
+    """The tanker's formula (its coefficients are its module's constants) at its nominal rps."""
+    return tanker_accelerations(u, v, r, d, _TANKER_RPS)
+
+
+@numba.njit(cache=False)
+def _typed_in_turn(ship_acc, n, dt, u0, rate, target, k_uv, k_ur, k_uud, states):
+    """A turn hand-written in numba: the ship's formula (``ship_acc(u, v, r, δ)``, its
+    coefficients frozen in as constants), a correction's three terms typed in, RK4, the rudder
+    moving at its rate to ``target`` (the practical limit of the compiled closed loop)."""
     u, v, r, psi, x, y, d = u0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     for k in range(n):
         states[k, 0], states[k, 1], states[k, 2] = u, v, r
@@ -355,7 +371,7 @@ def _typed_in_turn(n, dt, u0, rate, target, k_uv, k_ur, k_uud, states):
         ks = np.empty((4, 6))
         su, sv, sr, sp = u, v, r, psi
         for i in range(4):
-            a0, a1, a2 = mmg_accelerations(c, su, sv, sr, d, rps)
+            a0, a1, a2 = ship_acc(su, sv, sr, d)
             ks[i, 0] = a0
             ks[i, 1] = a1 + k_uv * su * sv
             ks[i, 2] = a2 + k_ur * su * sr + k_uud * su * su * d
@@ -433,10 +449,10 @@ def mmg_ships() -> None:
     for label, dyn, k in rows:
         assert isinstance(getattr(dyn, "reference", dyn), MMGDynamics)
         ours(dyn)
-        _typed_in_turn(n, dt, ship.approach_speed, ship.steering.max_rate,
+        _typed_in_turn(_mmg_turning_ship, n, dt, ship.approach_speed, ship.steering.max_rate,
                        ship.steering.max_angle, *k, mine)  # fmt: skip
         fast = best_of(lambda d=dyn: ours(d), 5)
-        hand = best_of(lambda k=k: _typed_in_turn(n, dt, ship.approach_speed,
+        hand = best_of(lambda k=k: _typed_in_turn(_mmg_turning_ship, n, dt, ship.approach_speed,
                                                   ship.steering.max_rate,
                                                   ship.steering.max_angle, *k, mine), 5)
         generic = CorrectedDynamics(dyn.reference, dyn.correction) if k[0] else NumpyPath(dyn)
@@ -461,6 +477,72 @@ def mmg_ships() -> None:
         fast = best_of(lambda s=compiled: turning_circle(s, 35, duration=200.0), 5)
         slow = best_of(lambda s=generic: turning_circle(s, 35, duration=200.0), 1)
         print(f"| {label} | {1e3 * fast:.1f} | {1e3 * slow:.0f} |")
+
+
+def corrected_tanker() -> None:
+    """The tanker corrected (``shipid correct tanker``), compiled since 2026-11-29: a 2000 s
+    10° turn's closed loop (the kernel entry, no log; its gear's lag left out, as the
+    hand-written loop has none) against the generic Python loop it ran on before and a
+    hand-written numba loop of the tanker's formula with the correction's terms typed in."""
+    import dataclasses
+
+    from shipid.dynamics.model import get_structure
+    from shipid.dynamics.steering import SteeringMachine
+    from shipid.identification.correction import CorrectedDynamics, corrected_dynamics
+    from shipid.trials.manoeuvres import _generic_closed_loop, manoeuvre_params, turning_circle
+    from shipid.vessels import tanker
+
+    ship = tanker()
+    ship = dataclasses.replace(ship, steering=SteeringMachine(ship.steering.max_angle,
+                                                              ship.steering.max_rate))
+    structure = get_structure("blanke-race")
+    coefficients = {d: dict.fromkeys(t, 0.0) for d, t in structure.terms.items()}
+    k = (1e-4, -2e-4, 3e-6)  # v: u v; r: u r, u² δ (a tenth of the tanker's own, about)
+    coefficients["v"]["u*v"], coefficients["r"]["u*r"], coefficients["r"]["u^2*delta"] = k
+    correction = ManoeuvringModel(structure, coefficients)
+    corrected = dataclasses.replace(ship, dynamics=corrected_dynamics(ship.dynamics, correction))
+    duration, dt = 2000.0, 0.05
+    n = int(duration / dt) + 1
+    params = manoeuvre_params(ship, kernel.MODE_HOLD, ship.steering.max_angle, 0.0, 0.0)
+    s0 = np.zeros((1, 6))
+    s0[0, 0] = ship.approach_speed
+    lim = (np.array([50.0]), np.array([10.0]))
+    states, rudder, valid = np.zeros((1, n, 6)), np.zeros((1, n)), np.zeros(1, dtype=np.int64)
+    mine = np.zeros((n, 6))
+    m = n // 10  # the generic loop runs a tenth of the turn
+
+    def ours(dyn):
+        dyn.integrate_closed(dt, n, s0, params[None].copy(), True, *lim, states, rudder, valid)
+        return states[0].copy()
+
+    def hand(k):
+        return _typed_in_turn(_tanker_turning_ship, n, dt, ship.approach_speed,
+                              ship.steering.max_rate, ship.steering.max_angle, *k, mine)
+
+    print(f"\nThe tanker corrected, a {duration:g} s 10° turn's closed loop (RK4, Δt {dt} s, {n} "
+          "steps): the compiled kernel entry against the generic Python loop it ran on before and "
+          "a hand-written numba loop (the tanker's formula, the correction typed in)\n")
+    print("| ship | compiled (ms) | steps/s | generic Python loop (s) | speed-up | "
+          "hand-written numba (ms) | vs hand-written | largest state difference |")
+    print("|---|---|---|---|---|---|---|---|")
+    for label, dyn, terms in (("tanker", ship.dynamics, (0.0, 0.0, 0.0)),
+                              ("tanker + correction", corrected.dynamics, k)):
+        ours(dyn)
+        hand(terms)
+        fast = best_of(lambda d=dyn: ours(d), 5)
+        typed = best_of(lambda t=terms: hand(t), 5)
+        generic = CorrectedDynamics(ship.dynamics, correction) if terms[0] else NumpyPath(dyn)
+        slow = best_of(lambda g=generic: _generic_closed_loop(g, params, m, dt, s0, "rk4",
+                                                              50.0, 10.0, None), 1) * n / m
+        diff = float(np.max(np.abs(ours(dyn)[:, :3] - mine[:, :3])))
+        print(f"| {label} | {1e3 * fast:.1f} | {n / fast:.3g} | {slow:.1f} | {slow / fast:.0f}× | "
+              f"{1e3 * typed:.1f} | {typed / fast:.2f}× | {diff:.1e} |")
+    generic = dataclasses.replace(ship, dynamics=CorrectedDynamics(ship.dynamics, correction))
+    fast = best_of(lambda: turning_circle(corrected, 10, duration=2000.0), 3)
+    slow = best_of(lambda: turning_circle(generic, 10, duration=200.0), 1) * 10
+    print(f"\nA 2000 s 10° turning circle of the corrected tanker with its log and indices: "
+          f"{1e3 * fast:.0f} ms compiled, {slow:.1f} s on the generic loop (a tenth of it run, "
+          "times ten)")
 
 
 def python_heading(a, b, c, n, dt, u0, rk4, target, gains, max_angle, rate):
@@ -645,5 +727,6 @@ if __name__ == "__main__":
     closed_loop()
     reference_ships()
     mmg_ships()
+    corrected_tanker()
     heading_autopilot()
     kvlcc2_against_solve_ivp()
