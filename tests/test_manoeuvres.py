@@ -253,3 +253,28 @@ def test_compiled_closed_and_open_loops_equal_the_numpy_path(name):
     np.testing.assert_allclose(replay.to_numpy(), again.to_numpy(), rtol=1e-10, atol=1e-12)
     np.testing.assert_allclose(replay[["u", "v", "r"]], fast[["u", "v", "r"]], rtol=1e-10,
                                atol=1e-12)  # fmt: skip
+
+
+def test_the_spiral_runs_to_the_largest_rudder_the_gear_allows(tmp_path, capsys):
+    """``manoeuvre tanker spiral`` stopped on its default 25°: the tanker's gear stops at 10°.
+    The default angles now run to the gear's limit (the standard sequence where it allows
+    25°), the same spiral as the angles given by hand, and the command says so."""
+    import json
+
+    from cli_helpers import run
+
+    from shipid.trials.manoeuvres import spiral, spiral_angles
+
+    assert spiral_angles() == (25, 15, 10, 5, 2, 0, -2, -5, -10, -15, -25, -15, -10, -5, -2, 0,
+                               2, 5, 10, 15, 25)  # fmt: skip
+    assert spiral_angles(10.0) == (10, 5, 2, 0, -2, -5, -10, -5, -2, 0, 2, 5, 10)
+    assert spiral_angles(7.5)[:4] == (7.5, 5, 2, 0) and spiral_angles(40.0) == spiral_angles()
+    tanker = get_vessel("tanker")
+    by_hand = spiral(tanker, spiral_angles(10.0), hold=600.0).indices["table"]
+    assert spiral(tanker, hold=600.0).indices["table"] == by_hand
+    code, _, err = run(["manoeuvre", "tanker", "spiral", "--duration", "600", "--json",
+                        tmp_path / "s.json"], capsys)  # fmt: skip
+    assert code == 0, err
+    assert "largest rudder is 10°: the spiral's angles run to it instead of 25°" in err
+    table = json.loads((tmp_path / "s.json").read_text())["indices"]["table"]
+    assert [row["rudder_deg"] for row in table] == [row["rudder_deg"] for row in by_hand]

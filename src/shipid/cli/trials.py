@@ -277,6 +277,7 @@ def cmd_manoeuvre(args) -> int:
     from shipid.evaluation.validate import faded_residual_notes
     from shipid.outputs import OutputSet, check_outputs
     from shipid.trials.manoeuvres import (
+        SPIRAL_ANGLES,
         astern_thrust_note,
         pull_out,
         spiral,
@@ -304,12 +305,16 @@ def cmd_manoeuvre(args) -> int:
         kw["wind"] = (args.wind_speed, math.radians(args.wind_from or 0.0))
     if args.duration is not None:
         kw["duration"] = args.duration
+    # The largest rudder the gear allows where it is less than a manoeuvre's standard one
+    # (MSC.137(76) §4.2; the tanker's is 10°, and `manoeuvre tanker turning` stopped on its own
+    # default, as its spiral on the 25°).
+    gear = steering if steering is not None else getattr(target, "steering", None)
+    limit = round(math.degrees(gear.max_angle), 6) if gear is not None else math.inf
+    if args.kind == "spiral" and limit < SPIRAL_ANGLES[0]:
+        _warn(f"the steering gear's largest rudder is {limit:g}°: the spiral's angles run to it "
+              f"instead of {SPIRAL_ANGLES[0]:g}°")  # fmt: skip
     if args.rudder_deg is None:
         standard = 35.0 if args.kind == "turning" else 20.0
-        # The largest rudder the gear allows where it is less (MSC.137(76) §4.2; the tanker's
-        # is 10°, and `manoeuvre tanker turning` stopped on its own default).
-        gear = steering if steering is not None else getattr(target, "steering", None)
-        limit = round(math.degrees(gear.max_angle), 6) if gear is not None else standard
         args.rudder_deg = min(standard, limit)
         if args.rudder_deg < standard and args.kind in ("turning", "zigzag", "pull-out"):
             kind = {"turning": "turning circle", "zigzag": "zig-zag"}.get(args.kind, args.kind)

@@ -627,9 +627,25 @@ def _stopping_indices(log: pd.DataFrame, vessel: Vessel) -> dict:
     return out
 
 
+# The spiral's rudder angles to one side [deg], largest first: held from the largest to one
+# side through 0 to the largest to the other and back.
+SPIRAL_ANGLES = (25.0, 15.0, 10.0, 5.0, 2.0)
+
+
+def spiral_angles(limit_deg: float | None = None) -> tuple[float, ...]:
+    """The spiral's default rudder angles, 25° to starboard through −25° and back to 25°
+    (``SPIRAL_ANGLES``), or up to ``limit_deg`` where the steering gear stops short of 25° (the
+    limit itself the largest: the tanker's 10°, 5°, 2°; its spiral stopped on the 25°)."""
+    top = list(SPIRAL_ANGLES)
+    if limit_deg is not None and limit_deg < top[0]:
+        top = [round(limit_deg, 6)] + [a for a in top if a < limit_deg - 1e-9]
+    return (*top, 0.0, *(-a for a in reversed(top)), *(-a for a in top[1:]), 0.0,
+            *reversed(top))
+
+
 def spiral(
     ship: Vessel | ManoeuvringModel | HybridModel,
-    rudders_deg=(25, 15, 10, 5, 2, 0, -2, -5, -10, -15, -25, -15, -10, -5, -2, 0, 2, 5, 10, 15, 25),
+    rudders_deg=None,
     hold: float | None = None,
     dt: float = 0.05,
     speed: float | None = None,
@@ -637,7 +653,8 @@ def spiral(
     rps: float | None = None,
     steering: SteeringMachine | None = None,
 ) -> ManoeuvreResult:
-    """Dieudonné spiral: each rudder angle (positive = to starboard, in degrees) held ``hold`` s
+    """Dieudonné spiral: each rudder angle (positive = to starboard, in degrees; by default
+    ``spiral_angles`` up to the steering gear's limit) held ``hold`` s
     from the state the previous one left; the steady yaw rate of each (mean over the last fifth)
     traces r(δ). A straight-line unstable ship shows a loop: at the same small rudder, a
     different steady rate coming from each side. Indices: the r(δ) table, ``loop`` (whether any
@@ -647,6 +664,8 @@ def spiral(
     from unsettled rates is a transient, not an instability); a row says whether it settled,
     ``unsettled_rudders_deg`` lists the angles that did not."""
     vessel = as_vessel(ship, speed, steering, rps)
+    if rudders_deg is None:
+        rudders_deg = spiral_angles(math.degrees(vessel.steering.max_angle))
     angles = [float(a) for a in rudders_deg]
     if not angles or any(not math.isfinite(a) or abs(math.radians(a)) > vessel.steering.max_angle
                          for a in angles):  # fmt: skip
