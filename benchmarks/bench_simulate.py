@@ -390,6 +390,58 @@ def _typed_in_turn(ship_acc, n, dt, u0, rate, target, k_uv, k_ur, k_uud, states)
     return n
 
 
+def _three_term_correction(k: tuple[float, float, float]) -> ManoeuvringModel:
+    """blanke-race's 21 terms as a correction, three of them non-zero: v: u v; r: u r, u² δ."""
+    from shipid.dynamics.model import get_structure
+
+    structure = get_structure("blanke-race")
+    coefficients = {d: dict.fromkeys(t, 0.0) for d, t in structure.terms.items()}
+    coefficients["v"]["u*v"], coefficients["r"]["u*r"], coefficients["r"]["u^2*delta"] = k
+    return ManoeuvringModel(structure, coefficients)
+
+
+def _held_turn_rows(ship, rows, ship_acc, speed_lim: float, duration: float = 2000.0,
+                    dt: float = 0.05) -> None:  # fmt: skip
+    """Print a table row per (label, dynamics, the correction's three terms typed in) of
+    ``ship``'s held turn at its largest rudder, the closed loop's kernel entry without the log:
+    compiled, the generic Python loop (a tenth of the turn, scaled) and the hand-written loop
+    of ``ship_acc`` with the terms typed in."""
+    from shipid.identification.correction import CorrectedDynamics
+    from shipid.trials.manoeuvres import _generic_closed_loop, manoeuvre_params
+
+    n = int(duration / dt) + 1
+    params = manoeuvre_params(ship, kernel.MODE_HOLD, ship.steering.max_angle, 0.0, 0.0)
+    s0 = np.zeros((1, 6))
+    s0[0, 0] = ship.approach_speed
+    lim = (np.array([speed_lim]), np.array([10.0]))
+    states, rudder, valid = np.zeros((1, n, 6)), np.zeros((1, n)), np.zeros(1, dtype=np.int64)
+    mine = np.zeros((n, 6))
+    m = n // 10  # the generic loop runs a tenth of the turn: 20 s of it otherwise
+
+    def ours(dyn):
+        dyn.integrate_closed(dt, n, s0, params[None].copy(), True, *lim, states, rudder, valid)
+        return states[0].copy()
+
+    def hand(k):
+        return _typed_in_turn(ship_acc, n, dt, ship.approach_speed, ship.steering.max_rate,
+                              ship.steering.max_angle, *k, mine)  # fmt: skip
+
+    print("| ship | compiled (ms) | steps/s | generic Python loop (s) | speed-up | "
+          "hand-written numba (ms) | vs hand-written | largest state difference |")
+    print("|---|---|---|---|---|---|---|---|")
+    for label, dyn, k in rows:
+        ours(dyn)
+        hand(k)
+        fast = best_of(lambda d=dyn: ours(d), 5)
+        typed = best_of(lambda k=k: hand(k), 5)
+        generic = CorrectedDynamics(dyn.reference, dyn.correction) if k[0] else NumpyPath(dyn)
+        slow = best_of(lambda g=generic: _generic_closed_loop(g, params, m, dt, s0, "rk4",
+                                                              speed_lim, 10.0, None), 1) * n / m
+        diff = float(np.max(np.abs(ours(dyn)[:, :3] - mine[:, :3])))
+        print(f"| {label} | {1e3 * fast:.1f} | {n / fast:.3g} | {slow:.1f} | {slow / fast:.0f}× | "
+              f"{1e3 * typed:.1f} | {typed / fast:.2f}× | {diff:.1e} |")
+
+
 def mmg_ships() -> None:
     """The MMG model compiled once for any coefficients (``shipid.vessels.mmg``): the built-in
     KVLCC2, the same ship from an MMG file and the KVLCC2 with a correction (``shipid
@@ -399,9 +451,7 @@ def mmg_ships() -> None:
     the coefficients frozen in as constants and the correction's terms typed in."""
     import dataclasses
 
-    from shipid.dynamics.model import get_structure
     from shipid.identification.correction import CorrectedDynamics, corrected_dynamics
-    from shipid.trials.manoeuvres import _generic_closed_loop, manoeuvre_params
     from shipid.vessels import kvlcc2
     from shipid.vessels.mmg import MMGDynamics
     from shipid.vessels.mmg_file import mmg_vessel
@@ -417,50 +467,16 @@ def mmg_ships() -> None:
             group, name = key.split(".")
             doc.setdefault(group, {})[name] = value
     from_file = mmg_vessel(doc)
-    structure = get_structure("blanke-race")
-    coefficients = {d: dict.fromkeys(t, 0.0) for d, t in structure.terms.items()}
-    coefficients["v"]["u*v"], coefficients["r"]["u*r"] = 0.01, -0.02
-    coefficients["r"]["u^2*delta"] = 0.003
-    correction = ManoeuvringModel(structure, coefficients)
+    correction = _three_term_correction((0.01, -0.02, 0.003))
     corrected = dataclasses.replace(ship, dynamics=corrected_dynamics(ship.dynamics, correction))
-    duration, dt = 2000.0, 0.05
-    n = int(duration / dt) + 1
-    params = manoeuvre_params(ship, kernel.MODE_HOLD, ship.steering.max_angle, 0.0, 0.0)
-    s0 = np.zeros((1, 6))
-    s0[0, 0] = ship.approach_speed
-    lim = (np.array([10.0]), np.array([10.0]))
-    states, rudder, valid = np.zeros((1, n, 6)), np.zeros((1, n)), np.zeros(1, dtype=np.int64)
-    mine = np.zeros((n, 6))
-    m = n // 10  # the generic loop runs a tenth of the turn: 20 s of it otherwise
-
-    def ours(dyn):
-        dyn.integrate_closed(dt, n, s0, params[None].copy(), True, *lim, states, rudder, valid)
-        return states[0].copy()
-
-    print(f"\nMMG ships, a {duration:g} s 35° turning circle's closed loop (RK4, Δt {dt} s, "
-          f"{n} steps): the compiled kernel entry against the generic Python loop and a "
-          "hand-written numba loop (coefficients as constants, the correction typed in)\n")
-    print("| ship | compiled (ms) | steps/s | generic Python loop (s) | speed-up | "
-          "hand-written numba (ms) | vs hand-written | largest state difference |")
-    print("|---|---|---|---|---|---|---|---|")
     rows = (("built-in KVLCC2", ship.dynamics, (0.0, 0.0, 0.0)),
             ("KVLCC2 from an MMG file", from_file.dynamics, (0.0, 0.0, 0.0)),
             ("KVLCC2 + correction", corrected.dynamics, (0.01, -0.02, 0.003)))
-    for label, dyn, k in rows:
-        assert isinstance(getattr(dyn, "reference", dyn), MMGDynamics)
-        ours(dyn)
-        _typed_in_turn(_mmg_turning_ship, n, dt, ship.approach_speed, ship.steering.max_rate,
-                       ship.steering.max_angle, *k, mine)  # fmt: skip
-        fast = best_of(lambda d=dyn: ours(d), 5)
-        hand = best_of(lambda k=k: _typed_in_turn(_mmg_turning_ship, n, dt, ship.approach_speed,
-                                                  ship.steering.max_rate,
-                                                  ship.steering.max_angle, *k, mine), 5)
-        generic = CorrectedDynamics(dyn.reference, dyn.correction) if k[0] else NumpyPath(dyn)
-        slow = best_of(lambda g=generic: _generic_closed_loop(g, params, m, dt, s0, "rk4",
-                                                              10.0, 10.0, None), 1) * n / m
-        diff = float(np.max(np.abs(ours(dyn)[:, :3] - mine[:, :3])))
-        print(f"| {label} | {1e3 * fast:.1f} | {n / fast:.3g} | {slow:.1f} | {slow / fast:.0f}× | "
-              f"{1e3 * hand:.1f} | {hand / fast:.2f}× | {diff:.1e} |")
+    assert all(isinstance(getattr(d, "reference", d), MMGDynamics) for _, d, _ in rows)
+    print("\nMMG ships, a 2000 s 35° turning circle's closed loop (RK4, Δt 0.05 s, 40001 steps): "
+          "the compiled kernel entry against the generic Python loop and a hand-written numba "
+          "loop (coefficients as constants, the correction typed in)\n")
+    _held_turn_rows(ship, rows, _mmg_turning_ship, 10.0)
     # What a user waits for: a 200 s 35° turn with its log and indices (turning_circle), the
     # ship compiled against the same ship stepped by the generic loop (the way an MMG file and
     # a corrected ship ran before).
@@ -486,57 +502,23 @@ def corrected_tanker() -> None:
     hand-written numba loop of the tanker's formula with the correction's terms typed in."""
     import dataclasses
 
-    from shipid.dynamics.model import get_structure
     from shipid.dynamics.steering import SteeringMachine
     from shipid.identification.correction import CorrectedDynamics, corrected_dynamics
-    from shipid.trials.manoeuvres import _generic_closed_loop, manoeuvre_params, turning_circle
+    from shipid.trials.manoeuvres import turning_circle
     from shipid.vessels import tanker
 
     ship = tanker()
     ship = dataclasses.replace(ship, steering=SteeringMachine(ship.steering.max_angle,
                                                               ship.steering.max_rate))
-    structure = get_structure("blanke-race")
-    coefficients = {d: dict.fromkeys(t, 0.0) for d, t in structure.terms.items()}
     k = (1e-4, -2e-4, 3e-6)  # v: u v; r: u r, u² δ (a tenth of the tanker's own, about)
-    coefficients["v"]["u*v"], coefficients["r"]["u*r"], coefficients["r"]["u^2*delta"] = k
-    correction = ManoeuvringModel(structure, coefficients)
+    correction = _three_term_correction(k)
     corrected = dataclasses.replace(ship, dynamics=corrected_dynamics(ship.dynamics, correction))
-    duration, dt = 2000.0, 0.05
-    n = int(duration / dt) + 1
-    params = manoeuvre_params(ship, kernel.MODE_HOLD, ship.steering.max_angle, 0.0, 0.0)
-    s0 = np.zeros((1, 6))
-    s0[0, 0] = ship.approach_speed
-    lim = (np.array([50.0]), np.array([10.0]))
-    states, rudder, valid = np.zeros((1, n, 6)), np.zeros((1, n)), np.zeros(1, dtype=np.int64)
-    mine = np.zeros((n, 6))
-    m = n // 10  # the generic loop runs a tenth of the turn
-
-    def ours(dyn):
-        dyn.integrate_closed(dt, n, s0, params[None].copy(), True, *lim, states, rudder, valid)
-        return states[0].copy()
-
-    def hand(k):
-        return _typed_in_turn(_tanker_turning_ship, n, dt, ship.approach_speed,
-                              ship.steering.max_rate, ship.steering.max_angle, *k, mine)
-
-    print(f"\nThe tanker corrected, a {duration:g} s 10° turn's closed loop (RK4, Δt {dt} s, {n} "
-          "steps): the compiled kernel entry against the generic Python loop it ran on before and "
-          "a hand-written numba loop (the tanker's formula, the correction typed in)\n")
-    print("| ship | compiled (ms) | steps/s | generic Python loop (s) | speed-up | "
-          "hand-written numba (ms) | vs hand-written | largest state difference |")
-    print("|---|---|---|---|---|---|---|---|")
-    for label, dyn, terms in (("tanker", ship.dynamics, (0.0, 0.0, 0.0)),
-                              ("tanker + correction", corrected.dynamics, k)):
-        ours(dyn)
-        hand(terms)
-        fast = best_of(lambda d=dyn: ours(d), 5)
-        typed = best_of(lambda t=terms: hand(t), 5)
-        generic = CorrectedDynamics(ship.dynamics, correction) if terms[0] else NumpyPath(dyn)
-        slow = best_of(lambda g=generic: _generic_closed_loop(g, params, m, dt, s0, "rk4",
-                                                              50.0, 10.0, None), 1) * n / m
-        diff = float(np.max(np.abs(ours(dyn)[:, :3] - mine[:, :3])))
-        print(f"| {label} | {1e3 * fast:.1f} | {n / fast:.3g} | {slow:.1f} | {slow / fast:.0f}× | "
-              f"{1e3 * typed:.1f} | {typed / fast:.2f}× | {diff:.1e} |")
+    print("\nThe tanker corrected, a 2000 s 10° turn's closed loop (RK4, Δt 0.05 s, 40001 steps): "
+          "the compiled kernel entry against the generic Python loop it ran on before and a "
+          "hand-written numba loop (the tanker's formula, the correction typed in)\n")
+    _held_turn_rows(ship, (("tanker", ship.dynamics, (0.0, 0.0, 0.0)),
+                           ("tanker + correction", corrected.dynamics, k)),
+                    _tanker_turning_ship, 50.0)
     generic = dataclasses.replace(ship, dynamics=CorrectedDynamics(ship.dynamics, correction))
     fast = best_of(lambda: turning_circle(corrected, 10, duration=2000.0), 3)
     slow = best_of(lambda: turning_circle(generic, 10, duration=200.0), 1) * 10
