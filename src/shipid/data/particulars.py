@@ -15,6 +15,8 @@ A small file (YAML or JSON) or options. Keys (SI units; aliases of common files 
     design_speed  approach speed of the trials [m/s]   (U0, speed)
     rho           water density [kg/m³]           (default 1025; the MARIN file gives 1000)
     xg            longitudinal centre of gravity from midship [m]   (x_G)
+    rudder_limit  the steering gear's largest rudder angle [deg], where it stops short of the
+                  35° the plausibility checks hold (the tanker's 10°)   (max_rudder)
 
 Only ``length`` is required (it turns indices into ship lengths); the rest is used where present.
 The MARIN ``ship_data.yml`` of the KVLCC2 reads as is. Particulars travel in log metadata and model
@@ -45,9 +47,11 @@ ALIASES = {
     "design_speed": ("design_speed", "U0", "speed"),
     "rho": ("rho",),
     "xg": ("xg", "x_G"),
+    "rudder_limit": ("rudder_limit", "max_rudder"),
 }
 POSITIVE = ("length", "beam", "draught", "block_coefficient", "mass", "rudder_area",
-            "rudder_height", "propeller_diameter", "scale", "design_speed", "rho")  # fmt: skip
+            "rudder_height", "propeller_diameter", "scale", "design_speed", "rho",
+            "rudder_limit")  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -66,6 +70,7 @@ class Particulars:
     design_speed: float | None = None
     rho: float = 1025.0
     xg: float = 0.0
+    rudder_limit: float | None = None  # [deg]
 
     def __post_init__(self) -> None:
         for f in dataclasses.fields(self):
@@ -84,6 +89,9 @@ class Particulars:
                               "(inconsistent: beam and draught swapped?)")  # fmt: skip
         if self.beam is not None and self.beam > self.length:
             raise ShipidError(f"particulars: beam {self.beam:g} m > length {self.length:g} m")
+        if self.rudder_limit is not None and not self.rudder_limit <= 90.0:
+            raise ShipidError(f"particulars: rudder_limit {self.rudder_limit:g}° is beyond 90° "
+                              "(it is in degrees)")  # fmt: skip
         if abs(self.xg) > 0.5 * self.length:
             raise ShipidError(f"particulars: xg {self.xg:g} m is outside the hull "
                               f"(|xg| ≤ L/2 = {0.5 * self.length:g} m)")  # fmt: skip

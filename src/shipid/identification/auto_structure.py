@@ -972,9 +972,9 @@ TURNS_APART = 1.25
 OVERSHOOTS_APART_DEG = 1.5
 # The unseen zig-zag run on the tied fits: the IMO's 10°/10°, to starboard first.
 ZIGZAG_APART = (10.0, 10.0)
-# The rudder the plausibility checks hold [deg], and how far below it the logs' largest must
-# stay for a check there to be beyond them.
-HELD_RUDDER_DEG, BEYOND_RUDDER_DEG = 35.0, 5.0
+# How far below the rudder the plausibility checks hold (``plausibility.held_rudder_deg``) the
+# logs' largest must stay for a check there to be beyond them [deg].
+BEYOND_RUDDER_DEG = 5.0
 
 
 def settled_yaw_rates(reports, side: str) -> list[float | None]:
@@ -995,13 +995,16 @@ def rates_apart(rates) -> bool:
 
 def _ruled_out_apart(chosen, name: str, score: float, ruled_out: Mapping[str, object], faults,
                      logs) -> list[str]:  # fmt: skip
-    """Warnings where a structure ruled out by the held 35° rudder checks alone predicted the
+    """Warnings where a structure ruled out by the held rudder's checks alone predicted the
     held-out logs better than the chosen one and runs a 10°/10° zig-zag more than
     ``OVERSHOOTS_APART_DEG`` from its: inside the logs' rudder, what the model predicts rests
     on a check beyond them. (On the MARIN KVLCC2 zig-zag, ``blanke`` is left out so and scores
     within one standard error but worse, 0.41 against 0.36: the other MARIN run confirms it.)"""
     reach = max(float(np.max(np.abs(log["delta"].to_numpy(dtype=float)))) for log in logs)
-    if not ruled_out or math.degrees(reach) > HELD_RUDDER_DEG - BEYOND_RUDDER_DEG:
+    from shipid.identification.plausibility import held_rudder_deg
+
+    held = held_rudder_deg()
+    if not ruled_out or math.degrees(reach) > held - BEYOND_RUDDER_DEG:
         return []  # the logs reach the held rudder: the check is theirs
     out = []
     for k, model in ruled_out.items():
@@ -1012,7 +1015,7 @@ def _ruled_out_apart(chosen, name: str, score: float, ruled_out: Mapping[str, ob
         if None in a + b or max(abs(a[0] - b[0]), abs(a[1] - b[1])) <= OVERSHOOTS_APART_DEG:
             continue
         out.append(f"{k} predicts the logs better than {name} (free-run scores {faults[k][1]:.3f} "
-                   f"and {score:.3f}) but was left out for its {HELD_RUDDER_DEG:g}° rudder held, "
+                   f"and {score:.3f}) but was left out for its {held:g}° rudder held, "
                    f"beyond the logs' {math.degrees(reach):.3g}° ({faults[k][2]}); their "
                    f"{ZIGZAG_APART[0]:g}°/{ZIGZAG_APART[1]:g}° zig-zags come apart (overshoots "
                    f"{name} {a[0]:.1f}°, {a[1]:.1f}°; {k} {b[0]:.1f}°, {b[1]:.1f}°): inside the "

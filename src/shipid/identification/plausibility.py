@@ -13,7 +13,8 @@ approach condition (speed u0, propeller speed n):
   against a negative n² balances at the approach and pushes a ship at rest astern. A warning:
   as a reason to rule candidates out it sent the Esso Osaka's zig-zag sets to fits that
   predict worse (``from_rest``).
-* held rudder: the largest rudder of the steering machine held to each side must stay bounded
+* held rudder: the largest rudder of the steering machine (35°, or the gear's own where the
+  particulars give a smaller ``rudder_limit``: ``held_rudder_at``) held to each side must stay bounded
   and settle to a steady turn (yaw rate and speed no longer changing): for ``duration`` seconds
   when given, else from 300 s doubled up to HELD_MAX_DOUBLINGS times while still settling (a
   full-scale ship turns ten times slower than its 1:100 model; 300 s fixed called the full-scale
@@ -30,6 +31,8 @@ approach condition (speed u0, propeller speed n):
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import copy
 import math
 import threading
@@ -333,11 +336,37 @@ THRUST_NOT_CHECKED = ("not checked: the model is driven by the logs' thrust, whi
                       "whose thrust follows the speed, and these checks")  # fmt: skip
 
 
+# The rudder the held turns hold [deg]: 35°, or the ship's gear's largest where it is less
+# (``held_rudder_at``). A check at 35° of a ship whose gear stops at 10° (the tanker) judged a
+# manoeuvre the ship cannot make: it ruled out the structure that predicted its logs four times
+# closer, whose 35° turn went the wrong way, and the fit kept turned its 10° turns 60 % wide.
+HELD_RUDDER_DEG = 35.0
+_HELD_RUDDER: contextvars.ContextVar[float] = contextvars.ContextVar("held_rudder",
+                                                                    default=HELD_RUDDER_DEG)
+
+
+def held_rudder_deg() -> float:
+    """The rudder the held-turn checks hold now [deg] (``held_rudder_at``)."""
+    return _HELD_RUDDER.get()
+
+
+@contextlib.contextmanager
+def held_rudder_at(limit_deg: float | None):
+    """Hold the checks' turns at ``limit_deg`` where it is less than 35° (the gear's largest
+    rudder: the particulars' ``rudder_limit``) inside the ``with`` block; None: 35°."""
+    value = HELD_RUDDER_DEG if limit_deg is None else min(HELD_RUDDER_DEG, float(limit_deg))
+    token = _HELD_RUDDER.set(value)
+    try:
+        yield value
+    finally:
+        _HELD_RUDDER.reset(token)
+
+
 def check_plausibility(
     model: ManoeuvringModel,
     speed: float,
     rps: float | None = None,
-    rudder_deg: float = 35.0,
+    rudder_deg: float | None = None,
     duration: float | None = None,
     curvature: float | None = None,
     astern: bool = False,
@@ -346,6 +375,8 @@ def check_plausibility(
     (``sharpest_curvature``), for the held rudder's path (``WIDE_SHARE``); ``astern``: also a
     crash stop (``crash_stop``), a warning, not a reason to rule a model out (for the model a
     command hands out, not the thousands a search checks)."""
+    if rudder_deg is None:
+        rudder_deg = held_rudder_deg()
     key = _checked_key(model, speed, rps, rudder_deg, duration, curvature, astern)
     if key is not None:
         with _CHECKED_LOCK:

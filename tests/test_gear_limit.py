@@ -1,0 +1,68 @@
+"""A steering gear that stops short of 35° (the particulars' ``rudder_limit``): the plausibility
+checks hold their turns at the gear's largest rudder. At 35° a tanker's checks (its gear stops
+at 10°) judged a manoeuvre the ship cannot make: they ruled out the structure that predicted its
+logs four times closer (its 35° turn went the wrong way), and the fit kept ran its 10° turns 60 %
+wide (``benchmarks/study_esso_sister_mmg.py``, ``tanker_truth_from_logs``)."""
+
+import json
+
+import pytest
+
+from shipid.data.particulars import Particulars, read_particulars
+from shipid.errors import ShipidError
+from shipid.identification.plausibility import (
+    check_plausibility,
+    held_rudder_at,
+    held_rudder_deg,
+)
+from shipid.trials.manoeuvres import zigzag
+from shipid.vessels import scale_ship, scale_ship_model
+
+
+def test_the_particulars_carry_the_gear_limit_in_degrees(tmp_path):
+    path = tmp_path / "ship.yml"
+    path.write_text("length: 300\nmax_rudder: 10\n")
+    assert read_particulars(path).rudder_limit == 10.0
+    assert Particulars(length=4.0).rudder_limit is None
+    for bad, said in ((0.0, "rudder_limit must be > 0"), (35 * 3.2, "beyond 90°")):
+        with pytest.raises(ShipidError, match=said):
+            Particulars(length=4.0, rudder_limit=bad)
+
+
+def test_the_checks_hold_the_gears_largest_rudder_inside_the_block_only():
+    model = scale_ship_model()
+    assert held_rudder_deg() == 35.0
+    with held_rudder_at(20.0) as held:
+        assert held == 20.0 == held_rudder_deg()
+        inside, _ = check_plausibility(model, 2.0)
+    given, _ = check_plausibility(model, 2.0, rudder_deg=20.0)
+    assert inside["rudder_deg"] == 20.0 and inside == given
+    assert held_rudder_deg() == 35.0
+    with held_rudder_at(40.0), held_rudder_at(None):
+        assert held_rudder_deg() == 35.0  # a gear beyond 35° changes nothing
+    at_35, _ = check_plausibility(model, 2.0)
+    steady = [inside["held_rudder"]["starboard"]["steady_yaw_rate"],
+              at_35["held_rudder"]["starboard"]["steady_yaw_rate"]]
+    assert abs(steady[0]) < abs(steady[1])  # a smaller rudder turns slower
+
+
+def test_identify_checks_at_the_particulars_rudder_limit_and_says_so(tmp_path, capsys):
+    from cli_helpers import run
+
+    from shipid.data.io import write_log
+
+    log = write_log(zigzag(scale_ship(), 20, 20, duration=60, dt=0.1).log, tmp_path / "zz.csv")
+    (tmp_path / "gear.yml").write_text("length: 4.0\nrudder_limit: 25\n")
+    (tmp_path / "plain.yml").write_text("length: 4.0\n")
+    records = {}
+    for name in ("gear", "plain"):
+        code, _, err = run(["identify", log, "--particulars", tmp_path / f"{name}.yml",
+                            "--model", "blanke", "-o", tmp_path / f"{name}.json"], capsys)
+        assert code == 0, err
+        records[name] = json.loads((tmp_path / f"{name}.json").read_text())
+    assert records["gear"]["identification"]["plausibility"]["rudder_deg"] == 25.0
+    assert records["plain"]["identification"]["plausibility"]["rudder_deg"] == 35.0
+    assert held_rudder_deg() == 35.0  # the command's limit ends with it
+    code, _, err = run(["identify", log, "--particulars", tmp_path / "missing.yml", "-o",
+                        tmp_path / "m.json"], capsys)  # fmt: skip
+    assert code == 1 and "missing.yml: no such particulars file" in err
