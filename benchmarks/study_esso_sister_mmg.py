@@ -201,6 +201,105 @@ def tanker_truth() -> None:
                                    f"{z['second_overshoot_deg']:.1f}" for z in zz) + " |")
 
 
+# Full-scale sensors for the tanker's training logs (an INS and a log speed of a VLCC's trials).
+TANKER_NOISE = {"u": 0.02, "v": 0.02, "r": 2e-4, "psi": math.radians(0.05)}
+
+
+def tanker_truth_from_logs(seeds: int = 5) -> None:
+    """The tanker's own 10°/10° zig-zags (both sides first, noisy) as training logs, the
+    manoeuvres they do not contain as the judge (its 10° turns, its 5°/5° zig-zags): the
+    default ``identify``, and with the particulars giving the gear's 10° limit
+    (``rudder_limit``: the plausibility checks hold 10° instead of 35°); the sister alone; the
+    sister corrected by the logs (``shipid correct``, blanke-race, γ 1e4, 100 and auto); the
+    logs fitted toward the sister
+    (``--prior SISTER.yml --model blanke-speed --crossflow --gamma 1``, the Esso's best one-file
+    setting). Medians over the seeds of the |error| of each index (turns: both sides; 5°/5°:
+    first to starboard)."""
+
+    import yaml
+
+    from shipid.data.io import write_log
+    from shipid.data.particulars import Particulars
+    from shipid.trials.manoeuvres import turning_circle, zigzag
+    from shipid.vessels import get_vessel, kvlcc2
+    from shipid.vessels.mmg_file import mmg_vessel, sister_ship
+    from shipid.vessels.sensors import SensorModel
+
+    start = time.perf_counter()
+    truth = get_vessel("tanker")
+    particulars = Particulars(length=truth.length, beam=47.17, draught=18.46, mass=225.5e6)
+    doc, _ = sister_ship(kvlcc2().dynamics.c, particulars, "tanker sister",
+                         truth.approach_speed, rudder_rate=math.degrees(truth.steering.max_rate))
+    doc["rudder_limit"] = math.degrees(truth.steering.max_angle)
+    sister = mmg_vessel(doc)
+
+    def indices(ship, **kw):
+        turns = [turning_circle(ship, 10, side=side, duration=3000, dt=0.5, **kw).indices
+                 for side in ("starboard", "port")]  # fmt: skip
+        zz = zigzag(ship, 5, 5, duration=1500, dt=0.5, **kw).indices
+        return ([t.get("tactical_diameter") for t in turns],
+                [abs(t.get("steady_yaw_rate") or math.nan) for t in turns],
+                [zz.get("first_overshoot_deg"), zz.get("second_overshoot_deg")])
+
+    true = indices(truth)
+    gear = {"speed": truth.approach_speed, "steering": truth.steering}
+    errors: dict[str, list] = {}
+
+    def judge(label, ship, **kw):
+        got = indices(ship, **kw)
+        rows = errors.setdefault(label, [[], [], []])
+        for k in range(2):
+            rows[k] += [100 * abs((g if g is not None else math.inf) / t - 1)
+                        for g, t in zip(got[k], true[k], strict=True)]  # fmt: skip
+        rows[2] += [abs((g if g is not None else math.inf) - t)
+                    for g, t in zip(got[2], true[2], strict=True)]  # fmt: skip
+
+    sensors = SensorModel(white=TANKER_NOISE)
+    with tempfile.TemporaryDirectory() as tmp, warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        sister_file = os.path.join(tmp, "sister.yml")
+        with open(sister_file, "w", encoding="utf-8") as f:
+            yaml.safe_dump(doc, f)
+        particulars_file, gear_file = (os.path.join(tmp, f) for f in ("tanker.yml", "gear.yml"))
+        hull = {"length": truth.length, "beam": 47.17, "draught": 18.46, "mass": 225.5e6}
+        for path, extra in ((particulars_file, {}), (gear_file, {"rudder_limit": 10.0})):
+            with open(path, "w", encoding="utf-8") as f:
+                yaml.safe_dump({**hull, **extra}, f)
+        for seed in range(seeds):
+            paths = [str(write_log(sensors.apply(zigzag(truth, 10, 10, first=side,
+                                                        duration=1500, dt=0.5).log, 2 * seed + k),
+                                   os.path.join(tmp, f"zz_{side}_{seed}.csv")))
+                     for k, side in enumerate(("starboard", "port"))]  # fmt: skip
+            logs = [read_trial_log(p) for p in paths]
+            for label, extra in (("identify (default)", []),
+                                 ("identify --particulars with the gear's rudder_limit 10",
+                                  ["--particulars", gear_file]),
+                                 ("identify --prior sister, blanke-speed --crossflow, γ 1",
+                                  ["--prior", sister_file, "--model", "blanke-speed",
+                                   "--crossflow", "--gamma", "1", "--particulars",
+                                   particulars_file])):  # fmt: skip
+                out = os.path.join(tmp, f"m{seed}.json")
+                if _quiet(["identify", *paths, *extra, "-o", out]) != 0:
+                    raise RuntimeError(f"identify {' '.join(extra)} failed")
+                judge(label, load_model(out), **gear)
+            judge("sister (fitted to nothing)", sister)
+            for gamma in (1e4, 1e2, "auto"):
+                fit = identify_correction(logs, sister, "blanke-race", gamma=gamma)
+                judge(f"sister corrected, γ {gamma:g}" if gamma != "auto"
+                      else "sister corrected, γ auto", fit.vessel)  # fmt: skip
+    print(f"\nThe tanker as a truth, trained on its 10°/10° zig-zags (both sides, noisy; "
+          f"{seeds} seeds), judged on its 10° turns and 5°/5° zig-zag: median |error| "
+          "(largest)\n")
+    print("| model | 10° turns' tactical diameter [%] | steady yaw rate [%] | 5°/5° "
+          "overshoots [deg] | cases |")
+    print("|---|---|---|---|---|")
+    for label, (td, r, os_) in errors.items():
+        print(f"| {label} | {np.median(td):.1f} ({np.max(td):.1f}) | {np.median(r):.1f} "
+              f"({np.max(r):.1f}) | {np.median(os_):.2f} ({np.max(os_):.2f}) | "
+              f"{len(td) // 2} |")
+    print(f"\n{time.perf_counter() - start:.0f} s")
+
+
 def _straight(ship, rps: float):
     from shipid.cli.common import _ship_approach
 
@@ -211,3 +310,4 @@ def _straight(ship, rps: float):
 if __name__ == "__main__":
     main()
     tanker_truth()
+    tanker_truth_from_logs()
