@@ -66,3 +66,36 @@ def test_identify_checks_at_the_particulars_rudder_limit_and_says_so(tmp_path, c
     code, _, err = run(["identify", log, "--particulars", tmp_path / "missing.yml", "-o",
                         tmp_path / "m.json"], capsys)  # fmt: skip
     assert code == 1 and "missing.yml: no such particulars file" in err
+
+
+def test_a_models_manoeuvres_and_criteria_turn_at_its_gears_limit(tmp_path, capsys):
+    """The model of a ship whose particulars give a 25° gear turns at 25° by default in
+    ``manoeuvre`` (as asked by hand, and said) and in ``criteria`` (the standard's largest
+    rudder); a model without them at 35°, and ``criteria --particulars`` with the limit at 25°."""
+    from cli_helpers import run
+
+    from shipid.data.io import write_log
+
+    log = write_log(zigzag(scale_ship(), 20, 20, duration=60, dt=0.1).log, tmp_path / "zz.csv")
+    (tmp_path / "gear.yml").write_text("length: 4.0\nrudder_limit: 25\n")
+    (tmp_path / "plain.yml").write_text("length: 4.0\n")
+    for name in ("gear", "plain"):
+        code, _, err = run(["identify", log, "--particulars", tmp_path / f"{name}.yml",
+                            "--model", "blanke", "-o", tmp_path / f"{name}.json"], capsys)
+        assert code == 0, err
+    turns = {}
+    for name, extra in (("gear", []), ("gear", ["--rudder", "25"]), ("plain", [])):
+        out = tmp_path / f"t-{name}-{len(extra)}.json"
+        code, _, err = run(["manoeuvre", tmp_path / f"{name}.json", "turning", *extra,
+                            "--json", out], capsys)  # fmt: skip
+        assert code == 0, err
+        assert ("largest rudder is 25°" in err) == (name == "gear" and not extra)
+        turns[name, len(extra)] = json.loads(out.read_text())["indices"]
+    assert turns["gear", 0] == turns["gear", 2]
+    assert turns["plain", 0]["tactical_diameter"] < turns["gear", 0]["tactical_diameter"]
+    for model, extra in (("gear", []), ("plain", ["--particulars", tmp_path / "gear.yml"]),
+                         ("plain", [])):  # fmt: skip
+        code, out, err = run(["criteria", tmp_path / f"{model}.json", *extra], capsys)
+        assert code == 0, err
+        limited = "the steering gear's largest rudder is 25°" in out + err
+        assert limited == (model == "gear" or bool(extra)), (model, extra)

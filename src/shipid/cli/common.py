@@ -897,6 +897,10 @@ def _steering(target, cond: dict, rate_deg_s: float | None, fallback: str = "ins
     from shipid.dynamics.steering import SteeringMachine
 
     own = getattr(target, "steering", None)
+    # A model's gear: 35°, or the particulars' rudder_limit where the ship's stops short of it.
+    particulars = cond.get("particulars")
+    limit = getattr(particulars, "rudder_limit", None)
+    largest = math.radians(min(35.0, limit) if limit else 35.0)
     if rate_deg_s is not None:
         rate, source = math.radians(rate_deg_s), "--rudder-rate"
     elif own is not None:
@@ -908,13 +912,13 @@ def _steering(target, cond: dict, rate_deg_s: float | None, fallback: str = "ins
     elif fallback == "caller":
         return None, None
     elif cond.get("rudder_unresolved"):
-        return SteeringMachine(), ("rudder: instantaneous (the training logs' rudder swings "
+        return SteeringMachine(largest), ("rudder: instantaneous (the training logs' rudder swings "
                                    "between two samples, faster than they resolve; give a rate "
                                    "with --rudder-rate DEG/S)")  # fmt: skip
     else:
-        return SteeringMachine(), ("rudder: instantaneous (the model file has no training rudder "
+        return SteeringMachine(largest), ("rudder: instantaneous (the model file has no training rudder "
                                    "rate; give one with --rudder-rate DEG/S)")  # fmt: skip
-    steering = (SteeringMachine(math.radians(35.0), rate) if own is None
+    steering = (SteeringMachine(largest, rate) if own is None
                 else dataclasses.replace(own, max_rate=rate))  # fmt: skip
     return steering, f"rudder rate {math.degrees(rate):.3g} °/s ({source})"
 

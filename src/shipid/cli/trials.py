@@ -83,7 +83,8 @@ def cmd_criteria(args) -> int:
     speed, rps, _ = _run_approach(target, cond, args.speed, args.rps)  # imo_criteria notes it
     from_rest = _from_rest_note(target, speed, rps)
     # Given, else the ship's gear or the training logs' rate, else imo_criteria's SOLAS rate.
-    steering, _ = _steering(target, cond, args.rudder_rate, fallback="caller")
+    steering, _ = _steering(target, {**cond, "particulars": particulars}, args.rudder_rate,
+                            fallback="caller")  # fmt: skip
     # The scale the training logs were read at, where neither option nor particulars give one.
     scale = args.scale or (particulars.scale if particulars else None) or cond.get("log_scale")
     rate_note = None

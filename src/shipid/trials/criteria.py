@@ -144,8 +144,10 @@ def imo_criteria(
                           "design_speed)")  # fmt: skip
     if steering is None:
         # A reference ship has its own steering gear; a model gets the SOLAS rate at its scale.
+        limit = particulars.rudder_limit if particulars else None
         steering = getattr(ship, "steering", None) or SteeringMachine(
-            math.radians(35.0), math.radians(SOLAS_RUDDER_RATE_DEG * math.sqrt(lam)))
+            math.radians(min(35.0, limit) if limit else 35.0),
+            math.radians(SOLAS_RUDDER_RATE_DEG * math.sqrt(lam)))  # fmt: skip
     l_over_v = L / V * math.sqrt(lam)
     first_lim, second_lim = overshoot_limits(l_over_v)
     # Long enough for any plausible ship: a turn reaches 180° within ~15 L/V, a zig-zag's second
