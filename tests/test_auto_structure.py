@@ -691,7 +691,7 @@ def test_identify_fits_the_chosen_structure_under_the_bounds_its_search_held(tmp
     write_log(zigzag(scale_ship(), 20, 20, duration=60, dt=0.2).log, log)
 
     def chosen(logs, names=None, physics=None, cv=None, estimator="lssvm", drop=None,
-               announce=None):  # fmt: skip
+               announce=None, paper_out=None):  # fmt: skip
         return auto.StructureChoice(get_structure("blanke"), "named", ["a test"],
                                     bounds=["u: |u|*u <= -1"])  # fmt: skip
 

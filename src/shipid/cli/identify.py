@@ -38,6 +38,27 @@ REFERENCE_PRIOR_GAMMAS = (0.1, 1.0, 10.0, 1e2, 1e3, 1e4, 1e5, 1e6)
 AVERAGED = "average of the candidates select's choice picks"
 
 
+def _paper_out_filtered(choice, table) -> str | None:
+    """Why the paper's structure, chosen for the logs (its unfiltered fit passed the checks), is
+    out after all, or None: none of its fits through the prefilters the logs cannot tell apart
+    passes them, so the one chosen does not either. The tanker's two 10°/10° zig-zags, its checks
+    at its gear's 10°: the paper's fit unfiltered passed, through 0.25 and 0.125 Hz it ended its
+    held turns going astern, and the model written all but stopped in its steady 10° turn
+    (the yaw rate 87 % off) where the race structure, compared, came within 16–22 %."""
+    from shipid.identification.auto_structure import PAPER
+
+    if choice is None or choice.how != "paper" or "implausible" not in table.columns:
+        return None
+    row = table[table["chosen"]].iloc[0]
+    why = row["implausible"]
+    if not isinstance(why, str) or not why:
+        return None
+    shown = "none" if row["cutoff_hz"] is None or row["cutoff_hz"] != row["cutoff_hz"] \
+        else f"{row['cutoff_hz']:.4g} Hz"  # fmt: skip
+    return (f"the paper's {PAPER}, fitted through the prefilters the logs cannot tell apart, is "
+            f"implausible ({shown}: {why.split('; ')[0]}), so the rudder's inflow is compared")
+
+
 def _ruled_out(table) -> str:
     """The fits the prefilter's choice checked and found implausible, 'none (its reason), 2.5 Hz
     (...)': passed over, or chosen where none tied on the logs was plausible."""
@@ -126,6 +147,7 @@ def cmd_identify(args) -> int:
     _refuse_no_headway(logs[0], names[0])  # before the fit: the checks start from it
     _edit_into_model(args, logs)
     gamma_given = args.gamma is not None
+    drop_given = args.drop
     choice = _choose_structure(args, logs, names)
     physics = _physics(args, logs, _structure(args), chosen=choice is not None)
     if physics is not None and physics.prior_source:
@@ -162,6 +184,32 @@ def cmd_identify(args) -> int:
         shown = "none" if cutoff is None else f"{cutoff:.4g} Hz"
         print(f"prefilter of u, v, r: {shown} (chosen by the free-run error on the logs"
               f"{_ruled_out(table)}; --filter HZ|none to set it)")  # fmt: skip
+        paper_out = _paper_out_filtered(choice, table)
+        if paper_out and not args.force:
+            try:  # a fit the logs cannot determine: identify's own refusal says why, as before
+                identify([lowpass(log, cutoff) for log in logs] if cutoff is not None else logs,
+                         model=args.model, gamma=1e4 if args.gamma == "auto" else args.gamma,
+                         names=names, force=False,
+                         estimator=args.estimator, physics=physics)  # fmt: skip
+            except ShipidError:
+                paper_out = None
+        if paper_out:
+            # The paper's structure as identify fits it fails the checks its unfiltered fit
+            # passed: the rudder's inflow is compared after all, each candidate through its own
+            # prefilter, and the choice's prefilter is chosen again.
+            from shipid.identification.auto_structure import AUTO
+
+            args.model, args.drop = AUTO, drop_given
+            args.gamma = args.gamma if gamma_given else None
+            choice = _choose_structure(args, logs, names, paper_out)
+            physics = _physics(args, logs, _structure(args), chosen=choice is not None)
+            members = choice.members if choice is not None and physics is None and \
+                not gamma_given else []  # fmt: skip
+            cutoff, table = choose_prefilter(logs, fit,
+                                             implausible=disqualifying_at_approach(logs))
+            shown = "none" if cutoff is None else f"{cutoff:.4g} Hz"
+            print(f"prefilter of u, v, r: {shown} (chosen by the free-run error on the logs"
+                  f"{_ruled_out(table)}; --filter HZ|none to set it)")  # fmt: skip
     elif cutoff == "none":
         cutoff = None
     if cutoff is not None:
@@ -547,10 +595,11 @@ def _rps_similar(text: str, rps: float | None, path) -> dict | None:
     return doc
 
 
-def _choose_structure(args, logs, names):
+def _choose_structure(args, logs, names, paper_out: str | None = None):
     """``--model auto``: the structure for the logs (``shipid.identification.auto_structure``),
     put into ``args.model``, and γ into ``args.gamma`` where none was given (select's, else
-    1e4). Returns the choice (None for a given structure)."""
+    1e4). Returns the choice (None for a given structure). ``paper_out``: why the paper's
+    structure is out (``_paper_out_filtered``)."""
     from shipid.identification.auto_structure import AUTO
 
     choice = None
@@ -562,7 +611,8 @@ def _choose_structure(args, logs, names):
         physics = _physics(args, logs, default_library(logs)[0], searched=True, chosen=True)
         choice = auto_structure(logs, names, physics, args.cv, args.estimator,
                                 _structure_edit(args, logs),
-                                announce=lambda m: print(m, file=sys.stderr))  # fmt: skip
+                                announce=lambda m: print(m, file=sys.stderr),
+                                paper_out=paper_out)  # fmt: skip
         print(choice.describe())
         for w in choice.warnings:
             _warn(f"structure: {w}")

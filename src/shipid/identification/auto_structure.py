@@ -147,15 +147,19 @@ def auto_structure(logs: Sequence[pd.DataFrame], names: Sequence[str] | None = N
                    physics: PhysicsOptions | None = None, cv: str | None = None,
                    estimator: str = "lssvm",
                    drop: Mapping[str, Sequence[str]] | StructureEdit | None = None,
-                   announce: Callable[[str], None] | None = None) -> StructureChoice:  # fmt: skip
+                   announce: Callable[[str], None] | None = None,
+                   paper_out: str | None = None) -> StructureChoice:  # fmt: skip
     """The structure for ``logs`` (see the module): ``blanke`` unless they hold a varying
     propulsion input or a material wind. ``cv`` for the selection (default
     ``cross_validation.choice_cv``: leave one log out, four blocks of each of one or two logs);
     ``physics`` goes into every fit of the search; the ``drop``
     terms (e.g. ``{"u": ["r^2"]}``) are left out of every candidate, and of the choice (a
     ``StructureEdit`` also puts the hull's cross-flow drag in each, ``--crossflow``);
-    ``announce`` is told before a search starts (it takes seconds where a fit takes less)."""
-    choice = _auto_structure(logs, names, physics, cv, estimator, drop, announce or _quiet)
+    ``announce`` is told before a search starts (it takes seconds where a fit takes less);
+    ``paper_out``: why the paper's ``blanke`` is out, found by the caller (``identify``: its fit
+    through the prefilter it is fitted with fails the checks its unfiltered fit passed)."""
+    choice = _auto_structure(logs, names, physics, cv, estimator, drop, announce or _quiet,
+                             paper_out)  # fmt: skip
     choice.structure = _without(choice.structure, drop)
     return choice
 
@@ -176,11 +180,13 @@ def beyond_the_paper(logs: Sequence[pd.DataFrame]) -> tuple[list[str], dict, obj
     return reasons, varying, wind
 
 
-def _auto_structure(logs, names, physics, cv, estimator, drop, announce) -> StructureChoice:
+def _auto_structure(logs, names, physics, cv, estimator, drop, announce,
+                    paper_out=None) -> StructureChoice:  # fmt: skip
     logs = [logs] if isinstance(logs, pd.DataFrame) else list(logs)
     reasons, varying, wind = beyond_the_paper(logs)
     if not reasons:
-        return _paper_or_race(logs, names, physics, cv, estimator, drop, announce)
+        return _paper_or_race(logs, names, physics, cv, estimator, drop, announce,
+                              paper_out=paper_out)  # fmt: skip
     if "thrust" in varying and "n" not in varying:
         return StructureChoice(get_structure("blanke-thrust" + ("+wind" if wind else "")),
                                "named", reasons)  # fmt: skip
@@ -191,7 +197,7 @@ def _auto_structure(logs, names, physics, cv, estimator, drop, announce) -> Stru
         # speed, diverged with 35° rudder held and missed the 30/30 zig-zag at the same rps by
         # 3.9 times its yaw rate's spread; blanke-race+race-damping+wind, compared, 0.28.
         choice = _paper_or_race(logs, names, physics, cv, estimator, drop, announce,
-                                suffix="+wind")  # fmt: skip
+                                suffix="+wind", paper_out=paper_out)  # fmt: skip
         if choice.how == "paper":
             # The wind is why it is not the paper's; the comparison, how it was kept.
             return StructureChoice(get_structure(PAPER + "+wind"), "named", reasons,
@@ -612,7 +618,7 @@ def _speed_varies_at_constant_rps(logs) -> tuple[float, float] | None:
 
 
 def _paper_or_race(logs, names, physics, cv, estimator, drop=None, announce=_quiet,
-                   suffix: str = "") -> StructureChoice:  # fmt: skip
+                   suffix: str = "", paper_out: str | None = None) -> StructureChoice:  # fmt: skip
     """``blanke``, unless the logs are run at a constant propeller speed while their speed
     varies: the paper's rudder force in δ holds at one speed, ``blanke-speed``'s u²δ where the
     rudder sees the ship's speed, ``blanke-race+race-damping`` where it sees the propeller's race
@@ -636,7 +642,7 @@ def _paper_or_race(logs, names, physics, cv, estimator, drop=None, announce=_qui
         reason = (f"the speed varies by {100 * found[1]:.0f} % at a constant {found[0]:.4g} rps, "
                   "so the rudder's inflow is compared")  # fmt: skip
     else:
-        reason = _paper_ruled_out(logs, names, physics, estimator, drop, paper)
+        reason = paper_out or _paper_ruled_out(logs, names, physics, estimator, drop, paper)
         if reason is None:
             return StructureChoice(get_structure(paper), "paper")
         # The paper's is out; the others are compared as identify will fit the one chosen,
