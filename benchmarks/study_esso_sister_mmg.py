@@ -167,14 +167,11 @@ def main() -> None:
     print(f"\n{time.perf_counter() - start:.0f} s")
 
 
-def tanker_truth() -> None:
-    """The same sister (the KVLCC2's coefficients) with the particulars of another VLCC whose
-    truth is known: the `tanker` (van Berlekom & Goddard's Esso 190 000 dwt, a Norrbin-type
-    model of another laboratory, course-unstable; reference-ships.md §4, its rudder limited to
-    10°): the sister's manoeuvres against the truth's, fitted to nothing. Its rudder area and
-    propeller diameter are not published: the KVLCC2's scaled by length."""
+def _tanker_and_sister():
+    """The tanker, and its sister's MMG document and ship: the KVLCC2's coefficients with the
+    tanker's particulars (its rudder area and propeller diameter not published: the KVLCC2's
+    scaled by length), its gear's 10° and 2.33 °/s."""
     from shipid.data.particulars import Particulars
-    from shipid.trials.manoeuvres import turning_circle, zigzag
     from shipid.vessels import get_vessel, kvlcc2
     from shipid.vessels.mmg_file import mmg_vessel, sister_ship
 
@@ -183,7 +180,18 @@ def tanker_truth() -> None:
     doc, _ = sister_ship(kvlcc2().dynamics.c, particulars, "tanker sister",
                          truth.approach_speed, rudder_rate=math.degrees(truth.steering.max_rate))
     doc["rudder_limit"] = math.degrees(truth.steering.max_angle)
-    sister = mmg_vessel(doc)
+    return truth, doc, mmg_vessel(doc)
+
+
+def tanker_truth() -> None:
+    """The same sister (the KVLCC2's coefficients) with the particulars of another VLCC whose
+    truth is known: the `tanker` (van Berlekom & Goddard's Esso 190 000 dwt, a Norrbin-type
+    model of another laboratory, course-unstable; reference-ships.md §4, its rudder limited to
+    10°): the sister's manoeuvres against the truth's, fitted to nothing. Its rudder area and
+    propeller diameter are not published: the KVLCC2's scaled by length."""
+    from shipid.trials.manoeuvres import turning_circle, zigzag
+
+    truth, doc, sister = _tanker_and_sister()
     print("\nThe tanker as a truth: the sister with its particulars (L 304.8 m, B 47.17 m, T "
           "18.46 m, 225 500 t; rudder limit 10°, 2.33 °/s), fitted to nothing\n")
     print("| ship | 10° turn: TD / L, steady r [rad/s] (starboard, port) | 10°/10° overshoots "
@@ -219,19 +227,11 @@ def tanker_truth_from_logs(seeds: int = 5) -> None:
     import yaml
 
     from shipid.data.io import write_log
-    from shipid.data.particulars import Particulars
     from shipid.trials.manoeuvres import turning_circle, zigzag
-    from shipid.vessels import get_vessel, kvlcc2
-    from shipid.vessels.mmg_file import mmg_vessel, sister_ship
     from shipid.vessels.sensors import SensorModel
 
     start = time.perf_counter()
-    truth = get_vessel("tanker")
-    particulars = Particulars(length=truth.length, beam=47.17, draught=18.46, mass=225.5e6)
-    doc, _ = sister_ship(kvlcc2().dynamics.c, particulars, "tanker sister",
-                         truth.approach_speed, rudder_rate=math.degrees(truth.steering.max_rate))
-    doc["rudder_limit"] = math.degrees(truth.steering.max_angle)
-    sister = mmg_vessel(doc)
+    truth, doc, sister = _tanker_and_sister()
 
     def indices(ship, **kw):
         turns = [turning_circle(ship, 10, side=side, duration=3000, dt=0.5, **kw).indices
