@@ -183,7 +183,8 @@ def test_a_structure_ruled_out_beyond_the_logs_is_named_where_it_predicts_them_b
     assert warning.startswith("blanke-race+race-damping predicts the logs better than "
                               "blanke-speed (free-run scores 0.050 and 0.283)")
     assert "left out for its 35° rudder held, beyond the logs' 20°" in warning
-    assert warning.endswith("or --model blanke-race+race-damping, decides")
+    assert "or --model blanke-race+race-damping, decides (where the ship's gear stops short " \
+        "of 35°, its rudder_limit in --particulars moves the check there)" in warning  # fmt: skip
     # Logs that reach the held rudder hold the check themselves: no warning.
     wide = [log.assign(delta=log["delta"] * 35 / 20) for log in logs]
     assert _ruled_out_apart(chosen, "blanke-speed", 0.283, {"blanke-race+race-damping": race},

@@ -1026,7 +1026,8 @@ def _ruled_out_apart(chosen, name: str, score: float, ruled_out: Mapping[str, ob
                    f"{ZIGZAG_APART[0]:g}°/{ZIGZAG_APART[1]:g}° zig-zags come apart (overshoots "
                    f"{name} {a[0]:.1f}°, {a[1]:.1f}°; {k} {b[0]:.1f}°, {b[1]:.1f}°): inside the "
                    "logs' rudder the choice rests on a check beyond them; a zig-zag log of that "
-                   f"kind, or --model {k}, decides")  # fmt: skip
+                   f"kind, or --model {k}, decides (where the ship's gear stops short of "
+                   f"{held:g}°, its rudder_limit in --particulars moves the check there)")  # fmt: skip
     return out
 
 
