@@ -912,12 +912,13 @@ def _steering(target, cond: dict, rate_deg_s: float | None, fallback: str = "ins
     elif fallback == "caller":
         return None, None
     elif cond.get("rudder_unresolved"):
-        return SteeringMachine(largest), ("rudder: instantaneous (the training logs' rudder swings "
-                                   "between two samples, faster than they resolve; give a rate "
-                                   "with --rudder-rate DEG/S)")  # fmt: skip
+        return SteeringMachine(largest), ("rudder: instantaneous (the training logs' rudder "
+                                          "swings between two samples, faster than they "
+                                          "resolve; give a rate with --rudder-rate DEG/S)")
     else:
-        return SteeringMachine(largest), ("rudder: instantaneous (the model file has no training rudder "
-                                   "rate; give one with --rudder-rate DEG/S)")  # fmt: skip
+        return SteeringMachine(largest), ("rudder: instantaneous (the model file has no "
+                                          "training rudder rate; give one with --rudder-rate "
+                                          "DEG/S)")  # fmt: skip
     steering = (SteeringMachine(largest, rate) if own is None
                 else dataclasses.replace(own, max_rate=rate))  # fmt: skip
     return steering, f"rudder rate {math.degrees(rate):.3g} °/s ({source})"

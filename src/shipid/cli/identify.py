@@ -59,6 +59,19 @@ def _paper_out_filtered(choice, table) -> str | None:
             f"implausible ({shown}: {why.split('; ')[0]}), so the rudder's inflow is compared")
 
 
+def _chosen_prefilter(logs, fit):
+    """The prefilter's cut-off chosen for the fits ``fit`` makes (``choose_prefilter``, the
+    plausibility checks breaking the logs' ties) and its table; printed."""
+    from shipid.identification.plausibility import disqualifying_at_approach
+    from shipid.identification.prefilter import choose_prefilter
+
+    cutoff, table = choose_prefilter(logs, fit, implausible=disqualifying_at_approach(logs))
+    shown = "none" if cutoff is None else f"{cutoff:.4g} Hz"
+    print(f"prefilter of u, v, r: {shown} (chosen by the free-run error on the logs"
+          f"{_ruled_out(table)}; --filter HZ|none to set it)")  # fmt: skip
+    return cutoff, table
+
+
 def _ruled_out(table) -> str:
     """The fits the prefilter's choice checked and found implausible, 'none (its reason), 2.5 Hz
     (...)': passed over, or chosen where none tied on the logs was plausible."""
@@ -172,18 +185,12 @@ def cmd_identify(args) -> int:
 
     cutoff, filter_by = args.filter, "given"
     if cutoff == "auto":
-        from shipid.identification.prefilter import choose_prefilter
 
         def fit(candidate_logs):
             return fit_model(candidate_logs, 1e4 if args.gamma == "auto" else args.gamma, names)
 
-        from shipid.identification.plausibility import disqualifying_at_approach
-
-        cutoff, table = choose_prefilter(logs, fit, implausible=disqualifying_at_approach(logs))
+        cutoff, table = _chosen_prefilter(logs, fit)
         filter_by = "free-run error, one-standard-error rule"
-        shown = "none" if cutoff is None else f"{cutoff:.4g} Hz"
-        print(f"prefilter of u, v, r: {shown} (chosen by the free-run error on the logs"
-              f"{_ruled_out(table)}; --filter HZ|none to set it)")  # fmt: skip
         paper_out = _paper_out_filtered(choice, table)
         if paper_out and not args.force:
             try:  # a fit the logs cannot determine: identify's own refusal says why, as before
@@ -205,11 +212,7 @@ def cmd_identify(args) -> int:
             physics = _physics(args, logs, _structure(args), chosen=choice is not None)
             members = choice.members if choice is not None and physics is None and \
                 not gamma_given else []  # fmt: skip
-            cutoff, table = choose_prefilter(logs, fit,
-                                             implausible=disqualifying_at_approach(logs))
-            shown = "none" if cutoff is None else f"{cutoff:.4g} Hz"
-            print(f"prefilter of u, v, r: {shown} (chosen by the free-run error on the logs"
-                  f"{_ruled_out(table)}; --filter HZ|none to set it)")  # fmt: skip
+            cutoff, table = _chosen_prefilter(logs, fit)
     elif cutoff == "none":
         cutoff = None
     if cutoff is not None:
