@@ -59,6 +59,7 @@ _EXPORTS = {
     "fit_residual": "shipid.identification.residual",
     "choose_residual": "shipid.identification.residual",
     "check_plausibility": "shipid.identification.plausibility",
+    "held_rudder_at": "shipid.identification.plausibility",
     "steady_approach": "shipid.dynamics.equilibrium",
     "validate": "shipid.evaluation.validate",
     "load_model": "shipid.reporting.modelfile",
