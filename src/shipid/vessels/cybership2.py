@@ -132,6 +132,7 @@ def _closed(n, dt, n_steps, s0, params, rk4, speed_lim, yaw_lim, states, rudder,
         n_valid[b] = kernel.closed_run(_this.rhs, (inp, n), inp, params[b], dt, n_steps, s0[b],
                                        rk4, speed_lim[b], yaw_lim[b], states[b], rudder[b])
 
+
 @numba.njit(cache=True)
 def open_corrected(n, terms, t, inputs, n_steps, s0, rk4, speed_lim, yaw_lim, out, n_valid):
     """Free runs of CyberShip II at propeller speed ``n`` plus a correction's terms
