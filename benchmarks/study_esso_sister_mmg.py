@@ -176,10 +176,10 @@ def _tanker_and_sister():
     from shipid.vessels.mmg_file import mmg_vessel, sister_ship
 
     truth = get_vessel("tanker")
-    particulars = Particulars(length=truth.length, beam=47.17, draught=18.46, mass=225.5e6)
+    particulars = Particulars(length=truth.length, beam=47.17, draught=18.46, mass=225.5e6,
+                              rudder_limit=math.degrees(truth.steering.max_angle))
     doc, _ = sister_ship(kvlcc2().dynamics.c, particulars, "tanker sister",
                          truth.approach_speed, rudder_rate=math.degrees(truth.steering.max_rate))
-    doc["rudder_limit"] = math.degrees(truth.steering.max_angle)
     return truth, doc, mmg_vessel(doc)
 
 

@@ -4,6 +4,7 @@ as the reference ``shipid correct`` keeps whole; bad files are named field by fi
 
 import importlib
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -187,6 +188,15 @@ def test_shipid_mmg_carries_a_similar_ships_coefficients_to_this_ships_particula
     scaled = twice.dynamics.derivatives(nu * [root, root, 1 / root], delta)
     np.testing.assert_allclose(scaled, built_in.dynamics.derivatives(nu, delta) * [1, 1, 0.5],
                                rtol=1e-9, atol=1e-13)  # fmt: skip
+    # The ship's own gear where its particulars give it (the tanker's stops at 10°), else the
+    # source's 35°.
+    assert np.degrees(twice.steering.max_angle) == pytest.approx(35.0)
+    geared = Path(_particulars(tmp_path, 2.0))
+    geared.write_text(geared.read_text() + "rudder_limit: 10\n")
+    code, _, err = run(["mmg", "kvlcc2", "--particulars", geared, "-o", tmp_path / "g.yml"],
+                       capsys)  # fmt: skip
+    assert code == 0, err
+    assert np.degrees(read_mmg(tmp_path / "g.yml").steering.max_angle) == pytest.approx(10.0)
 
 
 @pytest.mark.parametrize(("argv", "said"), [

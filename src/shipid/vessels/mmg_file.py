@@ -135,7 +135,8 @@ def sister_ship(source: Mapping, particulars, name: str, speed: float | None = N
     else the source's scaled by length, the rudder's height by the source's aspect ratio for
     the given area). The approach ``speed`` (else the particulars' design speed, else the
     source's at equal Froude number), ``rps`` (a number, "logs", or None: trimmed) and
-    ``rudder_rate`` [deg/s] (else the source's at equal Froude number). Returns the document and
+    ``rudder_rate`` [deg/s] (else the source's at equal Froude number); the rudder's limit the
+    particulars' ``rudder_limit`` where given, else the source's. Returns the document and
     notes saying what was scaled rather than given. The prime coefficients hold for the ship as
     far as the hulls are alike: the notes set both hulls' form side by side."""
     missing = [k for k in ("beam", "draught", "mass") if getattr(particulars, k) is None]
@@ -179,6 +180,8 @@ def sister_ship(source: Mapping, particulars, name: str, speed: float | None = N
              scale=particulars.scale if particulars.scale is not None else math.nan,
              follow_rps=rps == FOLLOW, rps=None if rps in (None, FOLLOW) else float(rps))
     c["propeller.diameter"], c["rudder.area"], c["rudder.height"] = diameter, area, height
+    if particulars.rudder_limit is not None:  # the ship's own gear, not the source's
+        c["rudder_limit"] = float(particulars.rudder_limit)
     doc = document_of(c)
     coefficients(doc, "the MMG model")  # the same checks as a file's
     form = {}
