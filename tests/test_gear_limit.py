@@ -23,7 +23,10 @@ def test_the_particulars_carry_the_gear_limit_in_degrees(tmp_path):
     path = tmp_path / "ship.yml"
     path.write_text("length: 300\nmax_rudder: 10\n")
     assert read_particulars(path).rudder_limit == 10.0
+    assert read_particulars(path).largest_rudder_deg == 10.0
     assert Particulars(length=4.0).rudder_limit is None
+    assert Particulars(length=4.0).largest_rudder_deg == 35.0
+    assert Particulars(length=4.0, rudder_limit=40.0).largest_rudder_deg == 35.0
     for bad, said in ((0.0, "rudder_limit must be > 0"), (35 * 3.2, "beyond 90°")):
         with pytest.raises(ShipidError, match=said):
             Particulars(length=4.0, rudder_limit=bad)
@@ -63,6 +66,16 @@ def test_identify_checks_at_the_particulars_rudder_limit_and_says_so(tmp_path, c
     assert records["gear"]["identification"]["plausibility"]["rudder_deg"] == 25.0
     assert records["plain"]["identification"]["plausibility"]["rudder_deg"] == 35.0
     assert held_rudder_deg() == 35.0  # the command's limit ends with it
+    # The limit travels with the logs' particulars: a log imported with them, fitted without
+    # --particulars, is checked at 25° too (it was 35°: only the option was read).
+    code, _, err = run(["import", log, "--particulars", tmp_path / "gear.yml", "-o",
+                        tmp_path / "geared.csv"], capsys)  # fmt: skip
+    assert code == 0, err
+    code, _, err = run(["identify", tmp_path / "geared.csv", "--model", "blanke", "-o",
+                        tmp_path / "from-log.json"], capsys)  # fmt: skip
+    assert code == 0, err
+    record = json.loads((tmp_path / "from-log.json").read_text())["identification"]
+    assert record["plausibility"]["rudder_deg"] == 25.0 and held_rudder_deg() == 35.0
     code, _, err = run(["identify", log, "--particulars", tmp_path / "missing.yml", "-o",
                         tmp_path / "m.json"], capsys)  # fmt: skip
     assert code == 1 and "missing.yml: no such particulars file" in err

@@ -15,6 +15,7 @@ options, the model or ship a command runs on), and the commands by what they do:
 
 from __future__ import annotations
 
+import contextvars
 import math
 import signal
 import sys
@@ -156,25 +157,6 @@ class _ClosableStdout:
         return getattr(self._stream, name)
 
 
-def _held_rudder(args):
-    """The steering gear's largest rudder from ``--particulars`` (``rudder_limit``), where the
-    command takes them and it is less than 35°: the plausibility checks' held turns hold it
-    (``shipid.identification.plausibility.held_rudder_at``); else nothing changes."""
-    import contextlib
-
-    path = getattr(args, "particulars", None)
-    if not path:
-        return contextlib.nullcontext()
-    from shipid.data.particulars import read_particulars
-
-    limit = read_particulars(path).rudder_limit
-    if limit is None:
-        return contextlib.nullcontext()
-    from shipid.identification.plausibility import held_rudder_at
-
-    return held_rudder_at(limit)
-
-
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit code (0, 1, 2 usage, 130 interrupted)."""
     args = build_parser().parse_args(argv)
@@ -197,8 +179,10 @@ def main(argv: list[str] | None = None) -> int:
             warnings.simplefilter("always", ShipidWarning)
             check_options(args)
             try:
-                with one_thread(), _held_rudder(args):  # BLAS: see shipid.blas
-                    code = args.func(args)
+                with one_thread():  # BLAS: see shipid.blas
+                    # In a copy of the caller's context: what a command sets there (the gear's
+                    # largest rudder its checks hold, from its logs' particulars) ends with it.
+                    code = contextvars.copy_context().run(args.func, args)
             except Exception:
                 # An error after an interrupt is the interrupt's doing (it broke a JIT compile,
                 # which then fails with its own RuntimeError), not a bug: exit 130 all the same.

@@ -117,6 +117,15 @@ def _training_logs(args) -> list:
               f"sees straight lines between its samples as measurements (their second "
               f"differences 0, so its sensor noise reads as none); fit at --dt {own:.3g} or "
               f"coarser (validate may run a model finer than its logs)")  # fmt: skip
+    from shipid.data.particulars import logs_particulars
+
+    particulars = logs_particulars(logs)
+    if particulars is not None and particulars.rudder_limit is not None:
+        # The checks of every fit this command makes hold the gear's largest rudder: set in
+        # the command's own context (``shipid.cli.main`` runs each in a copy of its caller's).
+        from shipid.identification.plausibility import hold_rudder
+
+        hold_rudder(particulars.largest_rudder_deg)
     return logs
 
 
@@ -899,8 +908,7 @@ def _steering(target, cond: dict, rate_deg_s: float | None, fallback: str = "ins
     own = getattr(target, "steering", None)
     # A model's gear: 35°, or the particulars' rudder_limit where the ship's stops short of it.
     particulars = cond.get("particulars")
-    limit = getattr(particulars, "rudder_limit", None)
-    largest = math.radians(min(35.0, limit) if limit else 35.0)
+    largest = math.radians(particulars.largest_rudder_deg if particulars else 35.0)
     if rate_deg_s is not None:
         rate, source = math.radians(rate_deg_s), "--rudder-rate"
     elif own is not None:

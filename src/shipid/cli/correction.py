@@ -3,8 +3,6 @@ of the same ship; the corrected ship written to a file the commands run as a ref
 
 from __future__ import annotations
 
-import math
-
 from shipid.cli.common import (
     VESSEL_NAMES,
     _json_text,
@@ -76,40 +74,22 @@ BEYOND = (("turning", "tactical_diameter"), ("turning", "steady_speed"),
           ("zigzag", "second_overshoot_deg"))  # fmt: skip
 
 
-# The bootstrap replicates' manoeuvres step coarser than the point's where the corrected ship
-# runs in Python (a correction of a model run at similar rps):
-# four times the manoeuvres' default step.
-REPLICATE_STEP = 0.2
-
-
-def _replicate_step(ship) -> float | None:
-    """The replicates' step: the manoeuvres' default where ``ship`` runs compiled."""
-    from shipid.dynamics.model import ManoeuvringModel
-
-    compiled = isinstance(ship.dynamics, ManoeuvringModel) or hasattr(ship.dynamics,
-                                                                      "integrate_closed")
-    return None if compiled else REPLICATE_STEP
-
-
 def _standard_rudders(ship) -> tuple[float, float]:
     """The held turn's and the zig-zag's rudder [deg]: 35° and 10°, or the largest the ship's
     steering gear allows where that is less."""
-    limit = math.degrees(ship.steering.max_angle) if ship.steering.max_angle else 35.0
-    return min(35.0, round(limit, 6)), min(10.0, round(limit, 6))
+    return ship.steering.capped_deg(35.0), ship.steering.capped_deg(10.0)
 
 
-def _standard(ship, side: str, dt: float | None = None) -> dict:
-    """The held turn and the 10°/10° zig-zag of ``ship`` to ``side`` (``_standard_rudders``;
-    at ``dt``, else the manoeuvres' default step)."""
+def _standard(ship, side: str) -> dict:
+    """The held turn and the 10°/10° zig-zag of ``ship`` to ``side`` (``_standard_rudders``)."""
     from shipid.cli.common import _ship_approach
     from shipid.trials.manoeuvres import turning_circle, zigzag
 
-    step = {} if dt is None else {"dt": dt}
     # A propeller that follows the runs' rate turns at its trim for the approach.
-    step["rps"] = _ship_approach(ship, None, None)[1]
+    rps = _ship_approach(ship, None, None)[1]
     turn, zig = _standard_rudders(ship)
-    return {"turning": turning_circle(ship, turn, side=side, **step),
-            "zigzag": zigzag(ship, zig, zig, first=side, **step)}  # fmt: skip
+    return {"turning": turning_circle(ship, turn, side=side, rps=rps),
+            "zigzag": zigzag(ship, zig, zig, first=side, rps=rps)}  # fmt: skip
 
 
 def _beyond_the_logs(reference, corrected, replicates=()) -> list[dict]:
@@ -120,13 +100,13 @@ def _beyond_the_logs(reference, corrected, replicates=()) -> list[dict]:
     from shipid.identification.uncertainty import interval
 
     rows = []
-    step = _replicate_step(corrected)
     turn_deg, zig_deg = _standard_rudders(corrected)
     labels = {"turning": f"{turn_deg:g}° turn", "zigzag": f"{zig_deg:g}°/{zig_deg:g}°"}
     for side in ("starboard", "port"):
         runs = {label: _standard(ship, side)
                 for label, ship in (("reference", reference), ("corrected", corrected))}
-        drawn = [_standard(ship, side, step) for ship in replicates]
+        # Every reference ship corrected runs compiled: the replicates at the point's step.
+        drawn = [_standard(ship, side) for ship in replicates]
         turn = runs["corrected"]["turning"]
         if turn.diverged or turn.indices.get("tactical_diameter") is None:
             _warn(f"the corrected ship's {labels['turning']} to {side} "
@@ -146,7 +126,6 @@ def _beyond_the_logs(reference, corrected, replicates=()) -> list[dict]:
             rows.append(row)
     print("Beyond the logs (the standard manoeuvres from the reference's approach"
           + (f"; intervals over {len(replicates)} bootstrap replicates of the correction"
-             + (f", run at {step:g} s steps" if step else "") if replicates else "")
-          + "):")  # fmt: skip
+             if replicates else "") + "):")  # fmt: skip
     print(_pd().DataFrame(rows).to_markdown(index=False, floatfmt=".4g"))
     return rows

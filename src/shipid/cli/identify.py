@@ -59,6 +59,12 @@ def _paper_out_filtered(choice, table) -> str | None:
             f"implausible ({shown}: {why.split('; ')[0]}), so the rudder's inflow is compared")
 
 
+def _members(choice, physics, gamma_given: bool) -> list:
+    """Select's candidates the model averages (``select --average``'s): where the terms were
+    chosen by select and no γ or physics (a prior, constraints: per structure) is given."""
+    return choice.members if choice is not None and physics is None and not gamma_given else []
+
+
 def _chosen_prefilter(logs, fit):
     """The prefilter's cut-off chosen for the fits ``fit`` makes (``choose_prefilter``, the
     plausibility checks breaking the logs' ties) and its table; printed."""
@@ -170,8 +176,7 @@ def cmd_identify(args) -> int:
     # Terms chosen by select: the model is the average of the candidates its choice rule picks
     # on resampled held-out logs (each at its own γ), as `select --average` writes it, where no
     # γ or physics (a prior, constraints: per structure) is given.
-    members = choice.members if choice is not None and physics is None and not gamma_given \
-        else []  # fmt: skip
+    members = _members(choice, physics, gamma_given)
 
     def fit_model(fit_logs, fit_gamma, fit_names=None):
         """The model of ``fit_logs`` fitted as the file's is: the structure, or the average
@@ -210,8 +215,7 @@ def cmd_identify(args) -> int:
             args.gamma = args.gamma if gamma_given else None
             choice = _choose_structure(args, logs, names, paper_out)
             physics = _physics(args, logs, _structure(args), chosen=choice is not None)
-            members = choice.members if choice is not None and physics is None and \
-                not gamma_given else []  # fmt: skip
+            members = _members(choice, physics, gamma_given)
             cutoff, table = _chosen_prefilter(logs, fit)
     elif cutoff == "none":
         cutoff = None

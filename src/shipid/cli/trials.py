@@ -310,13 +310,13 @@ def cmd_manoeuvre(args) -> int:
     # (MSC.137(76) §4.2; the tanker's is 10°, and `manoeuvre tanker turning` stopped on its own
     # default, as its spiral on the 25°).
     gear = steering if steering is not None else getattr(target, "steering", None)
-    limit = round(math.degrees(gear.max_angle), 6) if gear is not None else math.inf
-    if args.kind == "spiral" and limit < SPIRAL_ANGLES[0]:
-        _warn(f"the steering gear's largest rudder is {limit:g}°: the spiral's angles run to it "
+    top = gear.capped_deg(SPIRAL_ANGLES[0]) if gear is not None else SPIRAL_ANGLES[0]
+    if args.kind == "spiral" and top < SPIRAL_ANGLES[0]:
+        _warn(f"the steering gear's largest rudder is {top:g}°: the spiral's angles run to it "
               f"instead of {SPIRAL_ANGLES[0]:g}°")  # fmt: skip
     if args.rudder_deg is None:
         standard = 35.0 if args.kind == "turning" else 20.0
-        args.rudder_deg = min(standard, limit)
+        args.rudder_deg = gear.capped_deg(standard) if gear is not None else standard
         if args.rudder_deg < standard and args.kind in ("turning", "zigzag", "pull-out"):
             kind = {"turning": "turning circle", "zigzag": "zig-zag"}.get(args.kind, args.kind)
             _warn(f"the steering gear's largest rudder is {args.rudder_deg:g}°: the {kind} is "

@@ -49,6 +49,8 @@ ALIASES = {
     "xg": ("xg", "x_G"),
     "rudder_limit": ("rudder_limit", "max_rudder"),
 }
+# The largest rudder the standard manoeuvres and the plausibility checks hold [deg].
+STANDARD_RUDDER_DEG = 35.0
 POSITIVE = ("length", "beam", "draught", "block_coefficient", "mass", "rudder_area",
             "rudder_height", "propeller_diameter", "scale", "design_speed", "rho",
             "rudder_limit")  # fmt: skip
@@ -100,6 +102,12 @@ class Particulars:
             if not 0.8 <= self.mass / implied <= 1.25:
                 raise ShipidError(f"particulars: mass {self.mass:g} kg is inconsistent with "
                                   f"ρ·Cb·L·B·T = {implied:.4g} kg (more than 25 % apart)")
+
+    @property
+    def largest_rudder_deg(self) -> float:
+        """The largest rudder a standard manoeuvre holds [deg]: 35° (MSC.137(76)), or the
+        steering gear's ``rudder_limit`` where it stops short of it."""
+        return min(STANDARD_RUDDER_DEG, self.rudder_limit or STANDARD_RUDDER_DEG)
 
     @property
     def volume(self) -> float | None:

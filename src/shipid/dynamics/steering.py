@@ -35,6 +35,11 @@ class SteeringMachine:
         if not (self.time_constant >= 0):
             raise ValueError(f"time_constant must be ≥ 0, got {self.time_constant!r}")
 
+    def capped_deg(self, standard_deg: float) -> float:
+        """A standard manoeuvre's rudder ``standard_deg`` [deg], or this gear's largest where it
+        stops short of it (MSC.137(76) §4.2: the tanker's 10° for its turning circle)."""
+        return min(float(standard_deg), round(math.degrees(self.max_angle), 6))
+
     def step(self, delta: float, command: float, dt: float) -> float:
         """Rudder angle after dt seconds of following ``command`` from ``delta``."""
         command = min(max(command, -self.max_angle), self.max_angle)

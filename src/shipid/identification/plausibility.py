@@ -339,7 +339,7 @@ THRUST_NOT_CHECKED = ("not checked: the model is driven by the logs' thrust, whi
 # The rudder the held turns hold [deg]: 35°, or the ship's gear's largest where it is less
 # (``held_rudder_at``). A check at 35° of a ship whose gear stops at 10° (the tanker) judged a
 # manoeuvre the ship cannot make: it ruled out the structure that predicted its logs four times
-# closer, whose 35° turn went the wrong way, and the fit kept turned its 10° turns 60 % wide.
+# closer, whose 35° turn went the wrong way, and the fit kept turned its 10° turns 57 % wide.
 HELD_RUDDER_DEG = 35.0
 _HELD_RUDDER: contextvars.ContextVar[float] = contextvars.ContextVar("held_rudder",
                                                                     default=HELD_RUDDER_DEG)
@@ -348,6 +348,15 @@ _HELD_RUDDER: contextvars.ContextVar[float] = contextvars.ContextVar("held_rudde
 def held_rudder_deg() -> float:
     """The rudder the held-turn checks hold now [deg] (``held_rudder_at``)."""
     return _HELD_RUDDER.get()
+
+
+def hold_rudder(limit_deg: float | None) -> float:
+    """Hold the checks' turns at ``limit_deg`` where it is less than 35° (None: 35°) in the
+    caller's context from now on (a command of ``shipid.cli``, each of which runs in a copy of
+    its caller's context); ``held_rudder_at`` for a ``with`` block. Returns the rudder held."""
+    value = HELD_RUDDER_DEG if limit_deg is None else min(HELD_RUDDER_DEG, float(limit_deg))
+    _HELD_RUDDER.set(value)
+    return value
 
 
 @contextlib.contextmanager

@@ -144,9 +144,8 @@ def imo_criteria(
                           "design_speed)")  # fmt: skip
     if steering is None:
         # A reference ship has its own steering gear; a model gets the SOLAS rate at its scale.
-        limit = particulars.rudder_limit if particulars else None
         steering = getattr(ship, "steering", None) or SteeringMachine(
-            math.radians(min(35.0, limit) if limit else 35.0),
+            math.radians(particulars.largest_rudder_deg if particulars else 35.0),
             math.radians(SOLAS_RUDDER_RATE_DEG * math.sqrt(lam)))  # fmt: skip
     l_over_v = L / V * math.sqrt(lam)
     first_lim, second_lim = overshoot_limits(l_over_v)
@@ -162,7 +161,7 @@ def imo_criteria(
 
     # 35°, or the largest rudder the gear allows (MSC.137(76) §4.2: the maximum rudder angle
     # permissible at the test speed; the tanker's is 10°, and `criteria tanker` stopped on it).
-    turn_deg = min(35.0, round(math.degrees(steering.max_angle), 6))
+    turn_deg = steering.capped_deg(35.0)
     if turn_deg < 35.0:
         notes.append(f"the steering gear's largest rudder is {turn_deg:g}°: the turning circles "
                      "are run with it, the maximum rudder angle the standard allows for")
