@@ -999,6 +999,19 @@ def rates_apart(rates) -> bool:
     return len(known) < len(rates) or max(known) > TURNS_APART * min(known)
 
 
+def rudder_reach_deg(logs) -> float:
+    """The largest |δ| of ``logs`` [deg]."""
+    return max(math.degrees(float(np.max(np.abs(log["delta"].to_numpy(dtype=float)))))
+               for log in logs)  # fmt: skip
+
+
+def beyond_the_logs_rudder(held_deg: float, logs) -> bool:
+    """Whether a rudder of ``held_deg`` held lies beyond ``logs``' (their largest more than
+    ``BEYOND_RUDDER_DEG`` below it): a turn there is the fit's extrapolation in the rudder, not
+    a turn the logs' rudder reached."""
+    return rudder_reach_deg(logs) <= held_deg - BEYOND_RUDDER_DEG
+
+
 def _ruled_out_apart(chosen, name: str, score: float, ruled_out: Mapping[str, object], faults,
                      logs) -> list[str]:  # fmt: skip
     """Warnings where a structure ruled out by the held rudder's checks alone predicted the
@@ -1006,12 +1019,12 @@ def _ruled_out_apart(chosen, name: str, score: float, ruled_out: Mapping[str, ob
     ``OVERSHOOTS_APART_DEG`` from its: inside the logs' rudder, what the model predicts rests
     on a check beyond them. (On the MARIN KVLCC2 zig-zag, ``blanke`` is left out so and scores
     within one standard error but worse, 0.41 against 0.36: the other MARIN run confirms it.)"""
-    reach = max(float(np.max(np.abs(log["delta"].to_numpy(dtype=float)))) for log in logs)
     from shipid.identification.plausibility import held_rudder_deg
 
     held = held_rudder_deg()
-    if not ruled_out or math.degrees(reach) > held - BEYOND_RUDDER_DEG:
+    if not ruled_out or not beyond_the_logs_rudder(held, logs):
         return []  # the logs reach the held rudder: the check is theirs
+    reach = rudder_reach_deg(logs)
     out = []
     for k, model in ruled_out.items():
         overshoots = _zigzag_overshoots({name: chosen, k: model}, logs)
@@ -1022,7 +1035,7 @@ def _ruled_out_apart(chosen, name: str, score: float, ruled_out: Mapping[str, ob
             continue
         out.append(f"{k} predicts the logs better than {name} (free-run scores {faults[k][1]:.3f} "
                    f"and {score:.3f}) but was left out for its {held:g}° rudder held, "
-                   f"beyond the logs' {math.degrees(reach):.3g}° ({faults[k][2]}); their "
+                   f"beyond the logs' {reach:.3g}° ({faults[k][2]}); their "
                    f"{ZIGZAG_APART[0]:g}°/{ZIGZAG_APART[1]:g}° zig-zags come apart (overshoots "
                    f"{name} {a[0]:.1f}°, {a[1]:.1f}°; {k} {b[0]:.1f}°, {b[1]:.1f}°): inside the "
                    "logs' rudder the choice rests on a check beyond them; a zig-zag log of that "
