@@ -702,3 +702,28 @@ def test_identify_fits_the_chosen_structure_under_the_bounds_its_search_held(tmp
     model = json.loads((tmp_path / "m.json").read_text())["model"]
     assert model["coefficients"]["u"]["|u|*u"] == pytest.approx(-1.0)  # the truth's −0.032
     assert "held at its bound" in err
+
+
+def test_the_tied_fits_turns_are_compared_at_the_gears_rudder(paper_log):
+    """Where the particulars' ``rudder_limit`` holds the checks at the gear's largest rudder, the
+    tied fits' turns were still compared at 35°, a turn the ship cannot make, and named so."""
+    from shipid.data.log import approach
+    from shipid.identification.auto_structure import _predictions_apart
+    from shipid.identification.plausibility import held_rudder_at
+    from shipid.trials.manoeuvres import turning_circle
+    from shipid.vessels import scale_ship_model
+
+    ship = scale_ship_model()
+    stronger = ManoeuvringModel("blanke", {
+        d: {k: (3.0 * x if "delta" in k else x) for k, x in terms.items()}
+        for d, terms in ship.coefficients.items()})  # fmt: skip
+    models = {"paper": ship, "stronger": stronger}
+    with held_rudder_at(20.0):
+        (warning,) = [w for w in _predictions_apart(models, [paper_log])
+                      if "turning circle apart" in w]  # fmt: skip
+    assert "a 20° turning circle apart" in warning
+    dt = float(np.median(np.diff(paper_log["t"])))
+    for name, model in models.items():
+        r = turning_circle(model, 20.0, speed=approach(paper_log, "u"), method="euler",
+                           dt=dt).indices["steady_yaw_rate"]  # fmt: skip
+        assert f"{name} {abs(r):.3g} rad/s" in warning

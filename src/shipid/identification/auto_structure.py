@@ -1071,8 +1071,9 @@ def _zigzag_overshoots(models: Mapping[str, object], logs) -> dict | None:
 
 def _predictions_apart(models: Mapping[str, object], logs) -> list[str]:
     """Warnings where structures that predict the logs alike (free-run scores within one
-    standard error) predict an unseen manoeuvre far apart: a 35° turn (steady yaw rates apart
-    by more than ``TURNS_APART``) or a 10°/10° zig-zag (overshoots apart by more than
+    standard error) predict an unseen manoeuvre far apart: a turn at the rudder the
+    plausibility checks hold (35°, or the gear's ``rudder_limit``; steady yaw rates apart by more
+    than ``TURNS_APART``) or a 10°/10° zig-zag (overshoots apart by more than
     ``OVERSHOOTS_APART_DEG``), each run on their fits of the comparison from the first log's
     approach (the zig-zag at the logs' rudder rate).
 
@@ -1084,6 +1085,7 @@ def _predictions_apart(models: Mapping[str, object], logs) -> list[str]:
     On the real KVLCC2's three zig-zags the turns agree and the 10°/10° second overshoots do
     not. The logs cannot tell; the user is told."""
     from shipid.data.log import approach
+    from shipid.identification.plausibility import held_rudder_deg
     from shipid.trials.manoeuvres import turning_circle
 
     overshoots = _zigzag_overshoots(models, logs)
@@ -1091,9 +1093,10 @@ def _predictions_apart(models: Mapping[str, object], logs) -> list[str]:
         return []
     speed, rps = approach(logs[0], "u"), approach(logs[0], "n")
     dt = float(np.median(np.diff(logs[0]["t"].to_numpy())))
+    rudder = held_rudder_deg()  # the gear's largest (rudder_limit), as the checks hold
     rates = {}
     for name, model in models.items():
-        res = turning_circle(model, 35.0, speed=speed, rps=rps, method="euler", dt=dt)
+        res = turning_circle(model, rudder, speed=speed, rps=rps, method="euler", dt=dt)
         r = None if res.diverged else (res.indices or {}).get("steady_yaw_rate")
         rates[name] = abs(r) if r is not None and np.isfinite(r) else None
     alike = (f"{', '.join(models)} predict the logs alike (free-run scores within one standard "
@@ -1102,7 +1105,7 @@ def _predictions_apart(models: Mapping[str, object], logs) -> list[str]:
     if rates_apart(list(rates.values())):
         shown = ", ".join(f"{k} {'no steady turn' if r is None else f'{r:.3g} rad/s'}"
                           for k, r in rates.items())  # fmt: skip
-        out.append(f"{alike} a 35° turning circle apart (steady yaw rates of the compared fits: "
+        out.append(f"{alike} a {rudder:g}° turning circle apart (steady yaw rates of the compared fits: "
                    f"{shown}): the logs cannot choose what the model predicts beyond them; a "
                    "turning log, or --model, decides")  # fmt: skip
     known = [v for v in overshoots.values() if all(x is not None and np.isfinite(x) for x in v)]
