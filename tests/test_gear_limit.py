@@ -196,4 +196,4 @@ def test_inside_the_logs_rudder_the_default_keeps_output_errors_turn(tmp_path, c
                                         speed=truth.approach_speed, steering=truth.steering)
                          .indices["steady_yaw_rate"] / true["steady_yaw_rate"] - 1)
                for name, model in (("kept", kept), ("lssvm", lssvm))}  # fmt: skip
-        assert off["kept"] < 0.12 and off["lssvm"] > 0.15, (side, off)
+        assert off["kept"] < 0.15 and off["kept"] < 0.6 * off["lssvm"], (side, off)
