@@ -197,3 +197,26 @@ def test_inside_the_logs_rudder_the_default_keeps_output_errors_turn(tmp_path, c
                          .indices["steady_yaw_rate"] / true["steady_yaw_rate"] - 1)
                for name, model in (("kept", kept), ("lssvm", lssvm))}  # fmt: skip
         assert off["kept"] < 0.15 and off["kept"] < 0.6 * off["lssvm"], (side, off)
+
+
+def test_a_log_whose_rudder_exceeds_the_gears_limit_is_named(tmp_path, capsys):
+    """A rudder_limit of 5° given with logs whose rudder reaches 20° (a typo, or a rudder logged
+    in other units) held the checks at 5° without a word; each log beyond the limit by more than
+    its margin is now named, with how far it reaches."""
+    from cli_helpers import run
+
+    from shipid.data.io import write_log
+    from shipid.data.particulars import RUDDER_LIMIT_MARGIN_DEG, rudder_beyond_limit
+
+    log = zigzag(scale_ship(), 20, 20, duration=40, dt=0.1).log
+    path = write_log(log, tmp_path / "zz.csv")
+    for limit, warned in ((5.0, True), (20.0 + 0.5 * RUDDER_LIMIT_MARGIN_DEG, False)):
+        (tmp_path / "gear.yml").write_text(f"length: 4.0\nrudder_limit: {limit}\n")
+        code, _, err = run(["indices", path, "--particulars", tmp_path / "gear.yml"], capsys)
+        assert code == 0, err
+        said = f"{path}: the rudder reaches 20°, beyond the particulars' rudder_limit of 5°"
+        assert (said in err) is warned, err
+        log.attrs["particulars"] = {"length": 4.0, "rudder_limit": limit}
+        assert (rudder_beyond_limit(log, "zz") is not None) is warned
+    del log.attrs["particulars"]
+    assert rudder_beyond_limit(log, "zz") is None  # no limit given: nothing to say

@@ -58,6 +58,12 @@ def _read_logs(args, paths=None, cut_from_rest: bool = False) -> list:
     if particulars is not None:
         for log in logs:
             log.attrs["particulars"] = frozen(particulars.to_dict())
+    from shipid.data.particulars import rudder_beyond_limit
+
+    for path, log in zip(paths, logs, strict=True):
+        said = rudder_beyond_limit(log, str(path))
+        if said:
+            _warn(said)
     return logs
 
 

@@ -32,6 +32,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
+
 from shipid.errors import ShipidError
 
 ALIASES = {
@@ -161,6 +163,29 @@ def logs_particulars(logs) -> Particulars | None:
     log read is given, or a known format's own), or None."""
     found = next((log.attrs["particulars"] for log in logs if log.attrs.get("particulars")), None)
     return None if found is None else Particulars.from_mapping(found)
+
+
+# How far a log's rudder may read beyond the gear's ``rudder_limit`` [deg] (its sensor's noise,
+# an angle logged at the stock while the gear stops the tiller) before the two disagree.
+RUDDER_LIMIT_MARGIN_DEG = 1.0
+
+
+def rudder_beyond_limit(log, name: str) -> str | None:
+    """One line where ``log``'s rudder reaches more than ``RUDDER_LIMIT_MARGIN_DEG`` beyond the
+    ``rudder_limit`` of the particulars it carries (the checks and the standard manoeuvres then
+    hold a rudder the ship is seen to exceed: a limit or a rudder signal that is wrong), else
+    None."""
+    found = log.attrs.get("particulars")
+    limit = Particulars.from_mapping(found).rudder_limit if found else None
+    if limit is None or "delta" not in log.columns:
+        return None
+    reach = math.degrees(float(np.nanmax(np.abs(log["delta"].to_numpy(dtype=float)))))
+    if not reach > limit + RUDDER_LIMIT_MARGIN_DEG:
+        return None
+    return (f"{name}: the rudder reaches {reach:.3g}°, beyond the particulars' rudder_limit of "
+            f"{limit:g}° (the steering gear's largest), which the plausibility checks and the "
+            "standard manoeuvres hold: check the limit, or the rudder signal's units and column "
+            "(--degrees, --columns)")
 
 
 def read_particulars(path: str | Path) -> Particulars:
