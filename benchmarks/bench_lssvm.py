@@ -17,7 +17,7 @@ from sklearn.kernel_ridge import KernelRidge
 from timing import best_of
 
 from shipid.lssvm import LSSVR, LSSVRCV, kernel_matrix
-from shipid.lssvm.selection import DualLOOPath, PrimalLOOPath
+from shipid.lssvm.loo import DualLOOPath, PrimalLOOPath
 
 
 def smooth_target(X: np.ndarray) -> np.ndarray:

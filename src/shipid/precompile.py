@@ -45,7 +45,7 @@ def _models() -> list[str]:
     from shipid.evaluation.validate import validate
     from shipid.identification.identify import identify
     from shipid.identification.residual import fit_residual
-    from shipid.lssvm.selection import PrimalLOOPath
+    from shipid.lssvm.loo import PrimalLOOPath
     from shipid.trials.manoeuvres import zigzag
 
     done = []

@@ -19,7 +19,7 @@ Search (``search``):
   of thresholds.
 * ``none``: the library as it is (γ only; what ``identify --gamma auto`` runs).
 
-γ: the exact leave-one-out of the linear LS-SVM (closed form, ``shipid.lssvm.selection``) over the
+γ: the exact leave-one-out of the linear LS-SVM (closed form, ``shipid.lssvm.loo``) over the
 grid pre-screens; the free-run CV decides among the values within 1.5× of the best LOO error, for
 the full library and again for the chosen structure.
 
@@ -487,7 +487,7 @@ def _stlsq_terms(X: np.ndarray, y: np.ndarray, names: Sequence[str], threshold: 
 # ---------------------------------------------------------------------------- γ pre-screen
 def _loo_gamma_scores(data: _Data, terms, gammas) -> dict[float, float]:
     """Sum over DOFs of the exact LOO MSE of the linear LS-SVM / var(target), per γ."""
-    from shipid.lssvm.selection import PrimalLOOPath
+    from shipid.lssvm.loo import PrimalLOOPath
 
     scores = dict.fromkeys(gammas, 0.0)
     for dof in terms:
