@@ -455,3 +455,20 @@ def test_a_slow_approach_is_not_settled(tau, settled):
     assert np.ptp(tail) < 0.01  # what the earlier rule looked at alone
     assert _settled(r, 1.0) is settled
     assert _settled(-r, 1.0) is settled
+
+
+@pytest.mark.parametrize("n", [1, 2, 7, 100, 1001])
+@pytest.mark.parametrize("window", [1, 2, 5, 51, 2000])
+def test_the_trims_forward_extremes_are_scipys_filters(n, window):
+    """The rudder's spread over the window from each sample on (``trim.forward_extremes``, which
+    spares every trimming command ``scipy.ndimage``'s import) against SciPy's own filters."""
+    from scipy.ndimage import maximum_filter1d, minimum_filter1d
+
+    from shipid.data.trim import forward_extremes
+
+    x = np.random.default_rng(n * window).normal(size=n)
+    x[n // 2 :] = np.round(x[n // 2 :])  # ties, as a rudder's plateaus have
+    hi, lo = forward_extremes(x, window)
+    origin = -(window // 2)
+    assert np.array_equal(hi, maximum_filter1d(x, window, origin=origin, mode="nearest"))
+    assert np.array_equal(lo, minimum_filter1d(x, window, origin=origin, mode="nearest"))

@@ -21,12 +21,30 @@ TRIM_KEEP_WARN = 0.25
 DEFAULT_LEAD_S = 5.0  # --start auto: seconds kept before the execute
 
 
+def forward_extremes(x: np.ndarray, window: int) -> tuple[np.ndarray, np.ndarray]:
+    """The largest and the smallest of ``x`` over the ``window`` samples from each sample on
+    (the last sample repeated past the end), in O(n) whatever the window: blocks of ``window``
+    samples, the running extremes from each block's start and from its end, two of which
+    cover any window (van Herk 1992; Gil and Werman 1993). SciPy's ``maximum_filter1d`` does the
+    same, but importing ``scipy.ndimage`` cost every command that trims a log 0.1–0.3 s."""
+    n = x.size
+    blocks = -(-(n + window - 1) // window)
+    padded = np.full(blocks * window, x[-1], dtype=float)
+    padded[:n] = x
+    starts = np.arange(n)
+    out = []
+    for extreme in (np.maximum, np.minimum):
+        rows = padded.reshape(blocks, window)
+        from_start = extreme.accumulate(rows, axis=1).ravel()
+        to_end = extreme.accumulate(rows[:, ::-1], axis=1)[:, ::-1].ravel()
+        out.append(extreme(to_end[starts], from_start[starts + window - 1]))
+    return out[0], out[1]
+
+
 def rudder_execute_time(log: pd.DataFrame, name: str = "log") -> float:
     """Time of the rudder execute: the start of the swing to the first rudder plateau (constant
     within ±0.5° for 5 s) at least half the largest rudder angle. Helm corrections while the ship
     gathers speed are smaller or never steady."""
-    from scipy.ndimage import maximum_filter1d, minimum_filter1d  # 0.3 s: only when trimming
-
     from shipid.data.rudder_signal import rudder_for_events, stand_samples
 
     t = log["t"].to_numpy()
@@ -36,8 +54,7 @@ def rudder_execute_time(log: pd.DataFrame, name: str = "log") -> float:
     peak = float(dev.max())
     window = max(int(round(EXECUTE_HOLD_S / dt)), 1) + 1
     # Spread of the rudder over the window starting at each sample.
-    hi = maximum_filter1d(delta, window, origin=-(window // 2), mode="nearest")
-    lo = minimum_filter1d(delta, window, origin=-(window // 2), mode="nearest")
+    hi, lo = forward_extremes(delta, window)
     fits = np.arange(delta.size) + window <= delta.size
     plateau = (dev >= EXECUTE_FRACTION * peak) & (hi - lo <= np.radians(1.0)) & fits
     if peak < np.radians(1.0) or not plateau.any():
