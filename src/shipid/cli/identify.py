@@ -372,7 +372,8 @@ def cmd_identify(args) -> int:
         # LS-SVM's 35° turns never settled, output error's came within 2 % of the truth's, and
         # the default had handed out the LS-SVM fit.
         lssvm_fails = new_failures(refined_report, plausibility, ident.model)
-        from shipid.identification.auto_structure import beyond_the_logs_rudder, rudder_reach_deg
+        from shipid.data.log import rudder_reach_deg
+        from shipid.identification.auto_structure import beyond_the_logs_rudder
 
         held_beyond = bool(apart) and beyond_the_logs_rudder(plausibility["rudder_deg"], raw_logs)
         default_fit = (prep.get("output_error") or {}).get("fit") == "output error"

@@ -82,6 +82,12 @@ def make_log(columns: Mapping[str, np.ndarray], **meta: object) -> pd.DataFrame:
     return df
 
 
+def rudder_reach_deg(logs) -> float:
+    """The largest |δ| of ``logs`` [deg]."""
+    return max(math.degrees(float(np.nanmax(np.abs(log["delta"].to_numpy(dtype=float)))))
+               for log in logs)  # fmt: skip
+
+
 def log_name(log: pd.DataFrame, default: str = "log") -> str:
     """The log's name (its file name when read from a file)."""
     return str(log.attrs.get("name", default))

@@ -32,8 +32,6 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
-
 from shipid.errors import ShipidError
 
 ALIASES = {
@@ -179,7 +177,9 @@ def rudder_beyond_limit(log, name: str) -> str | None:
     limit = Particulars.from_mapping(found).rudder_limit if found else None
     if limit is None or "delta" not in log.columns:
         return None
-    reach = math.degrees(float(np.nanmax(np.abs(log["delta"].to_numpy(dtype=float)))))
+    from shipid.data.log import rudder_reach_deg
+
+    reach = rudder_reach_deg([log])
     if not reach > limit + RUDDER_LIMIT_MARGIN_DEG:
         return None
     return (f"{name}: the rudder reaches {reach:.3g}°, beyond the particulars' rudder_limit of "

@@ -999,16 +999,12 @@ def rates_apart(rates) -> bool:
     return len(known) < len(rates) or max(known) > TURNS_APART * min(known)
 
 
-def rudder_reach_deg(logs) -> float:
-    """The largest |δ| of ``logs`` [deg]."""
-    return max(math.degrees(float(np.max(np.abs(log["delta"].to_numpy(dtype=float)))))
-               for log in logs)  # fmt: skip
-
-
 def beyond_the_logs_rudder(held_deg: float, logs) -> bool:
     """Whether a rudder of ``held_deg`` held lies beyond ``logs``' (their largest more than
     ``BEYOND_RUDDER_DEG`` below it): a turn there is the fit's extrapolation in the rudder, not
     a turn the logs' rudder reached."""
+    from shipid.data.log import rudder_reach_deg
+
     return rudder_reach_deg(logs) <= held_deg - BEYOND_RUDDER_DEG
 
 
@@ -1024,6 +1020,8 @@ def _ruled_out_apart(chosen, name: str, score: float, ruled_out: Mapping[str, ob
     held = held_rudder_deg()
     if not ruled_out or not beyond_the_logs_rudder(held, logs):
         return []  # the logs reach the held rudder: the check is theirs
+    from shipid.data.log import rudder_reach_deg
+
     reach = rudder_reach_deg(logs)
     out = []
     for k, model in ruled_out.items():
