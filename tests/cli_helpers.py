@@ -42,3 +42,13 @@ def validated(model, log, capsys, folder: Path, *options) -> dict:
     assert code == 0, err
     (record,) = json.loads(out.read_text())["logs"]
     return record
+
+
+def fresh_python(code: str) -> str:
+    """What ``code`` prints run in a new interpreter (the imports a call makes, which this
+    process has made already): its standard output, the run asserted clean."""
+    import subprocess
+    import sys
+
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    return out.stdout

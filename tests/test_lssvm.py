@@ -338,25 +338,21 @@ def test_a_gamma_path_is_the_fits_at_each_gamma(params):
 def test_the_gamma_prescreen_does_not_import_scikit_learn():
     """``select``'s γ pre-screen (every ``identify`` and ``select`` that searches) imported
     scikit-learn with the LOO paths, 0.9 s of every such command; the paths are apart now."""
-    import subprocess
-    import sys
+    from cli_helpers import fresh_python
 
     code = ("import sys; from shipid.lssvm.loo import PrimalLOOPath; "
             "import shipid.identification.select; print('sklearn' in sys.modules)")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    assert out.stdout.strip() == "False"
+    assert fresh_python(code).strip() == "False"
 
 
 def test_a_fit_with_equalities_alone_does_not_import_scipy_optimize():
     """The constrained solve imported ``scipy.optimize`` (0.1–0.3 s) on every call, though only
     bounds use it: the Esso's default searches, whose fits hold equalities alone, paid it."""
-    import subprocess
-    import sys
+    from cli_helpers import fresh_python
 
     code = ("import sys, numpy as np; from shipid.lssvm.solvers import solve_primal_constrained; "
             "A = np.eye(3) + 0.1; b = np.ones(3); "
             "x, bias, _ = solve_primal_constrained(A, b, 1e4, equalities=(np.array([[1.0, 0, 0]]),"
             " np.array([0.5]))); "
             "print(round(float(x[0]), 12), 'scipy.optimize' in sys.modules)")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    assert out.stdout.split() == ["0.5", "False"]
+    assert fresh_python(code).split() == ["0.5", "False"]

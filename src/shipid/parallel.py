@@ -56,9 +56,9 @@ def run_tasks(fn: Callable[[object], dict], items: Sequence, scheduler: str | No
 
 
 def _bar(total: int, progress: bool, unit: str):
-    from tqdm import tqdm
+    from shipid.progress import progress_bar
 
-    return tqdm(total=total, desc=f"{unit}s", unit=unit, disable=not progress, leave=False)
+    return progress_bar(total, f"{unit}s", unit, shown=bool(progress), leave=False)
 
 
 def _run_on_dask(fn, items, scheduler, workers, progress, unit) -> list[dict]:

@@ -126,12 +126,12 @@ def cmd_validate(args) -> int:
                  + _yaw_rate_notes(cond, logs, names)
                  + (_reference_speed_notes(model, logs, names) if reference else [])):
         _warn(note)
-    from tqdm.auto import tqdm
+    from shipid.progress import progress
 
     vals = [validate(model, log, [name], method=args.method, kind=args.kind,
                      smooth_s=args.smooth, ensemble=ensemble, error_band=band)[0]
-            for log, name in tqdm(list(zip(logs, names, strict=True)), desc="logs", unit="log",
-                                  disable=args.quiet or len(logs) < 3)]  # fmt: skip
+            for log, name in progress(zip(logs, names, strict=True), "logs", "log",
+                                      shown=not (args.quiet or len(logs) < 3))]  # fmt: skip
     for v, log in zip(vals, logs, strict=True):
         if v.error is None:
             v.warnings.extend(outside_envelope(env, log) + _reversed_propeller_notes(model, cond,

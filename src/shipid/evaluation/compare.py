@@ -75,9 +75,9 @@ def compare(
     structure = get_structure(structure) if isinstance(structure, str) else structure
     inputs = ("delta", *structure.inputs)
     rows = []
-    from tqdm.auto import tqdm
+    from shipid.progress import progress as counted
 
-    for m in tqdm(list(methods), desc="methods", disable=not progress):
+    for m in counted(methods, "methods", shown=bool(progress)):
         if m.startswith("select:"):
             rows += _nested_select(logs, names, m.split(":", 1)[1], gamma, method,
                                    divergence_penalty)  # fmt: skip

@@ -232,11 +232,11 @@ def refine(
     speed_lim, yaw_lim = DivergenceBounds().resolved(float(np.max(np.abs(seg.shot0[:, 0]))))
     alive_grid = np.arange(L)[None, :]
 
-    from tqdm.auto import tqdm
+    from shipid.progress import progress_bar
 
     # Each cost evaluation and each column of the finite-difference Jacobian is one simulation.
-    bar = tqdm(total=max_nfev * (len(x0) + 1), desc="refinement", unit="sim",
-               disable=None if progress else True)  # fmt: skip
+    bar = progress_bar(max_nfev * (len(x0) + 1), "refinement", "sim",
+                       shown=None if progress else False)  # fmt: skip
 
     def residuals(x: np.ndarray) -> np.ndarray:
         bar.update()

@@ -912,9 +912,9 @@ def _one_standard_error(cands, best: Candidate, plausible) -> Candidate:
 
 
 def _progress(options: SelectOptions):
-    from tqdm.auto import tqdm
+    from shipid.progress import progress_bar
 
-    return tqdm(desc="candidates", unit="cand", total=None, disable=not options.progress)
+    return progress_bar(None, "candidates", "cand", shown=bool(options.progress))
 
 
 def _stacked(data: _Data, dof: str, terms) -> tuple[list[str], np.ndarray, np.ndarray]:

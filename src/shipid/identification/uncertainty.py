@@ -370,10 +370,10 @@ def bootstrap(
 
 
 def _bar(progress: bool, total: int):
-    from tqdm.auto import tqdm
+    """The bootstrap's bar, shown only on a terminal where ``progress`` asks for it."""
+    from shipid.progress import progress_bar
 
-    # disable=None: shown only on a terminal
-    return tqdm(total=total, desc="bootstrap", unit="fit", disable=None if progress else True)
+    return progress_bar(total, "bootstrap", "fit", shown=None if progress else False)
 
 
 Bands = dict[str, tuple[np.ndarray, np.ndarray]]

@@ -9,7 +9,8 @@ from sklearn.base import BaseEstimator, RegressorMixin
 from sklearn.model_selection import KFold
 from sklearn.utils import check_random_state
 from sklearn.utils.validation import check_is_fitted
-from tqdm.auto import tqdm
+
+from shipid.progress import progress_bar
 
 from .estimator import LSSVR
 from .kernels import kernel_matrix
@@ -135,7 +136,7 @@ class LSSVRCV(RegressorMixin, BaseEstimator):
 
         grid = [(s, g) for s in sigmas for g in gammas]
         mse = np.empty(len(grid))
-        with tqdm(total=len(grid), disable=not self.progress, desc="LS-SVM grid") as bar:
+        with progress_bar(len(grid), "LS-SVM grid", shown=bool(self.progress)) as bar:
             for i_s, s in enumerate(sigmas):
                 first = i_s * len(gammas)
                 if self.cv == "loo":
