@@ -375,7 +375,8 @@ def cmd_identify(args) -> int:
         from shipid.data.log import rudder_reach_deg
         from shipid.identification.auto_structure import beyond_the_logs_rudder
 
-        held_beyond = bool(apart) and beyond_the_logs_rudder(plausibility["rudder_deg"], raw_logs)
+        reach = rudder_reach_deg(raw_logs)
+        held_beyond = bool(apart) and beyond_the_logs_rudder(plausibility["rudder_deg"], reach)
         default_fit = (prep.get("output_error") or {}).get("fit") == "output error"
         if worse:
             # Never hand out a model that fails checks the LS-SVM model passes, or fails worse.
@@ -409,9 +410,8 @@ def cmd_identify(args) -> int:
         else:
             if default_fit and apart:
                 why = (f"the LS-SVM fit fails checks it passes ({lssvm_fails[0]})" if lssvm_fails
-                       else f"a turn the logs' rudder reached (their largest "
-                            f"{rudder_reach_deg(raw_logs):.3g}°), where output error's consistent "
-                            "fit holds")  # fmt: skip
+                       else f"a turn the logs' rudder reached (their largest {reach:.3g}°), "
+                            "where output error's consistent fit holds")  # fmt: skip
                 prep["output_error"]["turns"] = f"{apart.split(' (')[0]}, but {why}"
                 print(f"output error: kept; {prep['output_error']['turns']}")
             final, plausibility, notes = refinement.model, refined_report, refined_notes

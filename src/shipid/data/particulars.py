@@ -51,6 +51,13 @@ ALIASES = {
 }
 # The largest rudder the standard manoeuvres and the plausibility checks hold [deg].
 STANDARD_RUDDER_DEG = 35.0
+
+
+def largest_rudder_deg(rudder_limit: float | None) -> float:
+    """The largest rudder a standard manoeuvre holds [deg]: 35° (MSC.137(76)), or a steering
+    gear's ``rudder_limit`` where it stops short of it (None: no limit given)."""
+    return STANDARD_RUDDER_DEG if rudder_limit is None else min(STANDARD_RUDDER_DEG,
+                                                                float(rudder_limit))
 POSITIVE = ("length", "beam", "draught", "block_coefficient", "mass", "rudder_area",
             "rudder_height", "propeller_diameter", "scale", "design_speed", "rho",
             "rudder_limit")  # fmt: skip
@@ -105,9 +112,8 @@ class Particulars:
 
     @property
     def largest_rudder_deg(self) -> float:
-        """The largest rudder a standard manoeuvre holds [deg]: 35° (MSC.137(76)), or the
-        steering gear's ``rudder_limit`` where it stops short of it."""
-        return min(STANDARD_RUDDER_DEG, self.rudder_limit or STANDARD_RUDDER_DEG)
+        """``largest_rudder_deg`` of this ship's ``rudder_limit``."""
+        return largest_rudder_deg(self.rudder_limit)
 
     @property
     def volume(self) -> float | None:

@@ -999,13 +999,11 @@ def rates_apart(rates) -> bool:
     return len(known) < len(rates) or max(known) > TURNS_APART * min(known)
 
 
-def beyond_the_logs_rudder(held_deg: float, logs) -> bool:
-    """Whether a rudder of ``held_deg`` held lies beyond ``logs``' (their largest more than
-    ``BEYOND_RUDDER_DEG`` below it): a turn there is the fit's extrapolation in the rudder, not
-    a turn the logs' rudder reached."""
-    from shipid.data.log import rudder_reach_deg
-
-    return rudder_reach_deg(logs) <= held_deg - BEYOND_RUDDER_DEG
+def beyond_the_logs_rudder(held_deg: float, reach_deg: float) -> bool:
+    """Whether a rudder of ``held_deg`` held lies beyond the logs' (their largest, ``reach_deg``
+    of ``data.log.rudder_reach_deg``, more than ``BEYOND_RUDDER_DEG`` below it): a turn there
+    is the fit's extrapolation in the rudder, not a turn the logs' rudder reached."""
+    return reach_deg <= held_deg - BEYOND_RUDDER_DEG
 
 
 def _ruled_out_apart(chosen, name: str, score: float, ruled_out: Mapping[str, object], faults,
@@ -1015,14 +1013,12 @@ def _ruled_out_apart(chosen, name: str, score: float, ruled_out: Mapping[str, ob
     ``OVERSHOOTS_APART_DEG`` from its: inside the logs' rudder, what the model predicts rests
     on a check beyond them. (On the MARIN KVLCC2 zig-zag, ``blanke`` is left out so and scores
     within one standard error but worse, 0.41 against 0.36: the other MARIN run confirms it.)"""
+    from shipid.data.log import rudder_reach_deg
     from shipid.identification.plausibility import held_rudder_deg
 
-    held = held_rudder_deg()
-    if not ruled_out or not beyond_the_logs_rudder(held, logs):
+    held, reach = held_rudder_deg(), rudder_reach_deg(logs)
+    if not ruled_out or not beyond_the_logs_rudder(held, reach):
         return []  # the logs reach the held rudder: the check is theirs
-    from shipid.data.log import rudder_reach_deg
-
-    reach = rudder_reach_deg(logs)
     out = []
     for k, model in ruled_out.items():
         overshoots = _zigzag_overshoots({name: chosen, k: model}, logs)

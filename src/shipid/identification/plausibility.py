@@ -42,6 +42,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 import pandas as pd
 
+from shipid.data.particulars import STANDARD_RUDDER_DEG, largest_rudder_deg
 from shipid.dynamics.equilibrium import still_air_accelerations, surge_equilibrium
 from shipid.dynamics.model import ManoeuvringModel
 from shipid.dynamics.simulate import DivergenceBounds
@@ -340,7 +341,7 @@ THRUST_NOT_CHECKED = ("not checked: the model is driven by the logs' thrust, whi
 # (``held_rudder_at``). A check at 35° of a ship whose gear stops at 10° (the tanker) judged a
 # manoeuvre the ship cannot make: it ruled out the structure that predicted its logs four times
 # closer, whose 35° turn went the wrong way, and the fit kept turned its 10° turns 57 % wide.
-HELD_RUDDER_DEG = 35.0
+HELD_RUDDER_DEG = STANDARD_RUDDER_DEG
 _HELD_RUDDER: contextvars.ContextVar[float] = contextvars.ContextVar("held_rudder",
                                                                     default=HELD_RUDDER_DEG)
 
@@ -354,7 +355,7 @@ def hold_rudder(limit_deg: float | None) -> float:
     """Hold the checks' turns at ``limit_deg`` where it is less than 35° (None: 35°) in the
     caller's context from now on (a command of ``shipid.cli``, each of which runs in a copy of
     its caller's context); ``held_rudder_at`` for a ``with`` block. Returns the rudder held."""
-    value = HELD_RUDDER_DEG if limit_deg is None else min(HELD_RUDDER_DEG, float(limit_deg))
+    value = largest_rudder_deg(limit_deg)
     _HELD_RUDDER.set(value)
     return value
 
@@ -363,7 +364,7 @@ def hold_rudder(limit_deg: float | None) -> float:
 def held_rudder_at(limit_deg: float | None):
     """Hold the checks' turns at ``limit_deg`` where it is less than 35° (the gear's largest
     rudder: the particulars' ``rudder_limit``) inside the ``with`` block; None: 35°."""
-    value = HELD_RUDDER_DEG if limit_deg is None else min(HELD_RUDDER_DEG, float(limit_deg))
+    value = largest_rudder_deg(limit_deg)
     token = _HELD_RUDDER.set(value)
     try:
         yield value
