@@ -202,3 +202,43 @@ def test_the_steady_speed_in_a_true_wind_is_the_closed_form(source_deg, psi_deg,
     # Still air: the ship's own motion through it, from ahead.
     assert surge_equilibrium(model, 0.45, n) == pytest.approx(_head(A_UU, B_NN * n * n, -2e-3,
                                                                     0.0), rel=1e-6)  # fmt: skip
+
+
+def _whole_grid_root(model, speed, rps, span):
+    """The falling root nearest ``speed`` on the whole grid: what surge_equilibrium reads
+    outward from ``speed`` in blocks."""
+    from shipid.dynamics.equilibrium import still_air_accelerations
+
+    grid = np.linspace(0.0, span * speed, int(1000 * span) + 1)
+    zeros = np.zeros_like(grid)
+    udot = still_air_accelerations(model, grid, zeros, zeros, zeros, rps)[:, 0]
+    falling = np.flatnonzero((udot[:-1] > 0) & (udot[1:] <= 0))
+    if falling.size == 0:
+        return None
+    k = int(falling[np.argmin(np.abs(grid[falling] - speed))])
+    return float(grid[k] + (grid[k + 1] - grid[k]) * udot[k] / (udot[k] - udot[k + 1]))
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_root_read_outward_is_the_whole_grids(seed):
+    """u̇ a polynomial in u with one to four roots anywhere on the grid (some beyond it, some
+    rising, some a few points apart) and a propeller term: the same root to the bit, or none."""
+    terms = ("1", "u", "u^2", "u^3", "u^4", "|u|*u", "u*n")
+    structure = ModelStructure("roots", {"u": terms, "v": ("v",), "r": ("r",)})
+    rng = np.random.default_rng(seed)
+    found = 0
+    for _ in range(60):
+        speed, span = float(rng.uniform(0.05, 3.0)), float(rng.choice([3.0, 10.0]))
+        roots = np.sort(rng.uniform(0.0, 1.2 * span * speed, rng.integers(1, 4)))
+        if rng.random() < 0.3:  # two roots a few grid points apart
+            roots = np.append(roots, roots[0] + 3e-3 * speed)
+        poly = np.poly(roots)[::-1] * rng.choice([-1.0, 1.0])
+        coefficients = dict(zip(terms[:5], map(float, poly), strict=False))
+        coefficients.update({"|u|*u": 0.0, "u*n": float(rng.normal(scale=1e-3))})
+        model = ManoeuvringModel(structure, {"u": coefficients, "v": {"v": -1.0},
+                                             "r": {"r": -1.0}})  # fmt: skip
+        rps = float(rng.uniform(0.0, 20.0))
+        expected = _whole_grid_root(model, speed, rps, span)
+        assert surge_equilibrium(model, speed, rps, span) == expected
+        found += expected is not None
+    assert found > 15  # most draws have a falling root on the grid
