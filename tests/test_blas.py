@@ -51,3 +51,19 @@ def test_a_command_that_loads_numpy_inside_gets_one_thread():
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,
                          check=True).stdout.strip()  # fmt: skip
     assert out == "False [1]"
+
+
+def test_a_dense_solves_limit_holds_every_blas_and_none_costs_nothing():
+    """``blas_threads``: the libraries found once, every BLAS (NumPy's and SciPy's) set inside
+    and restored after; None touches nothing (the small solves, most of them)."""
+    import scipy.linalg  # noqa: F401
+
+    with threadpool_limits(limits=1, user_api="blas"):
+        with blas.blas_threads(2):
+            assert _blas_threads() == {2}
+        assert _blas_threads() == {1}
+        with blas.blas_threads(None):
+            assert _blas_threads() == {1}
+        with blas.blas_threads(2):  # the found libraries reused
+            assert _blas_threads() == {2}
+        assert _blas_threads() == {1}

@@ -38,8 +38,8 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 import pandas as pd
-from threadpoolctl import threadpool_limits
 
+from shipid.blas import blas_threads
 from shipid.dynamics.model import DOFS, ManoeuvringModel
 from shipid.dynamics.simulate import METHODS, DivergenceBounds, run_kernel
 from shipid.errors import ShipidError
@@ -224,7 +224,7 @@ def output_error(
         # The trust-region steps are BLAS SVDs: OpenBLAS's threads, left spinning between them,
         # slowed the compiled free runs on 2 cores 4-fold (the bounded fit took 10 times the
         # free one's 0.025 s on the paper's zig-zag; ``benchmarks/bench_physics.py``).
-        with threadpool_limits(limits=1, user_api="blas"):
+        with blas_threads(1):
             fit = least_squares(residuals, x, jac=jacobian, x_scale="jac", max_nfev=max_nfev,
                                 args=(sigma,), **solver)  # fmt: skip
         x, nfev = fit.x, nfev + int(fit.nfev)

@@ -21,9 +21,8 @@ from collections.abc import Iterable
 
 import numpy as np
 from scipy import linalg
-from threadpoolctl import threadpool_limits
 
-from shipid.blas import threads_for
+from shipid.blas import blas_threads, threads_for
 from shipid.errors import InfeasibleConstraintsError
 from shipid.limits import available_memory_bytes
 
@@ -79,7 +78,7 @@ def solve_dual(
     rhs[:, :q] = Y
     rhs[:, q] = 1.0
     threads = 1 if n > SINGLE_THREAD_CHOLESKY_ABOVE else threads_for(n)
-    with threadpool_limits(limits=threads):
+    with blas_threads(threads):
         if positive_definite:
             try:
                 factor = linalg.cho_factor(K, lower=True, overwrite_a=True, check_finite=False)
