@@ -810,3 +810,19 @@ def test_warnings_that_say_the_same_of_several_logs_are_one_line():
         "4 logs (a.csv, b.csv, c.csv, …): not a canonical log", "other: a.csv says",
         "d/a.csv: its own", "x.csv: not a canonical log"]
     assert _grouped(texts[:2], ["d/a.csv"]) == texts[:2]
+
+
+def test_the_shared_parser_carries_nothing_from_one_command_to_the_next():
+    """``main`` parses with one parser per process: a repeatable option, a default and a
+    subcommand's own defaults are each command's own, as from a fresh parser."""
+    from shipid.cli.parser import build_parser, shared_parser
+
+    argv = ["identify", "a.csv", "-o", "a.json", "--bound", "r: u*r <= 0", "--bound",
+            "v: delta >= 0"]  # fmt: skip
+    first = vars(shared_parser().parse_args(argv))
+    again = vars(shared_parser().parse_args(["identify", "b.csv", "-o", "b.json"]))
+    fresh = vars(build_parser().parse_args(["identify", "b.csv", "-o", "b.json"]))
+    assert first["bound"] == ["r: u*r <= 0", "v: delta >= 0"]
+    assert again == fresh and again["bound"] is None
+    assert vars(shared_parser().parse_args(["demo"])) == vars(build_parser().parse_args(["demo"]))
+    assert shared_parser() is shared_parser()

@@ -24,7 +24,7 @@ from pathlib import Path
 
 from shipid.blas import one_thread
 from shipid.cli.common import FORMATS
-from shipid.cli.parser import build_parser
+from shipid.cli.parser import build_parser, shared_parser
 from shipid.errors import ShipidError, ShipidWarning
 from shipid.outputs import Interrupted, check_stop, clear_stop, request_stop, stop_requested
 
@@ -159,7 +159,7 @@ class _ClosableStdout:
 
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit code (0, 1, 2 usage, 130 interrupted)."""
-    args = build_parser().parse_args(argv)
+    args = shared_parser().parse_args(argv)
     import threading
 
     # Only the main thread may handle signals; a Dask worker runs jobs in its own threads.
