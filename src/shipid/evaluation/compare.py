@@ -19,7 +19,7 @@ from collections.abc import Sequence
 import numpy as np
 import pandas as pd
 
-from shipid.data.log import common_rudder_convention
+from shipid.data.log import column_array, common_rudder_convention
 from shipid.dynamics.model import DOFS, ModelStructure, get_structure
 from shipid.dynamics.simulate import simulate_log
 from shipid.errors import ShipidError
@@ -48,8 +48,8 @@ def _black_box_fold(method: str, train: list[pd.DataFrame], test: pd.DataFrame, 
     estimators = [make_black_box(method, gamma).fit(X, Y[:, i]) for i in range(3)]
     dyn = RegressorDynamics(estimators, inputs, name=method)
     sim = simulate_log(dyn, test, method=sim_method)
-    measured = test[list(STATES)].to_numpy(dtype=float)
-    simulated = sim.log[list(STATES)].to_numpy(dtype=float)
+    measured = column_array(test, STATES)
+    simulated = column_array(sim.log, STATES)
     return normalised_error(measured, simulated, penalty), sim.diverged
 
 
@@ -111,8 +111,8 @@ def _nested_select(logs, names, library, gamma, method, penalty) -> list[dict]:
         sel = select(train, library=library, names=train_names, method=method,
                      divergence_penalty=penalty)  # fmt: skip
         sim = simulate_log(sel.model, test, method=method)
-        e = normalised_error(test[list(STATES)].to_numpy(float),
-                             sim.log[list(STATES)].to_numpy(float), penalty)  # fmt: skip
+        e = normalised_error(column_array(test, STATES),
+                             column_array(sim.log, STATES), penalty)  # fmt: skip
         rows.append({"method": f"select:{library}", "held_out": name, "diverged": sim.diverged,
                      **dict(zip(STATES, e.tolist(), strict=True)), "score": float(e.mean())})
     return rows

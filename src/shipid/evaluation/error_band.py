@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from shipid.data.log import column_array
 from shipid.errors import ShipidError
 
 STATES = ("u", "v", "r")
@@ -283,6 +284,6 @@ def cross_validated_band(fit, logs, names, cv: str = "auto", method: str = "eule
         # Validated, a held-out zig-zag or turn is also run closed loop: its indices predicted.
         v = validate(model, held, [names[k]], method, start_draws=False)[0]
         sim = v.simulation.log if v.error is None else simulate_log(model, held, method).log
-        runs.append((held[list(STATES)].to_numpy(dtype=float), sim[list(STATES)].to_numpy()))
+        runs.append((column_array(held, STATES), column_array(sim, STATES)))
         indices.append(key_indices(v.kind, v.indices) if v.error is None else None)
     return error_band(runs, level, held_out, names, indices)

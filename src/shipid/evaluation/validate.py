@@ -34,6 +34,7 @@ import numpy as np
 import pandas as pd
 
 from shipid.data.log import (
+    column_array,
     in_rudder_convention,
     mean_true_wind,
     require_states,
@@ -181,8 +182,8 @@ def validate_log(model, log: pd.DataFrame, name: str, method: str = "euler",
     out.warnings += faded_residual_notes(model, sim.log)
     if error_band is not None:
         out.error_band = error_band
-        out.band_shares = error_band.shares_within(whole[list(STATES)].to_numpy(dtype=float),
-                                                   sim.log[list(STATES)].to_numpy())  # fmt: skip
+        out.band_shares = error_band.shares_within(column_array(whole, STATES),
+                                                   column_array(sim.log, STATES))  # fmt: skip
     if ensemble is not None:
         runs = ensemble_runs(ensemble, whole, method)
         out.bands, out.ensemble_diverged = free_run_bands(runs, len(whole))

@@ -22,6 +22,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 import pandas as pd
 
+from shipid.data.log import column_array
 from shipid.dynamics.model import ManoeuvringModel
 from shipid.errors import ShipidError, require_function
 
@@ -74,8 +75,8 @@ def choose_prefilter(
         scores = []
         for log in logs:
             sim = simulate_log(model, log, method)
-            measured = log[["u", "v", "r"]].to_numpy(dtype=float)
-            simulated = sim.log[["u", "v", "r"]].to_numpy(dtype=float)
+            measured = column_array(log, ("u", "v", "r"))
+            simulated = column_array(sim.log, ("u", "v", "r"))
             row["diverged"] += int(sim.diverged)
             # Quarters of each log: the spread of the score, for the one-standard-error rule.
             for part in np.array_split(np.arange(len(measured)), SEGMENTS):

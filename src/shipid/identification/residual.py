@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
+from shipid.data.log import column_array
 from shipid.dynamics.hybrid import KernelResidual
 from shipid.dynamics.model import ManoeuvringModel
 from shipid.errors import ShipidError, require_function
@@ -67,8 +68,8 @@ def residual_data(physical: ManoeuvringModel, logs: Sequence[pd.DataFrame],
             log["thrust"].to_numpy(dtype=float) if "thrust" in log.columns else None,
             log["n"].to_numpy(dtype=float) if "n" in log.columns else None, **given)
         step = np.diff(t)[:, None]
-        observed = np.diff(log[["u", "v", "r"]].to_numpy(dtype=float), axis=0) / step
-        X.append(log[list(features)].to_numpy(dtype=float)[:-1])
+        observed = np.diff(column_array(log, ("u", "v", "r")), axis=0) / step
+        X.append(column_array(log, features)[:-1])
         Y.append(observed - acc[:-1])
     if not X:
         raise ShipidError("a kernel residual needs logs of at least two samples")
@@ -182,7 +183,7 @@ def choose_residual(fit: Callable[[list[pd.DataFrame]], tuple[ManoeuvringModel, 
     for i, held in enumerate(logs):
         physical, fitted_on = fit([x for j, x in enumerate(logs) if j != i])
         data = residual_data(physical, fitted_on, features)
-        measured = held[["u", "v", "r"]].to_numpy(dtype=float)
+        measured = column_array(held, ("u", "v", "r"))
         models = {(None, None): physical}
         for s in sigmas:
             fitted = fit_residuals(physical, fitted_on, gammas, s, features, data)
@@ -190,7 +191,7 @@ def choose_residual(fit: Callable[[list[pd.DataFrame]], tuple[ManoeuvringModel, 
                            for g, r in zip(gammas, fitted, strict=True)})  # fmt: skip
         for key in settings:
             sim = simulate_log(models[key], held, method).log
-            err = normalised_error(measured, sim[["u", "v", "r"]].to_numpy(), DIVERGENCE_PENALTY)
+            err = normalised_error(measured, column_array(sim, ("u", "v", "r")), DIVERGENCE_PENALTY)
             per_fold[key].append(float(np.mean(err)))
     scores = {key: float(np.mean(v)) for key, v in per_fold.items()}
     best = min(scores, key=lambda key: (scores[key], key[0] is not None))

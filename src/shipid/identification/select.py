@@ -48,7 +48,13 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from shipid.data.log import approach, common_rudder_convention, input_columns, require_states
+from shipid.data.log import (
+    approach,
+    column_array,
+    common_rudder_convention,
+    input_columns,
+    require_states,
+)
 from shipid.dynamics.model import DOFS, ManoeuvringModel, ModelStructure, get_structure
 from shipid.dynamics.similarity import similar_library
 from shipid.dynamics.simulate import DivergenceBounds, input_array, run_kernel
@@ -288,7 +294,7 @@ def _prepare(logs: Sequence[pd.DataFrame], names: Sequence[str], library: ModelS
         data.cross.append({d: ext.T @ y[d] for d in DOFS})
         series = {"delta": log["delta"].to_numpy(), **input_columns(log, library.inputs, name)}
         data.inputs.append(input_array(series, 1, len(log))[0])
-        data.measured.append(log[list(STATES)].to_numpy(dtype=float))
+        data.measured.append(column_array(log, STATES))
         first = log.iloc[0]
         data.s0[i] = [float(first.get(k, 0.0)) if k in log.columns else 0.0
                       for k in ("u", "v", "r", "psi", "x", "y")]  # fmt: skip
@@ -1044,7 +1050,7 @@ def _fold_report(data, scorer: _Scorer, weights, chosen: Candidate, logs, names)
                             "spread": {s: float(np.std(logs[h][s])) for s in STATES},
                             "kind": v.kind, "indices": v.indices})  # fmt: skip
                 runs.append((names[h], (data.measured[h],
-                                        v.simulation.log[list(STATES)].to_numpy()),
+                                        column_array(v.simulation.log, STATES)),
                              key_indices(v.kind, v.indices)))  # fmt: skip
             except ShipidError as exc:
                 out.append({"held_out": names[h], "error": str(exc)})

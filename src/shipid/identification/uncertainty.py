@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from shipid.data.log import column_array
 from shipid.dynamics.model import DOFS, ManoeuvringModel, ModelStructure
 from shipid.errors import ShipidError, require_function
 
@@ -398,7 +399,7 @@ def free_run_bands(runs: Sequence, n: int, level: float = LEVEL) -> tuple[Bands,
     values = np.full((len(runs), n, 3), np.nan)
     for k, sim in enumerate(runs):
         m = len(sim.log)
-        values[k, :m] = sim.log[["u", "v", "r"]].to_numpy()
+        values[k, :m] = column_array(sim.log, ("u", "v", "r"))
     lo, hi = conservative_percentiles(values, level)
     bands = {s: (lo[:, j], hi[:, j]) for j, s in enumerate(("u", "v", "r"))}
     return bands, sum(int(sim.diverged) for sim in runs)
