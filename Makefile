@@ -19,7 +19,7 @@ demo: $(STAMP)
 	$(BIN)/shipid demo --out shipid-demo
 
 test: $(STAMP)
-	$(BIN)/python -m pytest -q -n 2 --dist loadfile  # 2 cores; a file's tests on one worker, in order
+	$(BIN)/python -m pytest -q -n 2 --dist loadfile --no-loadscope-reorder  # 2 cores; a file's tests on one worker, in order; files in conftest.py's order
 
 lint: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks

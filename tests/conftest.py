@@ -16,14 +16,18 @@ if os.environ.get("PYTEST_XDIST_WORKER"):
     os.environ.setdefault("NUMBA_NUM_THREADS", "1")
 
 # ``make test`` runs two workers with ``--dist loadfile``: whole files go to whichever worker is
-# free, in collection order. Collected alphabetically, test_readme.py (a third of the suite's
+# free, in collection order. Collected alphabetically, test_readme.py (a fifth of the suite's
 # time: its blocks run in order on one worker) started late and ran alone at the end; the longest
-# files first balance the two workers (by their seconds in a --durations run: with the four
-# longest alone first, one worker ran 98 s of tests and the other 90 s).
-LONGEST_FIRST = ("test_readme.py", "test_other_rps.py", "test_real_data.py",
-                 "test_auto_structure.py", "test_select.py", "test_tanker.py",
-                 "test_output_error.py", "test_files.py", "test_cli.py", "test_steady_speed.py",
-                 "test_study.py")
+# files first balance the two workers (by their seconds in a --durations run), the short ones
+# fill in at the end. pytest-xdist reorders the files by their number of tests unless told not
+# to (``--no-loadscope-reorder``, which make test passes): with its order, test_readme.py started
+# at 72 % of the run, and the two workers ran 80.7 s and 75.0 s of tests.
+LONGEST_FIRST = ("test_readme.py", "test_auto_structure.py", "test_other_rps.py",
+                 "test_real_data.py", "test_cli.py", "test_select.py", "test_output_error.py",
+                 "test_files.py", "test_correction.py", "test_steady_speed.py", "test_tanker.py",
+                 "test_gear_limit.py", "test_control.py", "test_similarity.py", "test_tutorial.py",
+                 "test_study.py", "test_identify.py", "test_selection_ensemble.py",
+                 "test_precompile.py", "test_astern_thrust.py", "test_lssvm.py", "test_fuzz.py")
 
 
 def pytest_collection_modifyitems(session, config, items):
