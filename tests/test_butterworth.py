@@ -2,7 +2,6 @@
 
 import numpy as np
 import pytest
-from scipy.signal import butter, sosfiltfilt
 
 from shipid.data.butterworth import butter_lowpass_sos
 from shipid.data.butterworth import sosfiltfilt as own_sosfiltfilt
@@ -11,6 +10,10 @@ from shipid.data.butterworth import sosfiltfilt as own_sosfiltfilt
 @pytest.mark.parametrize("order", [1, 2, 3, 4, 5])
 @pytest.mark.parametrize("cutoff, fs", [(0.5, 5.0), (1.25, 10.0), (0.01, 2.0), (2.4, 5.0)])
 def test_design_and_filtering_match_scipy(order, cutoff, fs):
+    # Imported here: at the top, each test worker paid scipy.signal's 0.6 s while collecting,
+    # though one runs these tests (shipid itself never imports it).
+    from scipy.signal import butter, sosfiltfilt
+
     ref = butter(order, cutoff, fs=fs, output="sos")
     sos = butter_lowpass_sos(order, cutoff, fs)
     # the same cascade: equal frequency response at every frequency
