@@ -165,30 +165,43 @@ def test_the_inflow_comparison_widens_the_race_where_its_best_is_ruled_out(tmp_p
     assert line.startswith("structure: blanke-race+race-damping (") and "none plausible" in line
 
 
-def test_a_structure_ruled_out_beyond_the_logs_is_named_where_it_predicts_them_better():
+def test_a_structure_ruled_out_beyond_the_logs_is_named_where_it_predicts_them_better(
+        monkeypatch):
     """Where a structure left out for its held 35° rudder alone predicts the logs better than
-    the one fitted and a 10°/10° zig-zag apart from it, the user is told: inside the logs'
-    rudder the choice rests on a check beyond them (the tanker's race structure puts the
-    10°/10° second overshoot within 0.7°, blanke-speed 6.3° low)."""
+    the one fitted and a 10°/10° zig-zag apart from it, the user is told (the tanker's race
+    structure puts the 10°/10° second overshoot within 0.7°, blanke-speed 6.3° low), and
+    whether it fails the checks just beyond the logs' rudder too: this one ends its 25° turn
+    astern, where the ship runs ahead, so the warning no longer offers it as the choice that
+    only a check far beyond the logs ruled out."""
+    from shipid.identification import plausibility
     from shipid.identification.auto_structure import _ruled_out_apart
     from shipid.identification.identify import identify
 
-    logs = _zigzags_at_80_rpm(tanker(rudder_limit_deg=35.0))
+    ship = tanker(rudder_limit_deg=35.0)
+    logs = _zigzags_at_80_rpm(ship)
     chosen = identify(logs, model="blanke-speed").model
     race = identify(logs, model="blanke-race+race-damping").model
     why = "ends going astern with the rudder held to starboard"
-    (warning,) = _ruled_out_apart(chosen, "blanke-speed", 0.283,
-                                  {"blanke-race+race-damping": race},
-                                  {"blanke-race+race-damping": (1, 0.05, why)}, logs)
+    args = ({"blanke-race+race-damping": race}, {"blanke-race+race-damping": (1, 0.05, why)})
+    (warning,) = _ruled_out_apart(chosen, "blanke-speed", 0.283, *args, logs)
     assert warning.startswith("blanke-race+race-damping predicts the logs better than "
                               "blanke-speed (free-run scores 0.050 and 0.283)")
     assert "left out for its 35° rudder held, beyond the logs' 20°" in warning
-    assert "or --model blanke-race+race-damping, decides (where the ship's gear stops short " \
-        "of 35°, its rudder_limit in --particulars moves the check there)" in warning  # fmt: skip
+    assert "and it fails the checks with 25° held too (ends going astern with the rudder " \
+        "held to" in warning and "--model" not in warning  # fmt: skip
+    # The ship itself runs ahead with 25° held: the fit's failure there is the fit's.
+    turn = turning_circle(ship, 25, side="port", duration=3000, dt=1.0)
+    assert not turn.diverged and turn.log["u"].iloc[-300:].min() > 0.3 * ship.approach_speed
+    # A fit that passed them there would be offered, the choice resting on the check beyond.
+    monkeypatch.setattr(plausibility, "disqualifying_at_approach", lambda logs: lambda m: [])
+    (warning,) = _ruled_out_apart(chosen, "blanke-speed", 0.283, *args, logs)
+    assert "the choice rests on a check beyond them (it passes them with 25° held); a " \
+        "zig-zag log of that kind, or --model blanke-race+race-damping, decides (where the " \
+        "ship's gear stops short of 35°, its rudder_limit in --particulars moves the check " \
+        "there)" in warning  # fmt: skip
     # Logs that reach the held rudder hold the check themselves: no warning.
     wide = [log.assign(delta=log["delta"] * 35 / 20) for log in logs]
-    assert _ruled_out_apart(chosen, "blanke-speed", 0.283, {"blanke-race+race-damping": race},
-                            {"blanke-race+race-damping": (1, 0.05, why)}, wide) == []
+    assert _ruled_out_apart(chosen, "blanke-speed", 0.283, *args, wide) == []
 
 
 @pytest.fixture(scope="module")
