@@ -55,3 +55,33 @@ def test_turn_event_times_of_a_noisy_heading():
     got = manoeuvre_indices(_noisy_heading(clean, 1.0, 0))
     for name in ("time_to_90", "time_to_180"):
         assert got[name] == pytest.approx(want[name], abs=0.05), name
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_heading_read_without_unwrap_and_medians_is_numpys_and_the_medians_verdict(seed):
+    """``unwrapped_heading`` skips np.unwrap where no step reaches π and heading_noise's medians
+    where the steps' range settles the floor: the same heading to the bit, and the same choice
+    of raw or fused, on clean, barely noisy, noisy and wrapped headings."""
+    import pandas as pd
+
+    from shipid.data.preprocess import cumulative_integral
+    from shipid.trials.trial import heading_noise
+
+    rng = np.random.default_rng(seed)
+    n = 2000
+    t = np.arange(n) * 0.1
+    r = 0.05 * np.sin(t / 7.0)
+    integral = cumulative_integral(r, t, initial=0.0)
+    psi = integral + 1e-9 * np.cumsum(rng.normal(size=n))  # an integrator's own small drift
+    for sigma in (0.0, 0.2 * HEADING_NOISE_FLOOR, HEADING_NOISE_FLOOR, 3 * HEADING_NOISE_FLOOR):
+        for wrapped in (False, True):
+            heading = psi + sigma * rng.normal(size=n)
+            if wrapped:  # a compass's [-π, π): steps of 2π
+                heading = (heading + 3.0 + np.pi) % (2 * np.pi) - np.pi
+            log = pd.DataFrame({"t": t, "r": r, "psi": heading})
+            got = unwrapped_heading(log)
+            raw = np.unwrap(heading)
+            if heading_noise(raw, integral) <= HEADING_NOISE_FLOOR:
+                assert np.array_equal(got, raw), (sigma, wrapped)
+            else:
+                assert not np.array_equal(got, raw), (sigma, wrapped)
