@@ -3,10 +3,6 @@ leave-one-out refits, repeated samples, and the dense solution for the fixed-siz
 
 import numpy as np
 import pytest
-from sklearn.model_selection import GridSearchCV
-from sklearn.pipeline import make_pipeline
-from sklearn.preprocessing import StandardScaler
-from sklearn.utils.estimator_checks import check_estimator
 
 from shipid.lssvm import LSSVR, LSSVRCV, kernel_matrix, loo_residuals
 
@@ -269,6 +265,10 @@ def test_constant_and_collinear_features_are_legal(solver):
 # scikit-learn (and NumPy with it) before conftest.py could hold BLAS to one thread per worker.
 @pytest.mark.filterwarnings("ignore::sklearn.exceptions.SkipTestWarning")
 def test_passes_scikit_learn_estimator_checks():
+    # scikit-learn's checks and model selection imported in the two tests that use them: at
+    # the top they cost every test worker 0.8 s of its collection.
+    from sklearn.utils.estimator_checks import check_estimator
+
     failures = [
         (r["check_name"], str(r["exception"]))
         for r in check_estimator(LSSVR(), on_fail=None)
@@ -278,6 +278,10 @@ def test_passes_scikit_learn_estimator_checks():
 
 
 def test_works_in_pipeline_and_grid_search():
+    from sklearn.model_selection import GridSearchCV
+    from sklearn.pipeline import make_pipeline
+    from sklearn.preprocessing import StandardScaler
+
     X, y, _ = problem(n=60)
     pipe = make_pipeline(StandardScaler(), LSSVR(kernel="rbf"))
     search = GridSearchCV(pipe, {"lssvr__gamma": [0.1, 10.0], "lssvr__sigma": [1.0, 3.0]}, cv=3)
