@@ -26,6 +26,13 @@ def turns(monkeypatch):
         return original(*args, **kwargs)
 
     monkeypatch.setattr(plausibility, "turning_circle", counted)
+    batch = plausibility.held_turns  # both sides' first runs, together
+
+    def counted_batch(ship, rudder_deg, sides, *args, **kwargs):
+        calls.extend(sides)
+        return batch(ship, rudder_deg, sides, *args, **kwargs)
+
+    monkeypatch.setattr(plausibility, "held_turns", counted_batch)
     return calls
 
 
@@ -141,6 +148,13 @@ def test_the_held_turns_simulate_each_second_once(monkeypatch):
         return original(*args, **kwargs)
 
     monkeypatch.setattr(plausibility, "turning_circle", counted)
+    batch = plausibility.held_turns
+
+    def counted_batch(ship, rudder_deg, sides, duration, *args, **kwargs):
+        simulated.extend([duration] * len(sides))
+        return batch(ship, rudder_deg, sides, duration, *args, **kwargs)
+
+    monkeypatch.setattr(plausibility, "held_turns", counted_batch)
     out = plausibility.held_rudder(ship, ship.approach_speed, rudder_deg=10.0, drifting=False)
     for side in ("starboard", "port"):
         assert out[side]["settled"] and out[side]["duration"] == 1200.0
@@ -156,3 +170,34 @@ def test_threads_checking_side_by_side_get_each_its_own_models_report(turns):
     plausibility._CHECKED.clear()
     alone = {f: check_plausibility(_model(f), 1.6)[0] for f in set(factors)}
     assert all(r == alone[f] for r, f in zip(reports, factors, strict=True))
+
+
+@pytest.mark.parametrize("case", ["terms", "reference ship", "one side diverges"])
+def test_both_sides_run_together_are_each_side_run_alone(case):
+    """``held_turns`` runs the two sides' first held turns in one batch (side by side on numba's
+    threads): each the states, the log and the divergence report of its own turning circle."""
+    import pandas as pd
+
+    from shipid.trials.manoeuvres import as_vessel, held_turns, turning_circle
+    from shipid.vessels import tanker
+
+    if case == "terms":
+        ship, rudder, duration, dt = as_vessel(scale_ship_model(), 1.6), 35.0, 300.0, 0.1
+    elif case == "reference ship":
+        ship, rudder, duration, dt = tanker(), 10.0, 600.0, 0.5
+    else:  # a yaw that grows to the divergence bound to one side, within it to the other
+        lopsided = ModelStructure("lopsided", {"v": ("v", "r", "delta"),
+                                               "r": ("v", "r", "delta", "1")})  # fmt: skip
+        model = ManoeuvringModel(lopsided, {"v": {"v": -0.5, "r": 0.0, "delta": 0.0},
+                                            "r": {"v": 0.0, "r": 0.004, "delta": -0.005,
+                                                  "1": 0.002}})  # fmt: skip
+        ship, rudder, duration, dt = as_vessel(model, 1.0), 35.0, 600.0, 0.2
+    together = held_turns(ship, rudder, ("starboard", "port"), duration, dt)
+    for side, res in zip(("starboard", "port"), together, strict=True):
+        alone = turning_circle(ship, rudder, side=side, duration=duration, dt=dt, indices=False)
+        pd.testing.assert_frame_equal(res.log, alone.log, check_exact=True)
+        assert res.log.attrs == alone.log.attrs
+        assert (res.diverged, res.reason, res.diverged_at) == \
+            (alone.diverged, alone.reason, alone.diverged_at)  # fmt: skip
+    if case == "one side diverges":
+        assert [r.diverged for r in together] == [True, False]

@@ -51,6 +51,7 @@ from shipid.trials.manoeuvres import (
     as_vessel,
     astern_thrust_note,
     doubling,
+    held_turns,
     stopping,
     turning_circle,
 )
@@ -197,12 +198,16 @@ def held_rudder(model: ManoeuvringModel, speed: float, rps: float | None = None,
     the RK4 step, by default ``held_step``'s."""
     if dt is None:
         dt = held_step(model, speed, rps)
+    sides, first = ("starboard", "port"), duration or HELD_DURATION
+    made = _held_ship(model, speed, rps)
+    # Both sides' first runs in one batch (side by side on numba's threads), where most turns
+    # settle; a side that does not goes on alone.
+    firsts = held_turns(made[0], rudder_deg, sides, first, dt, rps, made[1])
     out = {}
-    for side in ("starboard", "port"):
+    for side, res in zip(sides, firsts, strict=True):
         out[side], _ = doubling(
-            _held_runs(model, speed, rps, rudder_deg, side, dt),
-            duration or HELD_DURATION,
-            lambda entry: duration is not None or entry["diverged"] or entry["settled"],
+            _held_runs(model, speed, rps, rudder_deg, side, dt, first=(first, res), ship=made),
+            first, lambda entry: duration is not None or entry["diverged"] or entry["settled"],
             2**HELD_MAX_DOUBLINGS)  # fmt: skip
         if drifting and _worth_entering_drifting(out[side], side, speed):
             start = drift_speed or speed
@@ -264,19 +269,27 @@ def _runaway_from_drift(model, speed, rps, rudder_deg, side, duration, dt,
     return None
 
 
-def _held_runs(model, speed, rps, rudder_deg, side, dt) -> Callable[[float], dict]:
+def _held_ship(model, speed, rps) -> tuple:
+    """The model as the ship of its held turns, and the bounds they diverge at."""
+    # Made once (where its rudder turns it, which a model works out from its terms, was a tenth
+    # of each run's time).
+    return (as_vessel(model, speed, rps=rps),
+            DivergenceBounds(speed=DivergenceBounds().resolved(speed)[0]))  # fmt: skip
+
+
+def _held_runs(model, speed, rps, rudder_deg, side, dt, first=None,
+               ship=None) -> Callable[[float], dict]:  # fmt: skip
     """``run(duration)``: the held turn's entry (``_held_entry``) for ``doubling``; a first call
-    runs from the approach. A longer run
+    runs from the approach (``first``: (length, result), a first run made already, as
+    ``held_turns`` makes both sides'; ``ship``: ``_held_ship``'s, made already). A longer run
     continues the one before from its last state and rudder instead of running again from the
     start: the same RK4 steps from the same state, rudder and divergence bounds, so the same
     states to the bit, and a turn that settles late costs its length once instead of twice (the
     full-scale ships' turns, which double up to 4800 s, were two fifths of the test suite's held
     turns). A continuation that diverges is run again from the start, for its report's time."""
-    bounds = DivergenceBounds(speed=DivergenceBounds().resolved(speed)[0])
-    # The model as the ship of its turns, made once (where its rudder turns it, which a model
-    # works out from its terms, was a tenth of each run's time).
-    ship = as_vessel(model, speed, rps=rps)
+    ship, bounds = ship or _held_ship(model, speed, rps)
     before: dict = {}  # of the last run that did not diverge: its r, u, last state, rudder
+    given = [first] if first is not None else []  # (length, result): a first run made already
 
     def run(duration: float) -> dict:
         n = int(round(duration / dt)) + 1
@@ -288,8 +301,11 @@ def _held_runs(model, speed, rps, rudder_deg, side, dt) -> Callable[[float], dic
             if not more.diverged and len(more.log) == n - m + 1:
                 _keep(before, more.log, goes_on=True)
                 return _held_entry(before["r"], before["u"], False, "", duration, dt)
-        res = turning_circle(ship, rudder_deg, side=side, duration=duration, dt=dt, rps=rps,
-                             indices=False, bounds=bounds)  # fmt: skip
+        if given and given[0][0] == duration and not before:
+            res = given.pop()[1]
+        else:
+            res = turning_circle(ship, rudder_deg, side=side, duration=duration, dt=dt,
+                                 rps=rps, indices=False, bounds=bounds)  # fmt: skip
         before.clear()
         if res.diverged:
             return _held_entry(None, None, True, res.reason, duration, dt)
