@@ -193,11 +193,17 @@ def test_both_sides_run_together_are_each_side_run_alone(case):
                                                   "1": 0.002}})  # fmt: skip
         ship, rudder, duration, dt = as_vessel(model, 1.0), 35.0, 600.0, 0.2
     together = held_turns(ship, rudder, ("starboard", "port"), duration, dt)
-    for side, res in zip(("starboard", "port"), together, strict=True):
-        alone = turning_circle(ship, rudder, side=side, duration=duration, dt=dt, indices=False)
-        pd.testing.assert_frame_equal(res.log, alone.log, check_exact=True)
-        assert res.log.attrs == alone.log.attrs
-        assert (res.diverged, res.reason, res.diverged_at) == \
-            (alone.diverged, alone.reason, alone.diverged_at)  # fmt: skip
+    # And entered drifting, each side from its own start (the runaway check's inward drift).
+    drift = [{"v": 0.1 * ship.approach_speed}, {"v": -0.1 * ship.approach_speed}]
+    drifting = held_turns(ship, rudder, ("starboard", "port"), duration, dt, initial=drift)
+    for k, side in enumerate(("starboard", "port")):
+        for res, initial in ((together[k], None), (drifting[k], drift[k])):
+            alone = turning_circle(ship, rudder, side=side, duration=duration, dt=dt,
+                                   indices=False, initial=initial)  # fmt: skip
+            pd.testing.assert_frame_equal(res.log, alone.log, check_exact=True)
+            assert res.log.attrs == alone.log.attrs
+            assert (res.diverged, res.reason, res.diverged_at) == \
+                (alone.diverged, alone.reason, alone.diverged_at)  # fmt: skip
+    assert not drifting[0].log.equals(together[0].log)  # the start is each side's own
     if case == "one side diverges":
         assert [r.diverged for r in together] == [True, False]

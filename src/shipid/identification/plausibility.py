@@ -209,11 +209,16 @@ def held_rudder(model: ManoeuvringModel, speed: float, rps: float | None = None,
             _held_runs(model, speed, rps, rudder_deg, side, dt, first=(first, res), ship=made),
             first, lambda entry: duration is not None or entry["diverged"] or entry["settled"],
             2**HELD_MAX_DOUBLINGS)  # fmt: skip
-        if drifting and _worth_entering_drifting(out[side], side, speed):
-            start = drift_speed or speed
-            reference = max(start, out[side].get("steady_speed") or 0.0)
-            runaway = _runaway_from_drift(model, start, rps, rudder_deg, side,
-                                          out[side]["duration"], dt, reference)  # fmt: skip
+    entering = [side for side in sides
+                if drifting and _worth_entering_drifting(out[side], side, speed)]  # fmt: skip
+    start = drift_speed or speed
+    # Entered drifting for as long as each side's turn ran: sides of one length together.
+    for length in dict.fromkeys(out[side]["duration"] for side in entering):
+        together = [side for side in entering if out[side]["duration"] == length]
+        for side, runaway in zip(together, _runaways_from_drift(
+                model, start, rps, rudder_deg, together, length, dt,
+                [max(start, out[side].get("steady_speed") or 0.0) for side in together]),
+                strict=True):  # fmt: skip
             if runaway:
                 out[side]["runaway"] = runaway
     return out
@@ -246,27 +251,31 @@ def crash_stop(model, speed: float, rps: float | None, duration: float | None = 
             "coasting": astern.note if astern and astern.kind == "coasting" else None}
 
 
-def _runaway_from_drift(model, speed, rps, rudder_deg, side, duration, dt,
-                        reference: float) -> dict | None:  # fmt: skip
-    """The held turn entered drifting inward, toward the turn's centre (v = ±
+def _runaways_from_drift(model, speed, rps, rudder_deg, sides, duration, dt,
+                         references) -> list[dict | None]:  # fmt: skip
+    """Each of ``sides``' held turn entered drifting inward, toward the turn's centre (v = ±
     ``DRIFT_START_SHARE`` of ``speed``, the side's sign: a ship in a steady turn drifts outward,
-    so this start comes at the turn's balance from the other side), where it diverges or ends
-    over ``SPEEDUP_FACTOR`` times ``reference`` (the faster of ``speed`` and the turn's own
-    steady speed entered straight): {"v0", "diverged", "reason" | "speed", "sway"}; else None.
-    Every runaway found so far came from the inward start (the Esso's, the tanker's
-    ``blanke-speed`` fits to either side): the outward one, tried too, doubled the cost."""
-    if not speed > 0:
-        return None
-    v0 = (1.0 if side == "starboard" else -1.0) * DRIFT_START_SHARE * speed
-    res = turning_circle(model, rudder_deg, side=side, duration=duration, dt=dt, speed=speed,
-                         rps=rps, indices=False, initial={"v": v0})  # fmt: skip
-    if res.diverged:
-        return {"v0": v0, "diverged": True, "reason": res.reason}
-    tail = res.log.iloc[int(0.9 * len(res.log)) :]
-    u = float(np.mean(tail["u"]))
-    if u > SPEEDUP_FACTOR * reference:
-        return {"v0": v0, "diverged": False, "speed": u, "sway": float(np.mean(tail["v"]))}
-    return None
+    so this start comes at the turn's balance from the other side), the sides run together
+    (``held_turns``), where it diverges or ends over ``SPEEDUP_FACTOR`` times its reference (the
+    faster of ``speed`` and the turn's own steady speed entered straight): {"v0", "diverged",
+    "reason" | "speed", "sway"}; else None. Every runaway found so far came from the inward
+    start (the Esso's, the tanker's ``blanke-speed`` fits to either side): the outward one,
+    tried too, doubled the cost."""
+    if not speed > 0 or not sides:
+        return [None] * len(sides)
+    v0 = [(1.0 if side == "starboard" else -1.0) * DRIFT_START_SHARE * speed for side in sides]
+    runs = held_turns(model, rudder_deg, sides, duration, dt, rps, speed=speed,
+                      initial=[{"v": v} for v in v0])  # fmt: skip
+    out = []
+    for v, res, reference in zip(v0, runs, references, strict=True):
+        if res.diverged:
+            out.append({"v0": v, "diverged": True, "reason": res.reason})
+            continue
+        tail = res.log.iloc[int(0.9 * len(res.log)) :]
+        u = float(np.mean(tail["u"]))
+        out.append({"v0": v, "diverged": False, "speed": u, "sway": float(np.mean(tail["v"]))}
+                   if u > SPEEDUP_FACTOR * reference else None)  # fmt: skip
+    return out
 
 
 def _held_ship(model, speed, rps) -> tuple:

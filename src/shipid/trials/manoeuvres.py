@@ -211,14 +211,15 @@ def run_closed_loops(
     dt: float,
     method: str = "rk4",
     bounds: DivergenceBounds | None = None,
-    initial: Mapping[str, float] | None = None,
+    initial: Mapping[str, float] | Sequence[Mapping[str, float] | None] | None = None,
     rps: float | None = None,
     engine: str | None = None,
 ) -> list[ManoeuvreResult]:
-    """``run_closed_loop`` of each row of ``params`` from the same start: one call of the
-    compiled kernel for them all, which runs them side by side on numba's threads (the two
-    sides of a plausibility check's held turn: 2.4 ms against 4.8 ms for two 6000-step runs on
-    two cores); each the same states as alone."""
+    """``run_closed_loop`` of each row of ``params`` (from ``initial``, or from each row's own
+    start where it is a sequence of them): one call of the compiled kernel for them all, which
+    runs them side by side on numba's threads (the two sides of a plausibility check's held
+    turn: 2.4 ms against 4.8 ms for two 6000-step runs on two cores); each the same states as
+    alone."""
     if method not in METHODS:
         raise ShipidError(f"method must be one of {METHODS}, got {method!r}")
     dt = _positive(dt, "step dt")
@@ -229,9 +230,13 @@ def run_closed_loops(
     n = int(round(duration / dt)) + 1
     rows = np.array([np.asarray(p, dtype=float) for p in params])
     b = len(rows)
-    start = {"u": vessel.approach_speed, **(initial or {})}
-    s0 = np.repeat(initial_states({k: v for k, v in start.items() if k != "delta"}, 1), b, 0)
-    speed_lim, yaw_lim = (bounds or DivergenceBounds()).resolved(float(s0[0, 0]))
+    starts = [initial] * b if initial is None or isinstance(initial, Mapping) else list(initial)
+    if len(starts) != b:
+        raise ValueError(f"{len(starts)} initial states for {b} runs")
+    s0 = np.vstack([initial_states({k: v for k, v in {"u": vessel.approach_speed,
+                                                      **(start or {})}.items() if k != "delta"},
+                                   1) for start in starts])  # fmt: skip
+    lims = [(bounds or DivergenceBounds()).resolved(float(s0[k, 0])) for k in range(b)]
     dyn = vessel.dynamics
     uses_rps = getattr(dyn, "uses_rps", False)
     if uses_rps and (rps is None or not math.isfinite(rps)):
@@ -239,7 +244,7 @@ def run_closed_loops(
                           "(rps=..., --rps)")  # fmt: skip
     states, rudder = np.zeros((b, n, 6)), np.zeros((b, n))
     n_valid = np.zeros(b, dtype=np.int64)
-    limits = (np.full(b, speed_lim), np.full(b, yaw_lim))
+    limits = (np.array([lim[0] for lim in lims]), np.array([lim[1] for lim in lims]))
     rk4 = method == "rk4"
     if isinstance(dyn, ManoeuvringModel):
         if dyn.uses_thrust:
@@ -267,10 +272,10 @@ def run_closed_loops(
     else:
         for k in range(b):
             states[k], rudder[k], n_valid[k] = _generic_closed_loop(
-                dyn, rows[k], n, dt, s0[k:k + 1], method, speed_lim, yaw_lim,
+                dyn, rows[k], n, dt, s0[k:k + 1], method, *lims[k],
                 rps if uses_rps else None)  # fmt: skip
     return [_closed_loop_result(vessel, rows[k], states[k], rudder[k], int(n_valid[k]), dt,
-                                rps if uses_rps else None, speed_lim, yaw_lim)
+                                rps if uses_rps else None, *lims[k])
             for k in range(b)]  # fmt: skip
 
 
@@ -482,14 +487,18 @@ def turning_circle(
 
 def held_turns(ship: Vessel | ManoeuvringModel | HybridModel, rudder_deg: float,
                sides: Sequence[str], duration: float, dt: float, rps: float | None = None,
-               bounds: DivergenceBounds | None = None) -> list[ManoeuvreResult]:  # fmt: skip
-    """``turning_circle(ship, rudder_deg, side, duration, dt, rps=rps, indices=False,
-    bounds=bounds)`` for each of ``sides``, run together (``run_closed_loops``): the same
-    states, the sides side by side on numba's threads (the plausibility checks' held turns)."""
-    vessel = as_vessel(ship, None, None, rps)
+               bounds: DivergenceBounds | None = None, speed: float | None = None,
+               initial: Sequence[Mapping[str, float] | None] | None = None,
+               ) -> list[ManoeuvreResult]:  # fmt: skip
+    """``turning_circle(ship, rudder_deg, side, duration, dt, speed=speed, rps=rps,
+    indices=False, bounds=bounds, initial=...)`` for each of ``sides`` (``initial``: each side's
+    start, without a rudder of its own), run together (``run_closed_loops``): the same states,
+    the sides side by side on numba's threads (the plausibility checks' held turns)."""
+    vessel = as_vessel(ship, speed, None, rps)
     rows = [manoeuvre_params(vessel, kernel.MODE_HOLD, _rudder_to(side, vessel, rudder_deg), 0.0,
                              0.0, rps=rps) for side in sides]  # fmt: skip
-    results = run_closed_loops(vessel, rows, duration, dt, bounds=bounds, rps=rps)
+    results = run_closed_loops(vessel, rows, duration, dt, bounds=bounds, rps=rps,
+                               initial=initial)  # fmt: skip
     for side, res in zip(sides, results, strict=True):
         res.log.attrs["manoeuvre"] = f"turning circle {rudder_deg:g}° to {side}"
     return results
