@@ -72,4 +72,3 @@ def blas_threads(threads: int | None) -> contextlib.AbstractContextManager:
 
         _CONTROLLER = ThreadpoolController()
     return _CONTROLLER.limit(limits=threads, user_api="blas")
-

@@ -469,7 +469,7 @@ def turning_circle(
     def run(length: float) -> ManoeuvreResult:
         res = run_closed_loop(vessel, params, length, dt, method, bounds=bounds, initial=initial,
                               rps=rps)  # fmt: skip
-        res.log.attrs["manoeuvre"] = f"turning circle {rudder_deg:g}° to {side}"
+        res.log.attrs["manoeuvre"] = _turning_label(rudder_deg, side)
         if not res.diverged and indices:
             res.indices = turning_indices(res.log, t_order=approach,
                                           length=_finite_or_none(vessel.length))  # fmt: skip
@@ -500,8 +500,13 @@ def held_turns(ship: Vessel | ManoeuvringModel | HybridModel, rudder_deg: float,
     results = run_closed_loops(vessel, rows, duration, dt, bounds=bounds, rps=rps,
                                initial=initial)  # fmt: skip
     for side, res in zip(sides, results, strict=True):
-        res.log.attrs["manoeuvre"] = f"turning circle {rudder_deg:g}° to {side}"
+        res.log.attrs["manoeuvre"] = _turning_label(rudder_deg, side)
     return results
+
+
+def _turning_label(rudder_deg: float, side: str) -> str:
+    """The ``manoeuvre`` a turning circle's log carries."""
+    return f"turning circle {rudder_deg:g}° to {side}"
 
 
 def pull_out(

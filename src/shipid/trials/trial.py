@@ -97,7 +97,11 @@ def heading_noise(psi: np.ndarray, integral: np.ndarray) -> float:
     manoeuvre itself cancels; a gyro's bias is a slow drift)."""
     if psi.size < 3:
         return 0.0
-    d = np.diff(psi - integral)
+    return _step_noise(np.diff(psi - integral))
+
+
+def _step_noise(d: np.ndarray) -> float:
+    """``heading_noise`` of the steps ``d`` of ψ − ∫r dt: their median absolute deviation."""
     return float(np.median(np.abs(d - np.median(d))) / 0.6745 / math.sqrt(2.0))
 
 
@@ -119,11 +123,10 @@ def _heading_noise_within(psi: np.ndarray, integral: np.ndarray, level: float) -
     """``heading_noise(psi, integral) <= level``: the median absolute deviation of the steps
     never exceeds their range (rounding keeps the order), so a range within ``level`` settles
     it without the medians."""
-    if psi.size >= 3:
-        d = np.diff(psi - integral)
-        if np.ptp(d) / 0.6745 / math.sqrt(2.0) <= level:
-            return True
-    return heading_noise(psi, integral) <= level
+    if psi.size < 3:
+        return heading_noise(psi, integral) <= level
+    d = np.diff(psi - integral)
+    return bool(np.ptp(d) / 0.6745 / math.sqrt(2.0) <= level or _step_noise(d) <= level)
 
 
 def unwrapped_heading(log: pd.DataFrame) -> np.ndarray:
