@@ -66,6 +66,42 @@ def test_compiled_kernel_equals_numpy_evaluation_of_every_term():
     np.testing.assert_allclose(compiled, numpy, rtol=1e-12, atol=1e-14)
 
 
+def test_the_kernels_table_holds_each_factor_once_and_rows_of_one_length():
+    from shipid.dynamics.terms import term_code
+
+    code = term_code(["1", "u", "|u|u", "u*|v|*r", "|v|v", "u*v"])
+    rows, sig, op, k, power, _ = code.arrays()
+    factors = list(zip(sig.tolist(), op.tolist(), k.tolist(), power.tolist(), strict=True))
+    assert len(code.signal) == 10
+    assert len(factors) == len(set(factors)) == 5  # u, |u|, |v|, r, v
+    per_term = np.diff(code.start).tolist()
+    assert per_term == [0, 1, 2, 3, 2, 2] and rows.shape == (6, 3)
+    # Each row: the term's own factors in its order, then the index past the distinct ones
+    # (the kernel's factor that reads 1).
+    for j, n in enumerate(per_term):
+        own = [(int(code.signal[f]), int(code.op[f]), float(code.k[f]), int(code.power[f]))
+               for f in range(code.start[j], code.start[j + 1])]  # fmt: skip
+        assert [factors[i] for i in rows[j, :n]] == own
+        assert (rows[j, n:] == len(factors)).all()
+
+
+def test_a_term_without_a_coefficient_is_never_evaluated():
+    # A wind term held at 0 in every equation: a log without the wind reads it as NaN, which
+    # 0·NaN would carry into every acceleration.
+    terms = ("ur", "uv", "delta", "U_A^2*cos(gamma_A)")
+    coefs = {"u": {"ur": 0.0, "uv": 0.0, "delta": -0.1, "U_A^2*cos(gamma_A)": 0.0},
+             "v": {"ur": -0.4, "uv": -0.5, "delta": 0.05, "U_A^2*cos(gamma_A)": 0.0},
+             "r": {"ur": -1.2, "uv": -0.7, "delta": -0.5, "U_A^2*cos(gamma_A)": 0.0}}
+    m = ManoeuvringModel(type(get_structure("blanke"))("held", {d: terms for d in "uvr"}), coefs)
+    states = np.array([[1.0, 0.1, -0.05], [0.8, -0.2, 0.1]])
+    inputs = np.array([[0.3, 0.0, 0.0, np.nan, np.nan], [-0.2, 0.0, 0.0, np.nan, np.nan]])
+    u, v, r = states.T
+    want = np.column_stack([-0.1 * inputs[:, 0],
+                            -0.4 * u * r - 0.5 * u * v + 0.05 * inputs[:, 0],
+                            -1.2 * u * r - 0.7 * u * v - 0.5 * inputs[:, 0]])  # fmt: skip
+    np.testing.assert_allclose(m.compiled_accelerations(states, inputs), want, rtol=1e-14)
+
+
 def test_compiled_simulation_equals_the_numpy_path():
     m = ManoeuvringModel(type(get_structure("blanke"))("no wind", {
         d: tuple(x for x in TERMS if "gamma_A" not in x) for d in ("u", "v", "r")}),

@@ -53,34 +53,34 @@ def hybrid_rhs(ctx, u, v, r, psi):
 
 
 @numba.njit(cache=True)
-def _ctx(th, start, sig, op, kk, pw, rud, derived, wind_true, vw, dw, mean, scale, centres,
+def _ctx(th, rows, sig, op, kk, pw, rud, derived, wind_true, vw, dw, mean, scale, centres,
          weights, intercept, inv_s2, inv_reach, fidx):  # fmt: skip
-    return (kernel._terms_ctx(th, start, sig, op, kk, pw, rud, derived, wind_true, vw, dw), mean,
+    return (kernel._terms_ctx(th, rows, sig, op, kk, pw, rud, derived, wind_true, vw, dw), mean,
             scale, centres, weights, intercept, inv_s2, inv_reach, fidx, np.zeros(5),
             np.zeros(5))  # fmt: skip
 
 
 @numba.njit(cache=True)
-def integrate_open(theta, start, sig, op, kk, pw, rud, derived, mean, scale, centres, weights,
+def integrate_open(theta, rows, sig, op, kk, pw, rud, derived, mean, scale, centres, weights,
                    intercept, inv_s2, inv_reach, fidx, t, inputs, n_steps, s0, rk4, speed_lim,
                    yaw_lim, out, n_valid):  # fmt: skip
     """Free runs driven by input series, as ``kernel.integrate_open``."""
     for b in range(theta.shape[0]):
-        ctx = _ctx(theta[b], start, sig, op, kk, pw, rud, derived, False, 0.0, 0.0, mean, scale,
+        ctx = _ctx(theta[b], rows, sig, op, kk, pw, rud, derived, False, 0.0, 0.0, mean, scale,
                    centres, weights, intercept, inv_s2, inv_reach, fidx)  # fmt: skip
         n_valid[b] = kernel.open_run(_self.hybrid_rhs, ctx, ctx[0][8], t, inputs[b], n_steps[b],
                                      s0[b], rk4, speed_lim[b], yaw_lim[b], out[b])  # fmt: skip
 
 
 @numba.njit(cache=True)
-def integrate_closed(theta, start, sig, op, kk, pw, rud, derived, mean, scale, centres, weights,
+def integrate_closed(theta, rows, sig, op, kk, pw, rud, derived, mean, scale, centres, weights,
                      intercept, inv_s2, inv_reach, fidx, dt, n_steps, s0, params, rk4, speed_lim,
                      yaw_lim, states, rudder, n_valid):  # fmt: skip
     """Closed-loop manoeuvres, as ``kernel.integrate_closed`` (still air is the apparent wind
     of the ship's own motion)."""
     for b in range(theta.shape[0]):
         p = params[b]
-        ctx = _ctx(theta[b], start, sig, op, kk, pw, rud, derived, True, p[kernel.P_WIND_SPEED],
+        ctx = _ctx(theta[b], rows, sig, op, kk, pw, rud, derived, True, p[kernel.P_WIND_SPEED],
                    p[kernel.P_WIND_DIR], mean, scale, centres, weights, intercept, inv_s2,
                    inv_reach, fidx)  # fmt: skip
         n_valid[b] = kernel.closed_run(_self.hybrid_rhs, ctx, ctx[0][8], p, dt, n_steps, s0[b],

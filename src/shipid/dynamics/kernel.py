@@ -156,21 +156,22 @@ def _factor(x, op, k, p):
 
 
 @numba.njit(cache=True, inline="always")
-def _acc(th, start, sig, op, kk, pw, s):
-    """(u̇, v̇, ṙ) = θ φ(s) for the signal vector s; terms with a zero column are skipped."""
+def _acc(th, rows, sig, op, kk, pw, fv, s):
+    """(u̇, v̇, ṙ) = θ φ(s) for the signal vector s: the distinct factors' values into ``fv``
+    (its last entry reads 1), then each term's row of them multiplied; θ (T, 3) holds only the
+    terms with a coefficient (``_terms_ctx``)."""
+    for i in range(sig.size):
+        fv[i] = _factor(s[sig[i]], op[i], kk[i], pw[i])
     a0 = 0.0
     a1 = 0.0
     a2 = 0.0
-    for j in range(start.size - 1):
-        c0, c1, c2 = th[0, j], th[1, j], th[2, j]
-        if c0 == 0.0 and c1 == 0.0 and c2 == 0.0:
-            continue
+    for j in range(rows.shape[0]):
         phi = 1.0
-        for f in range(start[j], start[j + 1]):
-            phi *= _factor(s[sig[f]], op[f], kk[f], pw[f])
-        a0 += c0 * phi
-        a1 += c1 * phi
-        a2 += c2 * phi
+        for f in range(rows.shape[1]):
+            phi *= fv[rows[j, f]]
+        a0 += th[j, 0] * phi
+        a1 += th[j, 1] * phi
+        a2 += th[j, 2] * phi
     return a0, a1, a2
 
 
@@ -185,8 +186,8 @@ def kinematics(u, v, r, psi):
 def terms_rhs(ctx, u, v, r, psi):
     """State derivative of a term-set model; ctx = (θ, factor table (5 arrays), derived, signal
     buffer, inputs, true wind?, wind speed, wind direction, hull length, which slots the buffer
-    has to fill)."""
-    th, start, sig, op, kk, pw, derived, s, inp, wind_true, vw, dw, _, _ = ctx
+    has to fill, the factors' values): ``_terms_ctx``'s."""
+    th, rows, sig, op, kk, pw, derived, s, inp, wind_true, vw, dw, _, _, fv = ctx
     _, xd, yd = kinematics(u, v, r, psi)
     s[0], s[1], s[2] = u, v, r
     if derived:
@@ -204,7 +205,7 @@ def terms_rhs(ctx, u, v, r, psi):
         s[9] = math.atan2(-by, -bx)
     else:
         s[8], s[9] = inp[3], inp[4]
-    a0, a1, a2 = _acc(th, start, sig, op, kk, pw, s)
+    a0, a1, a2 = _acc(th, rows, sig, op, kk, pw, fv, s)
     return a0, a1, a2, r, xd, yd
 
 
@@ -295,7 +296,9 @@ def open_run(rhs, ctx, inp, t, inputs, n_steps, s0, rk4, speed_lim, yaw_lim, out
 
 
 @numba.njit(cache=True)
-def _terms_ctx(th, start, sig, op, kk, pw, rud, derived, wind_true, vw, dw):
+def _terms_ctx(th, rows, sig, op, kk, pw, rud, derived, wind_true, vw, dw):
+    """A run's context for ``terms_rhs`` from θ (3, T) and the factor table
+    (``TermCode.arrays``): θ transposed to the terms with a coefficient, and their rows."""
     hull = 0.0
     reads_wind = False
     for f in range(sig.size):  # a cross-flow factor's k is the hull's length
@@ -303,22 +306,37 @@ def _terms_ctx(th, start, sig, op, kk, pw, rud, derived, wind_true, vw, dw):
             hull = kk[f]
         elif sig[f] == WIND_SPEED_SLOT or sig[f] == WIND_ANGLE_SLOT:
             reads_wind = True
+    # A term whose three coefficients are 0 is left out here, not tested at every evaluation.
+    kept = 0
+    for j in range(th.shape[1]):
+        if th[0, j] != 0.0 or th[1, j] != 0.0 or th[2, j] != 0.0:
+            kept += 1
+    coef = np.empty((kept, 3))
+    used = np.empty((kept, rows.shape[1]), dtype=np.int64)
+    i = 0
+    for j in range(th.shape[1]):
+        if th[0, j] != 0.0 or th[1, j] != 0.0 or th[2, j] != 0.0:
+            for e in range(3):
+                coef[i, e] = th[e, j]
+            for f in range(rows.shape[1]):
+                used[i, f] = rows[j, f]
+            i += 1
     slots = SLOTS_RUDDER if rud[0] > 0.0 else (SLOTS_CROSSFLOW if hull > 0.0 else SLOTS_NONE)
     buffer = np.zeros(N_SIGNALS)
     buffer[INFLOW_SLOT:] = rud
     # The apparent wind of a term set that reads none is never computed (a square root, an
     # arctangent and a sine and cosine in every evaluation of a closed loop's: 107 -> 91 ns).
-    return (th, start, sig, op, kk, pw, derived, buffer, np.zeros(N_INPUTS),
-            wind_true and reads_wind, vw, dw, hull, slots)
+    return (coef, used, sig, op, kk, pw, derived, buffer, np.zeros(N_INPUTS),
+            wind_true and reads_wind, vw, dw, hull, slots, np.ones(sig.size + 1))
 
 
 @numba.njit(cache=True, parallel=True)
-def integrate_open(theta, start, sig, op, kk, pw, rud, derived, t, inputs, n_steps, s0, rk4,
+def integrate_open(theta, rows, sig, op, kk, pw, rud, derived, t, inputs, n_steps, s0, rk4,
                    speed_lim, yaw_lim, out, n_valid):  # fmt: skip
     """Free runs driven by input series: out (B, N, 6), n_valid (B,) valid samples per run
     (a run stops at ``n_steps[b]`` samples or where it diverges)."""
     for b in numba.prange(theta.shape[0]):
-        ctx = _terms_ctx(theta[b], start, sig, op, kk, pw, rud, derived, False, 0.0, 0.0)
+        ctx = _terms_ctx(theta[b], rows, sig, op, kk, pw, rud, derived, False, 0.0, 0.0)
         if ctx[13] == SLOTS_CROSSFLOW:
             n_valid[b] = open_run(_kernel.terms_rhs_crossflow, ctx, ctx[8], t, inputs[b],
                                   n_steps[b], s0[b], rk4, speed_lim[b], yaw_lim[b], out[b])
@@ -457,13 +475,13 @@ def closed_run(rhs, ctx, inp, p, dt, n_steps, s0, rk4, speed_lim, yaw_lim, state
 
 
 @numba.njit(cache=True, parallel=True)
-def integrate_closed(theta, start, sig, op, kk, pw, rud, derived, dt, n_steps, s0, params, rk4,
+def integrate_closed(theta, rows, sig, op, kk, pw, rud, derived, dt, n_steps, s0, params, rk4,
                      speed_lim, yaw_lim, states, rudder, n_valid):  # fmt: skip
     """Closed-loop manoeuvres: states (B, N, 6), rudder (B, N), n_valid (B,)."""
     for b in numba.prange(theta.shape[0]):
         p = params[b]
         # Still air is wind too: the apparent wind of the ship's own motion.
-        ctx = _terms_ctx(theta[b], start, sig, op, kk, pw, rud, derived, True, p[P_WIND_SPEED],
+        ctx = _terms_ctx(theta[b], rows, sig, op, kk, pw, rud, derived, True, p[P_WIND_SPEED],
                          p[P_WIND_DIR])  # fmt: skip
         if ctx[13] == SLOTS_CROSSFLOW:
             n_valid[b] = closed_run(_kernel.terms_rhs_crossflow, ctx, ctx[8], p, dt, n_steps,
@@ -498,9 +516,9 @@ def open_corrected_runs(rhs, extra, terms, t, inputs, n_steps, s0, rk4, speed_li
                         n_valid):  # fmt: skip
     """Free runs of a reference ship (``rhs``, its context the input buffer and ``extra``) plus
     a correction's terms (``terms``: θ (3, T), its factor table and ``derived``)."""
-    theta, start, sig, op, kk, pw, rud, derived = terms
+    theta, rows, sig, op, kk, pw, rud, derived = terms
     for b in range(inputs.shape[0]):
-        own = _terms_ctx(theta, start, sig, op, kk, pw, rud, derived, False, 0.0, 0.0)
+        own = _terms_ctx(theta, rows, sig, op, kk, pw, rud, derived, False, 0.0, 0.0)
         inp = own[8]
         n_valid[b] = open_run(_kernel.corrected_rhs, (inp, rhs, (inp,) + extra, own), inp, t,
                               inputs[b], n_steps[b], s0[b], rk4, speed_lim[b], yaw_lim[b],
@@ -515,10 +533,10 @@ def closed_corrected_runs(rhs, extra, terms, windy, dt, n_steps, s0, params, rk4
     has wind terms (``windy``): the reference ships model none, so the terms meet it as the
     relative wind of the ship's own motion, as a term model's do; without such terms it is not
     computed at every evaluation."""
-    theta, start, sig, op, kk, pw, rud, derived = terms
+    theta, rows, sig, op, kk, pw, rud, derived = terms
     for b in range(params.shape[0]):
         p = params[b]
-        own = _terms_ctx(theta, start, sig, op, kk, pw, rud, derived, windy, p[P_WIND_SPEED],
+        own = _terms_ctx(theta, rows, sig, op, kk, pw, rud, derived, windy, p[P_WIND_SPEED],
                          p[P_WIND_DIR])  # fmt: skip
         inp = own[8]
         n_valid[b] = closed_run(_kernel.corrected_rhs, (inp, rhs, (inp,) + extra, own), inp, p,
@@ -527,10 +545,10 @@ def closed_corrected_runs(rhs, extra, terms, windy, dt, n_steps, s0, params, rk4
 
 
 @numba.njit(cache=True)
-def accelerations(theta, start, sig, op, kk, pw, rud, derived, states, inputs, out):
+def accelerations(theta, rows, sig, op, kk, pw, rud, derived, states, inputs, out):
     """(M, 3) accelerations of one coefficient set θ (3, T) at states (M, 3) and inputs (M, 5):
     the compiled evaluation, checked against ``term_matrix`` by the tests."""
-    ctx = _terms_ctx(theta, start, sig, op, kk, pw, rud, derived, False, 0.0, 0.0)
+    ctx = _terms_ctx(theta, rows, sig, op, kk, pw, rud, derived, False, 0.0, 0.0)
     inp = ctx[8]
     for i in range(states.shape[0]):
         for j in range(N_INPUTS):
