@@ -105,6 +105,27 @@ def test_a_log_built_from_one_block_is_the_frame_of_its_columns():
     ragged = make_log({"t": np.arange(3.0), "u": 1.0})  # a scalar column broadcast, as pandas does
     assert ragged["u"].tolist() == [1.0, 1.0, 1.0]
 
+def test_a_marin_record_that_starts_after_zero_keeps_its_times(tmp_path):
+    """MARIN's three-digit times are rebuilt uniform between the first and the last: a record
+    that starts at 50 s was stretched from 0 over its end time (its step 1.34 times too long)."""
+    t = np.linspace(50.0, 70.0, 201)  # 0.1 s, printed 5.00E+01, 5.01E+01, ...
+    rows = np.zeros((t.size, 11))
+    rows[:, 0], rows[:, 5], rows[:, 10] = t, 8.0, 90.0  # t, dx0/dt, n [rpm]
+    path = tmp_path / "MARIN_FREE_KVLCC2_part_m.dat"
+    path.write_text("MARIN(Maritime Research Institute Netherlands)\nZig-zag : 20 / -20\n\n"
+                    + "\n".join("\t".join(f"{x:.2E}" for x in row) for row in rows) + "\n",
+                    encoding="ascii")  # fmt: skip
+    log = read_log(path, fmt="simman-marin")
+    np.testing.assert_allclose(log["t"], t, rtol=0, atol=1e-12)
+    scaled = read_log(path, fmt="simman-marin", scale=45.7)
+    np.testing.assert_allclose(scaled["t"], t / math.sqrt(45.7), rtol=1e-13)
+    rows[:, 0] = 50.0
+    path.write_text("MARIN\nZig-zag\n" + "\n".join("\t".join(f"{x:.2E}" for x in row)
+                                                    for row in rows), encoding="ascii")  # fmt: skip
+    with pytest.raises(ShipidError, match="time runs from 50 to 50 s, not forward"):
+        read_log(path, fmt="simman-marin")
+
+
 @needs_data
 def test_imported_marin_file_identifies_as_is(tmp_path, capsys):
     csv = tmp_path / "zz20.csv"

@@ -2,10 +2,10 @@
 
 * ``simman-marin``: KVLCC2 free-running tests by MARIN (SIMMAN 2008), full scale, 11 tab-separated
   columns printed with three significant digits after two header lines. The time column repeats at
-  that precision, so time is rebuilt as uniform, t_i = i·t_end/(N − 1); velocities are earth-fixed and
-  are rotated to body axes; degrees become radians; positive rudder turns the ship to port. With
-  ``scale`` (λ) the log is Froude-scaled to model scale: lengths ÷ λ, times and speeds ÷ √λ,
-  rates and revolutions × √λ.
+  that precision, so time is rebuilt as uniform, t_i = t_0 + i·(t_end − t_0)/(N − 1); velocities
+  are earth-fixed and are rotated to body axes; degrees become radians; positive rudder turns the
+  ship to port. With ``scale`` (λ) the log is Froude-scaled to model scale: lengths ÷ λ, times
+  and speeds ÷ √λ, rates and revolutions × √λ.
 * ``simman-hsva``: KVLCC2 free-running tests by HSVA (SIMMAN 2008), model scale, four Latin-1 header
   lines then 12 whitespace-separated columns t, x0, y0, ψ [deg], ẋ0, ẏ0 (earth-fixed, rotated to body
   axes here), r [deg/s], roll [deg], δ [deg], n [rps], thrust [N], torque [N·m]; positive rudder
@@ -98,7 +98,13 @@ def read_simman_marin(path: str | Path, scale: float | None = None) -> pd.DataFr
     d = dict(zip(MARIN_COLUMNS, _numeric_rows(path, lines, 2, MARIN_COLUMNS, "simman-marin").T,
                  strict=True))  # fmt: skip
     n = len(d["t"])
-    t = np.arange(n) * (d["t"][-1] / (n - 1))
+    t0, t_end = d["t"][0], d["t"][-1]
+    if not t_end > t0:
+        raise ShipidError(f"{path}: time runs from {t0:g} to {t_end:g} s, not forward "
+                          f"(--format simman-marin)")  # fmt: skip
+    # From the first time, not from 0: a record cut from a longer one would otherwise be
+    # stretched over its own end time.
+    t = t0 + np.arange(n) * ((t_end - t0) / (n - 1))
     psi = np.radians(d["psi"])
     u, v = _body_velocities(d["xdot"], d["ydot"], psi)
     cols = {"t": t, "delta": np.radians(d["delta"]), "u": u, "v": v, "r": np.radians(d["r"]),
