@@ -32,6 +32,33 @@ def test_the_particulars_carry_the_gear_limit_in_degrees(tmp_path):
             Particulars(length=4.0, rudder_limit=bad)
 
 
+def test_a_misspelt_key_is_named_not_silently_ignored(tmp_path):
+    """``rudder_limt: 10`` was read as no limit: the checks held 35° without a word."""
+    import warnings
+
+    from shipid.errors import ShipidWarning
+
+    path = tmp_path / "ship.yml"
+    path.write_text("length: 300\nrudder_limt: 10\nBeam: 47\nA_r: 120\n")
+    with pytest.warns(ShipidWarning) as caught:
+        p = read_particulars(path)
+    assert p.rudder_limit is None and p.beam is None and p.rudder_area is None
+    said = sorted(str(w.message) for w in caught)
+    assert len(said) == 3
+    assert "'A_r' is not a particulars key and is ignored: did you mean 'A_R, the rudder_area'?" \
+        in said[0]  # fmt: skip
+    assert "'Beam' is not a particulars key and is ignored: did you mean 'beam'?" in said[1]
+    assert "'rudder_limt' is not a particulars key and is ignored: did you mean 'rudder_limit'?" \
+        in said[2]  # fmt: skip
+    # Keys of a file's own, far from every particular (the MARIN ship_data.yml's), pass quietly.
+    path.write_text("L: 7.0\nB: 1.27\nT: 0.46\nI_z: 10014\nvolume: 3.27\nx_p: -3.39\n"
+                    "x_r: -3.5\nw_p0: 0.4\nC_1: 2.0\nC_2_beta_p_pos: 1.6\ntdf: 0.22\n"
+                    "C_R: 0.19\nTWIN: 0\n")  # fmt: skip
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert read_particulars(path).length == 7.0
+
+
 def test_the_checks_hold_the_gears_largest_rudder_inside_the_block_only():
     model = scale_ship_model()
     assert held_rudder_deg() == 35.0

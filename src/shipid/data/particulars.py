@@ -207,7 +207,31 @@ def read_particulars(path: str | Path) -> Particulars:
             raise ShipidError(f"{path}: not a JSON particulars file ({exc})") from None
     else:
         data = _simple_yaml(text, path)
-    return Particulars.from_mapping(data, str(path))
+    particulars = Particulars.from_mapping(data, str(path))
+    _warn_near_misses(data, path)
+    return particulars
+
+
+def _warn_near_misses(data: Mapping, path: Path) -> None:
+    """A warning per key that is none of ours but close to one (a typo, another case): it is
+    ignored, and a ``rudder_limt: 10`` left the checks at 35° without a word. Keys far from all
+    of ours are the file's own business (the MARIN file's I_z, x_p, w_p0, TWIN, ...)."""
+    import difflib
+    import warnings
+
+    from shipid.errors import ShipidWarning
+
+    known = {alias: name for name, aliases in ALIASES.items() for alias in aliases}
+    lowered = {alias.lower(): alias for alias in known}
+    for key in data:
+        if not isinstance(key, str) or key in known:
+            continue
+        close = difflib.get_close_matches(key.lower(), list(lowered), n=1, cutoff=0.75)
+        if close:
+            alias = lowered[close[0]]
+            meant = alias if alias == known[alias] else f"{alias}, the {known[alias]}"
+            warnings.warn(f"{path}: {key!r} is not a particulars key and is ignored: did you "
+                          f"mean {meant!r}?", ShipidWarning, stacklevel=3)  # fmt: skip
 
 
 def _simple_yaml(text: str, path: Path) -> dict:
