@@ -105,6 +105,30 @@ def test_a_log_built_from_one_block_is_the_frame_of_its_columns():
     ragged = make_log({"t": np.arange(3.0), "u": 1.0})  # a scalar column broadcast, as pandas does
     assert ragged["u"].tolist() == [1.0, 1.0, 1.0]
 
+def test_column_options_that_do_nothing_say_so(tmp_path):
+    """--columns naming a column the file lacks, onto one it has, read the file's own column;
+    --columns and --degrees with a known --format were dropped: both without a word."""
+    from shipid.data.formats import read_simman_marin
+    from shipid.errors import ShipidWarning
+
+    log = zigzag(scale_ship(rudder_rate_deg=9.6), 20, 20, duration=30, dt=0.2, approach=2).log
+    path = write_log(log, tmp_path / "zz.csv")
+    with pytest.warns(ShipidWarning, match=r"--columns delta=rudr: the file has no column "
+                                           r"'rudr', so its own 'delta' is read"):  # fmt: skip
+        read = read_log(path, columns={"rudr": "delta"})
+    np.testing.assert_array_equal(read["delta"], log["delta"])
+    rows = np.zeros((40, 11))
+    rows[:, 0], rows[:, 5], rows[:, 10] = np.arange(40) * 0.1, 8.0, 90.0
+    marin = tmp_path / "MARIN_FREE_KVLCC2_zz_20_m.dat"
+    marin.write_text("MARIN\nZig-zag\n" + "\n".join("\t".join(f"{x:.2E}" for x in row)
+                                                    for row in rows), encoding="ascii")  # fmt: skip
+    with pytest.warns(ShipidWarning, match=r"--columns delta=rudder and --degrees psi not "
+                                           r"applied: --format simman-marin reads the file's "
+                                           r"own columns and units"):  # fmt: skip
+        read = read_log(marin, fmt="simman-marin", columns={"rudder": "delta"}, degrees=("psi",))
+    pd.testing.assert_frame_equal(read, read_simman_marin(marin))
+
+
 def test_a_marin_record_that_starts_after_zero_keeps_its_times(tmp_path):
     """MARIN's three-digit times are rebuilt uniform between the first and the last: a record
     that starts at 50 s was stretched from 0 over its end time (its step 1.34 times too long)."""

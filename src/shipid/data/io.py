@@ -129,6 +129,17 @@ def parse_column_map(spec: str | None) -> dict[str, str]:
     return out
 
 
+def _mapped_from_nothing(columns, mapping: Mapping[str, str], name: str) -> None:
+    """A warning where ``--columns`` maps a column the file lacks onto one it has: the file's
+    own column is read instead, which a misspelt ``delta=rudr`` left unsaid. (Where the file
+    has neither, the missing column's error names both.)"""
+    absent = [(canon, source) for source, canon in mapping.items()
+              if source not in columns and canon in columns]  # fmt: skip
+    for canon, source in absent:
+        warnings.warn(f"{name}: --columns {canon}={source}: the file has no column {source!r}, "
+                      f"so its own {canon!r} is read", ShipidWarning, stacklevel=3)  # fmt: skip
+
+
 def _check_file(path: Path) -> None:
     if not path.exists():
         raise ShipidError(f"{path}: no such file")
@@ -265,6 +276,12 @@ def read_log(path: str | Path, options: ReadOptions | None = None, **overrides) 
                           "(to carry a model to another scale: shipid rescale)")  # fmt: skip
     if options.fmt != "canonical":
         _check_file(path)
+        given = [f"--{o} {v}" for o, v in (("columns", ",".join(
+            f"{c}={f}" for f, c in options.columns.items())), ("degrees", ",".join(options.degrees)))
+            if v]  # fmt: skip
+        if given:
+            warnings.warn(f"{name}: {' and '.join(given)} not applied: --format {options.fmt} "
+                          "reads the file's own columns and units", ShipidWarning, stacklevel=2)
         log = read_format(path, options.fmt, options.scale)
         check_log(log, name, fill_gaps=options.fill_gaps)
         if _from_track(log.columns, options):
@@ -283,6 +300,7 @@ def read_log(path: str | Path, options: ReadOptions | None = None, **overrides) 
         bare, units = split_units(df.columns)
         df.columns = bare
         factors = si_factors(units, dict(options.columns), options.degrees, name)
+        _mapped_from_nothing(df.columns, options.columns, name)
         df = df.rename(columns=dict(options.columns))
         dup = df.columns[df.columns.duplicated()].tolist()
         if dup:
