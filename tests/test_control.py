@@ -420,6 +420,23 @@ def test_autopilot_and_follow_say_when_the_model_runs_beyond_its_training(tmp_pa
     assert code == 0 and "outside the training range" in err
 
 
+def test_the_autopilot_steps_to_port_and_refuses_a_step_beyond_half_a_turn(tmp_path, capsys):
+    """Its help said negative steps go to port, but --heading -20 was refused (a rule for the
+    zig-zag's switch heading, > 0, read it); --heading 400 ran, turned the ship 40° and printed
+    an overshoot of −359°, "not settled" after 1920 s."""
+    path = tmp_path / "m.json"
+    scale_ship_model().save(path)
+    code, out, err = run(["autopilot", path, "--speed", "1.93", "--heading", "-20", "--duration",
+                          "120"], capsys)  # fmt: skip
+    assert code == 0, err
+    final = float(out.split("final heading ")[1].split("°")[0])
+    overshoot = float(out.split("overshoot ")[1].split("°")[0])
+    assert final == pytest.approx(-20.0, abs=0.5) and 0.0 <= overshoot < 10.0
+    for bad in ("400", "-180", "0", "nan"):
+        code, _, err = run(["autopilot", path, "--speed", "1.93", "--heading", bad], capsys)
+        assert code == 1 and "--heading must be a step within ±180° other than 0" in err, err
+
+
 @pytest.mark.parametrize("side", ["port", "starboard"])
 def test_the_exported_module_says_which_way_its_rudder_turns(tmp_path, capsys, side):
     """The standalone module had no word of its rudder convention, units or sampling: used

@@ -168,38 +168,42 @@ def cmd_autopilot(args) -> int:
     from shipid.outputs import check_outputs
 
     check_outputs({"-o": (args.output, "figure")}, _model_inputs(args))
+    from shipid.control.autopilot import heading_step_deg
+
+    # Before the tuning: a step of 400° had turned the ship 40° and read "overshoot −359°".
+    step = heading_step_deg(args.heading_step)
     target, truth, speed, rps, steering, cond = _controlled(args)
     nm, pid = _tuned(target, speed, rps, args.omega)
     print(f"PID tuned on {args.model} (Nomoto K = {nm['K']:.4g} 1/s, T = {nm['T']:.4g} s): "
           f"Kp = {pid.kp:.4g}, Ki = {pid.ki:.4g} 1/s, Kd = {pid.kd:.4g} s")
     _oscillatory_note(nm)
-    runs = {args.model: heading_step(target, pid, args.heading, args.duration, args.dt,
+    runs = {args.model: heading_step(target, pid, step, args.duration, args.dt,
                                      speed, rps, steering=steering)}  # fmt: skip
     if truth is not None:
         pid_truth, note = _for_truth(pid, target, truth, speed, rps)
         if note:
             print(note)
-        runs[f"{args.truth} (truth)"] = heading_step(truth, pid_truth, args.heading,
+        runs[f"{args.truth} (truth)"] = heading_step(truth, pid_truth, step,
                                                      args.duration, args.dt)  # fmt: skip
         longest = max(float(log["t"].iloc[-1]) for log in runs.values())
         if args.duration is None and any(log["t"].iloc[-1] < longest for log in runs.values()):
             # One length for both, so that the figure compares them over the same time.
-            runs = {args.model: heading_step(target, pid, args.heading, longest, args.dt, speed,
+            runs = {args.model: heading_step(target, pid, step, longest, args.dt, speed,
                                              rps, steering=steering),
-                    f"{args.truth} (truth)": heading_step(truth, pid_truth, args.heading,
+                    f"{args.truth} (truth)": heading_step(truth, pid_truth, step,
                                                           longest, args.dt)}  # fmt: skip
     _warn_beyond_training(cond, args.model, runs[args.model])
     for name, log in runs.items():
         if log.attrs.get("incomplete") and log.attrs["incomplete"] != "diverged":
             _warn(f"{name}: {log.attrs['incomplete']}; give a longer --duration")
         psi = _np().degrees(log["psi"].to_numpy())
-        over = float(psi.max() - args.heading) if args.heading > 0 else float(args.heading - psi.min())
+        over = float(psi.max() - step) if step > 0 else float(step - psi.min())
         print(f"{name}: overshoot {over:.3g}°, final heading {psi[-1]:.4g}°, max rudder "
               f"{_np().degrees(log['delta'].abs().max()):.3g}°")
     if args.output:
         from shipid.reporting.plots import autopilot_figure
 
-        autopilot_figure(runs, args.output, f"heading autopilot, step to {args.heading:g}°")
+        autopilot_figure(runs, args.output, f"heading autopilot, step to {step:g}°")
         print(f"figure written to {args.output}")
     return 0
 

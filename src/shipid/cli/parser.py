@@ -544,7 +544,8 @@ def build_parser() -> argparse.ArgumentParser:
                        help="step [s] (default %(default)s)")
         if name == "autopilot":
             p.add_argument("--heading", type=float, default=20.0, metavar="DEG",
-                           help="heading step (default %(default)s; positive to starboard)")
+                           dest="heading_step", help="heading step, within ±180° (default "
+                           "%(default)s; positive to starboard, negative to port)")
             p.add_argument("--duration", type=float,
                            help="[s] (default: from 120 s, doubled until the heading settles)")
             p.add_argument("-o", "--output", metavar="FIG.png", help="figure of the responses")

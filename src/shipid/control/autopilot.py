@@ -196,6 +196,16 @@ def _run(ship, pid: PID, desired, duration: float, dt: float, speed: float | Non
 HEADING_STEP_DURATION, HEADING_STEP_MAX_DOUBLINGS, SETTLED_SHARE = 120.0, 4, 0.02
 
 
+def heading_step_deg(value: float) -> float:
+    """``value`` as a heading step [deg]: non-zero and within ±180°, since the autopilot steers
+    the heading error wrapped to half a turn (a step of 400° turned the ship 40°)."""
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value) \
+            or not 0.0 < abs(value) < 180.0:
+        raise ShipidError(f"--heading must be a step within ±180° other than 0 (positive to "
+                          f"starboard, negative to port), got {value!r}")  # fmt: skip
+    return float(value)
+
+
 def heading_step(ship, pid: PID, heading_deg: float, duration: float | None = None,
                  dt: float = 0.1, speed: float | None = None, rps: float | None = None,
                  steering: SteeringMachine | None = None,
@@ -206,7 +216,7 @@ def heading_step(ship, pid: PID, heading_deg: float, duration: float | None = No
     the compiled closed loop of the manoeuvres (``kernel.MODE_HEADING``), as ``heading_loop``
     does step by step in Python (the reference its tests check it against)."""
     vessel = as_vessel(ship, speed, steering, rps)
-    target = math.radians(heading_deg)
+    target = math.radians(heading_step_deg(heading_deg))
     params = manoeuvre_params(vessel, kernel.MODE_HEADING, target, 0.0, 0.0, rps=rps)
     params[kernel.P_KP], params[kernel.P_KI], params[kernel.P_KD] = pid.kp, pid.ki, pid.kd
     tol = SETTLED_SHARE * max(abs(target), math.radians(1.0))
