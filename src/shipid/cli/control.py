@@ -164,12 +164,10 @@ def _model_inputs(args) -> list:
 
 def cmd_autopilot(args) -> int:
     """``shipid autopilot``: heading step of a PID tuned on the model, run on model and truth."""
-    from shipid.control.autopilot import heading_step
+    from shipid.control.autopilot import heading_step, heading_step_deg
     from shipid.outputs import check_outputs
 
     check_outputs({"-o": (args.output, "figure")}, _model_inputs(args))
-    from shipid.control.autopilot import heading_step_deg
-
     # Before the tuning: a step of 400° had turned the ship 40° and read "overshoot −359°".
     step = heading_step_deg(args.heading_step)
     target, truth, speed, rps, steering, cond = _controlled(args)

@@ -276,9 +276,9 @@ def read_log(path: str | Path, options: ReadOptions | None = None, **overrides) 
                           "(to carry a model to another scale: shipid rescale)")  # fmt: skip
     if options.fmt != "canonical":
         _check_file(path)
-        given = [f"--{o} {v}" for o, v in (("columns", ",".join(
-            f"{c}={f}" for f, c in options.columns.items())), ("degrees", ",".join(options.degrees)))
-            if v]  # fmt: skip
+        mapped = ",".join(f"{canon}={source}" for source, canon in options.columns.items())
+        given = [f"--{option} {value}" for option, value
+                 in (("columns", mapped), ("degrees", ",".join(options.degrees))) if value]  # fmt: skip
         if given:
             warnings.warn(f"{name}: {' and '.join(given)} not applied: --format {options.fmt} "
                           "reads the file's own columns and units", ShipidWarning, stacklevel=2)
