@@ -134,6 +134,31 @@ def test_identification_errors():
         identify(uneven)
 
 
+@pytest.mark.parametrize(("logs", "says"), [
+    ("zz.csv", r"^a training log is a pandas DataFrame \(shipid.read_log reads a file into one\), "
+               r"got the path 'zz.csv'$"),
+    (["zz.csv"], r"^training log 1: a training log is a pandas DataFrame .*got the path 'zz.csv'$"),
+    ([None], r"^training log 1: .* got a NoneType$"),
+    ("empty", r": the training log has no samples$"),
+])  # fmt: skip
+def test_logs_that_are_not_logs_are_named_at_the_boundary(logs, says):
+    """A path handed to identify raised an AttributeError ('str' object has no attribute
+    'columns'), an empty log NumPy's 'zero-size array to reduction operation'; validate's paths
+    the same, while its empty log is a row that says why."""
+    log = zigzag(scale_ship(), 20, 20, duration=20, dt=0.2).log
+    if logs == "empty":
+        logs = [log.iloc[:0]]
+    with pytest.raises(ShipidError, match=says):
+        identify(logs)
+    model = identify(log).model
+    if logs and isinstance(logs[0], pd.DataFrame):
+        (row,) = validate(model, logs)
+        assert row.error.endswith("the log to validate against has no samples")
+        return
+    with pytest.raises(ShipidError, match=says.replace("training log", "log to validate against")):
+        validate(model, logs)
+
+
 # ---------------------------------------------------------------------------- CLI
 @pytest.fixture()
 def trial_csv(tmp_path, clean_zigzag):

@@ -22,6 +22,7 @@ import json
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from os import PathLike
 
 import numpy as np
 import pandas as pd
@@ -131,12 +132,32 @@ def require_columns(log: pd.DataFrame, columns, name: str | None = None, why: st
 STATE_COLUMNS = ("t", "delta", "u", "v", "r")
 
 
+def require_frames(logs, names=None, what: str = "log") -> list[pd.DataFrame]:
+    """``logs`` (a DataFrame or several) as a list, each a DataFrame, else one line naming it
+    (a path handed to ``identify`` or ``validate`` raised an AttributeError)."""
+    if isinstance(logs, str | bytes | PathLike):
+        raise ShipidError(f"a {what} is a pandas DataFrame (shipid.read_log reads a file into "
+                          f"one), got the path {str(logs)!r}")  # fmt: skip
+    logs = [logs] if isinstance(logs, pd.DataFrame) else list(logs)
+    for i, log in enumerate(logs):
+        if not isinstance(log, pd.DataFrame):
+            name = names[i] if names and i < len(names) else f"{what} {i + 1}"
+            shown = f"the path {str(log)!r}" if isinstance(log, str | bytes | PathLike) \
+                else f"a {type(log).__name__}"
+            raise ShipidError(f"{name}: a {what} is a pandas DataFrame (shipid.read_log reads "
+                              f"a file into one), got {shown}")  # fmt: skip
+    return logs
+
+
 def require_states(logs, names=None, what: str = "log") -> None:
     """``require_columns`` of t, δ, u, v and r on each of ``logs`` (a DataFrame or several),
-    named by ``names`` where given: what a fit or a free run of every state reads."""
-    for i, log in enumerate([logs] if isinstance(logs, pd.DataFrame) else logs):
-        require_columns(log, STATE_COLUMNS, names[i] if names and i < len(names) else None,
-                        f"a {what} has t, delta, u, v and r")  # fmt: skip
+    named by ``names`` where given: what a fit or a free run of every state reads; and samples
+    (an empty log raised NumPy's "zero-size array")."""
+    for i, log in enumerate(require_frames(logs, names, what)):
+        name = names[i] if names and i < len(names) else None
+        require_columns(log, STATE_COLUMNS, name, f"a {what} has t, delta, u, v and r")
+        if log.empty:
+            raise ShipidError(f"{name or log_name(log)}: the {what} has no samples")
 
 
 # A log whose first 2 % run slower than this share of its typical speed (the 90th percentile of

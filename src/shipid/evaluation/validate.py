@@ -37,6 +37,7 @@ from shipid.data.log import (
     column_array,
     in_rudder_convention,
     mean_true_wind,
+    require_frames,
     require_states,
     rudder_positive,
     starboard_sign,
@@ -569,8 +570,7 @@ def validate(
     intervals; with a cross-validated ``error_band`` (``Selection.error_band``): each log's share
     of samples within it; ``start_draws``: the closed loop's spread with its start
     (``start_spread``, ``START_DRAWS`` more closed-loop runs per log)."""
-    if isinstance(logs, pd.DataFrame):
-        logs = [logs]
+    logs = require_frames(logs, names, "log to validate against")
     names = names or [log.attrs.get("name", f"log {i}") for i, log in enumerate(logs)]
     out = []
     for log, name in zip(logs, names, strict=True):
