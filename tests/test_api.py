@@ -113,6 +113,37 @@ def test_a_dataframe_without_a_column_is_named(short_trial, call, column):
         calls[call]()
 
 
+@pytest.mark.parametrize("call", ["identify", "select", "validate", "simulate_log", "lowpass",
+                                  "resample", "manoeuvre_indices", "trim", "output_error",
+                                  "choose_prefilter", "auto_structure", "refine"])  # fmt: skip
+def test_a_path_where_a_log_belongs_is_named(short_trial, call):
+    """A file's path handed where a log (a DataFrame) belongs raised AttributeError ('str'
+    object has no attribute 'columns' or 'attrs') or TypeError ('string indices must be
+    integers') from deep inside."""
+    from shipid.errors import ShipidError
+    from shipid.vessels.scale_ship import scale_ship_model
+
+    model = scale_ship_model()
+    calls = {"identify": lambda p: shipid.identify(p), "select": lambda p: shipid.select(p),
+             "validate": lambda p: shipid.validate(model, p),
+             "simulate_log": lambda p: shipid.simulate_log(model, p),
+             "lowpass": lambda p: shipid.lowpass(p, 0.5), "resample": lambda p: shipid.resample(p, 0.5),
+             "manoeuvre_indices": lambda p: shipid.manoeuvre_indices(p),
+             "trim": lambda p: shipid.trim(p, start="auto"),
+             "output_error": lambda p: shipid.output_error(model, p),
+             "choose_prefilter": lambda p: shipid.choose_prefilter(p, lambda logs: model),
+             "auto_structure": lambda p: shipid.auto_structure(p),
+             "refine": lambda p: shipid.refine(model, p)}  # fmt: skip
+    one = call in ("simulate_log", "lowpass", "resample", "manoeuvre_indices", "trim")
+    for given in ("zz.csv",) if one else ("zz.csv", ["zz.csv"]):
+        said = r"is a pandas DataFrame \(shipid\.read_log reads a file into one\), got the path"
+        with pytest.raises(ShipidError, match=said + r" 'zz\.csv'$"):
+            calls[call](given)
+    if one:  # a list of logs where one log belongs
+        with pytest.raises(ShipidError, match=r"^a log is a pandas DataFrame .*, got a list$"):
+            calls[call]([short_trial])
+
+
 def test_a_function_is_asked_for_where_one_is_given_something_else(short_trial):
     """A structure or a model given where the fit function is asked for failed with "'X' object
     is not callable" from inside; trim's 'auto' without the rudder with a KeyError."""

@@ -122,7 +122,9 @@ def log_name(log: pd.DataFrame, default: str = "log") -> str:
 
 def require_columns(log: pd.DataFrame, columns, name: str | None = None, why: str = "") -> None:
     """One line naming the log and the ``columns`` it lacks (a DataFrame handed to the Python
-    API: the command line's reader checks its files, the functions raised a KeyError)."""
+    API: the command line's reader checks its files, the functions raised a KeyError), or
+    naming what was handed instead of a log (``require_frame``)."""
+    require_frame(log)
     missing = [c for c in columns if c not in log.columns]
     if missing:
         raise ShipidError(f"{name or log_name(log)}: missing column(s) {', '.join(missing)}"
@@ -130,6 +132,18 @@ def require_columns(log: pd.DataFrame, columns, name: str | None = None, why: st
 
 
 STATE_COLUMNS = ("t", "delta", "u", "v", "r")
+
+
+def require_frame(log, what: str = "log") -> pd.DataFrame:
+    """``log`` itself where it is a DataFrame, else one line naming what it is (a path handed to
+    ``simulate_log``, ``lowpass`` or ``manoeuvre_indices`` raised an AttributeError or a
+    TypeError deep inside)."""
+    if isinstance(log, pd.DataFrame):
+        return log
+    shown = f"the path {str(log)!r}" if isinstance(log, str | bytes | PathLike) \
+        else f"a {type(log).__name__}"
+    raise ShipidError(f"a {what} is a pandas DataFrame (shipid.read_log reads a file into one), "
+                      f"got {shown}")  # fmt: skip
 
 
 def require_frames(logs, names=None, what: str = "log") -> list[pd.DataFrame]:

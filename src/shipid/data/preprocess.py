@@ -68,6 +68,9 @@ def resample(log: pd.DataFrame, dt: float, name: str = "log", fill_gaps: bool = 
     """
     if not (isinstance(dt, int | float) and math.isfinite(dt) and dt > 0):
         raise ShipidError(f"--dt must be a finite number > 0, got {dt!r}")
+    from shipid.data.log import require_columns
+
+    require_columns(log, ("t",), name, "a log to resample has its time")
     t = log["t"].to_numpy()
     gaps = time_gaps(t)
     if gaps and not fill_gaps:
@@ -112,7 +115,9 @@ def lowpass(log: pd.DataFrame, cutoff_hz: float, columns=SIGNALS, order: int = 2
     regression (noise on ξ(k) sits both in the regressors and in the difference ξ(k+1) − ξ(k)).
     """
     from shipid.data.butterworth import butter_lowpass_sos, sosfiltfilt
+    from shipid.data.log import require_columns
 
+    require_columns(log, ("t",), why="a log to filter has its time")
     t = log["t"].to_numpy()
     fs = 1.0 / float(np.median(np.diff(t)))
     if not 0 < cutoff_hz < fs / 2:

@@ -48,6 +48,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
+from shipid.data.log import require_states
 from shipid.dynamics.model import DOFS, ModelStructure, StructureEdit, get_structure
 from shipid.dynamics.propeller import ADVANCE_TERMS
 from shipid.dynamics.similarity import SIDE_FORCE
@@ -158,6 +159,7 @@ def auto_structure(logs: Sequence[pd.DataFrame], names: Sequence[str] | None = N
     ``announce`` is told before a search starts (it takes seconds where a fit takes less);
     ``paper_out``: why the paper's ``blanke`` is out, found by the caller (``identify``: its fit
     through the prefilter it is fitted with fails the checks its unfiltered fit passed)."""
+    require_states(logs, names, "log to choose the structure on")
     choice = _auto_structure(logs, names, physics, cv, estimator, drop, announce or _quiet,
                              paper_out)  # fmt: skip
     choice.structure = _without(choice.structure, drop)

@@ -145,8 +145,9 @@ def output_error(
     The fit as a ``Refinement`` (``method`` and ``statistics``: noise, standard errors,
     covariance, initial states, residual autocorrelation) and the ensemble of draws.
     """
-    if isinstance(logs, pd.DataFrame):
-        logs = [logs]
+    from shipid.data.log import require_frames
+
+    logs = require_frames(logs, names, "log to fit")
     if not logs:
         raise ShipidError("no training logs given for the output-error fit")
     if method not in METHODS:

@@ -54,11 +54,13 @@ def choose_prefilter(
     but the first all but stopped in a 35° turn, its tactical diameter 98 % short, the second
     9 % short).
     """
+    from shipid.data.log import require_states
     from shipid.data.preprocess import lowpass
     from shipid.dynamics.simulate import simulate_log
     from shipid.identification.cross_validation import normalised_error
 
     require_function(fit, "choose_prefilter", "lambda logs: identify(logs, STRUCTURE).model")
+    require_states(logs, what="log to choose the prefilter on")
     if isinstance(logs, pd.DataFrame):
         logs = [logs]
     dt = float(np.median(np.diff(logs[0]["t"].to_numpy())))

@@ -197,8 +197,9 @@ def refine(
         fit; equal bounds give the coefficient (held there, not fitted), as in
         ``output_error``. ``reasons`` ({dof: {term: why}}) name them in the notes.
     """
-    if isinstance(logs, pd.DataFrame):
-        logs = [logs]
+    from shipid.data.log import require_frames
+
+    logs = require_frames(logs, names, "log to refine on")
     if not logs:
         raise ShipidError("no training logs given for the refinement")
     if method not in METHODS:
