@@ -144,6 +144,29 @@ def test_a_path_where_a_log_belongs_is_named(short_trial, call):
             calls[call]([short_trial])
 
 
+@pytest.mark.parametrize("call", ["validate", "simulate_log", "simulate", "output_error",
+                                  "refine", "turning_circle", "zigzag"])  # fmt: skip
+def test_a_path_or_a_name_where_a_model_belongs_is_named(short_trial, call):
+    """validate('m.json', logs) raised "'str' object has no attribute 'uses_thrust'",
+    output_error and refine the same of 'structure', the manoeuvres a TypeError: which function
+    reads a model file or a reference ship by name was left to guess."""
+    from shipid.errors import ShipidError
+
+    calls = {"validate": lambda m: shipid.validate(m, short_trial),
+             "simulate_log": lambda m: shipid.simulate_log(m, short_trial),
+             "simulate": lambda m: shipid.simulate(m, [0.0, 0.1], [0.0, 0.0], {"u": 1.0}),
+             "output_error": lambda m: shipid.output_error(m, short_trial),
+             "refine": lambda m: shipid.refine(m, short_trial),
+             "turning_circle": lambda m: shipid.turning_circle(m, 35),
+             "zigzag": lambda m: shipid.zigzag(m, 20, 20)}  # fmt: skip
+    for given in ("m.json", "kvlcc2"):
+        with pytest.raises(ShipidError, match=r"is a ManoeuvringModel, a HybridModel or a "
+                                              r"reference ship \(shipid\.load_model reads a model "
+                                              rf"file, shipid\.get_vessel a reference ship by "
+                                              rf"name\), got '{given}'$"):  # fmt: skip
+            calls[call](given)
+
+
 def test_a_function_is_asked_for_where_one_is_given_something_else(short_trial):
     """A structure or a model given where the fit function is asked for failed with "'X' object
     is not callable" from inside; trim's 'auto' without the rudder with a KeyError."""

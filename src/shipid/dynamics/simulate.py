@@ -15,6 +15,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from os import PathLike
 from typing import Protocol
 
 import numpy as np
@@ -54,6 +55,16 @@ class DivergenceBounds:
         speed = self.speed if math.isfinite(self.speed) else 10.0 * max(abs(u0), 1.0)
         return speed, self.yaw_rate
 
+
+
+def require_dynamics(dynamics, what: str = "model") -> None:
+    """One line where a file's path or a ship's name is handed where a model or a reference
+    ship belongs (``validate``, ``simulate_log``, ``output_error`` raised "'str' object has no
+    attribute ..." from inside)."""
+    if isinstance(dynamics, str | bytes | PathLike):
+        raise ShipidError(f"a {what} is a ManoeuvringModel, a HybridModel or a reference ship "
+                          f"(shipid.load_model reads a model file, shipid.get_vessel a reference "
+                          f"ship by name), got {str(dynamics)!r}")  # fmt: skip
 
 @dataclass
 class SimulationResult:
@@ -284,6 +295,7 @@ def simulate_batch(
     ``delta``, ``thrust``, ``rps`` (propeller speed) and further ``inputs`` (e.g. wind_speed,
     wind_angle) are (N,) (shared) or (B, N); ``initial`` is a mapping, (6,) or (B, 6).
     """
+    require_dynamics(dynamics)
     if method not in METHODS:
         raise ShipidError(f"method must be one of {METHODS}, got {method!r}")
     t = _check_time(t)
@@ -398,6 +410,7 @@ def simulate_log(
 ) -> SimulationResult:
     """Free-run simulation from a log's measured initial state, driven by its measured rudder (and
     thrust, propeller speed and wind where the model uses them): the paper's validation (§ 4)."""
+    require_dynamics(dynamics)
     require_columns(log, ("t", "delta"), why="a log drives a free run with its time and rudder")
     gaps = time_gaps(log["t"].to_numpy())
     if gaps:

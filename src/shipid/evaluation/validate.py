@@ -47,7 +47,7 @@ from shipid.data.trim import DEFAULT_LEAD_S
 from shipid.dynamics.equilibrium import surge_equilibrium
 from shipid.dynamics.hybrid import HybridModel
 from shipid.dynamics.model import ManoeuvringModel
-from shipid.dynamics.simulate import SimulationResult, simulate_log
+from shipid.dynamics.simulate import SimulationResult, require_dynamics, simulate_log
 from shipid.dynamics.steering import SteeringMachine
 from shipid.errors import ShipidError
 from shipid.evaluation.error_band import ErrorBand
@@ -570,6 +570,7 @@ def validate(
     intervals; with a cross-validated ``error_band`` (``Selection.error_band``): each log's share
     of samples within it; ``start_draws``: the closed loop's spread with its start
     (``start_spread``, ``START_DRAWS`` more closed-loop runs per log)."""
+    require_dynamics(model)
     logs = require_frames(logs, names, "log to validate against")
     names = names or [log.attrs.get("name", f"log {i}") for i, log in enumerate(logs)]
     out = []

@@ -146,7 +146,9 @@ def output_error(
     covariance, initial states, residual autocorrelation) and the ensemble of draws.
     """
     from shipid.data.log import require_frames
+    from shipid.dynamics.simulate import require_dynamics
 
+    require_dynamics(model)
     logs = require_frames(logs, names, "log to fit")
     if not logs:
         raise ShipidError("no training logs given for the output-error fit")

@@ -198,7 +198,9 @@ def refine(
         ``output_error``. ``reasons`` ({dof: {term: why}}) name them in the notes.
     """
     from shipid.data.log import require_frames
+    from shipid.dynamics.simulate import require_dynamics
 
+    require_dynamics(model)
     logs = require_frames(logs, names, "log to refine on")
     if not logs:
         raise ShipidError("no training logs given for the refinement")

@@ -149,6 +149,9 @@ def as_vessel(ship: Vessel | ManoeuvringModel | HybridModel, speed: float | None
                         rudder_positive=ship.rudder_positive_turns_at(speed, rps),
                         scale=float("nan"), source=ship.name)  # fmt: skip
     else:
+        from shipid.dynamics.simulate import require_dynamics
+
+        require_dynamics(ship, "ship")  # a path or a name: which function reads it
         raise TypeError(f"expected a Vessel, ManoeuvringModel or HybridModel, got "
                         f"{type(ship).__name__}")
     changes = {}
