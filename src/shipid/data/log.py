@@ -140,26 +140,27 @@ def require_frame(log, what: str = "log") -> pd.DataFrame:
     TypeError deep inside)."""
     if isinstance(log, pd.DataFrame):
         return log
-    shown = f"the path {str(log)!r}" if isinstance(log, str | bytes | PathLike) \
-        else f"a {type(log).__name__}"
     raise ShipidError(f"a {what} is a pandas DataFrame (shipid.read_log reads a file into one), "
-                      f"got {shown}")  # fmt: skip
+                      f"got {_given(log)}")  # fmt: skip
+
+
+def _given(obj) -> str:
+    """What was handed where a log belongs, for the message: a path, or the object's type."""
+    return f"the path {str(obj)!r}" if isinstance(obj, str | bytes | PathLike) \
+        else f"a {type(obj).__name__}"
 
 
 def require_frames(logs, names=None, what: str = "log") -> list[pd.DataFrame]:
     """``logs`` (a DataFrame or several) as a list, each a DataFrame, else one line naming it
     (a path handed to ``identify`` or ``validate`` raised an AttributeError)."""
     if isinstance(logs, str | bytes | PathLike):
-        raise ShipidError(f"a {what} is a pandas DataFrame (shipid.read_log reads a file into "
-                          f"one), got the path {str(logs)!r}")  # fmt: skip
+        require_frame(logs, what)
     logs = [logs] if isinstance(logs, pd.DataFrame) else list(logs)
     for i, log in enumerate(logs):
         if not isinstance(log, pd.DataFrame):
             name = names[i] if names and i < len(names) else f"{what} {i + 1}"
-            shown = f"the path {str(log)!r}" if isinstance(log, str | bytes | PathLike) \
-                else f"a {type(log).__name__}"
             raise ShipidError(f"{name}: a {what} is a pandas DataFrame (shipid.read_log reads "
-                              f"a file into one), got {shown}")  # fmt: skip
+                              f"a file into one), got {_given(log)}")  # fmt: skip
     return logs
 
 
