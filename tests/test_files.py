@@ -4,6 +4,7 @@ and units that look wrong. Each test reproduces a defect of issue #11 (numbered 
 import json
 import math
 import os
+import re
 import stat
 from pathlib import Path
 
@@ -508,6 +509,23 @@ def test_yaw_rate_in_degrees_on_a_gentle_manoeuvre_is_caught_by_the_heading(tmp_
     assert np.degrees(log["r"]).abs().max() < 3
     with pytest.raises(ShipidError, match="r looks like degrees per second; give --degrees r"):
         read_log(_write(tmp_path, log.assign(r=np.degrees(log["r"]))))
+
+
+@pytest.mark.parametrize(("column", "header", "said"), [
+    ("psi", "psi [deg]", "the heading 'psi', read in degrees (its header or --degrees psi), "
+                         "changes 57.3 times slower than the yaw rate 'r' says: psi looks like "
+                         "radians already"),
+    ("r", "r [deg/s]", "the heading 'psi' changes 57.3 times faster than the yaw rate 'r', read "
+                       "in degrees per second (its header or --degrees r), turns: r looks like "
+                       "radians per second already"),
+])  # fmt: skip
+def test_a_header_in_degrees_over_radians_names_its_own_column(tmp_path, trial, column, header,
+                                                               said):  # fmt: skip
+    """A heading whose header said '[deg]' over values in radians was refused with "r looks
+    like degrees per second; give --degrees r": the right column named wrong."""
+    path = _write(tmp_path, trial.rename(columns={column: header}))
+    with pytest.raises(ShipidError, match=re.escape(said)):
+        read_log(path)
 
 
 def test_over_long_lines_are_refused_quickly(tmp_path):

@@ -220,9 +220,12 @@ def check_log(df: pd.DataFrame, name: str, min_samples: int = 3, fill_gaps: bool
         raise ShipidError(f"{name}: {len(df)} samples, too short (at least {min_samples} needed)")
 
 
-def check_units(df: pd.DataFrame, name: str, degrees=(), offset_given: bool = False) -> None:
+def check_units(df: pd.DataFrame, name: str, degrees=(), offset_given: bool = False,
+                converted=()) -> None:  # fmt: skip
     """Refuse signals whose units are evidently not the canonical ones (after ``--degrees``);
-    name a gyro's offset on r unless one is to be subtracted (``offset_given``)."""
+    name a gyro's offset on r unless one is to be subtracted (``offset_given``). ``converted``:
+    the angle columns read in degrees (their header's unit, or ``--degrees``), which a heading
+    and a yaw rate that disagree by 180/π then name as the likelier culprit."""
     for c, limit in RADIAN_PLAUSIBLE.items():
         if c in df.columns and c not in degrees:
             peak = float(np.max(np.abs(df[c].to_numpy())))
@@ -241,7 +244,7 @@ def check_units(df: pd.DataFrame, name: str, degrees=(), offset_given: bool = Fa
                           "(milliseconds?): give t in seconds, or its unit in the header: "
                           "'time [ms]'")  # fmt: skip
     if "psi" in df.columns:
-        _check_heading_against_yaw_rate(df, name)
+        _check_heading_against_yaw_rate(df, name, converted)
         if not offset_given:
             _check_yaw_rate_offset(df, name)
         if {"x", "y"} <= set(df.columns):
@@ -430,14 +433,24 @@ def heading_rate_ratio(t: np.ndarray, psi: np.ndarray, r: np.ndarray) -> float |
     return float(rate @ rr) / denom if denom > 0 else None
 
 
-def _check_heading_against_yaw_rate(df: pd.DataFrame, name: str) -> None:
+def _check_heading_against_yaw_rate(df: pd.DataFrame, name: str, converted=()) -> None:
     ratio = heading_rate_ratio(df["t"].to_numpy(), df["psi"].to_numpy(), df["r"].to_numpy())
     if ratio is None or 0.5 <= ratio <= 2.0:
         return
+    # Where the column the ratio would blame was read as radians, the other one, read from
+    # degrees, is the likelier: a header '[deg]' over radians had the right column named wrong.
     if DEG / 2 <= ratio <= DEG * 2:
+        if "r" in converted and "psi" not in converted:
+            raise ShipidError(f"{name}: the heading 'psi' changes {ratio:.3g} times faster than "
+                              "the yaw rate 'r', read in degrees per second (its header or "
+                              "--degrees r), turns: r looks like radians per second already")
         raise ShipidError(f"{name}: the heading 'psi' changes {ratio:.3g} times faster than the "
                           "yaw rate 'r' turns: psi looks like degrees; give --degrees psi")
     if 1 / (2 * DEG) <= ratio <= 2 / DEG:
+        if "psi" in converted and "r" not in converted:
+            raise ShipidError(f"{name}: the heading 'psi', read in degrees (its header or "
+                              f"--degrees psi), changes {1 / ratio:.3g} times slower than the "
+                              "yaw rate 'r' says: psi looks like radians already")  # fmt: skip
         raise ShipidError(f"{name}: the heading 'psi' changes {1 / ratio:.3g} times slower than "
                           "the yaw rate 'r' says: r looks like degrees per second; give --degrees r")
     if 0.5e-3 <= ratio <= 2e-3:

@@ -274,6 +274,7 @@ def read_log(path: str | Path, options: ReadOptions | None = None, **overrides) 
         raise ShipidError(f"{name}: --scale applies to the SIMMAN files (MARIN's are full scale, "
                           f"Froude-scaled by it); a {options.fmt} log is read at its own scale "
                           "(to carry a model to another scale: shipid rescale)")  # fmt: skip
+    converted: set[str] = set()  # angle columns read in degrees, for check_units' messages
     if options.fmt != "canonical":
         _check_file(path)
         mapped = ",".join(f"{canon}={source}" for source, canon in options.columns.items())
@@ -332,6 +333,7 @@ def read_log(path: str | Path, options: ReadOptions | None = None, **overrides) 
                               "their own unit: drop the unit from its header")  # fmt: skip
         # Header units and --degrees (si_factors leaves a column --degrees names to it).
         factors.update({c: math.pi / 180.0 for c in options.degrees})
+        converted = {c for c, factor in factors.items() if factor == math.pi / 180.0}
         for c, factor in factors.items():
             if c in df.columns:
                 df[c] = df[c].to_numpy() * factor
@@ -350,7 +352,8 @@ def read_log(path: str | Path, options: ReadOptions | None = None, **overrides) 
         log.attrs.update(meta)
         stated = "rudder_positive" in meta
         log.attrs.update({k: df.attrs[k] for k in ("time_origin",) if k in df.attrs})
-    check_units(log, name, options.degrees, offset_given=options.yaw_rate_offset is not None)
+    check_units(log, name, options.degrees, offset_given=options.yaw_rate_offset is not None,
+                converted=converted)
     log.attrs["name"] = path.name
     if options.rudder_positive:
         log.attrs["rudder_positive"] = options.rudder_positive
