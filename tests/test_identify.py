@@ -139,6 +139,7 @@ def test_identification_errors():
                r"got the path 'zz.csv'$"),
     (["zz.csv"], r"^training log 1: a training log is a pandas DataFrame .*got the path 'zz.csv'$"),
     ([None], r"^training log 1: .* got a NoneType$"),
+    (3, r"^a training log is a pandas DataFrame .*, got an int$"),
     ("empty", r": the training log has no samples$"),
 ])  # fmt: skip
 def test_logs_that_are_not_logs_are_named_at_the_boundary(logs, says):
@@ -151,7 +152,7 @@ def test_logs_that_are_not_logs_are_named_at_the_boundary(logs, says):
     with pytest.raises(ShipidError, match=says):
         identify(logs)
     model = identify(log).model
-    if logs and isinstance(logs[0], pd.DataFrame):
+    if isinstance(logs, list) and isinstance(logs[0], pd.DataFrame):
         (row,) = validate(model, logs)
         assert row.error.endswith("the log to validate against has no samples")
         return

@@ -20,7 +20,7 @@ from __future__ import annotations
 import functools
 import json
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from os import PathLike
 
@@ -146,14 +146,16 @@ def require_frame(log, what: str = "log") -> pd.DataFrame:
 
 def _given(obj) -> str:
     """What was handed where a log belongs, for the message: a path, or the object's type."""
-    return f"the path {str(obj)!r}" if isinstance(obj, str | bytes | PathLike) \
-        else f"a {type(obj).__name__}"
+    if isinstance(obj, str | bytes | PathLike):
+        return f"the path {str(obj)!r}"
+    kind = type(obj).__name__
+    return f"{'an' if kind[0].lower() in 'aeiou' else 'a'} {kind}"
 
 
 def require_frames(logs, names=None, what: str = "log") -> list[pd.DataFrame]:
     """``logs`` (a DataFrame or several) as a list, each a DataFrame, else one line naming it
     (a path handed to ``identify`` or ``validate`` raised an AttributeError)."""
-    if isinstance(logs, str | bytes | PathLike):
+    if isinstance(logs, str | bytes | PathLike) or not isinstance(logs, pd.DataFrame | Iterable):
         require_frame(logs, what)
     logs = [logs] if isinstance(logs, pd.DataFrame) else list(logs)
     for i, log in enumerate(logs):
