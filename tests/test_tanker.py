@@ -189,9 +189,19 @@ def test_a_structure_ruled_out_beyond_the_logs_is_named_where_it_predicts_them_b
     assert "left out for its 35° rudder held, beyond the logs' 20°" in warning
     assert "and it fails the checks with 25° held too (ends going astern with the rudder " \
         "held to" in warning and "--model" not in warning  # fmt: skip
+    assert "the logs' own" not in warning  # it ends astern with their 20° held too
     # The ship itself runs ahead with 25° held: the fit's failure there is the fit's.
     turn = turning_circle(ship, 25, side="port", duration=3000, dt=1.0)
     assert not turn.diverged and turn.log["u"].iloc[-300:].min() > 0.3 * ship.approach_speed
+    # A fit that fails just beyond the logs' rudder but passes at it: a gear that stops there
+    # (its rudder_limit) holds the checks where it passes.
+    monkeypatch.setattr(plausibility, "disqualifying_at_approach", lambda logs: lambda m: (
+        ["spins"] if plausibility.held_rudder_deg() > 20.5 else []))
+    (warning,) = _ruled_out_apart(chosen, "blanke-speed", 0.283, *args, logs)
+    assert warning.endswith("and it fails the checks with 25° held too (spins): near the logs' "
+                            "rudder as beyond it; a zig-zag log of that kind decides; it passes "
+                            "them with 20° held, the logs' own: where the ship's gear stops "
+                            "there, its rudder_limit in --particulars holds the checks there")
     # A fit that passed them there would be offered, the choice resting on the check beyond.
     monkeypatch.setattr(plausibility, "disqualifying_at_approach", lambda logs: lambda m: [])
     (warning,) = _ruled_out_apart(chosen, "blanke-speed", 0.283, *args, logs)

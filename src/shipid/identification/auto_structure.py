@@ -1045,9 +1045,15 @@ def _ruled_out_apart(chosen, name: str, score: float, ruled_out: Mapping[str, ob
         with held_rudder_at(reach + BEYOND_RUDDER_DEG) as near:
             nearer = disqualifying_at_approach(logs)(model)
         if nearer:
+            # At the logs' own rudder it may pass: the choice a gear that stops there makes
+            # (the tanker's 10° gear: its race fit within 1.2 % of the 10° turns).
+            with held_rudder_at(reach) as own:
+                gear = "" if disqualifying_at_approach(logs)(model) else (
+                    f"; it passes them with {own:.3g}° held, the logs' own: where the ship's gear "
+                    f"stops there, its rudder_limit in --particulars holds the checks there")
             out.append(f"{head}, and it fails the checks with {near:.3g}° held too "
                        f"({'; '.join(nearer)}): near the logs' rudder as beyond it; a zig-zag "
-                       "log of that kind decides")  # fmt: skip
+                       f"log of that kind decides{gear}")  # fmt: skip
         else:
             out.append(f"{head}: inside the logs' rudder the choice rests on a check beyond "
                        f"them (it passes them with {near:.3g}° held); a zig-zag log of that "
