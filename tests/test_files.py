@@ -105,6 +105,18 @@ def test_a_log_built_from_one_block_is_the_frame_of_its_columns():
         assert column_array(log, names).shape == (7, len(names))
     ragged = make_log({"t": np.arange(3.0), "u": 1.0})  # a scalar column broadcast, as pandas does
     assert ragged["u"].tolist() == [1.0, 1.0, 1.0]
+    # Columns of different lengths are named (pandas said "All arrays must be of the same length").
+    with pytest.raises(ValueError, match=r"^log columns of different lengths: t 3, delta 2$"):
+        make_log({"t": np.arange(3.0), "delta": [0.0, 1.0], "u": 1.0})
+
+
+def test_write_log_names_what_is_not_a_log(tmp_path):
+    """write_log('notalog', path) raised "'str' object has no attribute 'copy'"; nothing is
+    written."""
+    with pytest.raises(ShipidError, match=r"^a log to write is a pandas DataFrame .*got the "
+                                          r"path 'notalog'$"):  # fmt: skip
+        write_log("notalog", tmp_path / "w.csv")
+    assert not (tmp_path / "w.csv").exists()
 
 def test_column_options_that_do_nothing_say_so(tmp_path):
     """--columns naming a column the file lacks, onto one it has, read the file's own column;

@@ -425,8 +425,10 @@ def write_log(log: pd.DataFrame, path: str | Path, out=None) -> Path:
 
     ``out``: an ``OutputSet`` to stage the file in (written with the set), else written at once.
     """
+    from shipid.data.log import require_frame
+
     path = Path(path)
-    frame = log.copy()
+    frame = require_frame(log, "log to write").copy()
     frame.attrs = metadata(log)
     if path.suffix.lower() in (".parquet", ".pq"):
         def writer(p: Path) -> None:

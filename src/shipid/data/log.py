@@ -81,6 +81,10 @@ def make_log(columns: Mapping[str, np.ndarray], **meta: object) -> pd.DataFrame:
         raise ValueError(f"not canonical log columns: {sorted(unknown)}; use {COLUMNS}")
     arrays = {c: np.asarray(columns[c], dtype=float) for c in COLUMNS if c in columns}
     lengths = {a.shape for a in arrays.values()}
+    if len({a.shape for a in arrays.values() if a.ndim}) > 1:  # a scalar is broadcast
+        # pandas' own "All arrays must be of the same length" named none of them.
+        raise ValueError("log columns of different lengths: " + ", ".join(
+            f"{c} {len(a)}" for c, a in arrays.items() if a.ndim))
     if len(lengths) == 1 and len(next(iter(lengths))) == 1:
         # One (columns, samples) block handed over whole: a dict of columns is copied and
         # stacked by pandas, 80 µs of a held turn's 180 µs log (a search builds thousands).
