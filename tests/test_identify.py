@@ -134,6 +134,22 @@ def test_identification_errors():
         identify(uneven)
 
 
+def test_names_one_per_log(clean_zigzag):
+    """Names for fewer or more logs than given raised zip()'s "argument 2 is shorter than
+    argument 1" from deep inside identify, validate, select and output_error."""
+    from shipid.identification.output_error import output_error
+    from shipid.identification.select import select
+
+    logs = [clean_zigzag, clean_zigzag.copy()]
+    model = identify(clean_zigzag).model
+    for call in (lambda n: identify(logs, names=n), lambda n: validate(model, logs, names=n),
+                 lambda n: select(logs, names=n), lambda n: output_error(model, logs, names=n)):
+        for names in (["a"], ["a", "b", "c"]):
+            with pytest.raises(ShipidError, match=rf"^names: {len(names)} given for 2 logs, "
+                                                  r"one per log$"):  # fmt: skip
+                call(names)
+
+
 @pytest.mark.parametrize(("logs", "says"), [
     ("zz.csv", r"^a training log is a pandas DataFrame \(shipid.read_log reads a file into one\), "
                r"got the path 'zz.csv'$"),

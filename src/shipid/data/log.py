@@ -162,6 +162,9 @@ def require_frames(logs, names=None, what: str = "log") -> list[pd.DataFrame]:
     if isinstance(logs, str | bytes | PathLike) or not isinstance(logs, pd.DataFrame | Iterable):
         require_frame(logs, what)
     logs = [logs] if isinstance(logs, pd.DataFrame) else list(logs)
+    if names is not None and not isinstance(names, str) and len(names) != len(logs):
+        # zip(strict=True) said "argument 2 is shorter than argument 1", deep inside.
+        raise ShipidError(f"names: {len(names)} given for {len(logs)} logs, one per log")
     for i, log in enumerate(logs):
         if not isinstance(log, pd.DataFrame):
             name = names[i] if names and i < len(names) else f"{what} {i + 1}"
