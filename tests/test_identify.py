@@ -261,6 +261,23 @@ def test_cli_bad_input_exits_1_with_one_line_and_no_output(tmp_path, capsys, nam
     assert not out.exists() and list(tmp_path.glob(".model.json*")) == []
 
 
+def test_cli_a_bound_on_a_term_the_chosen_structure_lacks_is_named(tmp_path, trial_csv, capsys):
+    """With the structure chosen for the logs, a bound applies where a structure has its term:
+    '--bound u: r^3 <= 0' (r² meant), met by a structure without r³, fitted nothing, without a
+    word. With --model it is refused, as before."""
+    out = tmp_path / "m.json"
+    code, _, err = run(["identify", trial_csv, "--bound", "u: r^3 <= 0", "--bound",
+                        "u: delta^2 <= 0", "--no-output-error", "-o", out], capsys)  # fmt: skip
+    assert code == 0, err
+    assert "--bound u: r^3: the u equation of the structure chosen (blanke) has no r^3: its " \
+        "absence (a coefficient of 0) meets the bound, which fits nothing (--model with the " \
+        "term fits it)" in err  # fmt: skip
+    assert "delta^2: the u" not in err  # a term it has: held
+    code, _, err = run(["identify", trial_csv, "--model", "blanke", "--bound", "u: r^3 <= 0",
+                        "-o", out], capsys)  # fmt: skip
+    assert code == 1 and "r^3 is not a free term of the u equation" in err
+
+
 @pytest.mark.parametrize(
     ("args", "match"),
     [(["--gamma", "0"], "gamma"), (["--model", "abkowitz"], "unknown model"),

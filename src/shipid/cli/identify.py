@@ -16,6 +16,7 @@ from shipid.cli.common import (
     _log_particulars,
     _log_record,
     _one_rps,
+    _parse_bounds,
     _parse_drop,
     _pd,
     _physics,
@@ -167,6 +168,7 @@ def cmd_identify(args) -> int:
     _edit_into_model(args, logs)
     gamma_given = args.gamma is not None
     drop_given = args.drop
+    bounds_given = list(args.bound or [])  # the choice may add its own
     choice = _choose_structure(args, logs, names)
     physics = _physics(args, logs, _structure(args), chosen=choice is not None)
     if physics is not None and physics.prior_source:
@@ -227,6 +229,8 @@ def cmd_identify(args) -> int:
     ident = identify(logs, model=args.model, form=args.form, gamma=gamma,
                      drop=_parse_drop(args.drop), names=names, force=args.force,
                      estimator=args.estimator, physics=physics)  # fmt: skip
+    if choice is not None:
+        _bounds_holding_nothing(bounds_given, ident.model)
     if members:
         averaged = fit_model(logs, gamma, names)
         worse = _average_fails(averaged, ident.model, logs)
@@ -640,6 +644,22 @@ def _choose_structure(args, logs, names, paper_out: str | None = None):
     if args.gamma is None:
         args.gamma = choice.gamma if choice is not None and choice.gamma else 1e4
     return choice
+
+
+def _bounds_holding_nothing(specs, model) -> None:
+    """A warning per ``--bound`` whose term the structure chosen for the logs lacks: such a
+    bound applies where a structure has the term (each candidate of the search), and held
+    nothing in the model written without a word. With an explicit ``--model`` it is refused.
+    (A bound is physics: the model is fitted, not averaged over select's candidates.)"""
+    from shipid.dynamics.terms import parse_term
+
+    for dof, bounds in _parse_bounds(specs).items():
+        have = {parse_term(t).text for t in model.structure.terms.get(dof, ())}
+        for term in bounds:
+            if parse_term(term).text not in have:
+                _warn(f"--bound {dof}: {term}: the {dof} equation of the structure chosen "
+                      f"({model.structure.name}) has no {term}: its absence (a coefficient of "
+                      "0) meets the bound, which fits nothing (--model with the term fits it)")
 
 
 def _edit_into_model(args, logs) -> None:
