@@ -261,7 +261,7 @@ def test_cli_bad_input_exits_1_with_one_line_and_no_output(tmp_path, capsys, nam
     assert not out.exists() and list(tmp_path.glob(".model.json*")) == []
 
 
-def test_cli_a_bound_on_a_term_the_chosen_structure_lacks_is_named(tmp_path, trial_csv, capsys):
+def test_cli_a_bound_or_drop_of_a_term_the_chosen_structure_lacks_is_named(tmp_path, trial_csv, capsys):
     """With the structure chosen for the logs, a bound applies where a structure has its term:
     '--bound u: r^3 <= 0' (r² meant), met by a structure without r³, fitted nothing, without a
     word. With --model it is refused, as before."""
@@ -276,6 +276,13 @@ def test_cli_a_bound_on_a_term_the_chosen_structure_lacks_is_named(tmp_path, tri
     code, _, err = run(["identify", trial_csv, "--model", "blanke", "--bound", "u: r^3 <= 0",
                         "-o", out], capsys)  # fmt: skip
     assert code == 1 and "r^3 is not a free term of the u equation" in err
+    # The same of a drop: it keeps a term out of every candidate that has it.
+    code, _, err = run(["identify", trial_csv, "--drop", "u:r^3,u:delta^2", "--no-output-error",
+                        "-o", out], capsys)  # fmt: skip
+    assert code == 0, err
+    assert "--drop u:r^3: the u equation of the structure chosen (blanke) has no r^3, so " \
+        "nothing was dropped" in err and "u:delta^2:" not in err  # fmt: skip
+    assert "delta^2" not in json.loads(out.read_text())["model"]["coefficients"]["u"]
 
 
 @pytest.mark.parametrize(

@@ -162,8 +162,25 @@ def auto_structure(logs: Sequence[pd.DataFrame], names: Sequence[str] | None = N
     require_states(logs, names, "log to choose the structure on")
     choice = _auto_structure(logs, names, physics, cv, estimator, drop, announce or _quiet,
                              paper_out)  # fmt: skip
+    dropped = drop.drop if isinstance(drop, StructureEdit) else drop
+    if dropped:
+        choice.warnings += _dropping_nothing(choice.structure, dropped)
     choice.structure = _without(choice.structure, drop)
     return choice
+
+
+def _dropping_nothing(structure: ModelStructure, drop: Mapping[str, Sequence[str]]) -> list[str]:
+    """A line per dropped term the structure chosen lacks: the drop keeps a term out of every
+    candidate that has it, and '--drop u:r^3' (r² meant) dropped nothing without a word."""
+    from shipid.dynamics.terms import parse_term
+
+    out = []
+    for dof, terms in drop.items():
+        have = {parse_term(t).text for t in structure.terms.get(dof, ())}
+        out += [f"--drop {dof}:{term}: the {dof} equation of the structure chosen "
+                f"({structure.name}) has no {term}, so nothing was dropped"
+                for term in terms if parse_term(term).text not in have]  # fmt: skip
+    return out
 
 
 def _quiet(message: str) -> None:
