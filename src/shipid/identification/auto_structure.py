@@ -162,10 +162,11 @@ def auto_structure(logs: Sequence[pd.DataFrame], names: Sequence[str] | None = N
     require_states(logs, names, "log to choose the structure on")
     choice = _auto_structure(logs, names, physics, cv, estimator, drop, announce or _quiet,
                              paper_out)  # fmt: skip
+    base = choice.structure
+    choice.structure = _without(base, drop)  # first: it refuses a term that does not parse
     dropped = drop.drop if isinstance(drop, StructureEdit) else drop
     if dropped:
-        choice.warnings += _dropping_nothing(choice.structure, dropped)
-    choice.structure = _without(choice.structure, drop)
+        choice.warnings += _dropping_nothing(base, dropped)
     return choice
 
 
