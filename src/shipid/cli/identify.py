@@ -231,6 +231,8 @@ def cmd_identify(args) -> int:
                      estimator=args.estimator, physics=physics)  # fmt: skip
     if choice is not None:
         _bounds_holding_nothing(bounds_given, ident.model)
+        for line in choice.nothing_dropped:
+            _warn(line)
     if members:
         averaged = fit_model(logs, gamma, names)
         worse = _average_fails(averaged, ident.model, logs)
@@ -636,8 +638,13 @@ def _choose_structure(args, logs, names, paper_out: str | None = None):
                                 announce=lambda m: print(m, file=sys.stderr),
                                 paper_out=paper_out)  # fmt: skip
         print(choice.describe())
+        # Once each: where the paper's structure gives way after the prefilter's choice, the
+        # structure is chosen a second time, and its warnings (a drop of nothing) came twice.
+        said = vars(args).setdefault("_structure_warnings_said", set())
         for w in choice.warnings:
-            _warn(f"structure: {w}")
+            if w not in said:
+                said.add(w)
+                _warn(f"structure: {w}")
         args.model, args.drop = choice.structure, None  # the drop is in the structure
         if choice.bounds:  # the search held them: the fit of its choice holds them too
             args.bound = [*(args.bound or []), *choice.bounds]

@@ -75,6 +75,9 @@ class StructureChoice:
     candidates: int | None = None
     notes: list[str] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)  # the search's (few folds, say)
+    # The user's dropped terms the structure chosen lacks (dropped nothing): said by the caller
+    # of the choice it keeps, not of one it chooses again.
+    nothing_dropped: list[str] = field(default_factory=list)
     # The structures that tied with the one fitted (free-run scores within one standard error):
     # what the logs could not rule out. As the comparison fitted them (γ 1e4, no prefilter);
     # ``identify`` refits them as it fits its model (prefilter, γ, physics) before the file.
@@ -166,7 +169,7 @@ def auto_structure(logs: Sequence[pd.DataFrame], names: Sequence[str] | None = N
     choice.structure = _without(base, drop)  # first: it refuses a term that does not parse
     dropped = drop.drop if isinstance(drop, StructureEdit) else drop
     if dropped:
-        choice.warnings += _dropping_nothing(base, dropped)
+        choice.nothing_dropped = _dropping_nothing(base, dropped)
     return choice
 
 
