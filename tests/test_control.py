@@ -434,7 +434,7 @@ def test_the_autopilot_steps_to_port_and_refuses_a_step_beyond_half_a_turn(tmp_p
     assert final == pytest.approx(-20.0, abs=0.5) and 0.0 <= overshoot < 10.0
     for bad in ("400", "-180", "0", "nan"):
         code, _, err = run(["autopilot", path, "--speed", "1.93", "--heading", bad], capsys)
-        assert code == 1 and "--heading must be a step within ±180° other than 0" in err, err
+        assert code == 1 and "the heading step (--heading) must be within ±180° other than 0" in err, err
 
 
 @pytest.mark.parametrize("side", ["port", "starboard"])

@@ -658,15 +658,10 @@ def _bounds_holding_nothing(specs, model) -> None:
     bound applies where a structure has the term (each candidate of the search), and held
     nothing in the model written without a word. With an explicit ``--model`` it is refused.
     (A bound is physics: the model is fitted, not averaged over select's candidates.)"""
-    from shipid.dynamics.terms import parse_term
-
-    for dof, bounds in _parse_bounds(specs).items():
-        have = {parse_term(t).text for t in model.structure.terms.get(dof, ())}
-        for term in bounds:
-            if parse_term(term).text not in have:
-                _warn(f"--bound {dof}: {term}: the {dof} equation of the structure chosen "
-                      f"({model.structure.name}) has no {term}: its absence (a coefficient of "
-                      "0) meets the bound, which fits nothing (--model with the term fits it)")
+    for dof, term in model.structure.lacking(_parse_bounds(specs)):
+        _warn(f"--bound {dof}: {term}: the {dof} equation of the structure chosen "
+              f"({model.structure.name}) has no {term}: its absence (a coefficient of 0) meets "
+              "the bound, which fits nothing (--model with the term fits it)")
 
 
 def _edit_into_model(args, logs) -> None:

@@ -201,8 +201,8 @@ def heading_step_deg(value: float) -> float:
     the heading error wrapped to half a turn (a step of 400° turned the ship 40°)."""
     if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value) \
             or not 0.0 < abs(value) < 180.0:
-        raise ShipidError(f"--heading must be a step within ±180° other than 0 (positive to "
-                          f"starboard, negative to port), got {value!r}")  # fmt: skip
+        raise ShipidError(f"the heading step (--heading) must be within ±180° other than 0 "
+                          f"(positive to starboard, negative to port), got {value!r}")  # fmt: skip
     return float(value)
 
 

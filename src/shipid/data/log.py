@@ -81,7 +81,7 @@ def make_log(columns: Mapping[str, np.ndarray], **meta: object) -> pd.DataFrame:
         raise ValueError(f"not canonical log columns: {sorted(unknown)}; use {COLUMNS}")
     arrays = {c: np.asarray(columns[c], dtype=float) for c in COLUMNS if c in columns}
     lengths = {a.shape for a in arrays.values()}
-    if len({a.shape for a in arrays.values() if a.ndim}) > 1:  # a scalar is broadcast
+    if len(lengths - {()}) > 1:  # a scalar is broadcast
         # pandas' own "All arrays must be of the same length" named none of them.
         raise ValueError("log columns of different lengths: " + ", ".join(
             f"{c} {len(a)}" for c, a in arrays.items() if a.ndim))
@@ -144,16 +144,17 @@ def require_frame(log, what: str = "log") -> pd.DataFrame:
     TypeError deep inside)."""
     if isinstance(log, pd.DataFrame):
         return log
-    raise ShipidError(f"a {what} is a pandas DataFrame (shipid.read_log reads a file into one), "
-                      f"got {_given(log)}")  # fmt: skip
+    raise ShipidError(_not_a_frame(log, what))
 
 
-def _given(obj) -> str:
-    """What was handed where a log belongs, for the message: a path, or the object's type."""
+def _not_a_frame(obj, what: str) -> str:
+    """The message for ``obj`` handed where a ``what`` (a log) belongs: a path, or its type."""
     if isinstance(obj, str | bytes | PathLike):
-        return f"the path {str(obj)!r}"
-    kind = type(obj).__name__
-    return f"{'an' if kind[0].lower() in 'aeiou' else 'a'} {kind}"
+        given = f"the path {str(obj)!r}"
+    else:
+        kind = type(obj).__name__
+        given = f"{'an' if kind[0].lower() in 'aeiou' else 'a'} {kind}"
+    return f"a {what} is a pandas DataFrame (shipid.read_log reads a file into one), got {given}"
 
 
 def require_frames(logs, names=None, what: str = "log") -> list[pd.DataFrame]:
@@ -168,8 +169,7 @@ def require_frames(logs, names=None, what: str = "log") -> list[pd.DataFrame]:
     for i, log in enumerate(logs):
         if not isinstance(log, pd.DataFrame):
             name = names[i] if names and i < len(names) else f"{what} {i + 1}"
-            raise ShipidError(f"{name}: a {what} is a pandas DataFrame (shipid.read_log reads "
-                              f"a file into one), got {_given(log)}")  # fmt: skip
+            raise ShipidError(f"{name}: {_not_a_frame(log, what)}")
     return logs
 
 

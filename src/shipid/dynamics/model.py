@@ -204,6 +204,15 @@ class ModelStructure:
         """Whether a term needs the relative wind columns."""
         return any(s in self.inputs for s in ("wind_speed", "wind_angle"))
 
+    def lacking(self, terms: Mapping[str, Sequence[str]]) -> list[tuple[str, str]]:
+        """The (dof, term) of ``terms`` ({dof: [term]}) this structure's equations do not hold,
+        compared as parsed ('r^2' and 'r*r' alike): a drop or a bound on them acts on nothing."""
+        out = []
+        for dof, names in terms.items():
+            have = {parse_term(t).text for t in self.terms.get(dof, ())}
+            out += [(dof, name) for name in names if parse_term(name).text not in have]
+        return out
+
     def without(self, drop: Mapping[str, tuple[str, ...] | list[str]],
                 missing_ok: bool = False) -> ModelStructure:  # fmt: skip
         """The structure with some terms dropped, e.g. ``{"u": ["r^2"]}`` as in the paper.
@@ -220,7 +229,7 @@ class ModelStructure:
             except ShipidError as exc:
                 raise ShipidError(f"cannot drop {list(names)} from the {dof} equation: {exc}") from None
             have = terms.get(dof, ())
-            missing = [n for n, c in zip(names, canon, strict=True) if c not in have]
+            missing = [n for _, n in self.lacking({dof: names})]
             if missing and not missing_ok:
                 raise ShipidError(f"cannot drop {missing} from the {dof} equation of "
                                   f"{self.name}: it has {list(terms[dof])}")

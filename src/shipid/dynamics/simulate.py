@@ -56,7 +56,6 @@ class DivergenceBounds:
         return speed, self.yaw_rate
 
 
-
 def require_dynamics(dynamics, what: str = "model") -> None:
     """One line where a file's path or a ship's name is handed where a model or a reference
     ship belongs (``validate``, ``simulate_log``, ``output_error`` raised "'str' object has no
@@ -65,6 +64,7 @@ def require_dynamics(dynamics, what: str = "model") -> None:
         raise ShipidError(f"a {what} is a ManoeuvringModel, a HybridModel or a reference ship "
                           f"(shipid.load_model reads a model file, shipid.get_vessel a reference "
                           f"ship by name), got {str(dynamics)!r}")  # fmt: skip
+
 
 @dataclass
 class SimulationResult:

@@ -176,15 +176,8 @@ def auto_structure(logs: Sequence[pd.DataFrame], names: Sequence[str] | None = N
 def _dropping_nothing(structure: ModelStructure, drop: Mapping[str, Sequence[str]]) -> list[str]:
     """A line per dropped term the structure chosen lacks: the drop keeps a term out of every
     candidate that has it, and '--drop u:r^3' (r² meant) dropped nothing without a word."""
-    from shipid.dynamics.terms import parse_term
-
-    out = []
-    for dof, terms in drop.items():
-        have = {parse_term(t).text for t in structure.terms.get(dof, ())}
-        out += [f"--drop {dof}:{term}: the {dof} equation of the structure chosen "
-                f"({structure.name}) has no {term}, so nothing was dropped"
-                for term in terms if parse_term(term).text not in have]  # fmt: skip
-    return out
+    return [f"--drop {dof}:{term}: the {dof} equation of the structure chosen ({structure.name}) "
+            f"has no {term}, so nothing was dropped" for dof, term in structure.lacking(drop)]
 
 
 def _quiet(message: str) -> None:
