@@ -877,6 +877,22 @@ def _from_rest_note(target, speed: float | None, rps: float | None) -> str | Non
     return f"plausibility: {note}" if note else None
 
 
+def _rudder_reversed_note(target, speed: float | None, rps: float | None) -> str | None:
+    """The plausibility warning of a model whose rudder turns the ship the other way at speeds
+    ahead short of its straight speed at ``rps`` or with the propeller stopped
+    (``shipid.identification.plausibility.rudder_reversed_warning``); None for a reference ship
+    or a model whose rudder turns it its way throughout."""
+    from shipid.dynamics.hybrid import HybridModel
+    from shipid.dynamics.model import ManoeuvringModel
+
+    if not isinstance(target, ManoeuvringModel | HybridModel):
+        return None
+    from shipid.identification.plausibility import rudder_reversed_warning
+
+    note = rudder_reversed_warning(target, speed, rps)
+    return f"plausibility: {note}" if note else None
+
+
 def _unused_inputs(target, args) -> list[str]:
     """Warnings for --rps, --astern-rps and --wind-speed given to a model without a term in the
     propeller speed or the wind: the run takes them and nothing changes (a manoeuvre "at 5 rps"

@@ -22,6 +22,7 @@ from shipid.cli.common import (
     _read_options,
     _reference_ship,
     _reference_speed_notes,
+    _rudder_reversed_note,
     _sampling_notes,
     _scale_notes,
     _ship_or_model,
@@ -100,9 +101,10 @@ def cmd_validate(args) -> int:
         _check_scale(args.model, cond, given.scale, f"--particulars {args.particulars}")
     env = cond["envelope"]
     # Logs that start from rest or slow down meet it (the Esso's random runs).
-    from_rest = _from_rest_note(model, cond["speed"], cond["rps"])
-    if from_rest:
-        _warn(from_rest)
+    for note in (_from_rest_note(model, cond["speed"], cond["rps"]),
+                 _rudder_reversed_note(model, cond["speed"], cond["rps"])):
+        if note:
+            _warn(note)
     from shipid.data.log import common_rudder_convention
     from shipid.trials.reading import read_trial_log
 

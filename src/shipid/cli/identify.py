@@ -142,7 +142,8 @@ def cmd_identify(args) -> int:
     flags = parse_constraints(args.constraints)
     given_physics = unboxed(SimpleNamespace(
         prior=args.prior, steady_speed=bool(args.steady_speed) or flags["steady_speed"],
-        stable=flags["stable"], derivatives=flags["derivatives"]))
+        stable=flags["stable"], derivatives=flags["derivatives"],
+        rudder_ahead=flags["rudder_ahead"]))
     if asked and given_physics:
         raise ShipidError(f"--output-error holds --constraints signs and --bound; it does not hold "
                           f"{given_physics[0]} (the LS-SVM fit does: leave out --output-error)")
@@ -448,6 +449,7 @@ def cmd_identify(args) -> int:
         below_the_logs_rps,
         given_steady_speeds,
         missed_steady_speed,
+        rudder_reversed_warning,
     )
 
     beyond = approach_beyond_logs(plausibility, ident.envelope)
@@ -458,6 +460,10 @@ def cmd_identify(args) -> int:
         if said:
             ident.warnings.append(said)
     ident.warnings.extend(at_the_logs_other_rps(hybrid or as_written(final), plausibility, logs))
+    reversed_rudder = rudder_reversed_warning(hybrid or as_written(final),
+                                              plausibility["approach_speed"], plausibility["rps"])
+    if reversed_rudder:
+        ident.warnings.append(f"plausibility: {reversed_rudder}")
 
     for u, n in given_steady_speeds(physics):  # where the user says the ship runs steady
         at = plausibility_at_approach(hybrid or as_written(final), u, n, u, n)[1]

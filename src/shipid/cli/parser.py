@@ -221,9 +221,10 @@ def _add_physics_options(p) -> None:
                    help="comma list: signs (damping, resistance, thrust, its fall with the "
                    "advance and rudder terms keep their physical sign), derivatives (the "
                    "linearised damping and rudder derivatives keep theirs, whatever terms carry "
-                   "them), steady-speed (u̇ = 0 on "
-                   "the approach), stable (straight-line stability at the approach: the yaw "
-                   "equation given the sway one)")
+                   "them), rudder-ahead (the rudder turns the ship its way at every speed ahead "
+                   "from rest to the approach, the propeller at the logs' rate and stopped), "
+                   "steady-speed (u̇ = 0 on the approach), stable (straight-line stability at "
+                   "the approach: the yaw equation given the sway one)")
     g.add_argument("--bound", action="append", metavar="'DOF: TERM <= X'",
                    help="a bound on one coefficient, e.g. 'r: u*r <= 0' (repeatable); "
                    "both ways at one value holds it there (given, not fitted)")
@@ -299,7 +300,8 @@ def build_parser() -> argparse.ArgumentParser:
                    "measurement noise, unlike any equation-error fit), with standard errors, "
                    "95 %% intervals and 200 covariance draws stored for prediction bands and "
                    "index intervals; the LS-SVM model is its start and stays in the file. "
-                   "Holds --constraints signs and --bound (not a prior, stable, derivatives or "
+                   "Holds --constraints signs and --bound (not a prior, stable, derivatives, "
+                   "rudder-ahead or "
                    "steady speed). Default: where the LS-SVM's free runs miss the logs by no "
                    "more than twice their sensor noise, and the output-error residuals come out "
                    "white (noise, not model error), without --refine, --bootstrap, --error-band "

@@ -17,6 +17,7 @@ from shipid.cli.common import (
     _markdown_dashed,
     _pd,
     _read_files,
+    _rudder_reversed_note,
     _run_approach,
     _ship_or_model,
     _simulated_metadata,
@@ -82,6 +83,7 @@ def cmd_criteria(args) -> int:
         _check_scale(args.model, cond, particulars.scale, f"--particulars {args.particulars}")
     speed, rps, _ = _run_approach(target, cond, args.speed, args.rps)  # imo_criteria notes it
     from_rest = _from_rest_note(target, speed, rps)
+    reversed_rudder = _rudder_reversed_note(target, speed, rps)
     # Given, else the ship's gear or the training logs' rate, else imo_criteria's SOLAS rate.
     steering, _ = _steering(target, {**cond, "particulars": particulars}, args.rudder_rate,
                             fallback="caller")  # fmt: skip
@@ -94,7 +96,7 @@ def cmd_criteria(args) -> int:
                   scale=scale, rps=rps, steering=steering, astern_rps=args.astern_rps,
                   dt=args.dt, steady_window=_steady_window(cond))  # fmt: skip
     crit = run(target)
-    crit.notes += [note for note in (rate_note, from_rest) if note]
+    crit.notes += [note for note in (rate_note, from_rest, reversed_rudder) if note]
     crit.notes += _unused_inputs(target, args)
     crit.notes += [n for n in (_step_note(cond, args.dt, CRITERIA_STEP),) if n]
     from shipid.evaluation.validate import faded_residual_notes
@@ -294,9 +296,9 @@ def cmd_manoeuvre(args) -> int:
         _warn(note)
     target, cond = _ship_or_model(args.model, hybrid=True)
     speed, rps, unsteady = _run_approach(target, cond, args.speed, args.rps)
-    from_rest = _from_rest_note(target, speed, rps)
-    if from_rest:
-        _warn(from_rest)
+    for note in (_from_rest_note(target, speed, rps), _rudder_reversed_note(target, speed, rps)):
+        if note:
+            _warn(note)
     steering, rudder_note = _steering(target, cond, args.rudder_rate)
     kw = {"dt": args.step, "speed": speed, "rps": rps, "steering": steering}
     coarse = _step_note(cond, args.step, MANOEUVRE_STEP)

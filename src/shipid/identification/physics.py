@@ -82,7 +82,7 @@ SIGN_RULES: tuple[tuple[str, frozenset[str], object, str], ...] = (
     ("r", _RUDDER_TERMS, RUDDER, "the rudder turns the ship its way"),
     ("v", _RUDDER_TERMS, "-" + RUDDER, "the rudder pushes the stern the other way"),
 )
-CONSTRAINTS = ("signs", "steady-speed", "stable", "derivatives")
+CONSTRAINTS = ("signs", "steady-speed", "stable", "derivatives", "rudder-ahead")
 # ``stable``: the sway–yaw eigenvalues' real parts at most −μ, μ this share of the sway damping
 # rate |∂v̇/∂v| (a scale the model itself sets): held at the limit, the slowest mode still decays,
 # slowly, also about a steady approach a little off the log's start.
@@ -106,6 +106,10 @@ class PhysicsOptions:
         the sway one; see the module's notes).
     derivatives : the linearised damping and rudder derivatives keep their physical sign at
         every training log's approach, whatever terms carry them (``DERIVATIVE_RULES``).
+    rudder_ahead : the rudder's derivatives (∂v̇/∂δ, ∂ṙ/∂δ at straight running) keep their
+        physical sign at every speed ahead from rest to each training log's approach, at its
+        propeller speed, beyond it, and with the propeller stopped (``RUDDER_AHEAD_SHARES``):
+        the rudder turns the ship its way wherever it moves ahead, not only where the logs ran.
     approach : {"u": u0, "n": n0}, or a sequence of them: the approaches ``steady_speed``,
         ``derivatives`` and ``stable`` hold at (default: each training log's start;
         ``with_approaches`` resolves them once for fits that repeat, as ``select``'s).
@@ -125,6 +129,7 @@ class PhysicsOptions:
     rudder_positive: str | None = None
     stable: bool = False
     derivatives: bool = False
+    rudder_ahead: bool = False
     prior_source: str = ""
     bounds_where_present: bool = False
 
@@ -132,7 +137,7 @@ class PhysicsOptions:
     def active(self) -> bool:
         """Whether the options change the plain fit."""
         return bool(self.prior or self.signs or self.bounds or self.steady_speed or self.stable
-                    or self.derivatives)
+                    or self.derivatives or self.rudder_ahead)
 
     def describe(self) -> dict:
         """A JSON-safe record for the model file."""
@@ -144,12 +149,12 @@ class PhysicsOptions:
                 "approach": (dict(self.approach) if isinstance(self.approach, Mapping)
                              else [dict(a) for a in self.approach] if self.approach else {}),
                 "rudder_positive": self.rudder_positive, "stable": self.stable,
-                "derivatives": self.derivatives}  # fmt: skip
+                "derivatives": self.derivatives, "rudder_ahead": self.rudder_ahead}  # fmt: skip
 
 
 def parse_constraints(text: str | None) -> dict[str, bool]:
-    """The ``PhysicsOptions`` flags (signs, steady_speed, stable, derivatives) of a comma list
-    such as ``signs,steady-speed``."""
+    """The ``PhysicsOptions`` flags (signs, steady_speed, stable, derivatives, rudder_ahead) of
+    a comma list such as ``signs,steady-speed``."""
     if not text:
         return {c.replace("-", "_"): False for c in CONSTRAINTS}
     items = [t.strip() for t in text.split(",") if t.strip()]
@@ -388,10 +393,12 @@ def with_approaches(options: PhysicsOptions | None, logs: Sequence[pd.DataFrame]
     """``options`` with the training logs' approaches resolved (``approach_states``), for fits
     that repeat on the same logs; ``options`` itself when it needs none or has them."""
     if options is None or options.approach or not (
-            options.steady_speed or options.derivatives or options.stable):
+            options.steady_speed or options.derivatives or options.stable
+            or options.rudder_ahead):
         return options
     what = "/".join(n for n, on in (("steady-speed", options.steady_speed),
                                     ("derivatives", options.derivatives),
+                                    ("rudder-ahead", options.rudder_ahead),
                                     ("stable", options.stable)) if on)  # fmt: skip
     states = approach_states(options, logs, what)
     return dataclasses.replace(options, approach=tuple({"u": u, "n": n} for u, n in states))
@@ -408,31 +415,72 @@ DERIVATIVE_RULES = (
 )
 
 
+# ``rudder_ahead``: the speeds at which the rudder's rows hold at each approach's propeller
+# speed, as shares of the approach speed: from rest to it evenly, then beyond it up to where the
+# u² terms alone count (by advance-ratio similarity, the approach speed with the propeller all but
+# stopped: a fit at one rps has no n to stop), and, where the model has terms in n, the same
+# speeds with the propeller stopped. A quadratic in u (the race's u², u·n, n²) that keeps its
+# sign at points h apart can go past it between two by at most |q''| h²/8.
+RUDDER_AHEAD_SHARES = (*np.linspace(0.0, 1.0, 11).tolist(), 1.5, 2.0, 3.0, 5.0, 10.0, 100.0,
+                       1000.0)
+
+
+def _derivative_states(options: PhysicsOptions, u0: float, n0: float
+                       ) -> list[tuple[float, float, bool]]:  # fmt: skip
+    """(u, n, rudder rules only) of one approach at which ``derivative_rows`` holds its rules."""
+    states = [(u0, n0, False)] if options.derivatives else []
+    if options.rudder_ahead:
+        speeds = [share * u0 for share in RUDDER_AHEAD_SHARES]
+        states += [(u, n0, True) for u in speeds if not (options.derivatives and u == u0)]
+        if n0:
+            states += [(u, 0.0, True) for u in speeds[1:]]
+    return states
+
+
 def derivative_rows(options: PhysicsOptions, dof: str, names: Sequence[str],
                     fixed: Mapping[str, float], logs: Sequence[pd.DataFrame],
                     ) -> tuple[np.ndarray, np.ndarray, list[str]] | None:  # fmt: skip
-    """The ``derivatives`` constraint of one equation: rows G over [free terms ``names``; bias],
-    h and a label per row, G z ≥ h for each rule of ``DERIVATIVE_RULES`` at each training log's
-    approach (None when no free term carries a rule's derivative). The rudder's rows need the
-    logs' rudder convention."""
+    """The ``derivatives`` and ``rudder_ahead`` constraints of one equation: rows G over [free
+    terms ``names``; bias], h and a label per row, G z ≥ h for each rule of ``DERIVATIVE_RULES``
+    at each training log's approach, and for its rudder rules at the speeds ahead from rest to
+    it and beyond, the propeller at the approach's rate and stopped (``_derivative_states``; a
+    row that repeats one already held is left out). None when no free term carries a rule's
+    derivative. The rudder's rows need the logs' rudder convention."""
     s = rudder_sign(logs, options.rudder_positive)
     rules = [(x, sign, why) for eq, x, sign, why in DERIVATIVE_RULES if eq == dof
              and (s is not None or sign not in (RUDDER, "-" + RUDDER))]  # fmt: skip
     if not rules or not names:
         return None
     wrt = [x for x, _, _ in rules]
-    rows, rhs, labels = [], [], []
-    for u0, n0 in approach_states(options, logs, "derivatives"):
-        g = _straight_running_slopes(names, u0, n0, wrt)
-        f = (_straight_running_slopes(list(fixed), u0, n0, wrt) @ np.array(list(fixed.values()))
-             if fixed else np.zeros(len(wrt)))  # fmt: skip
-        for i, (_, sign, why) in enumerate(rules):
-            if not np.any(g[i]):
-                continue  # no free term carries it
-            sigma = float(sign) if sign in (1, -1) else (s if sign == RUDDER else -s)
-            rows.append(np.append(sigma * g[i], 0.0))
-            rhs.append(-sigma * f[i])
-            labels.append(f"{why} at {u0:.3g} m/s")
+    what = "/".join(n for n, on in (("derivatives", options.derivatives),
+                                    ("rudder-ahead", options.rudder_ahead)) if on)  # fmt: skip
+    rows, rhs, labels, held = [], [], [], set()
+    for u0, n0 in approach_states(options, logs, what):
+        for u, n, rudder_only in _derivative_states(options, u0, n0):
+            g = _straight_running_slopes(names, u, n, wrt)
+            f = (_straight_running_slopes(list(fixed), u, n, wrt) @ np.array(list(fixed.values()))
+                 if fixed else np.zeros(len(wrt)))  # fmt: skip
+            for i, (_, sign, why) in enumerate(rules):
+                if rudder_only and sign in (1, -1):
+                    continue
+                if not np.any(g[i]):
+                    continue  # no free term carries it
+                sigma = float(sign) if sign in (1, -1) else (s if sign == RUDDER else -s)
+                # Rows to unit size: far ahead a u² slope is 10⁶ times the rest.
+                scale = float(np.hypot(np.linalg.norm(g[i]), f[i]))
+                row, bound = sigma * g[i] / scale, -sigma * f[i] / scale
+                key = (i, *np.round(row, 12), round(bound, 12))
+                if key in held:
+                    continue  # the same row (a rudder term without u or n)
+                held.add(key)
+                rows.append(np.append(row, 0.0))
+                rhs.append(bound)
+                if u > RUDDER_AHEAD_SHARES[-3] * u0:
+                    where = "far ahead, where its u² terms rule (the propeller all but stopped)"
+                else:
+                    where = f"at {u:.3g} m/s" + (" with the propeller stopped" if n0 and not n
+                                                 else "")  # fmt: skip
+                labels.append(f"{why} {where}")
     if not rows:
         return None
     return np.array(rows), np.array(rhs), labels
@@ -571,7 +619,11 @@ def dof_physics(options: PhysicsOptions | None, dof: str, names: Sequence[str], 
     if out.prior is not None:
         # A prior outside the bounds would pull against them: start from the feasible point.
         out.prior = np.clip(out.prior, out.lower, out.upper)
-    if options.derivatives:
+    if (options.rudder_ahead and dof in ("v", "r") and any("delta" in n for n in names)
+            and rudder_sign(logs, options.rudder_positive) is None):  # fmt: skip
+        out.notes.append(f"{dof}: rudder-ahead holds nothing: the logs do not state (or disagree "
+                         "on) the rudder sign convention (--rudder-positive)")
+    if options.derivatives or options.rudder_ahead:
         found = derivative_rows(options, dof, names, fixed, logs)
         if found is not None:
             out.inequalities, out.inequality_labels = found[:2], found[2]
@@ -590,14 +642,15 @@ def dof_physics(options: PhysicsOptions | None, dof: str, names: Sequence[str], 
 
 def unboxed(options) -> list[str]:
     """The options of ``options`` (a ``PhysicsOptions``, or anything with its ``prior``,
-    ``steady_speed``, ``stable`` and ``derivatives``: the command line checks its flags before
-    it reads the logs) that are not box bounds on the coefficients (the command-line flags that
-    give them), which an output-error fit does not hold: they are conditions on the
-    equation-error regression (a prior on its weights, rows of its solver)."""
+    ``steady_speed``, ``stable``, ``derivatives`` and ``rudder_ahead``: the command line checks
+    its flags before it reads the logs) that are not box bounds on the coefficients (the
+    command-line flags that give them), which an output-error fit does not hold: they are
+    conditions on the equation-error regression (a prior on its weights, rows of its solver)."""
     if options is None:
         return []
     flags = (("prior", "--prior"), ("steady_speed", "--steady-speed"),
-             ("stable", "--constraints stable"), ("derivatives", "--constraints derivatives"))
+             ("stable", "--constraints stable"), ("derivatives", "--constraints derivatives"),
+             ("rudder_ahead", "--constraints rudder-ahead"))
     return [flag for name, flag in flags if getattr(options, name)]
 
 

@@ -774,6 +774,82 @@ def from_rest_warning(model, speed: float | None, rps: float | None) -> str | No
     return None if found is None else _astern_from_rest(found, rps, straight, model)
 
 
+# The speeds (shares of the straight speed, rest left out: no flow, no force) at which
+# ``rudder_reversed`` reads the rudder's yaw derivative, and the share of its value at the
+# straight speed that a derivative of the other sign must pass to count (not a rounding's).
+RUDDER_REVERSED_SHARES = np.linspace(0.0, 1.0, 41)[1:]
+RUDDER_REVERSED_FLOOR = 0.01
+
+
+def rudder_reversed(model, rps: float | None, straight_speed: float | None
+                    ) -> dict[str, tuple[float, float]]:  # fmt: skip
+    """Where ``model``'s rudder turns the ship the other way than at its straight speed: the
+    yaw derivative ∂ṙ/∂δ at straight running (v = r = 0, still air) of the other sign, by more
+    than ``RUDDER_REVERSED_FLOOR`` of its value there, at speeds ahead up to ``straight_speed``
+    with the propeller at ``rps`` ("at_rps") and stopped ("stopped", a model with terms in n):
+    {case: (lowest, highest) such speed}, empty where it turns the ship its way throughout.
+
+    A fit of zig-zags at one propeller speed reads the race's u², u·n and n² only over the
+    logs' speeds; outside them their sum can change sign: the KVLCC2's MARIN 20/20 run fitted by
+    the default turns the ship the wrong way below 0.36 m/s ahead at its 10.33 rps (30 % of its
+    approach) and at any speed with the propeller stopped (``--constraints rudder-ahead`` holds
+    the sign there)."""
+    if (straight_speed is None or not straight_speed > 0 or "r" not in model.structure.dofs
+            or not any("delta" in t for t in model.structure.terms.get("r", ()))):  # fmt: skip
+        return {}
+    h = 1e-3
+    u = straight_speed * RUDDER_REVERSED_SHARES
+    zero = np.zeros_like(u)
+
+    def slope(n):
+        port = np.asarray(still_air_accelerations(model, u, zero, zero, zero + h, n))[:, 2]
+        stbd = np.asarray(still_air_accelerations(model, u, zero, zero, zero - h, n))[:, 2]
+        return (port - stbd) / (2 * h)
+
+    at_rps = slope(rps)
+    reference = at_rps[-1]
+    if not reference:
+        return {}
+    cases = {"at_rps": at_rps}
+    if getattr(model, "uses_rps", False) and rps:
+        cases["stopped"] = slope(0.0)
+    out = {}
+    for case, d in cases.items():
+        wrong = u[d * np.sign(reference) < -RUDDER_REVERSED_FLOOR * abs(reference)]
+        if wrong.size:
+            out[case] = (float(wrong.min()), float(wrong.max()))
+    return out
+
+
+def rudder_reversed_warning(model, speed: float | None, rps: float | None) -> str | None:
+    """``rudder_reversed``'s warning for ``model`` at the propeller speed ``rps``, its straight
+    speed the surge's equilibrium nearest ``speed`` (``speed`` itself for a model without surge);
+    None where its rudder turns the ship its way at every speed ahead up to it. ``identify``
+    gives it once; ``validate``, ``manoeuvre`` and ``criteria`` repeat it (as
+    ``from_rest_warning``): where a run starts slow, slows or stops its propeller."""
+    if getattr(model, "uses_thrust", False) or not (speed and speed > 0):
+        return None
+    straight = surge_equilibrium(model, speed, rps) if "u" in model.structure.dofs else speed
+    found = rudder_reversed(model, rps, straight)
+    if not found:
+        return None
+    at = f" at {rps:.4g} rps" if rps and getattr(model, "uses_rps", False) else ""
+    parts = []
+    if "at_rps" in found:
+        lo, hi = found["at_rps"]
+        where = (f"below {hi:.3g} m/s ahead" if lo <= straight * RUDDER_REVERSED_SHARES[0] + 1e-12
+                 else f"from {lo:.3g} to {hi:.3g} m/s ahead")  # fmt: skip
+        parts.append(f"{where}{at} ({100 * hi / straight:.0f} % of its straight speed "
+                     f"{straight:.3g} m/s)")
+    if "stopped" in found:
+        lo, hi = found["stopped"]
+        parts.append(f"from {lo:.3g} to {hi:.3g} m/s ahead with the propeller stopped")
+    return ("the rudder turns the ship the other way " + " and ".join(parts) + ": its terms "
+            "were fitted where the logs ran and their sum changes sign outside; a log at those "
+            "speeds decides, or --constraints rudder-ahead holds the sign at every speed ahead "
+            "(a trade: docs/physics-and-uncertainty.md)")
+
+
 def failed_checks(report: dict, model: ManoeuvringModel) -> dict[str, tuple[int, str]]:
     """{check: (severity ≥ 1, warning)} of the checks ``report`` fails."""
     if report.get("not_checked"):

@@ -1,0 +1,156 @@
+"""The rudder turns the ship its way at every speed ahead (``--constraints rudder-ahead``), and a
+model whose rudder does not is named (issue #10: "identified models turn the wrong way").
+
+A fit of zig-zags at one propeller speed reads the rudder's force in the race (u², u·n, n², at
+one n: u²δ, uδ, δ) only over the logs' speeds; outside them the sum of its terms can change sign.
+The truth is the KVLCC2's MMG model, whose rudder force goes with U_R² > 0 at every speed: its
+20/20 zig-zag fitted by ``blanke-race+race-damping`` turns the ship the wrong way below a sixth
+of its approach speed, and from slow ahead (a start, a harbour) its rudder all but does nothing."""
+
+import numpy as np
+import pytest
+from cli_helpers import run
+
+from shipid.data.io import write_log
+from shipid.dynamics.model import ManoeuvringModel
+from shipid.dynamics.simulate import simulate
+from shipid.identification.identify import identify
+from shipid.identification.physics import (
+    RUDDER_AHEAD_SHARES,
+    PhysicsOptions,
+    parse_constraints,
+)
+from shipid.identification.plausibility import rudder_reversed, rudder_reversed_warning
+from shipid.trials.manoeuvres import zigzag
+from shipid.vessels import kvlcc2
+from shipid.vessels.kvlcc2 import trimmed_revolutions
+
+RACE = "blanke-race+race-damping"
+
+
+@pytest.fixture(scope="module")
+def mmg_zigzag():
+    ship = kvlcc2()
+    rps = trimmed_revolutions(ship.approach_speed)
+    log = zigzag(ship, 20, 20, first="starboard", duration=250.0, dt=0.2, approach=5.0).log
+    return ship, rps, log.assign(n=rps)
+
+
+def _yaw_slope(model, u, rps):
+    """∂ṙ/∂δ at straight running, by central difference, at each of the speeds ``u``."""
+    u = np.asarray(u, dtype=float)
+    zero, n = np.zeros_like(u), np.full(u.shape, rps)
+    plus = model.accelerations(u, zero, zero, zero + 1e-4, None, n)[:, 2]
+    minus = model.accelerations(u, zero, zero, zero - 1e-4, None, n)[:, 2]
+    return (plus - minus) / 2e-4
+
+
+def _heading_after(dynamics, rps, seconds, u0=0.2, rudder_deg=20.0):
+    """The heading [deg] ``seconds`` after the rudder is put over from slow ahead (``u0``), the
+    propeller at ``rps``: a start from a harbour berth."""
+    t = np.arange(0.0, seconds + 0.05, 0.1)
+    res = simulate(dynamics, t, np.full(t.size, np.radians(rudder_deg)),
+                   {"u": u0, "v": 0.0, "r": 0.0}, rps=np.full(t.size, rps))  # fmt: skip
+    assert not res.diverged
+    return float(np.degrees(res.log["psi"].iloc[-1]))
+
+
+def test_the_reversal_is_where_the_quadratic_of_the_race_changes_sign():
+    """ṙ's rudder moment (0.02 u² − 0.03 u + 0.004) δ at one rps: its roots 0.1479 and 1.3521
+    m/s by the quadratic formula; at the straight speed 2 m/s the moment is +0.024 δ, so it turns
+    the ship the other way between the roots: on the grid of 2/40 m/s, 0.15 to 1.35, of which
+    0.15 and 1.35 by −0.00005 δ, under the 1 % of 0.024 a reversal must pass: 0.2 to 1.3."""
+    model = ManoeuvringModel("u: |u|*u, 1; v: u*v; r: u*r, u^2*delta, u*delta, delta", {
+        "u": {"|u|*u": -0.1, "1": 0.4}, "v": {"u*v": -0.5},
+        "r": {"u*r": -0.5, "u^2*delta": 0.02, "u*delta": -0.03, "delta": 0.004}})  # fmt: skip
+    roots = np.sort(np.roots([0.02, -0.03, 0.004]))
+    assert roots == pytest.approx([0.147920, 1.352080], abs=1e-6)
+    found = rudder_reversed(model, None, 2.0)
+    assert found == {"at_rps": pytest.approx((0.2, 1.3))}
+    note = rudder_reversed_warning(model, 2.0, None)
+    assert note.startswith("the rudder turns the ship the other way from 0.2 to 1.3 m/s ahead "
+                           "(65 % of its straight speed 2 m/s)")  # fmt: skip
+    assert "--constraints rudder-ahead" in note
+    # A rudder of one sign at every speed: nothing to say.
+    same = ManoeuvringModel(model.structure, {**model.coefficients,
+                                              "r": {"u*r": -0.5, "u^2*delta": 0.02,
+                                                    "u*delta": 0.01, "delta": 0.004}})
+    assert rudder_reversed(same, None, 2.0) == {}
+    assert rudder_reversed_warning(same, 2.0, None) is None
+
+
+def test_the_mmg_zigzags_fit_turns_the_wrong_way_slow_ahead_and_the_constraint_holds_it(
+        mmg_zigzag):
+    ship, rps, log = mmg_zigzag
+    u0 = float(log["u"].iloc[0])
+    free = identify(log, model=RACE).model
+    lo, hi = rudder_reversed(free, rps, u0)["at_rps"]
+    assert lo < 0.05 and 0.15 < hi < 0.3 * u0  # measured 0.029 to 0.206 m/s
+    held = identify(log, model=RACE, physics=PhysicsOptions(rudder_ahead=True))
+    assert rudder_reversed(held.model, rps, u0) == {}
+    # Checked apart from the rows that hold it: ∂ṙ/∂δ of one sign, the MMG logs' rudder being
+    # positive to starboard, at 400 speeds from rest to 20 times the approach and on to 1000
+    # times (the approach speed with the propeller all but stopped, by similarity).
+    assert log.attrs["rudder_positive"] == "starboard"
+    speeds = np.concatenate([np.linspace(0.0, 20 * u0, 400), np.geomspace(20, 1000, 50) * u0])
+    assert np.all(_yaw_slope(held.model, speeds, rps) >= -1e-9)
+    assert _yaw_slope(held.model, [u0], rps)[0] > 0.01  # it turns the ship, not held at 0
+    assert any(w.startswith("r: the rudder turns the ship its way (∂ṙ/∂δ)") and "held at 0" in w
+               for w in held.warnings)  # fmt: skip
+    # What it is for: from slow ahead the truth has turned 61.9° after 30 s; the constrained
+    # fit 53.6°, the free fit 18.8° (0.1° after 10 s: its rudder all but cancels there).
+    truth = _heading_after(ship.dynamics, rps, 30.0)
+    assert truth == pytest.approx(61.9, abs=0.5)
+    assert _heading_after(held.model, rps, 30.0) == pytest.approx(truth, rel=0.2)
+    assert _heading_after(free, rps, 30.0) < 0.4 * truth
+    # Inside the log's speeds the constraint costs the fit little: the same log's free run.
+    for model in (free, held.model):
+        res = simulate(model, log["t"].to_numpy(), log["delta"].to_numpy(),
+                       {k: float(log[k].iloc[0]) for k in ("u", "v", "r")}, rps=log["n"].to_numpy())
+        error = np.std(res.log["r"].to_numpy() - log["r"].to_numpy())
+        assert error < 0.1 * np.std(log["r"].to_numpy())
+
+
+def test_the_constraint_without_a_rudder_convention_says_it_holds_nothing(mmg_zigzag):
+    _, _, log = mmg_zigzag
+    log = log.copy()
+    log.attrs = {k: v for k, v in log.attrs.items() if k != "rudder_positive"}
+    fit = identify(log, model=RACE, physics=PhysicsOptions(rudder_ahead=True))
+    assert any(w.startswith("r: rudder-ahead holds nothing: the logs do not state")
+               for w in fit.warnings)  # fmt: skip
+
+
+def test_every_share_of_the_approach_is_held_and_the_flag_parses():
+    assert RUDDER_AHEAD_SHARES[0] == 0.0 and 1.0 in RUDDER_AHEAD_SHARES
+    assert parse_constraints("rudder-ahead")["rudder_ahead"] is True
+    assert PhysicsOptions(rudder_ahead=True).active
+    assert PhysicsOptions(rudder_ahead=True).describe()["rudder_ahead"] is True
+
+
+def test_the_commands_name_a_reversed_rudder_and_take_the_constraint(mmg_zigzag, tmp_path,
+                                                                       capsys):
+    _, rps, log = mmg_zigzag
+    path = write_log(log, tmp_path / "zz.csv")
+    free, held = tmp_path / "free.json", tmp_path / "held.json"
+    code, _, err = run(["identify", path, "--model", RACE, "-o", free], capsys)
+    assert code == 0, err
+    said = [line for line in err.splitlines() if "the rudder turns the ship the other way" in line]
+    assert len(said) == 1 and f"at {rps:.4g} rps" in said[0], err
+    assert "with the propeller stopped" in said[0]  # the file's forms carry it to every rps
+    for argv in (["manoeuvre", free, "turning"], ["validate", free, path],
+                 ["criteria", free, "--no-bands", "--length", "7"]):
+        code, out, err = run(argv, capsys)
+        assert code == 0, err
+        assert "the rudder turns the ship the other way" in err + out, argv
+    code, out, err = run(["identify", path, "--model", RACE, "--constraints", "rudder-ahead",
+                          "-o", held], capsys)  # fmt: skip
+    assert code == 0, err
+    assert "the rudder turns the ship the other way" not in err
+    assert "output error: not fitted, since it would not hold --constraints rudder-ahead" in out
+    assert "held at 0" in err
+    code, _, err = run(["manoeuvre", held, "turning"], capsys)
+    assert code == 0 and "the rudder turns the ship the other way" not in err
+    code, _, err = run(["identify", path, "--model", RACE, "--constraints", "rudder-ahead",
+                        "--output-error", "-o", tmp_path / "oe.json"], capsys)  # fmt: skip
+    assert code == 1 and "does not hold --constraints rudder-ahead" in err
+    assert not (tmp_path / "oe.json").exists()
