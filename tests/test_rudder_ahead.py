@@ -154,3 +154,16 @@ def test_the_commands_name_a_reversed_rudder_and_take_the_constraint(mmg_zigzag,
                         "--output-error", "-o", tmp_path / "oe.json"], capsys)  # fmt: skip
     assert code == 1 and "does not hold --constraints rudder-ahead" in err
     assert not (tmp_path / "oe.json").exists()
+
+
+def test_select_names_it_and_holds_it_too(mmg_zigzag, tmp_path, capsys):
+    ship, rps, log = mmg_zigzag
+    port = zigzag(ship, 20, 20, first="port", duration=250.0, dt=0.2, approach=5.0).log
+    paths = [write_log(log, tmp_path / "stbd.csv"), write_log(port.assign(n=rps), tmp_path / "port.csv")]
+    argv = ["select", *paths, "--library", RACE, "--search", "none", "--quiet"]
+    code, _, err = run([*argv, "-o", tmp_path / "free.json"], capsys)
+    assert code == 0, err
+    assert "plausibility: the rudder turns the ship the other way below" in err
+    code, _, err = run([*argv, "--constraints", "rudder-ahead", "-o", tmp_path / "held.json"], capsys)
+    assert code == 0, err
+    assert "the rudder turns the ship the other way" not in err

@@ -146,6 +146,8 @@ def cmd_select(args) -> int:
     one_rps = _one_rps(logs, args)
     ahead = _ahead(logs, args)
     written = _as_written(sel.model, one_rps, ahead)
+    speed = args.speed if args.speed is not None else _approach(logs[0], "u")
+    rps = args.rps if args.rps is not None else (one_rps or _approach(logs[0], "n"))
     if written is not sel.model:
         # Checked as the file will have it, from the approach select's own check of the fit
         # took (the logs' first, or --speed and --rps), with the crash stop it had.
@@ -154,13 +156,19 @@ def cmd_select(args) -> int:
             sharpest_curvature,
         )
 
-        speed = args.speed if args.speed is not None else _approach(logs[0], "u")
-        rps = args.rps if args.rps is not None else (one_rps or _approach(logs[0], "n"))
         plausibility, notes = plausibility_at_approach(
             written, speed, rps, args.speed, args.rps,
             curvature=sharpest_curvature(logs, speed), astern=True)  # fmt: skip
     ident.warnings.extend(f"plausibility: {n}" for n in notes)
-    from shipid.identification.plausibility import given_steady_speeds, missed_steady_speed
+    from shipid.identification.plausibility import (
+        given_steady_speeds,
+        missed_steady_speed,
+        rudder_reversed_warning,
+    )
+
+    reversed_rudder = rudder_reversed_warning(written, speed, rps)
+    if reversed_rudder:
+        ident.warnings.append(f"plausibility: {reversed_rudder}")
 
     for u, n in given_steady_speeds(physics):
         missed = missed_steady_speed(written, u, n)
