@@ -134,7 +134,7 @@ def cmd_identify(args) -> int:
     if asked and (args.refine or args.bootstrap is not None):
         raise ShipidError("--output-error is its own fit with its own intervals; it does not go "
                           "with --refine or --bootstrap")  # fmt: skip
-    from shipid.identification.physics import parse_constraints, unboxed
+    from shipid.identification.physics import ROW_CONSTRAINTS, parse_constraints, unboxed
 
     # Output error holds sign constraints and bounds (box bounds on its coefficients), not the
     # conditions on the equation-error regression: said before the logs are read and the
@@ -340,13 +340,20 @@ def cmd_identify(args) -> int:
     elif args.output_error == "auto" and not (args.refine or args.bootstrap is not None
                                              or explicit_band or args.residual):
         prep["output_error"] = {"fit": "LS-SVM"}
-        if given_physics:  # output error would fit them away
+        rows_only = [flag for _, flag in ROW_CONSTRAINTS if flag in given_physics]
+        if given_physics and len(rows_only) < len(given_physics):  # it would fit them away
             prep["output_error"]["why"] = f"it would not hold {given_physics[0]}"
             print(f"output error: not fitted, since {prep['output_error']['why']}; the LS-SVM "
                   "fit does")  # fmt: skip
         else:
+            from shipid.identification.physics import without_rows
+
             refinement, ensemble = _output_error_where_noise_is_left(
-                ident, raw_logs, names, args, prep["output_error"], physics)
+                ident, raw_logs, names, args, prep["output_error"],
+                without_rows(physics) if rows_only else physics)  # fmt: skip
+            if refinement is not None and rows_only:
+                refinement, ensemble = _output_error_holding_rows(
+                    refinement, ensemble, physics, logs, rows_only, prep["output_error"])
     elif args.output_error == "auto" and not (args.refine or given_physics):
         prep["output_error"] = _output_error_passed_over(ident, raw_logs, args, explicit_band)
     final = ident.model
@@ -766,6 +773,24 @@ def _output_error_where_noise_is_left(ident, logs, names, args, record: dict, ph
         return None, None
     record.update(fit="output error", why="noise is what the LS-SVM leaves")
     return fit, ensemble
+
+
+def _output_error_holding_rows(refinement, ensemble, physics, logs, flags, record: dict):
+    """Output error does not hold ``--constraints derivatives`` or ``rudder-ahead`` (rows on its
+    coefficients), but its fit can be checked against them: kept where it meets every row (said),
+    else the LS-SVM fit that holds them, and the first row it goes past. Returns (refinement,
+    ensemble), (None, None) for the LS-SVM."""
+    from shipid.identification.physics import rows_unmet
+
+    unmet = rows_unmet(physics, refinement.model, logs)
+    if unmet:
+        record.update(fit="LS-SVM", why=f"its fit goes past {' and '.join(flags)} ({unmet[0]}"
+                      + (f", and {len(unmet) - 1} more" if len(unmet) > 1 else "") + ")")
+        print(f"output error: {record['why']}; the model file keeps the LS-SVM fit, which holds "
+              "it")  # fmt: skip
+        return None, None
+    print(f"output error: its fit holds {' and '.join(flags)} too (checked on its coefficients)")
+    return refinement, ensemble
 
 
 def _output_error_passed_over(ident, logs, args, explicit_band: bool) -> dict:

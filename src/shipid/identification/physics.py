@@ -640,6 +640,41 @@ def dof_physics(options: PhysicsOptions | None, dof: str, names: Sequence[str], 
     return out
 
 
+# The constraints that are rows G z ≥ h on a fit's coefficients alone (no prior, no equality,
+# not the stability rows, which hold the yaw equation given the sway one's fit): any model's
+# coefficients can be checked against them after the fit, output error's too.
+ROW_CONSTRAINTS = (("derivatives", "--constraints derivatives"),
+                   ("rudder_ahead", "--constraints rudder-ahead"))
+
+
+def without_rows(options: PhysicsOptions | None) -> PhysicsOptions | None:
+    """``options`` less ``ROW_CONSTRAINTS``: what an output-error fit holds of them (its box
+    bounds), to be checked against the rows after (``rows_unmet``)."""
+    if options is None:
+        return None
+    return dataclasses.replace(options, **{name: False for name, _ in ROW_CONSTRAINTS})
+
+
+def rows_unmet(options: PhysicsOptions, model, logs: Sequence[pd.DataFrame]) -> list[str]:
+    """The rows of ``options``' ``derivatives`` and ``rudder_ahead`` that ``model``'s
+    coefficients go past (labels as the fit names them, with the equation), beyond a rounding's
+    size against the whole row: what a fit that does not hold them (output error, from the
+    LS-SVM fit that does) must be checked against before it replaces that fit."""
+    unmet = []
+    for dof in model.structure.dofs:
+        coef = model.coefficients[dof]
+        names = [t for t in coef if t != "1"]
+        found = derivative_rows(options, dof, names, {}, logs)
+        if found is None:
+            continue
+        G, h, labels = found
+        z = np.append([coef[t] for t in names], coef.get("1", 0.0))
+        tol = 1e-7 * (np.linalg.norm(G, axis=1) * np.linalg.norm(z) + np.abs(h)) + 1e-300
+        unmet += [f"{dof}: {label}" for label, slack, t in zip(labels, G @ z - h, tol,
+                                                              strict=True) if slack < -t]
+    return list(dict.fromkeys(unmet))
+
+
 def unboxed(options) -> list[str]:
     """The options of ``options`` (a ``PhysicsOptions``, or anything with its ``prior``,
     ``steady_speed``, ``stable``, ``derivatives`` and ``rudder_ahead``: the command line checks
