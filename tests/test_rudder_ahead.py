@@ -206,3 +206,23 @@ def test_output_error_is_kept_where_its_fit_holds_the_rows(tmp_path, capsys):
             assert "the model file keeps the LS-SVM fit, which holds it" in out
         assert doc["model"]["coefficients"]["v"]["delta"] > 0
         assert doc["model"]["coefficients"]["r"]["delta"] < 0
+
+
+@pytest.mark.parametrize("constraint", ["rudder-ahead", "derivatives"])
+def test_a_rudder_held_the_wrong_way_is_the_conflict_named(constraint, tmp_path, capsys):
+    """The paper's ship with its yaw rudder term held at +0.01 (positive to port: the rudder
+    turning the ship away from its side): the rows cannot be met, and the one line names the
+    rudder's row, not the row an infeasible SLSQP happened to stop furthest from (the yaw
+    damping's, before), once for the prefilter's candidates."""
+    from shipid.demo import TRAINING, synthesise_trials
+
+    paper = write_log(synthesise_trials(seed=0)[TRAINING], tmp_path / "paper.csv")
+    out = tmp_path / "m.json"
+    code, _, err = run(["identify", paper, "--constraints", constraint, "--bound",
+                        "r: delta >= 0.01", "--bound", "r: delta <= 0.01", "-o", out], capsys)
+    lines = [line for line in err.splitlines() if line.startswith("shipid: error")]
+    assert code == 1 and len(lines) == 1, err
+    assert lines[0].startswith("shipid: error: constraints conflict: the rudder turns the ship "
+                               "its way (∂ṙ/∂δ) at ")  # fmt: skip
+    assert lines[0].count("constraints conflict") == 1
+    assert not out.exists()

@@ -58,7 +58,8 @@ def fit_linear(X: np.ndarray, y: np.ndarray, estimator="lssvm", gamma: float = 1
         A, B = accumulate_normal_equations([(X, y[:, None], w)], X.shape[1], 1)
         coef, bias, physics.active = solve_primal_constrained(
             A, B[:, 0], gamma if estimator == "lssvm" else math.inf, physics.prior,
-            physics.lower, physics.upper, physics.solver_equalities(), physics.inequalities)
+            physics.lower, physics.upper, physics.solver_equalities(), physics.inequalities,
+            physics.inequality_labels)
         return coef, 0.0 if physics.no_constant else bias
     fit_kw = {} if sample_weight is None else {"sample_weight": sample_weight}
     if not isinstance(estimator, str):

@@ -454,7 +454,7 @@ def derivative_rows(options: PhysicsOptions, dof: str, names: Sequence[str],
     wrt = [x for x, _, _ in rules]
     what = "/".join(n for n, on in (("derivatives", options.derivatives),
                                     ("rudder-ahead", options.rudder_ahead)) if on)  # fmt: skip
-    rows, rhs, labels, held = [], [], [], set()
+    rows, rhs, labels, held = [], [], [], {}
     for u0, n0 in approach_states(options, logs, what):
         for u, n, rudder_only in _derivative_states(options, u0, n0):
             g = _straight_running_slopes(names, u, n, wrt)
@@ -470,9 +470,11 @@ def derivative_rows(options: PhysicsOptions, dof: str, names: Sequence[str],
                 scale = float(np.hypot(np.linalg.norm(g[i]), f[i]))
                 row, bound = sigma * g[i] / scale, -sigma * f[i] / scale
                 key = (i, *np.round(row, 12), round(bound, 12))
-                if key in held:
-                    continue  # the same row (a rudder term without u or n)
-                held.add(key)
+                if key in held:  # the same row (a rudder term without u or n): at every speed
+                    if rudder_only:
+                        labels[held[key]] = f"{why} at every speed ahead"
+                    continue
+                held[key] = len(rows)
                 rows.append(np.append(row, 0.0))
                 rhs.append(bound)
                 if u > RUDDER_AHEAD_SHARES[-3] * u0:

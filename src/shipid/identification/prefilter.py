@@ -95,6 +95,8 @@ def choose_prefilter(
         notes = list(dict.fromkeys(r["note"] for r in rows if r["note"]))
         if len(notes) == 1:  # not the filter's doing (a log's sampling, say): say it once
             raise ShipidError(notes[0])
+        if all(n.startswith("constraints conflict") for n in notes):
+            raise ShipidError(notes[0])  # the same rows at each candidate's approach: once
         raise ShipidError("no prefilter candidate could be fitted: " + "; ".join(notes)[:300])
     best = min(scored, key=lambda i: rows[i]["score"])
     # One standard error: the least filtering candidate as good as the best within its spread

@@ -343,7 +343,8 @@ def _fit_theta(data: _Data, terms: Mapping[str, Sequence[str]], gamma: float, tr
             A, b = gram[np.ix_(sel, sel)], cross[dof][sel]
             w, bias, _ = solve_primal_constrained(
                 A, b, gamma if estimator == "lssvm" else math.inf, extra.prior, extra.lower,
-                extra.upper, extra.solver_equalities(), extra.inequalities)
+                extra.upper, extra.solver_equalities(), extra.inequalities,
+                extra.inequality_labels)
         else:
             X = np.vstack([data.phi[j][:, cols] for j in train])
             y = np.concatenate([data.targets[j][dof] for j in train])

@@ -17,7 +17,7 @@ for fixed-size), the normal equations of the same problem are the (p+1)×(p+1) b
 from __future__ import annotations
 
 import warnings
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 
 import numpy as np
 from scipy import linalg
@@ -171,6 +171,7 @@ def solve_primal_constrained(
     upper: np.ndarray | None = None,
     equalities: tuple[np.ndarray, np.ndarray] | None = None,
     inequalities: tuple[np.ndarray, np.ndarray] | None = None,
+    labels: Sequence[str] | None = None,
 ) -> tuple[np.ndarray, float, np.ndarray]:
     """One output of the primal LS-SVM with physics: a prior, bounds, linear equalities and
     linear inequalities.
@@ -190,6 +191,8 @@ def solve_primal_constrained(
         the yaw equation given the sway one). Where the solution without them meets them it is
         returned as is; else the quadratic program with them is solved by SciPy's SLSQP from that
         solution and solved exactly again with the inequalities and bounds it holds as equalities.
+    labels : what each inequality row holds, in words: the one a conflict leaves furthest from
+        met is named in the error.
 
     Returns
     -------
@@ -211,7 +214,8 @@ def solve_primal_constrained(
         if not np.all(G @ np.append(x, bias)
                       >= h - INEQUALITY_TOLERANCE * _row_scale(G, x, bias, h)):
             x, bias, active = _solve_with_inequalities(A, b, gamma, prior, lower, upper,
-                                                       equalities, G, h, np.append(x, bias))
+                                                       equalities, G, h, np.append(x, bias),
+                                                       labels)  # fmt: skip
     if held is not None:
         mask, values = held
         x[mask], active[mask] = values, True  # on the value itself, not its solve's rounding
@@ -260,7 +264,29 @@ def _objective_terms(A, b, gamma, prior):
     return M, c
 
 
-def _solve_with_inequalities(A, b, gamma, prior, lower, upper, equalities, G, h, start):
+def _conflicting_rows(G, h, lower, upper, equalities, labels) -> str:
+    """What to name of an infeasible ``G z ≥ h`` within the box and the equalities: the first
+    row that no point of the box and the equalities meets on its own (a linear program per row:
+    the largest G_i z there), by its label; else the rows together. The point an infeasible
+    SLSQP stops at says nothing of which row is to blame."""
+    from scipy.optimize import linprog
+
+    named = labels is not None and len(labels) == len(h)
+    E, f = (None, None) if equalities is None else (
+        np.atleast_2d(np.asarray(equalities[0], dtype=float)),
+        np.atleast_1d(np.asarray(equalities[1], dtype=float)))  # fmt: skip
+    bounds = [(None if not np.isfinite(lo) else lo, None if not np.isfinite(hi) else hi)
+              for lo, hi in zip(lower, upper, strict=True)]  # fmt: skip
+    for i in range(len(h)):
+        res = linprog(-G[i], A_eq=E, b_eq=f, bounds=bounds, method="highs")
+        if res.status == 0 and -res.fun < h[i] - 1e-9 * (np.abs(G[i]).sum() + abs(h[i]) + 1.0):
+            return labels[i] if named else f"inequality row {i + 1}"
+    return ("the inequality rows together" + (f" ({', '.join(dict.fromkeys(labels))})"
+                                              if named else ""))  # fmt: skip
+
+
+def _solve_with_inequalities(A, b, gamma, prior, lower, upper, equalities, G, h, start,
+                             labels=None):
     """The quadratic program of ``solve_primal_constrained`` with ``G z ≥ h`` (SLSQP on the
     equilibrated problem, from ``start``), then solved exactly with what it holds active."""
     from scipy.optimize import minimize
@@ -288,8 +314,8 @@ def _solve_with_inequalities(A, b, gamma, prior, lower, upper, equalities, G, h,
     # SLSQP can report success on an infeasible set: judge the point itself (unit rows).
     if np.any(slack < -1e-6):
         raise InfeasibleConstraintsError(
-            "constraints conflict: the inequalities (straight-line stability) cannot be met "
-            f"within the bounds and equalities (signs, --bound, steady-speed): {res.message}")
+            f"constraints conflict: {_conflicting_rows(G, h, lo, hi, equalities, labels)} cannot "
+            "be met within the bounds and equalities (signs, --bound, steady-speed)")
     # Polish: the rows and bounds SLSQP holds, as equalities of the exact problem; its KKT
     # multipliers certify the optimum (≤ 0 on held inequalities and lower bounds, ≥ 0 on upper
     # bounds, with ∇f + Cᵀμ = 0), which SLSQP's own status does not (it stops with "positive
