@@ -791,9 +791,9 @@ def rudder_reversed(model, rps: float | None, straight_speed: float | None
 
     A fit of zig-zags at one propeller speed reads the race's u², u·n and n² only over the
     logs' speeds; outside them their sum can change sign: the KVLCC2's MARIN 20/20 run fitted by
-    the default turns the ship the wrong way below 0.36 m/s ahead at its 10.33 rps (30 % of its
-    approach) and at any speed with the propeller stopped (``--constraints rudder-ahead`` holds
-    the sign there)."""
+    ``blanke-race+race-damping`` turns the ship the wrong way below 0.35 m/s ahead at its 10.33
+    rps (28 % of its straight speed) and at most speeds with the propeller stopped
+    (``--constraints rudder-ahead`` holds the sign there)."""
     if (straight_speed is None or not straight_speed > 0 or "r" not in model.structure.dofs
             or not any("delta" in t for t in model.structure.terms.get("r", ()))):  # fmt: skip
         return {}

@@ -191,8 +191,8 @@ def solve_primal_constrained(
         the yaw equation given the sway one). Where the solution without them meets them it is
         returned as is; else the quadratic program with them is solved by SciPy's SLSQP from that
         solution and solved exactly again with the inequalities and bounds it holds as equalities.
-    labels : what each inequality row holds, in words: the one a conflict leaves furthest from
-        met is named in the error.
+    labels : what each inequality row holds, in words: where the rows cannot be met, the first
+        that no point of the bounds and equalities meets on its own is named in the error.
 
     Returns
     -------
