@@ -179,6 +179,10 @@ def test_the_commands_that_run_a_model_file_repeat_the_from_rest_warning(
     for argv in (["manoeuvre", path, "zigzag", "--duration", "20"],
                  ["manoeuvre", path, "turning", "--speed", "0.3", "--rps", str(n),
                   "--duration", "20"],
+                 # Begun below the lower root (0.115 m/s): no straight speed within
+                 # surge_equilibrium's span of 0.05, and the warning was passed over.
+                 ["manoeuvre", path, "turning", "--speed", "0.05", "--rps", str(n),
+                  "--duration", "20"],
                  ["criteria", path, "--length", "3", "--scale", "1"],
                  ["validate", path, log, "--no-bands"]):  # fmt: skip
         code, _, err = run(argv, capsys)

@@ -759,6 +759,11 @@ def _thrust_on_the_advance(model) -> str:
     return f"; {note[0]}: {note[1]}" if note else ""
 
 
+# How far above a given speed the warnings look for the straight speed where none lies within
+# ``surge_equilibrium``'s own span of it (``_straight_from``: a manoeuvre begun at 0.2 m/s).
+STRAIGHT_SPAN = 30.0
+
+
 def from_rest_warning(model, speed: float | None, rps: float | None) -> str | None:
     """``from_rest``'s warning for ``model`` at the propeller speed ``rps``, its straight speed
     the surge's equilibrium nearest ``speed``; None where the model gets under way, has no surge
@@ -769,9 +774,18 @@ def from_rest_warning(model, speed: float | None, rps: float | None) -> str | No
     if (getattr(model, "uses_thrust", False) or "u" not in model.structure.dofs
             or not (speed and speed > 0)):  # fmt: skip
         return None
-    straight = surge_equilibrium(model, speed, rps)
+    straight = _straight_from(model, speed, rps)
     found = from_rest(model, rps, straight)
     return None if found is None else _astern_from_rest(found, rps, straight, model)
+
+
+def _straight_from(model, speed: float, rps: float | None) -> float | None:
+    """The surge's equilibrium nearest ``speed`` (``surge_equilibrium``), looked for up to
+    ``STRAIGHT_SPAN`` times it where none lies within its own span: a manoeuvre begun slow
+    (``--speed 0.2``) balances well above the speed given, and the warnings that read from the
+    straight speed were passed over for exactly the runs that start slow."""
+    return (surge_equilibrium(model, speed, rps)
+            or surge_equilibrium(model, speed, rps, span=STRAIGHT_SPAN))  # fmt: skip
 
 
 # The speeds (shares of the straight speed, rest left out: no flow, no force) at which
@@ -829,7 +843,7 @@ def rudder_reversed_warning(model, speed: float | None, rps: float | None) -> st
     ``from_rest_warning``): where a run starts slow, slows or stops its propeller."""
     if getattr(model, "uses_thrust", False) or not (speed and speed > 0):
         return None
-    straight = surge_equilibrium(model, speed, rps) if "u" in model.structure.dofs else speed
+    straight = _straight_from(model, speed, rps) if "u" in model.structure.dofs else speed
     found = rudder_reversed(model, rps, straight)
     if not found:
         return None
