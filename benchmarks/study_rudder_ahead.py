@@ -17,12 +17,16 @@ The start from slow ahead: 0.2 m/s (a sixth of the approach speed), the propelle
 approach's rate, 20° rudder to starboard put over at once (in each model's rudder convention),
 the heading after 10, 30 and 60 s, positive to starboard.
 
-Run: .venv/bin/python benchmarks/study_rudder_ahead.py
+4. with ``tanker``: the single-screw tanker of ``study_tanker.py``, its truth known, from its
+   first two training sets, 3 seeds.
+
+Run: .venv/bin/python benchmarks/study_rudder_ahead.py [tanker]
 """
 
 from __future__ import annotations
 
 import json
+import sys
 import tempfile
 import warnings
 from pathlib import Path
@@ -142,6 +146,52 @@ def mmg_truth(seeds: int = 6, noise: float = 0.25) -> None:
                       f"{failed} |", flush=True)  # fmt: skip
 
 
+def tanker(seeds: int = 3) -> None:
+    """The single-screw tanker of ``study_tanker.py`` (its truth another laboratory's model, its
+    rudder in the race), its first two training sets, the default with and without the
+    constraint: the judged turns and zig-zag of ``study_tanker.judged``, the start from 1 m/s at
+    80 rpm with 20° of rudder (heading after 60, 180, 600 s), and whether `identify` names a
+    reversed rudder."""
+    from cli_models import noisy_files
+    from study_tanker import SEA_SENSORS, cells, judged, ship_at, trials, truth_indices
+    from study_tanker import TRAINING as TANKER_TRAINING
+
+    from shipid.identification.plausibility import rudder_reversed_warning
+
+    def start(model, positive):
+        sign = 1.0 if positive == "starboard" else -1.0
+        t = np.arange(0.0, 600.5, 1.0)
+        res = simulate(model, t, np.full(t.size, np.radians(sign * 20.0)),
+                       {"u": 1.0, "v": 0.0, "r": 0.0}, rps=np.full(t.size, 80 / 60))  # fmt: skip
+        psi = np.degrees(res.log["psi"].to_numpy())
+        return ", ".join(f"{abs(psi[k]):.0f}" if k < psi.size else "–" for k in (60, 180, 600))
+
+    clean, truth = trials(), truth_indices()
+    print(f"\nThe tanker (study_tanker.py's truth and judging; heading from 1 m/s at 80 rpm, 20° "
+          f"rudder, after 60, 180, 600 s: the truth's {start(ship_at(80).dynamics, 'port')}°)\n")
+    print("| trained on | seed | made by | 35° turns 80 rpm stbd, port, 50 rpm stbd, port; 20° "
+          "at 65 rpm: TD (steady r) | 10/10 at 65 rpm | slow start [°] | rudder reversed |")
+    print("|---|---|---|---|---|---|---|")
+    with tempfile.TemporaryDirectory() as folder:
+        for label, keys in list(TANKER_TRAINING.items())[:2]:
+            for seed in range(seeds):
+                files = noisy_files({f"{k}_{rpm}": clean[f"{k}_{rpm}"] for k, rpm in keys},
+                                    SEA_SENSORS, seed, folder)  # fmt: skip
+                for name, extra in (("identify", []), ("identify --constraints rudder-ahead", HELD)):
+                    out = f"{folder}/m.json"
+                    model = model_by_cli(["identify", "--dt", "1", *extra], list(files.values()), out)
+                    if model is None:
+                        print(f"| {label} | {seed} | {name} | failed | | | |")
+                        continue
+                    prep = json.loads(Path(out).read_text())["identification"]["preprocessing"]
+                    named = rudder_reversed_warning(model, prep["approach_speed"],
+                                                    prep.get("approach_rps"))  # fmt: skip
+                    row = cells(judged(model, truth))
+                    print(f"| {label} | {seed} | {name} | {'; '.join(row[:-1])} | {row[-1]} | "
+                          f"{start(model, prep.get('rudder_positive'))} | "
+                          f"{'yes' if named else 'no'} |", flush=True)  # fmt: skip
+
+
 def esso_single(_: Path) -> None:
     print()
     esso(False, {"default": [], "default --constraints rudder-ahead": HELD})
@@ -149,4 +199,7 @@ def esso_single(_: Path) -> None:
 
 if __name__ == "__main__":
     warnings.simplefilter("ignore")  # the MARIN yaw rate's offset (study_gyro_offset.py)
-    run_with_files(real_kvlcc2, lambda _: mmg_truth(), esso_single)
+    if sys.argv[1:] == ["tanker"]:
+        tanker()
+    else:
+        run_with_files(real_kvlcc2, lambda _: mmg_truth(), esso_single)
