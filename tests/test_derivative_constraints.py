@@ -76,3 +76,30 @@ def test_cli_takes_the_derivatives_constraint(tmp_path, capsys):
                        capsys)  # fmt: skip
     assert code == 0, err
     assert "yaw damping ∂ṙ/∂r ≤ 0 at 1 m/s held at 0" in err
+
+
+def test_the_slopes_of_many_states_at_once_are_the_closed_forms():
+    """``_slopes_at`` differentiates each term at every state in one evaluation (``rudder-ahead``
+    asks for 36 states per approach in every fit of a search): against the terms' own
+    derivatives at straight running, at rest, slow, at speed, far ahead and with the propeller
+    stopped; and the one-state form is its column."""
+    from shipid.identification.physics import _slopes_at
+
+    states = [(0.0, 10.0), (0.3, 10.0), (1.2, 10.33), (12.0, 0.0), (1200.0, 10.0)]
+    u, n = (np.array(c) for c in zip(*states, strict=True))
+    texts = ["|u|*u*delta", "u*pos(n)*delta", "pos(n)^2*delta", "u*r", "|v|*v", "r*|n|", "u*v"]
+    got = _slopes_at(texts, states, ("u", "v", "r", "delta"))
+    truth = {  # (∂/∂u, ∂/∂v, ∂/∂r, ∂/∂δ) at v = r = δ = 0
+        "|u|*u*delta": (0 * u, 0 * u, 0 * u, np.abs(u) * u),
+        "u*pos(n)*delta": (0 * u, 0 * u, 0 * u, u * np.maximum(n, 0)),
+        "pos(n)^2*delta": (0 * u, 0 * u, 0 * u, np.maximum(n, 0) ** 2),
+        "u*r": (0 * u, 0 * u, u, 0 * u),
+        "|v|*v": (0 * u, 0 * u, 0 * u, 0 * u),
+        "r*|n|": (0 * u, 0 * u, np.abs(n), 0 * u),
+        "u*v": (0 * u, u, 0 * u, 0 * u),
+    }
+    for j, text in enumerate(texts):
+        for w in range(4):
+            assert got[w, j] == pytest.approx(truth[text][w], rel=1e-7, abs=1e-7), (text, w)
+    one = _straight_running_slopes(texts, 1.2, 10.33, ("r", "delta"))
+    assert np.array_equal(one, _slopes_at(texts, [(1.2, 10.33)], ("r", "delta"))[:, :, 0])

@@ -357,35 +357,49 @@ def _straight_running_slopes(texts: Sequence[str], u0: float, n0: float,
     """(len(wrt), len(texts)): ∂/∂x of each term for x in ``wrt`` (of u, v, r, delta) at
     straight running (u0, v = r = 0, rudder amidships, propeller n0, still air: the apparent wind
     of the ship's own motion); see ``_term_slopes``."""
+    return _slopes_at(texts, ((float(u0), float(n0)),), wrt)[:, :, 0]
+
+
+def _slopes_at(texts: Sequence[str], states: Sequence[tuple[float, float]],
+               wrt: Sequence[str] = ("v", "r")) -> np.ndarray:
+    """(len(wrt), len(texts), len(states)): ``_straight_running_slopes`` at each straight-running
+    state (u0, n0) of ``states``, each term's at all of them in one evaluation."""
+    key = (tuple((float(u), float(n)) for u, n in states), tuple(wrt))
     if not len(texts):
-        return np.zeros((len(wrt), 0))
-    key = (float(u0), float(n0), tuple(wrt))  # a term's spelling is its own cache entry
-    return np.array([_term_slopes(t, *key) for t in texts]).T.reshape(len(wrt), len(texts))
+        return np.zeros((len(wrt), 0, len(key[0])))
+    return np.stack([_term_slopes(t, *key) for t in texts], axis=1)
 
 
 @functools.lru_cache(maxsize=4096)
-def _term_slopes(text: str, u0: float, n0: float, wrt: tuple[str, ...]) -> tuple[float, ...]:
-    """One term's slopes of ``_straight_running_slopes`` (cached: ``select`` asks for the same
-    terms at the same approaches in every fold of every candidate).
+def _term_slopes(text: str, states: tuple[tuple[float, float], ...], wrt: tuple[str, ...]
+                 ) -> np.ndarray:  # fmt: skip
+    """One term's slopes (len(wrt), len(states)) of ``_slopes_at`` (cached, read-only: ``select``
+    asks for the same terms at the same approaches in every fold of every candidate, and
+    ``rudder_ahead`` at 36 speeds of each).
 
     Central differences at steps h and 2h, combined (2 D(h) − D(2h)) so that the kink of a
     modulus term at 0 (|v|v, |r|r: slope 0, but h from a central difference) counts nothing: a
-    fit would otherwise buy stability with an |r|r coefficient of 10⁶."""
+    fit would otherwise buy stability with an |r|r coefficient of 10⁶. One term at one state at
+    a time (and the per-state entries overflowing the cache), `identify --constraints
+    rudder-ahead` of the tanker's four zig-zags at two rps took 237 s, 10 s now."""
+    u0, n0 = (np.array(column, dtype=float) for column in zip(*states, strict=True))
 
-    def value(du: float, dv: float, dr: float, dd: float) -> float:
-        u, v, r = np.array([u0 + du]), np.array([dv]), np.array([dr])
-        return float(term_matrix([text], u, v, r, still_air(u, v, np.array([dd]),
-                                                            np.array([n0])))[0, 0])
+    def value(du, dv, dr, dd) -> np.ndarray:
+        u, v, r = u0 + du, np.zeros_like(u0) + dv, np.zeros_like(u0) + dr
+        return term_matrix([text], u, v, r, still_air(u, v, np.zeros_like(u0) + dd, n0))[:, 0]
 
-    def central(h: float) -> np.ndarray:
-        out = np.zeros(len(wrt))
+    def central(h: np.ndarray) -> np.ndarray:
+        out = np.zeros((len(wrt), len(u0)))
+        zero = np.zeros_like(h)
         for i, x in enumerate(wrt):
-            step = np.array([h if x == name else 0.0 for name in ("u", "v", "r", "delta")])
-            out[i] = (value(*step) - value(*(-step))) / (2 * h)
+            step = [h if x == name else zero for name in ("u", "v", "r", "delta")]
+            out[i] = (value(*step) - value(*(-d for d in step))) / (2 * h)
         return out
 
-    h = 1e-6 * max(abs(u0), 1.0)
-    return tuple((2.0 * central(h) - central(2.0 * h)).tolist())
+    h = 1e-6 * np.maximum(np.abs(u0), 1.0)
+    out = 2.0 * central(h) - central(2.0 * h)
+    out.flags.writeable = False
+    return out
 
 
 def with_approaches(options: PhysicsOptions | None, logs: Sequence[pd.DataFrame]
@@ -454,35 +468,51 @@ def derivative_rows(options: PhysicsOptions, dof: str, names: Sequence[str],
     wrt = [x for x, _, _ in rules]
     what = "/".join(n for n, on in (("derivatives", options.derivatives),
                                     ("rudder-ahead", options.rudder_ahead)) if on)  # fmt: skip
-    rows, rhs, labels, held = [], [], [], {}
-    for u0, n0 in approach_states(options, logs, what):
-        for u, n, rudder_only in _derivative_states(options, u0, n0):
-            g = _straight_running_slopes(names, u, n, wrt)
-            f = (_straight_running_slopes(list(fixed), u, n, wrt) @ np.array(list(fixed.values()))
-                 if fixed else np.zeros(len(wrt)))  # fmt: skip
-            for i, (_, sign, why) in enumerate(rules):
-                if rudder_only and sign in (1, -1):
-                    continue
-                if not np.any(g[i]):
-                    continue  # no free term carries it
-                sigma = float(sign) if sign in (1, -1) else (s if sign == RUDDER else -s)
-                # Rows to unit size: far ahead a u² slope is 10⁶ times the rest.
-                scale = float(np.hypot(np.linalg.norm(g[i]), f[i]))
-                row, bound = sigma * g[i] / scale, -sigma * f[i] / scale
-                key = (i, *np.round(row, 12), round(bound, 12))
-                if key in held:  # the same row (a rudder term without u or n): at every speed
-                    if rudder_only:
-                        labels[held[key]] = f"{why} at every speed ahead"
-                    continue
-                held[key] = len(rows)
-                rows.append(np.append(row, 0.0))
-                rhs.append(bound)
-                if u > RUDDER_AHEAD_SHARES[-3] * u0:
-                    where = "far ahead, where its u² terms rule (the propeller all but stopped)"
-                else:
-                    where = f"at {u:.3g} m/s" + (" with the propeller stopped" if n0 and not n
-                                                 else "")  # fmt: skip
-                labels.append(f"{why} {where}")
+    states = [(u0, n0, *state) for u0, n0 in approach_states(options, logs, what)
+              for state in _derivative_states(options, u0, n0)]  # fmt: skip
+    points = [(u, n) for _, _, u, n, _ in states]
+    slopes = _slopes_at(names, points, wrt)  # every state at once: (wrt, names, states)
+    fixed_slopes = (np.einsum("wts,t->ws", _slopes_at(list(fixed), points, wrt),
+                              np.array(list(fixed.values()))) if fixed
+                    else np.zeros((len(wrt), len(points))))  # fmt: skip
+    # Each (state, rule) pair's row, in that order, at unit size (far ahead a u² slope is 10⁶
+    # times the rest), those no free term carries left out, each row held once.
+    pairs = [(k, i) for k, state in enumerate(states) for i, (_, sign, _) in enumerate(rules)
+             if not (state[4] and sign in (1, -1))]  # fmt: skip
+    if not pairs:
+        return None
+    ks, rs = (np.array(column) for column in zip(*pairs, strict=True))
+    sigma = np.array([float(sign) if sign in (1, -1) else (s if sign == RUDDER else -s)
+                      for _, sign, _ in rules])[rs]  # fmt: skip
+    G = sigma[:, None] * slopes[rs, :, ks]
+    h = -sigma * fixed_slopes[rs, ks]
+    carried = np.any(G != 0, axis=1)
+    ks, rs, G, h = ks[carried], rs[carried], G[carried], h[carried]
+    if not len(ks):
+        return None
+    scale = np.hypot(np.linalg.norm(G, axis=1), h)
+    G, h = G / scale[:, None], h / scale
+    keys = np.round(np.column_stack([rs, G, h]), 12)
+    _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
+    inverse = inverse.reshape(-1)
+    kept = np.sort(first)
+    repeated = np.zeros(len(ks), dtype=bool)  # a row a rudder-only state repeats: every speed
+    for j in np.flatnonzero(np.isin(np.arange(len(ks)), first, invert=True)):
+        if states[ks[j]][4]:
+            repeated[first[inverse[j]]] = True
+    rows, rhs, labels = [], [], []
+    for j in kept:
+        u0, n0, u, n, _ = states[ks[j]]
+        why = rules[rs[j]][2]
+        if repeated[j]:
+            where = "at every speed ahead"
+        elif u > RUDDER_AHEAD_SHARES[-3] * u0:
+            where = "far ahead, where its u² terms rule (the propeller all but stopped)"
+        else:
+            where = f"at {u:.3g} m/s" + (" with the propeller stopped" if n0 and not n else "")
+        rows.append(np.append(G[j], 0.0))
+        rhs.append(h[j])
+        labels.append(f"{why} {where}")
     if not rows:
         return None
     return np.array(rows), np.array(rhs), labels
