@@ -296,9 +296,11 @@ def cmd_manoeuvre(args) -> int:
         _warn(note)
     target, cond = _ship_or_model(args.model, hybrid=True)
     speed, rps, unsteady = _run_approach(target, cond, args.speed, args.rps)
-    for note in (_from_rest_note(target, speed, rps), _rudder_reversed_note(target, speed, rps)):
-        if note:
-            _warn(note)
+    # Said before the run, and kept for --json with the notes the run adds.
+    plausibility_notes = [note for note in (_from_rest_note(target, speed, rps),
+                                            _rudder_reversed_note(target, speed, rps)) if note]
+    for note in plausibility_notes:
+        _warn(note)
     steering, rudder_note = _steering(target, cond, args.rudder_rate)
     kw = {"dt": args.step, "speed": speed, "rps": rps, "steering": steering}
     coarse = _step_note(cond, args.step, MANOEUVRE_STEP)
@@ -422,7 +424,7 @@ def cmd_manoeuvre(args) -> int:
                    "other_side_indices": other_side,
                    "rudder_rate_deg_s": (math.degrees(gear.max_rate) if gear and gear.max_rate
                                          else None),
-                   "warnings": notes}  # fmt: skip
+                   "warnings": plausibility_notes + notes}  # fmt: skip
             out.write(args.json, lambda p: p.write_text(_json_text(doc), "utf-8"))
         if args.output:
             from shipid.data.io import write_log
