@@ -147,10 +147,14 @@ def test_the_commands_name_a_reversed_rudder_and_take_the_constraint(mmg_zigzag,
         code, out, err = run(argv, capsys)
         assert code == 0, err
         assert "the rudder turns the ship the other way" in err + out, argv
-    # and in the record a manoeuvre writes for a program to read
+    # and in the records manoeuvre and validate write for a program to read
     code, _, err = run(["manoeuvre", free, "turning", "--json", tmp_path / "turn.json"], capsys)
     assert code == 0, err
     said = json.loads((tmp_path / "turn.json").read_text())["warnings"]
+    assert any(w.startswith("plausibility: the rudder turns the ship the other way") for w in said)
+    code, _, err = run(["validate", free, path, "--json", tmp_path / "v.json"], capsys)
+    assert code == 0, err
+    said = json.loads((tmp_path / "v.json").read_text())["model_warnings"]
     assert any(w.startswith("plausibility: the rudder turns the ship the other way") for w in said)
     code, out, err = run(["identify", path, "--model", RACE, "--constraints", "rudder-ahead",
                           "-o", held], capsys)  # fmt: skip

@@ -100,11 +100,13 @@ def cmd_validate(args) -> int:
         _check_length(args.model, model, cond, given.length, f"--particulars {args.particulars}")
         _check_scale(args.model, cond, given.scale, f"--particulars {args.particulars}")
     env = cond["envelope"]
-    # Logs that start from rest or slow down meet it (the Esso's random runs).
-    for note in (_from_rest_note(model, cond["speed"], cond["rps"]),
-                 _rudder_reversed_note(model, cond["speed"], cond["rps"])):
-        if note:
-            _warn(note)
+    # The model's own, whatever the logs (those that start from rest or slow down meet them, as
+    # the Esso's random runs do): said now, and in --json beside each log's.
+    model_notes = [note for note in (_from_rest_note(model, cond["speed"], cond["rps"]),
+                                     _rudder_reversed_note(model, cond["speed"], cond["rps"]))
+                   if note]  # fmt: skip
+    for note in model_notes:
+        _warn(note)
     from shipid.data.log import common_rudder_convention
     from shipid.trials.reading import read_trial_log
 
@@ -201,7 +203,8 @@ def cmd_validate(args) -> int:
     with OutputSet() as out:
         if args.json:
             records = [v.to_dict() for v in vals] + [{"name": None, "error": e} for e in failed]
-            body = {"logs": records, **({"tied_structures": tied} if tied else {})}
+            body = {"logs": records, **({"tied_structures": tied} if tied else {}),
+                    **({"model_warnings": model_notes} if model_notes else {})}
             out.write(args.json, lambda p: p.write_text(_json_text(body), "utf-8"))
         figures: dict[str, dict[str, bytes]] = {}
         if args.plots:
