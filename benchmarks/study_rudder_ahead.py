@@ -192,9 +192,33 @@ def tanker(seeds: int = 3) -> None:
                           f"{'yes' if named else 'no'} |", flush=True)  # fmt: skip
 
 
-def esso_single(_: Path) -> None:
+def esso_single(folder: Path) -> None:
     print()
     esso(False, {"default": [], "default --constraints rudder-ahead": HELD})
+    esso_named(folder)
+
+
+def esso_named(folder: Path) -> None:
+    """Which of the Esso's default fits `identify` names a reversed rudder in: each zig-zag file
+    alone (as ``study_crossflow.py`` fits it, the files' own 0.1 s) and the nine together at the
+    README's 0.5 s (cut as ``shipid import --start auto --end auto`` cuts them)."""
+    from esso_logs import DATA as ESSO
+
+    from shipid.identification.plausibility import rudder_reversed_warning
+
+    def named(argv: list[str], files: list[str]) -> bool:
+        out = str(folder / "named.json")
+        model = model_by_cli(["identify", "--format", "osaka-frt", *argv], files, out)
+        prep = json.loads(Path(out).read_text())["identification"]["preprocessing"]
+        return rudder_reversed_warning(model, prep["approach_speed"],
+                                       prep.get("approach_rps")) is not None  # fmt: skip
+
+    files = [str(p) for p in sorted((ESSO / "zigzag").glob("*.csv"))]
+    alone = [Path(f).stem[-8:] for f in files if named([], [f])]
+    nine = named(["--start", "auto", "--end", "auto", "--dt", "0.5"], files)
+    print(f"\nA reversed rudder named by identify: {len(alone)} of {len(files)} single-file fits "
+          f"({', '.join(alone) or 'none'}); the nine files' fit at 0.5 s: "
+          f"{'named' if nine else 'not named'}")
 
 
 if __name__ == "__main__":

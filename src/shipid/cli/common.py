@@ -862,35 +862,22 @@ def _ship_approach(ship, speed: float | None, rps: float | None):
     return speed, rps, None
 
 
-def _from_rest_note(target, speed: float | None, rps: float | None) -> str | None:
-    """The plausibility warning of a model whose surge, from rest at ``rps``, pushes astern
-    (``shipid.identification.plausibility.from_rest_warning``), checked on the model as the
-    command runs it; None for a reference ship or a model that gets under way."""
+def _model_notes(target, speed: float | None, rps: float | None) -> list[str]:
+    """The plausibility warnings of a model file the commands run (``validate``, ``manoeuvre``,
+    ``criteria``), checked on the model as they run it: its surge pushes a ship at rest astern
+    (``from_rest_warning``), its rudder turns the ship the other way at speeds ahead short of its
+    straight speed or with the propeller stopped (``rudder_reversed_warning``); none for a
+    reference ship."""
     from shipid.dynamics.hybrid import HybridModel
     from shipid.dynamics.model import ManoeuvringModel
 
     if not isinstance(target, ManoeuvringModel | HybridModel):
-        return None
-    from shipid.identification.plausibility import from_rest_warning
+        return []
+    from shipid.identification.plausibility import from_rest_warning, rudder_reversed_warning
 
-    note = from_rest_warning(target, speed, rps)
-    return f"plausibility: {note}" if note else None
-
-
-def _rudder_reversed_note(target, speed: float | None, rps: float | None) -> str | None:
-    """The plausibility warning of a model whose rudder turns the ship the other way at speeds
-    ahead short of its straight speed at ``rps`` or with the propeller stopped
-    (``shipid.identification.plausibility.rudder_reversed_warning``); None for a reference ship
-    or a model whose rudder turns it its way throughout."""
-    from shipid.dynamics.hybrid import HybridModel
-    from shipid.dynamics.model import ManoeuvringModel
-
-    if not isinstance(target, ManoeuvringModel | HybridModel):
-        return None
-    from shipid.identification.plausibility import rudder_reversed_warning
-
-    note = rudder_reversed_warning(target, speed, rps)
-    return f"plausibility: {note}" if note else None
+    return [f"plausibility: {note}" for note in (from_rest_warning(target, speed, rps),
+                                                 rudder_reversed_warning(target, speed, rps))
+            if note]  # fmt: skip
 
 
 def _unused_inputs(target, args) -> list[str]:

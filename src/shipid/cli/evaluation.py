@@ -12,9 +12,9 @@ from shipid.cli.common import (
     VESSEL_NAMES,
     _check_length,
     _check_scale,
-    _from_rest_note,
     _json_text,
     _markdown_dashed,
+    _model_notes,
     _particulars,
     _pd,
     _print_yaw_rate_offsets,
@@ -22,7 +22,6 @@ from shipid.cli.common import (
     _read_options,
     _reference_ship,
     _reference_speed_notes,
-    _rudder_reversed_note,
     _sampling_notes,
     _scale_notes,
     _ship_or_model,
@@ -102,9 +101,7 @@ def cmd_validate(args) -> int:
     env = cond["envelope"]
     # The model's own, whatever the logs (those that start from rest or slow down meet them, as
     # the Esso's random runs do): said now, and in --json beside each log's.
-    model_notes = [note for note in (_from_rest_note(model, cond["speed"], cond["rps"]),
-                                     _rudder_reversed_note(model, cond["speed"], cond["rps"]))
-                   if note]  # fmt: skip
+    model_notes = _model_notes(model, cond["speed"], cond["rps"])
     for note in model_notes:
         _warn(note)
     from shipid.data.log import common_rudder_convention

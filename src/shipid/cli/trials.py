@@ -12,12 +12,11 @@ from shipid.cli.common import (
     MANOEUVRE_STEP,
     _check_length,
     _check_scale,
-    _from_rest_note,
     _json_text,
     _markdown_dashed,
+    _model_notes,
     _pd,
     _read_files,
-    _rudder_reversed_note,
     _run_approach,
     _ship_or_model,
     _simulated_metadata,
@@ -82,8 +81,7 @@ def cmd_criteria(args) -> int:
     if args.particulars and not args.scale:  # --scale is the user's to override with
         _check_scale(args.model, cond, particulars.scale, f"--particulars {args.particulars}")
     speed, rps, _ = _run_approach(target, cond, args.speed, args.rps)  # imo_criteria notes it
-    from_rest = _from_rest_note(target, speed, rps)
-    reversed_rudder = _rudder_reversed_note(target, speed, rps)
+    model_notes = _model_notes(target, speed, rps)
     # Given, else the ship's gear or the training logs' rate, else imo_criteria's SOLAS rate.
     steering, _ = _steering(target, {**cond, "particulars": particulars}, args.rudder_rate,
                             fallback="caller")  # fmt: skip
@@ -96,7 +94,7 @@ def cmd_criteria(args) -> int:
                   scale=scale, rps=rps, steering=steering, astern_rps=args.astern_rps,
                   dt=args.dt, steady_window=_steady_window(cond))  # fmt: skip
     crit = run(target)
-    crit.notes += [note for note in (rate_note, from_rest, reversed_rudder) if note]
+    crit.notes += ([rate_note] if rate_note else []) + model_notes
     crit.notes += _unused_inputs(target, args)
     crit.notes += [n for n in (_step_note(cond, args.dt, CRITERIA_STEP),) if n]
     from shipid.evaluation.validate import faded_residual_notes
@@ -297,8 +295,7 @@ def cmd_manoeuvre(args) -> int:
     target, cond = _ship_or_model(args.model, hybrid=True)
     speed, rps, unsteady = _run_approach(target, cond, args.speed, args.rps)
     # Said before the run, and kept for --json with the notes the run adds.
-    plausibility_notes = [note for note in (_from_rest_note(target, speed, rps),
-                                            _rudder_reversed_note(target, speed, rps)) if note]
+    plausibility_notes = _model_notes(target, speed, rps)
     for note in plausibility_notes:
         _warn(note)
     steering, rudder_note = _steering(target, cond, args.rudder_rate)

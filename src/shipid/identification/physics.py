@@ -716,8 +716,7 @@ def unboxed(options) -> list[str]:
     if options is None:
         return []
     flags = (("prior", "--prior"), ("steady_speed", "--steady-speed"),
-             ("stable", "--constraints stable"), ("derivatives", "--constraints derivatives"),
-             ("rudder_ahead", "--constraints rudder-ahead"))
+             ("stable", "--constraints stable"), *ROW_CONSTRAINTS)
     return [flag for name, flag in flags if getattr(options, name)]
 
 
