@@ -93,11 +93,14 @@ def test_a_model_without_a_rudder_goes_straight_not_on_a_radius():
         coefficients[dof]["1"] = 0.0  # and no rudder offset: it goes straight
     blind = ManoeuvringModel(SHIP.dynamics.structure, coefficients)
     report = plausibility_at_approach(blind, SHIP.approach_speed, None, curvature=curvature)[0]
-    assert report["held_rudder"]["starboard"]["steady_yaw_rate"] == 0.0
-    (note,) = [n for k, (_, n) in failed_checks(report, blind).items() if k.endswith("starboard")]
-    assert note == ("35° rudder held to starboard: the model turns on a straight path, wider "
-                    f"than 2.5 times the tightest the training logs run ({1 / curvature:.3g} m):"
-                    " it has all but lost the rudder")
+    # To port as to starboard: a yaw rate of 0 was port's "turns the other way (steady yaw rate
+    # 0 rad/s)", since copysign gives 0 starboard's sign.
+    for side in ("starboard", "port"):
+        assert report["held_rudder"][side]["steady_yaw_rate"] == 0.0
+        (note,) = [n for k, (_, n) in failed_checks(report, blind).items() if k.endswith(side)]
+        assert note == (f"35° rudder held to {side}: the model turns on a straight path, wider "
+                        f"than 2.5 times the tightest the training logs run ({1 / curvature:.3g}"
+                        " m): it has all but lost the rudder")
 
 
 def test_the_reference_ships_turn_far_tighter_than_the_rule():

@@ -966,9 +966,10 @@ def _straight_speed(report: dict) -> float:
 
 
 def _turns_wrong_way(entry: dict, side: str) -> bool:
-    """A held turn whose (last tenth's mean) yaw rate has the other side's sign."""
+    """A held turn whose (last tenth's mean) yaw rate has the other side's sign (none at all is
+    a straight path, not the other way: ``copysign`` gave 0 starboard's sign and −0 port's)."""
     r = entry.get("steady_yaw_rate")
-    return r is not None and math.copysign(1.0, r) != (1.0 if side == "starboard" else -1.0)
+    return r is not None and r != 0.0 and (r > 0) != (side == "starboard")
 
 
 def _stalls(entry: dict, approach_speed: float) -> bool:
