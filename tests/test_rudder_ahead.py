@@ -123,6 +123,18 @@ def test_the_constraint_without_a_rudder_convention_says_it_holds_nothing(mmg_zi
                for w in fit.warnings)  # fmt: skip
 
 
+def test_the_constraint_on_a_structure_without_rudder_terms_says_it_holds_nothing(mmg_zigzag):
+    """A structure whose sway and yaw leave out δ took the flag and held nothing, unsaid."""
+    _, _, log = mmg_zigzag
+    blind = "u: |u|*u, 1; v: v, r; r: v, r"
+    fit = identify(log, model=blind, physics=PhysicsOptions(rudder_ahead=True))
+    for dof in ("v", "r"):
+        assert (f"{dof}: rudder-ahead holds nothing: no free term of the {dof} equation carries "
+                "the rudder (∂/∂δ = 0 at every speed)") in fit.warnings
+    held = identify(log, model=RACE, physics=PhysicsOptions(rudder_ahead=True))
+    assert not any("holds nothing" in w for w in held.warnings)
+
+
 def test_every_share_of_the_approach_is_held_and_the_flag_parses():
     assert RUDDER_AHEAD_SHARES[0] == 0.0 and 1.0 in RUDDER_AHEAD_SHARES
     assert parse_constraints("rudder-ahead")["rudder_ahead"] is True

@@ -659,6 +659,15 @@ def dof_physics(options: PhysicsOptions | None, dof: str, names: Sequence[str], 
         found = derivative_rows(options, dof, names, fixed, logs)
         if found is not None:
             out.inequalities, out.inequality_labels = found[:2], found[2]
+        rudder_whys = tuple(why for eq, _, sign, why in DERIVATIVE_RULES
+                            if eq == dof and sign in (RUDDER, "-" + RUDDER))  # fmt: skip
+        if (options.rudder_ahead and rudder_whys
+                and rudder_sign(logs, options.rudder_positive) is not None
+                and not any(label.startswith(rudder_whys) for label in out.inequality_labels)):
+            # Said, not silent: a structure whose free terms leave out δ took the flag and
+            # held nothing (its held turns then go straight).
+            out.notes.append(f"{dof}: rudder-ahead holds nothing: no free term of the {dof} "
+                             "equation carries the rudder (∂/∂δ = 0 at every speed)")
     if options.steady_speed and dof == "u":
         E, f, out.approaches = _approach_rows(names, fixed, has_constant, options, logs)
         out.equalities = (E, f)
