@@ -379,3 +379,36 @@ def test_cli_select_checks_its_options_before_reading_the_logs(tmp_path, capsys,
     assert main(["select", *missing, *option, "-o", str(tmp_path / "m.json")]) == 1
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and message in err, err
+
+
+def test_select_names_a_turn_its_terms_set_apart_from_identifys_default(tmp_path, capsys):
+    """The demo's two zig-zags (20/20, 10/10) as they come: the default library's choice turns
+    its held 35° turns at about three times blanke's yaw rate, and the demo's unseen 20° turns
+    side with blanke. Zig-zags alone cannot show which turn holds: said, not silent."""
+    import json
+
+    from shipid.identification.auto_structure import turns_apart_from_the_default
+    from shipid.reporting.modelfile import load_model
+
+    logs = synthesise_trials(seed=0)
+    paths = [write_log(logs[name], tmp_path / f"{i}.csv")
+             for i, name in enumerate((TRAINING, "zigzag 10/10"))]  # fmt: skip
+    code = main(["select", *map(str, paths), "--quiet", "-o", str(tmp_path / "s.json")])
+    err = capsys.readouterr().err
+    assert code == 0, err
+    (said,) = [w for w in err.splitlines() if "far from blanke" in w]
+    assert "no training log is a turn" in said and "validate both on a turning log" in said
+    code = main(["identify", *map(str, paths), "-o", str(tmp_path / "b.json")])
+    capsys.readouterr()
+    assert code == 0
+    # The premise, on a turn neither was fitted to: blanke predicts its yaw rate far better.
+    turn = logs["turning δ = +20°"]
+    errors = [validate(load_model(tmp_path / f), [turn])[0].metrics["r"]["rmse"]
+              for f in ("s.json", "b.json")]  # fmt: skip
+    assert errors[0] > 5 * errors[1]
+    # A turn among the training logs: its free run is scored, nothing to say.
+    report = json.loads((tmp_path / "s.json").read_text())["identification"]["plausibility"]
+    training = [logs[TRAINING], logs["zigzag 10/10"]]
+    speed = float(training[0]["u"].iloc[0])
+    assert turns_apart_from_the_default(report, training, None, speed, None) is not None
+    assert turns_apart_from_the_default(report, [*training, turn], None, speed, None) is None

@@ -169,6 +169,11 @@ def cmd_select(args) -> int:
     reversed_rudder = rudder_reversed_warning(written, speed, rps)
     if reversed_rudder:
         ident.warnings.append(f"plausibility: {reversed_rudder}")
+    from shipid.identification.auto_structure import turns_apart_from_the_default
+
+    apart = turns_apart_from_the_default(plausibility, logs, names, speed, rps)
+    if apart:
+        ident.warnings.append(f"library: {apart}")
 
     for u, n in given_steady_speeds(physics):
         missed = missed_steady_speed(written, u, n)
