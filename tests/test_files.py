@@ -757,6 +757,34 @@ def test_logs_at_different_scales_are_not_fitted_together(tmp_path, capsys):
     assert not (tmp_path / "m.json").exists()
 
 
+def test_a_log_given_twice_is_refused_by_name_or_as_a_copy(tmp_path, capsys):
+    """A log given twice (a glob that overlaps, a copy under another name) was fitted twice as
+    hard, and select's fold that held one out still fitted the other: its score was the fit's
+    own samples, 0.43 of the spread for a 10/10 zig-zag "held out" from itself. One line, exit
+    1, no file; through the Python API too."""
+    from shipid.identification.select import select
+
+    log = zigzag(scale_ship(), 10, 10, duration=60, dt=0.2).log
+    a = write_log(log, tmp_path / "zz.csv")
+    b = write_log(log, tmp_path / "copy.csv")
+    other = write_log(zigzag(scale_ship(), 20, 20, duration=60, dt=0.2).log, tmp_path / "o.csv")
+    for argv, said in (
+            (["identify", a, other, tmp_path / "." / "zz.csv"], "zz.csv is given twice"),
+            (["select", a, b, "--library", "blanke"], "copy.csv holds the same samples as"),
+            (["compare", b, a], "zz.csv holds the same samples as"),
+            (["correct", "scale-ship", a, b], "copy.csv holds the same samples as")):
+        code, _, err = run([*argv, "-o", tmp_path / "m.json"] if argv[0] != "compare" else argv,
+                           capsys)  # fmt: skip
+        lines = [ln for ln in err.splitlines() if not ln.startswith("warning:")]
+        assert code == 1 and len(lines) == 1, err
+        assert said in lines[0] and lines[0].endswith("give each log once"), lines[0]
+    assert not (tmp_path / "m.json").exists()
+    with pytest.raises(ShipidError, match="^log 1 holds the same samples as log 0: "):
+        select([log, log.copy()], library="blanke")
+    code, _, err = run(["identify", a, other, "-o", tmp_path / "m.json"], capsys)
+    assert code == 0, err
+
+
 def test_scale_is_refused_where_it_would_be_ignored(tmp_path, capsys):
     """``--scale`` on a canonical or Osaka log was silently ignored: the user believed the log
     Froude-scaled. It is refused in one line."""

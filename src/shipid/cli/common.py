@@ -105,7 +105,15 @@ def _training_logs(args) -> list:
     """The logs a model is fitted to: ``_read_logs``, cut to the trials they hold (zig-zags and
     turns from rest to their manoeuvre, other runs before a propulsion dropout), refused when
     they are at different scales (a model-scale and a full-scale run fitted together mix two
-    ships' time scales)."""
+    ships' time scales), and refused where a log is given twice (by name or as a copy)."""
+    from shipid.data.log import GIVEN_TWICE, refuse_copies
+
+    seen: dict[Path, str] = {}
+    for path in args.logs:
+        key = Path(path).resolve()
+        if key in seen:
+            raise ShipidError(f"{path} is given twice{GIVEN_TWICE}")
+        seen[key] = str(path)
     logs = _read_logs(args, cut_from_rest=True)
     scales, upsampled = {}, []
     for path, log in zip(args.logs, logs, strict=True):
@@ -118,6 +126,7 @@ def _training_logs(args) -> list:
         raise ShipidError(f"{pb} is at scale 1:{b:g} and {pa} at 1:{a:g}: the logs of one fit "
                           "must be at one scale (read the trial files with the same "
                           "--scale)")  # fmt: skip
+    refuse_copies(logs, [str(p) for p in args.logs])
     for path, own in upsampled:
         _warn(f"{path}: --dt {args.dt:g} s is finer than its own sampling ({own:.3g} s): the fit "
               f"sees straight lines between its samples as measurements (their second "

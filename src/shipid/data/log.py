@@ -191,6 +191,32 @@ STANDSTILL_SHARE = 0.3
 RUNNING_SHARE = 0.5
 
 
+# Why a log given twice is refused: fitted twice as hard, and where logs are held out in turn
+# (select, --cv, the error band), a fold that holds one copy out still fits the other, and
+# scores the fit on its own samples as if they were unseen.
+GIVEN_TWICE = (": a held-out fold of it would score a fit of its own samples as a prediction; "
+               "give each log once")
+
+
+def refuse_copies(logs: Sequence[pd.DataFrame], names: Sequence[str] | None = None) -> None:
+    """A one-line error where two logs hold the same samples (t, δ, u, v, r): a copy under
+    another name is the same log given twice."""
+    import hashlib
+
+    seen: dict[str, int] = {}
+    for i, log in enumerate(logs):
+        digest = hashlib.sha256()
+        for column in ("t", "delta", "u", "v", "r"):
+            if column in log:
+                digest.update(np.ascontiguousarray(log[column].to_numpy(float)).tobytes())
+        j = seen.setdefault(digest.hexdigest(), i)
+        if j != i:
+            name, first = (names[k] if names is not None else log_name(logs[k], f"log {k + 1}")
+                           for k in (i, j))  # fmt: skip
+            same = "is given twice" if first == name else f"holds the same samples as {first}"
+            raise ShipidError(f"{name} {same}{GIVEN_TWICE}")
+
+
 def _running_samples(log: pd.DataFrame) -> np.ndarray | None:
     """Where a log that starts without headway runs ahead (None: it starts running)."""
     u = log["u"].to_numpy(dtype=float)

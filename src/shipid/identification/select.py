@@ -53,6 +53,7 @@ from shipid.data.log import (
     column_array,
     common_rudder_convention,
     input_columns,
+    refuse_copies,
     require_states,
 )
 from shipid.dynamics.model import DOFS, ManoeuvringModel, ModelStructure, get_structure
@@ -619,6 +620,7 @@ def _setup(logs, names, options: SelectOptions):
         logs = [logs]
     logs, _ = common_rudder_convention(list(logs))  # select() converts first, with notes
     names = list(names or [log.attrs.get("name", f"log {i}") for i, log in enumerate(logs)])
+    refuse_copies(logs, names)
     kind, k = parse_cv(options.cv)
     if kind == "blocks":
         logs, names = split_blocks(logs, names, k)
