@@ -201,8 +201,12 @@ def read_particulars(path: str | Path) -> Particulars:
         raise ShipidError(f"{path}: no such particulars file")
     text = path.read_text(encoding="utf-8", errors="replace")
     if path.suffix.lower() == ".json":
+        from shipid.data.mappings import DuplicateKeyError, duplicate_key_error, load_json
+
         try:
-            data = json.loads(text)
+            data = load_json(text)
+        except DuplicateKeyError as exc:
+            raise duplicate_key_error(path, exc) from None
         except json.JSONDecodeError as exc:
             raise ShipidError(f"{path}: not a JSON particulars file ({exc})") from None
     else:
@@ -237,8 +241,12 @@ def _warn_near_misses(data: Mapping, path: Path) -> None:
 def _simple_yaml(text: str, path: Path) -> dict:
     import yaml
 
+    from shipid.data.mappings import DuplicateKeyError, duplicate_key_error, load_yaml
+
     try:
-        data = yaml.safe_load(text)
+        data = load_yaml(text)
+    except DuplicateKeyError as exc:
+        raise duplicate_key_error(path, exc) from None
     except yaml.YAMLError as exc:
         raise ShipidError(f"{path}: not a YAML particulars file ({str(exc).splitlines()[0]})") \
             from None

@@ -162,8 +162,12 @@ def read_spec(path: str | Path):
         text = path.read_text(encoding="utf-8")
     except OSError as exc:
         raise ShipidError(f"{path}: {exc.strerror or exc}") from None
+    from shipid.data.mappings import DuplicateKeyError, duplicate_key_error, load_yaml
+
     try:
-        spec = yaml.safe_load(text)
+        spec = load_yaml(text)
+    except DuplicateKeyError as exc:
+        raise duplicate_key_error(path, exc) from None
     except yaml.YAMLError as exc:
         raise ShipidError(f"{path}: not valid YAML ({str(exc).splitlines()[0]})") from None
     spec = {} if spec is None else spec

@@ -285,9 +285,13 @@ def load_document(path: str | Path) -> dict:
         raise ShipidError(f"{path}: no such model file")
     if path.is_dir():
         raise ShipidError(f"{path}: is a directory, not a model file")
+    from shipid.data.mappings import DuplicateKeyError, duplicate_key_error, load_json
+
     try:
         text = path.read_text(encoding="utf-8")
-        doc = json.loads(text, parse_constant=_no_constants)
+        doc = load_json(text, parse_constant=_no_constants)
+    except DuplicateKeyError as exc:
+        raise duplicate_key_error(path, exc) from None
     except UnicodeDecodeError:
         raise ShipidError(f"{path}: not a JSON model file (not UTF-8 text)") from None
     except (json.JSONDecodeError, ValueError, RecursionError) as exc:

@@ -35,7 +35,6 @@ Positive δ turns to starboard.
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Mapping
 from pathlib import Path
@@ -203,12 +202,12 @@ def read_document(path) -> dict:
         text = p.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
         raise ShipidError(f"{path}: cannot read the MMG file ({exc})") from None
-    try:
-        if p.suffix.lower() == ".json":
-            return json.loads(text)
-        import yaml
+    from shipid.data.mappings import DuplicateKeyError, duplicate_key_error, load_json, load_yaml
 
-        return yaml.safe_load(text)
+    try:
+        return load_json(text) if p.suffix.lower() == ".json" else load_yaml(text)
+    except DuplicateKeyError as exc:
+        raise duplicate_key_error(path, exc) from None
     except Exception as exc:  # noqa: BLE001 - a parser's error, named in one line
         raise ShipidError(f"{path}: not a readable MMG file ({str(exc)[:120]})") from None
 
