@@ -30,22 +30,21 @@ def test_json_refuses_a_key_given_twice_and_reads_the_rest_as_json_does():
     assert load_yaml("a: 1\nb: [1, 2]\n") == {"a": 1, "b": [1, 2]}
 
 
-def test_every_hand_written_file_names_the_key_given_twice(tmp_path, capsys):
+@pytest.mark.parametrize(("name", "text", "read", "match"), [
+    ("p.yml", "length: 3\nbeam: 0.5\nlength: 4\n", read_particulars,
+     r"p\.yml: 'length' is given twice \(line 3\)"),
+    ("p.json", '{"length": 3, "length": 4}', read_particulars, r"p\.json: 'length' is given twice"),
+    ("s.yml", "seeds: 2\nseeds: 3\n", read_spec, r"s\.yml: 'seeds' is given twice"),
+    ("m.yml", "name: a\nname: b\n", read_document, r"m\.yml: 'name' is given twice"),
+    ("f.json", '{"format": "x", "format": "y"}', load_document, r"f\.json: 'format' is given twice"),
+])  # fmt: skip
+def test_every_hand_written_file_names_the_key_given_twice(tmp_path, name, text, read, match):
+    (tmp_path / name).write_text(text)
+    with pytest.raises(ShipidError, match=match):
+        read(tmp_path / name)
+
+
+def test_a_command_refuses_the_file_in_one_line(tmp_path, capsys):
     (tmp_path / "p.yml").write_text("length: 3\nbeam: 0.5\nlength: 4\n")
-    with pytest.raises(ShipidError, match=r"p\.yml: 'length' is given twice \(line 3\)"):
-        read_particulars(tmp_path / "p.yml")
-    (tmp_path / "p.json").write_text('{"length": 3, "length": 4}')
-    with pytest.raises(ShipidError, match=r"p\.json: 'length' is given twice"):
-        read_particulars(tmp_path / "p.json")
-    (tmp_path / "s.yml").write_text("seeds: 2\nseeds: 3\n")
-    with pytest.raises(ShipidError, match=r"s\.yml: 'seeds' is given twice"):
-        read_spec(tmp_path / "s.yml")
-    (tmp_path / "m.yml").write_text("name: a\nname: b\n")
-    with pytest.raises(ShipidError, match=r"m\.yml: 'name' is given twice"):
-        read_document(tmp_path / "m.yml")
-    (tmp_path / "f.json").write_text('{"format": "x", "format": "y"}')
-    with pytest.raises(ShipidError, match=r"f\.json: 'format' is given twice"):
-        load_document(tmp_path / "f.json")
-    # Through a command: one line, exit 1.
     code, _, err = run(["criteria", "scale-ship", "--particulars", tmp_path / "p.yml"], capsys)
     assert code == 1 and err.count("\n") == 1 and "'length' is given twice" in err
