@@ -262,13 +262,19 @@ def _displacements(t, x, y, psi, u, v, window_s: float, sway_sign: float = 1.0,
     k = int(round(window_s / float(np.median(h)))) if h.size else 0
     if k < 1 or len(t) < k + 10:
         return None
+    # Windows across a gap in time are left out: the velocities' integral draws a straight line
+    # over it, which told a log with a 20 s gap that its sway looked positive to port.
+    whole = (t[k:] - t[:-k]) <= 1.5 * k * float(np.median(h))
+    if np.count_nonzero(whole) < 10:
+        return None
     north, east = (y, x) if east_first else (x, y)
     c, s = np.cos(psi), np.sin(psi)
     sway = sway_sign * v
     measured_out, predicted_out = [], []
     for measured, rate in ((north, u * c - sway * s), (east, u * s + sway * c)):
         integral = cumulative_integral(rate, t)
-        dm, dp = measured[k:] - measured[:-k], integral[k:] - integral[:-k]
+        dm = (measured[k:] - measured[:-k])[whole]
+        dp = (integral[k:] - integral[:-k])[whole]
         measured_out.append(dm - dm.mean())
         predicted_out.append(dp - dp.mean())
     return np.concatenate(measured_out), np.concatenate(predicted_out)
