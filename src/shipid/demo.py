@@ -18,7 +18,6 @@ from shipid.dynamics.terms import parse_term
 from shipid.evaluation.validate import Validation, validate
 from shipid.identification.identify import Identification, identify
 from shipid.outputs import OutputSet
-from shipid.reporting.plots import measured_vs_simulated, rudder_and_heading, tracks
 from shipid.reporting.report import error_table, indices_table
 from shipid.trials.manoeuvres import turning_circle, zigzag
 from shipid.vessels import PAPER_IMU, SensorModel, scale_ship
@@ -134,6 +133,9 @@ def _slug(name: str) -> str:
 
 
 def _figures(out: Path, logs, validations, files: OutputSet) -> list[Path]:
+    # matplotlib on drawing, not with the demo's trials (0.25 s of every test module's import)
+    from shipid.reporting.plots import measured_vs_simulated, rudder_and_heading, tracks
+
     best = validations[f"increment + {FILTER_HZ} Hz filter"]
     paths = [rudder_and_heading(logs[TRAINING], out / "training-rudder-heading.png", out=files)]
     for v in best:
