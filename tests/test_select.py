@@ -398,6 +398,16 @@ def test_select_names_a_turn_its_terms_set_apart_from_identifys_default(tmp_path
     assert code == 0, err
     (said,) = [w for w in err.splitlines() if "far from blanke" in w]
     assert "no training log is a turn" in said and "validate both on a turning log" in said
+    # The held-out zig-zags cannot tell them apart: blanke scored on the selection's own folds
+    # (a search of blanke alone) within one standard error of the chosen candidate.
+    import re
+
+    chosen, se, theirs = (float(x) for x in re.search(
+        r"cannot tell apart \(free-run scores ([\d.]+) ± ([\d.]+) and blanke's ([\d.]+)\)",
+        said).groups())  # fmt: skip
+    alone = select([logs[TRAINING], logs["zigzag 10/10"]], library="blanke", search="none",
+                   names=[str(p) for p in paths], progress=False)  # fmt: skip
+    assert theirs == pytest.approx(alone.score, abs=5e-4) and theirs <= chosen + se
     code = main(["identify", *map(str, paths), "-o", str(tmp_path / "b.json")])
     capsys.readouterr()
     assert code == 0

@@ -171,7 +171,7 @@ def cmd_select(args) -> int:
         ident.warnings.append(f"plausibility: {reversed_rudder}")
     from shipid.identification.auto_structure import turns_apart_from_the_default
 
-    apart = turns_apart_from_the_default(plausibility, logs, names, speed, rps)
+    apart = turns_apart_from_the_default(plausibility, logs, names, speed, rps, selection=sel)
     if apart:
         ident.warnings.append(f"library: {apart}")
 

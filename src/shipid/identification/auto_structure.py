@@ -582,7 +582,8 @@ def _logs_hold_a_turn(logs) -> bool:
 
 
 def turns_apart_from_the_default(report: dict | None, logs, names, speed: float,
-                                 rps: float | None, announce=None) -> str | None:  # fmt: skip
+                                 rps: float | None, announce=None,
+                                 selection=None) -> str | None:  # fmt: skip
     """A warning where ``select``'s model (its plausibility ``report``) and the structure
     ``identify`` fits by default to the same logs without a library (``auto_structure``; the
     paper's ``blanke`` where the logs hold nothing beyond it), fitted on them, turn their held
@@ -598,7 +599,11 @@ def turns_apart_from_the_default(report: dict | None, logs, names, speed: float,
     drift. Over ten seeds of that pair and four of the KVLCC2's MMG model's two 20/20 zig-zags
     it warned every time, the library's steady yaw rates the further off in each
     (``benchmarks/study_select_turns.py``). Only where the logs hold nothing beyond the paper
-    (``beyond_the_paper``): otherwise ``identify``'s default is a term search itself."""
+    (``beyond_the_paper``): otherwise ``identify``'s default is a term search itself.
+    ``selection`` (the ``Selection`` the report is of): the default structure is also scored on
+    its held-out logs, and the warning says whether they tell the two apart (within one
+    standard error of the chosen candidate's score: on the demo's pair, 1.232 against 1.099 ±
+    0.238)."""
     from shipid.identification.identify import identify
     from shipid.identification.plausibility import plausibility_at_approach, sharpest_curvature
 
@@ -626,12 +631,41 @@ def turns_apart_from_the_default(report: dict | None, logs, names, speed: float,
     if not sides:
         return None
     rudder = report.get("rudder_deg", 35.0)
-    return (f"the chosen terms turn the held {rudder:g}° turns far from "
-            f"{choice.structure.name}, what identify fits to these logs by default (path radii "
-            f"{', '.join(sides)}, the selection's first): no training log is a turn, so the "
-            "held-out scores cannot show which turn holds and the library's terms, not the "
-            "logs, set it; validate both on a turning log (shipid identify LOG... -o for "
-            f"{choice.structure.name}), or train on one")
+    name = choice.structure.name
+    return (f"the chosen terms turn the held {rudder:g}° turns far from {name}, what identify "
+            f"fits to these logs by default (path radii {', '.join(sides)}, the selection's "
+            f"first){_scored_alike(selection, choice.structure, logs, names)}: no training log "
+            "is a turn, so the held-out scores cannot show which turn holds and the library's "
+            "terms, not the logs, set it; validate both on a turning log (shipid identify "
+            f"LOG... -o for {name}), or train on one")
+
+
+def _scored_alike(selection, structure, logs, names) -> str:
+    """', which the held-out logs cannot tell apart (free-run scores …)' or how they rank the
+    two, where ``structure`` scored on ``selection``'s folds ('' without a selection, or where
+    it cannot be scored so: a bound on a term it lacks)."""
+    import dataclasses
+
+    from shipid.identification.select import select
+
+    if selection is None:
+        return ""
+    chosen = selection.candidates[selection.candidates["chosen"]]
+    if chosen.empty:
+        return ""
+    score, se = float(chosen["score"].iloc[0]), float(chosen["score_se"].iloc[0])
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            own = select(logs, dataclasses.replace(selection.options, library=structure,
+                                                   search="none", keep=None, average=False,
+                                                   progress=False), names=names).score
+    except ShipidError:
+        return ""
+    scores = f"free-run scores {score:.3f} ± {se:.3f} and {structure.name}'s {own:.3f}"
+    if own <= score + se:
+        return f", which the held-out logs cannot tell apart ({scores})"
+    return f"; the held-out logs prefer the chosen terms ({scores}) but hold no turn"
 
 
 def _held_turns_apart(narrow, wide) -> str | None:
