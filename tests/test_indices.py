@@ -472,3 +472,27 @@ def test_the_trims_forward_extremes_are_scipys_filters(n, window):
     origin = -(window // 2)
     assert np.array_equal(hi, maximum_filter1d(x, window, origin=origin, mode="nearest"))
     assert np.array_equal(lo, minimum_filter1d(x, window, origin=origin, mode="nearest"))
+
+
+def test_a_zigzags_indices_do_not_import_numba(tmp_path):
+    """``shipid indices`` of a zig-zag needs no track, yet paid numba's import (0.25 s of its
+    0.52 s of imports) for the track smoother; compiled on first use now, as a turn's indices
+    need it (and the same as the whole loop run in Python)."""
+    from cli_helpers import fresh_python
+
+    from shipid.trials import indices
+    from shipid.trials.manoeuvres import turning_circle, zigzag
+    from shipid.vessels import PAPER_IMU, scale_ship
+
+    ship = scale_ship(rudder_rate_deg=9.6)
+    path = write_log(zigzag(ship, 10, 10, duration=60, dt=0.2).log, tmp_path / "zz.csv")
+    code = ("import sys, contextlib, io; from shipid.cli import main; "
+            "out = io.StringIO(); cm = contextlib.redirect_stdout(out); cm.__enter__(); "
+            f"rc = main(['indices', {str(path)!r}]); cm.__exit__(None, None, None); "
+            "print(rc, 'numba' in sys.modules)")  # fmt: skip
+    assert fresh_python(code).split() == ["0", "False"]
+    turn = PAPER_IMU.apply(turning_circle(ship, 20, duration=60, dt=0.2).log, seed=0)
+    args = (np.ascontiguousarray(np.c_[turn["x"], turn["y"]]),
+            np.ascontiguousarray(np.c_[turn["u"], turn["v"]] * 0.2), 0.25, 1e-4)  # fmt: skip
+    np.testing.assert_allclose(indices._rts_smooth(*args), indices._rts_smooth_loop(*args),
+                               rtol=1e-12, atol=1e-12)  # fmt: skip
