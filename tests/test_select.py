@@ -386,6 +386,7 @@ def test_select_names_a_turn_its_terms_set_apart_from_identifys_default(tmp_path
     its held 35° turns at about three times blanke's yaw rate, and the demo's unseen 20° turns
     side with blanke. Zig-zags alone cannot show which turn holds: said, not silent."""
     import json
+    import re
 
     from shipid.identification.auto_structure import turns_apart_from_the_default
     from shipid.reporting.modelfile import load_model
@@ -400,8 +401,6 @@ def test_select_names_a_turn_its_terms_set_apart_from_identifys_default(tmp_path
     assert "no training log is a turn" in said and "validate both on a turning log" in said
     # The held-out zig-zags cannot tell them apart: blanke scored on the selection's own folds
     # (a search of blanke alone) within one standard error of the chosen candidate.
-    import re
-
     chosen, se, theirs = (float(x) for x in re.search(
         r"cannot tell apart \(free-run scores ([\d.]+) ± ([\d.]+) and blanke's ([\d.]+)\)",
         said).groups())  # fmt: skip
