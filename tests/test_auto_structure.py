@@ -548,21 +548,24 @@ def test_the_held_turns_of_two_choices_are_compared_by_their_paths():
     """The Esso's nine zig-zags at 0.1 s given 0.35 m/s at 10 rps: the widened library's choice
     scored the held-out zig-zags better and turned its 35° turns 85–92 % wide where the default
     library's (plausible too) turned 5–33 %: their held turns' paths tell them apart."""
-    from types import SimpleNamespace
-
     from shipid.identification.auto_structure import _held_turns_apart
 
-    def selection(speed, rate):
-        turn = {"steady_speed": speed, "settled": True, "diverged": False}
-        return SimpleNamespace(plausibility={"rudder_deg": 35.0, "held_rudder": {
+    def report(speed, rate, settled=True):
+        turn = {"steady_speed": speed, "settled": settled, "diverged": False}
+        return {"rudder_deg": 35.0, "held_rudder": {
             "starboard": {**turn, "steady_yaw_rate": rate},
-            "port": {**turn, "steady_yaw_rate": -rate}}})  # fmt: skip
+            "port": {**turn, "steady_yaw_rate": -rate}}}  # fmt: skip
 
-    narrow = selection(0.30, 0.080)
-    assert _held_turns_apart(narrow, selection(0.30, 0.055)) == (
+    narrow = report(0.30, 0.080)
+    assert _held_turns_apart(narrow, report(0.30, 0.055)) == (
         "starboard 3.75 m against 5.45 m, port 3.75 m against 5.45 m")
     # Yaw rates within TURNS_APART (1.25) of each other: nothing to say.
-    assert _held_turns_apart(narrow, selection(0.32, 0.070)) is None
+    assert _held_turns_apart(narrow, report(0.32, 0.070)) is None
+    # A first turn that never settles: passed over, unless asked for (select's check).
+    unsettled = report(0.30, 0.080, settled=False)
+    assert _held_turns_apart(unsettled, report(0.30, 0.055)) is None
+    assert _held_turns_apart(unsettled, report(0.30, 0.055), first_may_fail=True) == (
+        "starboard no steady turn against 5.45 m, port no steady turn against 5.45 m")
 
 
 def test_a_turn_among_the_logs_lets_the_scores_decide_how_the_model_turns():

@@ -410,6 +410,12 @@ def test_select_names_a_turn_its_terms_set_apart_from_identifys_default(tmp_path
     code = main(["identify", *map(str, paths), "-o", str(tmp_path / "b.json")])
     capsys.readouterr()
     assert code == 0
+    # Its radius is that of identify's own model file (fitted through identify's prefilter:
+    # unfiltered, 9.5 m against the file's 10.1 m).
+    held = json.loads((tmp_path / "b.json").read_text())["identification"]["plausibility"]
+    turn = held["held_rudder"]["starboard"]
+    radius = float(re.search(r"starboard [\d.]+ m against ([\d.]+) m", said).group(1))
+    assert radius == pytest.approx(turn["steady_speed"] / abs(turn["steady_yaw_rate"]), rel=0.03)
     # The premise, on a turn neither was fitted to: blanke predicts its yaw rate far better.
     turn = logs["turning δ = +20°"]
     errors = [validate(load_model(tmp_path / f), [turn])[0].metrics["r"]["rmse"]

@@ -545,7 +545,8 @@ def widened_selection(sel, logs, names, options, drop=None, announce=_quiet,
     if not _chosen_passes(wide) or (_chosen_passes(sel) and not wide.score < sel.score):
         return None, [f"{why}; {name}, tried, predicts the held-out logs no better (score "
                       f"{wide.score:.4f} against {sel.score:.4f}) and is not kept"], None
-    apart = _held_turns_apart(sel, wide) if _chosen_passes(sel) else None
+    apart = (_held_turns_apart(sel.plausibility, wide.plausibility) if _chosen_passes(sel)
+             else None)  # fmt: skip
     if apart and not _logs_hold_a_turn(logs):
         rudder = (sel.plausibility or {}).get("rudder_deg", 35.0)
         said = (f"{why}; {name}, tried, predicts the held-out logs better (score "
@@ -582,14 +583,17 @@ def _logs_hold_a_turn(logs) -> bool:
 
 
 def turns_apart_from_the_default(report: dict | None, logs, names, speed: float,
-                                 rps: float | None, announce=None,
-                                 selection=None) -> str | None:  # fmt: skip
+                                 rps: float | None, selection=None) -> str | None:  # fmt: skip
     """A warning where ``select``'s model (its plausibility ``report``) and the structure
     ``identify`` fits by default to the same logs without a library (``auto_structure``; the
-    paper's ``blanke`` where the logs hold nothing beyond it), fitted on them, turn their held
-    turns far apart (``rates_apart`` on a side where both settle) and no training log is a turn
-    whose free run the held-out scores would judge: the library's terms then set the turn, not
-    the logs. None where they agree, a training log is a turn, or there is nothing to compare.
+    paper's ``blanke`` where the logs hold nothing beyond it), fitted on them through the
+    prefilter ``identify`` chooses, turn their held turns far apart (``rates_apart`` on a side
+    where its own settles, or the selection's has no steady turn there) and no training log is
+    a turn whose free run the held-out scores would judge: the library's terms then set the
+    turn, not the logs (the radii it gives are those of ``identify``'s own model file: 10.2 m
+    against 10.1 m on the demo's pair, 15.4 and 15.7 m on the MARIN pair; unfiltered they
+    were 9.5 m and 16.4 m). None where they agree, a training log is a turn, or there is
+    nothing to compare.
 
     On the demo's two zig-zags of the paper's ship (20/20 and 10/10, the IMU's noise) the
     default library's choice turned its held 35° turns at 0.95 rad/s against ``blanke``'s 0.35,
@@ -604,6 +608,7 @@ def turns_apart_from_the_default(report: dict | None, logs, names, speed: float,
     its held-out logs, and the warning says whether they tell the two apart (within one
     standard error of the chosen candidate's score: on the demo's pair, 1.232 against 1.099 ±
     0.238)."""
+    from shipid.data.preprocess import lowpass
     from shipid.identification.identify import identify
     from shipid.identification.plausibility import plausibility_at_approach, sharpest_curvature
 
@@ -612,28 +617,23 @@ def turns_apart_from_the_default(report: dict | None, logs, names, speed: float,
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            choice = auto_structure(logs, names, announce=announce)
-            fit = identify(logs, model=choice.structure, names=names, force=True).model
+            choice = auto_structure(logs, names)
+            # Through the prefilter identify chooses: unfiltered, the MMG model's race fit
+            # turned 69 % wide (benchmarks/README.md, *Terms chosen from zig-zags*).
+            cutoff = _prefilter(logs, choice.structure, names, None, "lssvm")
+            fit = identify(logs if cutoff is None else [lowpass(log, cutoff) for log in logs],
+                           model=choice.structure, names=names, force=True).model
             theirs = plausibility_at_approach(fit, speed, rps,
                                               curvature=sharpest_curvature(logs, speed))[0]
     except ShipidError:
         return None
-    sides = []
-    for side in ("starboard", "port"):
-        ours, default = settled_yaw_rates((report, theirs), side)
-        if default is None or not default or (ours is not None and not rates_apart(
-                [ours, default])):  # fmt: skip
-            continue
-        radius = theirs["held_rudder"][side]["steady_speed"] / abs(default)
-        mine = ("no steady turn" if not ours else
-                f"{report['held_rudder'][side]['steady_speed'] / abs(ours):.3g} m")
-        sides.append(f"{side} {mine} against {radius:.3g} m")
-    if not sides:
+    apart = _held_turns_apart(report, theirs, first_may_fail=True)
+    if not apart:
         return None
     rudder = report.get("rudder_deg", 35.0)
     name = choice.structure.name
     return (f"the chosen terms turn the held {rudder:g}° turns far from {name}, what identify "
-            f"fits to these logs by default (path radii {', '.join(sides)}, the selection's "
+            f"fits to these logs by default (path radii {apart}, the selection's "
             f"first){_scored_alike(selection, choice.structure, logs, names)}: no training log "
             "is a turn, so the held-out scores cannot show which turn holds and the library's "
             "terms, not the logs, set it; validate both on a turning log (shipid identify "
@@ -668,18 +668,21 @@ def _scored_alike(selection, structure, logs, names) -> str:
     return f"; the held-out logs prefer the chosen terms ({scores}) but hold no turn"
 
 
-def _held_turns_apart(narrow, wide) -> str | None:
-    """The two selections' held 35° turns' path radii, side by side ('starboard 3.69 m against
-    5.51 m, …'), where their steady yaw rates are far apart on a side (``rates_apart``, both
-    settled); else None."""
+def _held_turns_apart(first: dict | None, second: dict | None,
+                      first_may_fail: bool = False) -> str | None:
+    """Two plausibility reports' held turns' path radii, side by side ('starboard 3.69 m
+    against 5.51 m, …'), where their steady yaw rates are far apart on a side (``rates_apart``,
+    both settled; with ``first_may_fail``, also where the first has no steady turn and the
+    second has: 'no steady turn against 5.51 m'); else None."""
     sides = []
     for side in ("starboard", "port"):
-        rates = settled_yaw_rates((narrow.plausibility, wide.plausibility), side)
-        if any(r is None for r in rates) or not rates_apart(rates):
+        rates = settled_yaw_rates((first, second), side)
+        if not rates[1] or (rates[0] is None and not first_may_fail) or (
+                rates[0] and not rates_apart(rates)):  # fmt: skip
             continue
-        speeds = [x.plausibility["held_rudder"][side]["steady_speed"] for x in (narrow, wide)]
-        sides.append(f"{side} {speeds[0] / abs(rates[0]):.3g} m against "
-                     f"{speeds[1] / abs(rates[1]):.3g} m")
+        radii = [f"{x['held_rudder'][side]['steady_speed'] / abs(r):.3g} m" if r
+                 else "no steady turn" for x, r in zip((first, second), rates, strict=True)]
+        sides.append(f"{side} {radii[0]} against {radii[1]}")
     return ", ".join(sides) or None
 
 
