@@ -738,23 +738,78 @@ def test_a_hand_edited_model_file_drops_the_fits_intervals(tmp_path, capsys, tri
         encoding="utf-8")  # fmt: skip
 
 
-def test_logs_at_different_scales_are_not_fitted_together(tmp_path, capsys):
-    """A model-scale and a full-scale run fitted together mix two time scales; nothing said
-    so. identify, select and compare refuse them in one line naming both files."""
+PARTICULARS = {"length": 3.0, "beam": 0.489, "draught": 0.201, "mass": 244.6}
+
+
+@pytest.mark.parametrize(("other", "said"), [
+    ({"scale": 1.0}, r"full_scale.csv is at scale 1:1 and \S*model_scale.csv at 1:16.95: the logs "
+                     "of one fit must be at one scale"),
+    ({"ship": "Esso Osaka 3 m model"}, r"full_scale.csv is a log of ship 'Esso Osaka 3 m model' "
+                                       r"and \S*model_scale.csv of 'scale-ship': the logs of one "
+                                       "fit must be of one ship"),
+    ({"particulars": {**PARTICULARS, "length": 7.0}},
+     r"full_scale.csv's particulars give a length of 7 and \S*model_scale.csv's 3: the logs of "
+     "one fit must be of one ship"),
+])  # fmt: skip
+def test_logs_of_two_ships_or_scales_are_not_fitted_together(tmp_path, capsys, other, said):
+    """A model-scale and a full-scale run fitted together mix two time scales; the KVLCC2's and
+    the Esso Osaka's logs fitted together were written as one model, with the first log's
+    particulars for both, without a word. identify, select, compare and correct refuse them in
+    one line naming both files; so do select() and the cross-validation of the Python API."""
+    from shipid.evaluation.error_band import cross_validated_band
+    from shipid.identification.select import select
+
     log = zigzag(scale_ship(), 20, 20, duration=60, dt=0.2).log
+    log.attrs["particulars"] = PARTICULARS
     a = write_log(log, tmp_path / "model_scale.csv")
-    other = log.copy()
-    other.attrs = {**log.attrs, "scale": 1.0}
-    b = write_log(other, tmp_path / "full_scale.csv")
+    second = zigzag(scale_ship(), 10, 10, duration=60, dt=0.2).log
+    second.attrs = {**log.attrs, **other}
+    b = write_log(second, tmp_path / "full_scale.csv")
     for argv in (["identify", a, b, "-o", tmp_path / "m.json"],
                  ["select", a, b, "--library", "blanke", "-o", tmp_path / "m.json"],
+                 ["correct", "scale-ship", a, b, "-o", tmp_path / "m.json"],
                  ["compare", a, b]):  # fmt: skip
         code, _, err = run(argv, capsys)
         lines = [ln for ln in err.splitlines() if not ln.startswith("warning:")]
         assert code == 1 and len(lines) == 1, err
-        assert "model_scale.csv" in lines[0] and "full_scale.csv" in lines[0]
-        assert "must be at one scale" in lines[0]
+        assert re.search(said, lines[0]), lines[0]
     assert not (tmp_path / "m.json").exists()
+    for call in (lambda: select([log, second], library="blanke"),
+                 lambda: cross_validated_band(None, [log, second], ["a", "b"])):  # fmt: skip
+        with pytest.raises(ShipidError, match="must be .*one (ship|scale)"):
+            call()
+
+
+def test_one_ship_however_its_name_is_spaced_is_fitted_and_a_model_names_its_ship(tmp_path,
+                                                                                   capsys):
+    """Names that differ in case and spacing alone are one ship; the model file keeps it, and
+    validate and simulate say where a log is of another ship (by name, or by its particulars'
+    main dimensions): a KVLCC2 model judged on an Esso Osaka log printed its errors as any
+    other's."""
+    log = zigzag(scale_ship(), 20, 20, duration=60, dt=0.2).log
+    log.attrs["particulars"] = PARTICULARS
+    a = write_log(log, tmp_path / "a.csv")
+    second = zigzag(scale_ship(), 10, 10, duration=60, dt=0.2).log
+    second.attrs = {**log.attrs, "ship": " Scale-Ship ", "particulars": {**PARTICULARS,
+                                                                        "mass": 245.0}}
+    b = write_log(second, tmp_path / "b.csv")
+    model = tmp_path / "m.json"
+    code, _, err = run(["identify", a, b, "--model", "blanke", "-o", model], capsys)
+    assert code == 0, err
+    assert json.loads(model.read_text())["identification"]["preprocessing"]["ship"] == "scale-ship"
+    for attrs, said in (({"ship": "KVLCC2"}, "a log of ship 'KVLCC2', and the model was "
+                                             "identified from logs of 'scale-ship'"),
+                        ({"particulars": {**PARTICULARS, "beam": 0.6}},
+                         "its particulars give a beam of 0.6, the model's training logs 0.489"),
+                        ({}, None)):  # fmt: skip
+        other = second.copy()
+        other.attrs = {**log.attrs, **attrs}
+        c = write_log(other, tmp_path / "c.csv")
+        for argv in (["validate", model, c], ["simulate", model, c, "-o", tmp_path / "s.csv"]):
+            code, _, err = run(argv, capsys)
+            assert code == 0, err
+            notes = [ln for ln in err.splitlines() if "it predicts another ship" in ln]
+            assert (notes == []) if said is None else (len(notes) == 1 and said in notes[0]), err
 
 
 def test_a_log_given_twice_is_refused_by_name_or_as_a_copy(tmp_path, capsys):

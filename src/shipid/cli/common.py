@@ -104,9 +104,10 @@ def _count_logs(names) -> str:
 def _training_logs(args) -> list:
     """The logs a model is fitted to: ``_read_logs``, cut to the trials they hold (zig-zags and
     turns from rest to their manoeuvre, other runs before a propulsion dropout), refused when
-    they are at different scales (a model-scale and a full-scale run fitted together mix two
-    ships' time scales), and refused where a log is given twice (by name or as a copy)."""
-    from shipid.data.log import GIVEN_TWICE, refuse_copies
+    they are not of one ship at one scale (a model-scale and a full-scale run fitted together
+    mix two ships' time scales; ``refuse_other_ships``), and refused where a log is given twice
+    (by name or as a copy)."""
+    from shipid.data.log import GIVEN_TWICE, refuse_copies, refuse_other_ships
 
     seen: dict[Path, str] = {}
     for path in args.logs:
@@ -115,17 +116,10 @@ def _training_logs(args) -> list:
             raise ShipidError(f"{path} is given twice{GIVEN_TWICE}")
         seen[key] = str(path)
     logs = _read_logs(args, cut_from_rest=True)
-    scales, upsampled = {}, []
-    for path, log in zip(args.logs, logs, strict=True):
-        if "scale" in log.attrs:
-            scales.setdefault(float(log.attrs["scale"]), str(path))
-        if "measured_dt" in log.attrs:  # resampled finer than measured (preprocess.resample)
-            upsampled.append((path, log.attrs["measured_dt"]))
-    if len(scales) > 1:
-        (a, pa), (b, pb) = list(scales.items())[:2]
-        raise ShipidError(f"{pb} is at scale 1:{b:g} and {pa} at 1:{a:g}: the logs of one fit "
-                          "must be at one scale (read the trial files with the same "
-                          "--scale)")  # fmt: skip
+    # Resampled finer than measured (preprocess.resample).
+    upsampled = [(path, log.attrs["measured_dt"]) for path, log in zip(args.logs, logs, strict=True)
+                 if "measured_dt" in log.attrs]  # fmt: skip
+    refuse_other_ships(logs, [str(p) for p in args.logs])
     refuse_copies(logs, [str(p) for p in args.logs])
     for path, own in upsampled:
         _warn(f"{path}: --dt {args.dt:g} s is finer than its own sampling ({own:.3g} s): the fit "
@@ -569,7 +563,8 @@ def _log_record(args, logs) -> dict:
             "scale": args.scale, "approach_speed": _approach(logs[0], "u"),
             "approach_rps": _approach(logs[0], "n"), **_rudder_record(logs),
             "rudder_positive": logs[0].attrs.get("rudder_positive"),
-            "log_scale": _log_scale(logs), "yaw_rate_offset_deg_s": _yaw_rate_offsets(logs)}  # fmt: skip
+            "log_scale": _log_scale(logs), "yaw_rate_offset_deg_s": _yaw_rate_offsets(logs),
+            "ship": next((lg.attrs["ship"] for lg in logs if lg.attrs.get("ship")), None)}  # fmt: skip
 
 
 def _log_scale(logs) -> float | None:
@@ -611,6 +606,31 @@ def _scale_notes(cond: dict, logs, names) -> list[str]:
             out.append(f"{name}: this log is at scale 1:{lam:g} and the model's training logs were"
                        f" at 1:{trained:g}: {read}carry the model over with shipid rescale "
                        f"--factor {trained / lam:g}")  # fmt: skip
+    return out
+
+
+def _ship_notes(cond: dict, logs, names) -> list[str]:
+    """Logs of another ship than the model's training logs (by name, or by the main dimensions
+    of their particulars): a KVLCC2 model judged on an Esso Osaka log printed its errors as any
+    other's."""
+    from shipid.data.log import SHIP_DIMENSION_SLACK, SHIP_DIMENSIONS, ship_name
+
+    trained, particulars = cond.get("ship"), cond.get("particulars")
+    out = []
+    for log, name in zip(logs, names, strict=True):
+        ship = ship_name(log)
+        if trained and ship and ship != " ".join(str(trained).split()).casefold():
+            out.append(f"{name}: a log of ship {log.attrs['ship']!r}, and the model was "
+                       f"identified from logs of {trained!r}: it predicts another ship")
+            continue
+        given = log.attrs.get("particulars") or {}
+        for key in SHIP_DIMENSIONS if particulars is not None else ():
+            mine, theirs = given.get(key), getattr(particulars, key)
+            if mine is not None and theirs is not None and \
+                    abs(float(mine) / theirs - 1.0) > SHIP_DIMENSION_SLACK:
+                out.append(f"{name}: its particulars give a {key} of {float(mine):g}, the model's "
+                           f"training logs {theirs:g}: it predicts another ship")  # fmt: skip
+                break
     return out
 
 

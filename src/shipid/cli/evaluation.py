@@ -24,6 +24,7 @@ from shipid.cli.common import (
     _reference_speed_notes,
     _sampling_notes,
     _scale_notes,
+    _ship_notes,
     _ship_or_model,
     _simulated_metadata,
     _vessel_conditions,
@@ -123,7 +124,8 @@ def cmd_validate(args) -> int:
         logs, notes = common_rudder_convention(logs, cond["rudder_positive"])
         for note in notes:
             _warn(note)
-    for note in (_scale_notes(cond, logs, names) + _sampling_notes(cond, logs, names)
+    for note in (_scale_notes(cond, logs, names) + _ship_notes(cond, logs, names)
+                 + _sampling_notes(cond, logs, names)
                  + _yaw_rate_notes(cond, logs, names)
                  + (_reference_speed_notes(model, logs, names) if reference else [])):
         _warn(note)
@@ -414,6 +416,7 @@ def cmd_simulate(args) -> int:
     if note:
         _warn(note)
     for note in (_scale_notes(cond, [log], [str(log_path)])
+                 + _ship_notes(cond, [log], [str(log_path)])
                  + _sampling_notes(cond, [log], [str(log_path)])):
         _warn(note)
     res = simulate_log(dynamics, log, method=args.method)

@@ -217,6 +217,51 @@ def refuse_copies(logs: Sequence[pd.DataFrame], names: Sequence[str] | None = No
             raise ShipidError(f"{name} {same}{GIVEN_TWICE}")
 
 
+# The main dimensions two logs' particulars must share to be one ship's, and how closely (the
+# particulars of one ship are written to a few digits).
+SHIP_DIMENSIONS = ("length", "beam", "draught", "mass")
+SHIP_DIMENSION_SLACK = 0.01
+ONE_SHIP = "the logs of one fit must be of one ship (a model is one ship's); fit each ship apart"
+
+
+def ship_name(log: pd.DataFrame) -> str | None:
+    """The ship a log names (its metadata's ``ship``), with case and spacing evened out for
+    comparison (None where it names none)."""
+    name = " ".join(str(log.attrs.get("ship") or "").split()).casefold()
+    return name or None
+
+
+def refuse_other_ships(logs: Sequence[pd.DataFrame], names: Sequence[str] | None = None) -> None:
+    """A one-line error where the logs are not of one ship at one scale: two ship names, two
+    scales (``scale``), or particulars whose main dimensions differ. A fit of the KVLCC2's 7 m
+    model and the Esso Osaka's 3 m model together was written without a word, with the first
+    log's particulars for both."""
+    label = [names[k] if names is not None else log_name(log, f"log {k + 1}")
+             for k, log in enumerate(logs)]  # fmt: skip
+    first: dict[str, tuple[object, int]] = {}
+    for i, log in enumerate(logs):
+        ship, scale = ship_name(log), log.attrs.get("scale")
+        if ship is not None:
+            j = first.setdefault("ship", (ship, i))[1]
+            if ship != ship_name(logs[j]):
+                raise ShipidError(f"{label[i]} is a log of ship {log.attrs['ship']!r} and "
+                                  f"{label[j]} of {logs[j].attrs['ship']!r}: {ONE_SHIP}")
+        if scale is not None:
+            other, j = first.setdefault("scale", (float(scale), i))
+            if float(scale) != other:
+                raise ShipidError(f"{label[i]} is at scale 1:{float(scale):g} and {label[j]} at "
+                                  f"1:{other:g}: the logs of one fit must be at one scale (read "
+                                  "the trial files with the same --scale)")  # fmt: skip
+        for key in SHIP_DIMENSIONS:
+            value = (log.attrs.get("particulars") or {}).get(key)
+            if value is None:
+                continue
+            other, j = first.setdefault(key, (float(value), i))
+            if abs(float(value) / other - 1.0) > SHIP_DIMENSION_SLACK:
+                raise ShipidError(f"{label[i]}'s particulars give a {key} of {float(value):g} and "
+                                  f"{label[j]}'s {other:g}: {ONE_SHIP}")
+
+
 def _running_samples(log: pd.DataFrame) -> np.ndarray | None:
     """Where a log that starts without headway runs ahead (None: it starts running)."""
     u = log["u"].to_numpy(dtype=float)

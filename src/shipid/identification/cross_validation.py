@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from shipid.data.log import refuse_copies
+from shipid.data.log import refuse_copies, refuse_other_ships
 from shipid.errors import ShipidError
 
 # The choices ``identify`` makes by free-run cross-validation (the structure, select's terms, γ)
@@ -105,6 +105,7 @@ def held_out_logs(logs, names, cv: str, option: str) -> tuple[list, list[str], s
     logo from two logs, four blocks of one. Fewer than two to hold out is a one-line error
     naming ``option``."""
     logs, names = list(logs), list(names)
+    refuse_other_ships(logs, names)
     refuse_copies(logs, names)
     if cv == "auto":
         cv = "logo" if len(logs) >= 2 else "blocks:4"

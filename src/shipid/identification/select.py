@@ -54,6 +54,7 @@ from shipid.data.log import (
     common_rudder_convention,
     input_columns,
     refuse_copies,
+    refuse_other_ships,
     require_states,
 )
 from shipid.dynamics.model import DOFS, ManoeuvringModel, ModelStructure, get_structure
@@ -620,6 +621,7 @@ def _setup(logs, names, options: SelectOptions):
         logs = [logs]
     logs, _ = common_rudder_convention(list(logs))  # select() converts first, with notes
     names = list(names or [log.attrs.get("name", f"log {i}") for i, log in enumerate(logs)])
+    refuse_other_ships(logs, names)
     refuse_copies(logs, names)
     kind, k = parse_cv(options.cv)
     if kind == "blocks":
