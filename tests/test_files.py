@@ -812,6 +812,28 @@ def test_one_ship_however_its_name_is_spaced_is_fitted_and_a_model_names_its_shi
             assert (notes == []) if said is None else (len(notes) == 1 and said in notes[0]), err
 
 
+def test_particulars_given_for_a_log_that_has_its_own_of_another_ship_are_named(tmp_path,
+                                                                                 capsys):
+    """``--particulars`` replaces a log's own (its header's, or its format's: the Esso Osaka's):
+    the KVLCC2's 7 m particulars given for an Esso Osaka file judged its 3 m hull as a 7 m one,
+    unsaid. A warning names both lengths; the file still wins, as given."""
+    log = zigzag(scale_ship(), 20, 20, duration=60, dt=0.2).log
+    log.attrs["particulars"] = PARTICULARS
+    a = write_log(log, tmp_path / "a.csv")
+    for given, warned in (({**PARTICULARS, "length": 7.0}, True), (PARTICULARS, False)):
+        path = tmp_path / "p.yml"
+        path.write_text("".join(f"{k}: {v}\n" for k, v in given.items()), encoding="utf-8")
+        code, _, err = run(["identify", a, "--model", "blanke", "--particulars", path, "-o",
+                            tmp_path / "m.json"], capsys)  # fmt: skip
+        assert code == 0, err
+        said = [ln for ln in err.splitlines() if "the file's replace them" in ln]
+        assert said == [] if not warned else \
+            "--particulars " + str(path) + " gives a length of 7 where the log's own " \
+            "particulars give 3" in said[0], err
+        document = json.loads((tmp_path / "m.json").read_text())
+        assert document["particulars"]["length"] == given["length"]
+
+
 def test_a_log_given_twice_is_refused_by_name_or_as_a_copy(tmp_path, capsys):
     """A log given twice (a glob that overlaps, a copy under another name) was fitted twice as
     hard, and select's fold that held one out still fitted the other: its score was the fit's

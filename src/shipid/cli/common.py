@@ -56,7 +56,15 @@ def _read_logs(args, paths=None, cut_from_rest: bool = False) -> list:
     _print_yaw_rate_offsets(args, paths, logs)
     particulars = _particulars(args)
     if particulars is not None:
-        for log in logs:
+        from shipid.data.log import dimension_apart
+
+        for path, log in zip(paths, logs, strict=True):
+            apart = dimension_apart(particulars.to_dict(), log.attrs.get("particulars"))
+            if apart:  # a file of another ship's particulars, or the log of another ship
+                key, given, own = apart
+                _warn(f"{path}: --particulars {args.particulars} gives a {key} of {given:g} where "
+                      f"the log's own particulars give {own:g}: the file's replace them; check "
+                      "that both are of this ship")  # fmt: skip
             log.attrs["particulars"] = frozen(particulars.to_dict())
     from shipid.data.particulars import rudder_beyond_limit
 
@@ -613,7 +621,7 @@ def _ship_notes(cond: dict, logs, names) -> list[str]:
     """Logs of another ship than the model's training logs (by name, or by the main dimensions
     of their particulars): a KVLCC2 model judged on an Esso Osaka log printed its errors as any
     other's."""
-    from shipid.data.log import SHIP_DIMENSION_SLACK, SHIP_DIMENSIONS, ship_name
+    from shipid.data.log import dimension_apart, ship_name
 
     trained, particulars = cond.get("ship"), cond.get("particulars")
     out = []
@@ -623,14 +631,12 @@ def _ship_notes(cond: dict, logs, names) -> list[str]:
             out.append(f"{name}: a log of ship {log.attrs['ship']!r}, and the model was "
                        f"identified from logs of {trained!r}: it predicts another ship")
             continue
-        given = log.attrs.get("particulars") or {}
-        for key in SHIP_DIMENSIONS if particulars is not None else ():
-            mine, theirs = given.get(key), getattr(particulars, key)
-            if mine is not None and theirs is not None and \
-                    abs(float(mine) / theirs - 1.0) > SHIP_DIMENSION_SLACK:
-                out.append(f"{name}: its particulars give a {key} of {float(mine):g}, the model's "
-                           f"training logs {theirs:g}: it predicts another ship")  # fmt: skip
-                break
+        apart = dimension_apart(log.attrs.get("particulars"),
+                                particulars.to_dict() if particulars is not None else None)
+        if apart:
+            key, mine, theirs = apart
+            out.append(f"{name}: its particulars give a {key} of {mine:g}, the model's training "
+                       f"logs {theirs:g}: it predicts another ship")
     return out
 
 

@@ -224,6 +224,17 @@ SHIP_DIMENSION_SLACK = 0.01
 ONE_SHIP = "the logs of one fit must be of one ship (a model is one ship's); fit each ship apart"
 
 
+def dimension_apart(first: Mapping, second: Mapping) -> tuple[str, float, float] | None:
+    """(key, first's value, second's) of the first main dimension (``SHIP_DIMENSIONS``) the two
+    particulars (mappings) both give and that differ by more than ``SHIP_DIMENSION_SLACK``, or
+    None: particulars of one ship."""
+    for key in SHIP_DIMENSIONS:
+        a, b = (first or {}).get(key), (second or {}).get(key)
+        if a is not None and b is not None and abs(float(a) / float(b) - 1.0) > SHIP_DIMENSION_SLACK:
+            return key, float(a), float(b)
+    return None
+
+
 def ship_name(log: pd.DataFrame) -> str | None:
     """The ship a log names (its metadata's ``ship``), with case and spacing evened out for
     comparison (None where it names none)."""
@@ -252,13 +263,12 @@ def refuse_other_ships(logs: Sequence[pd.DataFrame], names: Sequence[str] | None
                 raise ShipidError(f"{label[i]} is at scale 1:{float(scale):g} and {label[j]} at "
                                   f"1:{other:g}: the logs of one fit must be at one scale (read "
                                   "the trial files with the same --scale)")  # fmt: skip
-        for key in SHIP_DIMENSIONS:
-            value = (log.attrs.get("particulars") or {}).get(key)
-            if value is None:
-                continue
-            other, j = first.setdefault(key, (float(value), i))
-            if abs(float(value) / other - 1.0) > SHIP_DIMENSION_SLACK:
-                raise ShipidError(f"{label[i]}'s particulars give a {key} of {float(value):g} and "
+        if log.attrs.get("particulars"):
+            j = first.setdefault("particulars", (None, i))[1]
+            apart = dimension_apart(log.attrs["particulars"], logs[j].attrs["particulars"])
+            if apart:
+                key, value, other = apart
+                raise ShipidError(f"{label[i]}'s particulars give a {key} of {value:g} and "
                                   f"{label[j]}'s {other:g}: {ONE_SHIP}")
 
 
