@@ -115,7 +115,7 @@ def _training_logs(args) -> list:
     they are not of one ship at one scale (a model-scale and a full-scale run fitted together
     mix two ships' time scales; ``refuse_other_ships``), and refused where a log is given twice
     (by name or as a copy)."""
-    from shipid.data.log import GIVEN_TWICE, refuse_copies, refuse_other_ships
+    from shipid.data.log import GIVEN_TWICE, partly_logged, refuse_copies, refuse_other_ships
 
     seen: dict[Path, str] = {}
     for path in args.logs:
@@ -129,6 +129,8 @@ def _training_logs(args) -> list:
                  if "measured_dt" in log.attrs]  # fmt: skip
     refuse_other_ships(logs, [str(p) for p in args.logs])
     refuse_copies(logs, [str(p) for p in args.logs])
+    for note in partly_logged(logs, [str(p) for p in args.logs]):
+        _warn(note)
     for path, own in upsampled:
         _warn(f"{path}: --dt {args.dt:g} s is finer than its own sampling ({own:.3g} s): the fit "
               f"sees straight lines between its samples as measurements (their second "

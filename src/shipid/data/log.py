@@ -272,6 +272,29 @@ def refuse_other_ships(logs: Sequence[pd.DataFrame], names: Sequence[str] | None
                                   f"{label[j]}'s {other:g}: {ONE_SHIP}")
 
 
+# The inputs a fit can hold only where every training log has them: (columns, what they are).
+PARTLY_LOGGED = ((("n",), "the propeller speed n"), (("thrust",), "the thrust"),
+                 (("wind_speed", "wind_angle"), "the relative wind"))  # fmt: skip
+
+
+def partly_logged(logs: Sequence[pd.DataFrame], names: Sequence[str]) -> list[str]:
+    """One note per input (``PARTLY_LOGGED``) some training logs have and others lack: a term of
+    it cannot be fitted where it is missing, so a fit leaves it out. One Esso Osaka file read
+    without its propeller speed beside one with it was fitted by the paper's structure without
+    n, unsaid, though the two ran at 15 and 16.7 rps."""
+    out = []
+    for columns, what in PARTLY_LOGGED:
+        lacking = [name for log, name in zip(logs, names, strict=True)
+                   if not set(columns) <= set(log.columns)]  # fmt: skip
+        if lacking and len(lacking) < len(logs):
+            shown = ", ".join(lacking[:3]) + (", …" if len(lacking) > 3 else "")
+            out.append(f"{what} is logged in {len(logs) - len(lacking)} of the {len(logs)} "
+                       f"training logs, not in {shown}: no term of it can be fitted to those, so "
+                       "the model leaves it out and cannot follow a change of it; log it in "
+                       "every training log, or fit those logs apart")  # fmt: skip
+    return out
+
+
 def _running_samples(log: pd.DataFrame) -> np.ndarray | None:
     """Where a log that starts without headway runs ahead (None: it starts running)."""
     u = log["u"].to_numpy(dtype=float)
