@@ -755,8 +755,10 @@ def test_logs_of_two_ships_or_scales_are_not_fitted_together(tmp_path, capsys, o
     """A model-scale and a full-scale run fitted together mix two time scales; the KVLCC2's and
     the Esso Osaka's logs fitted together were written as one model, with the first log's
     particulars for both, without a word. identify, select, compare and correct refuse them in
-    one line naming both files; so do select() and the cross-validation of the Python API."""
+    one line naming both files; so do identify(), select() and the cross-validation of the
+    Python API."""
     from shipid.evaluation.error_band import cross_validated_band
+    from shipid.identification.identify import identify
     from shipid.identification.select import select
 
     log = zigzag(scale_ship(), 20, 20, duration=60, dt=0.2).log
@@ -774,7 +776,8 @@ def test_logs_of_two_ships_or_scales_are_not_fitted_together(tmp_path, capsys, o
         assert code == 1 and len(lines) == 1, err
         assert re.search(said, lines[0]), lines[0]
     assert not (tmp_path / "m.json").exists()
-    for call in (lambda: select([log, second], library="blanke"),
+    for call in (lambda: identify([log, second], model="blanke"),
+                 lambda: select([log, second], library="blanke"),
                  lambda: cross_validated_band(None, [log, second], ["a", "b"])):  # fmt: skip
         with pytest.raises(ShipidError, match="must be .*one (ship|scale)"):
             call()

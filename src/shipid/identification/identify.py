@@ -11,7 +11,12 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from shipid.data.log import common_rudder_convention, require_states, true_air_velocity
+from shipid.data.log import (
+    common_rudder_convention,
+    refuse_other_ships,
+    require_states,
+    true_air_velocity,
+)
 from shipid.dynamics.model import (
     ManoeuvringModel,
     ModelStructure,
@@ -335,6 +340,7 @@ def _prepare(logs, model, form, gamma, drop, fixed, names, estimator, physics):
     if not logs:
         raise ShipidError("no training logs given")
     require_states(logs, names, "training log")  # the regressors read every state
+    refuse_other_ships(logs, names)
     logs, convention_notes = common_rudder_convention(list(logs))
     if form not in FORMS:
         raise ShipidError(f"unknown form {form!r}; use one of {', '.join(FORMS)}")
