@@ -623,13 +623,13 @@ def _ship_notes(cond: dict, logs, names) -> list[str]:
     """Logs of another ship than the model's training logs (by name, or by the main dimensions
     of their particulars): a KVLCC2 model judged on an Esso Osaka log printed its errors as any
     other's."""
-    from shipid.data.log import dimension_apart, ship_name
+    from shipid.data.log import dimension_apart, same_ship_key, ship_name
 
     trained, particulars = cond.get("ship"), cond.get("particulars")
     out = []
     for log, name in zip(logs, names, strict=True):
         ship = ship_name(log)
-        if trained and ship and ship != " ".join(str(trained).split()).casefold():
+        if trained and ship and ship != same_ship_key(trained):
             out.append(f"{name}: a log of ship {log.attrs['ship']!r}, and the model was "
                        f"identified from logs of {trained!r}: it predicts another ship")
             continue

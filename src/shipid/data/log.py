@@ -230,16 +230,22 @@ def dimension_apart(first: Mapping, second: Mapping) -> tuple[str, float, float]
     None: particulars of one ship."""
     for key in SHIP_DIMENSIONS:
         a, b = (first or {}).get(key), (second or {}).get(key)
-        if a is not None and b is not None and abs(float(a) / float(b) - 1.0) > SHIP_DIMENSION_SLACK:
-            return key, float(a), float(b)
+        if a is None or b is None:
+            continue
+        a, b = float(a), float(b)
+        if abs(a - b) > SHIP_DIMENSION_SLACK * max(abs(a), abs(b)):
+            return key, a, b
     return None
 
 
+def same_ship_key(name: object) -> str | None:
+    """A ship's name with case and spacing evened out, to compare (None for no name)."""
+    return " ".join(str(name or "").split()).casefold() or None
+
+
 def ship_name(log: pd.DataFrame) -> str | None:
-    """The ship a log names (its metadata's ``ship``), with case and spacing evened out for
-    comparison (None where it names none)."""
-    name = " ".join(str(log.attrs.get("ship") or "").split()).casefold()
-    return name or None
+    """The ship a log names (its metadata's ``ship``) as ``same_ship_key`` compares it."""
+    return same_ship_key(log.attrs.get("ship"))
 
 
 def refuse_other_ships(logs: Sequence[pd.DataFrame], names: Sequence[str] | None = None) -> None:
