@@ -13,6 +13,8 @@ turns at 10 rps are). Two truths whose turns are known stand in for them:
    rad/s in r), the default ``identify`` of the nine; judged on its 20° and 35° turns to
    starboard at 8 and 10 rps, from each model's own straight speed there.
 
+4. The sister's zig-zags again, each alone (as one real Esso file is fitted).
+
 Then the real Esso Osaka: the default ``identify`` of its nine zig-zag files and the README's
 ``select`` (twelve logs) hold 20° and 35° at 8 and 10 rps, against the sister's turns and the
 two measured 35° turns at 10 rps.
@@ -142,6 +144,38 @@ def sister_truth(seeds: int) -> None:
                   + f" | {got[(20, 10.0)][0] / got[(35, 10.0)][0]:.2f} |", flush=True)  # fmt: skip
 
 
+def sister_single_files(seed: int = 1) -> None:
+    """Each of the nine Esso-like zig-zags of the sister alone, as one real file is fitted."""
+    ship = _sister()
+    truth = {rud: _turn(ship, rud, "starboard", _sister_speed(ship, 10.0), 10.0)
+             for rud in (20, 35)}  # fmt: skip
+    print("\n4. The sister again, each of those zig-zags alone (the default identify of one "
+          "file); turns to starboard at 10 rps from each model's own straight speed\n")
+    print("| zig-zag | rps | structure | 20°: TD, steady r | 35°: TD, steady r |")
+    print("|---|---|---|---|---|")
+    print(f"| truth | | | {truth[20][0]:.2f} m, {truth[20][1]:.4f} | {truth[35][0]:.2f} m, "
+          f"{truth[35][1]:.4f} |")  # fmt: skip
+    rng = np.random.default_rng(seed)
+    off = []
+    with tempfile.TemporaryDirectory() as folder:
+        for i, (rud, rps) in enumerate(ESSO_ZIGZAGS):
+            log = zigzag(ship, rud, rud, ("starboard", "port")[i % 2], rps=rps,
+                         speed=_sister_speed(ship, rps), duration=150, dt=0.1).log  # fmt: skip
+            for state, sd in (("u", 0.003), ("v", 0.003), ("r", 5e-4)):
+                log[state] = log[state] + rng.normal(0.0, sd, len(log))
+            path = str(write_log(log.assign(n=rps), f"{folder}/{i}.csv"))
+            model, _ = _identified([path], folder)
+            speed = surge_equilibrium(model, _sister_speed(ship, 10.0), 10.0)
+            got = {r: _turn(model, r, "starboard", speed, 10.0) for r in (20, 35)}
+            off += [abs(got[r][0] / truth[r][0] - 1) for r in (20, 35)]
+            print(f"| {rud}/{rud} | {rps:g} | {model.structure.name} | "
+                  f"{_off(got[20][0], truth[20][0])}, {_off(got[20][1], truth[20][1])} | "
+                  f"{_off(got[35][0], truth[35][0])}, {_off(got[35][1], truth[35][1])} |",
+                  flush=True)  # fmt: skip
+    print(f"\ntactical diameters' |error| over the 18 turns: median {100 * np.median(off):.0f} %, "
+          f"largest {100 * np.max(off):.0f} %")  # fmt: skip
+
+
 def _sister_speed(ship, rps: float) -> float:
     """The sister's straight-running speed at ``rps`` (its propeller follows the run's rate),
     as ``shipid manoeuvre SHIP.yml --rps N`` finds it."""
@@ -199,6 +233,7 @@ def main_study(seeds: int = 4) -> None:
         warnings.simplefilter("ignore")
         mmg_kvlcc2(seeds)
         sister_truth(max(1, seeds - 1))
+        sister_single_files()
         real_esso()
     print(f"\n{time.perf_counter() - t0:.0f} s")
 
