@@ -837,19 +837,26 @@ def test_particulars_given_for_a_log_that_has_its_own_of_another_ship_are_named(
         assert document["particulars"]["length"] == given["length"]
 
 
-@pytest.mark.parametrize(("columns", "what"), [({"n": 10.0}, "the propeller speed n"),
-                                               ({"wind_speed": 1.0, "wind_angle": 0.5},
-                                                "the relative wind")])  # fmt: skip
-def test_an_input_some_training_logs_lack_is_named(tmp_path, capsys, columns, what):
+@pytest.mark.parametrize(("columns", "what", "everywhere"), [
+    ({"n": 10.0}, "the propeller speed n", {}),
+    ({"wind_speed": 1.0, "wind_angle": 0.5}, "the relative wind", {}),
+    ({"thrust": 50.0}, "the thrust", {}),
+    ({"thrust": 50.0}, None, {"n": 10.0}),
+])  # fmt: skip
+def test_an_input_some_training_logs_lack_is_named(tmp_path, capsys, columns, what, everywhere):
     """An Esso Osaka file read without its propeller speed beside one with it was fitted by the
     paper's structure without n, unsaid (the two ran at 15 and 16.7 rps); a log without the
-    wind beside one with it had the library's wind terms left out, the log unnamed."""
-    a = write_log(zigzag(scale_ship(), 20, 20, duration=60, dt=0.2).log.assign(**columns),
-                  tmp_path / "a.csv")
-    b = write_log(zigzag(scale_ship(), 10, 10, duration=60, dt=0.2).log, tmp_path / "b.csv")
-    both = write_log(zigzag(scale_ship(), 10, 10, duration=60, dt=0.2).log.assign(**columns),
-                     tmp_path / "c.csv")
-    for logs, named in (([a, b], True), ([a, both], False)):
+    wind beside one with it had the library's wind terms left out, the log unnamed. The thrust
+    of one log (HSVA's KVLCC2 run beside MARIN's) is no input where every log has its rps."""
+    a = write_log(zigzag(scale_ship(), 20, 20, duration=60, dt=0.2).log.assign(**columns,
+                                                                               **everywhere),
+                  tmp_path / "a.csv")  # fmt: skip
+    b = write_log(zigzag(scale_ship(), 10, 10, duration=60, dt=0.2).log.assign(**everywhere),
+                  tmp_path / "b.csv")
+    both = write_log(zigzag(scale_ship(), 10, 10, duration=60, dt=0.2).log.assign(**columns,
+                                                                                  **everywhere),
+                     tmp_path / "c.csv")  # fmt: skip
+    for logs, named in (([a, b], what is not None), ([a, both], False)):
         code, _, err = run(["identify", *logs, "--model", "blanke", "-o", tmp_path / "m.json"],
                            capsys)  # fmt: skip
         assert code == 0, err

@@ -289,7 +289,10 @@ def partly_logged(logs: Sequence[pd.DataFrame], names: Sequence[str]) -> list[st
     without its propeller speed beside one with it was fitted by the paper's structure without
     n, unsaid, though the two ran at 15 and 16.7 rps."""
     out = []
+    every_rps = all("n" in log.columns for log in logs)
     for columns, what in PARTLY_LOGGED:
+        if columns == ("thrust",) and every_rps:
+            continue  # the propeller is held by its rps; the thrust is then no input of a fit
         lacking = [name for log, name in zip(logs, names, strict=True)
                    if not set(columns) <= set(log.columns)]  # fmt: skip
         if lacking and len(lacking) < len(logs):
