@@ -403,6 +403,26 @@ def test_a_true_wind_without_terms_for_it_is_named(clean_zigzag, true_wind, mode
         assert "true wind 2 m/s" in notes[0] and "+wind" in notes[0]
 
 
+@pytest.mark.parametrize(("true_wind", "logs", "noted"), [
+    (2.0, 1, True),  # one log's gusts carry the wind's five coefficients alone
+    (2.0, 2, False),  # several logs: the Esso's pooled fits agree with each other
+    (0.0, 1, False),  # still air: no material wind
+])  # fmt: skip
+def test_one_logs_wind_terms_are_named(clean_zigzag, true_wind, logs, noted):
+    """From one Esso Osaka zig-zag file at a time the wind's coefficients scatter two to four
+    times, the surge's changing sign in two of nine, and with them the predictions of the other
+    logs (benchmarks/study_esso_wind_terms.py); nothing said so."""
+    u, v = clean_zigzag["u"].to_numpy(), clean_zigzag["v"].to_numpy()
+    ax, ay = u + true_wind, v
+    log = clean_zigzag.assign(wind_speed=np.hypot(ax, ay), wind_angle=np.arctan2(ay, ax))
+    second = log.iloc[: len(log) // 2].copy()
+    fit = identify([log, second][:logs], model="blanke+wind", force=True)
+    notes = [w for w in fit.warnings if "the wind's load is fitted from one log's gusts" in w]
+    assert len(notes) == int(noted)
+    if noted:
+        assert "(true wind 2 m/s" in notes[0] and "--bound" in notes[0]
+
+
 def test_identify_refuses_a_malformed_cv_before_reading(tmp_path, capsys):
     """Without --gamma auto or --residual a malformed --cv went unnoticed."""
     code, _, err = run(["identify", tmp_path / "absent.csv", "--cv", "foo", "-o",
