@@ -242,13 +242,18 @@ def varying_propulsion(logs) -> list[VaryingInput]:
     return out
 
 
+def _signals(structure: ModelStructure) -> set[str]:
+    """The signals (states and inputs) the structure's terms read."""
+    return {s for names in structure.terms.values() for n in names for s in parse_term(n).signals}
+
+
 def unmodelled_inputs(logs, structure: ModelStructure) -> list[str]:
     """Notes for a propulsion input (n; the thrust where no rps is logged) that varies in the
     training logs while no term of the structure holds it: its effect is then spread over the
     other terms, and the model cannot follow a change of it (the paper's ``blanke`` fitted to
     the Esso Osaka's zig-zags at 10–16.7 rps and three random runs finds no steady speed, and
     turning circles 2.5–3.4 times too wide)."""
-    used = {s for names in structure.terms.values() for n in names for s in parse_term(n).signals}
+    used = _signals(structure)
     notes = [f"{found.describe()} in the training logs but no term of the structure holds it: "
              "its effect is lumped into the others and the model cannot follow a change of it; "
              f"use a structure with it ({found.remedy}), or choose terms with shipid select"
@@ -270,7 +275,7 @@ def one_log_wind_note(logs, structure: ModelStructure) -> list[str]:
     nine), and the other logs' predictions with them; held at an aerodynamic estimate from the
     projected areas the other files' yaw rate came 0.26 of its spread instead of 0.34, and the
     35° turns 15 % off instead of 22 % (``benchmarks/study_esso_wind_terms.py``)."""
-    used = {s for names in structure.terms.values() for n in names for s in parse_term(n).signals}
+    used = _signals(structure)
     if len(logs) != 1 or not used & {"wind_speed", "wind_angle"}:
         return []
     wind = material_wind(logs)
