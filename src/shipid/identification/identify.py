@@ -338,8 +338,7 @@ def _check_states_measured(logs, structure: ModelStructure, names) -> None:
     """Refuse a training log that turns with a constant v, or whose rudder or sway moves with a
     constant r: that state was not measured. Alone, every term of it would be 0 ± ∞; beside
     other logs, its false values would pull the fit."""
-    used = set(structure.dofs) | {s for terms in structure.terms.values() for n in terms
-                                  for s in parse_term(n).signals}  # fmt: skip
+    used = set(structure.dofs) | _signals(structure)
     names = names or [f"log {i + 1}" for i in range(len(logs))]
     for log, name in zip(logs, names, strict=False):
         span = per_log(log, "span of delta, v, r", lambda log=log: {
