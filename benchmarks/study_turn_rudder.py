@@ -37,9 +37,11 @@ import numpy as np
 from shipid.cli import main
 from shipid.data.io import write_log
 from shipid.data.particulars import Particulars
-from shipid.dynamics.equilibrium import surge_equilibrium
+from shipid.dynamics.equilibrium import surge_equilibrium, vessel_straight_speed
 from shipid.reporting.modelfile import load_document, load_model, training_conditions
+from shipid.trials.indices import turning_indices
 from shipid.trials.manoeuvres import turning_circle, zigzag
+from shipid.trials.reading import read_trial_log
 from shipid.vessels import kvlcc2
 from shipid.vessels.kvlcc2 import trimmed_revolutions
 from shipid.vessels.mmg_file import mmg_vessel, sister_ship
@@ -179,13 +181,7 @@ def sister_single_files(seed: int = 1) -> None:
 def _sister_speed(ship, rps: float) -> float:
     """The sister's straight-running speed at ``rps`` (its propeller follows the run's rate),
     as ``shipid manoeuvre SHIP.yml --rps N`` finds it."""
-    from scipy.optimize import brentq
-
-    def surge(u: float) -> float:
-        return float(ship.dynamics.derivatives(np.array([[u, 0.0, 0.0]]), np.zeros(1), None,
-                                               np.array([rps]))[0, 0])  # fmt: skip
-
-    return float(brentq(surge, 1e-3, 10.0, xtol=1e-10))
+    return vessel_straight_speed(ship, rps)
 
 
 def real_esso() -> None:
@@ -198,25 +194,28 @@ def real_esso() -> None:
     random = [str(DATA / "random" / f"random_{t}.csv") for t in
               ("03-Aug-2020_11_04_37", "31-Jul-2020_12_48_39", "31-Jul-2020_14_52_18")]
     ship = _sister()
-    rows = {"the sister (fitted to nothing)": (ship, None)}
+    rows = {"the sister (fitted to nothing)": ship}
     with tempfile.TemporaryDirectory() as folder, warnings.catch_warnings():
         warnings.simplefilter("ignore")
+        measured = {p.stem: turning_indices(read_trial_log(p, fmt="osaka-frt"))
+                    for p in sorted((DATA / "turning").glob("*.csv"))}  # fmt: skip
         rows["identify, the nine zig-zag files"] = _identified(
-            zigzags, folder, "--format", "osaka-frt")  # fmt: skip
+            zigzags, folder, "--format", "osaka-frt")[0]  # fmt: skip
         out = f"{folder}/s.json"
         with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
             assert main(["select", "--format", "osaka-frt",
                          *zigzags, *random, "--library", "low-speed+wind+propeller-asymmetry",
                          "--dt", "0.5", "--quiet", "--average", "-o", out]) == 0  # fmt: skip
-        rows["select --average, the README's twelve logs"] = (load_model(out), None)
-    print("\n3. The real Esso Osaka (measured 35° turns at 10 rps: tactical diameters 7.27 m "
-          "to starboard, 7.52 m to port): turns to starboard in still air from each model's "
-          "straight speed\n")
+        rows["select --average, the README's twelve logs"] = load_model(out)
+    shown = ", ".join(f"{name[5:]} {ind['tactical_diameter']:.3g} m (steady r "
+                      f"{ind['steady_yaw_rate']:+.4f})" for name, ind in measured.items())  # fmt: skip
+    print(f"\n3. The real Esso Osaka (its 35° turns at 10 rps, measured: tactical diameters "
+          f"{shown}): turns to starboard in still air from each model's straight speed\n")
     cases = [(rud, rps) for rps in (8.0, 10.0) for rud in (20, 35)]
     print("| model | " + " | ".join(f"{r}° at {n:g} rps: TD [m], steady r" for r, n in cases)
           + " | TD 20° / TD 35° (10 rps) |")  # fmt: skip
     print("|---" * (len(cases) + 2) + "|")
-    for name, (target, _) in rows.items():
+    for name, target in rows.items():
         got = {}
         for rud, rps in cases:
             speed = (_sister_speed(ship, rps) if target is ship

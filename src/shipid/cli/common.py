@@ -881,20 +881,12 @@ def _ship_approach(ship, speed: float | None, rps: float | None):
     if rps is None:
         return speed, dyn.reference.n_prop if hasattr(dyn, "reference") else dyn.n_prop, None
     if speed is None:
-        import numpy as np
-        from scipy.optimize import brentq
+        from shipid.dynamics.equilibrium import vessel_straight_speed
 
-        def surge(u: float) -> float:
-            return float(dyn.derivatives(np.array([[u, 0.0, 0.0]]), np.zeros(1), None,
-                                         np.array([rps]))[0, 0])  # fmt: skip
-
-        top = 1e-3
-        while surge(top) > 0 and top < 1e3:
-            top *= 2.0
-        if not surge(1e-3) > 0 > surge(top):
+        speed = vessel_straight_speed(ship, rps)
+        if speed is None:
             raise ShipidError(f"{ship.name}: no straight-running speed at {rps:g} rps (the "
                               "propeller's thrust does not meet the resistance); give --speed")
-        speed = brentq(surge, 1e-3, top, xtol=1e-10)
         print(f"approach: {speed:.4g} m/s, {ship.name}'s straight-running speed at {rps:g} rps")
     return speed, rps, None
 

@@ -255,22 +255,22 @@ def refuse_other_ships(logs: Sequence[pd.DataFrame], names: Sequence[str] | None
     log's particulars for both."""
     label = [names[k] if names is not None else log_name(log, f"log {k + 1}")
              for k, log in enumerate(logs)]  # fmt: skip
-    first: dict[str, tuple[object, int]] = {}
+    first: dict[str, int] = {}  # what each check compares with: the first log that has it
     for i, log in enumerate(logs):
-        ship, scale = ship_name(log), log.attrs.get("scale")
-        if ship is not None:
-            j = first.setdefault("ship", (ship, i))[1]
-            if ship != ship_name(logs[j]):
+        if ship_name(log) is not None:
+            j = first.setdefault("ship", i)
+            if ship_name(log) != ship_name(logs[j]):
                 raise ShipidError(f"{label[i]} is a log of ship {log.attrs['ship']!r} and "
                                   f"{label[j]} of {logs[j].attrs['ship']!r}: {ONE_SHIP}")
-        if scale is not None:
-            other, j = first.setdefault("scale", (float(scale), i))
-            if float(scale) != other:
-                raise ShipidError(f"{label[i]} is at scale 1:{float(scale):g} and {label[j]} at "
+        if log.attrs.get("scale") is not None:
+            j = first.setdefault("scale", i)
+            scale, other = float(log.attrs["scale"]), float(logs[j].attrs["scale"])
+            if scale != other:
+                raise ShipidError(f"{label[i]} is at scale 1:{scale:g} and {label[j]} at "
                                   f"1:{other:g}: the logs of one fit must be at one scale (read "
                                   "the trial files with the same --scale)")  # fmt: skip
         if log.attrs.get("particulars"):
-            j = first.setdefault("particulars", (None, i))[1]
+            j = first.setdefault("particulars", i)
             apart = dimension_apart(log.attrs["particulars"], logs[j].attrs["particulars"])
             if apart:
                 key, value, other = apart

@@ -115,6 +115,26 @@ def surge_equilibrium(model: ManoeuvringModel, speed: float, rps: float | None =
     return float(grid[k] + (grid[k + 1] - grid[k]) * udot[k] / (udot[k] - udot[k + 1]))
 
 
+def vessel_straight_speed(ship, rps: float) -> float | None:
+    """The straight-running speed of a reference ship whose propeller follows the run's rate
+    (an MMG file's ``rps: logs``) at ``rps``: the root of u̇(u, 0, 0) with the rudder amidships,
+    bracketed by doubling from 1 mm/s; None where the thrust never meets the resistance."""
+    from scipy.optimize import brentq
+
+    dyn = ship.dynamics
+
+    def surge(u: float) -> float:
+        return float(dyn.derivatives(np.array([[u, 0.0, 0.0]]), np.zeros(1), None,
+                                     np.array([rps]))[0, 0])  # fmt: skip
+
+    top = 1e-3
+    while surge(top) > 0 and top < 1e3:
+        top *= 2.0
+    if not surge(1e-3) > 0 > surge(top):
+        return None
+    return float(brentq(surge, 1e-3, top, xtol=1e-10))
+
+
 @dataclass(frozen=True)
 class Approach:
     """The approach of a manoeuvre: speed [m/s], propeller speed [rps] (None for models without

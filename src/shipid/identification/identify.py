@@ -271,8 +271,9 @@ def unmodelled_inputs(logs, structure: ModelStructure) -> list[str]:
 def one_log_wind_note(logs, structure: ModelStructure) -> list[str]:
     """A note where one log with a material wind (``material_wind``) fits the structure's wind
     terms: its coefficients then rest on that log's gusts alone. Fitted from one Esso Osaka
-    zig-zag file at a time they scatter two to four times (the surge's changes sign in two of
-    nine), and the other logs' predictions with them; held at an aerodynamic estimate from the
+    zig-zag file at a time they differ 4 to 13 times in magnitude from file to file (the
+    surge's and the yaw's sin γ_A of the other sign than the nine files' fit in two files
+    each), and the other logs' predictions with them; held at an aerodynamic estimate from the
     projected areas the other files' yaw rate came 0.26 of its spread instead of 0.34, and the
     35° turns 15 % off instead of 22 % (``benchmarks/study_esso_wind_terms.py``)."""
     used = _signals(structure)
@@ -283,7 +284,8 @@ def one_log_wind_note(logs, structure: ModelStructure) -> list[str]:
         return []
     return [f"the wind's load is fitted from one log's gusts (true wind {wind[0]:.3g} m/s against "
             f"the ship's {wind[1]:.3g} m/s): from one Esso Osaka zig-zag file at a time its "
-            "coefficients scatter two to four times, and the other logs' predictions with them "
+            "coefficients differ 4 to 13 times from file to file, and the other logs' predictions "
+            "with them "
             "(benchmarks/study_esso_wind_terms.py); fit several logs, or hold the wind's terms "
             "at an estimate (--bound, both ways)"]  # fmt: skip
 
