@@ -96,3 +96,26 @@ def test_identify_names_the_published_model_of_a_ship_it_has(tmp_path, capsys):
         said[label] = out
     assert "shipid correct kvlcc2 LOG..." in said["model scale"]
     assert "published model" not in said["full scale"]
+
+
+@pytest.mark.parametrize(("block_coefficient", "logs", "said"),
+                         [(0.83, 1, True), (0.60, 1, False), (0.83, 2, False)])
+def test_identify_points_one_log_of_a_full_form_hull_to_a_sister_ship(
+        tmp_path, capsys, block_coefficient, logs, said):  # fmt: skip
+    """One log of a full-form hull with no built-in model (the Esso Osaka's case: its sister,
+    the KVLCC2's MMG model with its particulars, predicted its other logs better than a fit to
+    one of its files): identify names ``shipid mmg`` and the prior; not for a finer hull, nor
+    from two logs, where the fits did as well."""
+    ship = get_vessel("scale-ship")
+    particulars = {"length": 4.2, "beam": 0.8, "draught": 0.25, "mass": 600.0,
+                   "block_coefficient": block_coefficient}  # fmt: skip
+    paths = []
+    for i, side in enumerate(("starboard", "port")[:logs]):
+        log = zigzag(ship, 20, 20, first=side, duration=60, dt=0.2).log
+        log.attrs["particulars"] = particulars
+        paths.append(write_log(log, tmp_path / f"zz{i}.csv"))
+    code, out, err = run(["identify", *paths, "--model", "blanke", "--no-output-error",
+                          "-o", tmp_path / "m.json"], capsys)  # fmt: skip
+    assert code == 0, err
+    assert ("shipid mmg kvlcc2 --particulars FILE" in out) is said
+    assert (f"one log of a full-form hull (Cb {block_coefficient:.2f}" in out) is said
