@@ -213,8 +213,10 @@ def tanker_truth() -> None:
 TANKER_NOISE = {"u": 0.02, "v": 0.02, "r": 2e-4, "psi": math.radians(0.05)}
 
 
-def tanker_truth_from_logs(seeds: int = 5) -> None:
-    """The tanker's own 10°/10° zig-zags (both sides first, noisy) as training logs, the
+def tanker_truth_from_logs(seeds: int = 5, one_log: bool = False) -> None:
+    """The tanker's own 10°/10° zig-zags (both sides first, noisy; ``one_log``: one per seed,
+    to starboard first on even seeds and to port on odd ones, as ``identify``'s note on one log
+    of a full-form hull has it) as training logs, the
     manoeuvres they do not contain as the judge (its 10° turns, its 5°/5° zig-zags): the
     default ``identify``, and with the particulars giving the gear's 10° limit
     (``rudder_limit``: the plausibility checks hold 10° instead of 35°); the sister alone; the
@@ -266,10 +268,11 @@ def tanker_truth_from_logs(seeds: int = 5) -> None:
             with open(path, "w", encoding="utf-8") as f:
                 yaml.safe_dump({**hull, **extra}, f)
         for seed in range(seeds):
+            sides = (("starboard", "port")[seed % 2],) if one_log else ("starboard", "port")
             paths = [str(write_log(sensors.apply(zigzag(truth, 10, 10, first=side,
                                                         duration=1500, dt=0.5).log, 2 * seed + k),
                                    os.path.join(tmp, f"zz_{side}_{seed}.csv")))
-                     for k, side in enumerate(("starboard", "port"))]  # fmt: skip
+                     for k, side in enumerate(sides)]  # fmt: skip
             logs = [read_trial_log(p) for p in paths]
             for label, extra in (("identify (default)", []),
                                  ("identify --particulars with the gear's rudder_limit 10",
@@ -287,9 +290,10 @@ def tanker_truth_from_logs(seeds: int = 5) -> None:
                 fit = identify_correction(logs, sister, "blanke-race", gamma=gamma)
                 judge(f"sister corrected, γ {gamma:g}" if gamma != "auto"
                       else "sister corrected, γ auto", fit.vessel)  # fmt: skip
-    print(f"\nThe tanker as a truth, trained on its 10°/10° zig-zags (both sides, noisy; "
-          f"{seeds} seeds), judged on its 10° turns and 5°/5° zig-zag: median |error| "
-          "(largest)\n")
+    trained = "one 10°/10° zig-zag (to either side" if one_log else \
+        "its 10°/10° zig-zags (both sides"  # fmt: skip
+    print(f"\nThe tanker as a truth, trained on {trained}, noisy; {seeds} seeds), judged on its "
+          "10° turns and 5°/5° zig-zag: median |error| (largest)\n")
     print("| model | 10° turns' tactical diameter [%] | steady yaw rate [%] | 5°/5° "
           "overshoots [deg] | cases |")
     print("|---|---|---|---|---|")
@@ -311,3 +315,4 @@ if __name__ == "__main__":
     main()
     tanker_truth()
     tanker_truth_from_logs()
+    tanker_truth_from_logs(one_log=True)
