@@ -105,6 +105,13 @@ def cmd_linearise(args) -> int:
     print("B =")
     print(pd.DataFrame({"δ": nm["B"]}, index=["u", "v", "r"]).to_markdown(floatfmt=".5g"))
     print(_nomoto_line(nm))
+    if cond.get("envelope"):
+        # A model identified from logs (a reference ship's T2 is its published model's).
+        from shipid.identification.plausibility import slow_mode_note
+
+        note = slow_mode_note(nm["poles"]).removeprefix("; ")
+        if note:
+            print(note[0].upper() + note[1:] + ".")
     return 0
 
 

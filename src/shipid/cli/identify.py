@@ -123,6 +123,7 @@ def cmd_identify(args) -> int:
         new_failures,
         plausibility_at_approach,
         sharpest_curvature,
+        slow_mode_note,
     )
     from shipid.outputs import atomic_write_text, check_outputs
     from shipid.reporting.modelfile import model_text
@@ -444,7 +445,9 @@ def cmd_identify(args) -> int:
     sl = plausibility["straight_line"]
     if sl:
         print(f"straight-line {'stable' if sl['stable'] else 'UNSTABLE'} (largest sway–yaw "
-              f"eigenvalue real part {sl['max_real_part']:.3g} 1/s); surge equilibrium "
+              f"eigenvalue real part {sl['max_real_part']:.3g} 1/s"
+              f"{slow_mode_note(sl['eigenvalues'])}); "
+              "surge equilibrium "
               f"{_fmt_speed(plausibility['surge_equilibrium'])}; checked from the "
               f"{plausibility['approach']}"
               + (", with its kernel residual" if hybrid else ""))  # fmt: skip

@@ -167,6 +167,31 @@ def straight_line_stability(model: ManoeuvringModel, speed: float, rps: float | 
             "stable": bool(np.all(eig.real < 0)), "max_real_part": float(np.max(eig.real))}
 
 
+# An unstable real sway–yaw mode this much slower than the other is the near-neutral one, whose
+# rate logs of large manoeuvres leave to the form of the hull's nonlinear terms
+# (benchmarks/study_hull_form.py: the KVLCC2's fits' slow modes +0.02 to +0.07 1/s, in moduli or
+# cubic, against fast ones near −0.4; the MMG model's own +0.0004; the tanker's +0.0026 fitted
+# +0.0005 to +0.0044).
+SLOW_MODE_RATIO = 0.2
+
+
+def slow_mode_note(eigenvalues) -> str:
+    """A clause for a model's stability line, where its sway–yaw block is unstable in a real
+    slow mode (``SLOW_MODE_RATIO``): its time constant T2 rests on the hull terms' form more
+    than on the logs; else "". A stable slow mode is left (the paper's ship's, from its noisy
+    zig-zags, came within 0.04 1/s in the two forms). ``eigenvalues``: the two."""
+    real = [float(e.real) if isinstance(e, complex) and e.imag == 0 else e for e in eigenvalues]
+    if len(real) != 2 or not all(isinstance(e, float) for e in real):
+        return ""
+    slow, fast = sorted(real, key=abs)
+    if not slow > 0.0 or abs(slow) >= SLOW_MODE_RATIO * abs(fast):
+        return ""
+    return (f"; its slow mode, T2 {-1 / slow:.3g} s, rests on the form of the hull's nonlinear "
+            "terms more than on logs of large manoeuvres: the KVLCC2's runs give T2 −14 to −19 s "
+            "fitted in moduli, −28 to −47 s cubic, benchmarks/study_hull_form.py; a spiral test "
+            "measures it")  # fmt: skip
+
+
 def fastest_mode(model: ManoeuvringModel, speed: float, rps: float | None = None) -> float:
     """The largest |λ| [1/s] of ``approach_jacobian``: the model's fastest mode at its straight
     approach (inf where not finite)."""
