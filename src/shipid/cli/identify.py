@@ -549,9 +549,9 @@ def _sister_ship_note(logs) -> str | None:
             "shipid mmg kvlcc2 --particulars FILE --rps logs --speed U -o SHIP.yml writes the "
             "KVLCC2's MMG model with this ship's particulars, fitted to no log (shipid validate "
             "SHIP.yml LOG... judges it), and identify --model blanke-speed+wind --crossflow "
-            "--prior SHIP.yml --gamma 1 draws a fit toward it (+wind where the log has the "
-            "wind): from one "
-            "Esso Osaka zig-zag file at a time, the other zig-zags' yaw rate came 0.21 of its "
+            "--prior SHIP.yml --gamma 1 (blanke-speed where the log has no wind) draws a fit "
+            "toward it: from one Esso Osaka zig-zag file at a time, the other zig-zags' yaw "
+            "rate came 0.21 of its "
             "spread with the sister, 0.30 drawn toward it and 0.34 with the default, the 35° "
             "turns' tactical diameters 19 %, 13 % and 22 % off in the median, 23 %, 26 % and "
             "69 % at worst (docs/esso.md)")  # fmt: skip
