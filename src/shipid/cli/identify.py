@@ -499,7 +499,7 @@ def cmd_identify(args) -> int:
     for w in ident.warnings:
         _warn(w)
     print(f"model written to {args.output}")
-    note = _published_model_note(logs) or _sister_ship_note(logs)
+    note = _published_model_note(logs) or _sister_ship_note(logs, args.output, speed)
     if note:
         print(note)
     return 0
@@ -530,12 +530,14 @@ def _published_model_note(logs) -> str | None:
 FULL_FORM_CB = 0.75
 
 
-def _sister_ship_note(logs) -> str | None:
+def _sister_ship_note(logs, model_path, speed: float | None) -> str | None:
     """One log of a full-form hull whose particulars ``shipid mmg`` can take and which has no
     built-in model: the sister ship's MMG model (the KVLCC2's prime coefficients with these
     particulars), fitted to no log, predicted the Esso Osaka's other logs better than a fit to
     one of its zig-zag files (``benchmarks/study_esso_sister_mmg.py``); from two files on the
-    fits do about as well, so it is said for one log only."""
+    fits do about as well, so it is said for one log only. The command it gives takes the
+    particulars from the model file just written (``model_path``) and the log's approach
+    ``speed``."""
     from shipid.data.particulars import logs_particulars
 
     if len(logs) != 1:
@@ -544,12 +546,15 @@ def _sister_ship_note(logs) -> str | None:
     if found is None or None in (found.beam, found.draught, found.mass) \
             or found.block_coefficient is None or found.block_coefficient < FULL_FORM_CB:
         return None
+    approach = f"{speed:.3g}" if speed else "U"
     return (f"one log of a full-form hull (Cb {found.block_coefficient:.2f}, the KVLCC2's 0.81): a "
             "sister ship's model may predict its other manoeuvres better than a fit to one log. "
-            "shipid mmg kvlcc2 --particulars FILE --rps logs --speed U -o SHIP.yml writes the "
-            "KVLCC2's MMG model with this ship's particulars, fitted to no log (shipid validate "
-            "SHIP.yml LOG... judges it), and identify --model blanke-speed+wind --crossflow "
-            "--prior SHIP.yml --gamma 1 (blanke-speed where the log has no wind) draws a fit "
+            f"shipid mmg kvlcc2 --particulars {model_path} --rps logs --speed {approach} "
+            "-o SHIP.yml writes the KVLCC2's MMG model with "
+            "this ship's particulars (as this model file keeps them), fitted to no log (shipid "
+            "validate SHIP.yml LOG... judges it), and identify --model blanke-speed+wind "
+            "--crossflow --prior SHIP.yml --gamma 1 (blanke-speed where the log has no wind) "
+            "draws a fit "
             "toward it: from one Esso Osaka zig-zag file at a time, the other zig-zags' yaw "
             "rate came 0.21 of its "
             "spread with the sister, 0.30 drawn toward it and 0.34 with the default, the 35° "

@@ -195,7 +195,8 @@ def rudder_beyond_limit(log, name: str) -> str | None:
 
 
 def read_particulars(path: str | Path) -> Particulars:
-    """Particulars from a YAML (``key: value`` lines, comments) or JSON file."""
+    """Particulars from a YAML (``key: value`` lines, comments) or JSON file, or those a model
+    file keeps (``identify``'s output, where its logs or ``--particulars`` gave them)."""
     path = Path(path)
     if not path.is_file():
         raise ShipidError(f"{path}: no such particulars file")
@@ -209,6 +210,11 @@ def read_particulars(path: str | Path) -> Particulars:
             raise duplicate_key_error(path, exc) from None
         except json.JSONDecodeError as exc:
             raise ShipidError(f"{path}: not a JSON particulars file ({exc})") from None
+        if isinstance(data, Mapping) and data.get("format") == "shipid-model":
+            if not isinstance(data.get("particulars"), Mapping):
+                raise ShipidError(f"{path}: the model file keeps no particulars (its logs gave "
+                                  "none: identify with --particulars FILE, or give that file)")
+            data = data["particulars"]
     else:
         data = _simple_yaml(text, path)
     particulars = Particulars.from_mapping(data, str(path))
