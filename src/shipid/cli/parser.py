@@ -82,7 +82,8 @@ def _add_log_options(p: argparse.ArgumentParser) -> None:
                    "reference point, in the body frame (default 0,0)")
     g.add_argument("--particulars", metavar="FILE",
                    help="ship particulars (YAML or JSON: length, beam, draught, ...; the MARIN "
-                   "ship_data.yml reads as is), kept with the logs and the model")
+                   "ship_data.yml reads as is; or a model file that keeps its logs'), kept with "
+                   "the logs and the model")
 
 
 def _add_crossflow_option(p) -> None:
@@ -591,7 +592,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="the similar ship: a built-in MMG ship (kvlcc2) or an MMG model file")
     p.add_argument("--particulars", required=True, metavar="FILE",
                    help="this ship's particulars (length, beam, draught, mass; propeller "
-                   "diameter, rudder area and height, xg, rho where known)")
+                   "diameter, rudder area and height, xg, rho where known), or a model file "
+                   "of it that keeps them")
     p.add_argument("--speed", type=float, metavar="U",
                    help="approach speed [m/s] (default: the particulars' design speed, else the "
                    "source's at equal Froude number)")
