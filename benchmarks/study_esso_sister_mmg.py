@@ -15,7 +15,7 @@ rate run closed loop (|error| median / mean, largest, over every model's two tur
 runs stop and reverse the propeller, which the MMG standard method does not model: the MMG rows
 leave them out.
 
-Run: .venv/bin/python benchmarks/study_esso_sister_mmg.py
+Run: .venv/bin/python benchmarks/study_esso_sister_mmg.py [pairs]
 """
 
 from __future__ import annotations
@@ -24,6 +24,7 @@ import contextlib
 import io
 import math
 import os
+import sys
 import tempfile
 import time
 import warnings
@@ -304,6 +305,54 @@ def tanker_truth_from_logs(seeds: int = 5, one_log: bool = False) -> None:
     print(f"\n{time.perf_counter() - start:.0f} s")
 
 
+def _sister_file(folder: str) -> str:
+    """The sister's MMG file, as ``main`` makes it, written in ``folder``."""
+    particulars = f"{folder}/esso.yml"
+    with open(particulars, "w", encoding="utf-8") as fh:
+        fh.writelines(f"{k}: {v}\n" for k, v in ESSO_OSAKA_MODEL.items())
+    path = f"{folder}/esso-mmg.yml"
+    assert _quiet(["mmg", "kvlcc2", "--particulars", particulars, "--rps", "logs", "--speed",
+                   "0.35", "-o", path]) == 0  # fmt: skip
+    return path
+
+
+def wind_only_correction() -> None:
+    """The sister corrected in the wind's load alone (``shipid correct SHIP --model wind``: its
+    hydrodynamics kept whole, the five wind terms fitted) from each zig-zag file, judged as
+    ``main`` judges (the other zig-zags, the two turns)."""
+    warnings.simplefilter("ignore")
+    zigzags = sorted((DATA / "zigzag").glob("*.csv"))
+    files = zigzags + sorted((DATA / "turning").glob("*.csv"))
+    logs = {f: read_trial_log(f, fmt="osaka-frt") for f in files}
+    print("\nThe sister corrected in the wind's load alone, from one zig-zag file (9 models)\n")
+    print("| γ | held-out zig-zags: r / spread | 35° TD | 35° steady r |")
+    print("|---|---|---|---|")
+    with tempfile.TemporaryDirectory() as tmp:
+        sister = read_mmg(_sister_file(tmp))
+        for gamma in (1e4, 1e2, 1.0):
+            store: tuple[list, list, list] = ([], [], [])
+            for f in zigzags:
+                fit = identify_correction([logs[f]], sister, "wind", gamma=gamma)
+                _add(store, _judge(fit.vessel, {g: log for g, log in logs.items() if g != f}))
+            print(f"| {gamma:g} | {np.median(store[0]):.3f} | {_cell(store[1])} | "
+                  f"{_cell(store[2])} |")
+
+
+def pairs_toward_the_sister() -> None:
+    """Every pair of zig-zag files fitted toward the sister (``--model blanke-speed+wind
+    --crossflow --prior SHIP``, the one-file setting) against the default, judged as
+    ``study_crossflow.esso`` judges."""
+    from study_crossflow import esso
+
+    warnings.simplefilter("ignore")
+    print()
+    with tempfile.TemporaryDirectory() as tmp:
+        sister = _sister_file(tmp)
+        toward = ["--model", "blanke-speed+wind", "--crossflow", "--prior", sister]
+        esso(True, {"default": [], "toward the sister, γ 1": [*toward, "--gamma", "1"],
+                    "toward the sister, γ auto": [*toward, "--gamma", "auto"]})
+
+
 def _straight(ship, rps: float):
     from shipid.cli.common import _ship_approach
 
@@ -316,3 +365,6 @@ if __name__ == "__main__":
     tanker_truth()
     tanker_truth_from_logs()
     tanker_truth_from_logs(one_log=True)
+    wind_only_correction()
+    if "pairs" in sys.argv[1:]:
+        pairs_toward_the_sister()

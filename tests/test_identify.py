@@ -409,9 +409,10 @@ def test_a_true_wind_without_terms_for_it_is_named(clean_zigzag, true_wind, mode
     (0.0, 1, False),  # still air: no material wind
 ])  # fmt: skip
 def test_one_logs_wind_terms_are_named(clean_zigzag, true_wind, logs, noted):
-    """From one Esso Osaka zig-zag file at a time the wind's coefficients scatter two to four
-    times, the surge's changing sign in two of nine, and with them the predictions of the other
-    logs (benchmarks/study_esso_wind_terms.py); nothing said so."""
+    """From one Esso Osaka zig-zag file at a time the wind's coefficients differ 4 to 13 times
+    in magnitude, the surge's and the yaw's sin γ_A changing sign in two of nine each, and with
+    them the predictions of the other logs (benchmarks/study_esso_wind_terms.py); nothing said
+    so."""
     u, v = clean_zigzag["u"].to_numpy(), clean_zigzag["v"].to_numpy()
     ax, ay = u + true_wind, v
     log = clean_zigzag.assign(wind_speed=np.hypot(ax, ay), wind_angle=np.arctan2(ay, ax))

@@ -109,9 +109,9 @@ def cmd_linearise(args) -> int:
         # A model identified from logs (a reference ship's T2 is its published model's).
         from shipid.identification.plausibility import slow_mode_note
 
-        note = slow_mode_note(nm["poles"]).removeprefix("; ")
+        note = slow_mode_note(nm["poles"])
         if note:
-            print(note[0].upper() + note[1:] + ".")
+            print(f"{note[0].upper()}{note[1:]}.")
     return 0
 
 

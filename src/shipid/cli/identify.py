@@ -444,9 +444,9 @@ def cmd_identify(args) -> int:
               "quarters of this one (--error-band blocks:4)")  # fmt: skip
     sl = plausibility["straight_line"]
     if sl:
+        slow = slow_mode_note(sl["eigenvalues"])
         print(f"straight-line {'stable' if sl['stable'] else 'UNSTABLE'} (largest sway–yaw "
-              f"eigenvalue real part {sl['max_real_part']:.3g} 1/s"
-              f"{slow_mode_note(sl['eigenvalues'])}); "
+              f"eigenvalue real part {sl['max_real_part']:.3g} 1/s{'; ' + slow if slow else ''}); "
               "surge equilibrium "
               f"{_fmt_speed(plausibility['surge_equilibrium'])}; checked from the "
               f"{plausibility['approach']}"
@@ -549,17 +549,15 @@ def _sister_ship_note(logs, model_path, speed: float | None) -> str | None:
     approach = f"{speed:.3g}" if speed else "U"
     return (f"one log of a full-form hull (Cb {found.block_coefficient:.2f}, the KVLCC2's 0.81): a "
             "sister ship's model may predict its other manoeuvres better than a fit to one log. "
-            f"shipid mmg kvlcc2 --particulars {model_path} --rps logs --speed {approach} "
-            "-o SHIP.yml writes the KVLCC2's MMG model with "
-            "this ship's particulars (as this model file keeps them), fitted to no log (shipid "
-            "validate SHIP.yml LOG... judges it), and identify --model blanke-speed+wind "
-            "--crossflow --prior SHIP.yml --gamma 1 (blanke-speed where the log has no wind) "
-            "draws a fit "
-            "toward it: from one Esso Osaka zig-zag file at a time, the other zig-zags' yaw "
-            "rate came 0.21 of its "
-            "spread with the sister, 0.30 drawn toward it and 0.34 with the default, the 35° "
-            "turns' tactical diameters 19 %, 13 % and 22 % off in the median, 23 %, 26 % and "
-            "69 % at worst (docs/esso.md)")  # fmt: skip
+            f"shipid mmg kvlcc2 --particulars {model_path} --rps logs --speed {approach} -o "
+            "SHIP.yml writes the KVLCC2's MMG model with this ship's particulars (as this model "
+            "file keeps them), fitted to no log (shipid validate SHIP.yml LOG... judges it), and "
+            "identify --model blanke-speed+wind --crossflow --prior SHIP.yml --gamma 1 "
+            "(blanke-speed where the log has no wind) draws a fit toward it: from one Esso Osaka "
+            "zig-zag file at a time, the other zig-zags' yaw rate came 0.21 of its spread with "
+            "the sister, 0.30 drawn toward it and 0.34 with the default, the 35° turns' tactical "
+            "diameters 19 %, 13 % and 22 % off in the median, 23 %, 26 % and 69 % at worst "
+            "(docs/esso.md)")  # fmt: skip
 
 
 def _replicates_checked(ensemble, report: dict, model, as_written, speed, rps, curvature,

@@ -273,9 +273,13 @@ def one_log_wind_note(logs, structure: ModelStructure) -> list[str]:
     terms: its coefficients then rest on that log's gusts alone. Fitted from one Esso Osaka
     zig-zag file at a time they differ 4 to 13 times in magnitude from file to file (the
     surge's and the yaw's sin γ_A of the other sign than the nine files' fit in two files
-    each), and the other logs' predictions with them; held at an aerodynamic estimate from the
-    projected areas the other files' yaw rate came 0.26 of its spread instead of 0.34, and the
-    35° turns 15 % off instead of 22 % (``benchmarks/study_esso_wind_terms.py``)."""
+    each), and the other logs' predictions with them. Held at Blendermann's published
+    loaded-tanker coefficients (the lateral centroid at midships, 0.013 m from the model's), one
+    file's fit predicted the other files' yaw rate closer (0.30 of its spread against 0.34) but
+    not their turns (tactical diameters 30 % off in the median against 22 %); from two files the
+    fitted wind did better than the textbook estimate held
+    (``benchmarks/study_esso_wind_terms.py``). (A textbook estimate came closer on both, 0.26 and
+    15 %, but its yaw lever was set after the nine files' fit had shown its sign.)"""
     used = _signals(structure)
     if len(logs) != 1 or not used & {"wind_speed", "wind_angle"}:
         return []
@@ -285,9 +289,10 @@ def one_log_wind_note(logs, structure: ModelStructure) -> list[str]:
     return [f"the wind's load is fitted from one log's gusts (true wind {wind[0]:.3g} m/s against "
             f"the ship's {wind[1]:.3g} m/s): from one Esso Osaka zig-zag file at a time its "
             "coefficients differ 4 to 13 times from file to file, and the other logs' predictions "
-            "with them "
-            "(benchmarks/study_esso_wind_terms.py); fit several logs, or hold the wind's terms "
-            "at an estimate (--bound, both ways)"]  # fmt: skip
+            "with them (benchmarks/study_esso_wind_terms.py); fit several logs (from two files "
+            "the fitted wind predicted the others better than an estimate held), or hold the "
+            "wind's terms at an estimate (--bound, both ways: Blendermann's published one "
+            "brought the Esso's other zig-zags closer and its turns not)"]  # fmt: skip
 
 
 # A true wind of at least this share of the ship's speed (medians over the logs) is named.

@@ -176,17 +176,18 @@ SLOW_MODE_RATIO = 0.2
 
 
 def slow_mode_note(eigenvalues) -> str:
-    """A clause for a model's stability line, where its sway–yaw block is unstable in a real
-    slow mode (``SLOW_MODE_RATIO``): its time constant T2 rests on the hull terms' form more
-    than on the logs; else "". A stable slow mode is left (the paper's ship's, from its noisy
-    zig-zags, came within 0.04 1/s in the two forms). ``eigenvalues``: the two."""
+    """A clause on a model's sway–yaw ``eigenvalues`` (the two; real ones as numbers or with a
+    zero imaginary part), where it is unstable in a real slow mode (``SLOW_MODE_RATIO``): its
+    time constant T2 rests on the hull terms' form more than on the logs; else "". A stable
+    slow mode is left (the paper's ship's, from its noisy zig-zags, came within 0.04 1/s in the
+    two forms)."""
     real = [float(e.real) if isinstance(e, complex) and e.imag == 0 else e for e in eigenvalues]
     if len(real) != 2 or not all(isinstance(e, float) for e in real):
         return ""
     slow, fast = sorted(real, key=abs)
     if not slow > 0.0 or abs(slow) >= SLOW_MODE_RATIO * abs(fast):
         return ""
-    return (f"; its slow mode, T2 {-1 / slow:.3g} s, rests on the form of the hull's nonlinear "
+    return (f"its slow mode, T2 {-1 / slow:.3g} s, rests on the form of the hull's nonlinear "
             "terms more than on logs of large manoeuvres: the KVLCC2's runs give T2 −14 to −19 s "
             "fitted in moduli, −28 to −47 s cubic, benchmarks/study_hull_form.py; a spiral test "
             "measures it")  # fmt: skip
