@@ -77,7 +77,7 @@ def judged(path: str) -> tuple[int, Counter, set[float]]:
 def warned(path: str, train: list[Path]) -> dict[str, bool]:
     """Whether ``identify``'s warnings below and above the logs' propeller speeds fire on the
     model of ``path`` (trained on ``train``)."""
-    from shipid.identification.plausibility import above_the_logs_rps, below_the_logs_rps
+    from shipid.identification.beyond_the_logs import above_the_logs_rps, below_the_logs_rps
     from shipid.reporting.modelfile import model_from_document
     from shipid.trials.reading import read_trial_log
 

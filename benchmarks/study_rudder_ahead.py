@@ -156,7 +156,7 @@ def tanker(seeds: int = 3) -> None:
     from study_tanker import SEA_SENSORS, cells, judged, ship_at, trials, truth_indices
     from study_tanker import TRAINING as TANKER_TRAINING
 
-    from shipid.identification.plausibility import rudder_reversed_warning
+    from shipid.identification.beyond_the_logs import rudder_reversed_warning
 
     def start(model, positive):
         sign = 1.0 if positive == "starboard" else -1.0
@@ -204,7 +204,7 @@ def esso_named(folder: Path) -> None:
     README's 0.5 s (cut as ``shipid import --start auto --end auto`` cuts them)."""
     from esso_logs import DATA as ESSO
 
-    from shipid.identification.plausibility import rudder_reversed_warning
+    from shipid.identification.beyond_the_logs import rudder_reversed_warning
 
     def named(argv: list[str], files: list[str]) -> bool:
         out = str(folder / "named.json")

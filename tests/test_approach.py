@@ -101,7 +101,7 @@ def test_a_steady_speed_beyond_every_log_is_named(tmp_path, capsys, from_rest):
     from test_equilibrium import PROPELLED
 
     from shipid.dynamics.model import ManoeuvringModel
-    from shipid.identification.plausibility import approach_beyond_logs
+    from shipid.identification.beyond_the_logs import approach_beyond_logs
 
     # u̇ = a |u|u + b n⁺²: steady at n √(−b/a), 0.632 m/s at 10 rps, reached in minutes.
     a, b, rps = -0.01, 4e-5, 10.0

@@ -1,4 +1,4 @@
-"""identify's warning below the logs' propeller speeds (``plausibility.below_the_logs_rps``),
+"""identify's warning below the logs' propeller speeds (``beyond_the_logs.below_the_logs_rps``),
 on a model whose surge balance has a closed form: u̇ = −a|u|u + c|n|n − d (no rudder drag), so
 its steady straight speed is √((c n² − d)/a) and none where c n² < d. From logs at 10 rps, at
 0.6 of it (6 rps) c n² = 0.0432 < d = 0.05: no steady straight speed, said; with d = 0 the
@@ -11,7 +11,8 @@ import pandas as pd
 import pytest
 
 from shipid.dynamics.model import ManoeuvringModel, get_structure
-from shipid.identification.plausibility import below_the_logs_rps, plausibility_at_approach
+from shipid.identification.beyond_the_logs import below_the_logs_rps
+from shipid.identification.plausibility import plausibility_at_approach
 
 A, C = 0.0321, 0.0012  # |u|u and |n|n coefficients
 

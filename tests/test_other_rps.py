@@ -82,7 +82,8 @@ def _drag_model():
 def test_identify_warns_where_a_given_structure_fails_at_another_logs_rps():
     """A structure given with ``--model`` is fitted as it is: ``identify`` says where its held
     turn fails at a propeller speed its logs ran at."""
-    from shipid.identification.plausibility import at_the_logs_other_rps, plausibility_at_approach
+    from shipid.identification.beyond_the_logs import at_the_logs_other_rps
+    from shipid.identification.plausibility import plausibility_at_approach
 
     model = _drag_model()
     report = plausibility_at_approach(model, 0.22, 10.0)[0]
@@ -95,11 +96,8 @@ def test_identify_warns_where_a_given_structure_fails_at_another_logs_rps():
 @pytest.mark.parametrize(("rps", "warned"), [(10.0, True), (8.0, False)])
 def test_a_model_that_fails_above_the_logs_rps_is_named(rps, warned):
     """At 1.4 times the logs' highest rps: 14 rps fails (the drag wins from 11.6), 11.2 not."""
-    from shipid.identification.plausibility import (
-        above_the_logs_rps,
-        below_the_logs_rps,
-        plausibility_at_approach,
-    )
+    from shipid.identification.beyond_the_logs import above_the_logs_rps, below_the_logs_rps
+    from shipid.identification.plausibility import plausibility_at_approach
 
     model = _drag_model()
     report = plausibility_at_approach(model, 0.0224 * rps, rps)[0]

@@ -355,7 +355,7 @@ def test_a_pair_at_12_and_15_rps_turns_at_10_where_the_esso_turned(tmp_path, cap
     """Two zig-zag files at 12 and 15 rps (13_50_28, 13_57_45): the default model turned
     plausibly at both and failed at 10 rps, where the Esso's turns were run (their closed loops
     ended without a tactical diameter), and identify warned of it (at 0.6 of the logs' lowest
-    rps its held 35° turn failed a check, ``plausibility.below_the_logs_rps``). Its library held
+    rps its held 35° turn failed a check, ``beyond_the_logs.below_the_logs_rps``). Its library held
     a constant force, the same at every rps; written as advance-ratio similarity has it (n|n|,
     ``similarity.similar_library``), the model turns at 10 rps, +21 % and +6 % long with the
     hull's cross-flow drag, which the default also searches with on one or two logs and takes

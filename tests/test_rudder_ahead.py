@@ -16,6 +16,7 @@ from cli_helpers import run
 from shipid.data.io import write_log
 from shipid.dynamics.model import ManoeuvringModel
 from shipid.dynamics.simulate import simulate
+from shipid.identification.beyond_the_logs import rudder_reversed, rudder_reversed_warning
 from shipid.identification.identify import identify
 from shipid.identification.physics import (
     RUDDER_AHEAD_SHARES,
@@ -23,7 +24,6 @@ from shipid.identification.physics import (
     parse_constraints,
     rows_unmet,
 )
-from shipid.identification.plausibility import rudder_reversed, rudder_reversed_warning
 from shipid.trials.manoeuvres import zigzag
 from shipid.vessels import kvlcc2
 from shipid.vessels.kvlcc2 import trimmed_revolutions

@@ -12,7 +12,7 @@ from cli_helpers import run
 
 from shipid.data.particulars import Particulars
 from shipid.dynamics.model import ManoeuvringModel, ModelStructure
-from shipid.identification.plausibility import rudder_drag_ahead
+from shipid.identification.beyond_the_logs import rudder_drag_ahead
 from shipid.identification.priors import rudder_drag
 from shipid.reporting.modelfile import load_model
 
@@ -128,7 +128,7 @@ def test_select_gives_the_warning_of_the_model_it_writes(tmp_path, capsys, monke
     fit a drag that is one)."""
     from generated_logs import noisy_zigzags
 
-    import shipid.identification.plausibility as plausibility
+    import shipid.identification.beyond_the_logs as beyond_the_logs
     from shipid.data.io import write_log
 
     seen = []
@@ -137,7 +137,7 @@ def test_select_gives_the_warning_of_the_model_it_writes(tmp_path, capsys, monke
         seen.append((model, particulars, speed, rps))
         return "surge: (a stand-in for the rudder drag's warning)"
 
-    monkeypatch.setattr(plausibility, "rudder_drag_ahead", spy)
+    monkeypatch.setattr(beyond_the_logs, "rudder_drag_ahead", spy)
     logs = noisy_zigzags(seed=3)[:2]
     for log in logs:
         log.attrs["particulars"] = ESSO.to_dict()

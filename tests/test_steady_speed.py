@@ -15,9 +15,9 @@ from shipid.data.io import write_log
 from shipid.data.log import relative_wind, steady_start
 from shipid.dynamics.equilibrium import surge_equilibrium
 from shipid.errors import ShipidError
+from shipid.identification.beyond_the_logs import missed_steady_speed
 from shipid.identification.identify import identify
 from shipid.identification.physics import PhysicsOptions, similar_steady_speeds
-from shipid.identification.plausibility import missed_steady_speed
 from shipid.reporting.modelfile import load_model
 
 SPEC = "u: |u|u, pos(n)^2; v: u*r, u*v, delta; r: u*r, u*v, delta"

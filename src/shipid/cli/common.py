@@ -498,10 +498,10 @@ def _std_errors(ident) -> dict:
 
 def _rudder_drag_note(model, logs, speed, rps, std_errors=None) -> str | None:
     """``identify``'s and ``select``'s warning where the fitted surge's rudder drag pushes the
-    ship ahead (``plausibility.rudder_drag_ahead``), against the logs' particulars; None where it
+    ship ahead (``beyond_the_logs.rudder_drag_ahead``), against the logs' particulars; None where it
     is a drag or they cannot tell. ``std_errors``: the fit's {term: ±} of u̇ (not an average's)."""
     from shipid.data.particulars import logs_particulars
-    from shipid.identification.plausibility import rudder_drag_ahead
+    from shipid.identification.beyond_the_logs import rudder_drag_ahead
 
     return rudder_drag_ahead(model, logs_particulars(logs), speed, rps, std_errors)
 
@@ -902,7 +902,7 @@ def _model_notes(target, speed: float | None, rps: float | None) -> list[str]:
 
     if not isinstance(target, ManoeuvringModel | HybridModel):
         return []
-    from shipid.identification.plausibility import from_rest_warning, rudder_reversed_warning
+    from shipid.identification.beyond_the_logs import from_rest_warning, rudder_reversed_warning
 
     return [f"plausibility: {note}" for note in (from_rest_warning(target, speed, rps),
                                                  rudder_reversed_warning(target, speed, rps))

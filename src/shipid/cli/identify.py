@@ -452,7 +452,7 @@ def cmd_identify(args) -> int:
               f"{plausibility['approach']}"
               + (", with its kernel residual" if hybrid else ""))  # fmt: skip
     ident.warnings.extend(f"plausibility: {n}" for n in notes)
-    from shipid.identification.plausibility import (
+    from shipid.identification.beyond_the_logs import (
         above_the_logs_rps,
         approach_beyond_logs,
         at_the_logs_other_rps,

@@ -160,7 +160,7 @@ def cmd_select(args) -> int:
             written, speed, rps, args.speed, args.rps,
             curvature=sharpest_curvature(logs, speed), astern=True)  # fmt: skip
     ident.warnings.extend(f"plausibility: {n}" for n in notes)
-    from shipid.identification.plausibility import (
+    from shipid.identification.beyond_the_logs import (
         given_steady_speeds,
         missed_steady_speed,
         rudder_reversed_warning,

@@ -683,13 +683,13 @@ def select(
     """
     import dataclasses
 
+    from shipid.identification.beyond_the_logs import given_steady_speeds
     from shipid.identification.identify import identify
     from shipid.identification.plausibility import (
         crash_stop,
         disqualifying,
         disqualifying_checks,
         failed_checks,
-        given_steady_speeds,
         gross_at_other_rps,
         other_propeller_speeds,
         plausibility_at_approach,
