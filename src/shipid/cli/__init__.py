@@ -266,18 +266,28 @@ def _one_line(exc) -> str:
 def run() -> None:
     """Console entry point: :func:`main`, then exit with its code.
 
-    After an interrupt the process ends at once (``os._exit``) once the streams are flushed:
-    the temporaries are already removed while unwinding, and an interrupted JIT compile
-    leaves objects whose finalisers would print tracebacks during interpreter teardown.
+    The process ends with ``os._exit`` once the streams are flushed and the ``atexit`` handlers
+    have run (Dask's clusters closed, multiprocessing's children joined, logging flushed), where
+    no other thread is left: the interpreter's own teardown of the modules loaded (numba's LLVM,
+    pandas, SciPy) took 0.4–0.5 s of a 1.7 s ``identify`` and nothing needs it, every file being
+    closed where it is written. With a thread still running, a normal exit joins it.
+    After an interrupt the process ends at once: the temporaries are already removed while
+    unwinding, and an interrupted JIT compile leaves objects whose finalisers would print
+    tracebacks during interpreter teardown.
     """
-    code = main()
-    if code == 130:
-        import os
+    import os
+    import threading
 
-        for stream in (sys.stdout, sys.stderr):
-            try:
-                stream.flush()
-            except (OSError, ValueError):
-                pass
-        os._exit(code)
-    sys.exit(code)
+    code = main()
+    if code != 130 and threading.active_count() > 1:
+        sys.exit(code)
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError):
+            pass
+    if code != 130:
+        import atexit
+
+        atexit._run_exitfuncs()
+    os._exit(code)
