@@ -1,6 +1,11 @@
 """Progress bars: drawn where asked, and where not, neither drawn nor imported (the searches of
 every ``identify`` and ``select`` opened a disabled tqdm bar and imported tqdm for it)."""
 
+import io
+import subprocess
+import sys
+from pathlib import Path
+
 import pytest
 from cli_helpers import fresh_python
 
@@ -16,12 +21,38 @@ def test_a_hidden_bar_draws_nothing_and_imports_no_tqdm():
     assert fresh_python(code).split("\n")[0] == "[0, 1, 2] False"
 
 
+class Terminal(io.StringIO):
+    def isatty(self) -> bool:
+        return True
+
+
 @pytest.mark.parametrize("shown", [True, None])
-def test_a_shown_bar_counts_its_items(capsys, shown):
+@pytest.mark.parametrize("terminal", [True, False])
+def test_a_shown_bar_counts_its_items_where_it_is_watched(monkeypatch, shown, terminal):
+    """Drawn on a terminal; into a file or a pipe (pytest's captured stream is one), not."""
+    err = Terminal() if terminal else io.StringIO()
+    monkeypatch.setattr(sys, "stderr", err)
+    monkeypatch.delitem(sys.modules, "ipykernel", raising=False)
     assert list(progress(iter("abc"), "logs", "log", shown=shown)) == ["a", "b", "c"]
-    err = capsys.readouterr().err
-    # True: always drawn; None: only on a terminal (pytest's captured stderr is not one).
-    assert ("3/3" in err) is bool(shown)
+    assert ("3/3" in err.getvalue()) is terminal
     with progress_bar(4, "fits", "fit", shown=shown) as bar:
         bar.update(4)
-    assert ("4/4" in capsys.readouterr().err) is bool(shown)
+    assert ("4/4" in err.getvalue()) is terminal
+
+
+def test_validate_writes_no_bar_into_a_redirected_stderr(tmp_path):
+    """Three logs or more draw a bar on a terminal; ``2> file`` holds the warnings alone."""
+    from generated_logs import noisy_zigzags
+
+    from shipid.data.io import write_log
+
+    logs = noisy_zigzags(seed=1)[:3]
+    paths = [str(write_log(log, tmp_path / f"zz{i}.csv")) for i, log in enumerate(logs)]
+    exe = Path(sys.executable).parent / "shipid"
+    fit = subprocess.run([str(exe), "identify", paths[0], "-o", str(tmp_path / "m.json")],
+                         capture_output=True, text=True, timeout=120)  # fmt: skip
+    assert fit.returncode == 0, fit.stderr
+    res = subprocess.run([str(exe), "validate", str(tmp_path / "m.json"), *paths],
+                         capture_output=True, text=True, timeout=120)  # fmt: skip
+    assert res.returncode == 0, res.stderr
+    assert "log/s" not in res.stderr and "\r" not in res.stderr

@@ -1,12 +1,15 @@
-"""Progress bars on standard error, and none at all where they are not shown.
+"""Progress bars on standard error where someone watches it, and none at all elsewhere.
 
-A bar that is not shown costs nothing: tqdm (with ``tqdm.auto``'s notebook detection, which
-imports asyncio) is imported only for a bar that may be drawn. The searches of every
-``identify`` and ``select`` opened a disabled bar and paid 0.03-0.07 s of imports for it.
+A bar is drawn on a terminal or in a notebook, not into a file or a pipe: ``shipid validate
+... 2> log.txt`` wrote the bar's every redraw, carriage returns and all, into the file beside
+the warnings. A bar that is not shown costs nothing: tqdm (with ``tqdm.auto``'s notebook
+detection, which imports asyncio) is imported only for a bar that is drawn. The searches of
+every ``identify`` and ``select`` opened a disabled bar and paid 0.03-0.07 s of imports for it.
 """
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Iterable, Iterator
 
 
@@ -26,16 +29,25 @@ class _Hidden:
         return None
 
 
+def watched() -> bool:
+    """Whether standard error is seen as it is written: a terminal, or a notebook's kernel
+    (whose stream is no terminal, and where ``tqdm.auto`` draws a widget)."""
+    isatty = getattr(sys.stderr, "isatty", None)
+    try:
+        return bool(isatty and isatty()) or "ipykernel" in sys.modules
+    except (OSError, ValueError):  # a closed stream
+        return False
+
+
 def progress_bar(total: int | None, desc: str, unit: str = "it", shown: bool | None = True,
                  leave: bool = True):  # fmt: skip
-    """A bar counting to ``total`` (None: open-ended): ``shown`` True, always; None, where
-    standard error is a terminal (tqdm's rule); False, none (a ``_Hidden`` bar)."""
-    if shown is False:
+    """A bar counting to ``total`` (None: open-ended): ``shown`` True or None, where standard
+    error is watched (``watched``); False, none (a ``_Hidden`` bar)."""
+    if shown is False or not watched():
         return _Hidden()
     from tqdm.auto import tqdm
 
-    return tqdm(total=total, desc=desc, unit=unit, disable=shown, leave=leave) \
-        if shown is None else tqdm(total=total, desc=desc, unit=unit, leave=leave)  # fmt: skip
+    return tqdm(total=total, desc=desc, unit=unit, leave=leave)
 
 
 def progress(items: Iterable, desc: str, unit: str = "it", shown: bool | None = True
