@@ -548,7 +548,7 @@ def test_the_held_turns_of_two_choices_are_compared_by_their_paths():
     """The Esso's nine zig-zags at 0.1 s given 0.35 m/s at 10 rps: the widened library's choice
     scored the held-out zig-zags better and turned its 35° turns 85–92 % wide where the default
     library's (plausible too) turned 5–33 %: their held turns' paths tell them apart."""
-    from shipid.identification.auto_structure import _held_turns_apart
+    from shipid.identification.predictions_apart import held_turns_apart
 
     def report(speed, rate, settled=True):
         turn = {"steady_speed": speed, "settled": settled, "diverged": False}
@@ -557,14 +557,14 @@ def test_the_held_turns_of_two_choices_are_compared_by_their_paths():
             "port": {**turn, "steady_yaw_rate": -rate}}}  # fmt: skip
 
     narrow = report(0.30, 0.080)
-    assert _held_turns_apart(narrow, report(0.30, 0.055)) == (
+    assert held_turns_apart(narrow, report(0.30, 0.055)) == (
         "starboard 3.75 m against 5.45 m, port 3.75 m against 5.45 m")
     # Yaw rates within TURNS_APART (1.25) of each other: nothing to say.
-    assert _held_turns_apart(narrow, report(0.32, 0.070)) is None
+    assert held_turns_apart(narrow, report(0.32, 0.070)) is None
     # A first turn that never settles: passed over, unless asked for (select's check).
     unsettled = report(0.30, 0.080, settled=False)
-    assert _held_turns_apart(unsettled, report(0.30, 0.055)) is None
-    assert _held_turns_apart(unsettled, report(0.30, 0.055), first_may_fail=True) == (
+    assert held_turns_apart(unsettled, report(0.30, 0.055)) is None
+    assert held_turns_apart(unsettled, report(0.30, 0.055), first_may_fail=True) == (
         "starboard no steady turn against 5.45 m, port no steady turn against 5.45 m")
 
 
@@ -711,8 +711,8 @@ def test_the_tied_fits_turns_are_compared_at_the_gears_rudder(paper_log):
     """Where the particulars' ``rudder_limit`` holds the checks at the gear's largest rudder, the
     tied fits' turns were still compared at 35°, a turn the ship cannot make, and named so."""
     from shipid.data.log import approach
-    from shipid.identification.auto_structure import _predictions_apart
     from shipid.identification.plausibility import held_rudder_at
+    from shipid.identification.predictions_apart import predictions_apart
     from shipid.trials.manoeuvres import turning_circle
     from shipid.vessels import scale_ship_model
 
@@ -722,7 +722,7 @@ def test_the_tied_fits_turns_are_compared_at_the_gears_rudder(paper_log):
         for d, terms in ship.coefficients.items()})  # fmt: skip
     models = {"paper": ship, "stronger": stronger}
     with held_rudder_at(20.0):
-        (warning,) = [w for w in _predictions_apart(models, [paper_log])
+        (warning,) = [w for w in predictions_apart(models, [paper_log])
                       if "turning circle apart" in w]  # fmt: skip
     assert "a 20° turning circle apart" in warning
     dt = float(np.median(np.diff(paper_log["t"])))

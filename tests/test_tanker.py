@@ -174,8 +174,8 @@ def test_a_structure_ruled_out_beyond_the_logs_is_named_where_it_predicts_them_b
     astern, where the ship runs ahead, so the warning no longer offers it as the choice that
     only a check far beyond the logs ruled out."""
     from shipid.identification import plausibility
-    from shipid.identification.auto_structure import _ruled_out_apart
     from shipid.identification.identify import identify
+    from shipid.identification.predictions_apart import ruled_out_apart
 
     ship = tanker(rudder_limit_deg=35.0)
     logs = _zigzags_at_80_rpm(ship)
@@ -183,7 +183,7 @@ def test_a_structure_ruled_out_beyond_the_logs_is_named_where_it_predicts_them_b
     race = identify(logs, model="blanke-race+race-damping").model
     why = "ends going astern with the rudder held to starboard"
     args = ({"blanke-race+race-damping": race}, {"blanke-race+race-damping": (1, 0.05, why)})
-    (warning,) = _ruled_out_apart(chosen, "blanke-speed", 0.283, *args, logs)
+    (warning,) = ruled_out_apart(chosen, "blanke-speed", 0.283, *args, logs)
     assert warning.startswith("blanke-race+race-damping predicts the logs better than "
                               "blanke-speed (free-run scores 0.050 and 0.283)")
     assert "left out for its 35° rudder held, beyond the logs' 20°" in warning
@@ -197,21 +197,21 @@ def test_a_structure_ruled_out_beyond_the_logs_is_named_where_it_predicts_them_b
     # (its rudder_limit) holds the checks where it passes.
     monkeypatch.setattr(plausibility, "disqualifying_at_approach", lambda logs: lambda m: (
         ["spins"] if plausibility.held_rudder_deg() > 20.5 else []))
-    (warning,) = _ruled_out_apart(chosen, "blanke-speed", 0.283, *args, logs)
+    (warning,) = ruled_out_apart(chosen, "blanke-speed", 0.283, *args, logs)
     assert warning.endswith("and it fails the checks with 25° held too (spins): near the logs' "
                             "rudder as beyond it; a zig-zag log of that kind decides; it passes "
                             "them with 20° held, the logs' own: where the ship's gear stops "
                             "there, its rudder_limit in --particulars holds the checks there")
     # A fit that passed them there would be offered, the choice resting on the check beyond.
     monkeypatch.setattr(plausibility, "disqualifying_at_approach", lambda logs: lambda m: [])
-    (warning,) = _ruled_out_apart(chosen, "blanke-speed", 0.283, *args, logs)
+    (warning,) = ruled_out_apart(chosen, "blanke-speed", 0.283, *args, logs)
     assert "the choice rests on a check beyond them (it passes them with 25° held); a " \
         "zig-zag log of that kind, or --model blanke-race+race-damping, decides (where the " \
         "ship's gear stops short of 35°, its rudder_limit in --particulars moves the check " \
         "there)" in warning  # fmt: skip
     # Logs that reach the held rudder hold the check themselves: no warning.
     wide = [log.assign(delta=log["delta"] * 35 / 20) for log in logs]
-    assert _ruled_out_apart(chosen, "blanke-speed", 0.283, *args, wide) == []
+    assert ruled_out_apart(chosen, "blanke-speed", 0.283, *args, wide) == []
 
 
 @pytest.fixture(scope="module")

@@ -388,7 +388,7 @@ def cmd_identify(args) -> int:
         # the default had handed out the LS-SVM fit.
         lssvm_fails = new_failures(refined_report, plausibility, ident.model)
         from shipid.data.log import rudder_reach_deg
-        from shipid.identification.auto_structure import beyond_the_logs_rudder
+        from shipid.identification.predictions_apart import beyond_the_logs_rudder
 
         reach = rudder_reach_deg(raw_logs)
         held_beyond = bool(apart) and beyond_the_logs_rudder(plausibility["rudder_deg"], reach)
@@ -758,10 +758,10 @@ def _refit_alternatives(choice, args, logs, names, gamma) -> tuple[dict, bool]:
 
 def _turns_apart(lssvm: dict, refined: dict) -> str | None:
     """Why two fits' held-rudder turns (plausibility reports) disagree
-    (``auto_structure.rates_apart``), or None; a turn that diverges or never settles has no
+    (``predictions_apart.rates_apart``), or None; a turn that diverges or never settles has no
     steady yaw rate, and sides where neither turns steadily are left to the plausibility
     checks."""
-    from shipid.identification.auto_structure import rates_apart, settled_yaw_rates
+    from shipid.identification.predictions_apart import rates_apart, settled_yaw_rates
 
     shown = []
     for side in ("starboard", "port"):
