@@ -552,6 +552,36 @@ def test_run_ends_the_process_with_mains_code_after_atexit_and_threads(tmp_path,
     assert (tmp_path / "torn-down").exists() is (case == "thread")  # the teardown skipped alone
 
 
+LOST_AT_THE_END = """
+import sys
+import shipid.cli as cli
+
+class FullDisk:  # what a file on a full disk does: writes buffer, the flush fails
+    def write(self, text):
+        return len(text)
+
+    def flush(self):
+        raise OSError(28, "No space left on device")
+
+def main():
+    print("the last lines, still buffered")
+    return 0
+
+sys.stdout = FullDisk()
+cli.main = main
+cli.run()
+"""
+
+
+def test_output_lost_at_the_end_is_an_error_not_a_silent_success(tmp_path):
+    """What was still buffered when the command returned is lost where the last flush fails:
+    ``run`` says so and exits 1 (a reader gone, ``| head``, stays quiet: the test above)."""
+    proc = subprocess.run([sys.executable, "-c", LOST_AT_THE_END], capture_output=True,
+                          text=True, cwd=tmp_path, timeout=60)  # fmt: skip
+    assert proc.returncode == 1
+    assert proc.stderr == "shipid: error: standard output: No space left on device\n"
+
+
 def test_a_failing_demo_leaves_no_partial_folder(tmp_path, capsys, monkeypatch):
     import shipid.demo as demo
 

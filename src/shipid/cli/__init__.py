@@ -15,6 +15,7 @@ options, the model or ship a command runs on), and the commands by what they do:
 
 from __future__ import annotations
 
+import contextlib
 import contextvars
 import math
 import signal
@@ -284,8 +285,14 @@ def run() -> None:
     for stream in (sys.stdout, sys.stderr):
         try:
             stream.flush()
-        except (OSError, ValueError):
-            pass
+        except BrokenPipeError:
+            pass  # the reader has gone (| head): what it read, it wanted
+        except (OSError, ValueError) as exc:
+            if stream is sys.stdout and code == 0:  # the output's end is lost (a full disk)
+                code = 1
+                with contextlib.suppress(OSError, ValueError):
+                    print(f"shipid: error: standard output: {_one_line(exc)}", file=sys.stderr,
+                          flush=True)  # fmt: skip
     if code != 130:
         import atexit
 
