@@ -363,3 +363,27 @@ def test_a_fit_with_equalities_alone_does_not_import_scipy_optimize():
             " np.array([0.5]))); "
             "print(round(float(x[0]), 12), 'scipy.optimize' in sys.modules)")
     assert fresh_python(code).split() == ["0.5", "False"]
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_positive_definite_solve_is_scipys_to_the_bit(seed):
+    """``solve_positive`` (LAPACK's posv, called directly: select solves thousands of small
+    systems) gives SciPy's ``solve(assume_a="pos")`` bit for bit, one right-hand side or many,
+    for the bordered systems' two unknowns or more (SciPy divides a 1 × 1 one), and refuses a
+    matrix that is not positive definite as SciPy does."""
+    from scipy import linalg
+
+    from shipid.lssvm.solvers import solve_positive
+
+    rng = np.random.default_rng(seed)
+    for p in (2, 4, 17, 40):
+        F = rng.normal(size=(3 * p + 5, p)) * np.logspace(-3, 3, p)
+        M = F.T @ F + 1e-6 * np.eye(p)
+        for b in (rng.normal(size=p), rng.normal(size=(p, 3))):
+            assert np.array_equal(solve_positive(M, b),
+                                  linalg.solve(M, b, assume_a="pos", check_finite=False))
+    indefinite = np.diag([1.0, -1.0, 2.0])
+    with pytest.raises(linalg.LinAlgError):
+        solve_positive(indefinite, np.ones(3))
+    with pytest.raises(linalg.LinAlgError):
+        linalg.solve(indefinite, np.ones(3), assume_a="pos", check_finite=False)

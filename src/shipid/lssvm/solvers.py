@@ -150,11 +150,25 @@ def solve_primal(
             stacklevel=3,
         )
     try:
-        z = linalg.solve(Ms, B * d[:, None], assume_a="pos", check_finite=False)
+        z = solve_positive(Ms, B * d[:, None])
     except linalg.LinAlgError:
         z = linalg.lstsq(Ms, B * d[:, None], check_finite=False)[0]
     x = z * d[:, None]
     return x[:p].T.copy(), x[p].copy(), condition
+
+
+def solve_positive(M: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """x of M x = b for a symmetric positive definite M (Cholesky: LAPACK's ``posv``).
+
+    ``scipy.linalg.solve(..., assume_a="pos")`` runs the same routine, the same x to the bit
+    (from 2 × 2 on: it divides a 1 × 1 system), behind 25 µs of checks a call: ``select`` solves
+    thousands of small systems (3780 in the README's Esso recipe). Raises ``LinAlgError`` where
+    M is not positive definite.
+    """
+    _, x, info = linalg.lapack.dposv(M, b)
+    if info != 0:
+        raise linalg.LinAlgError(f"the system is not positive definite (LAPACK posv: {info})")
+    return x
 
 
 # Weight of the equality rows, relative to the equilibrated normal equations (unit diagonal), when
@@ -404,7 +418,7 @@ def _solve_boxed(A, b, gamma, prior, lower, upper, equalities):
                 z[held] = rhs_eq[-1]
     else:
         try:
-            z = linalg.solve(Ms, cs, assume_a="pos", check_finite=False)
+            z = solve_positive(Ms, cs)
         except linalg.LinAlgError:
             z = linalg.lstsq(Ms, cs, check_finite=False)[0]
     x = z * d
