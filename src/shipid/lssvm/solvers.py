@@ -162,7 +162,7 @@ def solve_positive(M: np.ndarray, b: np.ndarray) -> np.ndarray:
 
     ``scipy.linalg.solve(..., assume_a="pos")`` runs the same routine, the same x to the bit
     (from 2 × 2 on: it divides a 1 × 1 system), behind 25 µs of checks a call: ``select`` solves
-    thousands of small systems (3780 in the README's Esso recipe). Raises ``LinAlgError`` where
+    thousands of small systems (about 3800 in the README's Esso recipe). Raises ``LinAlgError`` where
     M is not positive definite.
     """
     _, x, info = linalg.lapack.dposv(M, b)
