@@ -37,6 +37,18 @@ CONFIGURATIONS = (("low-speed+wind", False), ("low-speed+wind+propeller-asymmetr
 TURN_KEYS = ("tactical_diameter", "steady_yaw_rate", "advance")
 
 
+def judged_fold(train, random, turns, library: str, average: bool):
+    """``select`` on ``train`` (leave one log out), judged on the two turns and the held-out
+    random run: (the selection, the validations, {turn index: [error of each turn, %]}, the
+    run's r and u error std over its spread)."""
+    sel = select(train, library=library, cv="logo", average=average)
+    results = validate(sel.model, turns + [random])
+    errors = {k: [_error(v, k) for v in results[:2]] for k in TURN_KEYS}
+    m = results[2].metrics
+    return (sel, results, errors, m["r"]["std"] / float(np.std(random["r"])),
+            m["u"]["std"] / float(np.std(random["u"])))  # fmt: skip
+
+
 def _error(v, key: str) -> float:
     meas, pred = v.indices["measured"], v.indices["simulated"]
     return 100 * (pred[key] / meas[key] - 1)
@@ -70,12 +82,8 @@ def main() -> None:
         rows = []
         for held, random in randoms.items():
             train = zigzags + [x for k, x in randoms.items() if k != held]
-            sel = select(train, library=library, cv="logo", average=average)
-            results = validate(sel.model, turns + [random])
-            errors = {k: [_error(v, k) for v in results[:2]] for k in TURN_KEYS}
-            m = results[2].metrics
-            r_ratio = m["r"]["std"] / float(np.std(random["r"]))
-            u_ratio = m["u"]["std"] / float(np.std(random["u"]))
+            sel, results, errors, r_ratio, u_ratio = judged_fold(train, random, turns, library,
+                                                                 average)  # fmt: skip
             early = [_early_yaw_ratio(v, lg) for v, lg in zip(results[:2], turns, strict=True)]
             rows.append((errors, r_ratio, u_ratio, early))
             n_terms = sum(len(t) for t in sel.model.structure.terms.values())

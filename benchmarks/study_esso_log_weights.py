@@ -22,11 +22,9 @@ import warnings
 
 import numpy as np
 from esso_logs import esso_logs
-from study_esso import TURN_KEYS, _error
+from study_esso import TURN_KEYS, judged_fold
 
 import shipid.identification.select as select_module
-from shipid.evaluation.validate import validate
-from shipid.identification.select import select
 
 LIBRARY = "low-speed+wind+propeller-asymmetry"
 PER_LOG = {"on": False}
@@ -66,12 +64,7 @@ def main() -> None:
         rows = []
         for held, random in randoms.items():
             train = zigzags + [x for k, x in randoms.items() if k != held]
-            sel = select(train, library=LIBRARY, cv="logo", average=True)
-            results = validate(sel.model, turns + [random])
-            errors = {k: [_error(v, k) for v in results[:2]] for k in TURN_KEYS}
-            m = results[2].metrics
-            ratios = (m["r"]["std"] / float(np.std(random["r"])),
-                      m["u"]["std"] / float(np.std(random["u"])))  # fmt: skip
+            _, _, errors, *ratios = judged_fold(train, random, turns, LIBRARY, True)
             rows.append((errors, *ratios))
             print(f"| {how} | {held} | "
                   + " | ".join(", ".join(f"{x:+.0f} %" for x in errors[k]) for k in TURN_KEYS)
