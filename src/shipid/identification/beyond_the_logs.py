@@ -1,9 +1,9 @@
 """Where an identified model leaves its logs: warnings for what its checks at the approach
 (``plausibility``) cannot see.
 
-A fit holds where its logs ran. ``identify``, ``select`` and the commands that run a model file
-again (``validate``, ``manoeuvre``, ``criteria``) warn, without ruling the model out, where it
-is asked beyond them:
+A fit holds where its logs ran. ``identify`` and ``select`` warn, without ruling the model out,
+where it is asked beyond them (the commands that run a model file again, ``validate``,
+``manoeuvre`` and ``criteria``, repeat the last two warnings, on the model as they run it):
 
 * its own steady straight speed well beyond every log's (``approach_beyond_logs``), or a
   straight speed a user gave that it does not hold (``missed_steady_speed``);
