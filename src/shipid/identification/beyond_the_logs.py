@@ -4,7 +4,7 @@
 A fit holds where its logs ran. ``identify`` warns, without ruling the model out, where it is
 asked beyond them (``select`` of a given steady speed, the rudder's drag and the rudder
 reversed; the commands that run a model file again, ``validate``, ``manoeuvre`` and
-``criteria``, of the last two items, on the model as they run it):
+``criteria``, of the last item, on the model as they run it):
 
 * its own steady straight speed well beyond every log's (``approach_beyond_logs``), or a
   straight speed a user gave that it does not hold (``missed_steady_speed``);
