@@ -56,3 +56,14 @@ def test_validate_writes_no_bar_into_a_redirected_stderr(tmp_path):
                          capture_output=True, text=True, timeout=120)  # fmt: skip
     assert res.returncode == 0, res.stderr
     assert "log/s" not in res.stderr and "\r" not in res.stderr
+
+
+def test_a_notebook_watches_its_stream(monkeypatch):
+    """In a notebook's kernel standard error is no terminal, and is watched all the same."""
+    from shipid.progress import watched
+
+    monkeypatch.setattr(sys, "stderr", io.StringIO())
+    monkeypatch.delitem(sys.modules, "ipykernel", raising=False)
+    assert not watched()
+    monkeypatch.setitem(sys.modules, "ipykernel", type(sys)("ipykernel"))
+    assert watched()
