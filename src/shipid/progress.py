@@ -39,19 +39,18 @@ def watched() -> bool:
         return False
 
 
-def progress_bar(total: int | None, desc: str, unit: str = "it", shown: bool | None = True,
+def progress_bar(total: int | None, desc: str, unit: str = "it", shown: bool = True,
                  leave: bool = True):  # fmt: skip
-    """A bar counting to ``total`` (None: open-ended): ``shown`` True or None, where standard
-    error is watched (``watched``); False, none (a ``_Hidden`` bar)."""
-    if shown is False or not watched():
+    """A bar counting to ``total`` (None: open-ended): ``shown``, where standard error is
+    watched (``watched``); not shown, none (a ``_Hidden`` bar)."""
+    if not shown or not watched():
         return _Hidden()
     from tqdm.auto import tqdm
 
     return tqdm(total=total, desc=desc, unit=unit, leave=leave)
 
 
-def progress(items: Iterable, desc: str, unit: str = "it", shown: bool | None = True
-             ) -> Iterator:  # fmt: skip
+def progress(items: Iterable, desc: str, unit: str = "it", shown: bool = True) -> Iterator:
     """``items`` with a bar counting them as they are taken (``progress_bar``'s ``shown``)."""
     items = list(items)
     with progress_bar(len(items), desc, unit, shown) as bar:

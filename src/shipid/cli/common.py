@@ -58,14 +58,15 @@ def _read_logs(args, paths=None, cut_from_rest: bool = False) -> list:
     if particulars is not None:
         from shipid.data.log import dimension_apart
 
+        from_file = particulars.to_dict()
         for path, log in zip(paths, logs, strict=True):
-            apart = dimension_apart(particulars.to_dict(), log.attrs.get("particulars"))
+            apart = dimension_apart(from_file, log.attrs.get("particulars"))
             if apart:  # a file of another ship's particulars, or the log of another ship
                 key, given, own = apart
                 _warn(f"{path}: --particulars {args.particulars} gives a {key} of {given:g} where "
                       f"the log's own particulars give {own:g}: the file's replace them; check "
                       "that both are of this ship")  # fmt: skip
-            log.attrs["particulars"] = frozen(particulars.to_dict())
+            log.attrs["particulars"] = frozen(from_file)
     from shipid.data.particulars import rudder_beyond_limit
 
     for path, log in zip(paths, logs, strict=True):

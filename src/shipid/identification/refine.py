@@ -239,7 +239,7 @@ def refine(
 
     # Each cost evaluation and each column of the finite-difference Jacobian is one simulation.
     bar = progress_bar(max_nfev * (len(x0) + 1), "refinement", "sim",
-                       shown=None if progress else False)  # fmt: skip
+                       shown=bool(progress))  # fmt: skip
 
     def residuals(x: np.ndarray) -> np.ndarray:
         bar.update()

@@ -374,7 +374,7 @@ def _bar(progress: bool, total: int):
     """The bootstrap's bar, shown only on a terminal where ``progress`` asks for it."""
     from shipid.progress import progress_bar
 
-    return progress_bar(total, "bootstrap", "fit", shown=None if progress else False)
+    return progress_bar(total, "bootstrap", "fit", shown=bool(progress))
 
 
 Bands = dict[str, tuple[np.ndarray, np.ndarray]]
