@@ -437,7 +437,7 @@ def test_the_average_of_candidates_and_its_bootstrap_refit():
     refit of it equal to it to the bit, on the same terms in the same order."""
     from types import SimpleNamespace
 
-    from shipid.cli.identify import _averaged_refit
+    from shipid.cli.structure_choice import _averaged_refit
     from shipid.dynamics.model import get_structure
     from shipid.identification.identify import averaged_model
 

@@ -187,7 +187,7 @@ def test_the_average_yields_to_the_chosen_candidate_check_by_check():
     reasons' words differ, and were compared as words (the tanker of study_tanker.py, from
     zig-zags at 80 and 50 rpm). Compared by check and severity, the average stays there, and
     yields where the chosen candidate passes or fails less badly."""
-    from shipid.cli.identify import _average_fails
+    from shipid.cli.structure_choice import _average_fails
     from shipid.identification.plausibility import DIVERGED, WRONG_WAY, disqualifying_checks
 
     logs = [zigzag(SHIP, 20, 20, duration=60, dt=0.1, method="euler").log]

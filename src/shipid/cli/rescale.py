@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import math
 
+from shipid.cli.as_written import _print_prime
 from shipid.cli.common import _json_text
-from shipid.cli.identify import _print_prime
 from shipid.errors import ShipidError
 
 

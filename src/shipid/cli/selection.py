@@ -7,6 +7,12 @@ import functools
 import sys
 from pathlib import Path
 
+from shipid.cli.as_written import (
+    _as_written,
+    _replicates_checked,
+    _report_replicates,
+    _written_text,
+)
 from shipid.cli.common import (
     _ahead,
     _approach,
@@ -25,12 +31,6 @@ from shipid.cli.common import (
     _training_logs,
     _warn,
     _warn_approach,
-)
-from shipid.cli.identify import (
-    _as_written,
-    _replicates_checked,
-    _report_replicates,
-    _written_text,
 )
 from shipid.errors import ShipidError
 
