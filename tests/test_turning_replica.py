@@ -232,6 +232,85 @@ def test_the_true_models_replica_of_its_own_trial_reads_every_index_as_measured(
         assert closed[k] == pytest.approx(measured[k], rel=tolerance, abs=1e-9), k
 
 
+YAW = 0.05  # rad/s: the heading turns 0.1° in 0.0349 s
+
+
+@pytest.mark.parametrize(("sampling", "duration", "yaw", "step"), [
+    (0.02, 20.0, YAW, 0.02), (0.1, 20.0, YAW, 0.1 / 3), (0.5, 20.0, YAW, 0.5 / 15),
+    (0.5, 20.0, 0.0, 0.5), (0.5, 20_000.0, YAW, 0.5 / 3)])  # fmt: skip
+def test_a_measured_log_is_replicated_at_steps_of_a_tenth_of_a_degree(sampling, duration, yaw,
+                                                                       step):  # fmt: skip
+    """Steps a whole fraction of the sampling in which the log's fastest yaw rate turns the
+    heading 0.1° (none where it is finer already, or never turns), at most 100 000 of them
+    (the 20 000 s log: 0.2 s at most, so a third of its 0.5 s); a simulated log's own step."""
+    from shipid.data.log import make_log
+    from shipid.evaluation.validate import replica_step
+
+    t = np.arange(0.0, duration + sampling / 2, sampling)
+    r = yaw * np.sin(t / 7.0)
+    r[len(r) // 3] = yaw  # its largest
+    measured = make_log({"t": t, "delta": 0.0, "u": 1.0, "v": 0.0, "r": r})
+    assert replica_step(measured) == pytest.approx(step, rel=1e-12)
+    made = make_log({"t": t, "delta": 0.0, "u": 1.0, "v": 0.0, "r": r},
+                    integrator={"method": "euler", "step": sampling})  # fmt: skip
+    assert replica_step(made) == sampling
+
+
+@pytest.mark.parametrize("suffix", ["csv", "parquet"])
+def test_a_simulated_trial_keeps_its_integrator_through_its_file(tmp_path, suffix):
+    """The replica of a simulated trial read back from its file runs at the trial's step (the
+    demo's trial files: the true model's replica is the trial); a bad ``integrator`` in a
+    file's metadata is named in one line."""
+    from shipid.data.io import read_log, write_log
+    from shipid.errors import ShipidError
+    from shipid.evaluation.validate import replica_step
+
+    log = turning_log("starboard")
+    assert log.attrs["integrator"] == {"method": "euler", "step": 0.1}
+    again = read_log(write_log(log, tmp_path / f"turn.{suffix}"))
+    assert again.attrs["integrator"] == log.attrs["integrator"]
+    assert replica_step(again) == 0.1
+    bad = tmp_path / "bad.csv"
+    bad.write_text('# shipid-log: {"integrator": {"method": "euler", "step": -1}}\n'
+                   "t,delta,u,v,r\n0,0,1,0,0\n1,0,1,0,0\n2,0,1,0,0\n")  # fmt: skip
+    with pytest.raises(ShipidError, match="bad.csv: metadata integrator must be"):
+        read_log(bad)
+
+
+def test_a_coarsely_sampled_zigzag_is_replicated_as_the_continuous_ship_ran_it():
+    """Bug: a replica stepped at the log's sampling reversed its rudder up to a step after its
+    heading reached the switch and stepped Euler at that step: the true ship's 20°/20° zig-zag
+    run at 0.01 s (RK4), sampled every 0.5 s as a measured log is (no integrator in its
+    metadata), came back from its true model with overshoots 2.0° and 8.7° too large (at 0.1 s
+    steps still 1.1° and 1.0°). At 0.0072 s, where its fastest yaw rate turns the heading 0.1°,
+    within 0.2° (the rest: the switch heading read off 0.5 s samples)."""
+    from shipid.trials.manoeuvres import zigzag
+    from shipid.vessels import scale_ship
+
+    truth = scale_ship()
+    fine = zigzag(truth, 20, 20, duration=80.0, dt=0.01, method="rk4", approach=5.0).log
+    log = fine.iloc[::50].reset_index(drop=True)
+    log.attrs = {k: v for k, v in fine.attrs.items() if k != "integrator"}
+    true_indices = zigzag(truth, 20, 20, duration=80.0, dt=0.01, method="rk4",
+                          approach=5.0).indices
+    (v,) = validate(truth, log, start_draws=False)
+    closed = v.indices["closed_loop"]
+    coarse = validate_at_the_logs_step(truth, log)
+    for k in ("first_overshoot_deg", "second_overshoot_deg"):
+        assert closed[k] == pytest.approx(true_indices[k], abs=0.25), k
+        assert abs(coarse[k] - true_indices[k]) > 0.8, k
+
+
+def validate_at_the_logs_step(model, log) -> dict:
+    """The closed-loop replica's indices at the log's own sampling (the code before)."""
+    from shipid.evaluation.validate import _indices_of, trial_replica
+
+    trial = describe_trial(log)
+    step = float(np.median(np.diff(log["t"].to_numpy())))
+    return _indices_of(trial_replica(model, log, "euler", trial, indices=False, step=step), trial,
+                       log)
+
+
 def test_the_closed_loops_spread_with_its_noisy_start_is_what_the_seeds_show(tmp_path, capsys):
     """The replica starts from the log's first measured u, v, r, one noisy sample each: over 60
     seeds of the demo's noisy 10°/10° zig-zag the true model's replica missed the measured

@@ -66,7 +66,10 @@ def test_cli_validates_a_reference_ship_with_its_report_and_horizons(ship_and_lo
 def test_the_mmg_model_on_hsvas_run_as_the_benchmark_reads_it(tmp_path, capsys):
     """The published KVLCC2 MMG model on HSVA's 20/10 zig-zag (7 m model scale, as the MMG
     model): its free run follows the yaw rate to 0.11 of its spread (an independent fit to
-    captive tests, not to this run), closed-loop overshoots within 0.7° and 1.5°."""
+    captive tests, not to this run), closed-loop overshoots 1.0° and 1.5° short of the measured
+    ones: its replica runs at a seventh of the log's 0.2 s (``replica_step``; at the log's step
+    its rudder reversed up to a step late, and the first overshoot read 10.39°, 0.4° nearer by
+    that lag; from the log at 0.05 s, 9.93° and 11.30° against 11.09° and 12.99° measured)."""
     code, out, err = run(["validate", "kvlcc2", "--format", "simman-hsva", "--dt", "0.2",
                           DATA / "kvlcc2-hsva" / "HSVA_CPMC_KVLCC2_Z_20_10_P.dat",
                           "--json", tmp_path / "v.json"], capsys)  # fmt: skip
@@ -76,7 +79,7 @@ def test_the_mmg_model_on_hsvas_run_as_the_benchmark_reads_it(tmp_path, capsys):
     assert r_std == pytest.approx(0.00357, abs=2e-5)
     closed, measured = record["indices"]["closed_loop"], record["indices"]["measured"]
     assert np.allclose([closed["first_overshoot_deg"], closed["second_overshoot_deg"]],
-                       [10.39, 11.46], atol=0.02)  # fmt: skip
+                       [9.98, 11.37], atol=0.02)  # fmt: skip
     assert measured["first_overshoot_deg"] == pytest.approx(11.0, abs=0.01)
 
 

@@ -10,7 +10,8 @@ length, 1 at full scale), ``manoeuvre``, ``time_origin``, ``yaw_rate_offset`` (a
 already subtracted from r, rad/s) and ``velocities`` (where u, v were read off the track: its
 window and the antenna's place; ``shipid.data.track_velocities``), ``track_origin`` (where x, y
 were read off a GNSS's latitude and longitude: the first fix's, in degrees;
-``shipid.data.geodetic``). They survive a round trip through
+``shipid.data.geodetic``), ``integrator`` (a simulated log's: its integration ``method`` and
+``step`` [s], which a closed-loop replica of it runs at). They survive a round trip through
 files: Parquet keeps them in its schema metadata, CSV in a first comment line
 ``# shipid-log: {...JSON...}`` (pandas reads such a file with ``comment="#"``).
 """
@@ -35,7 +36,7 @@ OPTIONAL = ("psi", "x", "y", "n", "thrust", "wind_speed", "wind_angle")
 COLUMNS = REQUIRED + OPTIONAL
 RUDDER_SIDES = ("port", "starboard")
 METADATA_KEYS = ("ship", "source", "rudder_positive", "scale", "manoeuvre", "time_origin",
-                 "particulars", "yaw_rate_offset", "velocities", "track_origin")
+                 "particulars", "yaw_rate_offset", "velocities", "track_origin", "integrator")
 CSV_METADATA_PREFIX = "# shipid-log: "
 
 
@@ -544,6 +545,12 @@ def check_metadata(meta: Mapping, name: str) -> dict:
                         for a in v.values())):
             raise ShipidError(f"{name}: metadata track_origin must be {{'lat': deg, 'lon': deg}}, "
                               f"got {v!r}")  # fmt: skip
+        if k == "integrator" and not (
+                isinstance(v, Mapping) and set(v) == {"method", "step"}
+                and v["method"] in ("euler", "rk4") and isinstance(v["step"], int | float)
+                and not isinstance(v["step"], bool) and math.isfinite(v["step"]) and v["step"] > 0):
+            raise ShipidError(f"{name}: metadata integrator must be {{'method': 'euler' or 'rk4', "
+                              f"'step': s > 0}}, got {v!r}")  # fmt: skip
         if k == "particulars":
             from shipid.data.particulars import Particulars
 

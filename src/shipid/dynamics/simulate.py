@@ -348,7 +348,11 @@ def simulate_batch(
                  and c in getattr(dynamics, "inputs", ())}  # fmt: skip
         _integrate_generic(dynamics, t, delta, thrust, rps if uses_rps else None, s0, method,
                            speed_lim, yaw_lim, out, n_valid, other)  # fmt: skip
-    return BatchResult(t, np.asarray(delta), out, n_valid, (speed_lim, yaw_lim), dict(meta))
+    # The run's own integrator, which a closed-loop replica of it runs at (a free run driven by
+    # a log would otherwise carry the log's).
+    step = float(np.median(np.diff(t))) if t.size > 1 else None
+    meta = {**meta, "integrator": {"method": method, "step": step} if step else None}
+    return BatchResult(t, np.asarray(delta), out, n_valid, (speed_lim, yaw_lim), meta)
 
 
 def divergence_report(

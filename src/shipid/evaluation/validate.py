@@ -496,29 +496,30 @@ def _reversal_notes(trial: Trial) -> list[str]:
 
 
 def trial_replica(model, log: pd.DataFrame, method: str = "euler", trial: Trial | None = None,
-                  start: dict | None = None,
-                  indices: bool = True) -> ManoeuvreResult | None:  # fmt: skip
+                  start: dict | None = None, indices: bool = True,
+                  step: float | None = None) -> ManoeuvreResult | None:  # fmt: skip
     """The log's manoeuvre run closed loop on ``model`` (``trial_zigzag``, ``trial_turning``);
     None for other logs. ``start``: states that replace the log's first ones. ``indices=False``:
     without the manoeuvre's own indices, for a caller that reads them as the log's are
-    (``_indices_of``; computed twice, they were half of ``start_spread``'s time)."""
+    (``_indices_of``; computed twice, they were half of ``start_spread``'s time). ``step``: the
+    integration step [s] (default ``replica_step(log)``)."""
     trial = trial or describe_trial(log)
     if trial.kind == "zigzag":
-        return trial_zigzag(model, log, method, trial, start, indices)
+        return trial_zigzag(model, log, method, trial, start, indices, step)
     if trial.kind in TURN_KINDS:  # a pull-out's replica is released where the log was
-        return trial_turning(model, log, method, trial, start, indices)
+        return trial_turning(model, log, method, trial, start, indices, step)
     return None
 
 
 def trial_turning(model, log: pd.DataFrame, method: str = "euler", trial: Trial | None = None,
-                  start: dict | None = None,
-                  indices: bool = True) -> ManoeuvreResult | None:  # fmt: skip
+                  start: dict | None = None, indices: bool = True,
+                  step: float | None = None) -> ManoeuvreResult | None:  # fmt: skip
     """The turning circle of a measured log run on ``model`` as ``shipid manoeuvre turning``
     runs it: where the log approaches steady and the model's surge answers the propeller, from
     the model's own steady straight speed at the log's propeller speed (straight, the log's
     heading and held rudder); else from the log's initial state. The log's rudder angle, side,
-    rate, execute time, propeller speed, duration and step. None when the log starts without
-    headway."""
+    rate, execute time, propeller speed and duration (``step``: as ``trial_replica``'s). None
+    when the log starts without headway."""
     trial = trial or describe_trial(log, "turning")
     if not float(log["u"].iloc[0]) > 0:
         return None
@@ -537,16 +538,50 @@ def trial_turning(model, log: pd.DataFrame, method: str = "euler", trial: Trial 
     return turning_circle(model, math.degrees(trial.plateau_angle),
                           "starboard" if turns > 0 else "port", speed=initial["u"], method=method,
                           rps=rps, initial=initial, release=release, indices=indices,
-                          **_replica_run(log, trial, wind))  # fmt: skip
+                          **_replica_run(log, trial, wind, step))  # fmt: skip
 
 
-def _replica_run(log: pd.DataFrame, trial: Trial, wind: tuple[float, float] | None) -> dict:
-    """What a closed-loop replica takes from the log as it is: duration, step, the execute time
-    (``approach``), the steering machine (the log's rudder rate, and an angle limit that holds
-    its rudder) and the true ``wind`` (``_log_wind``; the turn's own approach is found in it
-    too, ``_own_approach``)."""
+# A closed-loop replica of a measured log runs at steps in which its heading turns at most this
+# much at the log's largest yaw rate [rad], in at most ``REPLICA_MAX_STEPS`` steps.
+REPLICA_HEADING_STEP = math.radians(0.1)
+REPLICA_MAX_STEPS = 100_000
+
+
+def replica_step(log: pd.DataFrame) -> float:
+    """The step a closed-loop replica of ``log`` runs at: a simulated log's own integrator step
+    (its metadata's ``integrator``: the true model's replica of its trial is then that trial, to
+    the bit); for a measured log, the largest whole fraction of its sampling in which the heading
+    turns ``REPLICA_HEADING_STEP`` at the log's largest yaw rate (its sampling where that is
+    finer already), in no more than ``REPLICA_MAX_STEPS``.
+
+    A measured ship runs in continuous time, and a replica reverses its rudder at the first step
+    after its heading reaches the switch. At the log's own step that came up to a step late:
+    the true ship's 20°/20° zig-zag sampled every 0.5 s (its RK4 run at 0.01 s) came back from
+    its own model with overshoots 1.1° and 1.0° too large at 0.1 s steps, 2.0° and 8.7° at
+    0.5 s; on the Esso Osaka's nine zig-zags at Δk 0.5 s the README's model put the first
+    overshoots 1.1° larger on average than at 0.01 s (``benchmarks/study_replica_step.py``)."""
+    made = log.attrs.get("integrator")
+    if made:
+        return float(made["step"])
     t = log["t"].to_numpy()
-    return {"duration": float(t[-1] - t[0]), "dt": float(np.median(np.diff(t))),
+    sampling = float(np.median(np.diff(t)))
+    yaw = np.abs(log["r"].to_numpy(dtype=float)) if "r" in log.columns else np.zeros(1)
+    fastest = float(np.nanmax(yaw)) if np.isfinite(yaw).any() else 0.0
+    finest = max(REPLICA_HEADING_STEP / fastest if fastest > 0 else sampling,
+                 float(t[-1] - t[0]) / REPLICA_MAX_STEPS)  # fmt: skip
+    if not sampling > finest:
+        return sampling
+    return sampling / math.ceil(sampling / finest - 1e-9)
+
+
+def _replica_run(log: pd.DataFrame, trial: Trial, wind: tuple[float, float] | None,
+                 step: float | None = None) -> dict:
+    """What a closed-loop replica takes from the log as it is: duration, ``step`` (default
+    ``replica_step``), the execute time (``approach``), the steering machine (the log's rudder
+    rate, and an angle limit that holds its rudder) and the true ``wind`` (``_log_wind``; the
+    turn's own approach is found in it too, ``_own_approach``)."""
+    t = log["t"].to_numpy()
+    return {"duration": float(t[-1] - t[0]), "dt": step or replica_step(log),
             "approach": float(t[min(trial.execute_index + 1, len(t) - 1)] - t[0]),
             "steering": SteeringMachine(max_angle=max(math.radians(35.0), trial.plateau_angle),
                                         max_rate=trial.rudder_rate),
@@ -590,13 +625,14 @@ def validate(
 
 
 def trial_zigzag(model, log: pd.DataFrame, method: str = "euler", trial: Trial | None = None,
-                 start: dict | None = None, indices: bool = True) -> ManoeuvreResult | None:  # fmt: skip
+                 start: dict | None = None, indices: bool = True,
+                 step: float | None = None) -> ManoeuvreResult | None:  # fmt: skip
     """The zig-zag of a measured log run closed loop on ``model``: same initial state (u, v, r, ψ)
     and held rudder (or the model's own steady approach, ``_replica_start``), first execute time
     and side, rudder angle (the median plateau), rudder rate (over its swings,
     ``shipid.data.rudder_signal.rise_rate``), switch heading (inferred from the log; where the
     trial reversed unevenly, each reversal at its own: ``uneven_reversals``), mean propeller
-    speed, duration and step.
+    speed and duration (``step``: as ``trial_replica``'s).
     None when the log has no detectable switch heading or starts without headway (a zig-zag
     needs an approach speed)."""
     trial = trial or describe_trial(log, "zigzag")
@@ -608,9 +644,9 @@ def trial_zigzag(model, log: pd.DataFrame, method: str = "euler", trial: Trial |
     return zigzag(model, math.degrees(trial.plateau_angle), switch,
                   first="starboard" if turns > 0 else "port", speed=initial["u"], method=method,
                   initial=initial, rps=rps, switches=uneven_reversals(trial), indices=indices,
-                  **_replica_run(log, trial, wind))  # fmt: skip
+                  **_replica_run(log, trial, wind, step))  # fmt: skip
 
 
-__all__ = ["Validation", "free_run", "manoeuvre_from_approach", "steady_log_approach",
-           "trial_replica", "trial_turning", "trial_zigzag", "validate", "validate_log",
-           "zigzag_indices"]
+__all__ = ["Validation", "free_run", "manoeuvre_from_approach", "replica_step",
+           "steady_log_approach", "trial_replica", "trial_turning", "trial_zigzag", "validate",
+           "validate_log", "zigzag_indices"]

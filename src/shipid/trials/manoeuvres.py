@@ -278,15 +278,16 @@ def run_closed_loops(
                 dyn, rows[k], n, dt, s0[k:k + 1], method, *lims[k],
                 rps if uses_rps else None)  # fmt: skip
     return [_closed_loop_result(vessel, rows[k], states[k], rudder[k], int(n_valid[k]), dt,
-                                rps if uses_rps else None, *lims[k])
+                                rps if uses_rps else None, *lims[k], method)
             for k in range(b)]  # fmt: skip
 
 
 def _closed_loop_result(vessel: Vessel, params: np.ndarray, states: np.ndarray,
                         rudder: np.ndarray, m: int, dt: float, rps: float | None,
-                        speed_lim: float, yaw_lim: float) -> ManoeuvreResult:  # fmt: skip
-    """The log of a closed-loop run's ``m`` valid samples of ``states`` (N, 6) and ``rudder``,
-    and where it stopped short of N, why."""
+                        speed_lim: float, yaw_lim: float, method: str) -> ManoeuvreResult:  # fmt: skip
+    """The log of a closed-loop run's ``m`` valid samples of ``states`` (N, 6) and ``rudder``
+    (its metadata names its ``integrator``: ``method`` at ``dt``), and where it stopped short of
+    N, why."""
     n = len(states)
     t = np.arange(n) * dt
     cols = dict(zip(("u", "v", "r", "psi", "x", "y"), states[:m].T, strict=True))
@@ -297,7 +298,8 @@ def _closed_loop_result(vessel: Vessel, params: np.ndarray, states: np.ndarray,
         wind = (float(params[kernel.P_WIND_SPEED]), float(params[kernel.P_WIND_DIR]))
         cols["wind_speed"], cols["wind_angle"] = relative_wind(cols["u"], cols["v"],
                                                                cols["psi"], wind)  # fmt: skip
-    log = make_log({"t": t[:m], "delta": rudder[:m], **cols}, **vessel.log_metadata())
+    log = make_log({"t": t[:m], "delta": rudder[:m], **cols}, **vessel.log_metadata(),
+                   integrator={"method": method, "step": dt})
     if m == n:
         return ManoeuvreResult(log)
     t_div, reason = divergence_report(states, t, m, speed_lim, yaw_lim)
