@@ -56,6 +56,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/study_trim.py
 	$(BIN)/python benchmarks/study_gyro_offset.py
 	$(BIN)/python benchmarks/study_event_timing.py
+	$(BIN)/python benchmarks/study_replica_step.py
 	$(BIN)/python benchmarks/study_crossflow.py
 	$(BIN)/python benchmarks/study_turn_speed.py
 	$(BIN)/python benchmarks/study_replicate_plausibility.py
