@@ -341,13 +341,34 @@ def _indices_of(replica: ManoeuvreResult | None, trial: Trial, log: pd.DataFrame
     The replica's rudder moves at the log's samples, but the manoeuvre's own indices count from
     its order time, one sample later (the compiled step that gives the order moves the rudder
     in it). Read from there, the true model's replica of its own noise-free trial had the
-    advance 0.39 m (2.5 %) short and the initial turning time 0.2 s short (Δt 0.2 s)."""
+    advance 0.39 m (2.5 %) short and the initial turning time 0.2 s short (Δt 0.2 s).
+
+    A replica stepped finer than the log (``replica_step``) is read at the log's sampling, as
+    the log is: every sample of it that falls on one of the log's times (its switches stay
+    where its finer steps put them). Read at every step, a 100-replicate ensemble's two Esso
+    turns took 1.1 s of the 1.3 s its finer steps added to ``validate``."""
     if replica is None or replica.diverged:
         return {}
-    t_exec = float(replica.log["t"].iloc[0]) + trial.execute_time - float(log["t"].iloc[0])
-    read = _read_as_logged(replica.log, trial, t_exec)
+    run = _at_the_logs_sampling(replica.log, log)
+    t_exec = float(run["t"].iloc[0]) + trial.execute_time - float(log["t"].iloc[0])
+    read = _read_as_logged(run, trial, t_exec)
     read.pop("kind", None)
-    return {**read, "approach_speed": float(replica.log["u"].iloc[0])}
+    return {**read, "approach_speed": float(run["u"].iloc[0])}
+
+
+def _at_the_logs_sampling(run: pd.DataFrame, log: pd.DataFrame) -> pd.DataFrame:
+    """``run`` (a replica of ``log``) at ``log``'s sampling where it steps a whole fraction of
+    it; else as it is."""
+    t, step = log["t"].to_numpy(), run["t"].to_numpy()
+    if len(t) < 2 or len(step) < 2:
+        return run
+    sampling, dt = float(np.median(np.diff(t))), float(step[1] - step[0])
+    every = int(round(sampling / dt))
+    if every < 2 or abs(every * dt - sampling) > 1e-9 * sampling:
+        return run
+    out = run.iloc[::every].reset_index(drop=True)
+    out.attrs = dict(run.attrs)
+    return out
 
 
 def steady_log_approach(log: pd.DataFrame, trial: Trial) -> float | None:
