@@ -153,7 +153,11 @@ class _Identification:
         self.members: list = []
         self.filter_by = "given"
         self.residual = self.hybrid = self.band = self.ensemble = self.refinement = None
-        self.prep: dict = {}
+        self.prep: dict = {}  # the model file's preprocessing record
+        # From the first log's approach (``report_fit``), and the fit the file keeps with its
+        # checks (``choose_kept_fit``).
+        self.speed = self.rps = self.curvature = self.ahead = None
+        self.final = self.plausibility = self.notes = None
 
     def fit_model(self, fit_logs, fit_gamma, fit_names=None):
         """The model of ``fit_logs`` fitted as the file's is: the structure, or the average of
