@@ -237,12 +237,12 @@ YAW = 0.05  # rad/s: the heading turns 0.1° in 0.0349 s
 
 @pytest.mark.parametrize(("sampling", "duration", "yaw", "step"), [
     (0.02, 20.0, YAW, 0.02), (0.1, 20.0, YAW, 0.1 / 3), (0.5, 20.0, YAW, 0.5 / 15),
-    (0.5, 20.0, 0.0, 0.5), (0.5, 20_000.0, YAW, 0.5 / 3)])  # fmt: skip
+    (0.5, 20.0, 0.0, 0.5), (0.5, 20_000.0, YAW, 0.5 / 2), (0.5, 60_000.0, YAW, 0.5)])  # fmt: skip
 def test_a_measured_log_is_replicated_at_steps_of_a_tenth_of_a_degree(sampling, duration, yaw,
                                                                        step):  # fmt: skip
     """Steps a whole fraction of the sampling in which the log's fastest yaw rate turns the
     heading 0.1° (none where it is finer already, or never turns), at most 100 000 of them
-    (the 20 000 s log: 0.2 s at most, so a third of its 0.5 s); a simulated log's own step."""
+    (the 20 000 s log: half its 0.5 s; the 60 000 s one: its own); a simulated log's own step."""
     from shipid.data.log import make_log
     from shipid.evaluation.validate import replica_step
 

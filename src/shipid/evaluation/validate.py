@@ -605,11 +605,9 @@ def replica_step(log: pd.DataFrame) -> float:
     sampling = float(np.median(np.diff(t)))
     yaw = np.abs(log["r"].to_numpy(dtype=float)) if "r" in log.columns else np.zeros(1)
     fastest = float(np.nanmax(yaw)) if np.isfinite(yaw).any() else 0.0
-    finest = max(REPLICA_HEADING_STEP / fastest if fastest > 0 else sampling,
-                 float(t[-1] - t[0]) / REPLICA_MAX_STEPS)  # fmt: skip
-    if not sampling > finest:
-        return sampling
-    return sampling / math.ceil(sampling / finest - 1e-9)
+    needed = math.ceil(sampling * fastest / REPLICA_HEADING_STEP - 1e-9) if fastest > 0 else 1
+    allowed = math.floor(REPLICA_MAX_STEPS * sampling / max(float(t[-1] - t[0]), sampling))
+    return sampling / max(1, min(needed, allowed))
 
 
 def _replica_run(log: pd.DataFrame, trial: Trial, wind: tuple[float, float] | None,
