@@ -251,12 +251,27 @@ def build_parser() -> argparse.ArgumentParser:
                                  "manoeuvring models with LS-SVM (Moreno-Salinas et al. 2013).")
     ap.add_argument("--version", action="version", version=f"shipid {__version__}")
     sub = ap.add_subparsers(dest="command", required=True)
+    # Each command's arguments, in the order --help lists them.
+    for add in (
+            _add_demo, _add_identify, _add_select, _add_compare, _add_validate, _add_plot,
+            _add_simulate, _add_manoeuvre, _add_criteria, _add_linearise, _add_export,
+            _add_controllers, _add_correct, _add_mmg, _add_rescale, _add_study, _add_import,
+            _add_indices):
+        add(sub)
+    return ap
 
+
+
+def _add_demo(sub) -> None:
+    """``shipid demo``'s arguments."""
     p = sub.add_parser("demo", help="the paper's experiment on the embedded scale ship")
     p.add_argument("--out", default="shipid-demo", help="output folder (default ./%(default)s)")
     p.add_argument("--seed", type=int, default=0, help="noise seed (default %(default)s)")
     p.set_defaults(func=cmd_demo)
 
+
+def _add_identify(sub) -> None:
+    """``shipid identify``'s arguments."""
     p = sub.add_parser("identify", help="identify a model from trial logs")
     p.add_argument("logs", nargs="+", metavar="LOG")
     p.add_argument("--model", default="auto",
@@ -341,6 +356,9 @@ def build_parser() -> argparse.ArgumentParser:
     _add_log_options(p)
     p.set_defaults(func=cmd_identify)
 
+
+def _add_select(sub) -> None:
+    """``shipid select``'s arguments."""
     p = sub.add_parser("select", help="choose the structure and γ by cross-validated free-run "
                        "error over several logs")
     p.add_argument("logs", nargs="+", metavar="LOG")
@@ -392,6 +410,9 @@ def build_parser() -> argparse.ArgumentParser:
     _add_log_options(p)
     p.set_defaults(func=cmd_select)
 
+
+def _add_compare(sub) -> None:
+    """``shipid compare``'s arguments."""
     p = sub.add_parser("compare", help="methods × held-out logs: free-run cross-validation")
     p.add_argument("logs", nargs="+", metavar="LOG")
     p.add_argument("--model", help="structure for the semiphysical methods (default blanke, "
@@ -409,6 +430,9 @@ def build_parser() -> argparse.ArgumentParser:
     _add_log_options(p)
     p.set_defaults(func=cmd_compare)
 
+
+def _add_validate(sub) -> None:
+    """``shipid validate``'s arguments."""
     p = sub.add_parser("validate", help="free-run a model (or a reference ship) against logs: "
                        "error table and indices")  # fmt: skip
     p.add_argument("model", metavar="MODEL.json|VESSEL",
@@ -443,6 +467,9 @@ def build_parser() -> argparse.ArgumentParser:
     _add_log_options(p)
     p.set_defaults(func=cmd_validate)
 
+
+def _add_plot(sub) -> None:
+    """``shipid plot``'s arguments."""
     p = sub.add_parser("plot", help="figure of any logs: u, v, r, rudder, heading, track")
     p.add_argument("logs", nargs="+", metavar="LOG")
     p.add_argument("-o", "--output", required=True, metavar="FIG.png|.svg|.pdf")
@@ -450,6 +477,9 @@ def build_parser() -> argparse.ArgumentParser:
     _add_log_options(p)
     p.set_defaults(func=cmd_plot)
 
+
+def _add_simulate(sub) -> None:
+    """``shipid simulate``'s arguments."""
     p = sub.add_parser("simulate", help="drive a model or vessel with a logged rudder")
     p.add_argument("model", metavar="MODEL.json|VESSEL")
     p.add_argument("log", metavar="LOG", help="log whose rudder and inputs drive it")
@@ -459,6 +489,9 @@ def build_parser() -> argparse.ArgumentParser:
     _add_log_options(p)
     p.set_defaults(func=cmd_simulate)
 
+
+def _add_manoeuvre(sub) -> None:
+    """``shipid manoeuvre``'s arguments."""
     p = sub.add_parser("manoeuvre", help="run a standard manoeuvre on a model or vessel")
     p.add_argument("model", metavar="MODEL.json|VESSEL")
     p.add_argument("kind", choices=("zigzag", "turning", "pull-out", "spiral", "stopping"))
@@ -493,6 +526,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="skip the intervals from the model file's bootstrap ensemble")
     p.set_defaults(func=cmd_manoeuvre)
 
+
+def _add_criteria(sub) -> None:
+    """``shipid criteria``'s arguments."""
     p = sub.add_parser("criteria", help="IMO MSC.137(76) criteria: run the standard manoeuvres "
                        "on a model or vessel and judge them")
     p.add_argument("model", metavar="MODEL.json|VESSEL")
@@ -516,18 +552,27 @@ def build_parser() -> argparse.ArgumentParser:
                    help="skip the intervals from the model file's bootstrap ensemble")
     p.set_defaults(func=cmd_criteria)
 
+
+def _add_linearise(sub) -> None:
+    """``shipid linearise``'s arguments."""
     p = sub.add_parser("linearise", help="state-space A, B and Nomoto K, T of a model or vessel")
     p.add_argument("model", metavar="MODEL.json|VESSEL")
     p.add_argument("--speed", type=float, help="straight-running speed [m/s] (default: training)")
     p.add_argument("--rps", type=float, help="propeller speed for models with n terms")
     p.set_defaults(func=cmd_linearise)
 
+
+def _add_export(sub) -> None:
+    """``shipid export``'s arguments."""
     p = sub.add_parser("export", help="a model, or an MMG ship (kvlcc2, an MMG file, one "
                        "corrected), as a standalone NumPy module (no shipid needed)")  # fmt: skip
     p.add_argument("model", metavar="MODEL.json|SHIP")
     p.add_argument("-o", "--output", required=True, metavar="MODEL.py")
     p.set_defaults(func=cmd_export)
 
+
+def _add_controllers(sub) -> None:
+    """``shipid autopilot`` and ``shipid follow``: a controller tuned on a model."""
     for name, helptext in (("autopilot", "PID heading autopilot tuned on a model: a heading step "
                             "on the model and on a true ship"),
                            ("follow", "line-of-sight path following along waypoints with a PID "
@@ -563,6 +608,9 @@ def build_parser() -> argparse.ArgumentParser:
             p.add_argument("--json", metavar="OUT.json")
             p.set_defaults(func=cmd_follow)
 
+
+def _add_correct(sub) -> None:
+    """``shipid correct``'s arguments."""
     p = sub.add_parser("correct", help="a reference ship's model kept whole, an LS-SVM "
                        "correction fitted to logs of the same ship (the corrected ship a file "
                        "the commands run as a reference ship)")  # fmt: skip
@@ -586,6 +634,9 @@ def build_parser() -> argparse.ArgumentParser:
     _add_log_options(p)
     p.set_defaults(func=cmd_correct)
 
+
+def _add_mmg(sub) -> None:
+    """``shipid mmg``'s arguments."""
     p = sub.add_parser("mmg", help="an MMG model file of a ship without one: a similar "
                        "ship's prime coefficients with this ship's particulars")  # fmt: skip
     p.add_argument("source", metavar="VESSEL|MMG.yml",
@@ -606,6 +657,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", required=True, metavar="SHIP.yml")
     p.set_defaults(func=cmd_mmg)
 
+
+def _add_rescale(sub) -> None:
+    """``shipid rescale``'s arguments."""
     p = sub.add_parser("rescale", help="a model carried to a geometrically similar ship of "
                        "another length (Froude scaling, equal prime coefficients)")
     p.add_argument("model", metavar="MODEL.json")
@@ -618,6 +672,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", required=True, metavar="OUT.json")
     p.set_defaults(func=cmd_rescale)
 
+
+def _add_study(sub) -> None:
+    """``shipid study``'s arguments."""
     p = sub.add_parser("study", help="Monte Carlo identifiability study of the paper's "
                        "experiment (seeds × noise × γ × structure), or identify many log sets "
                        "(kind: logs), on Dask")
@@ -634,6 +691,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_study)
 
+
+def _add_import(sub) -> None:
+    """``shipid import``'s arguments."""
     p = sub.add_parser("import", help="convert trial files to canonical logs")
     p.add_argument("logs", nargs="+", metavar="FILE")
     p.add_argument("-o", "--output", required=True, metavar="LOG.csv|LOG.parquet|DIR",
@@ -644,6 +704,9 @@ def build_parser() -> argparse.ArgumentParser:
     _add_log_options(p)
     p.set_defaults(func=cmd_import)
 
+
+def _add_indices(sub) -> None:
+    """``shipid indices``'s arguments."""
     p = sub.add_parser("indices", help="IMO indices of measured logs")
     p.add_argument("logs", nargs="+", metavar="LOG")
     p.add_argument("--kind", choices=KINDS, help="default: detected")
@@ -653,4 +716,3 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", metavar="OUT.json")
     _add_log_options(p)
     p.set_defaults(func=cmd_indices)
-    return ap
