@@ -7,6 +7,7 @@ import math
 import sys
 from functools import partial
 from pathlib import Path
+from types import SimpleNamespace
 
 from shipid.cli.common import (
     VESSEL_NAMES,
@@ -47,140 +48,49 @@ def _unique_figure_names(names: list[str]) -> list[str]:
 
 
 def cmd_validate(args) -> int:
-    """``shipid validate``: free runs on logs, metrics, indices, figures, report."""
+    """``shipid validate``: free runs on logs, metrics, indices, figures, report. The steps: the
+    model (or reference ship) and what its file keeps, the logs read as its training logs were,
+    each log validated, the tables printed, the residual analysis and IMO criteria, then the
+    outputs (written only where some log validated)."""
     from shipid.evaluation.envelope import outside_envelope
     from shipid.evaluation.validate import validate
-    from shipid.identification.correction import ship_ensemble
-    from shipid.outputs import OutputSet, check_outputs
-    from shipid.reporting.modelfile import (
-        ensemble_from_document,
-        error_band_from_document,
-        has_refinement,
-        load_document,
-        model_from_document,
-        training_conditions,
-    )
-    from shipid.reporting.report import (
-        indices_frame,
-        metrics_frame,
-        start_spread_note,
-        switch_heading_note,
-    )
+    from shipid.outputs import check_outputs
+    from shipid.progress import progress
 
-    # A reference ship, shipid correct's corrected one or a ship's own MMG model.
-    ship = _reference_ship(args.model)
-    reference = ship is not None
     check_outputs({"--json": (args.json, "json"), "--plots": (args.plots, "dir"),
                    "--report": (args.report, "dir")},
                   [*([] if args.model in VESSEL_NAMES else [args.model]), *args.logs,
                    *_read_files(args)])  # fmt: skip
-    if reference:
-        # A reference ship against the logs (the published KVLCC2 MMG model against MARIN's
-        # runs): no fit of its own, so no training logs, error band or tied structures; a
-        # corrected one's bootstrap replicates give bands and intervals.
-        if args.lssvm:
-            raise ShipidError(f"--lssvm: {args.model} is a reference ship, not an identified "
-                              "model with an LS-SVM fit of its own")  # fmt: skip
-        doc, band, model = None, None, ship
-        ensemble = None if args.no_bands else ship_ensemble(ship)
-        # The logs are turned to the ship's own rudder convention.
-        cond = {**_vessel_conditions(), "rudder_positive": model.rudder_positive}
-    else:
-        doc = load_document(args.model)
-        if args.lssvm and not has_refinement(doc):
-            _warn(f"{args.model} has no refinement: its model is the LS-SVM one, which --lssvm "
-                  "validates")  # fmt: skip
-        model = model_from_document(doc, args.model, "lssvm" if args.lssvm else "model",
-                                    hybrid=True)  # fmt: skip
-        ensemble = None if args.no_bands else ensemble_from_document(doc, args.model, model)
-        band = None if args.no_bands or args.lssvm else error_band_from_document(doc, args.model)
-        cond = training_conditions(doc)
+    subject = _validated_model(args)
+    model, cond, band = subject.model, subject.cond, subject.band
     given = _particulars(args)  # checked before the runs: the criteria of the logs need it
     if given is not None:
         _check_length(args.model, model, cond, given.length, f"--particulars {args.particulars}")
         _check_scale(args.model, cond, given.scale, f"--particulars {args.particulars}")
-    env = cond["envelope"]
     # The model's own, whatever the logs (those that start from rest or slow down meet them, as
     # the Esso's random runs do): said now, and in --json beside each log's.
     model_notes = _model_notes(model, cond["speed"], cond["rps"])
     for note in model_notes:
         _warn(note)
-    from shipid.data.log import common_rudder_convention
-    from shipid.trials.reading import read_trial_log
-
-    options = _read_options(args)
-    logs, names, failed = [], [], []
-    for p in args.logs:
-        try:
-            # As the logs a model is fitted to are read (a zig-zag or turn from rest cut to its
-            # manoeuvre, a run ended before a propulsion dropout) unless --start or --end is given.
-            logs.append(read_trial_log(p, options))
-            names.append(str(p))
-        except ShipidError as exc:
-            failed.append(str(exc))
-    _warn_cut(names, logs, options.lead, judged=True)
-    _print_yaw_rate_offsets(args, names, logs)
-    if cond["rudder_positive"]:  # a file that does not say its convention: no guess
-        logs, notes = common_rudder_convention(logs, cond["rudder_positive"])
-        for note in notes:
-            _warn(note)
-    for note in (_scale_notes(cond, logs, names) + _ship_notes(cond, logs, names)
-                 + _sampling_notes(cond, logs, names)
-                 + _yaw_rate_notes(cond, logs, names)
-                 + (_reference_speed_notes(model, logs, names) if reference else [])):
-        _warn(note)
-    from shipid.progress import progress
-
+    logs, names, failed = _logs_to_validate(args, subject)
     vals = [validate(model, log, [name], method=args.method, kind=args.kind,
-                     smooth_s=args.smooth, ensemble=ensemble, error_band=band)[0]
+                     smooth_s=args.smooth, ensemble=subject.ensemble, error_band=band)[0]
             for log, name in progress(zip(logs, names, strict=True), "logs", "log",
                                       shown=not (args.quiet or len(logs) < 3))]  # fmt: skip
     for v, log in zip(vals, logs, strict=True):
         if v.error is None:
-            v.warnings.extend(outside_envelope(env, log) + _reversed_propeller_notes(model, cond,
-                                                                                    log))
-    if doc is not None:
-        _mark_training_logs(doc, vals)
+            v.warnings.extend(outside_envelope(cond["envelope"], log)
+                              + _reversed_propeller_notes(model, cond, log))  # fmt: skip
+    if subject.doc is not None:
+        _mark_training_logs(subject.doc, vals)
     good = [v for v in vals if v.error is None]
     if good:
-        if band is not None:
-            runs = band.runs_summary()
-            print(f"The model's {band.describe()}: a log like those is inside it for about "
-                  f"{100 * band.level:g} % of its samples (columns 'in CV band')"
-                  + (f"; {runs}." if runs else "."))  # fmt: skip
-        print(metrics_frame(good).to_markdown(index=False, floatfmt=".4g"))
-        table = indices_frame(good)
-        if len(table):
-            print()
-            print(_markdown_dashed(table, ".4g"))
-            note = switch_heading_note(good)
-            if note:
-                print(note)
-            spread = start_spread_note(good)
-            if spread:
-                print(spread)
+        _print_validations(good, band)
     if args.horizon and good:
-        _print_horizons(model, vals, logs, args, env)
-    tied, tied_table, tied_runs = ({}, None, {}) if args.lssvm or not good or doc is None else \
-        _tied_validations(doc, args, vals, logs)  # fmt: skip
-    residuals = {}
-    if args.resid or args.report:
-        from shipid.evaluation.metrics import residual_correlations
-
-        for v, log in zip(vals, logs, strict=True):
-            if v.error is None:
-                n = len(v.simulation.log)
-                residuals[v.name] = {s: residual_correlations(
-                    log[s].to_numpy()[:n], v.simulation.log[s].to_numpy(),
-                    log["delta"].to_numpy()[:n], args.max_lag) for s in ("u", "v", "r")}
-    if args.resid and residuals:
-        rows = [{"log": Path(name).name, **{f"{s} autocorr. outside band": a[s]["auto_outside"]
-                                            for s in ("u", "v", "r")},
-                 **{f"{s} corr. with δ outside band": a[s]["cross_outside"]
-                    for s in ("u", "v", "r")}} for name, a in residuals.items()]  # fmt: skip
-        print("\nResidual analysis of the free-run errors (share of lags outside the 95 % band "
-              "of white noise; ≈ 0.05 when the error is white and independent of the rudder):")
-        print(_pd().DataFrame(rows).to_markdown(index=False, floatfmt=".2f"))
+        _print_horizons(model, vals, logs, args, cond["envelope"])
+    tied, tied_table, tied_runs = ({}, None, {}) if args.lssvm or not good or subject.doc is None \
+        else _tied_validations(subject.doc, args, vals, logs)  # fmt: skip
+    residuals = _residual_analysis(args, vals, logs)
     particulars = given or cond["particulars"]
     crit = None
     if particulars is not None:
@@ -198,53 +108,201 @@ def cmd_validate(args) -> int:
         print(f"shipid: error: {e}", file=sys.stderr)
     if not good:
         return 1  # nothing validated: nothing to write
-    # Some logs validated: the outputs record every log, failed ones with their error.
+    _write_validation(args, subject, vals, logs, failed, model_notes,
+                      SimpleNamespace(table=tied_table, runs=tied_runs, record=tied),
+                      residuals, crit)  # fmt: skip
+    return 1 if errors else 0
+
+
+def _validated_model(args) -> SimpleNamespace:
+    """What ``validate`` runs: a reference ship (the published KVLCC2 MMG model, ``shipid
+    correct``'s corrected ship, a ship's own MMG model), or a model file's model (``--lssvm``:
+    its LS-SVM fit) with its ensemble and error band (``--no-bands``: none), and the conditions
+    it was fitted in. Returns ``model``, ``doc`` (None for a ship), ``ensemble``, ``band``,
+    ``cond`` and ``reference``."""
+    from shipid.identification.correction import ship_ensemble
+    from shipid.reporting.modelfile import (
+        ensemble_from_document,
+        error_band_from_document,
+        has_refinement,
+        load_document,
+        model_from_document,
+        training_conditions,
+    )
+
+    ship = _reference_ship(args.model)
+    if ship is not None:
+        # A reference ship against the logs (the published KVLCC2 MMG model against MARIN's
+        # runs): no fit of its own, so no training logs, error band or tied structures; a
+        # corrected one's bootstrap replicates give bands and intervals.
+        if args.lssvm:
+            raise ShipidError(f"--lssvm: {args.model} is a reference ship, not an identified "
+                              "model with an LS-SVM fit of its own")  # fmt: skip
+        # The logs are turned to the ship's own rudder convention.
+        return SimpleNamespace(
+            model=ship, doc=None, band=None, reference=True,
+            ensemble=None if args.no_bands else ship_ensemble(ship),
+            cond={**_vessel_conditions(), "rudder_positive": ship.rudder_positive})
+    doc = load_document(args.model)
+    if args.lssvm and not has_refinement(doc):
+        _warn(f"{args.model} has no refinement: its model is the LS-SVM one, which --lssvm "
+              "validates")  # fmt: skip
+    model = model_from_document(doc, args.model, "lssvm" if args.lssvm else "model",
+                                hybrid=True)  # fmt: skip
+    return SimpleNamespace(
+        model=model, doc=doc, reference=False,
+        ensemble=None if args.no_bands else ensemble_from_document(doc, args.model, model),
+        band=None if args.no_bands or args.lssvm else error_band_from_document(doc, args.model),
+        cond=training_conditions(doc))
+
+
+def _logs_to_validate(args, subject) -> tuple[list, list[str], list[str]]:
+    """The logs as the logs a model is fitted to are read (a zig-zag or turn from rest cut to
+    its manoeuvre, a run ended before a propulsion dropout, unless --start or --end is given),
+    turned to the model's rudder convention, with the notes on what they share with its
+    training logs (scale, ship, sampling, yaw rate). Returns (logs, names, the errors of those
+    that could not be read)."""
+    from shipid.data.log import common_rudder_convention
+    from shipid.trials.reading import read_trial_log
+
+    cond = subject.cond
+    options = _read_options(args)
+    logs, names, failed = [], [], []
+    for p in args.logs:
+        try:
+            logs.append(read_trial_log(p, options))
+            names.append(str(p))
+        except ShipidError as exc:
+            failed.append(str(exc))
+    _warn_cut(names, logs, options.lead, judged=True)
+    _print_yaw_rate_offsets(args, names, logs)
+    if cond["rudder_positive"]:  # a file that does not say its convention: no guess
+        logs, notes = common_rudder_convention(logs, cond["rudder_positive"])
+        for note in notes:
+            _warn(note)
+    for note in (_scale_notes(cond, logs, names) + _ship_notes(cond, logs, names)
+                 + _sampling_notes(cond, logs, names)
+                 + _yaw_rate_notes(cond, logs, names)
+                 + (_reference_speed_notes(subject.model, logs, names) if subject.reference
+                    else [])):  # fmt: skip
+        _warn(note)
+    return logs, names, failed
+
+
+def _print_validations(good, band) -> None:
+    """The validated logs' error band shares, metrics and indices (measured, replayed, closed
+    loop), with the notes on the switch headings and the closed loop's start."""
+    from shipid.reporting.report import (
+        indices_frame,
+        metrics_frame,
+        start_spread_note,
+        switch_heading_note,
+    )
+
+    if band is not None:
+        runs = band.runs_summary()
+        print(f"The model's {band.describe()}: a log like those is inside it for about "
+              f"{100 * band.level:g} % of its samples (columns 'in CV band')"
+              + (f"; {runs}." if runs else "."))  # fmt: skip
+    print(metrics_frame(good).to_markdown(index=False, floatfmt=".4g"))
+    table = indices_frame(good)
+    if len(table):
+        print()
+        print(_markdown_dashed(table, ".4g"))
+        note = switch_heading_note(good)
+        if note:
+            print(note)
+        spread = start_spread_note(good)
+        if spread:
+            print(spread)
+
+
+def _residual_analysis(args, vals, logs) -> dict:
+    """``--resid`` or ``--report``: each validated log's free-run error, its autocorrelation and
+    its correlation with the rudder ({name: {state: ...}}); printed with ``--resid``."""
+    residuals: dict = {}
+    if not (args.resid or args.report):
+        return residuals
+    from shipid.evaluation.metrics import residual_correlations
+
+    for v, log in zip(vals, logs, strict=True):
+        if v.error is None:
+            n = len(v.simulation.log)
+            residuals[v.name] = {s: residual_correlations(
+                log[s].to_numpy()[:n], v.simulation.log[s].to_numpy(),
+                log["delta"].to_numpy()[:n], args.max_lag) for s in ("u", "v", "r")}
+    if args.resid and residuals:
+        rows = [{"log": Path(name).name, **{f"{s} autocorr. outside band": a[s]["auto_outside"]
+                                            for s in ("u", "v", "r")},
+                 **{f"{s} corr. with δ outside band": a[s]["cross_outside"]
+                    for s in ("u", "v", "r")}} for name, a in residuals.items()]  # fmt: skip
+        print("\nResidual analysis of the free-run errors (share of lags outside the 95 % band "
+              "of white noise; ≈ 0.05 when the error is white and independent of the rudder):")
+        print(_pd().DataFrame(rows).to_markdown(index=False, floatfmt=".2f"))
+    return residuals
+
+
+def _write_validation(args, subject, vals, logs, failed, model_notes, tied, residuals,
+                      crit) -> None:  # fmt: skip
+    """``--json``, ``--plots`` and ``--report``, written together (``OutputSet``): every log,
+    failed ones with their error; the figures drawn once where the report shows them too."""
+    from shipid.outputs import OutputSet
+
+    good = [v for v in vals if v.error is None]
     with OutputSet() as out:
         if args.json:
             records = [v.to_dict() for v in vals] + [{"name": None, "error": e} for e in failed]
-            body = {"logs": records, **({"tied_structures": tied} if tied else {}),
+            body = {"logs": records, **({"tied_structures": tied.record} if tied.record else {}),
                     **({"model_warnings": model_notes} if model_notes else {})}
             out.write(args.json, lambda p: p.write_text(_json_text(body), "utf-8"))
         figures: dict[str, dict[str, bytes]] = {}
         if args.plots:
-            from shipid.reporting import plots
-
-            stems = _unique_figure_names([v.name for v in good])
-            pairs = [(v, log) for v, log in zip(vals, logs, strict=True) if v.error is None]
-            ext = "." + args.plot_format
-            # PNGs drawn once serve the folder and the report alike.
-            share = args.report is not None and args.plot_format == "png"
-            for (v, log), stem in zip(pairs, stems, strict=True):
-                title = Path(v.name).name
-                jobs = [("fit", stem + ext, partial(plots.measured_vs_simulated, log,
-                                                   v.simulation.log, title=title,
-                                                   bands=v.bands,
-                                                   error_band=v.error_band,
-                                                   tied=tied_runs.get(v.name)))]  # fmt: skip
-                if args.resid:
-                    jobs.append(("resid", stem + "-resid" + ext, partial(
-                        plots.residuals, residuals[v.name], title=f"{title}: residual analysis")))
-                for key, file_name, plot in jobs:
-                    if not share:
-                        plot(Path(args.plots) / file_name, out=out)
-                        continue
-                    buf = io.BytesIO()
-                    plot(buf)
-                    figures.setdefault(v.name, {})[key] = png = buf.getvalue()
-                    out.write(Path(args.plots) / file_name, partial(Path.write_bytes, data=png))
+            figures = _write_figures(args, vals, logs, tied.runs, residuals, out)
         if args.report:
             from shipid.reporting.html import validation_report
 
-            se, se_label = (None, "") if doc is None else \
-                _coefficient_errors(doc, model, args.lssvm)  # fmt: skip
-            text = validation_report(model, vals, logs, f"Validation of {Path(args.model).name}",
-                                     std_errors=se, std_errors_label=se_label, criteria=crit,
+            se, se_label = (None, "") if subject.doc is None else \
+                _coefficient_errors(subject.doc, subject.model, args.lssvm)  # fmt: skip
+            text = validation_report(subject.model, vals, logs,
+                                     f"Validation of {Path(args.model).name}", std_errors=se,
+                                     std_errors_label=se_label, criteria=crit,
                                      warnings=[w for v in good for w in v.warnings],
                                      residuals=residuals, figures=figures,
-                                     tied=tied_table, tied_runs=tied_runs)  # fmt: skip
+                                     tied=tied.table, tied_runs=tied.runs)  # fmt: skip
             out.write(Path(args.report) / "report.html",
                       lambda p: p.write_text(text, encoding="utf-8"))
-    return 1 if errors else 0
+
+
+def _write_figures(args, vals, logs, tied_runs, residuals, out) -> dict[str, dict[str, bytes]]:
+    """Each validated log's figure (and ``--resid``'s) into ``--plots``, staged in ``out``;
+    the PNGs drawn, by log, where the report shows them too ({} otherwise)."""
+    from shipid.reporting import plots
+
+    good = [v for v in vals if v.error is None]
+    stems = _unique_figure_names([v.name for v in good])
+    pairs = [(v, log) for v, log in zip(vals, logs, strict=True) if v.error is None]
+    ext = "." + args.plot_format
+    # PNGs drawn once serve the folder and the report alike.
+    share = args.report is not None and args.plot_format == "png"
+    figures: dict[str, dict[str, bytes]] = {}
+    for (v, log), stem in zip(pairs, stems, strict=True):
+        title = Path(v.name).name
+        jobs = [("fit", stem + ext, partial(plots.measured_vs_simulated, log, v.simulation.log,
+                                            title=title, bands=v.bands,
+                                            error_band=v.error_band,
+                                            tied=tied_runs.get(v.name)))]  # fmt: skip
+        if args.resid:
+            jobs.append(("resid", stem + "-resid" + ext, partial(
+                plots.residuals, residuals[v.name], title=f"{title}: residual analysis")))
+        for key, file_name, plot in jobs:
+            if not share:
+                plot(Path(args.plots) / file_name, out=out)
+                continue
+            buf = io.BytesIO()
+            plot(buf)
+            figures.setdefault(v.name, {})[key] = png = buf.getvalue()
+            out.write(Path(args.plots) / file_name, partial(Path.write_bytes, data=png))
+    return figures
 
 
 def _mark_training_logs(doc, vals) -> None:
