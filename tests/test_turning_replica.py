@@ -301,6 +301,29 @@ def test_a_coarsely_sampled_zigzag_is_replicated_as_the_continuous_ship_ran_it()
         assert abs(coarse[k] - true_indices[k]) > 0.8, k
 
 
+def test_a_measured_turns_replica_is_ordered_halfway_between_its_samples():
+    """Bug: the replica of a measured turn ordered its rudder at the first sample the rudder had
+    moved at, where the order fell anywhere since the sample before: the scale ship's 20° turn
+    (RK4 at 0.01 s) ordered at ten times across one 0.5 s sample, sampled every 0.5 s, came back
+    from the true ship 0.45 m longer in advance than measured, on average (U Δt / 2). Ordered
+    halfway, within 0.1 m."""
+    from shipid.evaluation.validate import _indices_of, trial_replica
+    from shipid.trials.indices import manoeuvre_indices
+    from shipid.vessels import scale_ship
+
+    ship = scale_ship()
+    longer = []
+    for order in np.arange(5.0, 5.5, 0.05):
+        fine = turning_circle(ship, 20, duration=80.0, dt=0.01, method="rk4",
+                              approach=float(order)).log  # fmt: skip
+        log = fine.iloc[::50].reset_index(drop=True)
+        log.attrs = {k: v for k, v in fine.attrs.items() if k != "integrator"}
+        trial = describe_trial(log)
+        replica = _indices_of(trial_replica(ship, log, "euler", trial, indices=False), trial, log)
+        longer.append(replica["advance"] - manoeuvre_indices(log, trial=trial)["advance"])
+    assert abs(np.mean(longer)) < 0.1
+
+
 def validate_at_the_logs_step(model, log) -> dict:
     """The closed-loop replica's indices at the log's own sampling (the code before)."""
     from shipid.evaluation.validate import _indices_of, trial_replica

@@ -613,12 +613,20 @@ def replica_step(log: pd.DataFrame) -> float:
 def _replica_run(log: pd.DataFrame, trial: Trial, wind: tuple[float, float] | None,
                  step: float | None = None) -> dict:
     """What a closed-loop replica takes from the log as it is: duration, ``step`` (default
-    ``replica_step``), the execute time (``approach``), the steering machine (the log's rudder
-    rate, and an angle limit that holds its rudder) and the true ``wind`` (``_log_wind``; the
-    turn's own approach is found in it too, ``_own_approach``)."""
+    ``replica_step``), the execute time (``approach``: the first sample the rudder has moved at
+    in a simulated log, halfway to it from the last one before in a measured log), the steering
+    machine (the log's rudder rate, and an angle limit that holds its rudder) and the true
+    ``wind`` (``_log_wind``; the turn's own approach is found in it too, ``_own_approach``)."""
     t = log["t"].to_numpy()
+    ordered = min(trial.execute_index + 1, len(t) - 1)
+    approach = float(t[ordered] - t[0])
+    if not log.attrs.get("integrator") and ordered > 0:
+        # A measured rudder was ordered between the last sample on the approach and the next,
+        # on average halfway (as the reversal headings are read): at the next sample, a turn of
+        # the scale ship sampled every 0.5 s came back 0.45 m long in advance, on average.
+        approach -= 0.5 * float(t[ordered] - t[ordered - 1])
     return {"duration": float(t[-1] - t[0]), "dt": step or replica_step(log),
-            "approach": float(t[min(trial.execute_index + 1, len(t) - 1)] - t[0]),
+            "approach": approach,
             "steering": SteeringMachine(max_angle=max(math.radians(35.0), trial.plateau_angle),
                                         max_rate=trial.rudder_rate),
             **({"wind": wind} if wind is not None else {})}  # fmt: skip
