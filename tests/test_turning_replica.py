@@ -282,7 +282,7 @@ def test_a_coarsely_sampled_zigzag_is_replicated_as_the_continuous_ship_ran_it()
     heading reached the switch and stepped Euler at that step: the true ship's 20°/20° zig-zag
     run at 0.01 s (RK4), sampled every 0.5 s as a measured log is (no integrator in its
     metadata), came back from its true model with overshoots 2.0° and 8.7° too large (at 0.1 s
-    steps still 1.1° and 1.0°). At 0.0072 s, where its fastest yaw rate turns the heading 0.1°,
+    steps still 1.1° and 0.8°). At 0.0072 s, where its fastest yaw rate turns the heading 0.1°,
     within 0.2° (the rest: the switch heading read off 0.5 s samples)."""
     from shipid.trials.manoeuvres import zigzag
     from shipid.vessels import scale_ship

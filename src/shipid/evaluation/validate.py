@@ -595,7 +595,7 @@ def replica_step(log: pd.DataFrame) -> float:
     A measured ship runs in continuous time, and a replica reverses its rudder at the first step
     after its heading reaches the switch. At the log's own step that came up to a step late:
     the true ship's 20°/20° zig-zag sampled every 0.5 s (its RK4 run at 0.01 s) came back from
-    its own model with overshoots 1.1° and 1.0° too large at 0.1 s steps, 2.0° and 8.7° at
+    its own model with overshoots 1.1° and 0.8° too large at 0.1 s steps, 2.0° and 8.7° at
     0.5 s; on the Esso Osaka's nine zig-zags at Δk 0.5 s the README's model put the first
     overshoots 1.1° larger on average than at 0.01 s (``benchmarks/study_replica_step.py``)."""
     made = log.attrs.get("integrator")
