@@ -6,6 +6,7 @@ from __future__ import annotations
 import functools
 import sys
 from pathlib import Path
+from types import SimpleNamespace
 
 from shipid.cli.as_written import (
     _as_written,
@@ -52,16 +53,59 @@ def _check_replicates(ensemble, report: dict, model, one_rps, ahead, logs, args,
 
 
 def cmd_select(args) -> int:
-    """``shipid select``: structure and γ by cross-validated free-run error."""
-    from shipid.dynamics.model import get_structure
-    from shipid.identification.cross_validation import parse_cv
-    from shipid.identification.select import RESAMPLES, SelectOptions, default_library, select
+    """``shipid select``: structure and γ by cross-validated free-run error. The steps: the
+    search (widened as ``identify``'s default is where its best is ruled out or nothing similar
+    is plausible), the choice printed, the model as its file will have it checked, the
+    bootstrap of the choice, the file."""
+    from shipid.identification.select import RESAMPLES
     from shipid.outputs import OutputSet, check_outputs
     from shipid.reporting.modelfile import model_text
 
     check_outputs({"-o": (args.output, "json"), "--table": (args.table, "log")},
                   [*args.logs, *_read_files(args)])  # fmt: skip
-    # The options logs do not decide, checked before the logs are read.
+    search = _searched(args)
+    sel, logs, names = search.selection, search.logs, search.names
+    ident = sel.identification
+    _print_selection(sel, search.options.cv, args.show)
+    _warn_approach(logs, names)
+    checked = _checked_as_written(args, search)
+    others = len(sel.shares) - (sel.chosen_share > 0)
+    print(f"\nThe choice on {RESAMPLES} resamples of the held-out logs: this candidate "
+          f"{100 * sel.chosen_share:.0f} %, {others} other(s) the rest (column share)")
+    ensemble = None
+    if args.bootstrap is not None:
+        ensemble = _selection_bootstrap(args, search, checked)
+    text = model_text(ident, args.logs, preprocessing=_log_record(args, logs),
+                      plausibility=checked.plausibility, model=sel.model,
+                      selection=sel.to_dict(), particulars=_log_particulars(logs),
+                      uncertainty=ensemble.to_dict() if ensemble else None)  # fmt: skip
+    text = _written_text(text, checked.one_rps, checked.ahead, args.output)[0]
+    with OutputSet() as out:
+        out.write(args.output, lambda p: p.write_text(text, encoding="utf-8"))
+        if args.table:
+            from shipid.data.io import write_table
+
+            write_table(sel.candidates, args.table, out)
+    # And those added here (the model as the file has it, the replicates, the speeds given):
+    # sel.warnings is the list select made.
+    for w in [*sel.warnings, *(w for w in ident.warnings if w not in sel.warnings)]:
+        _warn(w)
+    print(f"model written to {args.output}")
+    return 0
+
+
+def _searched(args) -> SimpleNamespace:
+    """The options checked (before the logs are read), the logs read and the search: the
+    library (given, or the default trimmed to the logs, with the hull's cross-flow drag or the
+    rudder's normal force), then as ``identify``'s default, where the best is ruled out by the
+    checks the library widened by the rudder's lift at the hull's drift, and where nothing
+    similar is plausible the constant, or the thrust held to its fall with the advance.
+    Returns ``selection``, ``logs``, ``names``, ``options`` and ``physics``."""
+    from shipid.dynamics.model import get_structure
+    from shipid.identification.auto_structure import unusable, widened_selection
+    from shipid.identification.cross_validation import parse_cv
+    from shipid.identification.select import SelectOptions, default_library, select
+
     parse_cv(args.cv)
     gammas = _parse_gammas(args.gammas)
     try:
@@ -90,8 +134,6 @@ def cmd_select(args) -> int:
                             average=args.average, keep=args.keep,
                             **({"gammas": gammas} if gammas else {}))
     sel = select(logs, options, names=names)
-    from shipid.identification.auto_structure import unusable, widened_selection
-
     say = functools.partial(print, file=sys.stderr)
     if args.library is None and sel.best_ruled_out:
         # As identify's default: where the logs' best fit from the default library is ruled out
@@ -120,18 +162,24 @@ def cmd_select(args) -> int:
             sel = constant.selection
             for note in constant.widening:
                 print(f"library: {note}")
-    ident = sel.identification
+    return SimpleNamespace(selection=sel, logs=logs, names=names, options=options,
+                           physics=physics)
+
+
+def _print_selection(sel, cv: str, show: int) -> None:
+    """The model (and the chosen candidate where it is an average), γ and the score, the best
+    ``show`` candidates (and the chosen one), the held-out logs and the error band."""
     if sel.model is not sel.chosen_model:
         print(f"The chosen candidate:\n{sel.chosen_model.equations()}\n\nThe model written, "
               f"the average of {len(sel.shares)} candidates weighted by how often the choice "
               "rule picks them on resampled held-out logs (--average):")  # fmt: skip
     print(sel.model.equations())
     whose = " of the chosen candidate" if sel.model is not sel.chosen_model else ""
-    print(f"\nγ = {sel.gamma:g}; free-run CV score{whose} {sel.score:.4f} ({options.cv}; 1 ≈ "
+    print(f"\nγ = {sel.gamma:g}; free-run CV score{whose} {sel.score:.4f} ({cv}; 1 ≈ "
           f"predicting the mean); {len(sel.candidates)} candidates")
     cols = ["chosen", "score", "score_se", "score_u", "score_v", "score_r", "gamma", "n_terms",
             "folds_diverged", "plausible", "share", "stage", "note"]
-    shown = sel.candidates.head(args.show)
+    shown = sel.candidates.head(show)
     if not shown["chosen"].any():
         shown = _pd().concat([shown, sel.candidates[sel.candidates["chosen"]]])
     print(shown[cols].to_markdown(index=False, floatfmt=".4g"))
@@ -141,7 +189,22 @@ def cmd_select(args) -> int:
     if sel.error_band is not None:
         print(f"Their {sel.error_band.describe()}; stored in the model file, validate reports "
               "each log's share of samples inside it.")  # fmt: skip
-    _warn_approach(logs, names)
+
+
+def _checked_as_written(args, search) -> SimpleNamespace:
+    """The model as its file will have it (carried to every rps, in its ahead forms), checked
+    from the approach select's own check of the fit took (the logs' first, or --speed and
+    --rps): the checks' notes, the rudder reversed, turns far from the default's, a given
+    steady speed missed and the rudder's drag, into the selection's warnings. Returns
+    ``plausibility``, ``one_rps`` and ``ahead``."""
+    from shipid.identification.auto_structure import turns_apart_from_the_default
+    from shipid.identification.beyond_the_logs import (
+        given_steady_speeds,
+        missed_steady_speed,
+        rudder_reversed_warning,
+    )
+    sel, logs, names = search.selection, search.logs, search.names
+    ident = sel.identification
     plausibility, notes = sel.plausibility, sel.plausibility_notes
     one_rps = _one_rps(logs, args)
     ahead = _ahead(logs, args)
@@ -149,8 +212,7 @@ def cmd_select(args) -> int:
     speed = args.speed if args.speed is not None else _approach(logs[0], "u")
     rps = args.rps if args.rps is not None else (one_rps or _approach(logs[0], "n"))
     if written is not sel.model:
-        # Checked as the file will have it, from the approach select's own check of the fit
-        # took (the logs' first, or --speed and --rps), with the crash stop it had.
+        # Checked as the file will have it, with the crash stop select's check had.
         from shipid.identification.plausibility import (
             plausibility_at_approach,
             sharpest_curvature,
@@ -160,22 +222,13 @@ def cmd_select(args) -> int:
             written, speed, rps, args.speed, args.rps,
             curvature=sharpest_curvature(logs, speed), astern=True)  # fmt: skip
     ident.warnings.extend(f"plausibility: {n}" for n in notes)
-    from shipid.identification.beyond_the_logs import (
-        given_steady_speeds,
-        missed_steady_speed,
-        rudder_reversed_warning,
-    )
-
     reversed_rudder = rudder_reversed_warning(written, speed, rps)
     if reversed_rudder:
         ident.warnings.append(f"plausibility: {reversed_rudder}")
-    from shipid.identification.auto_structure import turns_apart_from_the_default
-
     apart = turns_apart_from_the_default(plausibility, logs, names, speed, rps, selection=sel)
     if apart:
         ident.warnings.append(f"library: {apart}")
-
-    for u, n in given_steady_speeds(physics):
+    for u, n in given_steady_speeds(search.physics):
         missed = missed_steady_speed(written, u, n)
         if missed:
             ident.warnings.append(missed)
@@ -185,40 +238,26 @@ def cmd_select(args) -> int:
                              _std_errors(ident).get("u") if sel.model is sel.chosen_model else None)
     if drag:
         ident.warnings.append(drag)
-    prep = _log_record(args, logs)
-    ensemble = None
-    others = len(sel.shares) - (sel.chosen_share > 0)
-    print(f"\nThe choice on {RESAMPLES} resamples of the held-out logs: this candidate "
-          f"{100 * sel.chosen_share:.0f} %, {others} other(s) the rest (column share)")
-    if args.bootstrap is not None:
-        from shipid.identification.selection_ensemble import selection_ensemble
+    return SimpleNamespace(plausibility=plausibility, one_rps=one_rps, ahead=ahead)
 
-        # Each replicate: a candidate drawn by its share, refitted on a resample.
-        ensemble = selection_ensemble(logs, sel, args.bootstrap, args.block, args.seed,
-                                      names=names, progress=not args.quiet)  # fmt: skip
-        table = ensemble.coefficient_table()
-        table["term"] = [_term_display(t) for t in table["term"]]
-        print(f"\n95 % intervals of the coefficients ({ensemble.replicates} replicates: "
-              f"{ensemble.resampling}; a term outside the model "
-              "has value 0, inclusion the share of replicates that hold it):")  # fmt: skip
-        print(table.to_markdown(index=False, floatfmt=".4g"))
-        _check_replicates(ensemble, plausibility, sel.model, one_rps, ahead, logs, args, ident)
-    text = model_text(ident, args.logs, preprocessing=prep, plausibility=plausibility,
-                      model=sel.model, selection=sel.to_dict(), particulars=_log_particulars(logs),
-                      uncertainty=ensemble.to_dict() if ensemble else None)  # fmt: skip
-    text = _written_text(text, one_rps, ahead, args.output)[0]
-    with OutputSet() as out:
-        out.write(args.output, lambda p: p.write_text(text, encoding="utf-8"))
-        if args.table:
-            from shipid.data.io import write_table
 
-            write_table(sel.candidates, args.table, out)
-    # And those added here (the model as the file has it, the replicates, the speeds given):
-    # sel.warnings is the list select made.
-    for w in [*sel.warnings, *(w for w in ident.warnings if w not in sel.warnings)]:
-        _warn(w)
-    print(f"model written to {args.output}")
-    return 0
+def _selection_bootstrap(args, search, checked):
+    """``--bootstrap N``: each replicate a candidate drawn by its share, refitted on a
+    resample; the coefficients' intervals printed, the replicates checked as written."""
+    from shipid.identification.selection_ensemble import selection_ensemble
+
+    sel, logs = search.selection, search.logs
+    ensemble = selection_ensemble(logs, sel, args.bootstrap, args.block, args.seed,
+                                  names=search.names, progress=not args.quiet)  # fmt: skip
+    table = ensemble.coefficient_table()
+    table["term"] = [_term_display(t) for t in table["term"]]
+    print(f"\n95 % intervals of the coefficients ({ensemble.replicates} replicates: "
+          f"{ensemble.resampling}; a term outside the model "
+          "has value 0, inclusion the share of replicates that hold it):")  # fmt: skip
+    print(table.to_markdown(index=False, floatfmt=".4g"))
+    _check_replicates(ensemble, checked.plausibility, sel.model, checked.one_rps, checked.ahead,
+                      logs, args, sel.identification)  # fmt: skip
+    return ensemble
 
 
 def _fold_table(folds) -> str:
