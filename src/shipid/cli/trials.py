@@ -273,20 +273,13 @@ def _unused_manoeuvre_options(args) -> list[str]:
 
 
 def cmd_manoeuvre(args) -> int:
-    """``shipid manoeuvre``: a standard manoeuvre on a model or vessel."""
+    """``shipid manoeuvre``: a standard manoeuvre on a model or vessel. The steps: the approach
+    and steering gear, the manoeuvre chosen (its rudder capped at the gear's largest), the run
+    and its ensemble's, the indices with their intervals and the notes, the outputs."""
     from shipid.evaluation.envelope import implausible_indices, outside_envelope
     from shipid.evaluation.validate import faded_residual_notes
     from shipid.outputs import OutputSet, check_outputs
-    from shipid.trials.manoeuvres import (
-        SPIRAL_ANGLES,
-        astern_thrust_note,
-        pull_out,
-        spiral,
-        stopping,
-        turning_circle,
-        without_value,
-        zigzag,
-    )
+    from shipid.trials.manoeuvres import astern_thrust_note
 
     check_outputs({"--json": (args.json, "json"), "-o": (args.output, "log")},
                   _read_files(args, args.model if Path(args.model).exists() else None))
@@ -307,51 +300,7 @@ def cmd_manoeuvre(args) -> int:
         kw["wind"] = (args.wind_speed, math.radians(args.wind_from or 0.0))
     if args.duration is not None:
         kw["duration"] = args.duration
-    # The largest rudder the gear allows where it is less than a manoeuvre's standard one
-    # (MSC.137(76) §4.2; the tanker's is 10°, and `manoeuvre tanker turning` stopped on its own
-    # default, as its spiral on the 25°).
-    gear = steering if steering is not None else getattr(target, "steering", None)
-    top = gear.capped_deg(SPIRAL_ANGLES[0]) if gear is not None else SPIRAL_ANGLES[0]
-    if args.kind == "spiral" and top < SPIRAL_ANGLES[0]:
-        _warn(f"the steering gear's largest rudder is {top:g}°: the spiral's angles run to it "
-              f"instead of {SPIRAL_ANGLES[0]:g}°")  # fmt: skip
-    if args.rudder_deg is None:
-        standard = 35.0 if args.kind == "turning" else 20.0
-        args.rudder_deg = gear.capped_deg(standard) if gear is not None else standard
-        if args.rudder_deg < standard and args.kind in ("turning", "zigzag", "pull-out"):
-            kind = {"turning": "turning circle", "zigzag": "zig-zag"}.get(args.kind, args.kind)
-            _warn(f"the steering gear's largest rudder is {args.rudder_deg:g}°: the {kind} is "
-                  f"run with it instead of {standard:g}° (--rudder to choose)")  # fmt: skip
-    if args.kind == "zigzag":
-        heading = args.heading if args.heading is not None else args.rudder_deg
-        run = partial(zigzag, rudder_deg=args.rudder_deg, heading_deg=heading, first=args.first,
-                      **kw)  # fmt: skip
-    elif args.kind == "turning":
-        run = partial(turning_circle, rudder_deg=args.rudder_deg, side=args.first, **kw)
-    elif args.kind == "pull-out":
-        if args.duration is not None:
-            kw.pop("duration")
-            kw["hold"] = kw["release"] = args.duration / 2
-        run = partial(pull_out, rudder_deg=args.rudder_deg, side=args.first, **kw)
-    elif args.kind == "spiral":
-        kw.pop("wind", None)
-        if args.duration is not None:
-            kw["hold"] = kw.pop("duration")
-        run = partial(spiral, **kw)
-    else:
-        if not getattr(getattr(target, "dynamics", target), "uses_rps", False):
-            raise ShipidError(f"{args.model}: a stopping test needs a model with propeller-speed "
-                              "terms (n), whose thrust answers the astern order; "
-                              + ("this reference ship's propeller turns at one rate"
-                                 if not Path(args.model).exists() else
-                                 "this model has none (identify it from logs with the n "
-                                 "column)"))  # fmt: skip
-        if not rps:
-            raise ShipidError("stopping needs the approach propeller speed (--rps, or a model "
-                              "trained with the n column)")  # fmt: skip
-        kw.pop("rps")
-        kw.pop("steering")  # the rudder stays amidships
-        run = partial(stopping, rps=rps, astern_rps=args.astern_rps, **kw)
+    run = _manoeuvre_to_run(args, target, steering, rps, kw)
     res = run(target)
     print(rudder_note)
     if getattr(target, "uses_wind", False) and "wind" not in kw:
@@ -359,18 +308,8 @@ def cmd_manoeuvre(args) -> int:
         print("wind: still air (the model has wind terms; --wind-speed and --wind-from set a "
               "true wind)")  # fmt: skip
     gear = steering or getattr(target, "steering", None)  # the one the run used
-    intervals = {}
     ensemble = cond.get("ensemble")
-    if ensemble is not None and not args.no_bands and args.kind != "spiral":
-        from shipid.identification.uncertainty import index_intervals
-
-        runs = [run(member) for member in ensemble.members()]
-        # A diverged replicate has no indices; it widens the intervals rather than vanishing.
-        intervals = index_intervals([{} if r.diverged else r.indices for r in runs])
-        diverged = sum(r.diverged for r in runs)
-        print(f"95 % intervals over the model's {ensemble.replicates} {ensemble.members_label}"
-              + (f" ({diverged} diverged: an index is not bounded where more than 2.5 % of "
-                 "them diverged or lack it)" if diverged else "") + ":")
+    runs = _ensemble_runs(args, run, ensemble)
     if res.diverged:
         print(res.reason, file=sys.stderr)
     notes = ([unsteady] if unsteady else []) + _unused_inputs(target, args)
@@ -389,24 +328,7 @@ def cmd_manoeuvre(args) -> int:
     if args.kind == "turning" and not res.diverged:
         notes += implausible_indices(res.indices, speed or getattr(target, "approach_speed", None),
                                      getattr(target, "length", None), res.log)  # fmt: skip
-    unbounded = {}  # index: how many replicates have none, and why
-    for k, v in res.indices.items():
-        if k == "table":
-            print(_pd().DataFrame(v).to_markdown(index=False, floatfmt=".4g"))
-            continue
-        text = f"{k}: {v:.4g}" if isinstance(v, float) else f"{k}: {v}"
-        lo, hi = intervals.get(k, (math.nan, math.nan))
-        if math.isinf(lo) or math.isinf(hi):
-            missing, why = without_value(runs, [r.indices.get(k) for r in runs])
-            unbounded[k] = f"{missing} of {len(runs)} {ensemble.members_label} have none: {why}"
-            text += f"  [not bounded: {unbounded[k]}]"
-        elif math.isfinite(lo):
-            text += f"  [{lo:.4g}, {hi:.4g}]"
-            if isinstance(v, float) and not lo <= v <= hi:
-                notes.append(f"{k} {v:.4g} lies outside the interval of the model's "
-                             f"{ensemble.members_label}: they disagree with the fit, and the "
-                             "interval does not describe it")  # fmt: skip
-        print(text)
+    intervals, unbounded = _print_manoeuvre_indices(res, runs, ensemble, notes)
     tied = _tied_manoeuvres(run, cond.get("alternatives") or {}, args.kind,
                             cond.get("alternatives_fit", ""))  # fmt: skip
     for n in notes:
@@ -431,3 +353,107 @@ def cmd_manoeuvre(args) -> int:
             res.log.attrs.update(meta)
             write_log(res.log, args.output, out=out)
     return 0
+
+
+def _manoeuvre_to_run(args, target, steering, rps, kw: dict):
+    """The manoeuvre of ``args.kind`` as a function of the ship or model it runs on, with the
+    run's options ``kw`` (changed here as the manoeuvre takes them); its rudder by default the
+    standard one, or the gear's largest where that stops short of it (MSC.137(76) §4.2: the
+    tanker's 10°, where `manoeuvre tanker turning` stopped on its own default, as its spiral on
+    the 25°), said."""
+    from shipid.trials.manoeuvres import (
+        SPIRAL_ANGLES,
+        pull_out,
+        spiral,
+        stopping,
+        turning_circle,
+        zigzag,
+    )
+
+    gear = steering if steering is not None else getattr(target, "steering", None)
+    top = gear.capped_deg(SPIRAL_ANGLES[0]) if gear is not None else SPIRAL_ANGLES[0]
+    if args.kind == "spiral" and top < SPIRAL_ANGLES[0]:
+        _warn(f"the steering gear's largest rudder is {top:g}°: the spiral's angles run to it "
+              f"instead of {SPIRAL_ANGLES[0]:g}°")  # fmt: skip
+    if args.rudder_deg is None:
+        standard = 35.0 if args.kind == "turning" else 20.0
+        args.rudder_deg = gear.capped_deg(standard) if gear is not None else standard
+        if args.rudder_deg < standard and args.kind in ("turning", "zigzag", "pull-out"):
+            kind = {"turning": "turning circle", "zigzag": "zig-zag"}.get(args.kind, args.kind)
+            _warn(f"the steering gear's largest rudder is {args.rudder_deg:g}°: the {kind} is "
+                  f"run with it instead of {standard:g}° (--rudder to choose)")  # fmt: skip
+    if args.kind == "zigzag":
+        heading = args.heading if args.heading is not None else args.rudder_deg
+        return partial(zigzag, rudder_deg=args.rudder_deg, heading_deg=heading,
+                       first=args.first, **kw)  # fmt: skip
+    if args.kind == "turning":
+        return partial(turning_circle, rudder_deg=args.rudder_deg, side=args.first, **kw)
+    if args.kind == "pull-out":
+        if args.duration is not None:
+            kw.pop("duration")
+            kw["hold"] = kw["release"] = args.duration / 2
+        return partial(pull_out, rudder_deg=args.rudder_deg, side=args.first, **kw)
+    if args.kind == "spiral":
+        kw.pop("wind", None)
+        if args.duration is not None:
+            kw["hold"] = kw.pop("duration")
+        return partial(spiral, **kw)
+    if not getattr(getattr(target, "dynamics", target), "uses_rps", False):
+        raise ShipidError(f"{args.model}: a stopping test needs a model with propeller-speed "
+                          "terms (n), whose thrust answers the astern order; "
+                          + ("this reference ship's propeller turns at one rate"
+                             if not Path(args.model).exists() else
+                             "this model has none (identify it from logs with the n "
+                             "column)"))  # fmt: skip
+    if not rps:
+        raise ShipidError("stopping needs the approach propeller speed (--rps, or a model "
+                          "trained with the n column)")  # fmt: skip
+    kw.pop("rps")
+    kw.pop("steering")  # the rudder stays amidships
+    return partial(stopping, rps=rps, astern_rps=args.astern_rps, **kw)
+
+
+def _ensemble_runs(args, run, ensemble) -> list:
+    """The manoeuvre on each of the model file's replicates (none with ``--no-bands``, for a
+    spiral, or without an ensemble), the line that says how many diverged."""
+    if ensemble is None or args.no_bands or args.kind == "spiral":
+        return []
+    runs = [run(member) for member in ensemble.members()]
+    diverged = sum(r.diverged for r in runs)
+    print(f"95 % intervals over the model's {ensemble.replicates} {ensemble.members_label}"
+          + (f" ({diverged} diverged: an index is not bounded where more than 2.5 % of "
+             "them diverged or lack it)" if diverged else "") + ":")
+    return runs
+
+
+def _print_manoeuvre_indices(res, runs: list, ensemble, notes: list) -> tuple[dict, dict]:
+    """Each index of ``res``, with its 95 % interval over the replicates' ``runs`` (a diverged
+    replicate has no indices: it widens the interval rather than vanishing), or why it is not
+    bounded; a value outside its interval noted. Returns (intervals, not bounded: {index:
+    why})."""
+    from shipid.trials.manoeuvres import without_value
+
+    intervals: dict = {}
+    if runs:
+        from shipid.identification.uncertainty import index_intervals
+
+        intervals = index_intervals([{} if r.diverged else r.indices for r in runs])
+    unbounded = {}  # index: how many replicates have none, and why
+    for k, v in res.indices.items():
+        if k == "table":
+            print(_pd().DataFrame(v).to_markdown(index=False, floatfmt=".4g"))
+            continue
+        text = f"{k}: {v:.4g}" if isinstance(v, float) else f"{k}: {v}"
+        lo, hi = intervals.get(k, (math.nan, math.nan))
+        if math.isinf(lo) or math.isinf(hi):
+            missing, why = without_value(runs, [r.indices.get(k) for r in runs])
+            unbounded[k] = f"{missing} of {len(runs)} {ensemble.members_label} have none: {why}"
+            text += f"  [not bounded: {unbounded[k]}]"
+        elif math.isfinite(lo):
+            text += f"  [{lo:.4g}, {hi:.4g}]"
+            if isinstance(v, float) and not lo <= v <= hi:
+                notes.append(f"{k} {v:.4g} lies outside the interval of the model's "
+                             f"{ensemble.members_label}: they disagree with the fit, and the "
+                             "interval does not describe it")  # fmt: skip
+        print(text)
+    return intervals, unbounded
