@@ -67,6 +67,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/study_esso_rps_range.py
 	$(BIN)/python benchmarks/study_astern_thrust.py
 	$(BIN)/python benchmarks/bench_blas_threads.py
+	$(BIN)/python benchmarks/bench_validate_replicas.py
 
 clean:
 	rm -rf $(VENV) shipid-demo build *.egg-info src/*.egg-info

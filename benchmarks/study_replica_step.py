@@ -7,7 +7,9 @@ its own integrator's step).
 
 Printed:
 1. A truth: the scale ship's 20°/20° zig-zag run at 0.01 s (RK4), sampled as a measured log is,
-   and replicated on the true ship at the log's step, at 0.1 s and at ``replica_step``.
+   and replicated on the true ship at the log's step, at 0.1 s and at ``replica_step``; and its
+   20° turn ordered between two samples, the replica's first order at the later sample or
+   halfway.
 2. The Esso Osaka's nine zig-zags on the README's model (``select --average`` on the zig-zags and
    three random runs at Δk 0.5 s): their closed-loop overshoots, mean over the nine, by step.
 3. The same nine held out in turn (the README's structure refitted on the other eight and the
@@ -34,7 +36,7 @@ from shipid.evaluation.validate import _indices_of, replica_step, trial_replica
 from shipid.identification.identify import identify
 from shipid.identification.select import select
 from shipid.trials.indices import manoeuvre_indices, zigzag_indices
-from shipid.trials.manoeuvres import zigzag
+from shipid.trials.manoeuvres import turning_circle, zigzag
 from shipid.trials.trial import describe_trial
 from shipid.vessels import get_vessel, scale_ship
 
@@ -72,6 +74,35 @@ def truth() -> None:
         print(f"| {every * 0.01:g} | {pair(measured(log))} | {pair(replica(ship, log, every * 0.01))}"
               f" | {pair(replica(ship, log, 0.1))} | {pair(replica(ship, log))} "
               f"({step:.4f} s) |")  # fmt: skip
+
+
+def truth_turn_order() -> None:
+    """The scale ship's 20° turn (RK4 at 0.01 s) ordered at ten times across one 0.5 s sample,
+    sampled every 0.5 s as a measured log is: the replica's advance against the measured, its
+    rudder ordered at the first sample it has moved at (as before, and as a simulated log's
+    replica still is) or halfway from the sample before (a measured log's now)."""
+    ship = scale_ship()
+    longer: dict[str, list[float]] = {"at the later sample": [], "halfway": []}
+    for order in np.arange(5.0, 5.5, 0.05):
+        fine = turning_circle(ship, 20, duration=80.0, dt=0.01, method="rk4",
+                              approach=float(order)).log  # fmt: skip
+        log = fine.iloc[::50].reset_index(drop=True)
+        log.attrs = {k: v for k, v in fine.attrs.items() if k != "integrator"}
+        trial = describe_trial(log)
+        measured_advance = manoeuvre_indices(log, trial=trial)["advance"]
+        longer["halfway"].append(replica(ship, log)["advance"] - measured_advance)
+        # The same step, but the log read as a simulated one: ordered at the later sample.
+        as_simulated = log.copy()
+        as_simulated.attrs = {**log.attrs,
+                              "integrator": {"method": "euler", "step": replica_step(log)}}
+        longer["at the later sample"].append(replica(ship, as_simulated)["advance"]
+                                             - measured_advance)  # fmt: skip
+    print("\nThe scale ship's 20° turn ordered at ten times across one 0.5 s sample, sampled "
+          "every 0.5 s: the replica's advance minus the measured one (m)\n")
+    print("| first order of the replica | mean | range |")
+    print("|---|---|---|")
+    for name, x in longer.items():
+        print(f"| {name} | {np.mean(x):+.3f} | {min(x):+.3f} to {max(x):+.3f} |")
 
 
 def esso() -> None:
@@ -155,6 +186,7 @@ def main() -> None:
     warnings.simplefilter("ignore")
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores\n")
     truth()
+    truth_turn_order()
     if not DATA.is_dir():
         print("\n../shared/data is absent: the real logs' parts are skipped")
         return

@@ -250,8 +250,9 @@ def _say_why_values_lack(replicas: list, samples: Sequence[dict], members: Seque
     """Each replica in ``replicas`` that runs without diverging but lacks an index the others
     have, run again with the manoeuvre's own indices, whose ``incomplete`` says why (the counter
     rudder has not checked the yaw, the turn is not steady). Computed for every replica, those
-    indices were a third of a 100-replicate ensemble's closed loops in ``validate``, which reads
-    its values as the log's are (``_indices_of``)."""
+    indices, which ``validate`` never reads (it reads the values as the log's are,
+    ``_indices_of``), were about a third of a 100-replicate ensemble's closed loops (profiled,
+    ad hoc)."""
     keys = {k for sample in samples for k, x in sample.items()
             if isinstance(x, float) and math.isfinite(x)}  # fmt: skip
     for i, (replica, sample) in enumerate(zip(replicas, samples, strict=True)):
@@ -363,7 +364,8 @@ def _indices_of(replica: ManoeuvreResult | None, trial: Trial, log: pd.DataFrame
     A replica stepped finer than the log (``replica_step``) is read at the log's sampling, as
     the log is: every sample of it that falls on one of the log's times (its switches stay
     where its finer steps put them). Read at every step, a 100-replicate ensemble's two Esso
-    turns took 1.1 s of the 1.3 s its finer steps added to ``validate``."""
+    turns spent most of the time the finer steps added to ``validate`` reading them (profiled,
+    ad hoc); what they cost now: ``benchmarks/bench_validate_replicas.py``."""
     if replica is None or replica.diverged:
         return {}
     run = _at_the_logs_sampling(replica.log, log)
@@ -596,8 +598,10 @@ def replica_step(log: pd.DataFrame) -> float:
     after its heading reaches the switch. At the log's own step that came up to a step late:
     the true ship's 20°/20° zig-zag sampled every 0.5 s (its RK4 run at 0.01 s) came back from
     its own model with overshoots 1.1° and 0.8° too large at 0.1 s steps, 2.0° and 8.7° at
-    0.5 s; on the Esso Osaka's nine zig-zags at Δk 0.5 s the README's model put the first
-    overshoots 1.1° larger on average than at 0.01 s (``benchmarks/study_replica_step.py``)."""
+    0.5 s (now within 0.2°); the Esso Osaka's nine zig-zags, each held out at Δk 0.5 s, had
+    their first overshoots predicted 2.0° large on average, now 0.9°
+    (``benchmarks/study_replica_step.py``). It costs ``validate`` of the README's Esso example
+    (100 replicates) 1.4 times its time at the log's step (``bench_validate_replicas.py``)."""
     made = log.attrs.get("integrator")
     if made:
         return float(made["step"])
@@ -623,7 +627,8 @@ def _replica_run(log: pd.DataFrame, trial: Trial, wind: tuple[float, float] | No
     if not log.attrs.get("integrator") and ordered > 0:
         # A measured rudder was ordered between the last sample on the approach and the next,
         # on average halfway (as the reversal headings are read): at the next sample, a turn of
-        # the scale ship sampled every 0.5 s came back 0.45 m long in advance, on average.
+        # the scale ship sampled every 0.5 s came back 0.45 m long in advance, on average
+        # (``benchmarks/study_replica_step.py``).
         approach -= 0.5 * float(t[ordered] - t[ordered - 1])
     return {"duration": float(t[-1] - t[0]), "dt": step or replica_step(log),
             "approach": approach,
