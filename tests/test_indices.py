@@ -195,6 +195,34 @@ def test_forced_kind_and_per_log_errors_in_a_validate_batch(tmp_path, capsys, cl
     assert code == 0 and "first_overshoot" not in out
 
 
+def test_validate_says_why_a_log_has_no_indices_and_kind_judges_it(tmp_path, capsys,
+                                                                 clean_zigzag_10):
+    """A log read as no zig-zag, turn or pull-out (here a zig-zag whose propeller goes astern
+    at its end) got no index rows from validate and no word why (indices said it; the Esso's
+    13_22_52 zig-zag with its rudder halved, read at 0.5 s: "rudder swings of 3.93°–7.48° are
+    not one zig-zag angle"). Validate now names the log and the reason, in --json too; --kind
+    zigzag judges it as one."""
+    log = clean_zigzag_10.assign(n=np.where(clean_zigzag_10["t"] > 80.0, -2.0, 10.0))
+    path = write_log(log, tmp_path / "uneven.csv")
+    good = write_log(clean_zigzag_10, tmp_path / "good.csv")
+    out_json = tmp_path / "v.json"
+    assert main(["validate", "scale-ship", str(path), str(good), "--json", str(out_json)]) == 0
+    out = capsys.readouterr().out
+    reason = describe_trial(log).reason
+    assert reason == "the propeller is reversed"
+    assert f"No manoeuvre indices (read as no zig-zag, turning circle or pull-out; --kind " \
+           f"zigzag|turning|pull-out judges a log as one): uneven.csv ({reason})." in out
+    assert "good.csv (" not in out  # a zig-zag: its indices, no such note
+    import json
+
+    logs = json.loads(out_json.read_text())["logs"]
+    assert [(v["manoeuvre"], v["manoeuvre_reason"]) for v in logs] == [
+        ("other", reason), ("zigzag", describe_trial(clean_zigzag_10).reason)]
+    assert main(["validate", "scale-ship", str(path), "--kind", "zigzag"]) == 0
+    out = capsys.readouterr().out
+    assert "first_overshoot_deg" in out and "No manoeuvre indices" not in out
+
+
 def test_a_log_that_cannot_be_validated_is_named_and_the_others_still_run(tmp_path, capsys,
                                                                           clean_zigzag_10):
     good = write_log(clean_zigzag_10, tmp_path / "good.csv")

@@ -195,6 +195,7 @@ def _print_validations(good, band) -> None:
     from shipid.reporting.report import (
         indices_frame,
         metrics_frame,
+        no_manoeuvre_note,
         start_spread_note,
         switch_heading_note,
     )
@@ -215,6 +216,9 @@ def _print_validations(good, band) -> None:
         spread = start_spread_note(good)
         if spread:
             print(spread)
+    unjudged = no_manoeuvre_note(good)
+    if unjudged:
+        print(unjudged)
 
 
 def _residual_analysis(args, vals, logs) -> dict:

@@ -77,6 +77,8 @@ class Validation:
     kind: str | None = None
     error: str | None = None
     warnings: list[str] = field(default_factory=list)
+    # Why the log was read as the kind it was (``Trial.reason``): for "other", why no indices.
+    kind_reason: str = ""
     # With a bootstrap ensemble: 95 % bands of the free run per state, how many replicates
     # diverged, and {"simulated"/"closed_loop": {index: (lower, upper)}}.
     bands: dict | None = None
@@ -105,6 +107,7 @@ class Validation:
                 "diverged": sim.diverged if sim else None,
                 "diverged_at": sim.diverged_at if sim else None,
                 "reason": sim.reason if sim else "", "manoeuvre": self.kind,
+                "manoeuvre_reason": self.kind_reason,
                 "metrics": self.metrics, "indices": self.indices,
                 "index_intervals": {k: {i: list(b) for i, b in v.items()}
                                     for k, v in self.intervals.items()},
@@ -173,7 +176,8 @@ def validate_log(model, log: pd.DataFrame, name: str, method: str = "euler",
         elif isinstance(model, ManoeuvringModel | HybridModel | Vessel):
             indices["closed_loop"] = _replica_indices(model, log, method, trial)
     out = Validation(name, sim, metrics, indices, trial.kind,
-                     warnings=[convention] * bool(convention) + notes)  # fmt: skip
+                     warnings=[convention] * bool(convention) + notes,
+                     kind_reason=trial.reason)  # fmt: skip
     if indices.get("closed_loop") and start_draws:
         out.start_spread = start_spread(model, log, method, trial, indices["closed_loop"])
     out.warnings += _approach_notes(indices)

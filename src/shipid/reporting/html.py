@@ -89,6 +89,7 @@ def validation_report(
         horizons_frame,
         indices_frame,
         metrics_frame,
+        no_manoeuvre_note,
         start_spread_note,
         switch_heading_note,
     )
@@ -133,6 +134,9 @@ def validation_report(
                      start_spread_note([v for v, _ in good])):  # fmt: skip
             if note:
                 parts.append(f"<p>{html.escape(note)}</p>".replace("\n", "<br>"))
+    unjudged = no_manoeuvre_note([v for v, _ in good])
+    if unjudged:
+        parts.append(f"<p>{html.escape(unjudged)}</p>")
     if tied is not None and len(tied):
         parts += ["<h2>Structures the training logs could not tell apart</h2>",
                   "<p>The same logs run on the fits of the structures that tied with the model's "
