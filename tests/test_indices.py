@@ -195,6 +195,67 @@ def test_forced_kind_and_per_log_errors_in_a_validate_batch(tmp_path, capsys, cl
     assert code == 0 and "first_overshoot" not in out
 
 
+def _with_helm_corrections(log, corrections):
+    """``log`` with brief helm corrections added to its rudder: (start [s], held [s], angle
+    [deg]) each, a 1 s swing there and back."""
+    out = log.copy()
+    t = out["t"].to_numpy()
+    bumps = sum(np.interp(t, [t0, t0 + 1, t0 + 1 + held, t0 + 2 + held], [0, deg, deg, 0],
+                          left=0.0, right=0.0) for t0, held, deg in corrections)  # fmt: skip
+    out["delta"] = out["delta"] + np.radians(bumps)
+    return out
+
+
+def test_helm_corrections_larger_than_the_orders_are_not_the_execute():
+    """A 10°/10° zig-zag after 28 s of straight approach with the helm put over briefly to
+    20°, −16° and 13° (as the Esso Osaka's logs that start from rest do, up to 22°): the largest
+    deflection was a correction, so half of it was above the orders; the −16° held 2 s was read
+    as an earlier order (execute at 14 s), and with the 13° too as no zig-zag ("the rudder
+    reversals are not ordered at one switch heading"). The orders are now found against the
+    largest *held* deflection, and an earlier order must come at the trial's angle: the facts
+    of the log without the corrections, to the sample."""
+    import pandas as pd
+
+    z = zigzag(SHIP, 10, 10, duration=100.0, dt=0.1, method="rk4", approach=2.0).log
+    lead = z.iloc[[0] * 280].assign(t=np.arange(280) * 0.1)
+    lead["x"] = z["x"].iloc[0] + z["u"].iloc[0] * (lead["t"] - 28.0)
+    log = pd.concat([lead, z.assign(t=z["t"] + 28.0)], ignore_index=True)
+    log.attrs = z.attrs
+    plain = describe_trial(log)
+    assert plain.kind == "zigzag" and plain.execute_time == pytest.approx(29.9)
+    helmed = _with_helm_corrections(log, [(5.0, 1.5, 20.0), (14.0, 2.0, -16.0), (22.0, 1.2, 13.0)])
+    tr = describe_trial(helmed)
+    assert tr.kind == "zigzag", tr.reason
+    assert tr.execute_time == plain.execute_time
+    assert tr.reversal_headings_deg == pytest.approx(plain.reversal_headings_deg, abs=1e-9)
+    assert zigzag_indices(helmed) == pytest.approx(zigzag_indices(log))
+    assert trim(helmed, start="auto")["t"].iloc[0] <= plain.execute_time
+
+
+@needs_data
+def test_an_esso_zigzag_at_ten_degrees_after_its_start_from_rest_is_read():
+    """The Esso Osaka's 13_50_28 zig-zag (30° at 12 rps) starts from rest, the helm over to
+    22° in its first seconds. With its orders after the execute scaled to 10° (a 10°/10°
+    zig-zag after the same start), the correction was over twice the orders: --start auto
+    found no execute ("no rudder deflection held for 5 s") and the log read as no zig-zag. Now
+    the execute is the real one's, and so are its reversals."""
+    from shipid.data.trim import rudder_execute_time
+
+    log = read_log(OSAKA / "zigzag" / "zigzag_31-Jul-2020_13_50_28.csv", fmt="osaka-frt")
+    real = describe_trial(log)
+    t_exec = rudder_execute_time(log)
+    after = log["t"].to_numpy() >= t_exec
+    ten = log.copy()
+    ten.loc[after, "delta"] *= math.radians(10.0) / real.amplitude
+    assert np.degrees(np.max(np.abs(ten["delta"].to_numpy()[~after]))) > 20.0
+    assert rudder_execute_time(ten) == pytest.approx(t_exec)
+    tr = describe_trial(ten)
+    assert tr.kind == "zigzag", tr.reason
+    assert tr.execute_time == pytest.approx(real.execute_time)
+    assert math.degrees(tr.amplitude) == pytest.approx(10.0, abs=0.3)
+    assert tr.reversal_headings_deg == pytest.approx(real.reversal_headings_deg, abs=0.5)
+
+
 def test_validate_says_why_a_log_has_no_indices_and_kind_judges_it(tmp_path, capsys,
                                                                  clean_zigzag_10):
     """A log read as no zig-zag, turn or pull-out (here a zig-zag whose propeller goes astern

@@ -13,6 +13,7 @@ from shipid.errors import ShipidError, ShipidWarning
 
 EXECUTE_FRACTION = 0.5  # a swing reaching this fraction of the largest one is a manoeuvre
 EXECUTE_HOLD_S = 5.0  # ... and staying there this long (helm corrections do not)
+PLATEAU_SPREAD = math.radians(1.0)  # ... within this spread
 # A step of the rudder smaller than this fraction of the swing's steepest step is not part of the
 # swing: a resampled rudder creeps by 1e-4° per sample before the order, a real swing moves degrees.
 SWING_STEP_FRACTION = 0.05
@@ -41,23 +42,39 @@ def forward_extremes(x: np.ndarray, window: int) -> tuple[np.ndarray, np.ndarray
     return out[0], out[1]
 
 
+def held_plateaus(t: np.ndarray, delta: np.ndarray, hold_s: float = EXECUTE_HOLD_S
+                  ) -> np.ndarray:  # fmt: skip
+    """Where the rudder ``delta`` (sampled at ``t``) stays within ``PLATEAU_SPREAD`` for
+    ``hold_s`` from each sample on: a held order, which a helm correction is not."""
+    dt = float(np.median(np.diff(t)))
+    window = max(int(round(hold_s / dt)), 1) + 1
+    hi, lo = forward_extremes(delta, window)
+    fits = np.arange(delta.size) + window <= delta.size
+    return (hi - lo <= PLATEAU_SPREAD) & fits
+
+
+def held_peak(t: np.ndarray, dev: np.ndarray, hold_s: float = EXECUTE_HOLD_S) -> float:
+    """The largest deflection ``dev`` the rudder holds for ``hold_s`` (``held_plateaus``), or its
+    largest where it holds none: the trial's orders, not a larger helm correction made briefly
+    before them. A log that starts at rest carries such corrections (the Esso Osaka's, 13–22°
+    for one or two seconds); against the largest deflection, orders under half of it (a 10°
+    zig-zag after a 22° correction) were never found, and the log read as no manoeuvre."""
+    flat = held_plateaus(t, dev, hold_s)
+    return float(np.max(np.abs(dev[flat]))) if flat.any() else float(np.max(np.abs(dev)))
+
+
 def rudder_execute_time(log: pd.DataFrame, name: str = "log") -> float:
     """Time of the rudder execute: the start of the swing to the first rudder plateau (constant
-    within ±0.5° for 5 s) at least half the largest rudder angle. Helm corrections while the ship
-    gathers speed are smaller or never steady."""
+    within ±0.5° for 5 s) at least half the largest plateau's angle (``held_peak``). Helm
+    corrections while the ship gathers speed are smaller or never steady."""
     from shipid.data.rudder_signal import rudder_for_events, stand_samples
 
     t = log["t"].to_numpy()
     delta, noise = rudder_for_events(t, log["delta"].to_numpy())
-    dt = float(np.median(np.diff(t)))
     dev = np.abs(delta)
-    peak = float(dev.max())
-    window = max(int(round(EXECUTE_HOLD_S / dt)), 1) + 1
-    # Spread of the rudder over the window starting at each sample.
-    hi, lo = forward_extremes(delta, window)
-    fits = np.arange(delta.size) + window <= delta.size
-    plateau = (dev >= EXECUTE_FRACTION * peak) & (hi - lo <= np.radians(1.0)) & fits
-    if peak < np.radians(1.0) or not plateau.any():
+    peak = held_peak(t, delta)
+    plateau = (dev >= EXECUTE_FRACTION * peak) & held_plateaus(t, delta)
+    if dev.max() < np.radians(1.0) or not plateau.any():
         raise ShipidError(f"{name}: no rudder execute found (no rudder deflection held for "
                           f"{EXECUTE_HOLD_S:g} s); give --start in seconds")  # fmt: skip
     k = int(np.argmax(plateau))

@@ -26,7 +26,13 @@ import pandas as pd
 from shipid.data.log import require_columns
 from shipid.data.preprocess import cumulative_integral
 from shipid.data.rudder_signal import ramp_start, rise_rate, rudder_for_events, stand_samples
-from shipid.data.trim import DEFAULT_LEAD_S, EXECUTE_FRACTION, first_swing_index, swing_start
+from shipid.data.trim import (
+    DEFAULT_LEAD_S,
+    EXECUTE_FRACTION,
+    first_swing_index,
+    held_peak,
+    swing_start,
+)
 from shipid.errors import ShipidError
 
 KINDS = ("zigzag", "turning", "pull-out", "other")
@@ -216,8 +222,11 @@ def earlier_order(t: np.ndarray, delta: np.ndarray, i0: int, max_stand: int = 0)
     if i0 <= 0:
         return i0
     dev = delta - neutral_rudder(delta[i0:])
-    level = EARLIER_LEVEL * float(np.max(np.abs(dev[i0:])))
-    side = np.where(np.abs(dev) >= level, np.sign(dev), 0.0)
+    amplitude = float(np.max(np.abs(dev[i0:])))
+    level = EARLIER_LEVEL * amplitude
+    # At the trial's angle: a helm correction beyond it (16° before a 10° zig-zag) is none.
+    side = np.where((np.abs(dev) >= level) & (np.abs(dev) <= (1 + AMPLITUDE_SPREAD) * amplitude),
+                    np.sign(dev), 0.0)  # fmt: skip
     legs = [s for _, _, s in runs_of(side[_swing_end(t, delta, i0) :]) if s != 0]
     if sum(1 for a, b in zip(legs[:-1], legs[1:], strict=True) if a != b) < 2:
         return i0
@@ -295,7 +304,9 @@ def held_swing_index(t: np.ndarray, delta: np.ndarray, max_stand: int = 0) -> in
     and +19° around a 30° switch heading. Where no swing passes, ``first_swing_index``'s."""
     first = first_swing_index(delta, max_stand)
     dev = delta - delta[0]
-    peak = float(np.max(np.abs(dev)))
+    if not np.max(np.abs(dev)) > 0:
+        return first
+    peak = held_peak(t, dev)
     if not peak > 0:
         return first
     side = np.where(np.abs(dev) >= EXECUTE_FRACTION * peak, np.sign(dev), 0.0)
