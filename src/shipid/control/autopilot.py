@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from shipid.data.log import make_log
+from shipid.data.log import column_values, make_log
 from shipid.dynamics import kernel
 from shipid.dynamics.equilibrium import still_air_accelerations
 from shipid.dynamics.model import ManoeuvringModel
@@ -94,14 +94,14 @@ def _follow_compiled(vessel, pid: PID, wp: np.ndarray, lookahead: float, accept:
     res = run_closed_loop(vessel, params, duration, dt, method, initial={"psi": course}, rps=rps)
     log = res.log
     track = np.zeros((len(log), 2))
-    end = kernel.follow_track(params, log["x"].to_numpy(), log["y"].to_numpy(), track)
+    end = kernel.follow_track(params, column_values(log, "x"), column_values(log, "y"), track)
     done = end >= 0
     if done:
         log = log.iloc[: end + 1].copy()
     log["psi_d"], log["cross_track"] = track[: len(log), 0], track[: len(log), 1]
     log["x"] += wp[0, 0]
     log["y"] += wp[0, 1]
-    e = log["cross_track"].to_numpy()
+    e = column_values(log, "cross_track")
     return FollowResult(log, float(np.sqrt(np.mean(e * e))), float(np.max(np.abs(e))), done,
                         res.diverged and not done)  # fmt: skip
 
@@ -223,7 +223,7 @@ def heading_step(ship, pid: PID, heading_deg: float, duration: float | None = No
 
     def run(length: float):
         res = run_closed_loop(vessel, params, length, dt, method, rps=rps)
-        psi = res.log["psi"].to_numpy()
+        psi = column_values(res.log, "psi")
         tail = psi[int(0.8 * len(psi)):]
         return res, bool(np.ptp(tail) <= tol and abs(psi[-1] - target) <= tol)
 
@@ -321,6 +321,6 @@ def follow_path(
                                psi0=float(courses[0]))  # fmt: skip
     log["x"] += offset[0]
     log["y"] += offset[1]
-    e = log["cross_track"].to_numpy()
+    e = column_values(log, "cross_track")
     return FollowResult(log, float(np.sqrt(np.mean(e * e))), float(np.max(np.abs(e))), done,
                         diverged)  # fmt: skip

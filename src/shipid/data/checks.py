@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from shipid.data.log import COLUMNS, REQUIRED
+from shipid.data.log import COLUMNS, REQUIRED, column_values
 from shipid.data.preprocess import cumulative_integral
 from shipid.data.yaw_rate import heading_drift
 from shipid.errors import ShipidError, ShipidWarning
@@ -194,7 +194,7 @@ def check_log(df: pd.DataFrame, name: str, min_samples: int = 3, fill_gaps: bool
         first, last = true_runs(gaps["t"])[0]
         raise ShipidError(f"{name}: column 't' is missing at data rows {first + 1}–{last + 1}; "
                           "a log needs a time stamp on every row")  # fmt: skip
-    t = df["t"].to_numpy()
+    t = column_values(df, "t")
     for c, gap in gaps.items():
         runs = true_runs(gap)
         first, last = runs[0]
@@ -208,7 +208,7 @@ def check_log(df: pd.DataFrame, name: str, min_samples: int = 3, fill_gaps: bool
             raise ShipidError(f"{name}: column {c!r} has {span}{more}; trim them off with "
                               "--start/--end or interpolate with --fill-gaps")  # fmt: skip
         good = ~gap
-        df[c] = np.interp(t, t[good], df[c].to_numpy()[good])
+        df[c] = np.interp(t, t[good], column_values(df, c)[good])
     dt = np.diff(t)
     if np.any(dt == 0):
         row = int(np.argmax(dt == 0)) + 1
@@ -230,16 +230,16 @@ def check_units(df: pd.DataFrame, name: str, degrees=(), offset_given: bool = Fa
     and a yaw rate that disagree by 180/π then name as the likelier culprit."""
     for c, limit in RADIAN_PLAUSIBLE.items():
         if c in df.columns and c not in degrees:
-            peak = float(np.max(np.abs(df[c].to_numpy())))
+            peak = float(np.max(np.abs(column_values(df, c))))
             if peak > limit:
                 raise ShipidError(f"{name}: column {c!r} reaches {peak:.3g}, which looks like "
                                   f"degrees; give --degrees {c} (angles are radians inside)")
     for c in ("u", "v"):
-        peak = float(np.max(np.abs(df[c].to_numpy())))
+        peak = float(np.max(np.abs(column_values(df, c))))
         if peak > SPEED_PLAUSIBLE:
             raise ShipidError(f"{name}: column {c!r} reaches {peak:.3g}, not a ship speed in m/s "
                               "(knots or km/h? convert to m/s)")  # fmt: skip
-    t = df["t"].to_numpy()
+    t = column_values(df, "t")
     dt = float(np.median(np.diff(t))) if len(t) > 1 else 0.0
     if dt > MAX_SAMPLING_S:
         raise ShipidError(f"{name}: samples are {dt:g} apart in 't'; that is not seconds "
@@ -337,7 +337,7 @@ TRACK_SCALE_TOLERANCE = 0.2  # |k − 1| within it: metres and m/s
 
 
 def _check_track_against_velocities(df: pd.DataFrame, name: str) -> None:
-    parts = _all_displacements(*(df[c].to_numpy(dtype=float)
+    parts = _all_displacements(*(column_values(df, c, float)
                                  for c in ("t", "x", "y", "psi", "u", "v")))  # fmt: skip
     if parts is None:
         return
@@ -403,8 +403,8 @@ def material_yaw_rate_offset(df: pd.DataFrame):
     by as much as the checks name (see the constants above); None where it does not."""
     if "psi" not in df.columns:
         return None
-    r = df["r"].to_numpy(dtype=float)
-    drift = heading_drift(df["t"].to_numpy(dtype=float), df["psi"].to_numpy(dtype=float), r)
+    r = column_values(df, "r", float)
+    drift = heading_drift(column_values(df, "t", float), column_values(df, "psi", float), r)
     if drift is None:
         return None
     b = drift.offset
@@ -420,7 +420,7 @@ def _check_yaw_rate_offset(df: pd.DataFrame, name: str) -> None:
     if drift is None:
         return
     b = drift.offset
-    rms = float(np.sqrt(np.mean(df["r"].to_numpy(dtype=float) ** 2)))
+    rms = float(np.sqrt(np.mean(column_values(df, "r", float) ** 2)))
     warnings.warn(f"{name}: the yaw rate 'r' runs {math.degrees(b):+.3g} °/s off the heading's "
                   f"rate ({100 * abs(b) / rms:.1f} % of its rms), so ∫r dt ends "
                   f"{math.degrees(drift.drift):.2g}° from psi over the log's "
@@ -449,7 +449,7 @@ def heading_rate_ratio(t: np.ndarray, psi: np.ndarray, r: np.ndarray) -> float |
 
 
 def _check_heading_against_yaw_rate(df: pd.DataFrame, name: str, converted=()) -> None:
-    ratio = heading_rate_ratio(df["t"].to_numpy(), df["psi"].to_numpy(), df["r"].to_numpy())
+    ratio = heading_rate_ratio(column_values(df, "t"), column_values(df, "psi"), column_values(df, "r"))
     if ratio is None or 0.5 <= ratio <= 2.0:
         return
     # Where the column the ratio would blame was read as radians, the other one, read from
@@ -539,7 +539,7 @@ def rudder_response(log: pd.DataFrame) -> RudderResponse | None:
     when fewer than 20 bins run ahead; where their rudder reverses fewer than
     ``RUDDER_REVERSALS`` times (``rudder_reversals``), the turn it holds (``_held_turn``) or
     None."""
-    t = log["t"].to_numpy(dtype=float)
+    t = column_values(log, "t", float)
     if len(t) < 3:
         return None
     dt = float(np.median(np.diff(t)))
@@ -548,14 +548,14 @@ def rudder_response(log: pd.DataFrame) -> RudderResponse | None:
     bins = log[cols].groupby(np.arange(len(log)) // per_bin).mean()
     if len(bins) < 20:
         return None
-    tb, r = bins["t"].to_numpy(), bins["r"].to_numpy()
+    tb, r = column_values(bins, "t"), column_values(bins, "r")
     r_dot = np.gradient(r, tb)
-    u = bins["u"].to_numpy()
+    u = column_values(bins, "u")
     top = float(np.quantile(u, 0.9))
     ahead = u > RUDDER_AHEAD_SHARE * top if top > 0 else np.zeros(len(u), bool)
     if "n" in bins.columns:
-        ahead &= bins["n"].to_numpy() > 0
-    delta = bins["delta"].to_numpy()[ahead]
+        ahead &= column_values(bins, "n") > 0
+    delta = column_values(bins, "delta")[ahead]
     if ahead.sum() < 20 or not np.ptp(delta) > 0:
         return None
     if rudder_reversals(delta) < RUDDER_REVERSALS:
@@ -646,7 +646,7 @@ def propulsion_dropouts(log: pd.DataFrame) -> list[Dropout]:
     when their logging drops out. Empty without columns n and u, or without an ahead propeller."""
     if "n" not in log.columns or len(log) < 3:
         return []
-    t, n = log["t"].to_numpy(dtype=float), log["n"].to_numpy(dtype=float)
+    t, n = column_values(log, "t", float), column_values(log, "n", float)
     top = float(np.max(np.abs(n)))
     if not top > 0 or not np.any(n > STOPPED_SHARE * top):
         return []

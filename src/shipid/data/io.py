@@ -33,6 +33,7 @@ from shipid.data.header_units import si_factors, split_units
 from shipid.data.log import (
     COLUMNS,
     REQUIRED,
+    column_values,
     csv_metadata_line,
     frozen,
     metadata,
@@ -336,9 +337,9 @@ def read_log(path: str | Path, options: ReadOptions | None = None, **overrides) 
         converted = {c for c, factor in factors.items() if factor == math.pi / 180.0}
         for c, factor in factors.items():
             if c in df.columns:
-                df[c] = df[c].to_numpy() * factor
+                df[c] = column_values(df, c) * factor
         if geodetic:
-            lat, lon = (df[c].to_numpy(dtype=float) for c in GEODETIC_COLUMNS)
+            lat, lon = (column_values(df, c, float) for c in GEODETIC_COLUMNS)
             check_geodetic(lat, lon, name)
             df["x"], df["y"] = local_track(lat, lon)
             meta = {**meta, "track_origin": frozen({"lat": float(lat[0]), "lon": float(lon[0])})}

@@ -68,10 +68,10 @@ def resample(log: pd.DataFrame, dt: float, name: str = "log", fill_gaps: bool = 
     """
     if not (isinstance(dt, int | float) and math.isfinite(dt) and dt > 0):
         raise ShipidError(f"--dt must be a finite number > 0, got {dt!r}")
-    from shipid.data.log import require_columns
+    from shipid.data.log import column_values, require_columns
 
     require_columns(log, ("t",), name, "a log to resample has its time")
-    t = log["t"].to_numpy()
+    t = column_values(log, "t")
     gaps = time_gaps(t)
     if gaps and not fill_gaps:
         raise ShipidError(f"{name}: {gap_text(t, gaps)}: resampling would draw straight lines "
@@ -94,7 +94,7 @@ def resample(log: pd.DataFrame, dt: float, name: str = "log", fill_gaps: bool = 
     for c in log.columns:
         if c == "t":
             continue
-        values = log[c].to_numpy()
+        values = column_values(log, c)
         if c in ("psi", "wind_angle"):
             values = np.unwrap(values)
         cols[c] = np.interp(grid, t, values)
@@ -115,10 +115,10 @@ def lowpass(log: pd.DataFrame, cutoff_hz: float, columns=SIGNALS, order: int = 2
     regression (noise on ξ(k) sits both in the regressors and in the difference ξ(k+1) − ξ(k)).
     """
     from shipid.data.butterworth import butter_lowpass_sos, sosfiltfilt
-    from shipid.data.log import require_columns
+    from shipid.data.log import column_values, require_columns
 
     require_columns(log, ("t",), why="a log to filter has its time")
-    t = log["t"].to_numpy()
+    t = column_values(log, "t")
     fs = 1.0 / float(np.median(np.diff(t)))
     if not 0 < cutoff_hz < fs / 2:
         raise ShipidError(f"--filter cut-off must be between 0 and the Nyquist frequency "
@@ -128,6 +128,6 @@ def lowpass(log: pd.DataFrame, cutoff_hz: float, columns=SIGNALS, order: int = 2
     out.attrs = dict(log.attrs)
     for c in columns:
         if c in out.columns and len(out) > 3 * (2 * order + 1):
-            out[c] = sosfiltfilt(sos, out[c].to_numpy())
+            out[c] = sosfiltfilt(sos, column_values(out, c))
     out.attrs["lowpass_hz"] = cutoff_hz
     return out

@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from shipid.data.log import frozen
+from shipid.data.log import column_values, frozen
 from shipid.errors import ShipidError
 
 # A GNSS's speed [m/s] and course [rad, clockwise from north] over ground, read instead of a track.
@@ -211,8 +211,8 @@ def velocities_from_track(log: pd.DataFrame, options: TrackVelocities | None = N
     if missing:
         raise ShipidError(f"{name}: u, v are read off the track, which needs the columns x, y and "
                           f"psi; missing {', '.join(missing)}")  # fmt: skip
-    t = log["t"].to_numpy(dtype=float)
-    x, y = log["x"].to_numpy(dtype=float), log["y"].to_numpy(dtype=float)
+    t = column_values(log, "t", float)
+    x, y = column_values(log, "x", float), column_values(log, "y", float)
     window = options.window(t, x, y)
     step = float(np.median(np.diff(t)))
     if window < 4 * step:
@@ -221,7 +221,7 @@ def velocities_from_track(log: pd.DataFrame, options: TrackVelocities | None = N
     if t[-1] - t[0] < window:
         raise ShipidError(f"{name}: {t[-1] - t[0]:g} s of track is shorter than its window of "
                           f"{window:g} s (--track-window)")  # fmt: skip
-    psi = np.unwrap(log["psi"].to_numpy(dtype=float))
+    psi = np.unwrap(column_values(log, "psi", float))
     xdot, ydot = local_slope(t, x, window), local_slope(t, y, window)
     return _body_velocities(log, t, psi, xdot, ydot, options, name,
                             {"from": "track", "window_s": window})
@@ -235,7 +235,7 @@ def _body_velocities(log: pd.DataFrame, t: np.ndarray, psi: np.ndarray, xdot: np
     checked against the course; ``how`` and the rest in ``attrs["velocities"]``."""
     heading_window = None
     if "r" in log.columns:
-        r = log["r"].to_numpy(dtype=float)
+        r = column_values(log, "r", float)
     else:
         # A compass's heading is far less noisy for the ship's turn than a receiver's track
         # for its headway: its own window (a 0.2° compass on CyberShip II's zig-zag: 0.0069
@@ -252,8 +252,8 @@ def _body_velocities(log: pd.DataFrame, t: np.ndarray, psi: np.ndarray, xdot: np
     out["v"] = -xdot * s + ydot * c - r * fore
     out["r"] = r
     if {"x", "y"} <= set(out.columns):
-        out["x"] = out["x"].to_numpy(dtype=float) - (fore * c - starboard * s)
-        out["y"] = out["y"].to_numpy(dtype=float) - (fore * s + starboard * c)
+        out["x"] = column_values(out, "x", float) - (fore * c - starboard * s)
+        out["y"] = column_values(out, "y", float) - (fore * s + starboard * c)
     out.attrs["velocities"] = frozen({**how, "antenna": list(options.antenna),
                                       "r_from_heading": heading_window is not None,
                                       "heading_window_s": heading_window})  # fmt: skip
@@ -302,13 +302,13 @@ def velocities_from_ground_velocity(log: pd.DataFrame, options: TrackVelocities 
     against the course as against a track's (degrees, axes, an offset).
     """
     options = options or TrackVelocities()
-    t = log["t"].to_numpy(dtype=float)
-    sog, cog = log["sog"].to_numpy(dtype=float), log["cog"].to_numpy(dtype=float)
+    t = column_values(log, "t", float)
+    sog, cog = column_values(log, "sog", float), column_values(log, "cog", float)
     peak = float(np.max(np.abs(cog)))
     if peak > 2.0 * math.pi + 0.01:
         raise ShipidError(f"{name}: column 'cog' reaches {peak:.3g}, which looks like degrees; "
                           "give --degrees cog or 'cog [deg]' in the header")  # fmt: skip
-    psi = np.unwrap(log["psi"].to_numpy(dtype=float))
+    psi = np.unwrap(column_values(log, "psi", float))
     return _body_velocities(log, t, psi, sog * np.cos(cog), sog * np.sin(cog), options, name,
                             {"from": "ground velocity"})
 

@@ -8,7 +8,7 @@ import warnings
 import numpy as np
 import pandas as pd
 
-from shipid.data.log import require_columns
+from shipid.data.log import column_values, require_columns
 from shipid.errors import ShipidError, ShipidWarning
 
 EXECUTE_FRACTION = 0.5  # a swing reaching this fraction of the largest one is a manoeuvre
@@ -69,8 +69,8 @@ def rudder_execute_time(log: pd.DataFrame, name: str = "log") -> float:
     corrections while the ship gathers speed are smaller or never steady."""
     from shipid.data.rudder_signal import rudder_for_events, stand_samples
 
-    t = log["t"].to_numpy()
-    delta, noise = rudder_for_events(t, log["delta"].to_numpy())
+    t = column_values(log, "t")
+    delta, noise = rudder_for_events(t, column_values(log, "delta"))
     dev = np.abs(delta)
     peak = held_peak(t, delta)
     plateau = (dev >= EXECUTE_FRACTION * peak) & held_plateaus(t, delta)
@@ -121,15 +121,15 @@ def manoeuvre_end_time(log: pd.DataFrame, name: str = "log", execute: float | No
     """End of the manoeuvre: the last sample with the rudder at least half its largest angle, or
     earlier, the last sample before the propeller speed (column n) falls below 80 % of its median
     during the manoeuvre (the run is being stopped)."""
-    t = log["t"].to_numpy()
-    delta = log["delta"].to_numpy()
+    t = column_values(log, "t")
+    delta = column_values(log, "delta")
     if execute is None:
         execute = rudder_execute_time(log, name)
     start = int(np.searchsorted(t, execute))
     big = np.flatnonzero(np.abs(delta) >= EXECUTE_FRACTION * np.abs(delta).max())
     k = int(big[-1])
     if "n" in log.columns:
-        n = np.abs(log["n"].to_numpy())
+        n = np.abs(column_values(log, "n"))
         typical = float(np.median(n[start : k + 1]))
         low = np.flatnonzero(n[start : k + 1] < 0.8 * typical)
         if typical > 0 and low.size:

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from shipid.data.log import column_values
 from shipid.data.preprocess import cumulative_integral, time_gaps, white_noise_variance
 from shipid.errors import ShipidError
 
@@ -104,7 +105,7 @@ def correct_yaw_rate(log: pd.DataFrame, offset: float | str, name: str) -> pd.Da
         if "psi" not in log.columns:
             raise ShipidError(f"{name}: --yaw-rate-offset auto reads the offset off the heading, "
                               "and the log has no 'psi' column; give the offset in °/s")
-        value = yaw_rate_offset(*(log[c].to_numpy(dtype=float) for c in ("t", "psi", "r")))
+        value = yaw_rate_offset(*(column_values(log, c, float) for c in ("t", "psi", "r")))
         if value is None:
             raise ShipidError(f"{name}: too short to read the yaw rate's offset off the heading "
                               "(--yaw-rate-offset auto needs at least 10 samples)")
@@ -113,7 +114,7 @@ def correct_yaw_rate(log: pd.DataFrame, offset: float | str, name: str) -> pd.Da
     else:
         raise ShipidError(f"the yaw rate's offset must be 'auto' or a finite number [rad/s], "
                           f"got {offset!r}")
-    out = log.assign(r=log["r"].to_numpy(dtype=float) - value)
+    out = log.assign(r=column_values(log, "r", float) - value)
     # The file keeps the whole offset taken off its r; this reading's share is said apart.
     out.attrs = {**log.attrs,
                  "yaw_rate_offset": float(log.attrs.get("yaw_rate_offset", 0.0)) + value,

@@ -49,6 +49,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from shipid.data.log import column_values
 from shipid.dynamics.model import ManoeuvringModel, ModelStructure
 from shipid.dynamics.renaming import TermRenaming, renamed_model, renamed_terms
 from shipid.dynamics.terms import parse_term
@@ -70,7 +71,7 @@ def astern_form(dof: str, term: str) -> str:
 
 def logs_ahead(logs: Sequence[pd.DataFrame]) -> bool:
     """Whether every log runs ahead throughout (u > 0 in every sample)."""
-    return bool(logs) and all(float(np.min(log["u"].to_numpy(dtype=float))) > 0 for log in logs)
+    return bool(logs) and all(float(np.min(column_values(log, "u", float))) > 0 for log in logs)
 
 
 # The surge's thrust terms that logs which never reverse the propeller cannot tell apart.
@@ -89,7 +90,7 @@ def thrust_form(dof: str, term: str, ratio: float) -> str:
 def logs_never_reverse(logs: Sequence[pd.DataFrame]) -> bool:
     """Whether every log logs the propeller speed and never reverses it (n ≥ 0 throughout)."""
     return bool(logs) and all(
-        "n" in log.columns and float(np.nanmin(log["n"].to_numpy(dtype=float))) >= 0
+        "n" in log.columns and float(np.nanmin(column_values(log, "n", float))) >= 0
         for log in logs)  # fmt: skip
 
 

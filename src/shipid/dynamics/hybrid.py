@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from shipid.data.log import column_array
+from shipid.data.log import column_array, column_values
 from shipid.dynamics.kernel import c_array
 from shipid.dynamics.model import DOFS, ManoeuvringModel, ModelStructure
 from shipid.dynamics.terms import INPUT_SIGNALS
@@ -192,8 +192,8 @@ class HybridModel:
         """Share of a (simulated) log's samples where the residual is faded below half."""
         if len(log) == 0:
             return 0.0
-        rps = log["n"].to_numpy() if "n" in log.columns else None
-        x = self.features(column_array(log, ("u", "v", "r")), log["delta"].to_numpy(), rps)
+        rps = column_values(log, "n") if "n" in log.columns else None
+        x = self.features(column_array(log, ("u", "v", "r")), column_values(log, "delta"), rps)
         return float(np.mean(self.residual.fade(x) < 0.5))
 
     def rudder_positive_turns_at(self, speed: float = 1.0, rps: float | None = None) -> str:

@@ -21,7 +21,7 @@ from typing import Protocol
 import numpy as np
 import pandas as pd
 
-from shipid.data.log import input_columns, log_name, make_log, require_columns
+from shipid.data.log import column_values, input_columns, log_name, make_log, require_columns
 from shipid.data.preprocess import gap_text, time_gaps
 from shipid.dynamics import codegen, kernel
 from shipid.dynamics.hybrid import HybridModel
@@ -416,9 +416,9 @@ def simulate_log(
     thrust, propeller speed and wind where the model uses them): the paper's validation (§ 4)."""
     require_dynamics(dynamics)
     require_columns(log, ("t", "delta"), why="a log drives a free run with its time and rudder")
-    gaps = time_gaps(log["t"].to_numpy())
+    gaps = time_gaps(column_values(log, "t"))
     if gaps:
-        raise ShipidError(f"{log_name(log)}: {gap_text(log['t'].to_numpy(), gaps)}: a free run "
+        raise ShipidError(f"{log_name(log)}: {gap_text(column_values(log, 't'), gaps)}: a free run "
                           "would step across it with the rudder unknown; cut the log there "
                           "(--start/--end) or split it into two logs")  # fmt: skip
     first = log.iloc[0]
@@ -427,5 +427,5 @@ def simulate_log(
         initial.setdefault(k, 0.0)
     series = model_inputs(dynamics, log)
     thrust, rps = series.pop("thrust", None), series.pop("n", None)
-    return simulate(dynamics, log["t"].to_numpy(), log["delta"].to_numpy(), initial, thrust,
+    return simulate(dynamics, column_values(log, "t"), column_values(log, "delta"), initial, thrust,
                     method, bounds, rps=rps, inputs=series or None, **log.attrs)

@@ -19,7 +19,7 @@ from collections.abc import Sequence
 import numpy as np
 import pandas as pd
 
-from shipid.data.log import column_array, common_rudder_convention
+from shipid.data.log import column_array, column_values, common_rudder_convention
 from shipid.dynamics.model import DOFS, ModelStructure, get_structure
 from shipid.dynamics.simulate import simulate_log
 from shipid.errors import ShipidError
@@ -41,9 +41,9 @@ def _black_box_fold(method: str, train: list[pd.DataFrame], test: pd.DataFrame, 
     dt = float(np.median(np.diff(train[0]["t"])))
     features, targets = [], []
     for log in train:
-        X = np.column_stack([log[c].to_numpy() for c in ("u", "v", "r", *inputs)])
+        X = np.column_stack([column_values(log, c) for c in ("u", "v", "r", *inputs)])
         features.append(X[:-1])
-        targets.append(np.column_stack([np.diff(log[d].to_numpy()) / dt for d in DOFS]))
+        targets.append(np.column_stack([np.diff(column_values(log, d)) / dt for d in DOFS]))
     X, Y = np.vstack(features), np.vstack(targets)
     estimators = [make_black_box(method, gamma).fit(X, Y[:, i]) for i in range(3)]
     dyn = RegressorDynamics(estimators, inputs, name=method)

@@ -14,6 +14,8 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 import pandas as pd
 
+from shipid.data.log import column_values
+
 ENVELOPE_SIGNALS = ("u", "v", "r", "delta", "n", "wind_speed")
 UNITS = {"u": "m/s", "v": "m/s", "r": "rad/s", "delta": "rad", "n": "rps", "wind_speed": "m/s"}
 # A run may exceed the training range by this fraction of its span, and at least this fraction
@@ -34,7 +36,7 @@ def envelope(logs: Sequence[pd.DataFrame]) -> dict[str, list[float]]:
     """{signal: [min, max]} over the training logs, for the signals they have."""
     out = {}
     for s in ENVELOPE_SIGNALS:
-        values = [log[s].to_numpy() for log in logs if s in log.columns]
+        values = [column_values(log, s) for log in logs if s in log.columns]
         if values:
             allv = np.concatenate(values)
             out[s] = [float(np.min(allv)), float(np.max(allv))]
@@ -61,7 +63,7 @@ def outside_envelope(env: Mapping[str, Sequence[float]], log: pd.DataFrame) -> l
     for s, (lo, hi, margin) in allowed_ranges(env).items():
         if s not in log.columns:
             continue
-        x = log[s].to_numpy()
+        x = column_values(log, s)
         if x.size == 0:
             continue
         xmin, xmax = float(np.min(x)), float(np.max(x))
@@ -96,7 +98,7 @@ def implausible_indices(indices: Mapping, approach_speed: float | None,
     magnitude, and read +0.74 m/s for an Esso fit that ended its turn at −0.74 m/s)."""
     notes = []
     if log is not None and approach_speed and approach_speed > 0 and len(log):
-        end = float(np.mean(log["u"].to_numpy()[-max(1, len(log) // 10):]))
+        end = float(np.mean(column_values(log, "u")[-max(1, len(log) // 10):]))
         if end < 0:
             notes.append(f"the ship ends the turn going astern (u = {end:.3g} m/s, entered at "
                          f"{approach_speed:.3g} m/s ahead, the propeller unchanged): implausible")

@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
+from shipid.data.log import column_values
 from shipid.dynamics.simulate import model_inputs, simulate_batch
 from shipid.errors import ShipidError
 from shipid.evaluation.envelope import allowed_ranges
@@ -70,7 +71,7 @@ def windows_inside(env: Mapping[str, Sequence[float]], log: pd.DataFrame, index:
     for s, (lo, hi, margin) in allowed_ranges(env).items():
         if s not in log.columns:
             continue
-        x = log[s].to_numpy(dtype=float)[index]
+        x = column_values(log, s, float)[index]
         inside &= ~np.any(((x < lo - margin) | (x > hi + margin)) & real, axis=1)
     return inside
 
@@ -87,7 +88,7 @@ def horizon_errors(model, log: pd.DataFrame, horizon_s: float, method: str = "eu
         model = model.dynamics
     if not (isinstance(horizon_s, int | float) and math.isfinite(horizon_s) and horizon_s > 0):
         raise ShipidError(f"--horizon must be seconds > 0, got {horizon_s!r}")
-    t = log["t"].to_numpy(dtype=float)
+    t = column_values(log, "t", float)
     if len(t) < 3:
         raise ShipidError(f"{name}: too short for predictions over a horizon")
     dt = float(np.median(np.diff(t)))
@@ -101,10 +102,10 @@ def horizon_errors(model, log: pd.DataFrame, horizon_s: float, method: str = "eu
     initial = np.zeros((len(starts), 6))
     for j, s in enumerate(("u", "v", "r", "psi", "x", "y")):
         if s in log.columns:
-            initial[:, j] = log[s].to_numpy(dtype=float)[starts]
+            initial[:, j] = column_values(log, s, float)[starts]
     series = {k: np.asarray(v, dtype=float)[index] for k, v in model_inputs(model, log, name).items()}
     thrust, rps = series.pop("thrust", None), series.pop("n", None)
-    batch = simulate_batch(model, np.arange(steps + 1) * dt, log["delta"].to_numpy(float)[index],
+    batch = simulate_batch(model, np.arange(steps + 1) * dt, column_values(log, "delta", float)[index],
                            initial, thrust, method, rps=rps, inputs=series or None,
                            n_trajectories=len(starts))  # fmt: skip
     alive = np.arange(steps + 1)[None, :] < batch.n_valid[:, None]
@@ -115,7 +116,7 @@ def horizon_errors(model, log: pd.DataFrame, horizon_s: float, method: str = "eu
     if inside is not None:
         out.inside = int(inside.sum())
     for j, s in enumerate(STATES):
-        measured = log[s].to_numpy(dtype=float)
+        measured = column_values(log, s, float)
         spread = float(np.std(measured))
         error = batch.states[:, :, j] - measured[index]
         out.rmse[s] = _rms(error[keep])

@@ -35,6 +35,7 @@ import pandas as pd
 
 from shipid.data.log import (
     column_array,
+    column_values,
     in_rudder_convention,
     mean_true_wind,
     require_frames,
@@ -123,7 +124,7 @@ def free_run(model, log: pd.DataFrame, method: str = "euler") -> tuple[Simulatio
     sim = simulate_log(model.dynamics if isinstance(model, Vessel) else model, log,
                        method=method)  # fmt: skip
     n = len(sim.log)
-    return sim, {s: error_metrics(log[s].to_numpy()[:n], sim.log[s].to_numpy()) for s in STATES}
+    return sim, {s: error_metrics(column_values(log, s)[:n], column_values(sim.log, s)) for s in STATES}
 
 
 FADED_SHARE = 0.1  # a hybrid's run beyond its residual's envelope for more than this is named
@@ -230,7 +231,7 @@ def manoeuvre_from_approach(log: pd.DataFrame, trial: Trial) -> tuple[pd.DataFra
     gather speed for 120 s: from there the replay of a model fitted to the zig-zags put the
     +35° turn's tactical diameter at 4.1 m, from the approach 9.9 m (measured 7.3 m), and the
     −35° turn, which starts at −0.014 m/s, had no closed loop at all."""
-    t = log["t"].to_numpy(dtype=float)
+    t = column_values(log, "t", float)
     if trial.kind == "other" or trial.execute_time - t[0] <= APPROACH_LEAD_S + (t[1] - t[0]):
         return log, trial
     if float(log["u"].iloc[0]) > 0 and steady_start(log, trial.execute_index).steady:
@@ -343,7 +344,7 @@ def drawn_starts(model, log: pd.DataFrame, trial: Trial, n: int, seed: int = 0
             _own_approach(model, log, trial, _log_wind(model, log)) is not None:  # fmt: skip
         return None
     first = log.iloc[0]
-    sigma = {s: math.sqrt(white_noise_variance(log[s].to_numpy(dtype=float))) for s in STATES}
+    sigma = {s: math.sqrt(white_noise_variance(column_values(log, s, float))) for s in STATES}
     if not any(x > 0 for x in sigma.values()):
         return None
     rng = np.random.default_rng(seed)
@@ -382,7 +383,7 @@ def _indices_of(replica: ManoeuvreResult | None, trial: Trial, log: pd.DataFrame
 def _at_the_logs_sampling(run: pd.DataFrame, log: pd.DataFrame) -> pd.DataFrame:
     """``run`` (a replica of ``log``) at ``log``'s sampling where it steps a whole fraction of
     it; else as it is."""
-    t, step = log["t"].to_numpy(), run["t"].to_numpy()
+    t, step = column_values(log, "t"), column_values(run, "t")
     if len(t) < 2 or len(step) < 2:
         return run
     sampling, dt = float(np.median(np.diff(t))), float(step[1] - step[0])
@@ -446,7 +447,7 @@ def _replica_start(model, log: pd.DataFrame, trial: Trial, start: dict | None = 
     # The propeller speed the manoeuvre ran at: a log read whole ends with the propeller
     # stopped (the Esso Osaka's zig-zags for 2–8 s), which its mean counted (13_14_21: 15.6
     # rps for 16.7).
-    rps = float(np.median(log["n"].to_numpy()[trial.execute_index :])) \
+    rps = float(np.median(column_values(log, "n")[trial.execute_index :])) \
         if "n" in log.columns else None  # fmt: skip
     wind = _log_wind(model, log)
     own = _own_approach(model, log, trial, wind) \
@@ -571,7 +572,7 @@ def trial_turning(model, log: pd.DataFrame, method: str = "euler", trial: Trial 
     # turn's mid-range "neutral" puts its approach rudder on the other side). The largest swing
     # from the first sample was the release of a pull-out that starts on its order: its replica
     # turned the other way.
-    delta = log["delta"].to_numpy(dtype=float)
+    delta = column_values(log, "delta", float)
     held = float(np.median(delta[trial.execute_index : trial.held_end_index + 1]))
     turns = np.sign(held) * starboard_sign(rudder_positive(log))
     initial, rps, wind = _replica_start(model, log, trial, start)
@@ -609,9 +610,9 @@ def replica_step(log: pd.DataFrame) -> float:
     made = log.attrs.get("integrator")
     if made:
         return float(made["step"])
-    t = log["t"].to_numpy()
+    t = column_values(log, "t")
     sampling = float(np.median(np.diff(t)))
-    yaw = np.abs(log["r"].to_numpy(dtype=float)) if "r" in log.columns else np.zeros(1)
+    yaw = np.abs(column_values(log, "r", float)) if "r" in log.columns else np.zeros(1)
     fastest = float(np.nanmax(yaw)) if np.isfinite(yaw).any() else 0.0
     needed = math.ceil(sampling * fastest / REPLICA_HEADING_STEP - 1e-9) if fastest > 0 else 1
     allowed = math.floor(REPLICA_MAX_STEPS * sampling / max(float(t[-1] - t[0]), sampling))
@@ -625,7 +626,7 @@ def _replica_run(log: pd.DataFrame, trial: Trial, wind: tuple[float, float] | No
     in a simulated log, halfway to it from the last one before in a measured log), the steering
     machine (the log's rudder rate, and an angle limit that holds its rudder) and the true
     ``wind`` (``_log_wind``; the turn's own approach is found in it too, ``_own_approach``)."""
-    t = log["t"].to_numpy()
+    t = column_values(log, "t")
     ordered = min(trial.execute_index + 1, len(t) - 1)
     approach = float(t[ordered] - t[0])
     if not log.attrs.get("integrator") and ordered > 0:

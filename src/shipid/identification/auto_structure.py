@@ -49,7 +49,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from shipid.data.log import require_states
+from shipid.data.log import column_values, require_states
 from shipid.dynamics.model import DOFS, ModelStructure, StructureEdit, get_structure
 from shipid.dynamics.propeller import ADVANCE_TERMS
 from shipid.dynamics.similarity import SIDE_FORCE
@@ -704,10 +704,10 @@ def _speed_varies_at_constant_rps(logs) -> tuple[float, float] | None:
     speed varies by more than ``SPEED_VARIES``; else None."""
     if not all("n" in log.columns for log in logs):
         return None
-    n = np.concatenate([log["n"].to_numpy(dtype=float) for log in logs])
+    n = np.concatenate([column_values(log, "n", float) for log in logs])
     if varies(n) or not np.nanmedian(n) > 0:
         return None
-    share = spread(np.concatenate([log["u"].to_numpy(dtype=float) for log in logs]))
+    share = spread(np.concatenate([column_values(log, "u", float) for log in logs]))
     return (float(np.nanmedian(n)), share) if share > SPEED_VARIES else None
 
 
@@ -995,7 +995,7 @@ def _paper_ruled_out(logs, names, physics, estimator, drop, paper: str = PAPER
     the paper's is out without a fit."""
     if any("n" in log.columns for log in logs):
         return None  # a logged rps: constant, it was compared above, if the speed varies
-    share = spread(np.concatenate([log["u"].to_numpy(dtype=float) for log in logs]))
+    share = spread(np.concatenate([column_values(log, "u", float) for log in logs]))
     if not share > SPEED_VARIES:
         return None
     if share > SPEED_FALLS:

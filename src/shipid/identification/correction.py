@@ -39,7 +39,7 @@ from collections.abc import Sequence
 import numpy as np
 import pandas as pd
 
-from shipid.data.log import in_rudder_convention, require_states
+from shipid.data.log import column_values, in_rudder_convention, require_states
 from shipid.data.preprocess import lowpass
 from shipid.dynamics.model import ManoeuvringModel, ModelStructure, get_structure
 from shipid.dynamics.terms import INPUT_SIGNALS, parse_term
@@ -351,7 +351,7 @@ def identify_correction(
                                   f"{reference.name} runs at (its propeller follows the logs')")
             from shipid.vessels.mmg import ahead_only
 
-            ahead_only(log["n"].to_numpy(dtype=float), log["t"].to_numpy(dtype=float), name)
+            ahead_only(column_values(log, "n", float), column_values(log, "t", float), name)
     logs = [in_rudder_convention(log, reference.rudder_positive)[0] for log in logs]
     scores = {}
     if gamma == "auto":
@@ -384,10 +384,10 @@ def _reference_accelerations(reference: Vessel, log: pd.DataFrame) -> np.ndarray
     """The reference's accelerations at the log's samples but the last (at the log's propeller
     speed where the reference follows it)."""
     nu = log[list(DOFS)].to_numpy(dtype=float)[:-1]
-    delta = log["delta"].to_numpy(dtype=float)[:-1]
+    delta = column_values(log, "delta", float)[:-1]
     if not getattr(reference.dynamics, "uses_rps", False):
         return reference.dynamics.derivatives(nu, delta)
-    return reference.dynamics.derivatives(nu, delta, None, log["n"].to_numpy(dtype=float)[:-1])
+    return reference.dynamics.derivatives(nu, delta, None, column_values(log, "n", float)[:-1])
 
 
 def _fit(logs, names, reference: Vessel, structure: ModelStructure, gamma: float,

@@ -12,6 +12,7 @@ import numpy as np
 import pandas as pd
 
 from shipid.data.log import (
+    column_values,
     common_rudder_convention,
     refuse_other_ships,
     require_states,
@@ -231,7 +232,7 @@ def varying_propulsion(logs) -> list[VaryingInput]:
     has_rps = any("n" in log.columns for log in logs)
     out = []
     for signal, what, unit, remedy in _PROPULSION_INPUTS:
-        columns = [log[signal].to_numpy(dtype=float) for log in logs if signal in log.columns]
+        columns = [column_values(log, signal, float) for log in logs if signal in log.columns]
         if not columns or (signal == "thrust" and has_rps):
             continue
         values = np.concatenate(columns)
@@ -312,7 +313,7 @@ def material_wind(logs) -> tuple[float, float] | None:
     true, ship = [], []
     for log in with_wind:
         true.append(np.hypot(*true_air_velocity(log)))
-        ship.append(np.hypot(log["u"].to_numpy(dtype=float), log["v"].to_numpy(dtype=float)))
+        ship.append(np.hypot(column_values(log, "u", float), column_values(log, "v", float)))
     wind, speed = float(np.nanmedian(np.concatenate(true))), float(np.nanmedian(np.concatenate(ship)))
     if not wind >= MATERIAL_WIND * speed or not wind > 0:
         return None
@@ -325,7 +326,7 @@ def _check_rudder_excitation(logs, structure: ModelStructure, fixed: Mapping) ->
                            if "delta" in parse_term(n).signals and n not in fixed.get(dof, {})})
     if not rudder_terms:
         return
-    span = max(float(np.ptp(log["delta"].to_numpy())) for log in logs)
+    span = max(float(np.ptp(column_values(log, "delta"))) for log in logs)
     if span < math.radians(0.1):
         shown = ", ".join(_display(n) for n in rudder_terms)
         raise ShipidError(f"the rudder never moves in the training logs (range "
@@ -349,7 +350,7 @@ def _check_states_measured(logs, structure: ModelStructure, names) -> None:
     names = names or [f"log {i + 1}" for i in range(len(logs))]
     for log, name in zip(logs, names, strict=False):
         span = per_log(log, "span of delta, v, r", lambda log=log: {
-            c: float(np.ptp(log[c].to_numpy(dtype=float))) for c in ("delta", "v", "r")})
+            c: float(np.ptp(column_values(log, c, float))) for c in ("delta", "v", "r")})
         if "v" in used and span["v"] < STILL_V and span["r"] >= STILL_R:
             why, hint = "v", ("the ship turns, so it drifts: derive u, v from the track (x, y "
                               "or lat, lon) with --velocities-from-track")  # fmt: skip

@@ -40,6 +40,7 @@ import numpy as np
 import pandas as pd
 
 from shipid.blas import blas_threads
+from shipid.data.log import column_values
 from shipid.dynamics.model import DOFS, ManoeuvringModel
 from shipid.dynamics.simulate import METHODS, DivergenceBounds, run_kernel
 from shipid.errors import ShipidError
@@ -93,9 +94,9 @@ def noise_ratios(model: ManoeuvringModel, logs: Sequence[pd.DataFrame],
         run = simulate_log(model, log, method=method)
         row = {}
         for s in states:
-            measured = log[s].to_numpy(dtype=float)
+            measured = column_values(log, s, float)
             noise = math.sqrt(white_noise_variance(measured))
-            err = float(np.std(measured[: len(run.log)] - run.log[s].to_numpy()))
+            err = float(np.std(measured[: len(run.log)] - column_values(run.log, s)))
             if run.diverged:
                 row[s] = math.inf
             elif noise > 0:

@@ -46,6 +46,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 import pandas as pd
 
+from shipid.data.log import column_values
 from shipid.data.particulars import STANDARD_RUDDER_DEG, largest_rudder_deg
 from shipid.dynamics.equilibrium import still_air_accelerations, surge_equilibrium
 from shipid.dynamics.model import ManoeuvringModel
@@ -119,10 +120,10 @@ def sharpest_curvature(logs, speed: float) -> float | None:
     ``speed`` (the approach) or more: how tight the trials turned; None without such samples."""
     parts = []
     for log in logs:
-        u = log["u"].to_numpy(dtype=float)
+        u = column_values(log, "u", float)
         ahead = u >= 0.5 * speed
-        parts.append(np.abs(log["r"].to_numpy(dtype=float)[ahead])
-                     / np.hypot(u, log["v"].to_numpy(dtype=float))[ahead])  # fmt: skip
+        parts.append(np.abs(column_values(log, "r", float)[ahead])
+                     / np.hypot(u, column_values(log, "v", float))[ahead])  # fmt: skip
     values = np.concatenate(parts) if parts else np.empty(0)
     return float(np.percentile(values, 95)) if values.size else None
 
@@ -559,7 +560,7 @@ def held_propeller_speeds(logs) -> tuple[list[float], bool]:
     from shipid.identification.identify import varies
 
     held = [log for log in logs
-            if "n" in log.columns and not varies(log["n"].to_numpy(dtype=float))]  # fmt: skip
+            if "n" in log.columns and not varies(column_values(log, "n", float))]  # fmt: skip
     found = sorted(float(n) for n in (approach(log, "n") for log in held)
                    if n is not None and n > 0)  # fmt: skip
     return found, len(held) == len(logs)

@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from shipid.data.log import input_columns, require_columns
+from shipid.data.log import column_values, input_columns, require_columns
 from shipid.dynamics.model import DOFS, ManoeuvringModel
 from shipid.dynamics.simulate import METHODS, DivergenceBounds, run_kernel
 from shipid.dynamics.terms import INPUT_SIGNALS
@@ -107,7 +107,7 @@ def cut_logs(
         if not (math.isfinite(segment_s) and segment_s > 0):
             raise ShipidError(f"--segment must be > 0 s, got {segment_s!r}")
         steps = max(int(round(segment_s / dt)), 2)
-    inputs = [{"delta": log["delta"].to_numpy(), **input_columns(log, model.inputs, name)}
+    inputs = [{"delta": column_values(log, "delta"), **input_columns(log, model.inputs, name)}
               for log, name in zip(logs, names, strict=True)]  # fmt: skip
     bounds = []  # (log index, first sample, last sample)
     for i, log in enumerate(logs):
@@ -145,7 +145,7 @@ def cut_logs(
 
 
 def _signal(log: pd.DataFrame, s: str) -> np.ndarray:
-    x = log[s].to_numpy(dtype=float)
+    x = column_values(log, s, float)
     return np.unwrap(x) if s == "psi" else x
 
 
@@ -159,7 +159,7 @@ def _equation_error_spread(model: ManoeuvringModel, logs: Sequence[pd.DataFrame]
                                   **inputs)[:-1]  # fmt: skip
         for i, dof in enumerate(DOFS):
             if dof in errors:
-                x = log[dof].to_numpy()
+                x = column_values(log, dof)
                 errors[dof].append((x[1:] - x[:-1]) / dt - acc[:, i])
     return {d: max(float(np.std(np.concatenate(e))), 1e-12) for d, e in errors.items()}
 

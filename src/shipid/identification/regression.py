@@ -22,7 +22,7 @@ from typing import TypeVar
 import numpy as np
 import pandas as pd
 
-from shipid.data.log import input_columns
+from shipid.data.log import column_values, input_columns
 from shipid.data.preprocess import gap_text, time_gaps
 from shipid.dynamics.model import ModelStructure
 from shipid.dynamics.terms import parse_term, required_inputs, term_matrix
@@ -53,7 +53,7 @@ def sampling_time(log: pd.DataFrame, name: str = "log") -> float:
 
 
 def _sampling_time(log: pd.DataFrame, name: str) -> float:
-    t = log["t"].to_numpy()
+    t = column_values(log, "t")
     if len(t) < 3:
         raise ShipidError(f"{name}: {len(t)} samples, too short for identification")
     dts = np.diff(t)
@@ -137,9 +137,9 @@ def log_terms(log: pd.DataFrame, names: Sequence[str], name: str = "log") -> np.
 
 def _log_terms(log: pd.DataFrame, names: Sequence[str], name: str) -> np.ndarray:
     inputs = input_columns(log, required_inputs(names), name)
-    inputs["delta"] = log["delta"].to_numpy()
-    return term_matrix(list(names), log["u"].to_numpy(), log["v"].to_numpy(),
-                       log["r"].to_numpy(), inputs)  # fmt: skip
+    inputs["delta"] = column_values(log, "delta")
+    return term_matrix(list(names), column_values(log, "u"), column_values(log, "v"),
+                       column_values(log, "r"), inputs)  # fmt: skip
 
 
 def regression_problem(
@@ -174,7 +174,7 @@ def regression_problem(
     dt = common_sampling_time(logs, names)
     Xs, ys = [], []
     for log, name in zip(logs, names, strict=True):
-        xi = log[dof].to_numpy()
+        xi = column_values(log, dof)
         F = log_terms(log, free, name)[:-1]
         target = (xi[1:] - xi[:-1]) / dt
         if fixed:

@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from shipid.data.log import column_array
+from shipid.data.log import column_array, column_values
 from shipid.dynamics.hybrid import KernelResidual
 from shipid.dynamics.model import ManoeuvringModel
 from shipid.errors import ShipidError, require_function
@@ -46,7 +46,7 @@ def residual_features(logs: Sequence[pd.DataFrame]) -> tuple[str, ...]:
     only standardise its ripple)."""
     base = ("u", "v", "r", "delta")
     if logs and all("n" in log.columns for log in logs) and varies(
-            np.concatenate([log["n"].to_numpy(dtype=float) for log in logs])):  # fmt: skip
+            np.concatenate([column_values(log, "n", float) for log in logs])):  # fmt: skip
         return (*base, "n")
     return base
 
@@ -57,16 +57,16 @@ def residual_data(physical: ManoeuvringModel, logs: Sequence[pd.DataFrame],
     one-step acceleration residual (N, 3) there."""
     X, Y = [], []
     for log in logs:
-        t = log["t"].to_numpy(dtype=float)
+        t = column_values(log, "t", float)
         if len(t) < 2:
             continue
-        given = {c: log[c].to_numpy(dtype=float) for c in physical.inputs
+        given = {c: column_values(log, c, float) for c in physical.inputs
                  if c not in ("delta", "n", "thrust")}  # fmt: skip
         acc = physical.accelerations(
-            log["u"].to_numpy(dtype=float), log["v"].to_numpy(dtype=float),
-            log["r"].to_numpy(dtype=float), log["delta"].to_numpy(dtype=float),
-            log["thrust"].to_numpy(dtype=float) if "thrust" in log.columns else None,
-            log["n"].to_numpy(dtype=float) if "n" in log.columns else None, **given)
+            column_values(log, "u", float), column_values(log, "v", float),
+            column_values(log, "r", float), column_values(log, "delta", float),
+            column_values(log, "thrust", float) if "thrust" in log.columns else None,
+            column_values(log, "n", float) if "n" in log.columns else None, **given)
         step = np.diff(t)[:, None]
         observed = np.diff(column_array(log, ("u", "v", "r")), axis=0) / step
         X.append(column_array(log, features)[:-1])

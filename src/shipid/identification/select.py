@@ -51,6 +51,7 @@ import pandas as pd
 from shipid.data.log import (
     approach,
     column_array,
+    column_values,
     common_rudder_convention,
     input_columns,
     refuse_copies,
@@ -290,11 +291,11 @@ def _prepare(logs: Sequence[pd.DataFrame], names: Sequence[str], library: ModelS
         phi = log_terms(log, texts, name)
         ext = np.column_stack([phi[:-1], np.ones(len(log) - 1)])
         data.phi.append(phi[:-1])
-        y = {d: np.diff(log[d].to_numpy()) / dt for d in DOFS}
+        y = {d: np.diff(column_values(log, d)) / dt for d in DOFS}
         data.targets.append(y)
         data.gram.append(ext.T @ ext)
         data.cross.append({d: ext.T @ y[d] for d in DOFS})
-        series = {"delta": log["delta"].to_numpy(), **input_columns(log, library.inputs, name)}
+        series = {"delta": column_values(log, "delta"), **input_columns(log, library.inputs, name)}
         data.inputs.append(input_array(series, 1, len(log))[0])
         data.measured.append(column_array(log, STATES))
         first = log.iloc[0]

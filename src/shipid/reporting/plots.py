@@ -14,6 +14,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
+from shipid.data.log import column_values
 from shipid.outputs import OutputSet, atomic_write  # noqa: E402
 from shipid.trials.indices import track  # noqa: E402
 
@@ -96,7 +97,7 @@ def measured_vs_simulated(measured: pd.DataFrame, simulated: pd.DataFrame, path:
     fig = plt.figure(figsize=(12, 11))
     grid = fig.add_gridspec(4, 2, height_ratios=[1, 1, 1, 1.3])
     n = len(simulated)
-    t_sim = simulated["t"].to_numpy()
+    t_sim = column_values(simulated, "t")
     first = None
     for i, s in enumerate(("u", "v", "r")):
         ax = fig.add_subplot(grid[i, 0], sharex=first)
@@ -116,7 +117,7 @@ def measured_vs_simulated(measured: pd.DataFrame, simulated: pd.DataFrame, path:
         ax.set_ylabel(LABELS[s])
         ax.grid(alpha=0.3)
         err_ax = fig.add_subplot(grid[i, 1], sharex=first)
-        err = measured[s].to_numpy()[:n] - simulated[s].to_numpy()
+        err = column_values(measured, s)[:n] - column_values(simulated, s)
         err_ax.plot(t_sim, err, lw=0.8, color="C3")
         err_ax.axhline(0.0, color="0.3", lw=0.6)
         width = None if error_band is None else error_band.half_width[s]
@@ -201,7 +202,7 @@ def logs_figure(logs: Mapping[str, pd.DataFrame], path: str | Path, title: str =
     axes = [fig.add_subplot(grid[i, 0]) for i in range(rows)]
     track_ax = fig.add_subplot(grid[:, 1])
     for label, log in logs.items():
-        t = log["t"].to_numpy()
+        t = column_values(log, "t")
         psi, x, y = track(log)
         for ax, s in zip(axes, ("u", "v", "r"), strict=False):
             ax.plot(t, log[s], lw=1.0, label=label)

@@ -18,7 +18,7 @@ import math
 import numpy as np
 import pandas as pd
 
-from shipid.data.log import log_name
+from shipid.data.log import column_values, log_name
 from shipid.data.preprocess import cumulative_integral, gap_text, time_gaps, white_noise_variance
 from shipid.errors import ShipidError
 from shipid.trials.trial import (
@@ -115,11 +115,11 @@ def smoothed_positions(t, x, y, u, v, psi) -> tuple[np.ndarray, np.ndarray]:
 
 def track(log: pd.DataFrame) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Unwrapped heading and earth-fixed position (smoothed; dead-reckoned where absent)."""
-    t = log["t"].to_numpy()
+    t = column_values(log, "t")
     psi = unwrapped_heading(log)
-    u, v = log["u"].to_numpy(), log["v"].to_numpy()
+    u, v = column_values(log, "u"), column_values(log, "v")
     if "x" in log.columns and "y" in log.columns:
-        x, y = smoothed_positions(t, log["x"].to_numpy(), log["y"].to_numpy(), u, v, psi)
+        x, y = smoothed_positions(t, column_values(log, "x"), column_values(log, "y"), u, v, psi)
         return psi, x, y
     xd = u * np.cos(psi) - v * np.sin(psi)
     yd = u * np.sin(psi) + v * np.cos(psi)
@@ -128,8 +128,8 @@ def track(log: pd.DataFrame) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 def travelled(log: pd.DataFrame) -> np.ndarray:
     """Distance along the track from the first sample: ∫ √(u² + v²) dt."""
-    speed = np.hypot(log["u"].to_numpy(), log["v"].to_numpy())
-    return cumulative_integral(speed, log["t"].to_numpy(), initial=0.0)
+    speed = np.hypot(column_values(log, "u"), column_values(log, "v"))
+    return cumulative_integral(speed, column_values(log, "t"), initial=0.0)
 
 
 # ---------------------------------------------------------------------------- events
@@ -198,7 +198,7 @@ def zigzag_indices(
     """
     if trial is None:
         trial = describe_trial(log, "zigzag", heading_deg, t_order, indices_only=True)
-    t = log["t"].to_numpy()
+    t = column_values(log, "t")
     i0 = trial.execute_index
     dpsi = smooth_heading(unwrapped_heading(log) - trial.psi0, t, smooth_s)
     heading = heading_deg if heading_deg is not None else trial.switch_heading_deg
@@ -261,7 +261,7 @@ def turning_indices(
     (diameter, speed and yaw rate over the span with the rudder held and r settled)."""
     if trial is None:
         trial = describe_trial(log, "turning", t_order=t_order, indices_only=True)
-    t = log["t"].to_numpy()
+    t = column_values(log, "t")
     i0 = trial.execute_index
     psi, x, y = track(log)
     dpsi = psi - trial.psi0
@@ -300,7 +300,7 @@ def _steady_turn(log, t, turned, x, y, i0: int, held_end: int) -> dict:
     nan = math.nan
     empty = {"steady_turning_diameter": nan, "steady_speed": nan, "steady_yaw_rate": nan,
              "steady_from": nan, "steady_to": nan}  # fmt: skip
-    r = log["r"].to_numpy()
+    r = column_values(log, "r")
     k1 = held_end
     past180 = np.flatnonzero(turned[i0 : k1 + 1] >= math.pi)
     if past180.size == 0 or k1 - (i0 + int(past180[0])) < 3:
@@ -318,7 +318,7 @@ def _steady_turn(log, t, turned, x, y, i0: int, held_end: int) -> dict:
     if turned[k0] < lo:
         k0 += int(np.searchsorted(turned[k0 : k1 + 1], lo))  # the last 360°
     win = slice(k0, k1 + 1)
-    u, v, rr = log["u"].to_numpy()[win], log["v"].to_numpy()[win], r[win]
+    u, v, rr = column_values(log, "u")[win], column_values(log, "v")[win], r[win]
     speed = float(np.mean(np.hypot(u, v)))
     yaw_rate = float(np.mean(rr))
     span = math.degrees(turned[k1] - turned[k0])
@@ -374,7 +374,7 @@ def pull_out_indices(
     out = turning_indices(log, length=length, trial=trial)
     if trial.release_time is not None:
         out["release_time"] = trial.release_time
-        out.update(pull_out_yaw_rates(log["t"].to_numpy(), log["r"].to_numpy(),
+        out.update(pull_out_yaw_rates(column_values(log, "t"), column_values(log, "r"),
                                       trial.release_time, trial.execute_time))  # fmt: skip
     return _none_if_nan(out)
 
@@ -389,7 +389,7 @@ def _refuse_gap_after_execute(log: pd.DataFrame, trial: Trial) -> None:
     """A manoeuvre's indices read the heading, rate and track after the execute: a gap in time
     there (``time_gaps``) hides an overshoot's peak or a turn's advance (a 20/20 zig-zag with 7 s
     missing read its first overshoot 23.5° for 27.4°)."""
-    t = log["t"].to_numpy()
+    t = column_values(log, "t")
     gaps = [k for k in time_gaps(t) if k + 1 > trial.execute_index]
     if gaps:
         raise ShipidError(f"{log_name(log)}: {gap_text(t, gaps)}, after the {trial.kind}'s "

@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from shipid.data.log import make_log, relative_wind, starboard_sign
+from shipid.data.log import column_values, make_log, relative_wind, starboard_sign
 from shipid.dynamics import codegen, kernel
 from shipid.dynamics.equilibrium import astern_braking
 from shipid.dynamics.hybrid import HybridModel
@@ -481,7 +481,7 @@ def turning_circle(
             if res.indices.get("time_to_180") is None:
                 res.incomplete = f"the heading has not turned 180° within {length:g} s"
             elif (res.indices.get("steady_yaw_rate") is None
-                  or not _settled(res.log["r"].to_numpy(), abs(res.indices["steady_yaw_rate"]))):
+                  or not _settled(column_values(res.log, "r"), abs(res.indices["steady_yaw_rate"]))):
                 res.incomplete = f"the turn is not steady within {length:g} s"  # fmt: skip
         return res
 
@@ -544,8 +544,8 @@ def pull_out(
                               rps=rps)  # fmt: skip
         res.log.attrs["manoeuvre"] = f"pull-out {rudder_deg:g}° to {side}"
         if not res.diverged:
-            r = res.log["r"].to_numpy()
-            t = res.log["t"].to_numpy()
+            r = column_values(res.log, "r")
+            t = column_values(res.log, "t")
             res.indices = pull_out_yaw_rates(t, r, held)
             at_release = res.indices["yaw_rate_at_release"]
             if not (_settled(r[t <= held], abs(at_release))
@@ -664,7 +664,7 @@ def _stopping_indices(log: pd.DataFrame, vessel: Vessel) -> dict:
     (NaN where the ship has not stopped)."""
     from shipid.trials.indices import travelled
 
-    u, t = log["u"].to_numpy(), log["t"].to_numpy()
+    u, t = column_values(log, "u"), column_values(log, "t")
     stopped = np.flatnonzero(u <= 0.0)
     nan = math.nan
     out = {"track_reach": nan, "head_reach": nan, "lateral_deviation": nan, "time_to_stop": nan}
@@ -745,8 +745,8 @@ def spiral(
             # Within 1 % of the rate itself, or of a tenth of the largest (near 0 rudder); and
             # the speed, the slow mode that carries the yaw rate after it (a full-scale ship's
             # rate from 25° to 15° first fell, then crept up for 2000 s as the ship sped up).
-            speed = np.hypot(res.log["u"].to_numpy(), res.log["v"].to_numpy())
-            return res, (_settled(res.log["r"].to_numpy(), 0.1 * peak)
+            speed = np.hypot(column_values(res.log, "u"), column_values(res.log, "v"))
+            return res, (_settled(column_values(res.log, "r"), 0.1 * peak)
                          and _settled(speed, float(np.mean(speed))))  # fmt: skip
 
         (res, settled), length = doubling(

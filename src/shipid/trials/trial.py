@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from shipid.data.log import require_columns
+from shipid.data.log import column_values, require_columns
 from shipid.data.preprocess import cumulative_integral
 from shipid.data.rudder_signal import ramp_start, rise_rate, rudder_for_events, stand_samples
 from shipid.data.trim import (
@@ -142,11 +142,11 @@ def unwrapped_heading(log: pd.DataFrame) -> np.ndarray:
     the yaw rate: ∫r dt plus a ``HEADING_FUSION_S`` moving average of ψ − ∫r dt. On the raw
     heading the noise was counted as overshoot (a 20/20 zig-zag of the Mariner: first overshoot
     7.8° read as 11.4° with 1° of noise) and crossed the switch heading early."""
-    t = log["t"].to_numpy()
+    t = column_values(log, "t")
     if "psi" not in log.columns:
-        return cumulative_integral(log["r"].to_numpy(), t, initial=0.0)
-    psi = _unwrap(log["psi"].to_numpy())
-    integral = cumulative_integral(log["r"].to_numpy(), t, initial=0.0)
+        return cumulative_integral(column_values(log, "r"), t, initial=0.0)
+    psi = _unwrap(column_values(log, "psi"))
+    integral = cumulative_integral(column_values(log, "r"), t, initial=0.0)
     if _heading_noise_within(psi, integral, HEADING_NOISE_FLOOR):
         return psi
     n = max(1, int(round(HEADING_FUSION_S / float(np.median(np.diff(t))))))
@@ -261,8 +261,8 @@ def starts_on_order(log: pd.DataFrame, delta: np.ndarray, i0: int) -> int:
     approach with the helm held over (the Esso Osaka's −6°) turns far less than the trial."""
     if i0 <= 0 or np.ptp(delta[: i0 + 1]) > PLATEAU_TOLERANCE:
         return i0
-    r = np.abs(log["r"].to_numpy())
-    v = np.abs(log["v"].to_numpy())
+    r = np.abs(column_values(log, "r"))
+    v = np.abs(column_values(log, "v"))
     turning = float(np.max(r[: i0 + 1]))
     straight = r[0] <= STRAIGHT_START * turning and v[0] <= STRAIGHT_START * np.max(v[: i0 + 1])
     if turning >= TURNS_ON_FIRST_RUDDER * float(np.max(r[i0:])) and straight:
@@ -340,7 +340,7 @@ def execute_index(log: pd.DataFrame, delta: np.ndarray, rudder_noise: float) -> 
     largest deflection (``held_swing_index``), or an earlier, smaller one to the trial's plateau
     (``earlier_order``); on a noisy rudder the ramp extended back to where it left the approach;
     the first sample where the log starts on the order (``starts_on_order``)."""
-    t, raw = log["t"].to_numpy(), log["delta"].to_numpy()
+    t, raw = column_values(log, "t"), column_values(log, "delta")
     stand = stand_samples(t) if rudder_noise else 0
     i0 = earlier_order(t, delta, held_swing_index(t, delta, stand), stand)
     if rudder_noise:  # the dead band left the approach late: extend the ramp back
@@ -383,7 +383,7 @@ def logs_rudder_rate(logs: Sequence[pd.DataFrame]) -> float | None:
 def rudder_unresolved(log: pd.DataFrame) -> bool:
     """Whether the log's rudder swings faster than its sampling resolves: half its travel or more
     between two samples (``Trial.rudder_rate`` is None then, though the rudder moves)."""
-    delta = log["delta"].to_numpy(dtype=float)
+    delta = column_values(log, "delta", float)
     return bool(np.ptp(delta) > math.radians(2.0) and _swings_unresolved(delta))
 
 
@@ -408,8 +408,8 @@ def describe_trial(
     # The heading, and the yaw rate it is read with (or from, without ψ), besides the rudder.
     require_columns(log, ("t", "delta", "r"), why="a trial's facts are read off its time, "
                     "rudder, yaw rate and heading")  # fmt: skip
-    t = log["t"].to_numpy()
-    raw = log["delta"].to_numpy()
+    t = column_values(log, "t")
+    raw = column_values(log, "delta")
     delta, rudder_noise = rudder_for_events(t, raw)
     i0 = (execute_index(log, delta, rudder_noise) if t_order is None
           else min(int(np.searchsorted(t, t_order - 1e-9)), len(t) - 1))  # fmt: skip
@@ -582,10 +582,10 @@ def _classify(log, dpsi, dev, side, i0, held_end, amplitudes, orders, release_ti
         return "other", (f"the heading turns {math.degrees(before):.0f}° before the first rudder "
                          "order: no straight approach (a spiral, or a log cut inside a "
                          "manoeuvre)")  # fmt: skip
-    n = log["n"].to_numpy()[i0:] if "n" in log.columns else None
+    n = column_values(log, "n")[i0:] if "n" in log.columns else None
     reversed_prop = n is not None and np.min(n) < 0 < np.max(n)
     turned = np.abs(dpsi[i0 : held_end + 1])
-    t = log["t"].to_numpy()
+    t = column_values(log, "t")
     if release_time is not None and not reversed_prop and np.max(turned) >= PULL_OUT_TURN and \
             t[-1] - release_time >= PULL_OUT_RELEASED_SHARE * (release_time - t[i0]):  # fmt: skip
         return "pull-out", (f"rudder held through {math.degrees(np.max(turned)):.0f}° of heading,"

@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from shipid.data.log import frozen
+from shipid.data.log import column_values, frozen
 
 CHANNELS = ("u", "v", "r", "psi", "x", "y", "delta")
 
@@ -61,7 +61,7 @@ class SensorModel:
         rng = np.random.default_rng(seed)
         out = log.copy()
         out.attrs = dict(log.attrs)
-        t = log["t"].to_numpy()
+        t = column_values(log, "t")
         n = len(t)
         for ch in CHANNELS:
             if ch not in out.columns:
@@ -71,7 +71,7 @@ class SensorModel:
                 noise += self.white[ch] * rng.standard_normal(n)
             if self.bias.get(ch, 0.0) > 0:
                 noise += gauss_markov(t, self.bias[ch], self.bias_tau, rng)
-            out[ch] = out[ch].to_numpy() + noise
+            out[ch] = column_values(out, ch) + noise
         out.attrs["noise"] = frozen({"white": dict(self.white), "bias": dict(self.bias),
                                      "bias_tau": self.bias_tau, "seed": seed})  # fmt: skip
         return out
