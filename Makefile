@@ -68,6 +68,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/study_astern_thrust.py
 	$(BIN)/python benchmarks/bench_blas_threads.py
 	$(BIN)/python benchmarks/bench_validate_replicas.py
+	$(BIN)/python benchmarks/bench_columns.py
 
 clean:
 	rm -rf $(VENV) shipid-demo build *.egg-info src/*.egg-info
