@@ -127,6 +127,41 @@ def test_a_file_in_a_formats_layout_but_not_its_own_is_not_read_as_it(tmp_path):
         read_log(marin, columns={"time": "t"})
 
 
+def _numbers(line: str) -> bool:
+    try:
+        [float(x) for x in line.split()]
+    except ValueError:
+        return False
+    return True
+
+
+@needs_data
+@pytest.mark.parametrize("fmt, path, scale", [
+    ("simman-marin", MARIN / "MARIN_FREE_KVLCC2_zz_20_m.dat", LAMBDA),
+    ("simman-hsva", DATA / "kvlcc2-hsva" / "HSVA_CPMC_KVLCC2_Z_20_10_P.dat", None),
+])  # fmt: skip
+def test_a_simman_file_titled_in_more_or_fewer_lines_reads_the_same(tmp_path, fmt, path, scale):
+    """The readers took the shared files' header lengths as the format's (MARIN two lines,
+    HSVA four): another run's file titled in one line more was refused at its first line of
+    data-to-be ("line 3 is not numeric"), one line fewer lost its first row of data. The header
+    is now whatever precedes the first row of the format's numbers, and detection reads it so."""
+    import pandas as pd
+
+    from shipid.errors import ShipidWarning
+
+    lines = path.read_bytes().decode("latin-1").splitlines(keepends=True)
+    given = read_log(path, fmt=fmt, scale=scale)
+    first = next(k for k, ln in enumerate(lines) if len(ln.split()) >= 11 and _numbers(ln))
+    for header in ([*lines[:first], "run of 2008, second title line\n"], lines[:1]):
+        variant = tmp_path / path.name
+        variant.write_bytes("".join([*header, *lines[first:]]).encode("latin-1"))
+        pd.testing.assert_frame_equal(read_log(variant, fmt=fmt, scale=scale), given,
+                                      check_exact=True)  # fmt: skip
+        with pytest.warns(ShipidWarning, match=f"read as {fmt}"):
+            found = read_log(variant, scale=scale)
+        pd.testing.assert_frame_equal(found, given, check_exact=True)
+
+
 @needs_data
 @pytest.mark.parametrize("structure, r_std", [("blanke", 0.0065), ("blanke-speed", 0.004),
                                               ("blanke-race", 0.0022)])

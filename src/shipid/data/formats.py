@@ -38,7 +38,6 @@ FORMATS = ("canonical", "simman-marin", "simman-hsva", "osaka-frt")
 MARIN_COLUMNS = ("t", "x0", "y0", "phi", "psi", "xdot", "ydot", "p", "r", "delta", "n")
 HSVA_COLUMNS = ("t", "x0", "y0", "psi", "xdot", "ydot", "r", "roll", "delta", "n", "thrust",
                 "torque")  # fmt: skip
-HSVA_HEADER_LINES = 4
 OSAKA_COLUMNS = {"t [s]": "t", "x_position_mid [m]": "x", "u_velo [m/s]": "u",
                  "y_position_mid [m]": "y", "vm_velo [m/s]": "v", "psi_hat [rad]": "psi",
                  "r_angvelo [rad/s]": "r", "n_prop [rps]": "n",
@@ -55,7 +54,21 @@ ESSO_OSAKA_MODEL = {"length": 3.0, "beam": 0.489, "draught": 0.201, "block_coeff
 _NUMBER = re.compile(r"^[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")
 
 
-def _numeric_rows(path: Path, lines: list[str], first: int, columns: tuple, fmt: str) -> np.ndarray:
+def _header_length(lines: list[str], count: int, limit: int = 12) -> int | None:
+    """How many lines head a SIMMAN file: those before the first of ``count`` numbers, or None
+    where none of the first ``limit`` lines is one. The shared files have two (MARIN) and four
+    (HSVA); a file of another run titled in one more or one fewer line is still that layout."""
+    for k, line in enumerate(lines[:limit]):
+        if _all_numbers(line, count):
+            return k
+    return None
+
+
+def _numeric_rows(path: Path, lines: list[str], columns: tuple, fmt: str) -> np.ndarray:
+    first = _header_length(lines, len(columns))
+    if first is None:
+        raise ShipidError(f"{path}: no line of {len(columns)} numbers among its first lines "
+                          f"(--format {fmt}; truncated or not a {fmt} file?)")  # fmt: skip
     rows = []
     for i, line in enumerate(lines[first:], start=first + 1):
         fields = line.split()
@@ -95,7 +108,7 @@ def read_simman_marin(path: str | Path, scale: float | None = None) -> pd.DataFr
     except UnicodeDecodeError:
         raise ShipidError(f"{path}: not a text file (--format simman-marin expects a MARIN .dat)"
                           ) from None
-    d = dict(zip(MARIN_COLUMNS, _numeric_rows(path, lines, 2, MARIN_COLUMNS, "simman-marin").T,
+    d = dict(zip(MARIN_COLUMNS, _numeric_rows(path, lines, MARIN_COLUMNS, "simman-marin").T,
                  strict=True))  # fmt: skip
     n = len(d["t"])
     t0, t_end = d["t"][0], d["t"][-1]
@@ -129,8 +142,8 @@ def read_simman_hsva(path: str | Path, scale: float | None = None) -> pd.DataFra
     if b"\x00" in raw[:4096]:
         raise ShipidError(f"{path}: binary file, not an HSVA .dat (--format simman-hsva)")
     lines = raw.decode("latin-1").splitlines()
-    d = dict(zip(HSVA_COLUMNS, _numeric_rows(path, lines, HSVA_HEADER_LINES, HSVA_COLUMNS,
-                                             "simman-hsva").T, strict=True))  # fmt: skip
+    d = dict(zip(HSVA_COLUMNS, _numeric_rows(path, lines, HSVA_COLUMNS, "simman-hsva").T,
+                 strict=True))  # fmt: skip
     psi = np.radians(d["psi"])
     u, v = _body_velocities(d["xdot"], d["ydot"], psi)
     cols = {"t": d["t"], "delta": np.radians(d["delta"]), "u": u, "v": v,
@@ -213,8 +226,10 @@ def detect_format(path: str | Path) -> str | None:
         return "osaka-frt"
     data = [ln for ln in lines[:12] if ln.strip()]
     fmt = None
-    if len(data) >= 4 and not _all_numbers(data[0], 11) and _all_numbers(data[2], 11):
+    # A header (one line or more) over rows of eleven (MARIN) or twelve (HSVA) numbers.
+    marin, hsva = _header_length(data, 11), _header_length(data, 12)
+    if marin and len(data) >= marin + 2:
         fmt = "simman-marin"
-    elif len(data) >= 6 and _all_numbers(data[HSVA_HEADER_LINES], 12) and not _all_numbers(data[0], 12):
+    elif hsva and len(data) >= hsva + 2:
         fmt = "simman-hsva"
     return fmt if fmt and data[0].strip().startswith(SIGNATURES[fmt]) else None
