@@ -417,6 +417,33 @@ def test_an_osaka_file_with_text_in_a_column_names_it(tmp_path, capsys):
     assert len(err.strip().splitlines()) == 1 and not (tmp_path / "out.csv").exists()
 
 
+def test_an_osaka_file_with_empty_cells_is_refused_by_rows_or_filled(tmp_path, capsys):
+    """A sensor's dropout leaves cells empty mid-run (a wind vane's, a heading that wraps
+    around it): the reader refused the file at its first ("column 'wind_speed' is empty at data
+    row 1001") even with --fill-gaps, which a canonical log's empty cells take. Now the same
+    check as a canonical log's: the rows and times named, or --fill-gaps interpolates them (the
+    heading unwrapped around them, so across ±π it goes on, not back)."""
+    from shipid.data.formats import OSAKA_COLUMNS
+
+    t = np.arange(60) * 0.1
+    psi = np.angle(np.exp(1j * (3.0 + 0.05 * np.arange(60))))  # wrapped past +π at row 3
+    df = pd.DataFrame({c: t if c.startswith("t ") else 0.1 + 0 * t for c in OSAKA_COLUMNS})
+    df["psi_hat [rad]"] = psi
+    df.loc[20:22, "u_velo [m/s]"] = np.nan
+    df.loc[2:4, "psi_hat [rad]"] = np.nan
+    path = tmp_path / "frt.csv"
+    df.to_csv(path, index=False)
+    out = tmp_path / "out.csv"
+    code, _, err = run(["import", "--format", "osaka-frt", path, "-o", out], capsys)
+    assert code == 1 and "column 'u' has 3 missing values at data rows 21–23 (t = 2–2.2)" in err
+    assert "--fill-gaps" in err and not out.exists()
+    code, _, err = run(["import", "--format", "osaka-frt", "--fill-gaps", path, "-o", out], capsys)
+    assert code == 0, err
+    log = read_log(out)
+    assert np.allclose(log["psi"], 3.0 + 0.05 * np.arange(60))  # unwrapped, the gap filled
+    assert np.allclose(log["u"], 0.1)
+
+
 def test_an_unknown_vessel_lists_the_known_ones(capsys):
     code, _, err = run(["manoeuvre", "titanic", "turning"], capsys)
     assert code == 1 and "scale-ship, mariner, kvlcc2" in err

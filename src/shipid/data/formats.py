@@ -170,21 +170,22 @@ def read_osaka_frt(path: str | Path) -> pd.DataFrame:
     df = df[list(mapping)].rename(columns=mapping).dropna(how="all")
     if len(df) < 3:
         raise ShipidError(f"{path}: {len(df)} data rows, too short (--format osaka-frt)")
-    bad = df.isna().any(axis=1).to_numpy()
-    if bad.any():
-        row = int(np.argmax(bad))
-        col = df.columns[df.iloc[row].isna().to_numpy()][0]
-        raise ShipidError(f"{path}: column {col!r} is empty at data row {row + 1}")
     source = {v: k for k, v in mapping.items()}
     cols = {}
     for c in df.columns:
         values = pd.to_numeric(df[c], errors="coerce")
-        if values.isna().any():
-            row = int(np.argmax(values.isna().to_numpy()))
+        text = (values.isna() & df[c].notna()).to_numpy()
+        if text.any():
+            row = int(np.argmax(text))
             raise ShipidError(f"{path}: column {source[c]!r} is not numeric at data row "
                               f"{row + 1} ({df[c].iloc[row]!r}; --format osaka-frt)")  # fmt: skip
         cols[c] = values.to_numpy(dtype=float)
-    cols["psi"] = np.unwrap(cols["psi"])
+    # An empty cell (a sensor's dropout) stays missing: every reader's check then refuses it by
+    # its rows and times, or --fill-gaps interpolates it. The heading unwrapped around it.
+    psi = cols["psi"].copy()
+    known = np.isfinite(psi)
+    psi[known] = np.unwrap(psi[known])
+    cols["psi"] = psi
     if "wind_angle" in cols:
         cols["wind_angle"] = np.angle(np.exp(1j * cols["wind_angle"]))  # (−π, π]
     # No scale: the files do not give the ship the model is of, and 1 would say full scale.
