@@ -238,7 +238,7 @@ def test_an_esso_zigzag_at_ten_degrees_after_its_start_from_rest_is_read():
     22° in its first seconds. With its orders after the execute scaled to 10° (a 10°/10°
     zig-zag after the same start), the correction was over twice the orders: --start auto
     found no execute ("no rudder deflection held for 5 s") and the log read as no zig-zag. Now
-    the execute is the real one's, and so are its reversals."""
+    the execute is the real one's, and so are its reversals and its cut."""
     from shipid.data.trim import rudder_execute_time
 
     log = read_log(OSAKA / "zigzag" / "zigzag_31-Jul-2020_13_50_28.csv", fmt="osaka-frt")
@@ -254,6 +254,10 @@ def test_an_esso_zigzag_at_ten_degrees_after_its_start_from_rest_is_read():
     assert tr.execute_time == pytest.approx(real.execute_time)
     assert math.degrees(tr.amplitude) == pytest.approx(10.0, abs=0.3)
     assert tr.reversal_headings_deg == pytest.approx(real.reversal_headings_deg, abs=0.5)
+    # --start auto --end auto: the real one's span (the end was read against the correction,
+    # so at the execute itself, and the cut refused as "no single zig-zag").
+    cut, ten_cut = trim(log, start="auto", end="auto"), trim(ten, start="auto", end="auto")
+    assert ten_cut["t"].iloc[[0, -1]].tolist() == cut["t"].iloc[[0, -1]].tolist()
 
 
 def test_validate_says_why_a_log_has_no_indices_and_kind_judges_it(tmp_path, capsys,

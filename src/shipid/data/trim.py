@@ -118,16 +118,18 @@ def first_swing_index(delta: np.ndarray, max_stand: int = 0) -> int:
 
 
 def manoeuvre_end_time(log: pd.DataFrame, name: str = "log", execute: float | None = None) -> float:
-    """End of the manoeuvre: the last sample with the rudder at least half its largest angle, or
-    earlier, the last sample before the propeller speed (column n) falls below 80 % of its median
-    during the manoeuvre (the run is being stopped)."""
+    """End of the manoeuvre: the last sample with the rudder at least half its largest angle
+    from the execute on, or earlier, the last sample before the propeller speed (column n) falls
+    below 80 % of its median during the manoeuvre (the run is being stopped). From the execute
+    on: a helm correction before it larger than the orders (``held_peak``) ended a 10° zig-zag
+    at its own execute."""
     t = column_values(log, "t")
     delta = column_values(log, "delta")
     if execute is None:
         execute = rudder_execute_time(log, name)
-    start = int(np.searchsorted(t, execute))
-    big = np.flatnonzero(np.abs(delta) >= EXECUTE_FRACTION * np.abs(delta).max())
-    k = int(big[-1])
+    start = min(int(np.searchsorted(t, execute)), len(t) - 1)
+    after = np.abs(delta[start:])
+    k = start + int(np.flatnonzero(after >= EXECUTE_FRACTION * after.max())[-1])
     if "n" in log.columns:
         n = np.abs(column_values(log, "n"))
         typical = float(np.median(n[start : k + 1]))
