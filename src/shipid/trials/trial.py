@@ -217,8 +217,9 @@ def earlier_order(t: np.ndarray, delta: np.ndarray, i0: int, max_stand: int = 0)
     taken for the execute (the first overshoot read 18.5° from a heading averaged over the first
     leg). Where the rudder swings over from side to side at least twice after the swing at ``i0``
     (a zig-zag's reversals, by ``EARLIER_LEVEL`` of its deflection from their mid-range), the first
-    swing before ``i0`` to a plateau at that level held ``EARLIER_HOLD_S`` is the order; ``i0``
-    if there is none (or the trial is a turn: one swing, and back at the end of the run)."""
+    swing before ``i0`` to a plateau at that level, and no more than ``AMPLITUDE_SPREAD`` beyond
+    the trial's angle, held ``EARLIER_HOLD_S`` is the order; ``i0`` if there is none (or the
+    trial is a turn: one swing, and back at the end of the run)."""
     if i0 <= 0:
         return i0
     dev = delta - neutral_rudder(delta[i0:])
