@@ -232,6 +232,26 @@ def test_helm_corrections_larger_than_the_orders_are_not_the_execute():
     assert trim(helmed, start="auto")["t"].iloc[0] <= plain.execute_time
 
 
+def test_a_rest_angle_held_long_is_not_taken_for_a_quick_zigzags_orders():
+    """The orders are read against the largest angle held 5 s only where that is a good share
+    of the largest deflection: before a quick 20°/5° zig-zag (its rudder held under 5 s at each
+    plateau) a −6° helm held through a 30 s approach was the only held angle, its half the
+    threshold, and --start auto took the rest itself for the execute (t = 0). As before the
+    held angle was used: the zig-zag's execute, and --start auto asks for --start."""
+    import pandas as pd
+
+    from shipid.data.trim import rudder_execute_time
+
+    ship = scale_ship(rudder_rate_deg=30)
+    z = zigzag(ship, 20, 5, duration=60.0, dt=0.05, method="rk4", approach=2.0).log
+    lead = z.iloc[[0] * 600].assign(t=np.arange(600) * 0.05, delta=math.radians(-6.0))
+    log = pd.concat([lead, z.assign(t=z["t"] + 30.0)], ignore_index=True)
+    log.attrs = z.attrs
+    assert describe_trial(log).execute_time == pytest.approx(describe_trial(z).execute_time + 30)
+    with pytest.raises(ShipidError, match="no rudder execute found"):
+        rudder_execute_time(log)
+
+
 @needs_data
 def test_an_esso_zigzag_at_ten_degrees_after_its_start_from_rest_is_read():
     """The Esso Osaka's 13_50_28 zig-zag (30° at 12 rps) starts from rest, the helm over to

@@ -14,6 +14,9 @@ from shipid.errors import ShipidError, ShipidWarning
 EXECUTE_FRACTION = 0.5  # a swing reaching this fraction of the largest one is a manoeuvre
 EXECUTE_HOLD_S = 5.0  # ... and staying there this long (helm corrections do not)
 PLATEAU_SPREAD = math.radians(1.0)  # ... within this spread
+# Orders held are read against the largest angle held where it is this share of the largest
+# deflection or more (helm corrections up to 2.5 times the orders): ``held_peak``.
+HELD_PEAK_SHARE = 0.4
 # A step of the rudder smaller than this fraction of the swing's steepest step is not part of the
 # swing: a resampled rudder creeps by 1e-4° per sample before the order, a real swing moves degrees.
 SWING_STEP_FRACTION = 0.05
@@ -54,13 +57,18 @@ def held_plateaus(t: np.ndarray, delta: np.ndarray, hold_s: float = EXECUTE_HOLD
 
 
 def held_peak(t: np.ndarray, dev: np.ndarray, hold_s: float = EXECUTE_HOLD_S) -> float:
-    """The largest deflection ``dev`` the rudder holds for ``hold_s`` (``held_plateaus``), or its
-    largest where it holds none: the trial's orders, not a larger helm correction made briefly
-    before them. A log that starts at rest carries such corrections (the Esso Osaka's, 13–22°
-    for one or two seconds); against the largest deflection, orders under half of it (a 10°
-    zig-zag after a 22° correction) were never found, and the log read as no manoeuvre."""
+    """The largest deflection ``dev`` the rudder holds for ``hold_s`` (``held_plateaus``) where
+    it is at least ``HELD_PEAK_SHARE`` of the largest, else the largest: the trial's orders, not
+    a larger helm correction made briefly before them. A log that starts at rest carries such
+    corrections (the Esso Osaka's, 13–22° for one or two seconds); against the largest
+    deflection, orders under half of it (a 10° zig-zag after a 22° correction) were never found,
+    and the log read as no manoeuvre. The share keeps a small angle held long, where the orders
+    are held shorter than ``hold_s`` (a ship's rest angle on its approach, −6° before a quick
+    zig-zag's 20°), from being taken for them."""
+    largest = float(np.max(np.abs(dev)))
     flat = held_plateaus(t, dev, hold_s)
-    return float(np.max(np.abs(dev[flat]))) if flat.any() else float(np.max(np.abs(dev)))
+    held = float(np.max(np.abs(dev[flat]))) if flat.any() else largest
+    return held if held >= HELD_PEAK_SHARE * largest else largest
 
 
 def rudder_execute_time(log: pd.DataFrame, name: str = "log") -> float:
