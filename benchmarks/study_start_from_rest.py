@@ -4,7 +4,7 @@ The Esso Osaka's zig-zag files start from rest, the helm put over by up to 22° 
 gathers speed, then 15–30° orders. Each file read whole, its rudder after the execute scaled to
 10° and 5° (the approach's corrections kept as logged; the heading is the file's own, so the
 switch headings and overshoots are those of the real run): ``--start auto --end auto`` and the
-zig-zag's facts against the real file's. Before 2026-11-30 (b415d31, e4be4c8) the orders were
+zig-zag's facts against the real file's. Before 2026-11-30 (b415d31, e4be4c8, c255d84) the orders were
 read against the largest deflection, corrections included: see ``benchmarks/README.md``.
 
 Run: .venv/bin/python benchmarks/study_start_from_rest.py

@@ -306,6 +306,10 @@ def test_validate_says_why_a_log_has_no_indices_and_kind_judges_it(tmp_path, cap
     assert main(["validate", "scale-ship", str(path), "--kind", "zigzag"]) == 0
     out = capsys.readouterr().out
     assert "first_overshoot_deg" in out and "No manoeuvre indices" not in out
+    # Read as none because --kind other asked for it: nothing to explain.
+    assert main(["validate", "scale-ship", str(good), "--kind", "other"]) == 0
+    out = capsys.readouterr().out
+    assert "first_overshoot_deg" not in out and "No manoeuvre indices" not in out
 
 
 def test_a_log_that_cannot_be_validated_is_named_and_the_others_still_run(tmp_path, capsys,

@@ -454,7 +454,7 @@ def steady_start(log: pd.DataFrame, end_index: int | None = None) -> SteadyStart
     resid = uu - A @ coef
     se = float(np.sqrt(resid @ resid / max(len(tt) - 2, 1) / np.sum((tt - tt.mean()) ** 2)))
     change = float(coef[1]) * STEADY_WINDOW / speed
-    if abs(float(np.mean(log["r"].to_numpy()[: end + 1]))) * tt[-1] > STRAIGHT_RAD:
+    if abs(float(np.mean(column_values(log, "r")[: end + 1]))) * tt[-1] > STRAIGHT_RAD:
         return SteadyStart(speed, change, False)
     if abs(change) <= STEADY_SHARE:
         return SteadyStart(speed, change, True)
@@ -518,7 +518,7 @@ def input_columns(log: pd.DataFrame, columns, name: str | None = None) -> dict[s
         raise ShipidError(f"{label}: the model needs the log column {missing[0]!r} "
                           f"({COLUMN_DESCRIPTIONS.get(missing[0], missing[0])}), which this log "
                           "does not have")  # fmt: skip
-    return {c: log[c].to_numpy() for c in columns}
+    return {c: column_values(log, c) for c in columns}
 
 
 COLUMN_DESCRIPTIONS = {

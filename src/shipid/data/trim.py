@@ -56,7 +56,8 @@ def held_plateaus(t: np.ndarray, delta: np.ndarray, hold_s: float = EXECUTE_HOLD
     return (hi - lo <= PLATEAU_SPREAD) & fits
 
 
-def held_peak(t: np.ndarray, dev: np.ndarray, hold_s: float = EXECUTE_HOLD_S) -> float:
+def held_peak(t: np.ndarray, dev: np.ndarray, hold_s: float = EXECUTE_HOLD_S,
+              flat: np.ndarray | None = None) -> float:
     """The largest deflection ``dev`` the rudder holds for ``hold_s`` (``held_plateaus``) where
     it is at least ``HELD_PEAK_SHARE`` of the largest, else the largest: the trial's orders, not
     a larger helm correction made briefly before them. A log that starts at rest carries such
@@ -64,9 +65,10 @@ def held_peak(t: np.ndarray, dev: np.ndarray, hold_s: float = EXECUTE_HOLD_S) ->
     deflection, orders under half of it (a 10° zig-zag after a 22° correction) were never found,
     and the log read as no manoeuvre. The share keeps a small angle held long, where the orders
     are held shorter than ``hold_s`` (a ship's rest angle on its approach, −6° before a quick
-    zig-zag's 20°), from being taken for them."""
+    zig-zag's 20°), from being taken for them. ``flat``: ``held_plateaus(t, dev, hold_s)``,
+    where the caller has it."""
     largest = float(np.max(np.abs(dev)))
-    flat = held_plateaus(t, dev, hold_s)
+    flat = held_plateaus(t, dev, hold_s) if flat is None else flat
     held = float(np.max(np.abs(dev[flat]))) if flat.any() else largest
     return held if held >= HELD_PEAK_SHARE * largest else largest
 
@@ -80,8 +82,8 @@ def rudder_execute_time(log: pd.DataFrame, name: str = "log") -> float:
     t = column_values(log, "t")
     delta, noise = rudder_for_events(t, column_values(log, "delta"))
     dev = np.abs(delta)
-    peak = held_peak(t, delta)
-    plateau = (dev >= EXECUTE_FRACTION * peak) & held_plateaus(t, delta)
+    flat = held_plateaus(t, delta)
+    plateau = (dev >= EXECUTE_FRACTION * held_peak(t, delta, flat=flat)) & flat
     if dev.max() < np.radians(1.0) or not plateau.any():
         raise ShipidError(f"{name}: no rudder execute found (no rudder deflection held for "
                           f"{EXECUTE_HOLD_S:g} s); give --start in seconds")  # fmt: skip

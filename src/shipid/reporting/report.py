@@ -146,10 +146,11 @@ def start_spread_note(validations: Sequence[Validation]) -> str | None:
 
 def no_manoeuvre_note(validations: Sequence[Validation]) -> str | None:
     """The logs read as no standard manoeuvre, so given no indices, each with the reason its
-    reading gave (``Trial.reason``); None where every log is one. A zig-zag whose rudder or
+    reading gave (``Trial.reason``; not those ``--kind other`` asked for); None where every log
+    is one. A zig-zag whose rudder or
     switch heading wanders reads as none; without this line it only lacked rows in the table."""
     shown = [f"{Path(v.name).name} ({v.kind_reason})" for v in validations
-             if v.kind == "other" and v.kind_reason]  # fmt: skip
+             if v.kind == "other" and v.kind_reason not in ("", "given")]  # fmt: skip
     if not shown:
         return None
     return ("No manoeuvre indices (read as no zig-zag, turning circle or pull-out; --kind "
