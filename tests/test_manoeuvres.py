@@ -178,7 +178,9 @@ def test_zigzag_indices_of_a_heading_trace_with_known_extrema():
     assert ind["time_to_check_yaw"] == pytest.approx((math.pi / 2 - math.asin(0.8)) / w, abs=0.02)
     inferred = zigzag_indices(log, t_order=0.0)  # switch heading inferred from rudder reversals
     assert inferred["switch_heading_deg"] == pytest.approx(20.0, abs=0.05)
-    assert detect_manoeuvre(log) == "zigzag"
+    # Read without being told its order, the trace turns at its largest rate at its first
+    # sample: a log cut inside a zig-zag, whose approach heading it does not hold.
+    assert detect_manoeuvre(log) == "other"
 
 
 def test_sensor_model_is_seeded_and_has_the_stated_noise():
@@ -192,15 +194,32 @@ def test_sensor_model_is_seeded_and_has_the_stated_noise():
     assert np.all(a["delta"] == 0)
 
 
-@pytest.mark.parametrize("cut", [4.0, 4.5, 5.0, 5.5])
-def test_zigzag_detected_when_the_log_starts_with_the_rudder_over(cut):
-    """Bug: the neutral rudder was the first sample, so a trimmed zig-zag starting at −30° was
-    not recognised (its rudder never crossed −30°). Cut inside a leg, the ship is turning (5 s)
-    or drifting (4 s, at the heading's extreme): not a log that starts on its order."""
+@pytest.mark.parametrize("cut", [0.0, 1.0, 3.0, 4.0, 4.5, 5.0, 5.5, 8.0])
+def test_a_zigzag_cut_inside_its_manoeuvre_reads_as_none(cut):
+    """A log that starts inside a zig-zag holds no approach heading, which its overshoots are
+    measured from. Cut 3–8 s into the scale ship's 30/30 (after its first reversal, the rudder
+    at −30°, the ship turning or, at 4 s, at the heading's extreme and drifting), it read as a
+    zig-zag whose execute was its next reversal: overshoots 1.2°–9.0° and 22.0°–30.0° against
+    the whole run's 7.0° and 17.3°; cut 1 s in, 18.6° and none. It reads as none now, and
+    where the ship turns at its first sample, that is the reason; from its order (cut 0, the
+    rudder over from the first sample, the ship straight) it is the zig-zag it was."""
+    from shipid.trials.trial import describe_trial
+
     res = zigzag(scale_ship(), 30, 30, duration=60, dt=0.1)
+    whole = zigzag_indices(res.log)
     late = res.log[res.log["t"] >= cut].reset_index(drop=True)
     late.attrs = dict(res.log.attrs)
-    assert detect_manoeuvre(late) == "zigzag"
+    trial = describe_trial(late)
+    r = np.abs(late["r"].to_numpy())
+    if cut == 0.0:
+        assert trial.kind == "zigzag" and trial.turning_at_start is None
+        assert zigzag_indices(late)["first_overshoot_deg"] == whole["first_overshoot_deg"]
+        return
+    assert trial.kind == "other", trial
+    if r[0] > 0.1 * r.max():
+        assert trial.turning_at_start == pytest.approx(r[0] / r.max())
+        assert trial.reason.startswith(f"it starts inside its manoeuvre, the ship turning at "
+                                       f"{100 * r[0] / r.max():.0f} %")  # fmt: skip
 
 
 # Accelerations of the NumPy implementation the compiled physics replaced (commit af37349), at

@@ -61,7 +61,7 @@ from shipid.identification.uncertainty import (
 )
 from shipid.trials.indices import BOOKKEEPING, manoeuvre_indices, zigzag_indices
 from shipid.trials.manoeuvres import ManoeuvreResult, turning_circle, zigzag
-from shipid.trials.trial import TURN_KINDS, Trial, describe_trial
+from shipid.trials.trial import TURN_KINDS, Trial, describe_trial, started_inside_note
 from shipid.vessels.vessel import Vessel
 
 STATES = ("u", "v", "r")
@@ -181,6 +181,7 @@ def validate_log(model, log: pd.DataFrame, name: str, method: str = "euler",
                      kind_reason=trial.reason)  # fmt: skip
     if indices.get("closed_loop") and start_draws:
         out.start_spread = start_spread(model, log, method, trial, indices["closed_loop"])
+    out.warnings += [n for n in (started_inside_note(trial, replica=True),) if n and indices]
     out.warnings += _approach_notes(indices)
     out.warnings += _turn_notes(indices)
     if trial.kind == "zigzag" and "closed_loop" in indices:

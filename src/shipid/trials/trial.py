@@ -79,6 +79,8 @@ class Trial:
         the log resolves them.
     release_time : where the held rudder went back to the approach's angle (or midships) and
         stayed there to the log's end: the release of a pull-out (None where it did not).
+    turning_at_start : where the log starts inside its manoeuvre, the ship's yaw rate at its
+        first sample as a share of its largest (``turning_at_start``); else None.
     """
 
     kind: str
@@ -96,6 +98,7 @@ class Trial:
     reversal_headings_deg: tuple[float, ...] = ()
     reversal_step_deg: float = 0.0
     release_time: float | None = None
+    turning_at_start: float | None = None
 
 
 def heading_noise(psi: np.ndarray, integral: np.ndarray) -> float:
@@ -244,7 +247,8 @@ def earlier_order(t: np.ndarray, delta: np.ndarray, i0: int, max_stand: int = 0)
 
 # A log that starts on its order: the ship straight at the first sample (yaw rate and sway
 # within this share of their largest before the first swing), turning before that swing at least
-# this share as hard as after it.
+# this share as hard as after it. Turning faster than that share at its first sample, under the
+# first order's rudder, a log starts inside its manoeuvre (``turning_at_start``).
 STRAIGHT_START = 0.1
 TURNS_ON_FIRST_RUDDER = 0.5
 
@@ -256,19 +260,44 @@ def starts_on_order(log: pd.DataFrame, delta: np.ndarray, i0: int) -> int:
     the release of a pull-out, and was taken for the execute (the scale ship's 20/20 zig-zag read
     reversals at −27.9° and +12.5° from a heading averaged over its first leg, and a first
     overshoot of 8.7° against 3.7°; its pull-out read as a turn with advance 0). The rudder held
-    from the first sample to ``i0``, the ship straight at the start (neither turning nor
-    drifting: a log cut inside a zig-zag's leg does one or the other) and turning under that
-    rudder about as hard as it turns after ``i0``: the order came at the first sample. A straight
-    approach with the helm held over (the Esso Osaka's −6°) turns far less than the trial."""
-    if i0 <= 0 or np.ptp(delta[: i0 + 1]) > PLATEAU_TOLERANCE:
+    from the first sample to ``i0`` (or still swinging to where it is then held: a log cut
+    during the order), and the ship turning under that rudder about as hard as it turns after
+    ``i0``: the order came at the first sample, or before it where the ship already turns there
+    (a log cut inside its manoeuvre: ``turning_at_start`` says so; its first reversal was taken
+    for the execute, and MARIN's 20/20 zig-zag cut 3 s after its order read overshoots of 1.8°
+    and 25.7° against 14.7° and 11.8°). A straight approach with the helm held over (the Esso
+    Osaka's −6°) turns far less than the trial."""
+    if i0 <= 0 or np.ptp(delta[_swing_end_from_start(delta, i0) : i0 + 1]) > PLATEAU_TOLERANCE:
         return i0
     r = np.abs(column_values(log, "r"))
-    v = np.abs(column_values(log, "v"))
     turning = float(np.max(r[: i0 + 1]))
-    straight = r[0] <= STRAIGHT_START * turning and v[0] <= STRAIGHT_START * np.max(v[: i0 + 1])
-    if turning >= TURNS_ON_FIRST_RUDDER * float(np.max(r[i0:])) and straight:
+    return 0 if turning >= TURNS_ON_FIRST_RUDDER * float(np.max(r[i0:])) else i0
+
+
+def _swing_end_from_start(delta: np.ndarray, i0: int) -> int:
+    """Where the rudder, moving one way from the first sample (a log cut during a swing),
+    stops before ``i0`` (0 where it does not move at first)."""
+    steps = np.diff(delta[: i0 + 1])
+    moving = np.flatnonzero(np.abs(steps) > 0)
+    if not moving.size or moving[0] != 0:
         return 0
-    return i0
+    way = np.sign(steps[0])
+    against = np.flatnonzero(way * steps <= 0)
+    return int(against[0]) if against.size else i0
+
+
+def turning_at_start(log: pd.DataFrame, i0: int) -> float | None:
+    """The yaw rate at the first sample as a share of the largest after it, where the log
+    starts at its order (``i0`` 0) with the ship turning faster than ``STRAIGHT_START`` of
+    that: the log was cut after the execute, whose heading (a zig-zag's overshoots are measured
+    from it) and track (a turn's advance, transfer and times to 90° and 180°) it lacks. None
+    for a log that starts straight, or before its order."""
+    if i0 != 0:
+        return None
+    r = np.abs(column_values(log, "r"))
+    largest = float(np.max(r))
+    share = float(r[0]) / largest if largest > 0 else 0.0
+    return share if share > STRAIGHT_START else None
 
 
 # A rudder order is held within this spread of its extreme [rad] (``rudder_execute_time``'s
@@ -478,12 +507,28 @@ def describe_trial(
                  else _rudder_rate(t, delta),
                  held_end_index=held_end, reversal_headings_deg=reversals,
                  reversal_step_deg=step,
-                 release_time=release_time)  # fmt: skip
+                 release_time=release_time,
+                 turning_at_start=turning_at_start(log, i0))  # fmt: skip
     if kind is not None:
         return Trial(kind=kind, reason="given", **facts)
     found, reason = _classify(log, dpsi, dev, side, i0, held_end, amplitudes, orders,
-                              release_time)  # fmt: skip
+                              release_time, facts["turning_at_start"])  # fmt: skip
     return Trial(kind=found, reason=reason, **facts)
+
+
+def started_inside_note(trial: Trial, replica: bool = False) -> str | None:
+    """What a trial read from a log that starts inside its manoeuvre (``turning_at_start``)
+    measures, or None for one that starts straight. ``replica``: said of a replica run from the
+    log's first sample, which ``validate`` compares with it."""
+    if trial.turning_at_start is None or trial.kind == "other":
+        return None
+    what = ("its overshoots" if trial.kind == "zigzag" else
+            "its advance, transfer, tactical diameter and times to 90° and 180°")
+    return (f"the log starts inside its manoeuvre, the ship turning at "
+            f"{100 * trial.turning_at_start:.0f} % of its largest yaw rate at the first sample: the "
+            f"execute came before it, and {what} count from the first sample, not from the "
+            "trial's approach (its steady turn does not depend on it)"
+            + ("; the replica, run from the first sample, counts alike" if replica else ""))
 
 
 def _plateau_levels(side: np.ndarray, dev: np.ndarray, measured_dev: np.ndarray | None
@@ -572,8 +617,8 @@ PULL_OUT_TURN = math.radians(90.0)
 PULL_OUT_RELEASED_SHARE = 0.25
 
 
-def _classify(log, dpsi, dev, side, i0, held_end, amplitudes, orders, release_time
-              ) -> tuple[str, str]:  # fmt: skip
+def _classify(log, dpsi, dev, side, i0, held_end, amplitudes, orders, release_time,
+              turning_at_start=None) -> tuple[str, str]:  # fmt: skip
     if not amplitudes:
         return "other", "the rudder never swings"
     # A turn or zig-zag is measured from the heading of a straight approach. A spiral had turned
@@ -599,6 +644,15 @@ def _classify(log, dpsi, dev, side, i0, held_end, amplitudes, orders, release_ti
         return "other", "fewer than two rudder reversals"
     if reversed_prop:
         return "other", "the propeller is reversed"
+    if turning_at_start is not None:
+        # A zig-zag's overshoots are heading changes from its approach, which the log does not
+        # hold; a turn's steady part and a pull-out's release do not need it (above, with
+        # ``started_inside_note``).
+        return "other", (
+            f"it starts inside its manoeuvre, the ship turning at {100 * turning_at_start:.0f} % "
+            "of its largest yaw rate at the first sample: the heading of its approach, which a "
+            "zig-zag's overshoots are measured from, is not in the log (give the log from "
+            "before the first order, or --kind zigzag to measure from its first sample)")
     amp = np.array(amplitudes)
     med = float(np.median(amp))
     if np.any(np.abs(amp - med) > AMPLITUDE_SPREAD * med):

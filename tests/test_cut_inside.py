@@ -1,0 +1,102 @@
+"""Logs cut inside their manoeuvre: the execute came before the first sample. A turn's steady
+part is still the trial's, its advance and the rest count from the first sample, and the commands
+say so; a zig-zag's overshoots need the approach heading, which the log does not hold
+(``test_manoeuvres.py``). The truth is the scale ship's own manoeuvre, cut."""
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from cli_helpers import run
+
+from shipid.data.io import write_log
+from shipid.dynamics.steering import SteeringMachine
+from shipid.evaluation.validate import validate_log
+from shipid.trials.indices import manoeuvre_indices
+from shipid.trials.manoeuvres import turning_circle, zigzag
+from shipid.trials.trial import describe_trial
+from shipid.vessels import scale_ship
+
+MARIN = (Path(__file__).resolve().parents[2] / "shared" / "data" / "kvlcc2-marin"
+         / "MARIN_FREE_KVLCC2_zz_20_m.dat")  # fmt: skip
+
+
+def _cut(log, at):
+    late = log[log["t"] >= at].reset_index(drop=True)
+    late.attrs = dict(log.attrs)
+    return late
+
+
+@pytest.fixture(scope="module")
+def turn():
+    return turning_circle(scale_ship(), 35, duration=120, dt=0.1).log
+
+
+@pytest.mark.parametrize("at", [2.0, 10.0])
+def test_a_turn_cut_after_its_execute_keeps_its_steady_part_and_says_what_it_lacks(turn, at):
+    """Cut 2 s after the order, the scale ship's 35° turn read its advance 25 % short (6.3 m
+    against 8.4 m) and 10 s after, its tactical diameter twice the trial's, with no word."""
+    late = _cut(turn, at)
+    trial = describe_trial(late)
+    r = np.abs(late["r"].to_numpy())
+    assert trial.kind == "turning" and trial.execute_index == 0
+    assert trial.turning_at_start == pytest.approx(r[0] / r.max())
+    whole, cut = manoeuvre_indices(turn), manoeuvre_indices(late, trial=trial)
+    assert cut["advance"] < 0.8 * whole["advance"] or \
+        cut["tactical_diameter"] > 1.5 * whole["tactical_diameter"]  # fmt: skip
+    for key in ("steady_turning_diameter", "steady_yaw_rate", "steady_speed"):
+        assert cut[key] == pytest.approx(whole[key], rel=1e-3)
+    # The truth's replica (at the trial's own integrator) starts where the log does, so it
+    # counts alike: its indices are the cut log's own, not the whole turn's.
+    v = validate_log(scale_ship(), late, "cut", method="rk4")
+    closed, measured = v.indices["closed_loop"], v.indices["measured"]
+    for key in ("advance", "transfer", "tactical_diameter", "time_to_90"):
+        assert closed[key] == pytest.approx(measured[key], rel=1e-9), key
+    note = [w for w in v.warnings if "starts inside its manoeuvre" in w]
+    assert len(note) == 1 and f"{100 * trial.turning_at_start:.0f} %" in note[0]
+    assert "the replica, run from the first sample, counts alike" in note[0]
+
+
+def test_a_turn_from_its_order_or_its_approach_is_not_said_to_be_cut(turn):
+    assert describe_trial(turn).turning_at_start is None
+    assert not [w for w in validate_log(scale_ship(), turn, "whole").warnings
+                if "starts inside" in w]  # fmt: skip
+    # Cut during its rudder's swing to 35°, before the ship turns: the trial's approach.
+    gear = SteeringMachine(max_rate=math.radians(20.0))
+    steered = turning_circle(scale_ship(), 35, duration=60, dt=0.1, steering=gear).log
+    assert describe_trial(_cut(steered, 0.5)).turning_at_start is None
+
+
+def test_the_commands_name_a_log_cut_inside_its_manoeuvre(tmp_path, capsys, turn):
+    write_log(_cut(turn, 2.0), tmp_path / "turn.csv")
+    zz = zigzag(scale_ship(), 30, 30, duration=60, dt=0.1).log
+    write_log(_cut(zz, 5.0), tmp_path / "zz.csv")
+    code, out, err = run(["indices", tmp_path / "turn.csv", tmp_path / "zz.csv"], capsys)
+    assert code == 0, err
+    assert f"{tmp_path / 'turn.csv'}: turning" in out
+    assert f"{tmp_path / 'zz.csv'}: other (it starts inside its manoeuvre" in out
+    lines = [w for w in err.splitlines() if "starts inside its manoeuvre" in w]
+    assert len(lines) == 1 and "turn.csv" in lines[0] and "tactical diameter" in lines[0]
+    # Forced, the zig-zag is measured from its first sample, and said to be.
+    code, out, err = run(["indices", tmp_path / "zz.csv", "--kind", "zigzag"], capsys)
+    assert code == 0, err
+    assert "first_overshoot_deg" in out and "its overshoots count from the first sample" in err
+
+
+@pytest.mark.skipif(not MARIN.is_file(), reason="../shared/data is not present")
+def test_the_real_marin_zigzag_cut_after_its_order():
+    """MARIN's 20°/20° run cut 3 s after its order read as a zig-zag from its first reversal,
+    overshoots 1.8° and 25.7° against the run's 14.7° and 11.8°; cut 1 s after it, before the
+    ship turns, it is the run it was (its first overshoot the same)."""
+    from shipid.data.io import read_log
+
+    log = read_log(MARIN, fmt="simman-marin", scale=45.7, start="auto", end="auto")
+    trial = describe_trial(log)
+    whole = manoeuvre_indices(log, trial=trial)
+    early = _cut(log, trial.execute_time + 1.0)
+    assert describe_trial(early).kind == "zigzag"
+    assert manoeuvre_indices(early)["first_overshoot_deg"] == \
+        pytest.approx(whole["first_overshoot_deg"], abs=0.05)  # fmt: skip
+    late = describe_trial(_cut(log, trial.execute_time + 3.0))
+    assert late.kind == "other" and late.reason.startswith("it starts inside its manoeuvre")
