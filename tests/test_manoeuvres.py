@@ -212,12 +212,12 @@ def test_a_zigzag_cut_inside_its_manoeuvre_reads_as_none(cut):
     trial = describe_trial(late)
     r = np.abs(late["r"].to_numpy())
     if cut == 0.0:
-        assert trial.kind == "zigzag" and trial.turning_at_start is None
+        assert trial.kind == "zigzag" and trial.turning_at_order is None
         assert zigzag_indices(late)["first_overshoot_deg"] == whole["first_overshoot_deg"]
         return
     assert trial.kind == "other", trial
     if r[0] > 0.1 * r.max():
-        assert trial.turning_at_start == pytest.approx(r[0] / r.max())
+        assert trial.turning_at_order == pytest.approx(r[0] / r.max())
         assert trial.reason.startswith(f"it starts inside its manoeuvre, the ship turning at "
                                        f"{100 * r[0] / r.max():.0f} %")  # fmt: skip
 

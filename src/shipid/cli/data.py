@@ -36,7 +36,7 @@ def cmd_indices(args) -> int:
     """``shipid indices``: IMO indices of measured logs."""
     from shipid.outputs import atomic_write_text, check_outputs
     from shipid.trials.indices import manoeuvre_indices
-    from shipid.trials.trial import describe_trial, started_inside_note
+    from shipid.trials.trial import describe_trial, turning_at_order_note
 
     check_outputs({"--json": (args.json, "json")}, [*args.logs, *_read_files(args)])
     logs = _read_logs(args)
@@ -50,7 +50,7 @@ def cmd_indices(args) -> int:
             if found != args.kind:
                 _warn(f"{path}: --kind {args.kind}, but the log reads as {found}; its "
                       f"{args.kind} indices are those it reaches (None where it never does)")
-        inside = started_inside_note(trial)
+        inside = turning_at_order_note(trial)
         if inside:
             _warn(f"{path}: {inside}")
         ind = manoeuvre_indices(log, args.kind, heading_deg=args.heading, smooth_s=args.smooth,
