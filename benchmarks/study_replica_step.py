@@ -13,7 +13,9 @@ Printed:
 2. The Esso Osaka's nine zig-zags on the README's model (``select --average`` on the zig-zags and
    three random runs at Δk 0.5 s): their closed-loop overshoots, mean over the nine, by step.
 3. The same nine held out in turn (the README's structure refitted on the other eight and the
-   three random runs, at Δk 0.1 and 0.5 s): the overshoots' error against the 0.1 s log's.
+   three random runs, at Δk 0.1 and 0.5 s): the overshoots' error against the 0.1 s log's; and
+   the replica's rudder up to the order, the approach's mean (``validate.approach_rudder``)
+   against the log's first sample's (before 2026-11-30).
 4. The Esso's two 35° turns on the README's model: tactical diameter and advance by step.
 5. The KVLCC2's MARIN zig-zags, each predicted by the README's ``blanke-race+race-damping``
    identified from the other (Δk 0.2 s), and the published MMG model on HSVA's 20°/10° run.
@@ -31,7 +33,9 @@ import numpy as np
 from cli_models import model_by_cli
 from esso_logs import DATA, README_HELD, esso_logs
 
+import shipid.evaluation.validate as validate_module
 from shipid.data.io import read_log
+from shipid.data.log import column_values
 from shipid.evaluation.validate import _indices_of, replica_step, trial_replica
 from shipid.identification.identify import identify
 from shipid.identification.select import select
@@ -50,6 +54,11 @@ def replica(model, log, step=None) -> dict:
     trial = describe_trial(log)
     return _indices_of(trial_replica(model, log, "euler", trial, indices=False, step=step),
                        trial, log)  # fmt: skip
+
+
+def first_sample_rudder(log, trial) -> float:
+    """The replica's rudder up to the order before 2026-11-30: the log's first sample's."""
+    return float(column_values(log, "delta", float)[0])
 
 
 def measured(log) -> dict:
@@ -137,6 +146,15 @@ def esso() -> None:
             for label, step in (("the log's step", dt), ("replica_step", None)):
                 got = replica(fit, log, step)
                 errors[label].append([got[k] - truth_here[k] for k in KEYS])
+            # The replica's rudder up to the order as before: the log's first sample's.
+            kept = validate_module.approach_rudder
+            validate_module.approach_rudder = first_sample_rudder
+            try:
+                got = replica(fit, log)
+            finally:
+                validate_module.approach_rudder = kept
+            errors.setdefault("replica_step, the first sample's rudder up to the order", []
+                              ).append([got[k] - truth_here[k] for k in KEYS])  # fmt: skip
         for label, e in errors.items():
             e = np.array(e)
             print(f"| {dt:g} | {label} | {e[:, 0].mean():+.2f}, {np.abs(e[:, 0]).mean():.2f} | "

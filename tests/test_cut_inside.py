@@ -1,7 +1,9 @@
-"""Logs cut inside their manoeuvre: the execute came before the first sample. A turn's steady
-part is still the trial's, its advance and the rest count from the first sample, and the commands
-say so; a zig-zag's overshoots need the approach heading, which the log does not hold
-(``test_manoeuvres.py``). The truth is the scale ship's own manoeuvre, cut."""
+"""Logs whose manoeuvre does not start from a straight, held approach: cut inside it (the
+execute before the first sample), after an approach on which the ship still turns, or with a
+helm correction at the first sample. A turn's steady part is still the trial's, its advance and
+the rest count from where the trial starts, and the commands say so; a zig-zag's overshoots
+need the approach heading, which a cut log does not hold (``test_manoeuvres.py``). The truth is
+the scale ship's own manoeuvre."""
 
 import math
 from pathlib import Path
@@ -167,3 +169,33 @@ def test_no_real_approach_is_taken_for_a_turning_one():
         for dt in (None, 0.5):
             trial = describe_trial(read_log(path, fmt=fmt, dt=dt, **kw))
             assert trial.kind in ("zigzag", "turning") and trial.turning_at_order is None, path
+
+
+def test_the_replica_holds_the_rudder_the_ship_approached_with():
+    """The replica holds a rudder from the log's first sample to the order: it held the first
+    sample's, on the Esso Osaka's approaches a helm correction's. After a 6° helm held for one
+    0.1 s sample and 7.8 s amidships, the scale ship's own replica of its 20°/20° zig-zag held 6°
+    the whole approach and put the first overshoot 26° off the log's; now the approach's mean,
+    and within 1.1° (the blip's turn, which the mean does not replay)."""
+    from shipid.evaluation.validate import approach_rudder, trial_replica
+
+    ship = scale_ship()
+    t = np.arange(0.0, 8.0001, 0.1)
+    blip = np.where(t == 0.0, math.radians(6.0), 0.0)
+    pre = simulate(ship.dynamics, t, blip, {"u": ship.approach_speed}, method="rk4").log
+    last = pre.iloc[-1]
+    zz = zigzag(ship, 20, 20, duration=60, dt=0.1,
+                initial={k: float(last[k]) for k in ("u", "v", "r", "psi")}).log  # fmt: skip
+    zz = zz.assign(t=zz["t"] + 8.0, x=zz["x"] + last["x"], y=zz["y"] + last["y"])
+    log = pd.concat([pre.iloc[:-1], zz], ignore_index=True)
+    log.attrs = dict(zz.attrs)
+    trial = describe_trial(log)
+    assert trial.kind == "zigzag" and trial.turning_at_order is None
+    held = approach_rudder(log, trial)
+    assert held == pytest.approx(np.mean(log["delta"].to_numpy()[: trial.execute_index + 1]))
+    run = trial_replica(ship, log, "rk4", trial, indices=False).log
+    before = run["t"].to_numpy() < log["t"].iloc[trial.execute_index] - log["t"].iloc[0]
+    assert np.allclose(run["delta"].to_numpy()[before], held)
+    v = validate_log(ship, log, "zz", method="rk4")
+    first = "first_overshoot_deg"
+    assert abs(v.indices["closed_loop"][first] - v.indices["measured"][first]) < 1.1

@@ -457,14 +457,15 @@ def _own_approach(model, log: pd.DataFrame, trial: Trial, wind: tuple[float, flo
 def _replica_start(model, log: pd.DataFrame, trial: Trial, start: dict | None = None
                    ) -> tuple[dict, float | None, tuple[float, float] | None]:  # fmt: skip
     """(initial state, propeller speed, true wind) of a closed-loop replica: the log's first
-    state (or ``start``'s states in its place) and held rudder at its median rps from the
-    execute on; where the log approaches steady and ``model``'s surge answers the propeller,
-    straight at the model's own steady speed at the log's approach rps instead (the approach
-    ``shipid manoeuvre`` starts from); the wind ``_log_wind`` gives."""
+    state (or ``start``'s states in its place), its rudder held at ``approach_rudder`` up to
+    the execute, at its median rps from the execute on; where the log approaches steady and
+    ``model``'s surge answers the propeller, straight at the model's own steady speed at the
+    log's approach rps instead (the approach ``shipid manoeuvre`` starts from); the wind
+    ``_log_wind`` gives."""
     row = log.iloc[0]
     initial = {k: float(row[k]) for k in ("u", "v", "r", "psi") if k in log.columns}
     initial.update(start or {})
-    initial["delta"] = float(row["delta"])
+    initial["delta"] = approach_rudder(log, trial)
     # The propeller speed the manoeuvre ran at: a log read whole ends with the propeller
     # stopped (the Esso Osaka's zig-zags for 2–8 s), which its mean counted (13_14_21: 15.6
     # rps for 16.7).
@@ -477,6 +478,18 @@ def _replica_start(model, log: pd.DataFrame, trial: Trial, start: dict | None = 
         initial.update(u=own[0], v=0.0, r=0.0)
         rps = own[1]
     return initial, rps, wind
+
+
+def approach_rudder(log: pd.DataFrame, trial: Trial) -> float:
+    """The rudder a closed-loop replica holds from the log's first sample up to the execute:
+    the mean of the log's over that approach, the helm the ship held its course with. The
+    rudder of the first sample alone was a helm correction's on the Esso Osaka's approaches
+    (13_14_21: −2.8° against 6.6° on average over its 5 s, 14_03_39: −6.7° against −1.5°), which
+    the replica held for 5 s before its order: over the nine zig-zags each held out at Δk
+    0.5 s, their first overshoots' mean miss came down from 1.44° to 0.96° and the second's
+    from 2.23° to 1.77° (``benchmarks/study_replica_step.py``)."""
+    delta = column_values(log, "delta", float)
+    return float(np.mean(delta[: trial.execute_index + 1]))
 
 
 def _approach_notes(indices: dict) -> list[str]:
@@ -625,7 +638,7 @@ def replica_step(log: pd.DataFrame) -> float:
     the true ship's 20°/20° zig-zag sampled every 0.5 s (its RK4 run at 0.01 s) came back from
     its own model with overshoots 1.1° and 0.8° too large at 0.1 s steps, 2.0° and 8.7° at
     0.5 s (now within 0.2°); the Esso Osaka's nine zig-zags, each held out at Δk 0.5 s, had
-    their first overshoots predicted 2.0° large on average, now 0.9°
+    their first overshoots predicted 2.1° large on average, now 0.7° (with ``approach_rudder``)
     (``benchmarks/study_replica_step.py``). It costs ``validate`` of the README's Esso example
     (100 replicates) 1.4 times its time at the log's step (``bench_validate_replicas.py``)."""
     made = log.attrs.get("integrator")

@@ -246,10 +246,9 @@ def earlier_order(t: np.ndarray, delta: np.ndarray, i0: int, max_stand: int = 0)
     return i0
 
 
-# A log that starts on its order: the ship straight at the first sample (yaw rate and sway
-# within this share of their largest before the first swing), turning before that swing at least
-# this share as hard as after it. Turning faster than that share at its first sample, under the
-# first order's rudder, a log starts inside its manoeuvre (``turning_at_order``).
+# A ship turning at its order faster than this share of its largest yaw rate does not start
+# from a straight approach (``turning_at_order``). A log starts on its order where the ship turns
+# under the rudder of its first sample at least the second share as hard as after its first swing.
 STRAIGHT_START = 0.1
 TURNS_ON_FIRST_RUDDER = 0.5
 
