@@ -199,3 +199,22 @@ def test_the_replica_holds_the_rudder_the_ship_approached_with():
     v = validate_log(ship, log, "zz", method="rk4")
     first = "first_overshoot_deg"
     assert abs(v.indices["closed_loop"][first] - v.indices["measured"][first]) < 1.1
+
+
+@pytest.mark.parametrize("stop_deg", [60.0, 170.0])
+def test_a_turn_stopped_short_of_180_degrees_says_what_it_lacks(turn, stop_deg):
+    """A turning log that ends before the heading has turned 180° is no turning circle; it read
+    as 'fewer than two rudder reversals', which says nothing of what it lacks. Forced, it gives
+    the indices it reaches (an advance from 90°)."""
+    psi = np.unwrap(turn["psi"].to_numpy())
+    end = int(np.argmax(np.abs(psi - psi[0]) >= math.radians(stop_deg)))
+    short = turn.iloc[:end].reset_index(drop=True)
+    short.attrs = dict(turn.attrs)
+    trial = describe_trial(short)
+    assert trial.kind == "other"
+    reached = float(np.degrees(np.max(np.abs(psi[:end] - psi[0]))))
+    assert trial.reason.startswith(f"the rudder held to one side through {reached:.0f}° of "
+                                   "heading and not reversed")  # fmt: skip
+    forced = manoeuvre_indices(short, "turning")
+    assert (forced["advance"] is not None) == (stop_deg > 90.0)
+    assert forced["tactical_diameter"] is None

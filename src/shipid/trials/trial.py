@@ -668,6 +668,13 @@ def _classify(log, dpsi, dev, side, i0, held_end, amplitudes, orders, release_ti
     if len(orders) < 2:
         if np.max(np.abs(dpsi[i0:])) >= math.pi:
             return "other", "the heading turns 180° but the rudder is not held"
+        if turned.size and np.max(turned) >= MIN_SWITCH:
+            # A turn stopped short read "fewer than two rudder reversals", which says nothing of
+            # what it lacks.
+            return "other", (f"the rudder held to one side through "
+                             f"{math.degrees(np.max(turned)):.0f}° of heading and not reversed: "
+                             "short of a turning circle's 180°, without a zig-zag's reversals "
+                             "(--kind turning reads the indices it reaches)")  # fmt: skip
         return "other", "fewer than two rudder reversals"
     if reversed_prop:
         return "other", "the propeller is reversed"
