@@ -5,6 +5,7 @@ the rest count from where the trial starts, and the commands say so; a zig-zag's
 need the approach heading, which a cut log does not hold (``test_manoeuvres.py``). The truth is
 the scale ship's own manoeuvre."""
 
+import json
 import math
 from pathlib import Path
 
@@ -76,8 +77,12 @@ def test_the_commands_name_a_log_cut_inside_its_manoeuvre(tmp_path, capsys, turn
     write_log(_cut(turn, 2.0), tmp_path / "turn.csv")
     zz = zigzag(scale_ship(), 30, 30, duration=60, dt=0.1).log
     write_log(_cut(zz, 5.0), tmp_path / "zz.csv")
-    code, out, err = run(["indices", tmp_path / "turn.csv", tmp_path / "zz.csv"], capsys)
+    code, out, err = run(["indices", tmp_path / "turn.csv", tmp_path / "zz.csv", "--json",
+                          tmp_path / "ind.json"], capsys)  # fmt: skip
     assert code == 0, err
+    records = json.loads((tmp_path / "ind.json").read_text())["logs"]
+    assert "starts inside its manoeuvre" in records[0]["warnings"][0]
+    assert "warnings" not in records[1]  # read as none: its reason says why
     assert f"{tmp_path / 'turn.csv'}: turning" in out
     assert f"{tmp_path / 'zz.csv'}: other (it starts inside its manoeuvre" in out
     lines = [w for w in err.splitlines() if "starts inside its manoeuvre" in w]

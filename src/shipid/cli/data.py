@@ -43,19 +43,22 @@ def cmd_indices(args) -> int:
     out = []
     for path, log in zip(args.logs, logs, strict=True):
         trial = describe_trial(log, args.kind, args.heading)
+        notes = []
         if args.kind and args.kind != "other":
             # Its indices as that kind are those the log reaches; say so where it reads as
             # another (every turning index printed None for a zig-zag, without a word).
             found = describe_trial(log).kind
             if found != args.kind:
-                _warn(f"{path}: --kind {args.kind}, but the log reads as {found}; its "
-                      f"{args.kind} indices are those it reaches (None where it never does)")
-        inside = turning_at_order_note(trial)
-        if inside:
-            _warn(f"{path}: {inside}")
+                notes.append(f"--kind {args.kind}, but the log reads as {found}; its "
+                             f"{args.kind} indices are those it reaches (None where it never "
+                             "does)")  # fmt: skip
+        notes += [n for n in (turning_at_order_note(trial),) if n]
+        for note in notes:
+            _warn(f"{path}: {note}")
         ind = manoeuvre_indices(log, args.kind, heading_deg=args.heading, smooth_s=args.smooth,
                                 trial=trial)  # fmt: skip
-        record = {"name": str(path), "indices": ind}
+        # What qualifies the indices travels with them into --json.
+        record = {"name": str(path), "indices": ind, **({"warnings": notes} if notes else {})}
         kind = ind.get("kind")
         print(f"{path}: {kind}" + (f" ({ind['reason']})" if kind == "other" else ""))
         for k, v in ind.items():
