@@ -250,11 +250,13 @@ def from_a_turning_order(log: pd.DataFrame, trial: Trial) -> tuple[pd.DataFrame,
     """``log`` and its ``trial`` from the execute on, where the ship turns on its approach
     (``Trial.turning_at_order``); else both as they are.
 
-    The closed-loop replica runs to the execute with its rudder held as at the log's first
-    sample: after 4 s of −20° rudder, the scale ship's own replica of its 35° turn put the
-    advance 31 % short of the log's and the tactical diameter 16 % long, and ``validate`` laid
-    the log's approach on the model. From the execute, measured, replayed and replica
-    start from the state the ship was in there (``turning_at_order_note`` says so)."""
+    The closed-loop replica runs to the execute with one rudder held (``approach_rudder``), not
+    the approach's: after 4 s of −20° rudder, the scale ship's own replica of its 35° turn put
+    the advance 31 % short of the log's and the tactical diameter 16 % long with the rudder of
+    the log's first sample, 3 % and 1 % with the approach's mean (ad hoc), and ``validate``
+    laid the log's approach on the model. From the execute, measured, replayed and replica
+    start from the state the ship was in there, and agree (``turning_at_order_note`` says
+    so)."""
     if trial.kind == "other" or trial.turning_at_order is None or trial.execute_index == 0:
         return log, trial
     part = log.iloc[trial.execute_index :].reset_index(drop=True)

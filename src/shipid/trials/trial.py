@@ -571,10 +571,11 @@ def turning_at_order_note(trial: Trial, replica: bool = False) -> str | None:
              "sample: the execute came before it, and " if trial.execute_index == 0 else
              f"its approach is not straight, the ship turning at up to {share} in the "
              f"{APPROACH_HEADING_S:g} s before the order (t = {trial.execute_time:.6g} s): ")
-    return (f"{where}{what} count from {'the first sample' if trial.execute_index == 0 else 'the order'}"
-            ", not from the straight approach of the IMO's trial (its steady turn does not "
-            "depend on it)" + ("; the replica, run from the same state, counts alike" if replica
-                               else ""))  # fmt: skip
+    start = "the first sample" if trial.execute_index == 0 else "the order"
+    steady = "" if trial.kind == "zigzag" else " (its steady turn does not depend on it)"
+    alike = "; the replica, run from the same state, counts alike" if replica else ""
+    return (f"{where}{what} count from {start}, not from the straight approach of the IMO's "
+            f"trial{steady}{alike}")
 
 
 def _plateau_levels(side: np.ndarray, dev: np.ndarray, measured_dev: np.ndarray | None
