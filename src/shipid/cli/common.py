@@ -575,7 +575,23 @@ def _log_record(args, logs) -> dict:
             "approach_rps": _approach(logs[0], "n"), **_rudder_record(logs),
             "rudder_positive": logs[0].attrs.get("rudder_positive"),
             "log_scale": _log_scale(logs), "yaw_rate_offset_deg_s": _yaw_rate_offsets(logs),
-            "ship": next((lg.attrs["ship"] for lg in logs if lg.attrs.get("ship")), None)}  # fmt: skip
+            "ship": next((lg.attrs["ship"] for lg in logs if lg.attrs.get("ship")), None),
+            "manoeuvres": _manoeuvre_kinds(logs)}  # fmt: skip
+
+
+def _manoeuvre_kinds(logs) -> list[str | None]:
+    """What each training log reads as (``describe_trial``'s kind; None where it cannot be
+    read): the commands that run the model say where it is asked a kind none of them was."""
+    from shipid.errors import ShipidError
+    from shipid.trials.trial import describe_trial
+
+    kinds = []
+    for log in logs:
+        try:
+            kinds.append(describe_trial(log).kind)
+        except ShipidError:
+            kinds.append(None)
+    return kinds
 
 
 def _log_scale(logs) -> float | None:

@@ -52,7 +52,7 @@ def cmd_validate(args) -> int:
     model (or reference ship) and what its file keeps, the logs read as its training logs were,
     each log validated, the tables printed, the residual analysis and IMO criteria, then the
     outputs (written only where some log validated)."""
-    from shipid.evaluation.envelope import outside_envelope
+    from shipid.evaluation.envelope import outside_envelope, unseen_kind_note
     from shipid.evaluation.validate import validate
     from shipid.outputs import check_outputs
     from shipid.progress import progress
@@ -79,8 +79,10 @@ def cmd_validate(args) -> int:
                                       shown=not (args.quiet or len(logs) < 3))]  # fmt: skip
     for v, log in zip(vals, logs, strict=True):
         if v.error is None:
+            unseen = unseen_kind_note(cond.get("manoeuvres"), v.kind)
             v.warnings.extend(outside_envelope(cond["envelope"], log)
-                              + _reversed_propeller_notes(model, cond, log))  # fmt: skip
+                              + _reversed_propeller_notes(model, cond, log)
+                              + ([unseen] if unseen else []))  # fmt: skip
     if subject.doc is not None:
         _mark_training_logs(subject.doc, vals)
     good = [v for v in vals if v.error is None]

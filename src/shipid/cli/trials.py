@@ -103,6 +103,7 @@ def cmd_criteria(args) -> int:
                    for note in faded_residual_notes(target, res.log)]  # fmt: skip
     outside = _runs_outside(cond["envelope"], crit.runs)
     crit.notes += _criteria_envelope_notes(cond["envelope"], crit.runs, outside)
+    crit.notes += _criteria_unseen_kinds(cond.get("manoeuvres"), crit.runs)
     table = crit.table.copy()
     ensemble = cond.get("ensemble")
     if ensemble is not None and not args.no_bands:
@@ -204,6 +205,20 @@ def _criteria_envelope_notes(env, runs, outside) -> list[str]:
     return notes
 
 
+def _criteria_unseen_kinds(trained, runs) -> list[str]:
+    """``unseen_kind_note`` for each kind of manoeuvre the criteria run (a zig-zag, a turning
+    circle) that none of the model's training logs is, naming the runs."""
+    from shipid.evaluation.envelope import unseen_kind_note
+
+    notes = []
+    for kind in ("turning", "zigzag"):
+        names = [name for name in runs if name.startswith(kind[:4])]
+        note = unseen_kind_note(trained, kind) if names else None
+        if note:
+            notes.append(f"criteria ({', '.join(names)}): {note}")
+    return notes
+
+
 def _tied_manoeuvres(run, alternatives: dict, kind: str, fitted: str = "") -> dict:
     """The same manoeuvre on the structures that tied with the model's in ``identify``'s inflow
     comparison (``identification.structure_choice.alternatives``), printed one line each: what
@@ -276,7 +291,7 @@ def cmd_manoeuvre(args) -> int:
     """``shipid manoeuvre``: a standard manoeuvre on a model or vessel. The steps: the approach
     and steering gear, the manoeuvre chosen (its rudder capped at the gear's largest), the run
     and its ensemble's, the indices with their intervals and the notes, the outputs."""
-    from shipid.evaluation.envelope import implausible_indices, outside_envelope
+    from shipid.evaluation.envelope import implausible_indices, outside_envelope, unseen_kind_note
     from shipid.evaluation.validate import faded_residual_notes
     from shipid.outputs import OutputSet, check_outputs
     from shipid.trials.manoeuvres import astern_thrust_note
@@ -317,6 +332,7 @@ def cmd_manoeuvre(args) -> int:
         astern = astern_thrust_note(target, speed, rps, args.astern_rps)
         notes += [astern.note] if astern else []
     notes += outside_envelope(cond["envelope"], res.log)
+    notes += [n for n in (unseen_kind_note(cond.get("manoeuvres"), args.kind),) if n]
     notes += faded_residual_notes(target, res.log)
     if res.incomplete and not res.diverged:
         notes.append(f"{res.incomplete}: indices that need it are missing or those of a "

@@ -75,6 +75,36 @@ def outside_envelope(env: Mapping[str, Sequence[float]], log: pd.DataFrame) -> l
     return notes
 
 
+# The kinds of manoeuvre a model's prediction of one kind is carried from: a pull-out is a turn
+# released, so the two count as one.
+KIND_GROUPS = {"zigzag": ("zigzag",), "turning": ("turning", "pull-out"),
+               "pull-out": ("turning", "pull-out")}  # fmt: skip
+KIND_NAMES = {"zigzag": "zig-zag", "turning": "turning circle or pull-out",
+              "pull-out": "turning circle or pull-out"}  # fmt: skip
+
+
+def unseen_kind_note(trained: Sequence[str] | None, kind: str | None) -> str | None:
+    """A note where a manoeuvre of ``kind`` is predicted by a model none of whose training logs
+    (their kinds, ``trained``: the model file's ``preprocessing.manoeuvres``) is of that kind;
+    None where one is, for other kinds, or for a file that does not record them. The envelope
+    says where a run's signals leave the logs; a turn predicted from zig-zags can stay inside
+    every signal's range and still be an extrapolation, its steady turn and its first 90° lying
+    in no log (on the Esso Osaka, the intervals of such a model held its turns' advances in a
+    quarter of the cases, docs/esso.md)."""
+    trained = [k for k in trained or () if k]
+    if not trained or kind not in KIND_GROUPS:
+        return None
+    if any(k in KIND_GROUPS[kind] for k in trained):
+        return None
+    counts = {k: list(trained).count(k) for k in dict.fromkeys(trained)}
+    read = ", ".join(f"{n} {KIND_NAMES.get(k, k) if k != 'other' else 'other'}" for k, n in
+                     counts.items())  # fmt: skip
+    return (f"none of the model's {len(trained)} training logs is a {KIND_NAMES[kind]} (they "
+            f"read as {read}): its {KIND_NAMES[kind].split(' or ')[0]} is carried from "
+            "manoeuvres of other kinds, which its intervals, where it has them, do not hold "
+            "(they resample those logs); a log of this kind among the training logs decides")
+
+
 def signals_outside(env: Mapping[str, Sequence[float]], log: pd.DataFrame) -> list[str]:
     """The signals of ``log`` that leave the envelope (``outside_envelope``'s, by name)."""
     return [note.split(" ", 1)[0] for note in outside_envelope(env, log)]

@@ -804,7 +804,8 @@ def training_conditions(doc: Mapping) -> dict:
            "rudder_positive": prep.get("rudder_positive"),
            "yaw_rate_offset_deg_s": prep.get("yaw_rate_offset_deg_s"),
            "dt": ident.get("dt") if isinstance(ident.get("dt"), int | float) else None,
-           "time_scale": time_scale(doc), "ship": prep.get("ship")}  # fmt: skip
+           "time_scale": time_scale(doc), "ship": prep.get("ship"),
+           "manoeuvres": prep.get("manoeuvres")}  # fmt: skip
     if doc.get("particulars"):
         from shipid.data.particulars import Particulars
 
