@@ -69,6 +69,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_blas_threads.py
 	$(BIN)/python benchmarks/bench_validate_replicas.py
 	$(BIN)/python benchmarks/bench_columns.py
+	$(BIN)/python benchmarks/study_cut_logs.py
 
 clean:
 	rm -rf $(VENV) shipid-demo build *.egg-info src/*.egg-info
