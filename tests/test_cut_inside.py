@@ -122,12 +122,18 @@ def _after_a_turning_approach(manoeuvre: str):
         rudder[t >= 9.0] = math.radians(35.0)
         return simulate(ship.dynamics, t, rudder, {"u": ship.approach_speed}, method="rk4").log
     t = t[t <= 8.0]
-    pre = simulate(ship.dynamics, t, np.where(t >= 5.0, math.radians(-8.0), 0.0),
-                   {"u": ship.approach_speed}, method="rk4").log  # fmt: skip
+    return _zigzag_after(ship, t, np.where(t >= 5.0, math.radians(-8.0), 0.0))
+
+
+def _zigzag_after(ship, t, rudder):
+    """The ship's 20°/20° zig-zag run closed loop from the state an approach of ``rudder`` over
+    ``t`` (simulated open loop) left it in, ordered at its last time: one log, each sample
+    following from the last."""
+    pre = simulate(ship.dynamics, t, rudder, {"u": ship.approach_speed}, method="rk4").log
     last = pre.iloc[-1]
     zz = zigzag(ship, 20, 20, duration=60, dt=0.1,
                 initial={k: float(last[k]) for k in ("u", "v", "r", "psi")}).log  # fmt: skip
-    zz = zz.assign(t=zz["t"] + 8.0, x=zz["x"] + last["x"], y=zz["y"] + last["y"])
+    zz = zz.assign(t=zz["t"] + t[-1], x=zz["x"] + last["x"], y=zz["y"] + last["y"])
     log = pd.concat([pre.iloc[:-1], zz], ignore_index=True)
     log.attrs = dict(zz.attrs)
     return log
@@ -186,14 +192,7 @@ def test_the_replica_holds_the_rudder_the_ship_approached_with():
 
     ship = scale_ship()
     t = np.arange(0.0, 8.0001, 0.1)
-    blip = np.where(t == 0.0, math.radians(6.0), 0.0)
-    pre = simulate(ship.dynamics, t, blip, {"u": ship.approach_speed}, method="rk4").log
-    last = pre.iloc[-1]
-    zz = zigzag(ship, 20, 20, duration=60, dt=0.1,
-                initial={k: float(last[k]) for k in ("u", "v", "r", "psi")}).log  # fmt: skip
-    zz = zz.assign(t=zz["t"] + 8.0, x=zz["x"] + last["x"], y=zz["y"] + last["y"])
-    log = pd.concat([pre.iloc[:-1], zz], ignore_index=True)
-    log.attrs = dict(zz.attrs)
+    log = _zigzag_after(ship, t, np.where(t == 0.0, math.radians(6.0), 0.0))
     trial = describe_trial(log)
     assert trial.kind == "zigzag" and trial.turning_at_order is None
     held = approach_rudder(log, trial)
