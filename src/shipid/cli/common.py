@@ -549,13 +549,13 @@ def _yaw_rate_offsets(logs) -> list[float] | None:
     return [math.degrees(float(log.attrs.get("yaw_rate_offset", 0.0))) for log in logs]
 
 
-def _rudder_record(logs) -> dict:
+def _rudder_record(logs, trials) -> dict:
     """The training logs' rudder rate for the model file [rad/s] (None where none swings or the
     sampling does not resolve it), and whether their rudder swings faster than their sampling
     resolves (``rudder_unresolved``: the Esso Osaka's 35° in under 0.3 s at 10 Hz)."""
     from shipid.trials.trial import logs_rudder_rate, rudder_unresolved
 
-    rate = logs_rudder_rate(logs)
+    rate = logs_rudder_rate(logs, trials)
     return {"rudder_rate": rate,
             "rudder_unresolved": rate is None and any(rudder_unresolved(lg) for lg in logs)}
 
@@ -565,33 +565,22 @@ def _log_record(args, logs) -> dict:
     options given) and what they hold (approach, rudder, convention, scale, gyro offsets), as
     ``identify`` and ``select`` both write it."""
     from shipid.trials.reading import CUT_AT_DROPOUT, CUT_TO_MANOEUVRE
+    from shipid.trials.trial import describe_trial
 
     cut, ended = ([log.attrs.get("name") for log in logs if log.attrs.get(key)]
                   for key in (CUT_TO_MANOEUVRE, CUT_AT_DROPOUT))  # fmt: skip
+    # Read once: the rudder rate and what each log reads as (the commands that run the model
+    # say where it is asked a kind of manoeuvre none of them was).
+    trials = [describe_trial(log) for log in logs]
     return {"dt": args.dt, "start": args.start, "end": args.end, "lead": args.lead,
             "cut_to_manoeuvre": cut or None, "cut_at_dropout": ended or None,
             "columns": args.columns, "degrees": args.degrees, "format": args.format,
             "scale": args.scale, "approach_speed": _approach(logs[0], "u"),
-            "approach_rps": _approach(logs[0], "n"), **_rudder_record(logs),
+            "approach_rps": _approach(logs[0], "n"), **_rudder_record(logs, trials),
             "rudder_positive": logs[0].attrs.get("rudder_positive"),
             "log_scale": _log_scale(logs), "yaw_rate_offset_deg_s": _yaw_rate_offsets(logs),
             "ship": next((lg.attrs["ship"] for lg in logs if lg.attrs.get("ship")), None),
-            "manoeuvres": _manoeuvre_kinds(logs)}  # fmt: skip
-
-
-def _manoeuvre_kinds(logs) -> list[str | None]:
-    """What each training log reads as (``describe_trial``'s kind; None where it cannot be
-    read): the commands that run the model say where it is asked a kind none of them was."""
-    from shipid.errors import ShipidError
-    from shipid.trials.trial import describe_trial
-
-    kinds = []
-    for log in logs:
-        try:
-            kinds.append(describe_trial(log).kind)
-        except ShipidError:
-            kinds.append(None)
-    return kinds
+            "manoeuvres": [trial.kind for trial in trials]}  # fmt: skip
 
 
 def _log_scale(logs) -> float | None:

@@ -212,7 +212,7 @@ def _criteria_unseen_kinds(trained, runs) -> list[str]:
 
     notes = []
     for kind in ("turning", "zigzag"):
-        names = [name for name in runs if name.startswith(kind[:4])]
+        names = [name for name in runs if name.split(" ", 1)[0] == kind]  # "turning 35° port"
         note = unseen_kind_note(trained, kind) if names else None
         if note:
             notes.append(f"criteria ({', '.join(names)}): {note}")

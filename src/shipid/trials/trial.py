@@ -308,23 +308,27 @@ def turning_at_order(log: pd.DataFrame, i0: int) -> float | None:
     scale ship, whose approach turns at 5 % of its largest yaw rate, read as turning in 2 of 40
     seeds, at five times the noise in 36 of 40."""
     t, r = column_values(log, "t"), column_values(log, "r", float)
-    largest = float(np.max(np.abs(r[i0:])))
+    largest = max(float(np.max(r[i0:])), -float(np.min(r[i0:])))  # no |r| array
     if not largest > 0:
         return None
-    noise = math.sqrt(white_noise_variance(r))
     if i0 == 0:
-        turning, spread = abs(float(r[0])), noise
+        turning, width = abs(float(r[0])), 1
     else:
-        width = max(1, int(round(ORDER_YAW_S / float(np.median(np.diff(t))))))
         first = int(np.searchsorted(t, t[i0] - APPROACH_HEADING_S))
+        # The approach's own sampling: a median over the whole log cost every replica's read.
+        sampling = float(np.median(np.diff(t[max(0, first - 1) : i0 + 1])))
+        width = max(1, int(round(ORDER_YAW_S / sampling)))
         lead = r[max(0, first - width + 1) : i0 + 1]
         width = min(width, lead.size)
-        medians = np.median(np.lib.stride_tricks.sliding_window_view(lead, width), axis=1)
-        # A median of ``width`` samples of white noise spreads 1.2533/√width as far.
-        turning, spread = float(np.max(np.abs(medians))), 1.2533 * noise / math.sqrt(width)
-    if turning <= STRAIGHT_START * largest + ORDER_NOISE * spread:
-        return None
-    return turning / largest
+        turning = float(np.max(np.abs(np.median(
+            np.lib.stride_tricks.sliding_window_view(lead, width), axis=1))))  # fmt: skip
+    if turning <= STRAIGHT_START * largest:
+        return None  # straight whatever the noise: its two medians over the log are spared
+    # A median of ``width`` samples of white noise spreads 1.2533/√width as far (1 for one).
+    spread = (1.2533 / math.sqrt(width) if width > 1 else 1.0) * \
+        math.sqrt(white_noise_variance(r))  # fmt: skip
+    return turning / largest if turning > STRAIGHT_START * largest + ORDER_NOISE * spread \
+        else None  # fmt: skip
 
 
 # A rudder order is held within this spread of its extreme [rad] (``rudder_execute_time``'s
@@ -430,10 +434,13 @@ def _rudder_rate(t: np.ndarray, delta: np.ndarray) -> float | None:
     return swings if swings is not None else float(np.percentile(rate[moving], 90))
 
 
-def logs_rudder_rate(logs: Sequence[pd.DataFrame]) -> float | None:
+def logs_rudder_rate(logs: Sequence[pd.DataFrame], trials: Sequence[Trial] | None = None
+                     ) -> float | None:  # fmt: skip
     """The rudder rate of a set of logs [rad/s]: the fastest of their ``Trial.rudder_rate`` (the
-    steering gear's, which manoeuvres on a model of them run at); None where none swings."""
-    rates = [r for r in (describe_trial(log).rudder_rate for log in logs) if r]
+    steering gear's, which manoeuvres on a model of them run at); None where none swings.
+    ``trials``: the logs' ``describe_trial``, where the caller has them."""
+    trials = trials if trials is not None else [describe_trial(log) for log in logs]
+    rates = [t.rudder_rate for t in trials if t.rudder_rate]
     return max(rates) if rates else None
 
 
