@@ -88,6 +88,31 @@ def test_the_generated_loop_is_the_interpreters(tmp_path, monkeypatch):
     model = surge_model(0.6)
     np.testing.assert_allclose(_reversing_run(model, "generated"),
                                _reversing_run(model, "interpreted"), rtol=1e-12, atol=1e-12)
+    _no_cached_kernel_took_a_compiled_function(codegen.load(model.code,
+                                                            codegen.nonzero_pairs(model.code,
+                                                                                  model.theta)))
+
+
+def _no_cached_kernel_took_a_compiled_function(generated):
+    """The generated module was compiled in this process (a new folder), and with it the shared
+    loops it calls with its rhs. numba keys a cached entry by its arguments' types, and a compiled
+    function's type by its dispatcher, new in every process: a cached loop taking one gained an
+    index entry in every process that compiled a term set, and once the index held more than the
+    128 dispatchers numba keeps alive, saving it failed ("underlying object has vanished")."""
+    from numba.core import types
+    from numba.core.caching import NullCache
+
+    from shipid.dynamics import kernel
+
+    compiled = 0
+    for module in (kernel, generated):
+        for name, obj in vars(module).items():
+            if not hasattr(obj, "signatures") or isinstance(getattr(obj, "_cache", None), NullCache):
+                continue
+            for sig in obj.signatures:
+                compiled += 1
+                assert not any(isinstance(a, types.Dispatcher) for a in sig), name
+    assert compiled  # the generated kernel's own entries were seen
 
 
 def test_the_exported_module_runs_it(tmp_path):

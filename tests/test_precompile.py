@@ -47,3 +47,25 @@ def test_every_compiled_kernel_is_called_once_at_install():
     # The kernels found and those called from other kernels: a broken search would find none.
     assert int(out[0]) >= 30 and 10 <= int(out[1]) < int(out[0])
     assert out[2].strip() == "[]", f"never called by shipid.precompile: {out[2]}"
+
+
+def test_install_deletes_the_entries_of_kernels_no_longer_cached(tmp_path, monkeypatch):
+    """An older install cached ``kernel.open_run`` and ``closed_run``, one entry a process
+    (see ``kernel.open_run``); the files are never read again, and the install deletes them,
+    leaving the cached kernels' own."""
+    from pathlib import Path
+
+    from shipid import precompile
+    from shipid.dynamics import kernel
+
+    folder = tmp_path / "__pycache__"
+    folder.mkdir()
+    monkeypatch.setattr(kernel, "__file__", str(tmp_path / "kernel.py"))
+    stale = [folder / "kernel.open_run-280.py311.nbi", folder / "kernel.open_run-280.py311.7.nbc",
+             folder / "kernel.closed_run-446.py311.nbi"]  # fmt: skip
+    kept = [folder / "kernel.integrate_open-339.py311.nbi", folder / "kernel.steer-357.py311.nbi",
+            folder / "mmg._open-120.py311.nbi"]  # fmt: skip
+    for f in stale + kept:
+        f.write_bytes(b"")
+    assert sorted(precompile.drop_uncached_entries()) == sorted(stale)
+    assert sorted(Path(folder).iterdir()) == sorted(kept)

@@ -102,9 +102,31 @@ def _part(part: str) -> list[str]:
         return precompile(part)
 
 
+def drop_uncached_entries() -> list[Path]:
+    """Delete numba's files of the kernel's functions that are no longer cached on their own
+    (``kernel.open_run``, ``closed_run``: an older install's, one entry a process, never read
+    again); the files deleted."""
+    from numba.core.caching import NullCache
+
+    from shipid.dynamics import kernel
+
+    folder = Path(kernel.__file__).parent / "__pycache__"
+    dropped = []
+    for name, obj in vars(kernel).items():
+        if isinstance(getattr(obj, "_cache", None), NullCache):
+            for stale in folder.glob(f"kernel.{name}-*.nb[ic]"):
+                try:
+                    stale.unlink()
+                    dropped.append(stale)
+                except OSError:
+                    pass  # a read-only install: nothing of it is read either
+    return dropped
+
+
 def main() -> int:
     """``python -m shipid.precompile``: compile, then say what and how long."""
     start = time.perf_counter()
+    drop_uncached_entries()
     # Python's own bytecode too: an editable install writes none, and where
     # PYTHONDONTWRITEBYTECODE is set no command ever would (0.13 s of every start).
     compileall.compile_dir(Path(__file__).parent, quiet=1)

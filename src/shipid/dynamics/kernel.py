@@ -277,7 +277,13 @@ def _ok(st, speed_lim, yaw_lim):
             and math.isfinite(st[3]) and math.isfinite(st[4]) and math.isfinite(st[5]))  # fmt: skip
 
 
-@numba.njit(cache=True)
+# Not cached on its own (nor closed_run): numba keys such an entry by the rhs's dispatcher, whose
+# identity is new in every process, so each process that compiled a caller (a generated term
+# set's kernel, a reference ship's) added one entry to one index, read whole at every later
+# compile (0.35 s at 123 entries), and once it held more entries than numba keeps dispatchers
+# alive (128) writing it failed ("underlying object has vanished"). Their cached callers keep
+# them compiled in.
+@numba.njit
 def open_run(rhs, ctx, inp, t, inputs, n_steps, s0, rk4, speed_lim, yaw_lim, out):
     """One free run driven by the input series ``inputs`` (N, 5), copied step by step into
     ``inp`` (the buffer ``rhs`` reads); out (N, 6). Returns the valid samples."""
@@ -449,7 +455,7 @@ def propeller(p, t):
     return p[P_RPS] + frac * (p[P_RPS_TO] - p[P_RPS])
 
 
-@numba.njit(cache=True)
+@numba.njit  # not cached on its own: see open_run
 def closed_run(rhs, ctx, inp, p, dt, n_steps, s0, rk4, speed_lim, yaw_lim, states, rudder):
     """One closed-loop manoeuvre of parameters ``p``: each step the rudder command through the
     steering machine, the state recorded, then one step with δ and the propeller speed set in
