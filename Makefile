@@ -38,6 +38,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/study_stability.py
 	$(BIN)/python benchmarks/bench_study.py
 	$(BIN)/python benchmarks/bench_figures.py
+	$(BIN)/python benchmarks/bench_startup.py
 	$(BIN)/python benchmarks/study_esso.py
 	$(BIN)/python benchmarks/study_esso_port_turn.py
 	$(BIN)/python benchmarks/study_esso_whole_logs.py
