@@ -354,7 +354,7 @@ def pairs_toward_the_sister() -> None:
 
 
 def _straight(ship, rps: float):
-    from shipid.cli.common import _ship_approach
+    from shipid.cli.targets import _ship_approach
 
     with contextlib.redirect_stdout(io.StringIO()):
         return _ship_approach(ship, None, rps)

@@ -74,6 +74,13 @@ def test_the_cli_knows_every_reader():
     assert CLI_FORMATS == FORMATS
 
 
+def test_the_cli_knows_every_linear_estimator():
+    from shipid.cli.parser import LINEAR_ESTIMATORS as CLI_ESTIMATORS
+    from shipid.identification.estimators import LINEAR_ESTIMATORS
+
+    assert CLI_ESTIMATORS == LINEAR_ESTIMATORS
+
+
 @pytest.fixture(scope="module")
 def short_trial():
     from shipid.trials.manoeuvres import zigzag

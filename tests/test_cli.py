@@ -133,7 +133,8 @@ def test_a_run_coarser_than_the_models_step_is_warned(tmp_path, files, capsys):
     code, _, err = run(["autopilot", model, "--dt", "1"], capsys)
     assert "--dt 1 s is 5 times the model's Δk" in err
     # A model of logs at 0.02 s (the MARIN files' own) is not warned at the default step.
-    from shipid.cli.common import MANOEUVRE_STEP, _step_note
+    from shipid.cli.notes import _step_note
+    from shipid.cli.targets import MANOEUVRE_STEP
 
     assert _step_note({"dt": 0.02}, MANOEUVRE_STEP, MANOEUVRE_STEP) is None
     assert "5 times the model's Δk (0.02 s)" in _step_note({"dt": 0.02}, 0.1, MANOEUVRE_STEP)

@@ -515,7 +515,7 @@ def test_a_spiral_is_no_turning_circle():
 
 
 def test_the_command_line_knows_every_kind(tmp_path, capsys):
-    from shipid.cli.common import KINDS as CLI_KINDS
+    from shipid.cli.parser import KINDS as CLI_KINDS
     from shipid.trials.trial import KINDS
 
     assert CLI_KINDS == KINDS

@@ -7,10 +7,12 @@ extension or an unwritable folder is refused before anything is computed. A comm
 are written together at its end (``shipid.outputs.OutputSet``). Warnings print as ``warning:``
 lines on stderr and go into the JSON outputs.
 
-One module per concern: ``parser`` (every command's options), ``common`` (reading logs, physics
-options, the model or ship a command runs on), and the commands by what they do: ``identify``,
-``selection`` (select, compare), ``rescale``, ``evaluation``, ``trials``, ``control``, ``data``,
-``experiments`` (demo, study).
+One module per concern: ``parser`` (every command's options); what the commands share:
+``reading`` (the logs they read), ``physics_options`` (a fit's structure, prior, constraints and
+bounds), ``targets`` (the model or reference ship a command runs on, its approach and steering),
+``notes`` (where what a command is asked differs from what the model was identified from) and
+``printing``; and the commands by what they do: ``identify``, ``selection`` (select, compare),
+``rescale``, ``evaluation``, ``trials``, ``control``, ``data``, ``experiments`` (demo, study).
 """
 
 from __future__ import annotations
@@ -24,8 +26,7 @@ import warnings
 from pathlib import Path
 
 from shipid.blas import one_thread
-from shipid.cli.common import FORMATS
-from shipid.cli.parser import build_parser, shared_parser
+from shipid.cli.parser import FORMATS, build_parser, shared_parser
 from shipid.errors import ShipidError, ShipidWarning
 from shipid.outputs import Interrupted, check_stop, clear_stop, request_stop, stop_requested
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import json
 
-from shipid.cli.common import _json_text, _pd, _term_display
+from shipid.cli.printing import _json_text, _pd, _term_display
 
 
 def _replicates_checked(ensemble, report: dict, model, as_written, speed, rps, curvature,

@@ -5,21 +5,16 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from shipid.cli.common import (
+from shipid.cli.notes import _step_note, _unused_inputs, _warn_beyond_training
+from shipid.cli.printing import _json_text, _np, _pd, _warn
+from shipid.cli.reading import _read_files
+from shipid.cli.targets import (
     CONTROL_STEP,
     VESSEL_NAMES,
-    _json_text,
-    _np,
-    _pd,
-    _read_files,
     _reference_ship,
     _run_approach,
     _ship_or_model,
     _steering,
-    _step_note,
-    _unused_inputs,
-    _warn,
-    _warn_beyond_training,
 )
 from shipid.errors import ShipidError
 

@@ -3,14 +3,10 @@ of the same ship; the corrected ship written to a file the commands run as a ref
 
 from __future__ import annotations
 
-from shipid.cli.common import (
-    VESSEL_NAMES,
-    _json_text,
-    _read_files,
-    _reference_speed_notes,
-    _training_logs,
-    _warn,
-)
+from shipid.cli.notes import _reference_speed_notes
+from shipid.cli.printing import _json_text, _warn
+from shipid.cli.reading import _read_files, _training_logs
+from shipid.cli.targets import VESSEL_NAMES
 
 
 def cmd_correct(args) -> int:
@@ -82,7 +78,7 @@ def _standard_rudders(ship) -> tuple[float, float]:
 
 def _standard(ship, side: str) -> dict:
     """The held turn and the 10°/10° zig-zag of ``ship`` to ``side`` (``_standard_rudders``)."""
-    from shipid.cli.common import _ship_approach
+    from shipid.cli.targets import _ship_approach
     from shipid.trials.manoeuvres import turning_circle, zigzag
 
     # A propeller that follows the runs' rate turns at its trim for the approach.
@@ -96,7 +92,7 @@ def _beyond_the_logs(reference, corrected, replicates=()) -> list[dict]:
     """Print the standard manoeuvres of both ships side by side (with the 95 % interval over
     the bootstrap ``replicates`` where there are some), warn where the corrected ship's turn
     diverges, never comes round, or turns the other way; the rows, for the file."""
-    from shipid.cli.common import _pd
+    from shipid.cli.printing import _pd
     from shipid.identification.uncertainty import interval
 
     rows = []

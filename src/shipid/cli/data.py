@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from shipid.cli.common import _json_text, _read_files, _read_logs, _warn
+from shipid.cli.printing import _json_text, _warn
+from shipid.cli.reading import _read_files, _read_logs
 from shipid.errors import ShipidError
 
 

@@ -9,30 +9,31 @@ from functools import partial
 from pathlib import Path
 from types import SimpleNamespace
 
-from shipid.cli.common import (
-    VESSEL_NAMES,
-    _check_length,
-    _check_scale,
-    _json_text,
-    _markdown_dashed,
+from shipid.cli.notes import (
     _model_notes,
-    _particulars,
-    _pd,
-    _print_yaw_rate_offsets,
-    _read_files,
-    _read_options,
-    _reference_ship,
     _reference_speed_notes,
     _sampling_notes,
     _scale_notes,
     _ship_notes,
-    _ship_or_model,
     _simulated_metadata,
-    _vessel_conditions,
-    _warn,
     _warn_beyond_training,
-    _warn_cut,
     _yaw_rate_notes,
+)
+from shipid.cli.printing import _json_text, _markdown_dashed, _pd, _warn
+from shipid.cli.reading import (
+    _particulars,
+    _print_yaw_rate_offsets,
+    _read_files,
+    _read_options,
+    _warn_cut,
+)
+from shipid.cli.targets import (
+    VESSEL_NAMES,
+    _check_length,
+    _check_scale,
+    _reference_ship,
+    _ship_or_model,
+    _vessel_conditions,
 )
 from shipid.errors import ShipidError
 

@@ -7,7 +7,7 @@ import sys
 import time
 from pathlib import Path
 
-from shipid.cli.common import _cores, _warn
+from shipid.cli.printing import _cores, _warn
 from shipid.errors import ShipidError
 
 

@@ -13,27 +13,7 @@ from shipid.cli.as_written import (
     _report_replicates,
     _written_text,
 )
-from shipid.cli.common import (
-    VESSEL_NAMES,
-    _ahead,
-    _approach,
-    _fmt_speed,
-    _log_particulars,
-    _log_record,
-    _one_rps,
-    _parse_drop,
-    _pd,
-    _physics,
-    _read_files,
-    _reference_speed_notes,
-    _rudder_drag_note,
-    _std_errors,
-    _structure,
-    _term_display,
-    _training_logs,
-    _warn,
-    _warn_approach,
-)
+from shipid.cli.notes import _reference_speed_notes, _rudder_drag_note, _std_errors
 from shipid.cli.output_error_fit import (
     _free_run_table,
     _output_error,
@@ -41,6 +21,18 @@ from shipid.cli.output_error_fit import (
     _output_error_passed_over,
     _output_error_where_noise_is_left,
     _turns_apart,
+)
+from shipid.cli.physics_options import _parse_drop, _physics, _structure
+from shipid.cli.printing import _fmt_speed, _pd, _term_display, _warn
+from shipid.cli.reading import (
+    _ahead,
+    _approach,
+    _log_particulars,
+    _log_record,
+    _one_rps,
+    _read_files,
+    _training_logs,
+    _warn_approach,
 )
 from shipid.cli.structure_choice import (
     AVERAGED,
@@ -55,6 +47,7 @@ from shipid.cli.structure_choice import (
     _paper_out_filtered,
     _refit_alternatives,
 )
+from shipid.cli.targets import VESSEL_NAMES
 from shipid.errors import ShipidError
 
 

@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from shipid.cli.common import VESSEL_NAMES, _warn
+from shipid.cli.printing import _warn
+from shipid.cli.targets import VESSEL_NAMES
 
 
 def cmd_mmg(args) -> int:
@@ -41,7 +42,7 @@ def cmd_mmg(args) -> int:
     doc, notes = sister_ship(source, particulars, name, args.speed, rps, args.rudder_rate)
     ship = mmg_vessel(doc, f"the MMG model of {name}")  # trims its propeller: checks it holds
     if Path(args.output).suffix.lower() == ".json":
-        from shipid.cli.common import _json_text
+        from shipid.cli.printing import _json_text
 
         text = _json_text(doc)
     else:

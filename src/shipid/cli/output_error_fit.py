@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import sys
 
-from shipid.cli.common import _term_display
+from shipid.cli.printing import _term_display
 
 
 def _free_run_table(refinement) -> str:

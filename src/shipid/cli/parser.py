@@ -7,15 +7,6 @@ import functools
 import math
 
 from shipid import __version__
-from shipid.cli.common import (
-    CONTROL_STEP,
-    CRITERIA_STEP,
-    FORMATS,
-    KINDS,
-    LINEAR_ESTIMATORS,
-    MANOEUVRE_STEP,
-    VESSEL_NAMES,
-)
 from shipid.cli.control import cmd_autopilot, cmd_export, cmd_follow, cmd_linearise
 from shipid.cli.correction import cmd_correct
 from shipid.cli.data import cmd_import, cmd_indices, cmd_plot
@@ -25,7 +16,14 @@ from shipid.cli.identify import cmd_identify
 from shipid.cli.mmg import cmd_mmg
 from shipid.cli.rescale import cmd_rescale
 from shipid.cli.selection import cmd_compare, cmd_select
+from shipid.cli.targets import CONTROL_STEP, CRITERIA_STEP, MANOEUVRE_STEP, VESSEL_NAMES
 from shipid.cli.trials import cmd_criteria, cmd_manoeuvre
+
+# The choices of --format, --estimator and --kind, kept here so that --help and --version import
+# no pandas (tests check each against the module it names).
+FORMATS = ("canonical", "simman-marin", "simman-hsva", "osaka-frt")  # shipid.data.formats'
+LINEAR_ESTIMATORS = ("lssvm", "ols", "ridge", "lasso", "svr")  # identification.estimators'
+KINDS = ("zigzag", "turning", "pull-out", "other")  # shipid.trials.trial's
 
 
 def _pair(text: str) -> tuple[float, float]:

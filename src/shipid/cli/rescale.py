@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 
 from shipid.cli.as_written import _print_prime
-from shipid.cli.common import _json_text
+from shipid.cli.printing import _json_text
 from shipid.errors import ShipidError
 
 

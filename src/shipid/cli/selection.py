@@ -14,23 +14,17 @@ from shipid.cli.as_written import (
     _report_replicates,
     _written_text,
 )
-from shipid.cli.common import (
+from shipid.cli.notes import _rudder_drag_note, _std_errors
+from shipid.cli.physics_options import _parse_gammas, _physics, _structure_edit
+from shipid.cli.printing import _json_text, _pd, _term_display, _warn
+from shipid.cli.reading import (
     _ahead,
     _approach,
-    _json_text,
     _log_particulars,
     _log_record,
     _one_rps,
-    _parse_gammas,
-    _pd,
-    _physics,
     _read_files,
-    _rudder_drag_note,
-    _std_errors,
-    _structure_edit,
-    _term_display,
     _training_logs,
-    _warn,
     _warn_approach,
 )
 from shipid.errors import ShipidError

@@ -6,14 +6,9 @@ from __future__ import annotations
 
 import sys
 
-from shipid.cli.common import (
-    _approach,
-    _parse_bounds,
-    _physics,
-    _structure,
-    _structure_edit,
-    _warn,
-)
+from shipid.cli.physics_options import _parse_bounds, _physics, _structure, _structure_edit
+from shipid.cli.printing import _warn
+from shipid.cli.reading import _approach
 from shipid.errors import ShipidError
 
 # γ grid of --gamma auto with a reference ship's prior (select's default starts at 1e2).

@@ -7,24 +7,18 @@ import sys
 from functools import partial
 from pathlib import Path
 
-from shipid.cli.common import (
+from shipid.cli.notes import _model_notes, _simulated_metadata, _step_note, _unused_inputs
+from shipid.cli.printing import _json_text, _markdown_dashed, _pd, _warn
+from shipid.cli.reading import _read_files
+from shipid.cli.targets import (
     CRITERIA_STEP,
     MANOEUVRE_STEP,
     _check_length,
     _check_scale,
-    _json_text,
-    _markdown_dashed,
-    _model_notes,
-    _pd,
-    _read_files,
     _run_approach,
     _ship_or_model,
-    _simulated_metadata,
     _steady_window,
     _steering,
-    _step_note,
-    _unused_inputs,
-    _warn,
 )
 from shipid.errors import ShipidError
 
