@@ -102,7 +102,8 @@ def unseen_kind_note(trained: Sequence[str] | None, kind: str | None) -> str | N
     return (f"none of the model's {len(trained)} training logs is a {KIND_NAMES[kind]} (they "
             f"read as {read}): its {KIND_NAMES[kind].split(' or ')[0]} is carried from "
             "manoeuvres of other kinds, which its intervals, where it has them, do not hold "
-            "(they resample those logs); a log of this kind among the training logs decides")
+            "(they come from those logs alone); a log of this kind among the training logs "
+            "decides")
 
 
 def signals_outside(env: Mapping[str, Sequence[float]], log: pd.DataFrame) -> list[str]:
