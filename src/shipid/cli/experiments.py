@@ -3,11 +3,12 @@
 
 from __future__ import annotations
 
+import os
 import sys
 import time
 from pathlib import Path
 
-from shipid.cli.printing import _cores, _warn
+from shipid.cli.printing import _warn
 from shipid.errors import ShipidError
 
 
@@ -34,7 +35,7 @@ def cmd_study(args) -> int:
     check_outputs({"-o": (args.output, "log")}, [args.spec])
     spec = read_spec(args.spec)
     where = ("this process" if args.scheduler == "serial" else args.scheduler
-             or f"a local Dask cluster of {args.workers or _cores()} workers")  # fmt: skip
+             or f"a local Dask cluster of {args.workers or os.cpu_count() or 1} workers")  # fmt: skip
     if hasattr(spec, "jobs"):
         return _study_logs(args, spec, where)
     if args.models:

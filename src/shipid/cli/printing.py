@@ -48,12 +48,6 @@ def _pd():
     return pd
 
 
-def _cores() -> int:
-    import os
-
-    return os.cpu_count() or 1
-
-
 def _np():
     import numpy as np
 
