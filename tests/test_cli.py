@@ -6,7 +6,6 @@ import os
 import signal
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
@@ -477,8 +476,16 @@ def test_sigterm_gives_one_line_exit_130_and_no_temporaries(tmp_path):
     exe = Path(sys.executable).parent / "shipid"
     out = tmp_path / "long.csv"
     proc = subprocess.Popen([str(exe), "manoeuvre", "kvlcc2", "turning", "--duration", "20000",
-                             "-o", str(out)], stderr=subprocess.PIPE, text=True, cwd=tmp_path)
-    time.sleep(2.5)  # past start-up, inside the manoeuvre (about 8 s of work)
+                             "-o", str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, cwd=tmp_path, env={**os.environ, "PYTHONUNBUFFERED": "1"})
+    # Signalled once the indices are printed, while the 400 000 samples of its log are written (3
+    # of its 4.5 s). A fixed 2.5 s sleep, from when the run took 8 s, fell in that write only
+    # while the machine was slow enough: twice as fast, the command would have finished first.
+    for line in proc.stdout:
+        if line.startswith("tactical_diameter"):
+            break
+    else:
+        pytest.fail("the manoeuvre printed no indices")
     proc.send_signal(signal.SIGTERM)
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 130, err
