@@ -43,6 +43,7 @@ from shipid.trials.indices import manoeuvre_indices, zigzag_indices
 from shipid.trials.manoeuvres import turning_circle, zigzag
 from shipid.trials.trial import describe_trial
 from shipid.vessels import get_vessel, scale_ship
+from shipid.vessels.sensors import sampled_as_measured
 
 LIBRARY = "low-speed+wind+propeller-asymmetry"
 KEYS = ("first_overshoot_deg", "second_overshoot_deg")
@@ -77,8 +78,7 @@ def truth() -> None:
     print("| sampling (s) | measured | replica at the log's step | at 0.1 s | at replica_step |")
     print("|---|---|---|---|---|")
     for every in (10, 20, 50):
-        log = fine.log.iloc[::every].reset_index(drop=True)
-        log.attrs = {k: v for k, v in fine.log.attrs.items() if k != "integrator"}
+        log = sampled_as_measured(fine.log, every)
         step = replica_step(log)
         print(f"| {every * 0.01:g} | {pair(measured(log))} | {pair(replica(ship, log, every * 0.01))}"
               f" | {pair(replica(ship, log, 0.1))} | {pair(replica(ship, log))} "
@@ -95,8 +95,7 @@ def truth_turn_order() -> None:
     for order in np.arange(5.0, 5.5, 0.05):
         fine = turning_circle(ship, 20, duration=80.0, dt=0.01, method="rk4",
                               approach=float(order)).log  # fmt: skip
-        log = fine.iloc[::50].reset_index(drop=True)
-        log.attrs = {k: v for k, v in fine.attrs.items() if k != "integrator"}
+        log = sampled_as_measured(fine, 50)
         trial = describe_trial(log)
         measured_advance = manoeuvre_indices(log, trial=trial)["advance"]
         longer["halfway"].append(replica(ship, log)["advance"] - measured_advance)

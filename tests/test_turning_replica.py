@@ -20,6 +20,7 @@ from shipid.evaluation.validate import (
 )
 from shipid.trials.manoeuvres import turning_circle
 from shipid.trials.trial import describe_trial
+from shipid.vessels.sensors import sampled_as_measured
 
 RPS = 10.0
 
@@ -289,8 +290,7 @@ def test_a_coarsely_sampled_zigzag_is_replicated_as_the_continuous_ship_ran_it()
 
     truth = scale_ship()
     fine = zigzag(truth, 20, 20, duration=80.0, dt=0.01, method="rk4", approach=5.0).log
-    log = fine.iloc[::50].reset_index(drop=True)
-    log.attrs = {k: v for k, v in fine.attrs.items() if k != "integrator"}
+    log = sampled_as_measured(fine, 50)
     true_indices = zigzag(truth, 20, 20, duration=80.0, dt=0.01, method="rk4",
                           approach=5.0).indices
     (v,) = validate(truth, log, start_draws=False)
@@ -316,8 +316,7 @@ def test_a_measured_turns_replica_is_ordered_halfway_between_its_samples():
     for order in np.arange(5.0, 5.5, 0.05):
         fine = turning_circle(ship, 20, duration=80.0, dt=0.01, method="rk4",
                               approach=float(order)).log  # fmt: skip
-        log = fine.iloc[::50].reset_index(drop=True)
-        log.attrs = {k: v for k, v in fine.attrs.items() if k != "integrator"}
+        log = sampled_as_measured(fine, 50)
         trial = describe_trial(log)
         replica = _indices_of(trial_replica(ship, log, "euler", trial, indices=False), trial, log)
         longer.append(replica["advance"] - manoeuvre_indices(log, trial=trial)["advance"])

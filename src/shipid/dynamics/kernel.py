@@ -280,9 +280,9 @@ def _ok(st, speed_lim, yaw_lim):
 # Not cached on its own (nor closed_run): numba keys such an entry by the rhs's dispatcher, whose
 # identity is new in every process, so each process that compiled a caller (a generated term
 # set's kernel, a reference ship's) added one entry to one index, read whole at every later
-# compile (0.35 s at 123 entries), and once it held more entries than numba keeps dispatchers
-# alive (128) writing it failed ("underlying object has vanished"). Their cached callers keep
-# them compiled in.
+# compile (0.35 s at 123 entries, measured once), and once it held more entries than numba
+# keeps dispatchers alive (128) writing it failed ("underlying object has vanished"). Their
+# cached callers keep them compiled in.
 @numba.njit
 def open_run(rhs, ctx, inp, t, inputs, n_steps, s0, rk4, speed_lim, yaw_lim, out):
     """One free run driven by the input series ``inputs`` (N, 5), copied step by step into

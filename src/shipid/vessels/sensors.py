@@ -93,3 +93,12 @@ PAPER_IMU = SensorModel(
 )  # fmt: skip
 PAPER_IMU_SPEC = SensorModel(white={**PAPER_IMU.white, "v": 0.04})
 NOISE_FREE = SensorModel()
+
+
+def sampled_as_measured(log: pd.DataFrame, every: int) -> pd.DataFrame:
+    """Every ``every``-th sample of a simulated ``log``, as a logger would keep them, and without
+    its ``integrator`` metadata: a measured log's replica steps finer than its sampling and its
+    orders fall between samples (``validate.replica_step``), a simulated one's at its own step."""
+    out = log.iloc[::every].reset_index(drop=True)
+    out.attrs = {k: v for k, v in log.attrs.items() if k != "integrator"}
+    return out
